@@ -1,0 +1,243 @@
+"""The magnitude-frequency analysis of one inventory: power law, Gumbel and GEV side by side.
+
+:func:`analyse_inventory` runs every fit the data allow and
+:class:`FrequencyAnalysis` turns them into the design-mass table, figures and
+machine-readable summaries written by ``riskrf fit``.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .extremes import MIN_MAXIMA, GEVFit, GumbelFit, fit_gev, fit_gumbel
+from .inventory import Inventory
+from .magnitude import GutenbergRichterFit, fit_gutenberg_richter
+from .outputs import write_json
+from .validation import RiskrfWarning
+
+#: Return periods of the design-mass table [yr].
+DESIGN_RETURN_PERIODS = (10, 50, 100, 300, 1000)
+
+
+@dataclass(frozen=True)
+class FrequencyAnalysis:
+    """Every magnitude-frequency model fitted to one inventory."""
+
+    inventory: Inventory
+    power_law: GutenbergRichterFit
+    power_law_lsq: GutenbergRichterFit | None
+    bootstrap_p: float | None
+    n_bootstrap: int
+    seed: int | None
+    comparison: pd.DataFrame
+    maxima: pd.Series | None = None
+    gumbel: GumbelFit | None = None
+    gev: GEVFit | None = None
+    deviance: dict | None = None
+    skipped: dict = field(default_factory=dict)
+    warnings: tuple = ()
+
+    def design_masses(self, T=DESIGN_RETURN_PERIODS, level: float = 0.95) -> pd.DataFrame:
+        """Design masses [kg] by return period from each model, with intervals.
+
+        Models: ``power law N(>=m)=1/T`` (Wyllie's return period of a mass),
+        ``power law annual max`` (the T-year annual maximum the Poisson power law
+        implies), ``Gumbel`` and ``GEV`` (annual maxima).  ``extrapolated`` marks
+        return periods longer than twice the record.
+        """
+        T = np.asarray(T, dtype=float)
+        rows = []
+        gr = self.power_law
+        rho = self.inventory.density_kg_m3
+        record = self.inventory.duration_years
+
+        def add(model, values, lo, hi, how):
+            for t, v, a, b in zip(T, values, lo, hi):
+                rows.append({"model": model, "T_years": t, "mass_kg": v, "ci_low_kg": a, "ci_high_kg": b,
+                             "volume_m3": v / rho, "ci_method": how, "extrapolated": bool(t > 2 * record)})
+
+        valid = T * gr.rate_min >= 1
+        if valid.any():
+            Tv = T[valid]
+            lo, hi = gr.mass_at_return_period_ci(Tv, level)
+            fill = np.full(T.size, np.nan)
+            vals, los, his = fill.copy(), fill.copy(), fill.copy()
+            vals[valid], los[valid], his[valid] = gr.mass_at_return_period(Tv), lo, hi
+            add("power law N(>=m)=1/T", vals, los, his, "delta method (b, rate)")
+        add("power law annual max", gr.annual_max_return_level(T), np.full(T.size, np.nan),
+            np.full(T.size, np.nan), "")
+        for name, fit in (("Gumbel", self.gumbel), ("GEV", self.gev)):
+            if fit is None:
+                continue
+            lo, hi = fit.return_level_ci(T, level=level)
+            add(f"{name} ({fit.method})", fit.return_level(T), lo, hi, fit.default_ci_method)
+        return pd.DataFrame(rows)
+
+    def design_table(self, T=DESIGN_RETURN_PERIODS) -> pd.DataFrame:
+        """Wide table of design masses [kg]: one row per return period, one column per model."""
+        d = self.design_masses(T)
+        return d.pivot(index="T_years", columns="model", values="mass_kg")
+
+    def to_dict(self) -> dict:
+        gr = self.power_law
+        out = {
+            "inventory": self.inventory.summary()["value"].to_dict(),
+            "units": {"mass": "kg", "volume": "m3", "rate": "1/yr", "return_period": "yr"},
+            "power_law": {
+                "method": gr.method, "a": gr.a, "b": gr.b, "b_stderr": gr.b_stderr, "b_ci": list(gr.b_ci),
+                "b_ci_method": gr.b_ci_method, "m_min_kg": gr.m_min, "m_min_method": gr.m_min_method,
+                "m_max_kg": gr.m_max, "rate_min_per_year": gr.rate_min, "n_tail": gr.n_tail,
+                "ks_distance": gr.ks_distance, "bootstrap_p_value": self.bootstrap_p,
+                "n_bootstrap": self.n_bootstrap, "seed": self.seed,
+                "likelihood_ratio_tests": self.comparison.reset_index().to_dict(orient="records"),
+            },
+            "design_masses": self.design_masses().to_dict(orient="records"),
+            "skipped": self.skipped,
+            "warnings": list(self.warnings),
+        }
+        if self.power_law_lsq is not None:
+            lsq = self.power_law_lsq
+            out["power_law_lsq"] = {"a": lsq.a, "b": lsq.b, "b_stderr": lsq.b_stderr, "m_min_kg": lsq.m_min,
+                                    "note": "least squares on log cumulative frequency (practitioners' method)"}
+        for name, fit in (("gumbel", self.gumbel), ("gev", self.gev)):
+            if fit is not None:
+                out[name] = {"method": fit.method, **dict(zip(fit.param_names, fit.params)),
+                             "stderr": list(fit.stderr), "p_zero": fit.p_zero, "n_years": fit.n_years,
+                             "n_maxima": int(fit.data.size), "loglik": fit.loglik,
+                             "ci_method": fit.default_ci_method}
+        if self.deviance is not None:
+            out["gumbel_vs_gev"] = self.deviance
+        return out
+
+    def summary_text(self) -> str:
+        """A readable report of the fits (what ``riskrf fit`` prints)."""
+        inv, gr = self.inventory, self.power_law
+        lines = [f"Inventory: {inv.source}" + (f"  ({inv.site})" if inv.site else ""),
+                 f"  {inv.n_events} falls over {inv.duration_years:.3g} years (record period from "
+                 f"{inv.period_source}); density {inv.density_kg_m3:g} kg/m3"
+                 + (" (default)" if inv.density_is_default else ""), "",
+                 "Power law  log10 N(>=m) = a - b log10 m   [N per year, m in kg]  (Wyllie 2014, 8.4.1)",
+                 f"  method   maximum likelihood (Aki 1965 / Clauset et al. 2009)" if gr.method == "mle" else
+                 "  method   least squares (practitioners' method)",
+                 f"  b        {gr.b:.4f} ± {gr.b_stderr:.4f}  ({gr.level:.0%} interval {gr.b_ci[0]:.4f} - "
+                 f"{gr.b_ci[1]:.4f}, {gr.b_ci_method.split(' (')[0]})",
+                 f"  a        {gr.a:.4f}",
+                 f"  m_min    {gr.m_min:.5g} kg ({gr.m_min / inv.density_kg_m3:.4g} m3), "
+                 f"{'Kolmogorov-Smirnov search' if gr.m_min_method == 'ks' else 'given'}; "
+                 f"{gr.n_tail} of {gr.n_total} falls above it, {gr.rate_min:.4g} per year"]
+        if gr.m_max is not None:
+            lines.append(f"  m_max    {gr.m_max:.5g} kg (upper truncation)")
+        if self.bootstrap_p is not None:
+            verdict = "plausible" if self.bootstrap_p > 0.1 else "rejected"
+            lines.append(f"  fit      KS distance {gr.ks_distance:.4f}; bootstrap p = {self.bootstrap_p:.3f} "
+                         f"({self.n_bootstrap} replicates, seed {self.seed}): power law {verdict} (plausible when p > 0.1)")
+        for alt, row in self.comparison.iterrows():
+            lines.append(f"  vs {alt:<12} log-likelihood ratio R = {row['loglik_ratio_R']:+.2f}, "
+                         f"p = {row['p_value']:.3f} -> {row['favoured']}")
+        if self.power_law_lsq is not None:
+            lsq = self.power_law_lsq
+            lines.append(f"  least squares (for comparison): b = {lsq.b:.4f} ± {lsq.b_stderr:.4f}, a = {lsq.a:.4f}")
+        for name, fit in (("Gumbel", self.gumbel), ("GEV", self.gev)):
+            if fit is None:
+                continue
+            se = fit.stderr
+            pars = ", ".join(f"{p} = {v:.5g} ± {s:.3g}" for p, v, s in zip(fit.param_names, fit.params, se))
+            lines += ["", f"{name} of annual maxima ({fit.method}; {fit.data.size} maxima in {fit.n_years} years, "
+                          f"p0 = {fit.p_zero:.3f} years without a fall)", f"  {pars}"]
+        if self.deviance is not None:
+            d = self.deviance
+            lines.append(f"  deviance Gumbel vs GEV: D = {d['deviance']:.3f}, p = {d['p_value']:.3f} -> "
+                         f"{'Gumbel adequate' if d['gumbel_adequate'] else 'GEV needed'}")
+        for name, why in self.skipped.items():
+            lines += ["", f"{name}: not fitted ({why})"]
+        table = self.design_table()
+        lines += ["", "Design masses [kg] by return period (intervals in design_masses.csv):",
+                  table.to_string(float_format=lambda v: f"{v:,.4g}")]
+        if self.warnings:
+            lines += ["", "Warnings:"] + [f"  - {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+    def write(self, out_dir) -> list[Path]:
+        """Write summary.json, design_masses.csv, completeness.csv and PNG figures into ``out_dir``."""
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from .plotting import plot_gumbel, plot_magnitude_frequency, plot_return_levels
+
+        out = Path(out_dir)
+        written = []
+        write_json(self.to_dict(), out / "summary.json")
+        self.design_masses().to_csv(out / "design_masses.csv", index=False)
+        self.inventory.completeness().to_csv(out / "completeness.csv")
+        written += [out / "summary.json", out / "design_masses.csv", out / "completeness.csv"]
+        ax = plot_magnitude_frequency(self.power_law)
+        ax.set_title("Magnitude - cumulative frequency")
+        ax.figure.savefig(out / "magnitude_frequency.png", dpi=120, bbox_inches="tight")
+        plt.close(ax.figure)
+        written.append(out / "magnitude_frequency.png")
+        if self.gumbel is not None:
+            ax = plot_gumbel(self.gumbel)
+            ax.set_title("Gumbel probability plot of annual maxima")
+            ax.figure.savefig(out / "gumbel_plot.png", dpi=120, bbox_inches="tight")
+            plt.close(ax.figure)
+            fits = {f"Gumbel ({self.gumbel.method})": self.gumbel}
+            if self.gev is not None:
+                fits["GEV"] = self.gev
+            ax = plot_return_levels(fits, power_law=self.power_law, maxima=self.maxima)
+            ax.set_title("Return levels of the annual maximum mass")
+            ax.figure.savefig(out / "return_levels.png", dpi=120, bbox_inches="tight")
+            plt.close(ax.figure)
+            written += [out / "gumbel_plot.png", out / "return_levels.png"]
+        return written
+
+
+def analyse_inventory(inventory: Inventory, *, m_min=None, method: str = "mle", m_max=None,
+                      gumbel_method: str = "mle", n_bootstrap: int = 1000, seed: int | None = 1,
+                      compare_lsq: bool = True) -> FrequencyAnalysis:
+    """Fit the power law to all masses and, when the inventory is dated, Gumbel and GEV to annual maxima.
+
+    Every warning raised by the fits is collected in ``warnings``; models the
+    data cannot support are listed in ``skipped`` with the reason.
+    """
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RiskrfWarning)
+        gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=m_min, method=method,
+                                   m_max=m_max)
+        lsq = None
+        if compare_lsq and method == "mle":
+            try:
+                lsq = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=gr.m_min,
+                                            method="lsq")
+            except ValueError:
+                lsq = None
+        p = gr.bootstrap_pvalue(n_bootstrap, seed=seed) if (n_bootstrap and method == "mle") else None
+        comparison = gr.compare()
+        maxima = gumbel = gev = deviance = None
+        skipped = {}
+        if not inventory.is_dated:
+            skipped["Gumbel/GEV"] = "the inventory has no dates, so there are no annual maxima"
+        else:
+            maxima = inventory.annual_maxima()
+            n_max = int(maxima.notna().sum())
+            if n_max >= MIN_MAXIMA["gumbel"]:
+                gumbel = fit_gumbel(maxima, method=gumbel_method)
+            else:
+                skipped["Gumbel"] = f"{n_max} annual maxima; at least {MIN_MAXIMA['gumbel']} are needed"
+            if n_max >= MIN_MAXIMA["gev"]:
+                gev = fit_gev(maxima)
+                deviance = gev.deviance_vs_gumbel()
+            else:
+                skipped["GEV"] = f"{n_max} annual maxima; at least {MIN_MAXIMA['gev']} are needed"
+    notes = list(inventory.notes)
+    for w in caught:
+        msg = str(w.message)
+        if msg not in notes:
+            notes.append(msg)
+    return FrequencyAnalysis(inventory=inventory, power_law=gr, power_law_lsq=lsq, bootstrap_p=p,
+                             n_bootstrap=int(n_bootstrap or 0), seed=seed, comparison=comparison, maxima=maxima,
+                             gumbel=gumbel, gev=gev, deviance=deviance, skipped=skipped, warnings=tuple(notes))

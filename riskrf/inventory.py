@@ -1,0 +1,487 @@
+"""Rock fall inventories: reading, validating and summarising a record of falls.
+
+An inventory is a list of rock falls with a size (volume in m³ or mass in kg),
+optionally a date (full date or year only) and a location, together with the
+length of the period over which falls were recorded.  The record period turns
+counts into annual rates (Wyllie 2014, section 8.4), so it is never guessed
+silently: it is given as an argument, read from a sidecar TOML file beside the
+inventory (``<name>.toml`` with a ``[record]`` table), or inferred from the dates
+with a warning.
+
+Years with no recorded fall are kept in :meth:`Inventory.annual_maxima` as
+missing values (NaN), never dropped and never set to zero: the extreme-value
+fits then use the mixed model that gives such years their own probability
+(see :func:`riskrf.fit_gumbel`).
+"""
+from __future__ import annotations
+
+import csv
+import datetime as _dt
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .validation import check_positive, warn
+
+#: Rock density used when none is given [kg/m³] (a typical value for granite
+#: and limestone; Wyllie 2014 uses 2.6-2.7 t/m³).
+DEFAULT_DENSITY_KG_M3 = 2650.0
+
+_VOLUME_NAMES = {"volume", "vol", "v", "volume_m3", "vol_m3", "v_m3", "volum", "volumen"}
+_MASS_NAMES = {"mass", "masse", "m", "weight", "block_mass"}
+_DATE_NAMES = {"date", "datum", "event_date", "date_time", "datetime", "skreddato", "dato", "year", "jahr", "ar"}
+_LOCATION_NAMES = {"location", "chainage", "chainage_m", "station", "place", "site", "km", "stedsangivelse"}
+_NOTES_NAMES = {"notes", "note", "comment", "comments", "remarks", "bemerkung"}
+_MASS_UNITS = {"kg": 1.0, "t": 1000.0, "tonne": 1000.0, "tonnes": 1000.0, "tons": 1000.0}
+_VOLUME_UNITS = {"m3": 1.0, "dm3": 1e-3, "l": 1e-3, "litre": 1e-3, "cm3": 1e-6}
+
+
+def _normalise(name: str) -> str:
+    """Lower-case a column name and turn brackets, units and spaces into ``root_unit``."""
+    s = str(name).strip().lower().replace("³", "3").replace("^3", "3")
+    s = re.sub(r"[\[\]\(\)\{\}]", " ", s)
+    s = re.sub(r"[^0-9a-zæøåäöüß]+", "_", s).strip("_")
+    return s
+
+
+def _split_unit(norm: str, units: dict) -> tuple[str, str | None]:
+    """Split ``mass_kg`` into (``mass``, ``kg``); the unit is None when absent."""
+    for unit in sorted(units, key=len, reverse=True):
+        if norm.endswith("_" + unit):
+            return norm[: -len(unit) - 1], unit
+    return norm, None
+
+
+def _find_column(columns, roots: set, units: dict | None = None):
+    """Return (original column, unit) for the first column whose root is in ``roots``."""
+    for col in columns:
+        norm = _normalise(col)
+        root, unit = _split_unit(norm, units) if units else (norm, None)
+        if root in roots or norm in roots:
+            return col, unit
+    return None, None
+
+
+@dataclass(frozen=True)
+class Inventory:
+    """A validated rock fall inventory.
+
+    Attributes
+    ----------
+    events : pandas.DataFrame
+        One row per fall, columns ``date`` (datetime64, NaT when unknown),
+        ``year`` (Int64, missing when unknown), ``volume_m3``, ``mass_kg``,
+        ``location``, ``notes`` and ``source_row`` (line number in the file).
+    duration_years : float
+        Length of the record [yr].
+    start, end : datetime.date or None
+        Record period, when known.
+    density_kg_m3 : float
+        Density used to convert between volume and mass [kg/m³].
+    density_is_default : bool
+        True when no density was given and :data:`DEFAULT_DENSITY_KG_M3` was used.
+    source : str
+        File the inventory was read from (or ``"<array>"``).
+    period_source : str
+        Where the record period came from: ``"argument"``, the sidecar path, or
+        ``"inferred from the dates"``.
+    size_column : str
+        ``"volume"`` or ``"mass"``: which size was recorded (the other is derived).
+    notes : tuple of str
+        Every warning raised while reading, kept for reports.
+    """
+
+    events: pd.DataFrame
+    duration_years: float
+    start: _dt.date | None = None
+    end: _dt.date | None = None
+    density_kg_m3: float = DEFAULT_DENSITY_KG_M3
+    density_is_default: bool = True
+    source: str = "<array>"
+    period_source: str = "argument"
+    size_column: str = "volume"
+    site: str = ""
+    notes: tuple = field(default_factory=tuple)
+
+    @property
+    def masses(self) -> np.ndarray:
+        """Block masses [kg], in record order."""
+        return self.events["mass_kg"].to_numpy(dtype=float)
+
+    @property
+    def volumes(self) -> np.ndarray:
+        """Block volumes [m³], in record order."""
+        return self.events["volume_m3"].to_numpy(dtype=float)
+
+    @property
+    def n_events(self) -> int:
+        return len(self.events)
+
+    @property
+    def is_dated(self) -> bool:
+        """True when every event has at least a year."""
+        return bool(self.events["year"].notna().all()) and self.n_events > 0
+
+    def record_years(self) -> list[int]:
+        """Calendar years covered (wholly or partly) by the record period."""
+        if self.start is None or self.end is None:
+            years = self.events["year"].dropna()
+            if years.empty:
+                return []
+            return list(range(int(years.min()), int(years.max()) + 1))
+        return list(range(self.start.year, self.end.year + 1))
+
+    def annual_maxima(self, *, unit: str = "kg") -> pd.Series:
+        """Largest fall of each calendar year of the record [kg, or m³ with ``unit="m3"``].
+
+        Every year of the record period appears; a year with no recorded fall
+        has NaN (not zero, not dropped), and a warning says how many such years
+        there are.  Partly covered first and last years are kept and named in a
+        warning.  Raises ``ValueError`` for an undated inventory.
+        """
+        if not self.is_dated:
+            raise ValueError(
+                f"{self.source}: annual maxima need a date or year for every event; "
+                f"{int(self.events['year'].isna().sum())} of {self.n_events} events have none")
+        col = {"kg": "mass_kg", "m3": "volume_m3"}.get(unit)
+        if col is None:
+            raise ValueError(f"unit = {unit!r} is not one of 'kg', 'm3'")
+        years = self.record_years()
+        maxima = self.events.groupby(self.events["year"].astype(int))[col].max()
+        series = maxima.reindex(years)
+        series.index.name = "year"
+        series.name = f"annual_max_{col}"
+        empty = series.index[series.isna()].tolist()
+        if empty:
+            warn(f"{self.source}: {len(empty)} of {len(years)} years have no recorded fall "
+                 f"({', '.join(map(str, empty[:10]))}{' ...' if len(empty) > 10 else ''}); they are kept "
+                 "as NaN and the Gumbel/GEV fits treat them with the mixed (zero-year) model")
+        partial = [y for y in (years[:1] + years[-1:]) if self._coverage(y) < 0.999]
+        if partial:
+            warn(f"{self.source}: year(s) {sorted(set(partial))} are only partly covered by the record "
+                 f"period {self.start} to {self.end}; their maxima may be low")
+        return series
+
+    def _coverage(self, year: int) -> float:
+        if self.start is None or self.end is None:
+            return 1.0
+        lo = max(self.start, _dt.date(year, 1, 1))
+        hi = min(self.end, _dt.date(year, 12, 31))
+        return max((hi - lo).days + 1, 0) / (366 if year % 4 == 0 else 365)
+
+    def completeness(self) -> pd.DataFrame:
+        """Events per year and the smallest, median and largest recorded size per year.
+
+        A rising smallest size or a falling count over time shows a change in
+        recording practice (completeness), which the magnitude-frequency fit
+        must respect.  Undated inventories give one row for the whole record.
+        """
+        ev = self.events
+        key = ev["year"].astype("Int64") if self.is_dated else pd.Series("all", index=ev.index)
+        g = ev.groupby(key)
+        table = pd.DataFrame({
+            "n_events": g.size(),
+            "smallest_m3": g["volume_m3"].min(),
+            "median_m3": g["volume_m3"].median(),
+            "largest_m3": g["volume_m3"].max(),
+            "smallest_kg": g["mass_kg"].min(),
+            "largest_kg": g["mass_kg"].max(),
+        })
+        if self.is_dated:
+            table = table.reindex(self.record_years())
+            table["n_events"] = table["n_events"].fillna(0).astype(int)
+        table.index.name = "year" if self.is_dated else "record"
+        return table
+
+    def summary(self) -> pd.DataFrame:
+        """One-column table describing the inventory (sizes, period, density and its origin)."""
+        v, m = self.volumes, self.masses
+        rows = {
+            "source": self.source,
+            "site": self.site,
+            "events": self.n_events,
+            "recorded size": self.size_column,
+            "record start": self.start.isoformat() if self.start else "",
+            "record end": self.end.isoformat() if self.end else "",
+            "duration [yr]": round(self.duration_years, 3),
+            "record period from": self.period_source,
+            "events per year": round(self.n_events / self.duration_years, 3),
+            "density [kg/m3]": f"{self.density_kg_m3:g}" + (" (default)" if self.density_is_default else ""),
+            "volume min / median / max [m3]": f"{v.min():.4g} / {np.median(v):.4g} / {v.max():.4g}",
+            "mass min / median / max [kg]": f"{m.min():.4g} / {np.median(m):.4g} / {m.max():.4g}",
+            "dated": self.is_dated,
+        }
+        return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
+
+
+def _read_table(path: Path) -> pd.DataFrame:
+    suffix = path.suffix.lower()
+    if suffix in (".csv", ".txt", ".tsv"):
+        with open(path, encoding="utf-8-sig", errors="replace") as fh:
+            sample = fh.read(8192)
+        try:
+            sep = csv.Sniffer().sniff(sample, delimiters=",;\t|").delimiter
+        except csv.Error:
+            sep = ","
+        try:
+            return pd.read_csv(path, sep=sep, dtype=str, skip_blank_lines=False, keep_default_na=False,
+                               encoding="utf-8-sig")
+        except (pd.errors.ParserError, UnicodeDecodeError) as exc:
+            raise ValueError(f"{path}: cannot read as a {sep!r}-separated table: {exc}") from exc
+    if suffix in (".xlsx", ".xlsm"):
+        return pd.read_excel(path, dtype=str, keep_default_na=False)
+    if suffix == ".parquet":
+        return pd.read_parquet(path).astype(object).where(lambda d: d.notna(), "").astype(str)
+    raise ValueError(f"{path}: unsupported inventory format {suffix!r}; use .csv, .xlsx or .parquet")
+
+
+def _sidecar(path: Path) -> tuple[dict, Path | None]:
+    side = path.with_suffix(".toml")
+    if not side.exists():
+        return {}, None
+    try:
+        with open(side, "rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{side}: not valid TOML: {exc}") from exc
+    record = data.get("record", data)
+    known = {"start", "end", "duration_years", "density_kg_m3", "site"}
+    unknown = set(record) - known
+    if unknown:
+        raise ValueError(f"{side}: unknown field(s) {sorted(unknown)} in [record]; expected {sorted(known)}")
+    return record, side
+
+
+def _as_date(value, what: str) -> _dt.date:
+    if isinstance(value, _dt.datetime):
+        return value.date()
+    if isinstance(value, _dt.date):
+        return value
+    try:
+        return _dt.date.fromisoformat(str(value))
+    except ValueError as exc:
+        raise ValueError(f"{what} = {value!r} is not a date (use YYYY-MM-DD)") from exc
+
+
+def _parse_dates(raw: pd.Series, path, col: str, rows: np.ndarray):
+    """Return (dates as datetime64, years as Int64); raise naming the row for bad or future values."""
+    text = raw.str.strip()
+    years = pd.Series(pd.NA, index=raw.index, dtype="Int64")
+    dates = pd.Series(pd.NaT, index=raw.index, dtype="datetime64[ns]")
+    today = pd.Timestamp(_dt.date.today())
+    for i, s in text.items():
+        if s == "":
+            continue
+        if re.fullmatch(r"\d{4}(\.0)?", s):
+            years[i] = int(float(s))
+            stamp = None
+        else:
+            try:
+                stamp = pd.Timestamp(s)
+            except (ValueError, TypeError):
+                stamp = pd.NaT
+            if stamp is pd.NaT or pd.isna(stamp):
+                raise ValueError(f"{path}: row {rows[i]}, column {col!r}: cannot read date {s!r} "
+                                 "(use YYYY-MM-DD or a four-digit year)")
+            if stamp > today:
+                raise ValueError(f"{path}: row {rows[i]}, column {col!r}: date {s!r} is in the future")
+            dates[i] = stamp
+            years[i] = stamp.year
+        if years[i] > today.year:
+            raise ValueError(f"{path}: row {rows[i]}, column {col!r}: date {s!r} is in the future")
+    return dates, years
+
+
+def _parse_sizes(raw: pd.Series, path, col: str, rows: np.ndarray) -> pd.Series:
+    text = raw.str.strip().str.replace(",", ".", regex=False) if raw.dtype == object else raw
+    values = pd.to_numeric(text.replace("", np.nan), errors="coerce")
+    bad = values.isna() & (text != "")
+    if bad.any():
+        i = bad.idxmax()
+        raise ValueError(f"{path}: row {rows[i]}, column {col!r}: {raw[i]!r} is not a number")
+    nonpos = values.notna() & ~(values > 0)
+    if nonpos.any():
+        i = nonpos.idxmax()
+        raise ValueError(f"{path}: row {rows[i]}, column {col!r}: size {raw[i]!r} must be > 0")
+    inf = values.notna() & ~np.isfinite(values)
+    if inf.any():
+        i = inf.idxmax()
+        raise ValueError(f"{path}: row {rows[i]}, column {col!r}: size {raw[i]!r} is not finite")
+    return values
+
+
+def read_inventory(path, *, start=None, end=None, duration_years=None, density_kg_m3=None,
+                   volume_column=None, mass_column=None, date_column=None, location_column=None,
+                   mass_unit=None, volume_unit=None) -> Inventory:
+    """Read a rock fall inventory from CSV, Excel (.xlsx) or Parquet.
+
+    Parameters
+    ----------
+    path : str or Path
+        The inventory file.  Never modified.
+    start, end : date or str, optional
+        Record period (inclusive).  Overrides the sidecar file.
+    duration_years : float, optional
+        Length of the record [yr] when there are no dates (e.g. a laser-scanning
+        campaign).  Overrides the sidecar file.
+    density_kg_m3 : float, optional
+        Rock density [kg/m³]; default :data:`DEFAULT_DENSITY_KG_M3` (reported).
+    volume_column, mass_column, date_column, location_column : str, optional
+        Column names when they cannot be recognised.  By default names are
+        matched case-insensitively: ``volume``/``vol``/``volume_m3``/``Volume [m³]``,
+        ``mass``/``masse``/``mass_kg``/``Mass [t]``, ``date``/``datum``/``year``, ...
+    mass_unit : {"kg", "t"}, optional
+        Unit of the mass column when its name does not say (default kg).
+    volume_unit : {"m3", "dm3", "cm3"}, optional
+        Unit of the volume column when its name does not say (default m³).
+
+    Returns
+    -------
+    Inventory
+
+    Notes
+    -----
+    The record period is taken, in this order, from ``start``/``end`` or
+    ``duration_years``; from ``<path stem>.toml`` beside the file
+    (``[record]`` with ``start``, ``end`` or ``duration_years``, and optionally
+    ``density_kg_m3`` and ``site``); or from the first and last dates, with a
+    warning (this underestimates the period by the waiting time to the first
+    and after the last fall).  Rows with an empty size are dropped with a
+    warning that lists them; events dated outside the record period are
+    excluded with a warning.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"inventory file not found: {path}")
+    table = _read_table(path)
+    blank = (table.apply(lambda c: c.str.strip()) == "").all(axis=1)
+    rows = np.arange(len(table)) + (1 if path.suffix.lower() == ".parquet" else 2)
+    table = table.loc[~blank]
+    rows = rows[~blank.to_numpy()]
+    table.index = range(len(table))
+    columns = [c for c in table.columns if not str(c).startswith("Unnamed")]
+    notes: list[str] = []
+
+    def note(msg):
+        notes.append(msg)
+        warn(msg)
+
+    vcol, vunit = (volume_column, None) if volume_column else _find_column(columns, _VOLUME_NAMES, _VOLUME_UNITS)
+    mcol, munit = (mass_column, None) if mass_column else _find_column(columns, _MASS_NAMES, _MASS_UNITS)
+    for given, what in ((volume_column, "volume_column"), (mass_column, "mass_column"),
+                        (date_column, "date_column"), (location_column, "location_column")):
+        if given is not None and given not in table.columns:
+            raise ValueError(f"{path}: {what} = {given!r} is not a column; columns are {columns}")
+    if vcol is None and mcol is None:
+        raise ValueError(f"{path}: no volume or mass column found among {columns}; name one 'volume_m3' or "
+                         "'mass_kg', or pass volume_column=/mass_column=")
+    if table.empty:
+        raise ValueError(f"{path}: the inventory has no rows")
+    dcol = date_column or _find_column(columns, _DATE_NAMES)[0]
+    lcol = location_column or _find_column(columns, _LOCATION_NAMES)[0]
+    ncol = _find_column(columns, _NOTES_NAMES)[0]
+
+    sidecar, side_path = _sidecar(path)
+    if density_kg_m3 is None and "density_kg_m3" in sidecar:
+        density_kg_m3 = sidecar["density_kg_m3"]
+    density_is_default = density_kg_m3 is None
+    density = DEFAULT_DENSITY_KG_M3 if density_is_default else check_positive(density_kg_m3, "density_kg_m3")
+
+    if vcol is not None:
+        unit = volume_unit or vunit or "m3"
+        if unit not in _VOLUME_UNITS:
+            raise ValueError(f"volume_unit = {volume_unit!r} is not one of {sorted(_VOLUME_UNITS)}")
+        volume = _parse_sizes(table[vcol], path, vcol, rows) * _VOLUME_UNITS[unit]
+    if mcol is not None:
+        unit = mass_unit or munit or "kg"
+        if unit not in _MASS_UNITS:
+            raise ValueError(f"mass_unit = {mass_unit!r} is not one of {sorted(_MASS_UNITS)}")
+        mass = _parse_sizes(table[mcol], path, mcol, rows) * _MASS_UNITS[unit]
+    if vcol is None:
+        volume = mass / density
+        size_column = "mass"
+    elif mcol is None:
+        mass = volume * density
+        size_column = "volume"
+    else:
+        size_column = "mass"
+        volume = volume.fillna(mass / density)
+        mass = mass.fillna(volume * density)
+    if density_is_default:
+        note(f"{path}: density not given; the default {DEFAULT_DENSITY_KG_M3:g} kg/m3 converts "
+             f"{'volume to mass' if size_column == 'volume' else 'mass to volume'}")
+
+    if dcol is not None:
+        dates, years = _parse_dates(table[dcol].astype(str), path, dcol, rows)
+    else:
+        dates = pd.Series(pd.NaT, index=table.index, dtype="datetime64[ns]")
+        years = pd.Series(pd.NA, index=table.index, dtype="Int64")
+    events = pd.DataFrame({
+        "date": dates, "year": years, "volume_m3": volume.astype(float), "mass_kg": mass.astype(float),
+        "location": table[lcol].astype(str) if lcol else "",
+        "notes": table[ncol].astype(str) if ncol else "",
+        "source_row": rows,
+    })
+    missing = events["mass_kg"].isna()
+    if missing.any():
+        lines = events.loc[missing, "source_row"].tolist()
+        note(f"{path}: {len(lines)} row(s) have no size and are left out (rows "
+             f"{', '.join(map(str, lines[:12]))}{' ...' if len(lines) > 12 else ''})")
+        events = events.loc[~missing]
+
+    # Record period.
+    if start is not None or end is not None:
+        if start is None or end is None:
+            raise ValueError("give both start and end of the record period, or duration_years")
+        start, end = _as_date(start, "start"), _as_date(end, "end")
+        period_source = "argument"
+    elif duration_years is not None:
+        period_source = "argument"
+    elif "start" in sidecar or "end" in sidecar or "duration_years" in sidecar:
+        if "duration_years" in sidecar:
+            duration_years = sidecar["duration_years"]
+        else:
+            if "start" not in sidecar or "end" not in sidecar:
+                raise ValueError(f"{side_path}: [record] needs both start and end, or duration_years")
+            start = _as_date(sidecar["start"], f"{side_path}: start")
+            end = _as_date(sidecar["end"], f"{side_path}: end")
+        period_source = str(side_path)
+    else:
+        if events["year"].isna().all():
+            raise ValueError(f"{path}: the record period is unknown: the events are undated, so pass "
+                             f"duration_years= or start=/end=, or write {path.with_suffix('.toml')} "
+                             "with [record] duration_years = ...")
+        first, last = events["date"].min(), events["date"].max()
+        if pd.isna(first):
+            start = _dt.date(int(events["year"].min()), 1, 1)
+            end = _dt.date(int(events["year"].max()), 12, 31)
+        else:
+            start, end = first.date(), last.date()
+        period_source = "inferred from the dates"
+        note(f"{path}: record period not given; inferred {start} to {end} from the dates. "
+             "Give start/end (or a sidecar .toml) if the record was longer")
+    if start is not None:
+        if end < start:
+            raise ValueError(f"record period ends ({end}) before it starts ({start})")
+        duration_years = ((end - start).days + 1) / 365.25
+        outside = events["date"].notna() & ((events["date"] < pd.Timestamp(start)) |
+                                            (events["date"] > pd.Timestamp(end)))
+        outside |= events["date"].isna() & events["year"].notna() & (
+            (events["year"] < start.year) | (events["year"] > end.year))
+        if outside.any():
+            lines = events.loc[outside, "source_row"].tolist()
+            note(f"{path}: {len(lines)} event(s) dated outside the record period {start} to {end} are left "
+                 f"out (rows {', '.join(map(str, lines[:12]))}{' ...' if len(lines) > 12 else ''})")
+            events = events.loc[~outside]
+    duration_years = check_positive(duration_years, "duration_years")
+    if events.empty:
+        raise ValueError(f"{path}: no usable events (every row lacked a size or lay outside the record period)")
+    events = events.reset_index(drop=True)
+    return Inventory(events=events, duration_years=duration_years, start=start, end=end,
+                     density_kg_m3=density, density_is_default=density_is_default, source=str(path),
+                     period_source=period_source, size_column=size_column,
+                     site=str(sidecar.get("site", "")), notes=tuple(notes))

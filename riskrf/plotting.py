@@ -1,0 +1,114 @@
+"""Figures of the fits.  Each ``plot_x(result, ax=None) -> Axes`` draws on the given axes
+(or a new figure) and never changes global matplotlib state.  matplotlib is imported
+only when a figure is drawn."""
+from __future__ import annotations
+
+import numpy as np
+
+from .extremes import gumbel_reduced_variate, plotting_positions
+
+
+def _axes(ax, figsize=(6.4, 4.8)):
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+    return plt.figure(figsize=figsize).add_subplot()
+
+
+def plot_magnitude_frequency(fit, ax=None, *, level_label=True):
+    """Magnitude-cumulative-frequency plot on log-log axes (Wyllie 2014, fig. 8.x style).
+
+    Points: the observed annual frequency of falls at least as large as each
+    recorded size.  Line: the fitted law above m_min, with the band spanned by
+    the confidence interval of b (rate at m_min held).  m_min is marked.
+    """
+    ax = _axes(ax)
+    x = np.sort(np.asarray(fit.data))
+    values = np.unique(x)
+    counts = x.size - np.searchsorted(x, values, side="left")
+    ax.loglog(values, counts / fit.duration_years, "o", ms=3.5, mfc="none", color="0.35",
+              label=f"inventory ({fit.n_total} falls, {fit.duration_years:g} yr)")
+    top = fit.m_max if fit.m_max is not None else max(x.max() * 3, fit.m_min * 10)
+    m = np.geomspace(fit.m_min, top * (0.999 if fit.m_max else 1), 200)
+    ax.loglog(m, fit.annual_frequency(m), "-", color="C0", lw=2,
+              label=f"{fit.method.upper()} fit: b = {fit.b:.3f} ± {fit.b_stderr:.3f}")
+    lo, hi = fit.b_ci
+    band = [fit.rate_min * (m / fit.m_min) ** (-b) for b in (lo, hi)]
+    ax.fill_between(m, np.minimum(*band), np.maximum(*band), color="C0", alpha=0.2,
+                    label=f"{fit.level:.0%} interval of b" if level_label else None)
+    ax.axvline(fit.m_min, color="C3", ls="--", lw=1, label=f"m_min = {fit.m_min:.4g} {fit.units}")
+    ax.set_xlabel(f"size m [{fit.units}]")
+    ax.set_ylabel("annual frequency N(≥ m) [1/yr]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="small")
+    return ax
+
+
+def plot_gumbel(fit, ax=None, *, formula: str = "gringorten", level: float = 0.95, units: str = "kg"):
+    """Gumbel probability plot: annual maxima against the reduced variate -ln(-ln F).
+
+    Empirical non-exceedance probabilities use ``formula`` plotting positions
+    over all years (years without a fall sit below every maximum, as in the
+    mixed model).  The fitted line and its delta-method band follow.
+    """
+    ax = _axes(ax)
+    x = np.sort(fit.data)
+    n_years = fit.n_years
+    F = plotting_positions(n_years, formula)[n_years - x.size:]
+    ax.plot(-np.log(-np.log(F)), x, "o", ms=4, mfc="none", color="0.3", label=f"annual maxima ({formula})")
+    T = np.geomspace(1.05 / (1 - fit.p_zero), 1000, 100)
+    y = gumbel_reduced_variate(T)
+    ax.plot(y, fit.return_level(T), "-", color="C0", lw=2, label=f"{type(fit).__name__[:-3]} ({fit.method})")
+    try:
+        lo, hi = fit.return_level_ci(T, level=level, method="delta")
+        ax.fill_between(y, lo, hi, color="C0", alpha=0.2, label=f"{level:.0%} delta-method band")
+    except ValueError:
+        pass
+    ax.set_xlabel("Gumbel reduced variate y = -ln(-ln F)")
+    ax.set_ylabel(f"annual maximum [{units}]")
+    top = ax.secondary_xaxis("top", functions=(lambda v: v, lambda v: v))
+    ticks = np.array([2, 5, 10, 50, 100, 500, 1000])
+    top.set_xticks(gumbel_reduced_variate(ticks), [str(t) for t in ticks])
+    top.set_xlabel("return period [yr]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    return ax
+
+
+def plot_return_levels(fits, ax=None, *, power_law=None, maxima=None, formula: str = "gringorten",
+                       level: float = 0.95, units: str = "kg", T_max: float = 1000.0):
+    """Return level against return period for one or more annual-maximum fits.
+
+    ``fits`` is a fit or a dict ``{label: fit}``.  With ``power_law`` (a
+    :class:`~riskrf.GutenbergRichterFit`) the annual-maximum law it implies,
+    exp(-N(>=m)) (Frechet when untruncated), is drawn too, so the two models of
+    Wyllie's chapter 8 can be compared.  ``maxima`` adds the empirical points.
+    """
+    ax = _axes(ax)
+    if not isinstance(fits, dict):
+        fits = {type(fits).__name__[:-3]: fits}
+    for i, (label, fit) in enumerate(fits.items()):
+        T = np.geomspace(1.05 / (1 - fit.p_zero), T_max, 120)
+        ax.semilogx(T, fit.return_level(T), "-", color=f"C{i}", lw=2, label=label)
+        try:
+            lo, hi = fit.return_level_ci(T, level=level, method="delta")
+            ax.fill_between(T, lo, hi, color=f"C{i}", alpha=0.15)
+        except ValueError:
+            pass
+    if power_law is not None:
+        T0 = 1.0 / (-np.expm1(-power_law.rate_min))
+        T = np.geomspace(max(1.05, T0 * 1.001), T_max, 120)
+        ax.semilogx(T, power_law.annual_max_return_level(T), "--", color="k", lw=1.5,
+                    label=f"implied by power law (b = {power_law.b:.2f})")
+    if maxima is not None:
+        values = np.asarray(maxima, dtype=float)
+        n = values.size
+        x = np.sort(values[~np.isnan(values)])
+        F = plotting_positions(n, formula)[n - x.size:]
+        ax.semilogx(1 / (1 - F), x, "o", ms=4, mfc="none", color="0.3", label=f"annual maxima ({formula})")
+    ax.set_xlabel("return period T [yr]")
+    ax.set_ylabel(f"return level [{units}]")
+    ax.set_yscale("log")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="small", title=f"bands: {level:.0%} delta method")
+    return ax

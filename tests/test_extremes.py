@@ -1,0 +1,153 @@
+"""Gumbel and GEV fits of annual maxima against published values (issue 2, item 4)."""
+import numpy as np
+import pandas as pd
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import stats
+
+from riskrf import (encounter_probability, fit_gev, fit_gumbel, gumbel_frequency_factor, gumbel_reduced_variate,
+                    plotting_positions)
+
+from .conftest import DATA
+
+PORT_PIRIE = pd.read_csv(DATA / "coles2001" / "portpirie.csv")["sea_level_m"].to_numpy()
+
+
+def test_coles_port_pirie_gev_mle_covariance_and_return_levels():
+    gev = fit_gev(PORT_PIRIE)
+    # ismev::gev.fit / Coles (2001) example 3.4.1: (3.87474692, 0.19804120, -0.05008773), loglik 4.339058
+    np.testing.assert_allclose(gev.params, [3.87474692, 0.19804120, -0.05008773], atol=5e-5)
+    assert gev.loglik == pytest.approx(4.339058, abs=1e-5)
+    # Coles (2001) p. 59: covariance matrix of (mu, sigma, xi)
+    V = np.array([[0.000780, 0.000197, -0.00107], [0.000197, 0.000410, -0.000778], [-0.00107, -0.000778, 0.00965]])
+    np.testing.assert_allclose(gev.cov, V, rtol=5e-3, atol=5e-6)
+    # p. 60: 10- and 100-year return levels 4.30 and 4.69 m; Var(x_10) = 0.00303
+    np.testing.assert_allclose(gev.return_level([10, 100]), [4.30, 4.69], atol=0.005)
+    assert gev._return_level_variance(10) == pytest.approx(0.00303, abs=5e-6)
+    lo, hi = gev.return_level_ci(10, method="delta")
+    assert (float(lo), float(hi)) == pytest.approx((4.19, 4.40), abs=0.01)   # 4.30 +- 1.96 sqrt(0.00303)
+    plo, phi = gev.return_level_ci(100)                                      # profile (default)
+    assert plo > lo and phi > 4.69 + (4.69 - plo)                            # skewed to the right
+
+
+def test_port_pirie_deviance_says_gumbel_is_adequate():
+    gev = fit_gev(PORT_PIRIE)
+    d = gev.deviance_vs_gumbel()
+    assert d["gumbel_adequate"] and d["p_value"] > 0.5
+    assert d["deviance"] == pytest.approx(2 * (4.339058 - d["loglik_gumbel"]), abs=1e-4)
+
+
+def test_gumbel_methods_agree_with_scipy_and_closed_forms():
+    mle = fit_gumbel(PORT_PIRIE)
+    loc, scale = stats.gumbel_r.fit(PORT_PIRIE)
+    assert mle.loc == pytest.approx(loc, rel=1e-5) and mle.scale == pytest.approx(scale, rel=1e-4)
+    mom = fit_gumbel(PORT_PIRIE, method="moments")
+    s = np.std(PORT_PIRIE, ddof=1)
+    assert mom.scale == pytest.approx(s * np.sqrt(6) / np.pi)
+    assert mom.loc == pytest.approx(PORT_PIRIE.mean() - 0.5772157 * mom.scale)
+    lmom = fit_gumbel(PORT_PIRIE, method="lmoments")
+    lm3 = pytest.importorskip("lmoments3")
+    from lmoments3 import distr
+    ref = distr.gum.lmom_fit(PORT_PIRIE)
+    assert lmom.loc == pytest.approx(ref["loc"], rel=1e-6) and lmom.scale == pytest.approx(ref["scale"], rel=1e-6)
+
+
+def test_wyllie_moment_equations_worked_example():
+    # domain-methods.md E15: M = 2.0 t, S = 1.0 t -> beta = 0.77970, alpha = 1.54995,
+    # x_10 = 3.3046, x_50 = 4.5923, x_100 = 5.1367, x_500 = 6.3947 t; SE(x_100 | n = 20) = 0.877 t (Kite 1977).
+    z = np.random.default_rng(1).normal(size=20)
+    x = 2.0 + (z - z.mean()) / z.std(ddof=1)
+    g = fit_gumbel(x, method="moments")
+    assert g.scale == pytest.approx(0.77970, abs=5e-6) and g.loc == pytest.approx(1.54995, abs=5e-6)
+    np.testing.assert_allclose(g.return_level([10, 50, 100, 500]), [3.3046, 4.5923, 5.1367, 6.3947], atol=5e-5)
+    assert g.return_period(5.0) == pytest.approx(1 / 0.011904, rel=5e-4)
+    lo, hi = g.return_level_ci(100)          # delta method (default for moments)
+    assert (hi - lo) / (2 * 1.959964) == pytest.approx(0.877, abs=5e-4)
+
+
+def test_gumbel_reduced_variates_and_frequency_factors():
+    # Standard table for an infinite sample (Chow 1951; domain-methods.md 2.1).
+    T = [2, 5, 10, 25, 50, 100, 200, 500, 1000]
+    y = [0.3665, 1.4999, 2.2504, 3.1985, 3.9019, 4.6001, 5.2958, 6.2136, 6.9073]
+    K = [-0.1643, 0.7194, 1.3046, 2.0438, 2.5923, 3.1367, 3.6791, 4.3947, 4.9355]
+    np.testing.assert_allclose(gumbel_reduced_variate(T), y, atol=5e-5)
+    np.testing.assert_allclose(gumbel_frequency_factor(T), K, atol=5e-5)
+
+
+@pytest.mark.parametrize("T,n,p,tol", [(100, 30, 0.260, 5e-4), (50, 10, 0.183, 5e-4), (500, 30, 0.058, 5e-4),
+                                       (10, 4, 0.3439, 5e-5), (475, 50, 0.10, 5e-4), (2475, 50, 0.02, 5e-5)])
+def test_encounter_probabilities(T, n, p, tol):
+    # E1-E5 of domain-methods.md: 1 - (1 - 1/T)^n
+    assert encounter_probability(T, n) == pytest.approx(p, abs=tol)
+
+
+def test_plotting_positions():
+    np.testing.assert_allclose(plotting_positions(4, "weibull"), [0.2, 0.4, 0.6, 0.8])
+    np.testing.assert_allclose(plotting_positions(4, "hazen"), [0.125, 0.375, 0.625, 0.875])
+    np.testing.assert_allclose(plotting_positions(3, "gringorten"), (np.arange(1, 4) - 0.44) / 3.12)
+    np.testing.assert_allclose(plotting_positions(3, "cunnane"), (np.arange(1, 4) - 0.4) / 3.2)
+    np.testing.assert_allclose(plotting_positions(3, "blom"), (np.arange(1, 4) - 0.375) / 3.25)
+    with pytest.raises(ValueError, match="formula = 'x' is not one of"):
+        plotting_positions(3, "x")
+
+
+def test_mixed_model_for_years_without_falls():
+    rng = np.random.default_rng(8)
+    values = stats.gumbel_r.rvs(loc=100, scale=30, size=30, random_state=rng)
+    maxima = np.concatenate([values, [np.nan] * 10])             # 10 of 40 years empty
+    g = fit_gumbel(maxima)
+    assert g.p_zero == 0.25 and g.n_years == 40 and g.data.size == 30
+    x100 = g.return_level(100)
+    assert g.sf(x100) == pytest.approx(0.01)
+    assert 0.75 * g.dist.sf(x100) == pytest.approx(0.01)
+    dropped = fit_gumbel(maxima, zero_years="drop")
+    assert dropped.return_level(100) > x100
+    with pytest.raises(ValueError, match="return period must exceed"):
+        g.return_level(1.2)
+
+
+def test_bootstrap_interval_is_seeded():
+    g = fit_gumbel(PORT_PIRIE, method="lmoments")
+    a = g.return_level_ci(100, n_bootstrap=200, seed=5)
+    b = g.return_level_ci(100, n_bootstrap=200, seed=5)
+    assert a == b and a[0] < g.return_level(100) < a[1]
+
+
+def test_too_few_maxima_and_bad_values():
+    with pytest.raises(ValueError, match="3 annual maxima .* a gumbel fit needs at least 5"):
+        fit_gumbel([1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match="a gev fit needs at least 10"):
+        fit_gev([1.0, 2.0, 3.0, 4, 5, 6])
+    with pytest.raises(ValueError, match="maxima\\[1\\] is infinite"):
+        fit_gumbel([1.0, np.inf, 3.0, 4, 5])
+    with pytest.raises(ValueError, match="return periods must be finite and > 1 year"):
+        fit_gumbel(PORT_PIRIE).return_level(0.5)
+
+
+def test_gumbel_ci_coverage_seeded():
+    rng = np.random.default_rng(99)
+    true = stats.gumbel_r(loc=50, scale=10).isf(0.01)
+    hits = 0
+    for _ in range(150):
+        g = fit_gumbel(stats.gumbel_r.rvs(loc=50, scale=10, size=40, random_state=rng))
+        lo, hi = g.return_level_ci(100, method="delta")
+        hits += lo <= true <= hi
+    assert 0.88 <= hits / 150 <= 0.99
+
+
+@settings(max_examples=30, deadline=None)
+@given(loc=st.floats(1, 1e4), scale=st.floats(0.1, 1e3), T=st.floats(1.01, 1e5))
+def test_gumbel_return_level_and_period_invert(loc, scale, T):
+    x = np.random.default_rng(0).gumbel(loc, scale, size=30)
+    g = fit_gumbel(x, method="moments")
+    assert g.return_period(g.return_level(T)) == pytest.approx(T, rel=1e-6)
+
+
+@settings(max_examples=20, deadline=None)
+@given(seed=st.integers(0, 1000))
+def test_return_levels_monotone_in_T(seed):
+    x = np.random.default_rng(seed).gumbel(10, 3, size=25)
+    T = np.array([2, 5, 10, 100, 1000])
+    for fit in (fit_gumbel(x), fit_gev(x)):
+        assert np.all(np.diff(fit.return_level(T)) > 0)
