@@ -1,0 +1,142 @@
+"""Running a scenario: seeding blocks, chunking, and collecting the kernel's outputs.
+
+``run(scenario, n, seed)`` draws every block's initial state with NumPy
+generators spawned from ``SeedSequence(seed)`` (one per quantity, so the draws
+do not depend on chunking), runs the compiled kernel chunk by chunk (default
+100,000 blocks per chunk, so a million blocks never hold more than one chunk
+of per-crossing rows in flight), and merges the results.  Per-impact random
+numbers come from a stream keyed by (seed, block index): the same seed gives
+the same numbers whatever the chunk size.
+"""
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+from . import kernel
+from .result import SimulationResult
+from .scenario import Scenario
+
+DEFAULT_CHUNK = 100_000
+
+
+def _material_arrays(scenario: Scenario):
+    mats = scenario.materials
+    f = lambda attr: np.array([getattr(m, attr) for m in mats], dtype=float)  # noqa: E731
+    return dict(
+        m_en_law=np.array([m.en_law for m in mats], dtype=np.int64), m_en_mean=f("en_mean"), m_en_std=f("en_std"),
+        m_et_law=np.array([m.et_law for m in mats], dtype=np.int64), m_et_mean=f("et_mean"), m_et_std=f("et_std"),
+        m_phi=f("friction_deg"), m_phi_std=f("friction_std_deg"), m_rough=f("roughness_m"),
+        m_roll=np.array([m.ground_motion == "roll" for m in mats]),
+        m_mu_ground=np.tan(np.radians(f("ground_friction_deg"))),
+        m_gain=np.array([m.allow_energy_gain for m in mats]))
+
+
+def seed_blocks(scenario: Scenario, n: int, seed) -> dict:
+    """Initial state of n blocks: position [m], velocity [m/s], spin [rad/s], mass [kg], radius [m]."""
+    sd = scenario.seeder
+    ss = np.random.SeedSequence(seed)
+    g_x, g_h, g_m, g_vx, g_vz, g_w = (np.random.default_rng(c) for c in ss.spawn(6))
+    x = g_x.uniform(sd.x_low, sd.x_high, n) if sd.x_high > sd.x_low else np.full(n, sd.x_low)
+    h = sd.height_m.sample(g_h, n)
+    mass = sd.mass_kg.sample(g_m, n)
+    radius = (3.0 * mass / (4.0 * np.pi * sd.density_kg_m3)) ** (1.0 / 3.0)
+    return {"x": x, "z": scenario.profile.ground(x) + h, "vx": sd.vx_ms.sample(g_vx, n),
+            "vz": sd.vz_ms.sample(g_vz, n), "w": sd.angular_velocity_rads.sample(g_w, n),
+            "mass": mass, "radius": radius}
+
+
+def _progress_bar(done: int, total: int, started: float, stream) -> None:
+    frac = done / total
+    bar = "#" * int(30 * frac)
+    rate = done / max(time.perf_counter() - started, 1e-9)
+    stream.write(f"\rsimulating [{bar:<30}] {done:>9,}/{total:,} blocks  {rate:,.0f} blocks/s")
+    stream.flush()
+    if done == total:
+        stream.write("\n")
+
+
+def run(scenario: Scenario, n: int = 10_000, seed=None, *, chunk_size: int = DEFAULT_CHUNK,
+        record_paths: int = 20, progress: bool | None = None) -> SimulationResult:
+    """Simulate ``n`` blocks released by the scenario's seeder.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        From :func:`simulation.load_scenario`.
+    n : int
+        Number of blocks (> 0).
+    seed : int, optional
+        Random seed; the same seed gives identical results for any ``chunk_size``.
+    chunk_size : int
+        Blocks per kernel call (memory bound; results do not depend on it).
+    record_paths : int
+        Keep the full event sequence of the first ``record_paths`` blocks for plotting.
+    progress : bool, optional
+        Show a progress bar on standard error (default: when n >= 200,000 and stderr is a terminal).
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
+        raise ValueError(f"n must be a positive whole number of blocks; got {n!r}")
+    if chunk_size <= 0:
+        raise ValueError(f"chunk_size must be > 0; got {chunk_size!r}")
+    n = int(n)
+    if progress is None:
+        progress = n >= 200_000 and sys.stderr.isatty()
+    key = np.random.SeedSequence(seed).generate_state(1, dtype=np.uint64)[0]
+    blocks = seed_blocks(scenario, n, seed)
+    prof = scenario.profile
+    st = scenario.settings
+    mats = _material_arrays(scenario)
+    cols = scenario.collectors
+    c_x = np.array([c.x for c in cols], dtype=float)
+    c_cap = np.array([np.nan if c.capacity_kj is None else c.capacity_kj for c in cols], dtype=float)
+    c_h = np.array([np.nan if c.height_m is None else c.height_m for c in cols], dtype=float)
+    nb = st.envelope_bins
+    edges = np.linspace(prof.x[0], prof.x[-1], nb + 1)
+    env_x = 0.5 * (edges[:-1] + edges[1:]) if nb else np.empty(0)
+    env_acc = np.zeros((env_x.size, 7))
+    n_paths = min(int(record_paths), n)
+    path_cap = max(n_paths * (st.max_events * 3 + 8), 1)
+    paths = {k: np.empty(path_cap, dtype=dt) for k, dt in
+             (("block", np.int64), ("t", float), ("x", float), ("z", float), ("vx", float), ("vz", float),
+              ("mode", np.int64))}
+    pcount = np.zeros(1, np.int64)
+    per_block = {k: np.empty(n, dtype=dt) for k, dt in
+                 (("x", float), ("z", float), ("reason", np.int64), ("impacts", np.int64), ("t", float))}
+    rows = []
+    dropped = 0
+    started = time.perf_counter()
+    for lo in range(0, n, chunk_size):
+        hi = min(lo + chunk_size, n)
+        m = hi - lo
+        cap = max(4 * m * max(len(cols), 1), 16)
+        r = {k: np.empty(cap, dtype=dt) for k, dt in
+             (("block", np.int64), ("coll", np.int64), ("t", float), ("vx", float), ("vz", float), ("w", float),
+              ("h", float), ("outcome", np.int64))}
+        r_count = np.zeros(2, np.int64)
+        kernel.simulate(
+            np.arange(lo, hi, dtype=np.int64), blocks["x"][lo:hi], blocks["z"][lo:hi], blocks["vx"][lo:hi],
+            blocks["vz"][lo:hi], blocks["w"][lo:hi], blocks["mass"][lo:hi], blocks["radius"][lo:hi],
+            prof.x, prof.z, prof.tree_zmax, prof.n_leaves, prof.material_index, **mats,
+            c_x=c_x, c_cap=c_cap, c_h=c_h, env_x=env_x, env_acc=env_acc,
+            g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
+            max_events=st.max_events, key=key, n_path_blocks=n_paths,
+            out_x=per_block["x"][lo:hi], out_z=per_block["z"][lo:hi], out_reason=per_block["reason"][lo:hi],
+            out_impacts=per_block["impacts"][lo:hi], out_t=per_block["t"][lo:hi],
+            r_block=r["block"], r_coll=r["coll"], r_t=r["t"], r_vx=r["vx"], r_vz=r["vz"], r_w=r["w"],
+            r_h=r["h"], r_outcome=r["outcome"], r_count=r_count,
+            pb=paths["block"], pt=paths["t"], pxs=paths["x"], pzs=paths["z"], pvx=paths["vx"], pvz=paths["vz"],
+            pmode=paths["mode"], pcount=pcount)
+        k = int(r_count[0])
+        rows.append({name: arr[:k].copy() for name, arr in r.items()})
+        dropped += int(r_count[1])
+        if progress:
+            _progress_bar(hi, n, started, sys.stderr)
+    elapsed = time.perf_counter() - started
+    merged = {name: np.concatenate([c[name] for c in rows]) for name in rows[0]}
+    k = int(pcount[0])
+    return SimulationResult(scenario=scenario, n=n, seed=seed, blocks=blocks, per_block=per_block,
+                            crossings=merged, dropped_crossings=dropped, envelope_x=env_x, envelope_acc=env_acc,
+                            paths={name: arr[:k] for name, arr in paths.items()}, elapsed_s=elapsed)

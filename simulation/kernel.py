@@ -1,0 +1,469 @@
+"""The compiled trajectory kernel: one block at a time, event to event.
+
+Events are impacts, segment ends during ground contact, collector crossings and
+stops.  Between events motion is exact: parabolic flight (no time stepping),
+constant-acceleration rolling or sliding along a straight segment.  The next
+impact segment is found by descending the profile's max-elevation tree
+(:mod:`simulation.slope`), so the cost per impact grows as log S, not S.
+
+Random numbers come from a counter-based SplitMix64 stream keyed by (run seed,
+block index): a block's trajectory is the same whatever chunk it is run in.
+
+Everything here is numba-compiled plain functions on arrays; the Python layer
+(:mod:`simulation.engine`) prepares the arrays and turns outputs into tables.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .impact import impact
+
+# Stop reasons.
+RUNNING, STOPPED, LEFT_PROFILE, CAUGHT, MAX_EVENTS = 0, 1, 2, 3, 4
+STOP_REASONS = {STOPPED: "stopped", LEFT_PROFILE: "left profile", CAUGHT: "caught by barrier",
+                MAX_EVENTS: "event limit reached"}
+# Collector outcomes.
+CROSSED, BARRIER_CAUGHT, BARRIER_THROUGH, BARRIER_OVER = 0, 1, 2, 3
+OUTCOMES = {CROSSED: "crossed", BARRIER_CAUGHT: "caught", BARRIER_THROUGH: "through", BARRIER_OVER: "over"}
+# Path modes.
+MODE_FLIGHT, MODE_CONTACT, MODE_STOP = 0, 1, 2
+
+_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
+_M1 = np.uint64(0xBF58476D1CE4E5B9)
+_M2 = np.uint64(0x94D049BB133111EB)
+
+
+@njit(cache=True)
+def _next_u64(state):
+    s = state[0] + _GOLDEN
+    state[0] = s
+    z = s
+    z = (z ^ (z >> np.uint64(30))) * _M1
+    z = (z ^ (z >> np.uint64(27))) * _M2
+    return z ^ (z >> np.uint64(31))
+
+
+@njit(cache=True)
+def _uniform(state):
+    return (_next_u64(state) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@njit(cache=True)
+def _normal(state):
+    u1 = _uniform(state)
+    u2 = _uniform(state)
+    return math.sqrt(-2.0 * math.log(max(u1, 1e-300))) * math.cos(2.0 * math.pi * u2)
+
+
+@njit(cache=True)
+def _seg_of(px, x):
+    """Segment index under x by bisection (left segment at a vertex)."""
+    n = px.shape[0] - 1
+    lo, hi = 0, n - 1
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if px[mid] <= x:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
+@njit(cache=True)
+def _ground(px, pz, x):
+    k = _seg_of(px, x)
+    return pz[k] + (pz[k + 1] - pz[k]) * (x - px[k]) / (px[k + 1] - px[k])
+
+
+@njit(cache=True)
+def _leaf_hit(px, pz, k, x0, z0, vx, vz, g):
+    """Time > 0 at which the parabola comes down through segment k within its x-range, or inf."""
+    slope = (pz[k + 1] - pz[k]) / (px[k + 1] - px[k])
+    c0 = z0 - (pz[k] + slope * (x0 - px[k]))
+    c1 = vz - slope * vx
+    disc = c1 * c1 + 2.0 * g * c0
+    if disc < 0.0:
+        return math.inf
+    t = (c1 + math.sqrt(disc)) / g
+    if t <= 1e-12:
+        return math.inf
+    x = x0 + vx * t
+    tol = 1e-9 * (1.0 + abs(x))
+    if x < px[k] - tol or x > px[k + 1] + tol:
+        return math.inf
+    return t
+
+
+@njit(cache=True)
+def find_impact(px, pz, tree, n_leaves, x0, z0, vx, vz, g, seg_now, stack):
+    """First (time, segment) where the flight from (x0, z0) meets the ground; segment -1 if it leaves."""
+    n_seg = px.shape[0] - 1
+    if abs(vx) < 1e-12:
+        return _leaf_hit(px, pz, seg_now, x0, z0, 0.0, vz, g), seg_now
+    if vx > 0:
+        xa_travel, xb_travel = x0, px[n_seg]
+    else:
+        xa_travel, xb_travel = px[0], x0
+    stack_node, stack_lo, stack_hi = stack[0], stack[1], stack[2]
+    stack_node[0], stack_lo[0], stack_hi[0] = 1, 0, n_leaves - 1
+    top = 1
+    while top > 0:
+        top -= 1
+        node, lo, hi = stack_node[top], stack_lo[top], stack_hi[top]
+        if lo >= n_seg:
+            continue
+        xa = max(px[lo], xa_travel)
+        xb = min(px[min(hi + 1, n_seg)], xb_travel)
+        if xa > xb:
+            continue
+        ta = (xa - x0) / vx
+        tb = (xb - x0) / vx
+        za = z0 + vz * ta - 0.5 * g * ta * ta
+        zb = z0 + vz * tb - 0.5 * g * tb * tb
+        if min(za, zb) > tree[node] + 1e-9:
+            continue
+        if lo == hi:
+            t = _leaf_hit(px, pz, lo, x0, z0, vx, vz, g)
+            if t < math.inf:
+                return t, lo
+            continue
+        mid = (lo + hi) // 2
+        left, right = 2 * node, 2 * node + 1
+        # Push the far child first so the near child (in the direction of travel) is examined first.
+        if vx > 0:
+            stack_node[top], stack_lo[top], stack_hi[top] = right, mid + 1, hi
+            stack_node[top + 1], stack_lo[top + 1], stack_hi[top + 1] = left, lo, mid
+        else:
+            stack_node[top], stack_lo[top], stack_hi[top] = left, lo, mid
+            stack_node[top + 1], stack_lo[top + 1], stack_hi[top + 1] = right, mid + 1, hi
+        top += 2
+    # No impact: time to reach the end of the profile.
+    if vx > 0:
+        return (px[n_seg] - x0) / vx, -1
+    return (px[0] - x0) / vx, -1
+
+
+@njit(cache=True)
+def _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, block, t, x, z, vx, vz, mode):
+    i = pcount[0]
+    if i < pb.shape[0]:
+        pb[i], pt[i], pxs[i], pzs[i], pvx[i], pvz[i], pmode[i] = block, t, x, z, vx, vz, mode
+        pcount[0] = i + 1
+
+
+@njit(cache=True)
+def _envelope(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass, inertia, r, contact_speed0, contact_a,
+              contact_dir, cosb, contact, roll):
+    """Update per-bin passage count, max/sum of speed, height and energy for bins between xa and xb."""
+    lo, hi = (xa, xb) if xa <= xb else (xb, xa)
+    i0 = np.searchsorted(env_x, lo)
+    i1 = np.searchsorted(env_x, hi)
+    for i in range(i0, i1):
+        xc = env_x[i]
+        if contact:
+            s = contact_dir * (xc - x0) / cosb
+            if abs(contact_a) < 1e-12:
+                sp = contact_speed0
+            else:
+                sp = math.sqrt(max(contact_speed0 * contact_speed0 + 2.0 * contact_a * s, 0.0))
+            v, h = sp, 0.0
+            wc = sp / r if roll else 0.0
+        else:
+            t = (xc - x0) / vx
+            vzz = vz - g * t
+            v = math.sqrt(vx * vx + vzz * vzz)
+            h = z0 + vz * t - 0.5 * g * t * t - _ground(px, pz, xc)
+            wc = w
+        e = (0.5 * mass * v * v + 0.5 * inertia * wc * wc) / 1000.0
+        env_acc[i, 0] += 1.0
+        env_acc[i, 1] = max(env_acc[i, 1], v)
+        env_acc[i, 2] = max(env_acc[i, 2], h)
+        env_acc[i, 3] = max(env_acc[i, 3], e)
+        env_acc[i, 4] += v
+        env_acc[i, 5] += h
+        env_acc[i, 6] += e
+
+
+@njit(cache=True)
+def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
+             px, pz, tree, n_leaves, seg_mat,
+             m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
+             m_roll, m_mu_ground, m_gain,
+             c_x, c_cap, c_h, env_x, env_acc,
+             g, v_contact, v_stop, max_events, key, n_path_blocks,
+             out_x, out_z, out_reason, out_impacts, out_t,
+             r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
+             pb, pt, pxs, pzs, pvx, pvz, pmode, pcount):
+    """Run every block of a chunk; fill the per-block and per-crossing output arrays in place."""
+    n_coll = c_x.shape[0]
+    n_seg = px.shape[0] - 1
+    state = np.empty(1, np.uint64)
+    cross_t = np.empty(n_coll)
+    stack = np.empty((3, 128), np.int64)
+    for b in range(block_ids.shape[0]):
+        bid = block_ids[b]
+        state[0] = key ^ (np.uint64(bid + 1) * _GOLDEN)
+        mass, r = bmass[b], bradius[b]
+        inertia = 0.4 * mass * r * r
+        x, z, vx, vz, w = bx[b], bz[b], bvx[b], bvz[b], bw[b]
+        t_abs = 0.0
+        seg = _seg_of(px, x)
+        record = bid < n_path_blocks
+        h0 = z - (pz[seg] + (pz[seg + 1] - pz[seg]) * (x - px[seg]) / (px[seg + 1] - px[seg]))
+        contact = h0 <= 1e-9
+        if contact:
+            z = z - h0
+            dxs, dzs = px[seg + 1] - px[seg], pz[seg + 1] - pz[seg]
+            ls = math.sqrt(dxs * dxs + dzs * dzs)
+            v_along = (vx * dxs + vz * dzs) / ls
+        else:
+            v_along = 0.0
+        reason = RUNNING
+        impacts = 0
+        events = 0
+        if record:
+            _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, vx, vz,
+                         MODE_CONTACT if contact else MODE_FLIGHT)
+        while reason == RUNNING:
+            events += 1
+            if events > max_events:
+                reason = MAX_EVENTS
+                break
+            if not contact:
+                t_hit, k = find_impact(px, pz, tree, n_leaves, x, z, vx, vz, g, seg, stack)
+                if t_hit == math.inf:          # vertical motion already at the ground: settle into contact
+                    contact = True
+                    z = _ground(px, pz, x)
+                    v_along = 0.0
+                    continue
+                x_end = x + vx * t_hit
+                # Collector crossings on this flight, in time order; a barrier may cut the flight.
+                cut = False
+                for j in range(n_coll):
+                    cross_t[j] = (c_x[j] - x) / vx if abs(vx) > 1e-12 else -1.0
+                order = np.argsort(cross_t)
+                for jj in range(n_coll):
+                    j = order[jj]
+                    tc = cross_t[j]
+                    if not (1e-12 < tc <= t_hit):
+                        continue
+                    zc = z + vz * tc - 0.5 * g * tc * tc
+                    vzc = vz - g * tc
+                    h = zc - _ground(px, pz, c_x[j])
+                    outcome = CROSSED
+                    vxn, vzn, wn = vx, vz, w
+                    if not math.isnan(c_cap[j]):
+                        if h <= c_h[j]:
+                            e = (0.5 * mass * (vx * vx + vzc * vzc) + 0.5 * inertia * w * w) / 1000.0
+                            if e <= c_cap[j]:
+                                outcome = BARRIER_CAUGHT
+                            else:
+                                outcome = BARRIER_THROUGH
+                                f = math.sqrt((e - c_cap[j]) / e)
+                                vxn, vzn, wn = vx * f, vzc * f, w * f
+                        else:
+                            outcome = BARRIER_OVER
+                    i = r_count[0]
+                    if i < r_block.shape[0]:
+                        r_block[i], r_coll[i], r_t[i] = bid, j, t_abs + tc
+                        r_vx[i], r_vz[i], r_w[i], r_h[i], r_outcome[i] = vx, vzc, w, h, outcome
+                        r_count[0] = i + 1
+                    else:
+                        r_count[1] += 1
+                    if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
+                        if env_x.shape[0] > 0:
+                            _envelope(env_x, env_acc, x, c_x[j], x, z, vx, vz, w, g, px, pz, mass, inertia, r,
+                                      0.0, 0.0, 1.0, 1.0, False, False)
+                        t_abs += tc
+                        x, z = c_x[j], zc
+                        seg = _seg_of(px, x)
+                        if outcome == BARRIER_CAUGHT:
+                            z = _ground(px, pz, x)
+                            reason = CAUGHT
+                        else:
+                            vx, vz, w = vxn, vzn, wn
+                        if record:
+                            _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, zc, vx, vz,
+                                         MODE_STOP if reason == CAUGHT else MODE_FLIGHT)
+                        cut = True
+                        break
+                if cut:
+                    continue
+                if env_x.shape[0] > 0:
+                    _envelope(env_x, env_acc, x, x_end, x, z, vx, vz, w, g, px, pz, mass, inertia, r,
+                              0.0, 0.0, 1.0, 1.0, False, False)
+                z_end = z + vz * t_hit - 0.5 * g * t_hit * t_hit
+                vz_end = vz - g * t_hit
+                t_abs += t_hit
+                x, z, vz = x_end, z_end, vz_end
+                if k < 0:
+                    reason = LEFT_PROFILE
+                    if record:
+                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, vx, vz, MODE_STOP)
+                    break
+                seg = k
+                z = pz[k] + (pz[k + 1] - pz[k]) * (x - px[k]) / (px[k + 1] - px[k])
+                # Impact on segment k.
+                impacts += 1
+                mat = seg_mat[k]
+                beta = math.atan2(pz[k + 1] - pz[k], px[k + 1] - px[k])
+                theta_max = math.atan(m_rough[mat] / r) if r > 0 else 0.0
+                delta = (2.0 * _uniform(state) - 1.0) * theta_max
+                bp = beta + delta
+                vn = -vx * math.sin(bp) + vz * math.cos(bp)
+                if vn >= 0.0:
+                    bp = beta
+                    vn = -vx * math.sin(bp) + vz * math.cos(bp)
+                vt = vx * math.cos(bp) + vz * math.sin(bp)
+                gain = m_gain[mat]
+                cap = 10.0 if gain else 1.0
+                en = min(max(m_en_mean[mat] + m_en_std[mat] * _normal(state), 0.0), cap) \
+                    if m_en_std[mat] > 0 else m_en_mean[mat]
+                et = min(max(m_et_mean[mat] + m_et_std[mat] * _normal(state), 0.0), cap) \
+                    if m_et_std[mat] > 0 else m_et_mean[mat]
+                phi = m_phi[mat] + (m_phi_std[mat] * _normal(state) if m_phi_std[mat] > 0 else 0.0)
+                mu = math.tan(math.radians(min(max(phi, 0.0), 89.0)))
+                if vn < 0.0:
+                    vn2, vt2, w, _ = impact(vn, vt, w, r, m_en_law[mat], en, m_et_law[mat], et, mu, gain)
+                else:
+                    vn2, vt2 = 0.0, vt
+                vx = vt2 * math.cos(bp) - vn2 * math.sin(bp)
+                vz = vt2 * math.sin(bp) + vn2 * math.cos(bp)
+                vn_true = -vx * math.sin(beta) + vz * math.cos(beta)
+                if record:
+                    _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, vx, vz, MODE_FLIGHT)
+                if vn_true < v_contact:
+                    contact = True
+                    v_along = vx * math.cos(beta) + vz * math.sin(beta)
+                    if record:
+                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z,
+                                     v_along * math.cos(beta), v_along * math.sin(beta), MODE_CONTACT)
+                continue
+
+            # ---- ground contact on segment `seg`: roll or slide with constant acceleration ----
+            k = seg
+            mat = seg_mat[k]
+            cosb_raw = px[k + 1] - px[k]
+            sinb_raw = pz[k + 1] - pz[k]
+            ls = math.sqrt(cosb_raw * cosb_raw + sinb_raw * sinb_raw)
+            cosb, sinb = cosb_raw / ls, sinb_raw / ls
+            mu = m_mu_ground[mat]
+            factor = 5.0 / 7.0 if m_roll[mat] else 1.0
+            if abs(v_along) < v_stop or v_along == 0.0:
+                if abs(sinb) <= mu * cosb:
+                    reason = STOPPED
+                    w = 0.0
+                    if record:
+                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, 0.0, 0.0,
+                                     MODE_STOP)
+                    break
+                direction = -1.0 if sinb > 0 else 1.0
+                v_along = 0.0
+            else:
+                direction = 1.0 if v_along > 0 else -1.0
+            a_dir = factor * (-g * sinb * direction - mu * g * cosb)   # acceleration along the motion
+            u = abs(v_along)
+            if direction > 0:
+                dist = (px[k + 1] - x) / cosb
+            else:
+                dist = (x - px[k]) / cosb
+            stops_here = a_dir < 0 and u * u < -2.0 * a_dir * dist
+            if stops_here:
+                t_step = u / (-a_dir)
+                d_step = u * u / (-2.0 * a_dir)
+                u_end = 0.0
+            else:
+                u_end = math.sqrt(max(u * u + 2.0 * a_dir * dist, 0.0))
+                if abs(a_dir) > 1e-12:
+                    t_step = (u_end - u) / a_dir
+                elif u > 0:
+                    t_step = dist / u
+                else:
+                    reason = STOPPED
+                    break
+                d_step = dist
+            x_new = x + direction * d_step * cosb
+            # Collector crossings during this contact step.
+            cut = False
+            for j in range(n_coll):
+                cross_t[j] = direction * (c_x[j] - x) / cosb   # distance along the slope to the collector
+            order = np.argsort(cross_t)
+            for jj in range(n_coll):
+                j = order[jj]
+                s_c = cross_t[j]
+                if not (1e-12 < s_c <= d_step):
+                    continue
+                if abs(a_dir) < 1e-12:
+                    tc = s_c / u
+                    uc = u
+                else:
+                    uc = math.sqrt(max(u * u + 2.0 * a_dir * s_c, 0.0))
+                    tc = (uc - u) / a_dir
+                wc = direction * uc / r if m_roll[mat] else 0.0
+                vxc, vzc = direction * uc * cosb, direction * uc * sinb
+                outcome = CROSSED
+                if not math.isnan(c_cap[j]):
+                    e = (0.5 * mass * uc * uc + 0.5 * inertia * wc * wc) / 1000.0
+                    outcome = BARRIER_CAUGHT if e <= c_cap[j] else BARRIER_THROUGH
+                i = r_count[0]
+                if i < r_block.shape[0]:
+                    r_block[i], r_coll[i], r_t[i] = bid, j, t_abs + tc
+                    r_vx[i], r_vz[i], r_w[i], r_h[i], r_outcome[i] = vxc, vzc, wc, 0.0, outcome
+                    r_count[0] = i + 1
+                else:
+                    r_count[1] += 1
+                if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
+                    if env_x.shape[0] > 0:
+                        _envelope(env_x, env_acc, x, c_x[j], x, z, 0.0, 0.0, 0.0, g, px, pz, mass, inertia, r, u,
+                                  a_dir, direction, cosb, True, m_roll[mat])
+                    t_abs += tc
+                    x = c_x[j]
+                    z = _ground(px, pz, x)
+                    if outcome == BARRIER_CAUGHT:
+                        reason = CAUGHT
+                    else:
+                        e_left = (e - c_cap[j]) / e
+                        v_along = direction * uc * math.sqrt(e_left)
+                    if record:
+                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z,
+                                     v_along * cosb, v_along * sinb, MODE_STOP if reason == CAUGHT else MODE_CONTACT)
+                    cut = True
+                    break
+            if cut:
+                continue
+            if env_x.shape[0] > 0:
+                _envelope(env_x, env_acc, x, x_new, x, z, 0.0, 0.0, 0.0, g, px, pz, mass, inertia, r, u, a_dir,
+                          direction, cosb, True, m_roll[mat])
+            t_abs += t_step
+            x = x_new
+            z = pz[k] + (pz[k + 1] - pz[k]) * (x - px[k]) / (px[k + 1] - px[k])
+            w = direction * u_end / r if m_roll[mat] else 0.0
+            if stops_here:
+                v_along = 0.0
+                if record:
+                    _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, 0.0, 0.0,
+                                 MODE_CONTACT)
+                continue
+            # Reached a vertex: next segment, or off the profile.
+            k2 = k + 1 if direction > 0 else k - 1
+            vxe, vze = direction * u_end * cosb, direction * u_end * sinb
+            if record:
+                _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, vxe, vze, MODE_CONTACT)
+            if k2 < 0 or k2 >= n_seg:
+                reason = LEFT_PROFILE
+                vx, vz = vxe, vze
+                break
+            c2x, c2z = px[k2 + 1] - px[k2], pz[k2 + 1] - pz[k2]
+            l2 = math.sqrt(c2x * c2x + c2z * c2z)
+            cos2, sin2 = c2x / l2, c2z / l2
+            if -vxe * sin2 + vze * cos2 > 1e-9:
+                contact = False            # convex edge: the block takes off
+                vx, vz = vxe, vze
+                seg = k2
+            else:
+                seg = k2
+                v_along = vxe * cos2 + vze * sin2
+        out_x[b], out_z[b], out_reason[b], out_impacts[b], out_t[b] = x, z, reason, impacts, t_abs

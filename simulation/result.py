@@ -1,0 +1,161 @@
+"""Results of a simulation run: collector tables, runout, stop reasons, envelopes, paths."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from .kernel import MODE_FLIGHT, OUTCOMES, STOP_REASONS
+
+
+def wilson_interval(k, n, level: float = 0.95):
+    """Wilson score interval of a binomial proportion k/n (Monte Carlo confidence interval)."""
+    k, n = np.asarray(k, dtype=float), np.asarray(n, dtype=float)
+    z = stats.norm.isf((1 - level) / 2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        p = k / n
+        centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+        half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return np.clip(centre - half, 0, 1), np.clip(centre + half, 0, 1)
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """Everything a run produced.  Units: m, m/s, rad/s, kg, kJ, s."""
+
+    scenario: object
+    n: int
+    seed: object
+    blocks: dict = field(repr=False)
+    per_block: dict = field(repr=False)
+    crossings: dict = field(repr=False)
+    dropped_crossings: int = 0
+    envelope_x: np.ndarray = field(repr=False, default=None)
+    envelope_acc: np.ndarray = field(repr=False, default=None)
+    paths: dict = field(repr=False, default=None)
+    elapsed_s: float = 0.0
+
+    # ---- collectors --------------------------------------------------------------
+    def collector(self, name: str, *, first_only: bool = False) -> pd.DataFrame:
+        """One row per crossing of collector ``name``.
+
+        Columns: ``block``, ``time_s``, ``velocity_ms``, ``vx_ms``, ``vz_ms``,
+        ``angular_velocity_rads``, ``height_m`` (of the block centre above the
+        ground), ``mass_kg``, ``radius_m``, ``energy_translational_kj``,
+        ``energy_rotational_kj``, ``energy_kj`` (total), ``crossing_angle_deg``
+        (below horizontal), ``outcome`` (crossed / caught / through / over).
+        With ``first_only`` only each block's first crossing is kept.
+        """
+        j = self.scenario.collector_index(name)
+        sel = self.crossings["coll"] == j
+        blk = self.crossings["block"][sel]
+        vx, vz, w = self.crossings["vx"][sel], self.crossings["vz"][sel], self.crossings["w"][sel]
+        mass = self.blocks["mass"][blk]
+        radius = self.blocks["radius"][blk]
+        v = np.hypot(vx, vz)
+        e_t = 0.5 * mass * v ** 2 / 1000.0
+        e_r = 0.5 * 0.4 * mass * radius ** 2 * w ** 2 / 1000.0
+        df = pd.DataFrame({
+            "block": blk, "time_s": self.crossings["t"][sel], "velocity_ms": v, "vx_ms": vx, "vz_ms": vz,
+            "angular_velocity_rads": w, "height_m": self.crossings["h"][sel], "mass_kg": mass, "radius_m": radius,
+            "energy_translational_kj": e_t, "energy_rotational_kj": e_r, "energy_kj": e_t + e_r,
+            "crossing_angle_deg": np.degrees(np.arctan2(-vz, np.abs(vx))),
+            "outcome": pd.Categorical.from_codes(self.crossings["outcome"][sel], [OUTCOMES[i] for i in range(4)]),
+        })
+        if first_only:
+            df = df.sort_values(["block", "time_s"]).drop_duplicates("block", keep="first")
+        return df.reset_index(drop=True)
+
+    def reach_probability(self, name: str, level: float = 0.95):
+        """Fraction of released blocks that cross collector ``name``, with its Wilson interval."""
+        k = self.collector(name, first_only=True).shape[0]
+        lo, hi = wilson_interval(k, self.n, level)
+        return k / self.n, float(lo), float(hi)
+
+    def exceedance(self, name: str, column: str, value, level: float = 0.95) -> pd.DataFrame:
+        """P(column > value) among blocks reaching ``name`` (first crossings), with Monte Carlo intervals."""
+        df = self.collector(name, first_only=True)
+        if column not in df.columns:
+            raise KeyError(f"column {column!r} not in collector table; columns are {list(df.columns)}")
+        x = np.sort(df[column].to_numpy())
+        values = np.atleast_1d(np.asarray(value, dtype=float))
+        k = x.size - np.searchsorted(x, values, side="right")
+        lo, hi = wilson_interval(k, max(x.size, 1), level)
+        return pd.DataFrame({column: values, "probability": k / max(x.size, 1), "ci_low": lo, "ci_high": hi,
+                             "n_reaching": x.size})
+
+    # ---- runout and stops ---------------------------------------------------------
+    @property
+    def runout(self) -> pd.DataFrame:
+        """Per block: where and why it stopped, impacts, travel time and mass."""
+        reasons = self.per_block["reason"]
+        return pd.DataFrame({
+            "x_stop_m": self.per_block["x"], "z_stop_m": self.per_block["z"],
+            "reason": pd.Categorical([STOP_REASONS.get(int(r), "running") for r in reasons]),
+            "impacts": self.per_block["impacts"], "time_s": self.per_block["t"], "mass_kg": self.blocks["mass"]})
+
+    @property
+    def stop_reasons(self) -> pd.Series:
+        """How many blocks ended for each reason (never a silent truncation)."""
+        counts = pd.Series(self.per_block["reason"]).map(lambda r: STOP_REASONS.get(int(r), "running"))
+        return counts.value_counts().rename("blocks")
+
+    @property
+    def n_impacts(self) -> int:
+        return int(self.per_block["impacts"].sum())
+
+    # ---- envelopes and paths -----------------------------------------------------
+    @property
+    def envelopes(self) -> pd.DataFrame:
+        """Per x bin: passages, maximum and mean speed [m/s], height [m] and energy [kJ]."""
+        acc = self.envelope_acc
+        n = np.maximum(acc[:, 0], 1)
+        return pd.DataFrame({"x_m": self.envelope_x, "passages": acc[:, 0].astype(int),
+                             "velocity_max_ms": acc[:, 1], "velocity_mean_ms": acc[:, 4] / n,
+                             "height_max_m": acc[:, 2], "height_mean_m": acc[:, 5] / n,
+                             "energy_max_kj": acc[:, 3], "energy_mean_kj": acc[:, 6] / n})
+
+    def path(self, block: int, dt: float = 0.01) -> pd.DataFrame:
+        """Sampled path (x, z) of one of the recorded blocks, exact between events."""
+        sel = self.paths["block"] == block
+        if not sel.any():
+            raise KeyError(f"block {block} was not recorded; run with record_paths > {block}")
+        t, x, z = self.paths["t"][sel], self.paths["x"][sel], self.paths["z"][sel]
+        vx, vz, mode = self.paths["vx"][sel], self.paths["vz"][sel], self.paths["mode"][sel]
+        g = self.scenario.settings.gravity_ms2
+        xs, zs = [x[:1]], [z[:1]]
+        for i in range(len(t) - 1):
+            span = t[i + 1] - t[i]
+            if mode[i] == MODE_FLIGHT and span > 0:
+                tt = np.arange(dt, span, dt)
+                xs.append(x[i] + vx[i] * tt)
+                zs.append(z[i] + vz[i] * tt - 0.5 * g * tt ** 2)
+            xs.append(x[i + 1:i + 2])
+            zs.append(z[i + 1:i + 2])
+        return pd.DataFrame({"x_m": np.concatenate(xs), "z_m": np.concatenate(zs)})
+
+    # ---- summary -------------------------------------------------------------------
+    def summary(self) -> pd.DataFrame:
+        """Run facts and, per collector, reach probability and speed/height/energy percentiles."""
+        rows = {"blocks": self.n, "seed": self.seed, "impacts": self.n_impacts,
+                "run time [s]": round(self.elapsed_s, 3),
+                "impacts per second": round(self.n_impacts / max(self.elapsed_s, 1e-9)),
+                "blocks per second": round(self.n / max(self.elapsed_s, 1e-9))}
+        for reason, count in self.stop_reasons.items():
+            rows[f"stopped: {reason}"] = int(count)
+        if self.dropped_crossings:
+            rows["collector rows dropped (buffer full)"] = self.dropped_crossings
+        for c in self.scenario.collectors:
+            df = self.collector(c.name, first_only=True)
+            p, lo, hi = self.reach_probability(c.name)
+            rows[f"{c.name}: reach probability"] = f"{p:.4f} ({lo:.4f}-{hi:.4f})"
+            if len(df):
+                for col, unit in (("velocity_ms", "m/s"), ("height_m", "m"), ("energy_kj", "kJ")):
+                    q = np.percentile(df[col], [50, 95, 99])
+                    rows[f"{c.name}: {col} p50/p95/p99 [{unit}]"] = " / ".join(f"{v:.3g}" for v in q)
+                if c.is_barrier:
+                    rows[f"{c.name}: outcomes"] = ", ".join(f"{k} {v}" for k, v in
+                                                           df["outcome"].value_counts().items() if v)
+        return pd.DataFrame({"value": pd.Series(rows, dtype=object)})

@@ -1,0 +1,379 @@
+"""Scenarios: slope profile, materials, seeder, collectors and settings, read from TOML.
+
+See the README section "Scenario files" for every field.  Unknown fields are an
+error (with a did-you-mean), and every error names the file and the field.
+"""
+from __future__ import annotations
+
+import difflib
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+
+from .impact import EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_FRICTION
+from .slope import Profile
+
+
+class ScenarioError(ValueError):
+    """A scenario file or dictionary is invalid; the message names the file and field."""
+
+
+def _check_keys(table: dict, allowed, where: str, source: str):
+    for key in table:
+        if key not in allowed:
+            close = difflib.get_close_matches(key, list(allowed), n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else f"; allowed: {', '.join(sorted(allowed))}"
+            raise ScenarioError(f"{source}: unknown field {where}{key!r}{hint}")
+
+
+def _number(value, where: str, source: str, *, lo=-math.inf, hi=math.inf, lo_open=False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ScenarioError(f"{source}: {where} must be a number; got {value!r}")
+    v = float(value)
+    if not math.isfinite(v) or v < lo or v > hi or (lo_open and v == lo):
+        rng = f"{'(' if lo_open else '['}{lo:g}, {hi:g}]"
+        raise ScenarioError(f"{source}: {where} = {value!r} is outside the physical range {rng}")
+    return v
+
+
+@dataclass(frozen=True)
+class Distribution:
+    """A sampling distribution given in a scenario: a number, or a table with ``dist``.
+
+    ``{dist = "uniform", low, high}``, ``{dist = "normal", mean, std, min?, max?}``
+    (truncated), ``{dist = "lognormal", median, sigma, max?}`` (sigma of ln x),
+    ``{dist = "triangular", low, mode, high}``.
+    """
+
+    kind: str
+    params: dict = field(default_factory=dict)
+
+    @classmethod
+    def parse(cls, spec, where: str, source: str, *, lo=-math.inf, hi=math.inf, lo_open=False) -> "Distribution":
+        if isinstance(spec, (int, float)) and not isinstance(spec, bool):
+            return cls("constant", {"value": _number(spec, where, source, lo=lo, hi=hi, lo_open=lo_open)})
+        if not isinstance(spec, dict) or "dist" not in spec:
+            raise ScenarioError(f"{source}: {where} must be a number or a table with 'dist'; got {spec!r}")
+        kind = spec["dist"]
+        fields = {"uniform": {"low", "high"}, "normal": {"mean", "std", "min", "max"},
+                  "lognormal": {"median", "sigma", "max"}, "triangular": {"low", "mode", "high"},
+                  "constant": {"value"}}
+        if kind not in fields:
+            raise ScenarioError(f"{source}: {where}.dist = {kind!r} is not one of {sorted(fields)}")
+        _check_keys({k: v for k, v in spec.items() if k != "dist"}, fields[kind], f"{where}.", source)
+        p = {k: _number(v, f"{where}.{k}", source) for k, v in spec.items() if k != "dist"}
+        required = {"uniform": ("low", "high"), "normal": ("mean", "std"), "lognormal": ("median", "sigma"),
+                    "triangular": ("low", "mode", "high"), "constant": ("value",)}[kind]
+        for k in required:
+            if k not in p:
+                raise ScenarioError(f"{source}: {where} ({kind}) needs {k!r}")
+        if kind in ("uniform", "triangular") and not p["low"] <= p.get("mode", p["low"]) <= p["high"]:
+            raise ScenarioError(f"{source}: {where} needs low <= mode <= high; got {spec}")
+        if p.get("std", 0) < 0 or p.get("sigma", 0) < 0:
+            raise ScenarioError(f"{source}: {where} spread must be >= 0; got {spec}")
+        dist = cls(kind, p)
+        lo_v, hi_v = dist.bounds()
+        if lo_v < lo or hi_v > hi or (lo_open and lo_v == lo and kind != "lognormal"):
+            raise ScenarioError(f"{source}: {where} = {spec} reaches values outside the physical range "
+                                f"[{lo:g}, {hi:g}]")
+        return dist
+
+    def bounds(self):
+        p = self.params
+        if self.kind == "constant":
+            return p["value"], p["value"]
+        if self.kind in ("uniform", "triangular"):
+            return p["low"], p["high"]
+        if self.kind == "normal":
+            return p.get("min", -math.inf if p["std"] > 0 else p["mean"]), \
+                p.get("max", math.inf if p["std"] > 0 else p["mean"])
+        return (0.0 if p["sigma"] > 0 else p["median"]), p.get("max", math.inf if p["sigma"] > 0 else p["median"])
+
+
+    @property
+    def mean(self) -> float:
+        return float(np.mean(self.sample(np.random.default_rng(0), 20000))) if self.kind != "constant" \
+            else self.params["value"]
+
+    def sample(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        p = self.params
+        if self.kind == "constant":
+            return np.full(n, p["value"])
+        if self.kind == "uniform":
+            return rng.uniform(p["low"], p["high"], n)
+        if self.kind == "triangular":
+            if p["low"] == p["high"]:
+                return np.full(n, p["low"])
+            return rng.triangular(p["low"], p["mode"], p["high"], n)
+        if self.kind == "normal":
+            if p["std"] == 0:
+                return np.full(n, p["mean"])
+            a = (p.get("min", -np.inf) - p["mean"]) / p["std"]
+            b = (p.get("max", np.inf) - p["mean"]) / p["std"]
+            return stats.truncnorm.ppf(rng.uniform(size=n), a, b, loc=p["mean"], scale=p["std"])
+        # lognormal, optionally truncated above
+        u = rng.uniform(size=n)
+        if "max" in p and p["sigma"] > 0:
+            u = u * stats.norm.cdf(math.log(p["max"] / p["median"]) / p["sigma"])
+        return p["median"] * np.exp(p["sigma"] * stats.norm.ppf(u)) if p["sigma"] > 0 else np.full(n, p["median"])
+
+
+@dataclass(frozen=True)
+class Material:
+    """Impact and ground-contact behaviour of a slope material.
+
+    normal law: ``en_law`` (constant/wyllie/velocity) with mean and spread of e_N;
+    tangential law: ``et_law`` friction (Stronge sphere, friction angle) or constant e_T;
+    ``roughness_m``: asperity amplitude; the slope angle at an impact is perturbed
+    uniformly within +-atan(roughness / block radius);
+    ``ground_motion``: ``"roll"`` (sphere rolling, a = 5/7 g (sin psi - tan(phi_g) cos psi))
+    or ``"slide"`` (a = g (sin psi - tan(phi_g) cos psi)), phi_g = ``ground_friction_angle_deg``.
+    """
+
+    name: str
+    en_law: int
+    en_mean: float
+    en_std: float
+    et_law: int
+    et_mean: float
+    et_std: float
+    friction_deg: float
+    friction_std_deg: float
+    roughness_m: float
+    ground_motion: str
+    ground_friction_deg: float
+    allow_energy_gain: bool
+
+    @classmethod
+    def parse(cls, name: str, spec: dict, source: str) -> "Material":
+        where = f"materials.{name}."
+        _check_keys(spec, {"normal_restitution", "tangential", "roughness_m", "ground_motion",
+                           "ground_friction_angle_deg", "allow_energy_gain"}, where, source)
+        gain = bool(spec.get("allow_energy_gain", False))
+        en_max = 10.0 if gain else 1.0
+        en = spec.get("normal_restitution", {"law": "wyllie"})
+        if isinstance(en, str):
+            en = {"law": en}
+        if isinstance(en, (int, float)) and not isinstance(en, bool):
+            en = {"law": "constant", "mean": en}
+        if not isinstance(en, dict):
+            raise ScenarioError(f"{source}: {where}normal_restitution must be a number, a law name or a table")
+        _check_keys(en, {"law", "mean", "std"}, f"{where}normal_restitution.", source)
+        laws = {"constant": EN_CONSTANT, "wyllie": EN_WYLLIE, "velocity": EN_VELOCITY}
+        if en.get("law", "constant") not in laws:
+            raise ScenarioError(f"{source}: {where}normal_restitution.law = {en.get('law')!r} is not one of "
+                                f"{sorted(laws)}")
+        en_law = laws[en.get("law", "constant")]
+        en_mean = 0.0 if en_law == EN_WYLLIE else _number(en.get("mean"), f"{where}normal_restitution.mean",
+                                                           source, lo=0.0, hi=en_max)
+        en_std = _number(en.get("std", 0.0), f"{where}normal_restitution.std", source, lo=0.0, hi=1.0)
+
+        et = spec.get("tangential", {"law": "friction", "friction_angle_deg": 30.0})
+        if not isinstance(et, dict):
+            raise ScenarioError(f"{source}: {where}tangential must be a table with 'law'")
+        _check_keys(et, {"law", "mean", "std", "friction_angle_deg", "std_deg"}, f"{where}tangential.", source)
+        if et.get("law", "friction") == "friction":
+            et_law, et_mean, et_std = ET_FRICTION, 0.0, 0.0
+            phi = _number(et.get("friction_angle_deg", 30.0), f"{where}tangential.friction_angle_deg", source,
+                          lo=0.0, hi=89.0)
+            phi_std = _number(et.get("std_deg", 0.0), f"{where}tangential.std_deg", source, lo=0.0, hi=30.0)
+        elif et["law"] == "constant":
+            et_law, phi, phi_std = ET_CONSTANT, 0.0, 0.0
+            et_mean = _number(et.get("mean"), f"{where}tangential.mean", source, lo=0.0, hi=en_max)
+            et_std = _number(et.get("std", 0.0), f"{where}tangential.std", source, lo=0.0, hi=1.0)
+        else:
+            raise ScenarioError(f"{source}: {where}tangential.law = {et['law']!r} is not 'friction' or 'constant'")
+        motion = spec.get("ground_motion", "roll")
+        if motion not in ("roll", "slide"):
+            raise ScenarioError(f"{source}: {where}ground_motion = {motion!r} is not 'roll' or 'slide'")
+        return cls(name=name, en_law=en_law, en_mean=en_mean, en_std=en_std, et_law=et_law, et_mean=et_mean,
+                   et_std=et_std, friction_deg=phi, friction_std_deg=phi_std,
+                   roughness_m=_number(spec.get("roughness_m", 0.0), f"{where}roughness_m", source, lo=0.0, hi=10.0),
+                   ground_motion=motion,
+                   ground_friction_deg=_number(spec.get("ground_friction_angle_deg", 30.0 if motion == "slide"
+                                                        else 15.0), f"{where}ground_friction_angle_deg", source,
+                                               lo=0.0, hi=89.0),
+                   allow_energy_gain=gain)
+
+
+@dataclass(frozen=True)
+class Seeder:
+    """Where blocks start: a point or a line (uniform in x) at ``height_m`` above the ground."""
+
+    x_low: float
+    x_high: float
+    height_m: Distribution
+    mass_kg: Distribution
+    density_kg_m3: float
+    vx_ms: Distribution
+    vz_ms: Distribution
+    angular_velocity_rads: Distribution
+
+
+@dataclass(frozen=True)
+class Collector:
+    """A vertical line at ``x`` [m]; with ``capacity_kj`` it is a barrier of height ``height_m``."""
+
+    name: str
+    x: float
+    capacity_kj: float | None = None
+    height_m: float | None = None
+
+    @property
+    def is_barrier(self) -> bool:
+        return self.capacity_kj is not None
+
+
+@dataclass(frozen=True)
+class Settings:
+    gravity_ms2: float = 9.81
+    contact_velocity_ms: float = 0.5
+    stop_velocity_ms: float = 0.05
+    max_events: int = 5000
+    envelope_bins: int = 50
+
+
+@dataclass(frozen=True)
+class Scenario:
+    name: str
+    description: str
+    profile: Profile
+    materials: tuple
+    seeder: Seeder
+    collectors: tuple
+    settings: Settings
+    source: str = "<dict>"
+
+    def collector_index(self, name: str) -> int:
+        names = [c.name for c in self.collectors]
+        if name not in names:
+            raise KeyError(f"{self.source}: no collector named {name!r}; collectors are {names}")
+        return names.index(name)
+
+    def with_barrier(self, name: str, capacity_kj: float, height_m: float) -> "Scenario":
+        """A copy whose collector ``name`` is a barrier of the given capacity [kJ] and height [m]."""
+        from dataclasses import replace
+        i = self.collector_index(name)
+        cols = list(self.collectors)
+        cols[i] = replace(cols[i], capacity_kj=float(capacity_kj), height_m=float(height_m))
+        return replace(self, collectors=tuple(cols))
+
+
+def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None = None) -> Scenario:
+    """Build and validate a :class:`Scenario` from a parsed TOML dictionary."""
+    _check_keys(data, {"name", "description", "profile", "materials", "seeder", "collectors", "settings"}, "",
+                source)
+    for key in ("profile", "materials", "seeder"):
+        if key not in data:
+            raise ScenarioError(f"{source}: missing [{key}] table")
+    mats = data["materials"]
+    if not isinstance(mats, dict) or not mats:
+        raise ScenarioError(f"{source}: [materials] must define at least one material table")
+    materials = tuple(Material.parse(name, spec, source) for name, spec in mats.items())
+    names = [m.name for m in materials]
+
+    prof = data["profile"]
+    _check_keys(prof, {"x", "z", "points", "materials", "material"}, "profile.", source)
+    if "points" in prof:
+        pts = np.asarray(prof["points"], dtype=float)
+        if pts.ndim != 2 or pts.shape[1] != 2:
+            raise ScenarioError(f"{source}: profile.points must be a list of [x, z] pairs")
+        x, z = pts[:, 0], pts[:, 1]
+    else:
+        if "x" not in prof or "z" not in prof:
+            raise ScenarioError(f"{source}: [profile] needs x and z (or points)")
+        x, z = np.asarray(prof["x"], dtype=float), np.asarray(prof["z"], dtype=float)
+    seg_mats = prof.get("materials", prof.get("material", names[0]))
+    if isinstance(seg_mats, str):
+        seg_mats = [seg_mats] * (len(x) - 1)
+    for i, m in enumerate(seg_mats):
+        if m not in names:
+            close = difflib.get_close_matches(str(m), names, n=1)
+            raise ScenarioError(f"{source}: profile.materials[{i}] = {m!r} is not a defined material "
+                                f"({', '.join(names)}){f'; did you mean {close[0]!r}?' if close else ''}")
+    try:
+        profile = Profile.build(x, z, [names.index(m) for m in seg_mats], names, source=f"{source}: profile")
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from exc
+
+    sd = data["seeder"]
+    _check_keys(sd, {"type", "x", "height_m", "mass_kg", "density_kg_m3", "vx_ms", "vz_ms",
+                     "angular_velocity_rads"}, "seeder.", source)
+    kind = sd.get("type", "line" if isinstance(sd.get("x"), list) else "point")
+    if kind not in ("point", "line"):
+        raise ScenarioError(f"{source}: seeder.type = {kind!r} is not 'point' or 'line'")
+    xs = sd.get("x")
+    if kind == "line":
+        if not (isinstance(xs, list) and len(xs) == 2):
+            raise ScenarioError(f"{source}: a line seeder needs x = [x_start, x_end]; got {xs!r}")
+        x_low, x_high = (_number(v, "seeder.x", source) for v in xs)
+    else:
+        x_low = x_high = _number(xs, "seeder.x", source)
+    for v in (x_low, x_high):
+        if not profile.contains(v) or v >= profile.x[-1]:
+            raise ScenarioError(f"{source}: seeder.x = {v:g} m is outside the profile "
+                                f"[{profile.x[0]:g}, {profile.x[-1]:g}) m")
+    if x_high < x_low:
+        raise ScenarioError(f"{source}: seeder.x = {xs!r} must be [low, high]")
+    if "mass_kg" not in sd:
+        raise ScenarioError(f"{source}: seeder.mass_kg is required (a number or a distribution table)")
+    seeder = Seeder(
+        x_low=x_low, x_high=x_high,
+        height_m=Distribution.parse(sd.get("height_m", 1.0), "seeder.height_m", source, lo=0.0, hi=1e4),
+        mass_kg=Distribution.parse(sd["mass_kg"], "seeder.mass_kg", source, lo=0.0, hi=1e9, lo_open=True),
+        density_kg_m3=_number(sd.get("density_kg_m3", 2650.0), "seeder.density_kg_m3", source, lo=500, hi=6000),
+        vx_ms=Distribution.parse(sd.get("vx_ms", 0.0), "seeder.vx_ms", source, lo=-200, hi=200),
+        vz_ms=Distribution.parse(sd.get("vz_ms", 0.0), "seeder.vz_ms", source, lo=-200, hi=200),
+        angular_velocity_rads=Distribution.parse(sd.get("angular_velocity_rads", 0.0),
+                                                 "seeder.angular_velocity_rads", source, lo=-1e3, hi=1e3))
+
+    collectors = []
+    for i, c in enumerate(data.get("collectors", [])):
+        where = f"collectors[{i}]."
+        _check_keys(c, {"name", "x", "capacity_kj", "height_m"}, where, source)
+        if "name" not in c or "x" not in c:
+            raise ScenarioError(f"{source}: {where[:-1]} needs a name and an x")
+        cx = _number(c["x"], f"{where}x", source)
+        if not profile.x[0] < cx < profile.x[-1]:
+            raise ScenarioError(f"{source}: {where}x = {cx:g} m (collector {c['name']!r}) is outside the profile "
+                                f"({profile.x[0]:g}, {profile.x[-1]:g}) m")
+        cap = c.get("capacity_kj")
+        cap = None if cap is None else _number(cap, f"{where}capacity_kj", source, lo=0.0, lo_open=True)
+        h = c.get("height_m")
+        h = None if h is None else _number(h, f"{where}height_m", source, lo=0.0, lo_open=True)
+        if cap is not None and h is None:
+            raise ScenarioError(f"{source}: {where}height_m is required for a barrier (capacity_kj given)")
+        collectors.append(Collector(str(c["name"]), cx, cap, h))
+    cnames = [c.name for c in collectors]
+    if len(set(cnames)) != len(cnames):
+        raise ScenarioError(f"{source}: collector names must be unique; got {cnames}")
+
+    st = data.get("settings", {})
+    _check_keys(st, set(Settings.__dataclass_fields__), "settings.", source)
+    settings = Settings(
+        gravity_ms2=_number(st.get("gravity_ms2", 9.81), "settings.gravity_ms2", source, lo=0.0, lo_open=True),
+        contact_velocity_ms=_number(st.get("contact_velocity_ms", 0.5), "settings.contact_velocity_ms", source,
+                                    lo=0.0),
+        stop_velocity_ms=_number(st.get("stop_velocity_ms", 0.05), "settings.stop_velocity_ms", source, lo=0.0),
+        max_events=int(_number(st.get("max_events", 5000), "settings.max_events", source, lo=1)),
+        envelope_bins=int(_number(st.get("envelope_bins", 50), "settings.envelope_bins", source, lo=0, hi=10000)))
+    return Scenario(name=str(data.get("name", Path(source).stem)), description=str(data.get("description", "")),
+                    profile=profile, materials=materials, seeder=seeder, collectors=tuple(collectors),
+                    settings=settings, source=source)
+
+
+def load_scenario(path) -> Scenario:
+    """Read a scenario TOML file (see the README section "Scenario files")."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"scenario file not found: {path}")
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{path}: not valid TOML: {exc}") from exc
+    return scenario_from_dict(data, source=str(path), base_dir=path.parent)
