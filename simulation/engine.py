@@ -119,7 +119,7 @@ def run(scenario: Scenario, n: int = 10_000, seed=None, *, chunk_size: int = DEF
         kernel.simulate(
             np.arange(lo, hi, dtype=np.int64), blocks["x"][lo:hi], blocks["z"][lo:hi], blocks["vx"][lo:hi],
             blocks["vz"][lo:hi], blocks["w"][lo:hi], blocks["mass"][lo:hi], blocks["radius"][lo:hi],
-            prof.x, prof.z, prof.tree_zmax, prof.n_leaves, prof.material_index, **mats,
+            prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.material_index, prof.run_first, prof.run_last, **mats,
             c_x=c_x, c_cap=c_cap, c_h=c_h, env_x=env_x, env_acc=env_acc,
             g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
             max_events=st.max_events, key=key, n_path_blocks=n_paths,

@@ -98,32 +98,34 @@ def _leaf_hit(px, pz, k, x0, z0, vx, vz, g):
 
 
 @njit(cache=True)
-def find_impact(px, pz, tree, n_leaves, x0, z0, vx, vz, g, seg_now, stack):
-    """First (time, segment) where the flight from (x0, z0) meets the ground; segment -1 if it leaves."""
+def _may_hit(px, pz, tree, node, lo, hi, n_seg, x0, z0, vx, vz, g, xa_travel, xb_travel):
+    """False when the parabola stays above the ground of ``node`` over the travelled x-range."""
+    if lo >= n_seg:
+        return False
+    xa = max(px[lo], xa_travel)
+    xb = min(px[min(hi + 1, n_seg)], xb_travel)
+    if xa > xb:
+        return False
+    k0, k1 = lo, min(hi + 1, n_seg)
+    slope = (pz[k1] - pz[k0]) / (px[k1] - px[k0])
+    ta = (xa - x0) / vx
+    tb = (xb - x0) / vx
+    ha = z0 + vz * ta - 0.5 * g * ta * ta - (pz[k0] + slope * (xa - px[k0]))
+    hb = z0 + vz * tb - 0.5 * g * tb * tb - (pz[k0] + slope * (xb - px[k0]))
+    # parabola - chord is concave, so its minimum over [xa, xb] is at an end
+    return min(ha, hb) <= tree[node] + 1e-9 * (1.0 + abs(z0))
+
+
+@njit(cache=True)
+def _descend(px, pz, tree, root, root_lo, root_hi, x0, z0, vx, vz, g, xa_travel, xb_travel, stack):
+    """Earliest hit inside the subtree ``root`` covering segments root_lo..root_hi (near child first)."""
     n_seg = px.shape[0] - 1
-    if abs(vx) < 1e-12:
-        return _leaf_hit(px, pz, seg_now, x0, z0, 0.0, vz, g), seg_now
-    if vx > 0:
-        xa_travel, xb_travel = x0, px[n_seg]
-    else:
-        xa_travel, xb_travel = px[0], x0
-    stack_node, stack_lo, stack_hi = stack[0], stack[1], stack[2]
-    stack_node[0], stack_lo[0], stack_hi[0] = 1, 0, n_leaves - 1
+    stack[0, 0], stack[1, 0], stack[2, 0] = root, root_lo, root_hi
     top = 1
     while top > 0:
         top -= 1
-        node, lo, hi = stack_node[top], stack_lo[top], stack_hi[top]
-        if lo >= n_seg:
-            continue
-        xa = max(px[lo], xa_travel)
-        xb = min(px[min(hi + 1, n_seg)], xb_travel)
-        if xa > xb:
-            continue
-        ta = (xa - x0) / vx
-        tb = (xb - x0) / vx
-        za = z0 + vz * ta - 0.5 * g * ta * ta
-        zb = z0 + vz * tb - 0.5 * g * tb * tb
-        if min(za, zb) > tree[node] + 1e-9:
+        node, lo, hi = stack[0, top], stack[1, top], stack[2, top]
+        if not _may_hit(px, pz, tree, node, lo, hi, n_seg, x0, z0, vx, vz, g, xa_travel, xb_travel):
             continue
         if lo == hi:
             t = _leaf_hit(px, pz, lo, x0, z0, vx, vz, g)
@@ -131,15 +133,82 @@ def find_impact(px, pz, tree, n_leaves, x0, z0, vx, vz, g, seg_now, stack):
                 return t, lo
             continue
         mid = (lo + hi) // 2
-        left, right = 2 * node, 2 * node + 1
-        # Push the far child first so the near child (in the direction of travel) is examined first.
-        if vx > 0:
-            stack_node[top], stack_lo[top], stack_hi[top] = right, mid + 1, hi
-            stack_node[top + 1], stack_lo[top + 1], stack_hi[top + 1] = left, lo, mid
+        if vx > 0:    # push the far (right) child first so the near one is examined first
+            stack[0, top], stack[1, top], stack[2, top] = 2 * node + 1, mid + 1, hi
+            stack[0, top + 1], stack[1, top + 1], stack[2, top + 1] = 2 * node, lo, mid
         else:
-            stack_node[top], stack_lo[top], stack_hi[top] = left, lo, mid
-            stack_node[top + 1], stack_lo[top + 1], stack_hi[top + 1] = right, mid + 1, hi
+            stack[0, top], stack[1, top], stack[2, top] = 2 * node, lo, mid
+            stack[0, top + 1], stack[1, top + 1], stack[2, top + 1] = 2 * node + 1, mid + 1, hi
         top += 2
+    return math.inf, -1
+
+
+@njit(cache=True)
+def _run_hit(px, pz, k0, k1, x0, z0, vx, vz, g):
+    """Like _leaf_hit for the straight run of segments k0..k1 (one line); returns (t, segment)."""
+    slope = (pz[k0 + 1] - pz[k0]) / (px[k0 + 1] - px[k0])
+    c0 = z0 - (pz[k0] + slope * (x0 - px[k0]))
+    c1 = vz - slope * vx
+    disc = c1 * c1 + 2.0 * g * c0
+    if disc < 0.0:
+        return math.inf, -1
+    t = (c1 + math.sqrt(disc)) / g
+    if t <= 1e-12:
+        return math.inf, -1
+    x = x0 + vx * t
+    tol = 1e-9 * (1.0 + abs(x))
+    if x < px[k0] - tol or x > px[k1 + 1] + tol:
+        return math.inf, -1
+    lo, hi = k0, k1
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if px[mid] <= x:
+            lo = mid
+        else:
+            hi = mid - 1
+    return t, lo
+
+
+@njit(cache=True)
+def find_impact(px, pz, tree, n_leaves, run_first, run_last, x0, z0, vx, vz, g, seg_now, stack):
+    """First (time, segment) where the flight from (x0, z0) meets the ground; segment -1 if it leaves.
+
+    Finger search in the max-elevation tree: test the current segment, then climb
+    from its leaf and descend only into sibling subtrees ahead of the block whose
+    highest ground the parabola can reach.  Cost O(log d) for a flight over d
+    segments, independent of the total number of segments.
+    """
+    n_seg = px.shape[0] - 1
+    if abs(vx) < 1e-12:
+        return _leaf_hit(px, pz, seg_now, x0, z0, vx, vz, g), seg_now
+    # The straight run (collinear segments of one material) the block leaves from acts as one segment.
+    t, k = _run_hit(px, pz, run_first[seg_now], run_last[seg_now], x0, z0, vx, vz, g)
+    if k >= 0:
+        return t, k
+    if vx > 0:
+        xa_travel, xb_travel = x0, px[n_seg]
+    else:
+        xa_travel, xb_travel = px[0], x0
+    node, lo, hi = n_leaves + seg_now, seg_now, seg_now
+    while node > 1:
+        size = hi - lo + 1
+        if node % 2 == 0:      # left child: the sibling lies ahead when moving right
+            if vx > 0 and _may_hit(px, pz, tree, node + 1, hi + 1, hi + size, n_seg, x0, z0, vx, vz, g,
+                                   xa_travel, xb_travel):
+                t, k = _descend(px, pz, tree, node + 1, hi + 1, hi + size, x0, z0, vx, vz, g,
+                                xa_travel, xb_travel, stack)
+                if k >= 0:
+                    return t, k
+            hi += size
+        else:                  # right child: the sibling lies ahead when moving left
+            if vx < 0 and _may_hit(px, pz, tree, node - 1, lo - size, lo - 1, n_seg, x0, z0, vx, vz, g,
+                                   xa_travel, xb_travel):
+                t, k = _descend(px, pz, tree, node - 1, lo - size, lo - 1, x0, z0, vx, vz, g,
+                                xa_travel, xb_travel, stack)
+                if k >= 0:
+                    return t, k
+            lo -= size
+        node >>= 1
     # No impact: time to reach the end of the profile.
     if vx > 0:
         return (px[n_seg] - x0) / vx, -1
@@ -189,7 +258,7 @@ def _envelope(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass, inerti
 
 @njit(cache=True)
 def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
-             px, pz, tree, n_leaves, seg_mat,
+             px, pz, tree, n_leaves, seg_mat, run_first, run_last,
              m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
              m_roll, m_mu_ground, m_gain,
              c_x, c_cap, c_h, env_x, env_acc,
@@ -233,7 +302,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
                 reason = MAX_EVENTS
                 break
             if not contact:
-                t_hit, k = find_impact(px, pz, tree, n_leaves, x, z, vx, vz, g, seg, stack)
+                t_hit, k = find_impact(px, pz, tree, n_leaves, run_first, run_last, x, z, vx, vz, g, seg, stack)
                 if t_hit == math.inf:          # vertical motion already at the ground: settle into contact
                     contact = True
                     z = _ground(px, pz, x)
@@ -366,10 +435,13 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
                 direction = 1.0 if v_along > 0 else -1.0
             a_dir = factor * (-g * sinb * direction - mu * g * cosb)   # acceleration along the motion
             u = abs(v_along)
+            # Collinear segments of the same material are crossed in one step.
             if direction > 0:
-                dist = (px[k + 1] - x) / cosb
+                k_far = run_last[k]
+                dist = (px[k_far + 1] - x) / cosb
             else:
-                dist = (x - px[k]) / cosb
+                k_far = run_first[k]
+                dist = (x - px[k_far]) / cosb
             stops_here = a_dir < 0 and u * u < -2.0 * a_dir * dist
             if stops_here:
                 t_step = u / (-a_dir)
@@ -422,6 +494,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
                     t_abs += tc
                     x = c_x[j]
                     z = _ground(px, pz, x)
+                    seg = min(max(_seg_of(px, x), min(k, k_far)), max(k, k_far))
                     if outcome == BARRIER_CAUGHT:
                         reason = CAUGHT
                     else:
@@ -443,12 +516,14 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
             w = direction * u_end / r if m_roll[mat] else 0.0
             if stops_here:
                 v_along = 0.0
+                if k_far != k:
+                    seg = min(max(_seg_of(px, x), min(k, k_far)), max(k, k_far))
                 if record:
                     _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, 0.0, 0.0,
                                  MODE_CONTACT)
                 continue
             # Reached a vertex: next segment, or off the profile.
-            k2 = k + 1 if direction > 0 else k - 1
+            k2 = k_far + 1 if direction > 0 else k_far - 1
             vxe, vze = direction * u_end * cosb, direction * u_end * sinb
             if record:
                 _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, vxe, vze, MODE_CONTACT)

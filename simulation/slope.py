@@ -1,10 +1,13 @@
 """Slope profiles: a 2-D polyline of ground vertices, each segment with a material.
 
 The profile must be a function of x (x strictly increasing): overhangs are not
-supported.  For the flight solver the segments are arranged in a binary tree
-whose nodes hold the highest ground elevation of the segments below them, so
-the first segment a parabola can reach is found by descending the tree:
-O(log S) nodes per flight for S segments, never a test of every segment.
+supported.  For the flight solver the segments are arranged in a binary tree;
+each node stores how far the ground rises above the chord joining the ends of
+its segments, so ``ground <= chord + offset`` bounds the ground over the node.
+A parabola whose height above the chord exceeds the offset at both ends of the
+node's range (it is concave, so that suffices) cannot land there.  The first
+segment a flight reaches is found by a finger search in this tree: O(log d)
+nodes for a flight over d segments, never a test of every segment.
 """
 from __future__ import annotations
 
@@ -21,8 +24,10 @@ class Profile:
     z: np.ndarray
     material_index: np.ndarray
     material_names: tuple
-    tree_zmax: np.ndarray = field(repr=False, default=None)
+    tree_offset: np.ndarray = field(repr=False, default=None)
     n_leaves: int = 0
+    run_first: np.ndarray = field(repr=False, default=None)
+    run_last: np.ndarray = field(repr=False, default=None)
 
     @classmethod
     def build(cls, x, z, material_index, material_names, source: str = "profile") -> "Profile":
@@ -47,12 +52,32 @@ class Profile:
         n_leaves = 1
         while n_leaves < mi.size:
             n_leaves *= 2
+        # For each tree node covering segments lo..hi: the largest height of a vertex above the chord
+        # joining the node's end vertices (ground <= chord + offset over the node's x-range).
         tree = np.full(2 * n_leaves, -np.inf)
-        tree[n_leaves:n_leaves + mi.size] = np.maximum(z[:-1], z[1:])
-        for node in range(n_leaves - 1, 0, -1):
-            tree[node] = max(tree[2 * node], tree[2 * node + 1])
-        return cls(x=x, z=z, material_index=mi, material_names=tuple(material_names), tree_zmax=tree,
-                   n_leaves=n_leaves)
+        for node in range(1, 2 * n_leaves):
+            depth = node.bit_length() - 1
+            size = n_leaves >> depth
+            lo = (node - (1 << depth)) * size
+            if lo >= mi.size:
+                continue
+            hi = min(lo + size - 1, mi.size - 1)
+            xs, zs = x[lo:hi + 2], z[lo:hi + 2]
+            chord = zs[0] + (zs[-1] - zs[0]) * (xs - xs[0]) / (xs[-1] - xs[0])
+            tree[node] = float(np.max(zs - chord))
+        # Runs of collinear segments of one material: ground contact crosses them in one step.
+        angle = np.arctan2(np.diff(z), dx)
+        same = (np.abs(np.diff(angle)) < 1e-12) & (mi[1:] == mi[:-1])
+        run_first = np.arange(mi.size)
+        run_last = np.arange(mi.size)
+        for k in range(1, mi.size):
+            if same[k - 1]:
+                run_first[k] = run_first[k - 1]
+        for k in range(mi.size - 2, -1, -1):
+            if same[k]:
+                run_last[k] = run_last[k + 1]
+        return cls(x=x, z=z, material_index=mi, material_names=tuple(material_names), tree_offset=tree,
+                   n_leaves=n_leaves, run_first=run_first, run_last=run_last)
 
     @property
     def n_segments(self) -> int:

@@ -149,3 +149,33 @@ def test_barrier_catches_passes_through_or_is_overtopped():
     sc = scenario([0, 200], [0, 0], collectors=[{"name": "b", "x": 10.0, "capacity_kj": 1e6, "height_m": 1.0}],
                   **base)
     assert simulation.run(sc, n=1, seed=1).collector("b")["outcome"].iloc[0] == "over"
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 10_000), n_seg=st.integers(1, 300))
+def test_impact_search_matches_brute_force(seed, n_seg):
+    """The tree search finds the same first impact as scanning the parabola against every segment."""
+    from simulation.kernel import find_impact
+    from simulation.slope import Profile
+    rng = np.random.default_rng(seed)
+    x = np.cumsum(rng.uniform(0.1, 3.0, n_seg + 1))
+    z = np.cumsum(rng.normal(-0.8, 1.0, n_seg + 1))
+    if seed % 3 == 0:       # collinear runs
+        z = np.interp(x, x[:: max(n_seg // 4, 1)], z[:: max(n_seg // 4, 1)])
+    prof = Profile.build(x, z, np.zeros(n_seg, dtype=int), ["m"])
+    x0 = rng.uniform(x[0], x[-1])
+    z0 = prof.ground(x0) + rng.uniform(0.01, 20.0)
+    vx, vz = rng.normal(0, 10), rng.normal(0, 5)
+    seg = int(prof.segment_at(x0))
+    t, k = find_impact(prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.run_first, prof.run_last,
+                       x0, z0, vx, vz, G, seg, np.empty((3, 128), np.int64))
+    ts = np.linspace(0, 60, 600_001)[1:]
+    xs = x0 + vx * ts
+    inside = (xs >= x[0]) & (xs <= x[-1])
+    below = inside & (z0 + vz * ts - 0.5 * G * ts ** 2 < np.interp(xs, x, z))
+    if below.any():
+        t_ref = ts[np.argmax(below)]
+        assert k >= 0 and t == pytest.approx(t_ref, abs=2e-4)
+        assert x[k] - 1e-9 <= x0 + vx * t <= x[k + 1] + 1e-9
+    else:
+        assert k == -1
