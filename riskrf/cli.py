@@ -57,6 +57,73 @@ def cmd_fit(args) -> int:
     return 0
 
 
+def write_table(df, path: Path) -> None:
+    """Write a DataFrame as Parquet or CSV by the file suffix, atomically (temporary name, then rename)."""
+    import os
+    import tempfile
+    suffix = path.suffix.lower()
+    if suffix not in (".parquet", ".csv"):
+        raise ValueError(f"--out {path}: use a .parquet or .csv file name")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    os.close(fd)
+    try:
+        if suffix == ".parquet":
+            df.to_parquet(tmp, index=False)
+        else:
+            df.to_csv(tmp, index=False)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def cmd_simulate(args) -> int:
+    import pandas as pd
+
+    import simulation
+
+    from .outputs import atomic_output_dir
+
+    scenario = simulation.load_scenario(args.scenario)
+    out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-crossings.parquet")
+    if out.suffix.lower() not in (".parquet", ".csv"):
+        raise ValueError(f"--out {out}: use a .parquet or .csv file name")
+    figures = Path(args.figures) if args.figures else out.with_name(f"{out.stem}-figures")
+    progress = None if args.progress is None else args.progress
+    result = simulation.run(scenario, n=args.n, seed=args.seed, progress=progress)
+    print(f"Scenario {scenario.name} ({scenario.source}): {args.n:,} blocks, seed {args.seed}")
+    print(result.summary().to_string(header=False))
+    tables = [result.collector(c.name).assign(collector=c.name) for c in scenario.collectors]
+    crossings = pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
+    if "outcome" in crossings:
+        crossings["outcome"] = crossings["outcome"].astype(str)
+    write_table(crossings, out)
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from simulation.plotting import plot_collector_distributions, plot_envelopes, plot_profile
+    with atomic_output_dir(figures) as tmp:
+        ax = plot_profile(result)
+        ax.figure.savefig(tmp / "profile_trajectories.png", dpi=120, bbox_inches="tight")
+        plt.close(ax.figure)
+        for c in scenario.collectors:
+            axes = plot_collector_distributions(result, c.name)
+            axes[0][0].figure.tight_layout()
+            axes[0][0].figure.savefig(tmp / f"collector_{c.name}.png", dpi=110, bbox_inches="tight")
+            plt.close(axes[0][0].figure)
+        if scenario.settings.envelope_bins:
+            axes = plot_envelopes(result)
+            axes[0].figure.savefig(tmp / "envelopes.png", dpi=110, bbox_inches="tight")
+            plt.close(axes[0].figure)
+        result.runout.to_csv(tmp / "runout.csv", index=False)
+        result.envelopes.to_csv(tmp / "envelopes.csv", index=False)
+    print(f"\nWrote {len(crossings):,} collector crossings to {out} and figures, runout.csv and "
+          f"envelopes.csv to {figures}/")
+    return 0
+
+
 def cmd_demo(args) -> int:
     from importlib import resources
 
@@ -101,6 +168,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default=None, metavar="DIR",
                    help="output directory (default: <inventory name>-fit); written only when complete")
     p.set_defaults(func=cmd_fit)
+
+    p = sub.add_parser("simulate", help="Monte Carlo rock fall trajectories on a slope scenario",
+                       description="Simulate blocks released by a scenario's seeder (TOML; see the README section "
+                       "'Scenario files') and write one row per collector crossing (velocity_ms, "
+                       "angular_velocity_rads, height_m, energy_kj, ...) to a Parquet or CSV file, with figures: "
+                       "the profile and trajectories, distributions at each collector, envelopes.", epilog=EPILOG)
+    p.add_argument("scenario", help="scenario TOML file, e.g. simulation/scenarios/road_cut_barrier.toml")
+    p.add_argument("-n", type=int, default=100_000, help="number of blocks to release (default 100,000)")
+    p.add_argument("--seed", type=int, default=1, help="random seed; the same seed gives identical results")
+    p.add_argument("--out", default=None, metavar="FILE",
+                   help="crossings table, .parquet or .csv (default <scenario>-crossings.parquet)")
+    p.add_argument("--figures", default=None, metavar="DIR", help="figure directory (default <out>-figures)")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="show a progress bar (default: on for 200,000 blocks or more on a terminal)")
+    p.set_defaults(func=cmd_simulate)
 
     p = sub.add_parser("demo", help="run the analysis on the bundled example inventories",
                        description="Run riskrf on the bundled example: the real Lauterbrunnen laser-scanning "

@@ -1,0 +1,111 @@
+"""Figures of a simulation: profile with trajectories, collector distributions, envelopes.
+
+Each function draws on ``ax`` (or a new figure) and returns the Axes; matplotlib
+is imported only when called and no global style is changed.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def _axes(ax, figsize=(8, 4.5)):
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+    return plt.figure(figsize=figsize).add_subplot()
+
+
+def plot_profile(result, ax=None, *, n_paths: int = 20):
+    """Slope profile coloured by material, collectors and barriers, and recorded trajectories."""
+    ax = _axes(ax)
+    sc = result.scenario
+    prof = sc.profile
+    for i, name in enumerate(prof.material_names):
+        segs = np.flatnonzero(prof.material_index == i)
+        for j, s in enumerate(segs):
+            ax.plot(prof.x[s:s + 2], prof.z[s:s + 2], color=f"C{i}", lw=3, label=name if j == 0 else None)
+    blocks = np.unique(result.paths["block"])[:n_paths] if result.paths is not None else []
+    for b in blocks:
+        p = result.path(int(b))
+        ax.plot(p["x_m"], p["z_m"], color="0.4", lw=0.6, alpha=0.7)
+    zmin, zmax = prof.z.min(), prof.z.max()
+    for c in sc.collectors:
+        zg = float(prof.ground(c.x))
+        if c.is_barrier:
+            ax.plot([c.x, c.x], [zg, zg + c.height_m], color="C3", lw=3)
+            ax.annotate(f"{c.name}\n{c.capacity_kj:g} kJ, {c.height_m:g} m", (c.x, zg + c.height_m),
+                        fontsize="small", ha="center", va="bottom")
+        else:
+            ax.axvline(c.x, color="C3", ls=":", lw=1)
+            ax.annotate(c.name, (c.x, zmax), fontsize="small", ha="left", va="top", rotation=90)
+    sd = sc.seeder
+    ax.axvspan(sd.x_low, max(sd.x_high, sd.x_low + 0.2), color="C1", alpha=0.2, label="release")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("z [m]")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_ylim(zmin - 0.05 * (zmax - zmin + 1), None)
+    ax.legend(fontsize="small", loc="upper right")
+    ax.set_title(f"{sc.name}: {len(blocks)} of {result.n:,} trajectories")
+    return ax
+
+
+def plot_collector_distributions(result, name: str, axes=None):
+    """Histograms and exceedance curves of speed, height and energy at collector ``name`` (2 x 3 axes)."""
+    import matplotlib.pyplot as plt
+    df = result.collector(name, first_only=True)
+    if axes is None:
+        fig, axes = plt.subplots(2, 3, figsize=(12, 6.5))
+    cols = (("velocity_ms", "speed [m/s]"), ("height_m", "height above slope [m]"), ("energy_kj", "energy [kJ]"))
+    for j, (col, label) in enumerate(cols):
+        x = np.sort(df[col].to_numpy())
+        top, bottom = axes[0][j], axes[1][j]
+        if x.size == 0:
+            top.set_title(f"{name}: no block reached")
+            continue
+        log = col == "energy_kj" and x.max() > 100 * max(np.percentile(x, 5), 1e-6)
+        bins = np.geomspace(max(x.min(), 1e-3), x.max() * 1.001, 40) if log else 40
+        top.hist(x, bins=bins, color="C0", alpha=0.8)
+        if log:
+            top.set_xscale("log")
+        top.set_xlabel(label)
+        top.set_ylabel("blocks")
+        p = 1.0 - np.arange(x.size) / x.size
+        bottom.step(x, p, where="post", color="C0")
+        lo = np.clip(p - 1.96 * np.sqrt(p * (1 - p) / x.size), 1 / x.size / 10, 1)
+        hi = np.clip(p + 1.96 * np.sqrt(p * (1 - p) / x.size), 0, 1)
+        bottom.fill_between(x, lo, hi, step="post", color="C0", alpha=0.2, label="95% Monte Carlo band")
+        bottom.set_yscale("log")
+        if log:
+            bottom.set_xscale("log")
+        for q in (95, 99):
+            v = np.percentile(x, q)
+            bottom.axvline(v, color="C3", ls=":", lw=1)
+            bottom.annotate(f"p{q} {v:.3g}", (v, 0.5), rotation=90, fontsize="x-small", va="center")
+        bottom.set_xlabel(label)
+        bottom.set_ylabel("P(exceeded | reaches)")
+        bottom.grid(True, which="both", alpha=0.3)
+    axes[0][0].set_title(f"{name}: {len(df):,} blocks reached ({len(df) / result.n:.1%})", loc="left")
+    axes[1][0].legend(fontsize="x-small")
+    return axes
+
+
+def plot_envelopes(result, axes=None):
+    """Maximum and mean speed, bounce height and energy along the slope (3 stacked axes)."""
+    import matplotlib.pyplot as plt
+    env = result.envelopes
+    if axes is None:
+        fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
+    for ax, (col, label) in zip(axes, (("velocity", "speed [m/s]"), ("height", "height [m]"),
+                                       ("energy", "energy [kJ]"))):
+        unit = {"velocity": "ms", "height": "m", "energy": "kj"}[col]
+        ax.plot(env["x_m"], env[f"{col}_max_{unit}"], color="C3", label="maximum")
+        ax.plot(env["x_m"], env[f"{col}_mean_{unit}"], color="C0", label="mean")
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+    for c in result.scenario.collectors:
+        for ax in axes:
+            ax.axvline(c.x, color="0.5", ls=":", lw=1)
+    axes[0].legend(fontsize="small")
+    axes[-1].set_xlabel("x [m]")
+    axes[0].set_title("Envelopes along the slope")
+    return axes
