@@ -124,6 +124,86 @@ def cmd_simulate(args) -> int:
     return 0
 
 
+def build_energy_hazard(args, inventory):
+    """Power-law fit of the inventory combined with a simulation or a velocity file (for energy and assess)."""
+    import numpy as np
+
+    import simulation
+
+    from .hazard import EnergyHazard
+    from .magnitude import fit_gutenberg_richter
+    from .velocities import read_velocities
+
+    gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=args.m_min, m_max=args.m_max)
+    rate = gr.rate_min * args.rate_scale
+    if (args.scenario is None) == (args.velocities is None):
+        raise ValueError("give exactly one of --scenario (simulate the velocities) or --velocities (a file)")
+    if args.scenario is not None:
+        scenario = simulation.load_scenario(args.scenario)
+        scenario.collector_index(args.collector)
+        result = simulation.run(scenario, n=args.n, seed=args.seed, progress=None)
+        hazard = EnergyHazard.from_simulation(gr, result, args.collector, rate_per_year=rate,
+                                              condition_on_mass=args.condition_on_mass)
+    else:
+        df = read_velocities(args.velocities, collector=args.collector if args.collector_given else None)
+        v = df["velocity_ms"].to_numpy(dtype=float)
+        note = f"velocities: {len(df):,} samples from {args.velocities}"
+        if "angular_velocity_rads" in df and "radius_m" in df:
+            v = np.sqrt(v ** 2 + 0.4 * (df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()) ** 2)
+            note += "; rotational energy included"
+        note += f"; reach probability {args.reach_probability:g} as given" + (
+            " (default: every fall assumed to reach the line)" if args.reach_probability == 1.0 else "")
+        hazard = EnergyHazard(mass=gr, velocity=v, rate_per_year=rate, reach_probability=args.reach_probability,
+                              heights_m=df["height_m"].to_numpy(dtype=float) if "height_m" in df else None,
+                              collector=args.collector, notes=(note,))
+    if args.rate_scale != 1.0:
+        hazard = type(hazard)(**{**hazard.__dict__, "notes": hazard.notes + (
+            f"rate scaled by {args.rate_scale:g} (share of the inventoried source above this line)",)})
+    return gr, hazard
+
+
+def cmd_energy(args) -> int:
+    from .energy_analysis import analyse_energy
+    from .outputs import atomic_output_dir
+
+    inv = _read(args, args.inventory)
+    gr, hazard = build_energy_hazard(args, inv)
+    analysis = analyse_energy(hazard, fences=args.fence or (2000.0, 5000.0), fence_height_m=args.fence_height,
+                              free_board_m=args.free_board, design_T=args.design_period,
+                              density_kg_m3=inv.density_kg_m3, n_bootstrap=args.bootstrap, seed=args.seed)
+    print(f"Inventory {inv.source}: power law b = {gr.b:.4f} ± {gr.b_stderr:.4f} above m_min = {gr.m_min:.5g} kg "
+          f"({gr.n_tail} falls, {gr.rate_min:.4g} per year)" + (f", m_max = {gr.m_max:.5g} kg" if gr.m_max else ""))
+    print(analysis.summary_text())
+    out = Path(args.out) if args.out else Path(f"{Path(args.inventory).stem}-energy")
+    with atomic_output_dir(out) as tmp:
+        analysis.write(tmp)
+    print(f"\nWrote energy_summary.json, design_energies.csv, fence_checks.csv and figures to {out}/")
+    return 0
+
+
+def _add_energy_arguments(p):
+    p.add_argument("--scenario", default=None, help="scenario TOML: simulate the velocities at --collector")
+    p.add_argument("--velocities", default=None, metavar="FILE",
+                   help="velocity samples at the barrier line (.csv/.parquet: a velocity_ms column, optionally "
+                        "height_m, angular_velocity_rads, radius_m, collector; RocFall/RAMMS exports with columns "
+                        "such as 'Translational Velocity (m/s)' and 'Bounce Height (m)' are recognised)")
+    p.add_argument("--collector", default="barrier", help="collector (barrier line) name (default 'barrier')")
+    p.add_argument("-n", type=int, default=100_000, help="blocks to simulate with --scenario (default 100,000)")
+    p.add_argument("--reach-probability", type=float, default=1.0, metavar="P",
+                   help="with --velocities: probability that a fall reaches the line (default 1)")
+    p.add_argument("--rate-scale", type=float, default=1.0, metavar="F",
+                   help="multiply the inventory's rate of falls by F, e.g. the share of the inventoried cliff "
+                        "above this line (default 1)")
+    p.add_argument("--condition-on-mass", action="store_true",
+                   help="condition simulated velocities on block mass (when velocity depends on size)")
+    p.add_argument("--m-min", type=float, default=None, metavar="KG", help="power-law threshold (default: KS)")
+    p.add_argument("--m-max", type=float, default=None, metavar="KG",
+                   help="maximum credible block mass, kg (upper truncation; default none)")
+    p.add_argument("--seed", type=int, default=1, help="random seed (simulation and bootstrap; default 1)")
+    p.add_argument("--bootstrap", type=int, default=300, metavar="N",
+                   help="bootstrap replicates for the intervals (default 300)")
+
+
 def cmd_demo(args) -> int:
     from importlib import resources
 
@@ -184,6 +264,25 @@ def build_parser() -> argparse.ArgumentParser:
                    help="show a progress bar (default: on for 200,000 blocks or more on a terminal)")
     p.set_defaults(func=cmd_simulate)
 
+    p = sub.add_parser("energy", help="impact-energy hazard at a barrier line and fence checks",
+                       description="Combine the power law fitted to an inventory with velocities at a barrier line "
+                       "(simulated from a scenario, or read from a file) into the annual frequency of impacts above "
+                       "each energy, design energies for 10-1000 years with bootstrap intervals, percentiles, "
+                       "ETAG 027 MEL/SEL checks of candidate fences and the UNI 11211-4 design energy.",
+                       epilog=EPILOG)
+    p.add_argument("--inventory", required=True, help="inventory file (as for riskrf fit)")
+    _add_inventory_arguments(p)
+    _add_energy_arguments(p)
+    p.add_argument("--fence", type=float, action="append", metavar="KJ",
+                   help="candidate fence capacity (MEL) in kJ; repeat for several (default 2000 and 5000)")
+    p.add_argument("--fence-height", type=float, default=5.0, metavar="M", help="fence height in m (default 5)")
+    p.add_argument("--free-board", type=float, default=0.5, metavar="M",
+                   help="free board above the p95 bounce height, m (UNI 11211-4: at least 0.5; default 0.5)")
+    p.add_argument("--design-period", type=float, default=100.0, metavar="YR",
+                   help="return period of the fence checks and UNI design block, years (default 100)")
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-energy)")
+    p.set_defaults(func=cmd_energy)
+
     p = sub.add_parser("demo", help="run the analysis on the bundled example inventories",
                        description="Run riskrf on the bundled example: the real Lauterbrunnen laser-scanning "
                        "inventory (power law) and the clearly labelled SYNTHETIC 40-year road-cut record "
@@ -198,6 +297,8 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    if getattr(args, "command", None) in ("energy", "assess"):
+        args.collector_given = "--collector" in (argv if argv is not None else sys.argv)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # every warning is reported in the printed summary instead

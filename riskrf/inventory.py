@@ -218,15 +218,20 @@ class Inventory:
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
 
+def sniff_delimiter(path) -> str:
+    """The delimiter of a text table among , ; tab and |, defaulting to a comma."""
+    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+        sample = fh.read(8192)
+    try:
+        return csv.Sniffer().sniff(sample, delimiters=",;\t|").delimiter
+    except csv.Error:
+        return ","
+
+
 def _read_table(path: Path) -> pd.DataFrame:
     suffix = path.suffix.lower()
     if suffix in (".csv", ".txt", ".tsv"):
-        with open(path, encoding="utf-8-sig", errors="replace") as fh:
-            sample = fh.read(8192)
-        try:
-            sep = csv.Sniffer().sniff(sample, delimiters=",;\t|").delimiter
-        except csv.Error:
-            sep = ","
+        sep = sniff_delimiter(path)
         try:
             return pd.read_csv(path, sep=sep, dtype=str, skip_blank_lines=False, keep_default_na=False,
                                encoding="utf-8-sig")

@@ -112,3 +112,55 @@ def plot_return_levels(fits, ax=None, *, power_law=None, maxima=None, formula: s
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize="small", title=f"bands: {level:.0%} delta method")
     return ax
+
+
+def plot_energy_exceedance(hazard, ax=None, *, fences=(), level: float = 0.95, n_bootstrap: int = 200, seed=1):
+    """Annual frequency of impacts above each energy at the barrier line (log-log), with the
+    bootstrap band of the energy for each frequency and candidate fence capacities marked."""
+    ax = _axes(ax)
+    e = np.geomspace(1.0, 1e8, 200)
+    lam = hazard.annual_frequency(e)
+    keep = lam > 1e-7
+    ax.loglog(e[keep], lam[keep], color="C0", lw=2, label="annual frequency of impacts > E")
+    T = np.geomspace(max(1.01, 1.0 / hazard.arrival_rate * 1.01), 1e5, 40)
+    lo, hi = hazard.energy_at_return_period_ci(T, level=level, n_bootstrap=n_bootstrap, seed=seed)
+    ax.fill_betweenx(1.0 / T, lo, hi, color="C0", alpha=0.2, label=f"{level:.0%} interval of the energy")
+    for i, cap in enumerate(fences):
+        ax.axvline(cap, color=f"C{i + 1}", ls="--", lw=1.5, label=f"fence {cap:g} kJ (SEL {cap / 3:.0f} kJ)")
+    for t in (100, 300):
+        ax.axhline(1.0 / t, color="0.5", ls=":", lw=1)
+        ax.annotate(f"{t} yr", (e[0] * 1.5, 1.0 / t), fontsize="small", va="bottom")
+    ax.set_xlabel("impact energy E [kJ]")
+    ax.set_ylabel("annual frequency λ(E > e) [1/yr]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="small")
+    return ax
+
+
+def plot_mass_velocity(hazard, ax=None, *, energies=(100, 500, 1000, 2000, 5000, 10000), n_points: int = 3000,
+                       seed=1):
+    """Sampled masses and velocities of falls reaching the line, with iso-energy curves E = 1/2 m v^2."""
+    from .energy import mass_model
+    ax = _axes(ax)
+    rng = np.random.default_rng(seed)
+    m = mass_model(hazard.mass).rvs(n_points, rng)
+    v = hazard.velocity
+    if hasattr(v, "velocity_ms"):
+        v = v.velocity_ms
+    if hasattr(v, "rvs"):
+        vs = np.abs(v.rvs(size=n_points, random_state=rng))
+    elif hasattr(v, "dist"):
+        vs = np.abs(v.dist.rvs(size=n_points, random_state=rng))
+    else:
+        vs = rng.choice(np.asarray(v), size=n_points)
+    ax.scatter(vs, m, s=3, alpha=0.3, color="0.3", label="sampled falls")
+    vv = np.linspace(max(vs.min(), 0.5), vs.max() * 1.05, 100)
+    for i, e in enumerate(energies):
+        ax.plot(vv, 2000.0 * e / vv ** 2, color=f"C{i % 10}", lw=1.2, label=f"{e:g} kJ")
+    ax.set_yscale("log")
+    ax.set_ylim(max(m.min() * 0.5, 1e-3), m.max() * 2)
+    ax.set_xlabel("velocity at the barrier [m/s]")
+    ax.set_ylabel("block mass [kg]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="x-small", title="E = ½ m v²", ncol=2)
+    return ax

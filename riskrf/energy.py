@@ -1,0 +1,337 @@
+"""Impact energy of one fall: combining a mass model with a velocity model (Wyllie 2014, 8.1-8.3).
+
+    P(E > e) = integral f_V(v) P(M > 2000 e / v^2) dv,     E = 1/2 m v^2 / 1000  [kJ]
+
+(plus the rotational energy 1/2 I w^2 of a sphere, I = 2/5 m r^2, r from m and the
+density, when angular velocities are given with velocity samples).
+
+Mass models: a fitted power law (:class:`~riskrf.GutenbergRichterFit`, the truncated
+law between m_min and m_max), a Gumbel/GEV fit of annual maxima (then E is the
+energy of the year's largest block), any scipy frozen distribution, or an array of
+masses (empirical).  Velocity models: a scipy frozen distribution, an array of
+samples (a simulator collector, or a RocFall/RAMMS export), a :class:`VelocityFit`
+(parametric model chosen by AIC), or :class:`PairedSamples` (velocity samples with
+the mass of each block, to condition on mass).
+
+The default ``method="quad"`` integrates in log space: Gauss-Legendre panels on
+ln v for a parametric velocity, an exact average over velocity samples, or
+panels on ln P(M > m) when conditioning on mass.  It is accurate to about 1e-6
+relative down to probabilities of 1e-8 (tested against the exact lognormal case)
+and takes milliseconds.  ``method="mc"`` samples instead, for cross-checks.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy import optimize, stats
+
+from .extremes import _AnnualMaximumFit
+from .magnitude import GutenbergRichterFit
+from .validation import check_choice
+
+_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
+SPHERE_INERTIA = 0.4
+
+
+# ---------------------------------------------------------------- velocity models
+@dataclass(frozen=True)
+class VelocityFit:
+    """A parametric velocity model chosen among candidates by AIC.
+
+    ``name`` is the chosen family, ``dist`` the frozen scipy distribution,
+    ``table`` the AIC and Kolmogorov-Smirnov statistic of every candidate.
+    """
+
+    name: str
+    dist: object
+    table: pd.DataFrame
+    n: int
+
+    def summary(self) -> pd.DataFrame:
+        return self.table
+
+
+def fit_velocity(samples, candidates=("normal", "lognormal", "gamma", "weibull")) -> VelocityFit:
+    """Fit candidate distributions to velocity samples [m/s] by maximum likelihood and keep the lowest AIC.
+
+    The table reports for each candidate its parameters, log-likelihood, AIC,
+    ΔAIC and the KS distance and p-value (the p-value is optimistic because the
+    parameters were fitted to the same data).
+    """
+    v = _positive_samples(samples, "velocity")
+    families = {"normal": stats.norm, "lognormal": stats.lognorm, "gamma": stats.gamma,
+                "weibull": stats.weibull_min}
+    rows, fitted = [], {}
+    for name in candidates:
+        check_choice(name, "candidates", tuple(families))
+        fam = families[name]
+        params = fam.fit(v) if name == "normal" else fam.fit(v, floc=0)
+        dist = fam(*params)
+        ll = float(np.sum(dist.logpdf(v)))
+        k = len(params) - (0 if name == "normal" else 1)
+        ks = stats.kstest(v, dist.cdf)
+        fitted[name] = dist
+        rows.append({"model": name, "params": tuple(round(float(p), 6) for p in params), "loglik": ll,
+                     "aic": 2 * k - 2 * ll, "ks_distance": ks.statistic, "ks_p_value": ks.pvalue})
+    table = pd.DataFrame(rows).set_index("model").sort_values("aic")
+    table["delta_aic"] = table["aic"] - table["aic"].min()
+    best = table.index[0]
+    return VelocityFit(name=best, dist=fitted[best], table=table, n=v.size)
+
+
+@dataclass(frozen=True)
+class PairedSamples:
+    """Velocity samples [m/s] with the mass [kg] of each block, to condition velocity on mass.
+
+    Use when velocity depends on block size (roughness scaled by radius,
+    rotation).  The exceedance probability then averages, over the mass model,
+    the conditional exceedance of the blocks of similar mass (``n_bins``
+    mass classes of equal counts).
+    """
+
+    velocity_ms: np.ndarray
+    mass_kg: np.ndarray
+    n_bins: int = 10
+
+    @classmethod
+    def from_collector(cls, df: pd.DataFrame, n_bins: int = 10) -> "PairedSamples":
+        return cls(np.asarray(df["velocity_ms"], dtype=float), np.asarray(df["mass_kg"], dtype=float), n_bins)
+
+    def classes(self):
+        order = np.argsort(self.mass_kg)
+        groups = np.array_split(order, min(self.n_bins, max(1, self.mass_kg.size // 20)))
+        edges = [np.sqrt(self.mass_kg[g[-1]] * self.mass_kg[h[0]]) for g, h in zip(groups[:-1], groups[1:])]
+        return np.array(edges), [np.sort(self.velocity_ms[g]) for g in groups]
+
+
+def _positive_samples(values, name):
+    arr = np.asarray(values, dtype=float).ravel()
+    if arr.size == 0:
+        raise ValueError(f"{name} samples are empty")
+    bad = ~np.isfinite(arr) | (arr < 0)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(f"{name} sample [{i}] = {float(arr[i])!r}: samples must be finite and >= 0")
+    return arr
+
+
+# ---------------------------------------------------------------- mass models
+@dataclass(frozen=True)
+class _MassModel:
+    sf: object           # callable m [kg] -> P(M > m)
+    isf: object          # callable p -> m
+    rvs: object          # callable (n, rng) -> masses
+    description: str
+    support: tuple
+
+
+def mass_model(mass) -> _MassModel:
+    """Wrap any accepted mass description in a uniform interface (sf, isf, rvs)."""
+    if isinstance(mass, GutenbergRichterFit):
+        if mass.units != "kg":
+            raise ValueError(f"the power-law fit is in {mass.units!r}; convert it with .to_mass(density) first")
+        return _MassModel(mass.sf, mass.isf, lambda n, rng: mass.rvs(n, rng),
+                          f"power law b = {mass.b:.3f} above {mass.m_min:.4g} kg"
+                          + (f", truncated at {mass.m_max:.4g} kg" if mass.m_max else ""), mass.support)
+    if isinstance(mass, _AnnualMaximumFit):
+        d = mass.dist
+        lo = float(d.ppf(1e-12))
+        if lo <= 0:
+            # Annual-maximum laws fitted to masses can put a little probability below zero: condition on m > 0.
+            p0 = float(d.cdf(0.0))
+            return _MassModel(lambda m: np.minimum(d.sf(np.maximum(m, 0.0)) / (1 - p0), 1.0),
+                              lambda p: d.isf(np.asarray(p) * (1 - p0)),
+                              lambda n, rng: d.isf(rng.uniform(size=n) * (1 - p0)),
+                              f"{type(mass).__name__[:-3]} annual maximum (conditioned on m > 0)", (0.0, np.inf))
+        return _MassModel(d.sf, d.isf, lambda n, rng: d.rvs(size=n, random_state=rng),
+                          f"{type(mass).__name__[:-3]} annual maximum", (lo, float(d.isf(1e-12))))
+    if hasattr(mass, "sf") and hasattr(mass, "isf") and hasattr(mass, "rvs"):
+        lo = float(mass.ppf(0.0)) if hasattr(mass, "ppf") else 0.0
+        if not np.isfinite(lo) or lo < 0:
+            raise ValueError(f"mass model {getattr(mass.dist, 'name', mass)!r} has support reaching {lo:g} kg: "
+                             "masses must be positive; use a positive distribution (lognormal, gamma, ...) or "
+                             "truncate it")
+        return _MassModel(mass.sf, mass.isf, lambda n, rng: mass.rvs(size=n, random_state=rng),
+                          f"scipy {getattr(getattr(mass, 'dist', None), 'name', 'distribution')}",
+                          (lo, float(mass.isf(0.0))))
+    m = np.sort(_positive_samples(mass, "mass"))
+    if np.any(m <= 0):
+        raise ValueError(f"mass samples must be > 0; found {int(np.sum(m <= 0))} zero masses")
+
+    def sf(x):
+        return 1.0 - np.searchsorted(m, x, side="right") / m.size
+
+    def isf(p):
+        return np.quantile(m, 1.0 - np.asarray(p), method="inverted_cdf")
+    return _MassModel(sf, isf, lambda n, rng: rng.choice(m, size=n), f"empirical ({m.size} masses)",
+                      (float(m[0]), float(m[-1])))
+
+
+def _threshold_mass(e_kj, v, w, density):
+    """Mass m with 1/2 m v^2 + 1/2 (2/5) m r(m)^2 w^2 = 1000 e, r = (3m / 4 pi rho)^(1/3); vectorised."""
+    m = 2000.0 * e_kj / np.maximum(v * v, 1e-300)
+    if w is None:
+        return m
+    c = 0.5 * SPHERE_INERTIA * (3.0 / (4.0 * np.pi * density)) ** (2.0 / 3.0) * w * w   # kJ*1000 per m^(5/3)
+    target = 1000.0 * e_kj
+    lo = np.full(np.broadcast(e_kj, v).shape, -700.0)
+    hi = np.log(np.maximum(m, 1e-300)) + 1.0
+    for _ in range(80):      # bisection on ln m; the energy is increasing in m
+        mid = 0.5 * (lo + hi)
+        mm = np.exp(mid)
+        f = 0.5 * mm * v * v + c * mm ** (5.0 / 3.0) - target
+        lo = np.where(f < 0, mid, lo)
+        hi = np.where(f < 0, hi, mid)
+    return np.exp(0.5 * (lo + hi))
+
+
+def _check_energies(energy_kj):
+    e = np.asarray(energy_kj, dtype=float)
+    bad = ~np.isfinite(e) | (e < 0)
+    if bad.any():
+        raise ValueError(f"energy_kj = {float(e[bad].ravel()[0])!r}: energies must be finite and >= 0 kJ")
+    return e
+
+
+def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, density_kg_m3: float = 2650.0,
+                           method: str = "quad", n_samples: int = 1_000_000, seed=None):
+    """P(E > e) for one fall: the probability that its impact energy exceeds ``energy_kj``.
+
+    Parameters
+    ----------
+    energy_kj : float or array
+        Energies [kJ], finite and >= 0.
+    mass : GutenbergRichterFit, GumbelFit, GEVFit, scipy frozen distribution or array
+        Mass model [kg] (see module notes).
+    velocity : scipy frozen distribution, array, VelocityFit or PairedSamples
+        Velocity model [m/s] at the barrier line.
+    angular_velocity : array, optional
+        Angular velocities [rad/s] paired with velocity samples; adds the
+        rotational energy of a sphere of density ``density_kg_m3``.
+    method : {"quad", "mc"}
+        Numerical integration (default) or Monte Carlo with ``n_samples`` draws.
+    """
+    e = _check_energies(energy_kj)
+    check_choice(method, "method", ("quad", "mc"))
+    mm = mass_model(mass)
+    if method == "mc":
+        return exceedance_probability_mc(e, mass, velocity, angular_velocity=angular_velocity,
+                                         density_kg_m3=density_kg_m3, n_samples=n_samples, seed=seed)[0]
+    if isinstance(velocity, VelocityFit):
+        velocity = velocity.dist
+    if isinstance(velocity, PairedSamples):
+        return _conditional_on_mass(e, mm, velocity)
+    if hasattr(velocity, "pdf") and hasattr(velocity, "isf"):
+        if angular_velocity is not None:
+            raise ValueError("angular_velocity needs velocity samples paired with it, not a distribution")
+        return _integrate_velocity_dist(e, mm, velocity)
+    v = _positive_samples(velocity, "velocity")
+    w = None
+    if angular_velocity is not None:
+        w = np.asarray(angular_velocity, dtype=float).ravel()
+        if w.size != v.size:
+            raise ValueError(f"angular_velocity has {w.size} values but velocity has {v.size}: they must be paired")
+    out = np.empty(e.size)
+    for i, ei in enumerate(e.ravel()):
+        out[i] = np.mean(mm.sf(_threshold_mass(ei, v, w, density_kg_m3)))
+    return out.reshape(e.shape)
+
+
+def _integrate_velocity_dist(e, mm, vdist):
+    p_pos = float(vdist.sf(0.0))
+    if p_pos <= 0:
+        raise ValueError("the velocity model puts no probability on positive speeds")
+    lo = max(float(vdist.ppf(max(1e-15, 1 - p_pos + 1e-15))), 1e-6)
+    hi = float(vdist.isf(1e-17))
+    if not np.isfinite(hi):
+        hi = float(vdist.isf(1e-12))
+    edges = np.linspace(np.log(lo), np.log(hi), 513)
+    half = 0.5 * np.diff(edges)
+    mid = 0.5 * (edges[:-1] + edges[1:])
+    u = (mid[:, None] + half[:, None] * _GL_NODES[None, :]).ravel()
+    wts = (half[:, None] * _GL_WEIGHTS[None, :]).ravel()
+    v = np.exp(u)
+    dens = vdist.pdf(v) * v * wts / p_pos
+    out = np.empty(e.size)
+    for i, ei in enumerate(e.ravel()):
+        out[i] = np.sum(dens * mm.sf(2000.0 * ei / (v * v)))
+    return np.clip(out, 0.0, 1.0).reshape(e.shape)
+
+
+def _conditional_on_mass(e, mm, paired: PairedSamples):
+    """Integrate over ln P(M > m): P = int_0^1 P(V > sqrt(2000 e / m(p)) | m(p)) dp."""
+    edges_m, vel = paired.classes()
+    lp = np.linspace(np.log(1e-14), 0.0, 257)
+    half = 0.5 * np.diff(lp)
+    mid = 0.5 * (lp[:-1] + lp[1:])
+    u = (mid[:, None] + half[:, None] * _GL_NODES[None, :]).ravel()
+    p = np.exp(u)
+    wts = (half[:, None] * _GL_WEIGHTS[None, :]).ravel() * p
+    m = mm.isf(p)
+    cls = np.searchsorted(edges_m, m)
+    out = np.empty(e.size)
+    for i, ei in enumerate(e.ravel()):
+        vstar = np.sqrt(2000.0 * ei / np.maximum(m, 1e-300))
+        cond = np.empty(m.size)
+        for c, vs in enumerate(vel):
+            sel = cls == c
+            cond[sel] = 1.0 - np.searchsorted(vs, vstar[sel], side="right") / vs.size
+        out[i] = np.sum(wts * cond) + 1e-14 * cond[0]
+    return np.clip(out, 0.0, 1.0).reshape(e.shape)
+
+
+def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=None, density_kg_m3: float = 2650.0,
+                              n_samples: int = 1_000_000, seed=None, level: float = 0.95):
+    """Monte Carlo estimate of P(E > e) with its Wilson interval: (p, lower, upper) arrays."""
+    from simulation.result import wilson_interval
+
+    e = _check_energies(energy_kj)
+    rng = np.random.default_rng(seed)
+    mm = mass_model(mass)
+    m = mm.rvs(n_samples, rng)
+    w = None
+    if isinstance(velocity, VelocityFit):
+        velocity = velocity.dist
+    if isinstance(velocity, PairedSamples):
+        edges_m, vel = velocity.classes()
+        cls = np.searchsorted(edges_m, m)
+        v = np.empty(n_samples)
+        for c, vs in enumerate(vel):
+            sel = cls == c
+            v[sel] = rng.choice(vs, size=int(sel.sum()))
+    elif hasattr(velocity, "rvs"):
+        v = np.abs(velocity.rvs(size=n_samples, random_state=rng))
+    else:
+        samples = _positive_samples(velocity, "velocity")
+        idx = rng.integers(0, samples.size, n_samples)
+        v = samples[idx]
+        if angular_velocity is not None:
+            w = np.asarray(angular_velocity, dtype=float)[idx]
+    energy = 0.5 * m * v * v / 1000.0
+    if w is not None:
+        r = (3.0 * m / (4.0 * np.pi * density_kg_m3)) ** (1.0 / 3.0)
+        energy = energy + 0.5 * SPHERE_INERTIA * m * r * r * w * w / 1000.0
+    energy.sort()
+    k = n_samples - np.searchsorted(energy, e.ravel(), side="right")
+    lo, hi = wilson_interval(k, n_samples, level)
+    return (k / n_samples).reshape(e.shape), lo.reshape(e.shape), hi.reshape(e.shape)
+
+
+def energy_quantile(p, mass, velocity, **kwargs):
+    """Energy [kJ] exceeded with probability p by one fall (inverse of :func:`exceedance_probability`)."""
+    p = np.atleast_1d(np.asarray(p, dtype=float))
+    if np.any((p <= 0) | (p >= 1)):
+        raise ValueError(f"p = {p[(p <= 0) | (p >= 1)][0]!r}: probabilities must lie strictly between 0 and 1")
+    out = []
+    for pi in p:
+        f = lambda le: np.log(max(exceedance_probability(np.exp(le), mass, velocity, **kwargs).item(),  # noqa: E731
+                                  1e-300)) - np.log(pi)
+        lo, hi = -10.0, 5.0
+        while f(hi) > 0:
+            hi += 5.0
+        while f(lo) < 0:
+            lo -= 5.0
+        out.append(np.exp(optimize.brentq(f, lo, hi, xtol=1e-10)))
+    return np.array(out)

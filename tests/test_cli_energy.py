@@ -1,0 +1,50 @@
+"""`riskrf energy` (issue 4, item 5)."""
+import json
+
+import numpy as np
+import pandas as pd
+
+from riskrf.cli import main
+
+from .conftest import INVENTORIES
+from .test_simulation_run import BARRIER
+
+LAUTER = INVENTORIES / "lauterbrunnen" / "lauterbrunnen_tls_2018.csv"
+
+
+def test_energy_from_scenario_on_real_inventory(tmp_path, capsys):
+    out = tmp_path / "e"
+    rc = main(["energy", "--inventory", str(LAUTER), "--scenario", str(BARRIER), "-n", "5000", "--m-max", "2e6",
+               "--rate-scale", "0.05", "--bootstrap", "40", "--out", str(out)])
+    assert rc == 0
+    text = capsys.readouterr().out
+    assert "Design energies" in text and "Fence 2000 kJ / 5 m" in text and "Fence 5000 kJ / 5 m" in text
+    summary = json.loads((out / "energy_summary.json").read_text())
+    assert summary["units"]["energy"] == "kJ"
+    table = pd.read_csv(out / "design_energies.csv")
+    assert list(table["T_years"]) == [10, 50, 100, 300, 1000]
+    assert (table["ci_low_kj"] <= table["energy_kj"]).all() and (table["energy_kj"] <= table["ci_high_kj"]).all()
+    for name in ("energy_exceedance.png", "mass_velocity.png", "fence_checks.csv"):
+        assert (out / name).stat().st_size > 0
+
+
+def test_energy_from_velocity_file(tmp_path, capsys):
+    vel = tmp_path / "v.csv"
+    rng = np.random.default_rng(1)
+    pd.DataFrame({"velocity_ms": rng.normal(15, 2, 2000).clip(1), "height_m": rng.exponential(1, 2000)}).to_csv(
+        vel, index=False)
+    rc = main(["energy", "--inventory", str(LAUTER), "--velocities", str(vel), "--reach-probability", "0.3",
+               "--bootstrap", "20", "--fence", "1000", "--out", str(tmp_path / "o")])
+    assert rc == 0
+    text = capsys.readouterr().out
+    assert "reach probability 0.3 as given" in text and "Fence 1000 kJ" in text
+
+
+def test_energy_bad_velocity_file_writes_nothing(tmp_path, capsys):
+    vel = tmp_path / "v.csv"
+    pd.DataFrame({"speedometer": [1.0, 2.0]}).to_csv(vel, index=False)
+    rc = main(["energy", "--inventory", str(LAUTER), "--velocities", str(vel), "--out", str(tmp_path / "o")])
+    assert rc == 2 and "no velocity column" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+    rc = main(["energy", "--inventory", str(LAUTER), "--out", str(tmp_path / "o")])
+    assert rc == 2 and "exactly one of --scenario" in capsys.readouterr().err
