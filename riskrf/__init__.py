@@ -14,9 +14,12 @@ from .frequency import FrequencyAnalysis, analyse_inventory
 from .inventory import DEFAULT_DENSITY_KG_M3, Inventory, read_inventory
 from .magnitude import GutenbergRichterFit, find_m_min, fit_gutenberg_richter
 from .validation import RiskrfWarning
+from .decision import DecisionTree
+from .energy import exceedance_probability, fit_velocity
+from .hazard import EnergyHazard
 
 __all__ = [
-    "DEFAULT_DENSITY_KG_M3", "FrequencyAnalysis", "GEVFit", "GumbelFit", "GutenbergRichterFit", "Inventory",
+    "DEFAULT_DENSITY_KG_M3", "DecisionTree", "EnergyHazard", "FrequencyAnalysis", "exceedance_probability", "fit_velocity", "GEVFit", "GumbelFit", "GutenbergRichterFit", "Inventory",
     "RiskrfWarning", "analyse_inventory", "encounter_probability", "find_m_min", "fit_gev", "fit_gumbel",
     "fit_gutenberg_richter", "gumbel_frequency_factor", "gumbel_reduced_variate", "plotting_positions",
     "read_inventory",
