@@ -6,6 +6,8 @@ import sys
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 from . import __version__
 
 EPILOG = "Units: mass kg, volume m3, density kg/m3, energy kJ, velocity m/s, time in years."
@@ -134,6 +136,7 @@ def build_energy_hazard(args, inventory):
     from .magnitude import fit_gutenberg_richter
     from .velocities import read_velocities
 
+    result = None
     gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=args.m_min, m_max=args.m_max)
     rate = gr.rate_min * args.rate_scale
     if (args.scenario is None) == (args.velocities is None):
@@ -159,7 +162,7 @@ def build_energy_hazard(args, inventory):
     if args.rate_scale != 1.0:
         hazard = type(hazard)(**{**hazard.__dict__, "notes": hazard.notes + (
             f"rate scaled by {args.rate_scale:g} (share of the inventoried source above this line)",)})
-    return gr, hazard
+    return gr, hazard, result
 
 
 def cmd_energy(args) -> int:
@@ -167,7 +170,7 @@ def cmd_energy(args) -> int:
     from .outputs import atomic_output_dir
 
     inv = _read(args, args.inventory)
-    gr, hazard = build_energy_hazard(args, inv)
+    gr, hazard, _ = build_energy_hazard(args, inv)
     analysis = analyse_energy(hazard, fences=args.fence or (2000.0, 5000.0), fence_height_m=args.fence_height,
                               free_board_m=args.free_board, design_T=args.design_period,
                               density_kg_m3=inv.density_kg_m3, n_bootstrap=args.bootstrap, seed=args.seed)
@@ -179,6 +182,132 @@ def cmd_energy(args) -> int:
         analysis.write(tmp)
     print(f"\nWrote energy_summary.json, design_energies.csv, fence_checks.csv and figures to {out}/")
     return 0
+
+
+def road_share(result, barrier: str, road: str | None) -> float:
+    """P(reaches the road | reaches the barrier line) from a simulation (1 without a road collector)."""
+    if result is None or road is None or road not in [c.name for c in result.scenario.collectors]:
+        return 1.0
+    b = result.reach_probability(barrier)[0]
+    return min(result.reach_probability(road)[0] / b, 1.0) if b > 0 else 1.0
+
+
+def cmd_decide(args) -> int:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .decision import DecisionTree
+    from .mitigation import load_mitigation
+    from .outputs import atomic_output_dir, write_json
+    from .plotting_decision import plot_fn, plot_risk_profiles, plot_tornado, plot_tree
+
+    if (args.tree is None) == (args.options is None):
+        raise ValueError("give a decision tree file (riskrf decide TREE.json) or --options OPTIONS.toml with "
+                         "--inventory and --scenario, not both")
+    out = Path(args.out) if args.out else Path("decision")
+    if args.tree is not None:
+        tree = DecisionTree.from_file(args.tree)
+        rb = tree.rollback(risk_tolerance=args.risk_tolerance)
+        ranking = tree.ranking(risk_tolerance=args.risk_tolerance)
+        print(f"Decision tree {args.tree} (objective {tree.objective}"
+              + (f", exponential utility with risk tolerance {args.risk_tolerance:g}" if args.risk_tolerance
+                 else ", expected values") + ")")
+        print(ranking.to_string(index=False))
+        print("\nOptimal policy:")
+        for path, choice in rb.policy.items():
+            print(f"  at {path}: {choice}")
+        for var in tree.variables():
+            print(f"  EVPI of {var!r}: {tree.evpi(var):.6g}")
+        tornado = tree.tornado() if tree.parameters else None
+        with atomic_output_dir(out) as tmp:
+            ranking.to_csv(tmp / "ranking.csv", index=False)
+            tree.risk_profile().to_csv(tmp / "risk_profiles.csv", index=False)
+            write_json({"objective": tree.objective, "value": rb.value, "options": rb.option_values,
+                        "policy": rb.policy, "evpi": {v: tree.evpi(v) for v in tree.variables()}},
+                       tmp / "decision.json")
+            ax = plot_tree(tree)
+            ax.figure.savefig(tmp / "tree.png", dpi=110, bbox_inches="tight")
+            plt.close(ax.figure)
+            ax = plot_risk_profiles(tree.risk_profile())
+            ax.figure.savefig(tmp / "risk_profiles.png", dpi=110, bbox_inches="tight")
+            plt.close(ax.figure)
+            if tornado is not None and len(tornado):
+                tornado.to_csv(tmp / "tornado.csv", index=False)
+                ax = plot_tornado(tornado)
+                ax.figure.savefig(tmp / "tornado.png", dpi=110, bbox_inches="tight")
+                plt.close(ax.figure)
+        print(f"\nWrote ranking.csv, decision.json and figures to {out}/")
+        return 0
+
+    inv = _read(args, args.inventory)
+    gr, hazard, result = build_energy_hazard(args, inv)
+    study = load_mitigation(args.options, hazard, road_share=road_share(result, args.collector, args.road_collector))
+    report = study_report(study)
+    print(report["text"])
+    with atomic_output_dir(out) as tmp:
+        write_mitigation_outputs(study, report, tmp)
+    print(f"\nWrote ranking.csv, tornado.csv, break_even.csv, decision.json and figures to {out}/")
+    return 0
+
+
+def study_report(study) -> dict:
+    """Ranking, tornado, break-even and a printable text of a mitigation study."""
+    import pandas as pd
+    ranking = study.ranking()
+    tornado = study.tornado()
+    be = study.break_even_table()
+    cur = study.currency
+    show = ranking.copy()
+    for c in ("capital", "pv_maintenance", "pv_expected_loss", "expected_total_cost"):
+        show[c] = show[c].map(lambda v: f"{v:,.0f}")
+    show["individual_risk"] = show["individual_risk"].map(lambda v: f"{v:.2e}")
+    show["road_falls_per_year"] = show["road_falls_per_year"].map(lambda v: f"{v:.3g}")
+    show["deaths_per_year"] = show["deaths_per_year"].map(lambda v: f"{v:.2e}")
+    show["benefit_cost_ratio"] = show["benefit_cost_ratio"].map(lambda v: "" if pd.isna(v) else f"{v:.2f}")
+    a, b = ranking["option"].iloc[0], ranking["option"].iloc[1]
+    lines = [f"Mitigation ranking by expected total cost ({cur}, present values over "
+             f"{study.economics.horizon_years:g} years at {study.economics.discount_rate:.1%}):",
+             show.drop(columns=["kind"]).to_string(index=False), "",
+             f"Best: {a}.  What would make {b!r} as good (break-even, other inputs unchanged):"]
+    for r in be.itertuples():
+        if np.isfinite(r.break_even):
+            lines.append(f"  {r.parameter}: {r.current:,.4g} -> {r.break_even:,.4g} (x{r.factor:.3g})")
+        else:
+            lines.append(f"  {r.parameter}: {r.note}")
+    lines += ["", "Tornado (best option's expected total cost with each input halved / doubled):"]
+    for r in tornado.itertuples():
+        lines.append(f"  {r.parameter:<40} {r.cost_at_low:>14,.0f} .. {r.cost_at_high:>14,.0f}   "
+                     f"best: {r.best_at_low} / {r.best_at_high}")
+    if study.defaults_used:
+        lines += ["", "Defaults used: " + "; ".join(study.defaults_used)]
+    return {"ranking": ranking, "tornado": tornado, "break_even": be, "text": "\n".join(lines)}
+
+
+def write_mitigation_outputs(study, report, tmp) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .outputs import write_json
+    from .plotting_decision import plot_fn, plot_tornado, plot_tree
+    report["ranking"].to_csv(tmp / "ranking.csv", index=False)
+    report["tornado"].to_csv(tmp / "tornado.csv", index=False)
+    report["break_even"].to_csv(tmp / "break_even.csv", index=False)
+    tree = study.to_tree()
+    write_json({"currency": study.currency, "ranking": report["ranking"], "break_even": report["break_even"],
+                "tornado": report["tornado"], "tree_value": tree.rollback().value,
+                "defaults_used": list(study.defaults_used)}, tmp / "decision.json")
+    ax = plot_tree(tree)
+    ax.figure.savefig(tmp / "tree.png", dpi=110, bbox_inches="tight")
+    plt.close(ax.figure)
+    ax = plot_tornado(report["tornado"], currency=study.currency)
+    ax.figure.savefig(tmp / "tornado.png", dpi=110, bbox_inches="tight")
+    plt.close(ax.figure)
+    curves = {o.name: study.fn_curve(o.name) for o in study.options if o.kind != "realignment"}
+    ax = plot_fn(curves)
+    ax.figure.savefig(tmp / "fn_curve.png", dpi=110, bbox_inches="tight")
+    plt.close(ax.figure)
 
 
 def _add_energy_arguments(p):
@@ -283,6 +412,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-energy)")
     p.set_defaults(func=cmd_energy)
 
+    p = sub.add_parser("decide", help="rank mitigation options, or roll back any decision tree",
+                       description="Two uses.  (1) riskrf decide TREE.json|TREE.toml: roll back a decision tree "
+                       "(format in the README), print the ranking, optimal policy and EVPI, and draw the tree, risk "
+                       "profiles and tornado.  (2) riskrf decide --options OPTIONS.toml --inventory INV --scenario "
+                       "SCENARIO: build the energy hazard, evaluate each mitigation option's residual hazard and rank "
+                       "them by expected total cost, with break-even values, tornado chart and F-N curves.",
+                       epilog=EPILOG)
+    p.add_argument("tree", nargs="?", default=None, help="decision tree file (.json or .toml)")
+    p.add_argument("--options", default=None, metavar="TOML", help="mitigation options file")
+    p.add_argument("--inventory", default=None, help="inventory file (with --options)")
+    p.add_argument("--road-collector", default="road",
+                   help="collector at the road: P(road | barrier) from the simulation (default 'road')")
+    p.add_argument("--risk-tolerance", type=float, default=None,
+                   help="exponential-utility risk tolerance for tree rollback (default: expected values)")
+    _add_inventory_arguments(p)
+    _add_energy_arguments(p)
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default ./decision)")
+    p.set_defaults(func=cmd_decide)
+
     p = sub.add_parser("demo", help="run the analysis on the bundled example inventories",
                        description="Run riskrf on the bundled example: the real Lauterbrunnen laser-scanning "
                        "inventory (power law) and the clearly labelled SYNTHETIC 40-year road-cut record "
@@ -297,7 +445,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    if getattr(args, "command", None) in ("energy", "assess"):
+    if getattr(args, "command", None) in ("energy", "assess", "decide"):
         args.collector_given = "--collector" in (argv if argv is not None else sys.argv)
     try:
         with warnings.catch_warnings():

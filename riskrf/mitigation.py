@@ -52,8 +52,8 @@ class Exposure:
     speed_kmh: float = 80.0
     occupants_per_vehicle: float = 1.5
     commuter_trips_per_day: float = 2.0
-    hours_rock_on_road: float = 1.0
-    p_cannot_stop: float = 0.1
+    hours_rock_on_road: float = 0.5
+    p_cannot_stop: float = 0.002
     share_stopping_on_road: float = 0.3
 
 
@@ -249,13 +249,16 @@ class MitigationStudy:
         b = option_b or rank["option"].iloc[1]
 
         def diff(log_f):
-            t = self._scaled(parameter, float(np.exp(log_f))).ranking().set_index("option")["expected_total_cost"]
-            return t[a] - t[b]
+            try:
+                t = self._scaled(parameter, float(np.exp(log_f))).ranking().set_index("option")
+            except ValueError:          # e.g. traffic so dense that P(S:T) >= 1: outside the model
+                return np.nan
+            return t["expected_total_cost"][a] - t["expected_total_cost"][b]
         lo, hi = np.log(factor_range[0]), np.log(factor_range[1])
         grid = np.linspace(lo, hi, 61)
         vals = [diff(g) for g in grid]
         for g0, g1, v0, v1 in zip(grid[:-1], grid[1:], vals[:-1], vals[1:]):
-            if np.sign(v0) != np.sign(v1):
+            if np.isfinite(v0) and np.isfinite(v1) and np.sign(v0) != np.sign(v1):
                 from scipy.optimize import brentq
                 f = float(np.exp(brentq(diff, g0, g1, xtol=1e-10)))
                 return f, self._parameter_value(parameter) * f

@@ -1,0 +1,143 @@
+"""Figures of the decision analysis: tree diagram, tornado chart, risk profiles, F-N curve."""
+from __future__ import annotations
+
+import numpy as np
+
+from .plotting import _axes
+from .risk import HK_GEO_FN_LINES
+
+
+def _fmt(v):
+    a = abs(v)
+    if a >= 1e6:
+        return f"{v / 1e6:.3g}M"
+    if a >= 1e3:
+        return f"{v / 1e3:.3g}k"
+    return f"{v:.3g}"
+
+
+def plot_tree(tree, ax=None, *, max_label: int = 28):
+    """Decision-tree diagram: squares decide, circles are chance, triangles end; the optimal path is red.
+
+    Each node shows its rolled-back value; each branch its name, probability and cost.
+    """
+    rb = tree.rollback()
+    leaves = []
+    pos = {}
+
+    def layout(node, depth):
+        if not node.branches:
+            y = float(len(leaves))
+            leaves.append(node)
+        else:
+            ys = [layout(b.child, depth + 1) for b in node.branches]
+            y = float(np.mean(ys))
+        pos[id(node)] = (depth, y)
+        return y
+    layout(tree.root, 0)
+    n_leaves = max(len(leaves), 1)
+    depth = max(d for d, _ in pos.values()) + 1
+    ax = _axes(ax, figsize=(3.2 * depth + 2, 0.45 * n_leaves + 1.5))
+    values = {}
+    better = min if tree.objective == "min" else max
+
+    def value(node):
+        from .decision import _evaluate
+        if node.type == "terminal":
+            v = _evaluate(node.value, tree.parameters, node.path)
+        else:
+            vals = [tree._net(b) + value(b.child) for b in node.branches]
+            if node.type == "decision":
+                v = better(vals)
+            else:
+                v = sum(_evaluate(b.probability, tree.parameters, b.name) * x for b, x in zip(node.branches, vals))
+        values[id(node)] = v
+        return v
+    value(tree.root)
+
+    def draw(node, on_path):
+        x, y = pos[id(node)]
+        marker = {"decision": "s", "chance": "o", "terminal": "<"}[node.type]
+        ax.plot(x, y, marker, ms=9, color="C3" if on_path else "0.3", zorder=3)
+        if node.type != "terminal" or values[id(node)] != 0:
+            ax.annotate(_fmt(values[id(node)]), (x, y), xytext=(-4, -12), textcoords="offset points", ha="right",
+                        fontsize="x-small", color="C3" if on_path else "0.2", fontweight="bold")
+        chosen = rb.policy.get(node.path) if node.type == "decision" else None
+        for b in node.branches:
+            cx, cy = pos[id(b.child)]
+            best = on_path and (node.type != "decision" or b.name == chosen)
+            ax.plot([x, x + 0.15, cx], [y, cy, cy], color="C3" if best else "0.6", lw=2.2 if best else 0.9,
+                    zorder=1)
+            label = b.name if len(b.name) <= max_label else b.name[:max_label - 1] + "…"
+            extra = []
+            if b.probability is not None:
+                from .decision import _evaluate
+                extra.append(f"p={_evaluate(b.probability, tree.parameters, b.name):.3g}")
+            net = tree._net(b)
+            if net:
+                extra.append(f"{'cost' if tree.objective == 'min' else 'value'} {_fmt(net)}")
+            ax.annotate(label + (f"  ({', '.join(extra)})" if extra else ""), ((x + cx) / 2 + 0.05, cy),
+                        xytext=(0, 3), textcoords="offset points", fontsize="x-small", va="bottom")
+            draw(b.child, best)
+    draw(tree.root, True)
+    ax.set_xlim(-0.3, depth - 0.2)
+    ax.set_ylim(-1, n_leaves)
+    ax.invert_yaxis()
+    ax.axis("off")
+    ax.set_title(f"{tree.root.name or 'decision'}: best = {tree.ranking()['option'].iloc[0]} "
+                 f"({'expected cost' if tree.objective == 'min' else 'expected value'} {_fmt(rb.value)})")
+    return ax
+
+
+def plot_tornado(table, ax=None, *, currency: str = ""):
+    """Tornado chart from :meth:`MitigationStudy.tornado` or :meth:`DecisionTree.tornado`."""
+    ax = _axes(ax, figsize=(7, 0.5 * len(table) + 1.5))
+    base = float(table["base"].iloc[0])
+    lo_col = "cost_at_low" if "cost_at_low" in table else "value_at_low"
+    hi_col = "cost_at_high" if "cost_at_high" in table else "value_at_high"
+    for i, r in enumerate(table.itertuples()):
+        lo, hi = getattr(r, lo_col), getattr(r, hi_col)
+        ax.barh(i, lo - base, left=base, color="C0", alpha=0.8, label="input low" if i == 0 else None)
+        ax.barh(i, hi - base, left=base, color="C3", alpha=0.8, label="input high" if i == 0 else None)
+    ax.axvline(base, color="k", lw=1)
+    ax.set_yticks(range(len(table)), table["parameter"])
+    ax.invert_yaxis()
+    ax.set_xlabel(f"expected total cost of the best option {currency}".strip())
+    ax.legend(fontsize="small")
+    ax.grid(True, axis="x", alpha=0.3)
+    return ax
+
+
+def plot_risk_profiles(profile, ax=None):
+    """Cumulative risk profiles (outcome distributions) of the options, from ``DecisionTree.risk_profile()``."""
+    ax = _axes(ax)
+    for i, (name, g) in enumerate(profile.groupby("option", sort=False)):
+        x = np.concatenate([[g["value"].min()], g["value"].to_numpy()])
+        y = np.concatenate([[0.0], g["cumulative"].to_numpy()])
+        ax.step(x, y, where="post", color=f"C{i % 10}", label=name)
+    ax.set_xlabel("outcome (net cost or value)")
+    ax.set_ylabel("cumulative probability")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="x-small")
+    return ax
+
+
+def plot_fn(curves: dict, ax=None, *, criteria: dict | None = None):
+    """F-N curves ``{label: DataFrame(N, F)}`` on log-log axes with criterion lines F = C / N^k."""
+    ax = _axes(ax)
+    criteria = HK_GEO_FN_LINES if criteria is None else criteria
+    nmax = 10.0
+    for i, (label, df) in enumerate(curves.items()):
+        if len(df):
+            ax.step(df["N"], df["F"], where="post", color=f"C{i % 10}", lw=2, label=label, marker="o", ms=3)
+            nmax = max(nmax, float(df["N"].max()) * 10)
+    N = np.geomspace(1, nmax, 50)
+    for j, (name, (C, k)) in enumerate(criteria.items()):
+        ax.loglog(N, C / N ** k, color="k", ls=["--", ":"][j % 2], lw=1, label=f"criterion: {name}")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("number of fatalities N")
+    ax.set_ylabel("annual frequency of N or more fatalities F [1/yr]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="x-small")
+    return ax
