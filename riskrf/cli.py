@@ -127,42 +127,13 @@ def cmd_simulate(args) -> int:
 
 
 def build_energy_hazard(args, inventory):
-    """Power-law fit of the inventory combined with a simulation or a velocity file (for energy and assess)."""
-    import numpy as np
-
-    import simulation
-
-    from .hazard import EnergyHazard
-    from .magnitude import fit_gutenberg_richter
-    from .velocities import read_velocities
-
-    result = None
-    gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=args.m_min, m_max=args.m_max)
-    rate = gr.rate_min * args.rate_scale
-    if (args.scenario is None) == (args.velocities is None):
-        raise ValueError("give exactly one of --scenario (simulate the velocities) or --velocities (a file)")
-    if args.scenario is not None:
-        scenario = simulation.load_scenario(args.scenario)
-        scenario.collector_index(args.collector)
-        result = simulation.run(scenario, n=args.n, seed=args.seed, progress=None)
-        hazard = EnergyHazard.from_simulation(gr, result, args.collector, rate_per_year=rate,
-                                              condition_on_mass=args.condition_on_mass)
-    else:
-        df = read_velocities(args.velocities, collector=args.collector if args.collector_given else None)
-        v = df["velocity_ms"].to_numpy(dtype=float)
-        note = f"velocities: {len(df):,} samples from {args.velocities}"
-        if "angular_velocity_rads" in df and "radius_m" in df:
-            v = np.sqrt(v ** 2 + 0.4 * (df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()) ** 2)
-            note += "; rotational energy included"
-        note += f"; reach probability {args.reach_probability:g} as given" + (
-            " (default: every fall assumed to reach the line)" if args.reach_probability == 1.0 else "")
-        hazard = EnergyHazard(mass=gr, velocity=v, rate_per_year=rate, reach_probability=args.reach_probability,
-                              heights_m=df["height_m"].to_numpy(dtype=float) if "height_m" in df else None,
-                              collector=args.collector, notes=(note,))
-    if args.rate_scale != 1.0:
-        hazard = type(hazard)(**{**hazard.__dict__, "notes": hazard.notes + (
-            f"rate scaled by {args.rate_scale:g} (share of the inventoried source above this line)",)})
-    return gr, hazard, result
+    """Power-law fit of the inventory combined with a simulation or a velocity file (energy and decide)."""
+    from .assess import energy_hazard_from_inputs
+    return energy_hazard_from_inputs(
+        inventory, m_min=args.m_min, m_max=args.m_max, rate_scale=args.rate_scale, scenario=args.scenario,
+        velocities=args.velocities, collector=args.collector, n=args.n, seed=args.seed,
+        reach_probability=args.reach_probability, collector_given=args.collector_given,
+        condition_on_mass=args.condition_on_mass)
 
 
 def cmd_energy(args) -> int:
@@ -184,14 +155,6 @@ def cmd_energy(args) -> int:
     return 0
 
 
-def road_share(result, barrier: str, road: str | None) -> float:
-    """P(reaches the road | reaches the barrier line) from a simulation (1 without a road collector)."""
-    if result is None or road is None or road not in [c.name for c in result.scenario.collectors]:
-        return 1.0
-    b = result.reach_probability(barrier)[0]
-    return min(result.reach_probability(road)[0] / b, 1.0) if b > 0 else 1.0
-
-
 def cmd_decide(args) -> int:
     import matplotlib
     matplotlib.use("Agg")
@@ -200,7 +163,8 @@ def cmd_decide(args) -> int:
     from .decision import DecisionTree
     from .mitigation import load_mitigation
     from .outputs import atomic_output_dir, write_json
-    from .plotting_decision import plot_fn, plot_risk_profiles, plot_tornado, plot_tree
+    from .decision_report import study_report, write_mitigation_outputs
+    from .plotting_decision import plot_risk_profiles, plot_tornado, plot_tree
 
     if (args.tree is None) == (args.options is None):
         raise ValueError("give a decision tree file (riskrf decide TREE.json) or --options OPTIONS.toml with "
@@ -242,6 +206,7 @@ def cmd_decide(args) -> int:
 
     inv = _read(args, args.inventory)
     gr, hazard, result = build_energy_hazard(args, inv)
+    from .assess import road_share
     study = load_mitigation(args.options, hazard, road_share=road_share(result, args.collector, args.road_collector))
     report = study_report(study)
     print(report["text"])
@@ -249,65 +214,6 @@ def cmd_decide(args) -> int:
         write_mitigation_outputs(study, report, tmp)
     print(f"\nWrote ranking.csv, tornado.csv, break_even.csv, decision.json and figures to {out}/")
     return 0
-
-
-def study_report(study) -> dict:
-    """Ranking, tornado, break-even and a printable text of a mitigation study."""
-    import pandas as pd
-    ranking = study.ranking()
-    tornado = study.tornado()
-    be = study.break_even_table()
-    cur = study.currency
-    show = ranking.copy()
-    for c in ("capital", "pv_maintenance", "pv_expected_loss", "expected_total_cost"):
-        show[c] = show[c].map(lambda v: f"{v:,.0f}")
-    show["individual_risk"] = show["individual_risk"].map(lambda v: f"{v:.2e}")
-    show["road_falls_per_year"] = show["road_falls_per_year"].map(lambda v: f"{v:.3g}")
-    show["deaths_per_year"] = show["deaths_per_year"].map(lambda v: f"{v:.2e}")
-    show["benefit_cost_ratio"] = show["benefit_cost_ratio"].map(lambda v: "" if pd.isna(v) else f"{v:.2f}")
-    a, b = ranking["option"].iloc[0], ranking["option"].iloc[1]
-    lines = [f"Mitigation ranking by expected total cost ({cur}, present values over "
-             f"{study.economics.horizon_years:g} years at {study.economics.discount_rate:.1%}):",
-             show.drop(columns=["kind"]).to_string(index=False), "",
-             f"Best: {a}.  What would make {b!r} as good (break-even, other inputs unchanged):"]
-    for r in be.itertuples():
-        if np.isfinite(r.break_even):
-            lines.append(f"  {r.parameter}: {r.current:,.4g} -> {r.break_even:,.4g} (x{r.factor:.3g})")
-        else:
-            lines.append(f"  {r.parameter}: {r.note}")
-    lines += ["", "Tornado (best option's expected total cost with each input halved / doubled):"]
-    for r in tornado.itertuples():
-        lines.append(f"  {r.parameter:<40} {r.cost_at_low:>14,.0f} .. {r.cost_at_high:>14,.0f}   "
-                     f"best: {r.best_at_low} / {r.best_at_high}")
-    if study.defaults_used:
-        lines += ["", "Defaults used: " + "; ".join(study.defaults_used)]
-    return {"ranking": ranking, "tornado": tornado, "break_even": be, "text": "\n".join(lines)}
-
-
-def write_mitigation_outputs(study, report, tmp) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .outputs import write_json
-    from .plotting_decision import plot_fn, plot_tornado, plot_tree
-    report["ranking"].to_csv(tmp / "ranking.csv", index=False)
-    report["tornado"].to_csv(tmp / "tornado.csv", index=False)
-    report["break_even"].to_csv(tmp / "break_even.csv", index=False)
-    tree = study.to_tree()
-    write_json({"currency": study.currency, "ranking": report["ranking"], "break_even": report["break_even"],
-                "tornado": report["tornado"], "tree_value": tree.rollback().value,
-                "defaults_used": list(study.defaults_used)}, tmp / "decision.json")
-    ax = plot_tree(tree)
-    ax.figure.savefig(tmp / "tree.png", dpi=110, bbox_inches="tight")
-    plt.close(ax.figure)
-    ax = plot_tornado(report["tornado"], currency=study.currency)
-    ax.figure.savefig(tmp / "tornado.png", dpi=110, bbox_inches="tight")
-    plt.close(ax.figure)
-    curves = {o.name: study.fn_curve(o.name) for o in study.options if o.kind != "realignment"}
-    ax = plot_fn(curves)
-    ax.figure.savefig(tmp / "fn_curve.png", dpi=110, bbox_inches="tight")
-    plt.close(ax.figure)
 
 
 def _add_energy_arguments(p):
@@ -333,27 +239,32 @@ def _add_energy_arguments(p):
                    help="bootstrap replicates for the intervals (default 300)")
 
 
+def cmd_assess(args) -> int:
+    from .assess import run_assessment, write_assessment
+    from .outputs import atomic_output_dir
+    from .site import load_site
+
+    site = load_site(args.site)          # every input is checked before anything is computed
+    out = Path(args.out) if args.out else Path(f"{Path(args.site).stem}-assessment")
+    assessment = run_assessment(site, seed=args.seed, n_blocks=args.n)
+    with atomic_output_dir(out) as tmp:
+        write_assessment(assessment, tmp)
+    s = assessment.summary()
+    print(f"\nBest option: {s['best_option']} (then {s['second_option']}).")
+    print(f"Report: {(out / 'report.html').resolve()}")
+    return 0
+
+
 def cmd_demo(args) -> int:
     from importlib import resources
 
-    from .frequency import analyse_inventory
-    from .inventory import read_inventory
-    from .outputs import atomic_output_dir
-
-    data = resources.files("riskrf") / "data"
-    out = Path(args.out)
-    with atomic_output_dir(out) as tmp:
-        for name, sub in (("lauterbrunnen_tls_2018.csv", "fit-lauterbrunnen"),
-                          ("synthetic_corridor_1985_2024.csv", "fit-synthetic-corridor")):
-            with resources.as_file(data / name) as path:
-                inv = read_inventory(path)
-            analysis = analyse_inventory(inv, n_bootstrap=args.bootstrap, seed=args.seed)
-            print("=" * 78)
-            print(analysis.summary_text())
-            (tmp / sub).mkdir()
-            analysis.write(tmp / sub)
-    print(f"\nDemo results written to {out.resolve()}/")
-    return 0
+    with resources.as_file(resources.files("riskrf") / "data" / "demo_site.toml") as site:
+        args.site = str(site)
+        if args.out is None:
+            args.out = "riskrf-demo"
+        print(f"riskrf demo: the bundled site {site.name} (real Lauterbrunnen inventory, shipped road-cut "
+              "scenario, illustrative costs)")
+        return cmd_assess(args)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -431,13 +342,27 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default ./decision)")
     p.set_defaults(func=cmd_decide)
 
-    p = sub.add_parser("demo", help="run the analysis on the bundled example inventories",
-                       description="Run riskrf on the bundled example: the real Lauterbrunnen laser-scanning "
-                       "inventory (power law) and the clearly labelled SYNTHETIC 40-year road-cut record "
-                       "(annual maxima).  Works from any directory.", epilog=EPILOG)
-    p.add_argument("--out", default="riskrf-demo", metavar="DIR", help="output directory (default riskrf-demo)")
-    p.add_argument("--bootstrap", type=int, default=1000, metavar="N", help="bootstrap replicates (default 1000)")
-    p.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
+    p = sub.add_parser("assess", help="the whole chain for one site file: fits, simulation, energy, decision",
+                       description="Run the whole assessment of one site described by a TOML file (see the README "
+                       "section 'Site files'): magnitude-frequency fits, trajectory simulation, impact-energy hazard "
+                       "and fence checks, risk to road users and the ranking of mitigation options.  Writes "
+                       "report.html (self-contained), summary.json, CSV tables, PNG figures and a copy of the inputs "
+                       "with the version and seed; the directory appears only when everything succeeded.",
+                       epilog=EPILOG)
+    p.add_argument("site", help="site file (.toml); paths in it are relative to it")
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <site>-assessment)")
+    p.add_argument("--seed", type=int, default=None, help="random seed (default: the site file's, else 1)")
+    p.add_argument("-n", type=int, default=None, help="simulated blocks (default: the site file's, else 50,000)")
+    p.set_defaults(func=cmd_assess)
+
+    p = sub.add_parser("demo", help="run the whole chain on the bundled example site",
+                       description="Run riskrf assess on the bundled example site: the real Lauterbrunnen "
+                       "laser-scanning inventory (power law), the clearly labelled SYNTHETIC 40-year record (annual "
+                       "maxima), the shipped road-cut barrier scenario and illustrative traffic, costs and options. "
+                       "Works from any directory; takes well under a minute.", epilog=EPILOG)
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default ./riskrf-demo)")
+    p.add_argument("--seed", type=int, default=None, help="random seed (default 1)")
+    p.add_argument("-n", type=int, default=None, help="simulated blocks (default 50,000)")
     p.set_defaults(func=cmd_demo)
     return parser
 
@@ -451,7 +376,7 @@ def main(argv=None) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # every warning is reported in the printed summary instead
             return args.func(args)
-    except (ValueError, TypeError, FileNotFoundError, KeyError) as exc:
+    except (ValueError, TypeError, FileNotFoundError, KeyError) as exc:   # includes SiteError, ScenarioError
         print(f"riskrf {args.command}: error: {exc}", file=sys.stderr)
         return 2
 

@@ -428,6 +428,7 @@ def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0) -> M
             data = tomllib.load(fh)
         except tomllib.TOMLDecodeError as exc:
             raise MitigationError(f"{path}: not valid TOML: {exc}") from exc
+    data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard")}   # a site file works too
     options, exposure, consequences, economics, used = parse_mitigation(data, str(path))
     return MitigationStudy(hazard=hazard, options=options, exposure=exposure, consequences=consequences,
                            economics=economics, road_share=road_share, source=str(path), defaults_used=used)

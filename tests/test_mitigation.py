@@ -103,7 +103,7 @@ def test_bad_mitigation_files(data, match):
 
 def test_decide_command_on_bundled_site(tmp_path, capsys):
     out = tmp_path / "d"
-    rc = main(["decide", "--options", str(ROOT / "riskrf" / "data" / "demo_mitigation.toml"), "--inventory",
+    rc = main(["decide", "--options", str(ROOT / "riskrf" / "data" / "demo_site.toml"), "--inventory",
                str(INVENTORIES / "lauterbrunnen" / "lauterbrunnen_tls_2018.csv"), "--scenario", str(BARRIER),
                "-n", "5000", "--m-max", "2e6", "--rate-scale", "0.05", "--out", str(out)])
     assert rc == 0

@@ -1,0 +1,281 @@
+"""The whole chain for one site: inventory -> fits -> simulation -> energy hazard -> mitigation ranking.
+
+``run_assessment(site)`` computes; ``write_assessment(assessment, directory)`` writes
+report.html, summary.json, CSV tables, PNG figures and a copy of the inputs with the
+package version and seed.  ``riskrf assess`` and ``riskrf demo`` call both, writing
+into a temporary directory that is moved into place only when complete.
+"""
+from __future__ import annotations
+
+import json
+import platform
+import shutil
+import sys
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+from .energy_analysis import EnergyAnalysis, analyse_energy
+from .frequency import FrequencyAnalysis, analyse_inventory
+from .hazard import EnergyHazard
+from .inventory import Inventory, read_inventory
+from .magnitude import fit_gutenberg_richter
+from .mitigation import MitigationStudy
+from .outputs import write_json
+from .site import Site
+from .validation import RiskrfWarning
+
+
+def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, rate_scale: float = 1.0,
+                              scenario=None, velocities=None, collector: str = "barrier", n: int = 50_000,
+                              seed=1, reach_probability: float = 1.0, collector_given: bool = True,
+                              condition_on_mass: bool = False):
+    """Power-law fit of the inventory combined with simulated or given velocities.
+
+    Returns (power-law fit, EnergyHazard, SimulationResult or None).
+    """
+    import simulation
+
+    from .velocities import read_velocities
+
+    gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=m_min, m_max=m_max)
+    rate = gr.rate_min * rate_scale
+    if (scenario is None) == (velocities is None):
+        raise ValueError("give exactly one of --scenario (simulate the velocities) or --velocities (a file)")
+    result = None
+    if scenario is not None:
+        sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
+        sc.collector_index(collector)
+        result = simulation.run(sc, n=n, seed=seed)
+        hazard = EnergyHazard.from_simulation(gr, result, collector, rate_per_year=rate,
+                                              condition_on_mass=condition_on_mass)
+    else:
+        df = read_velocities(velocities, collector=collector if collector_given else None)
+        v = df["velocity_ms"].to_numpy(dtype=float)
+        note = f"velocities: {len(df):,} samples from {velocities}"
+        if "angular_velocity_rads" in df and "radius_m" in df:
+            v = np.sqrt(v ** 2 + 0.4 * (df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()) ** 2)
+            note += "; rotational energy included"
+        note += f"; reach probability {reach_probability:g} as given" + (
+            " (default: every fall assumed to reach the line)" if reach_probability == 1.0 else "")
+        hazard = EnergyHazard(mass=gr, velocity=v, rate_per_year=rate, reach_probability=reach_probability,
+                              heights_m=df["height_m"].to_numpy(dtype=float) if "height_m" in df else None,
+                              collector=collector, notes=(note,))
+    if rate_scale != 1.0:
+        hazard = EnergyHazard(**{**hazard.__dict__, "notes": hazard.notes + (
+            f"rate scaled by {rate_scale:g} (share of the inventoried source above this line)",)})
+    return gr, hazard, result
+
+
+def road_share(result, barrier: str, road: str | None) -> float:
+    """P(reaches the road | reaches the barrier line) from a simulation (1 without a road collector)."""
+    if result is None or road is None or road not in [c.name for c in result.scenario.collectors]:
+        return 1.0
+    b = result.reach_probability(barrier)[0]
+    return min(result.reach_probability(road)[0] / b, 1.0) if b > 0 else 1.0
+
+
+@dataclass
+class Assessment:
+    site: Site
+    inventory: Inventory
+    frequency: FrequencyAnalysis
+    maxima_frequency: FrequencyAnalysis | None
+    result: object
+    energy: EnergyAnalysis
+    study: MitigationStudy
+    decision: dict
+    seed: int
+    n_blocks: int
+    warnings: list = field(default_factory=list)
+    timings: dict = field(default_factory=dict)
+
+    def summary(self) -> dict:
+        """Every headline number, machine-readable, with units."""
+        fr, gr = self.frequency, self.frequency.power_law
+        hz = self.energy.hazard
+        ranking = self.decision["ranking"]
+        nothing = ranking[ranking["kind"] == "none"]
+        out = {
+            "site": self.site.name, "riskrf_version": __version__, "seed": self.seed, "n_blocks": self.n_blocks,
+            "units": {"mass": "kg", "volume": "m3", "energy": "kJ", "height": "m", "velocity": "m/s",
+                      "rate": "1/yr", "return_period": "yr", "money": self.study.currency},
+            "inventory": {"source": self.inventory.source, "events": self.inventory.n_events,
+                          "duration_years": self.inventory.duration_years,
+                          "density_kg_m3": self.inventory.density_kg_m3,
+                          "density_is_default": self.inventory.density_is_default},
+            "power_law": {"b": gr.b, "b_stderr": gr.b_stderr, "b_ci": list(gr.b_ci), "a": gr.a, "m_min_kg": gr.m_min,
+                          "m_min_method": gr.m_min_method, "rate_min_per_year": gr.rate_min,
+                          "bootstrap_p_value": fr.bootstrap_p},
+            "design_masses": fr.design_masses().to_dict(orient="records"),
+            "hazard": {"power_law_for_hazard": {"b": float(hz.mass.b), "m_max_kg": hz.mass.m_max,
+                                                "m_min_kg": float(hz.mass.m_min)},
+                       "falls_per_year": hz.rate_per_year, "reach_probability": hz.reach_probability,
+                       "arrivals_per_year": hz.arrival_rate,
+                       "road_share": self.study.road_share,
+                       "energy_p95_kj": float(hz.energy_percentile(95)[0]),
+                       "energy_p99_kj": float(hz.energy_percentile(99)[0]),
+                       "height_p95_m": float(hz.height_percentile(95)) if hz.heights_m is not None else None},
+            "design_energies": self.energy.design.to_dict(orient="records"),
+            "fences": self.energy.fence_verdicts().to_dict(orient="records"),
+            "ranking": ranking.to_dict(orient="records"),
+            "best_option": ranking["option"].iloc[0],
+            "second_option": ranking["option"].iloc[1],
+            "break_even": self.decision["break_even"].to_dict(orient="records"),
+            "individual_risk_do_nothing": float(nothing["individual_risk"].iloc[0]) if len(nothing) else None,
+            "defaults_used": list(self.site.defaults_used),
+            "warnings": self.warnings,
+            "timings_s": self.timings,
+        }
+        if fr.gumbel is not None or (self.maxima_frequency and self.maxima_frequency.gumbel is not None):
+            src = fr if fr.gumbel is not None else self.maxima_frequency
+            out["annual_maxima"] = {"source": src.inventory.source, "gumbel": dict(zip(src.gumbel.param_names,
+                                                                                      src.gumbel.params)),
+                                    "gev": dict(zip(src.gev.param_names, src.gev.params)) if src.gev else None,
+                                    "deviance_test": src.deviance}
+        return out
+
+
+def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None = None, log=print) -> Assessment:
+    """Run the whole chain for a validated site, logging each stage with its duration."""
+    from .decision_report import study_report
+
+    seed = site.hazard["seed"] if seed is None else seed
+    n_blocks = site.hazard["n_blocks"] if n_blocks is None else n_blocks
+    timings = {}
+    stages = 5
+
+    def stage(i, text):
+        log(f"[{i}/{stages}] {text}")
+        return time.perf_counter()
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RiskrfWarning)
+        inv_cfg = site.inventory
+        t = stage(1, "reading the inventory and fitting magnitude-frequency models")
+        inventory = read_inventory(site.resolve(inv_cfg["path"]), start=inv_cfg["start"], end=inv_cfg["end"],
+                                   duration_years=inv_cfg["duration_years"], density_kg_m3=inv_cfg["density_kg_m3"])
+        frequency = analyse_inventory(inventory, m_min=inv_cfg["m_min_kg"], n_bootstrap=500, seed=seed)
+        maxima_frequency = None
+        if inv_cfg["annual_maxima"]:
+            dated = read_inventory(site.resolve(inv_cfg["annual_maxima"]))
+            maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
+        timings["fits"] = round(time.perf_counter() - t, 2)
+
+        hz_cfg = site.hazard
+        t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
+        gr, hazard, result = energy_hazard_from_inputs(
+            inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=inv_cfg["rate_scale"],
+            scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
+            velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
+            collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"])
+        timings["simulation"] = round(time.perf_counter() - t, 2)
+
+        t = stage(3, "computing the impact-energy hazard, design energies and fence checks")
+        energy = analyse_energy(hazard, fences=tuple(hz_cfg["fences_kj"]), fence_height_m=hz_cfg["fence_height_m"],
+                                free_board_m=hz_cfg["free_board_m"], design_T=hz_cfg["design_period_years"],
+                                density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed)
+        timings["energy"] = round(time.perf_counter() - t, 2)
+
+        t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
+        share = road_share(result, hz_cfg["collector"], hz_cfg["road_collector"])
+        study = MitigationStudy(hazard=hazard, road_share=share, source=str(site.path),
+                                defaults_used=site.defaults_used, **site.mitigation)
+        decision = study_report(study)
+        timings["decision"] = round(time.perf_counter() - t, 2)
+    notes = []
+    for w in list(frequency.warnings) + [str(c.message) for c in caught]:
+        if w not in notes:
+            notes.append(w)
+    T_max = float(max(frequency.design_masses()["T_years"]))
+    if T_max > 2 * inventory.duration_years:
+        notes.append(f"design values for {T_max:g} years extrapolate a {inventory.duration_years:.3g}-year "
+                     "record far beyond the data")
+    if frequency.bootstrap_p is not None and frequency.bootstrap_p <= 0.1:
+        notes.append(f"the power law is questionable for this inventory (bootstrap p = {frequency.bootstrap_p:.3f})")
+    if frequency.power_law.n_tail < 50:
+        notes.append(f"only {frequency.power_law.n_tail} falls above m_min: the exponent b is uncertain")
+    return Assessment(site=site, inventory=inventory, frequency=frequency, maxima_frequency=maxima_frequency,
+                      result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
+                      warnings=notes, timings=timings)
+
+
+def write_assessment(a: Assessment, out: Path, log=print) -> None:
+    """Write every output of an assessment into ``out`` (an empty directory)."""
+    import matplotlib
+    matplotlib.use("Agg")
+
+    from .decision_report import write_mitigation_outputs
+    from .report import render_report
+
+    log("[5/5] writing the report, tables and figures")
+    t = time.perf_counter()
+    out = Path(out)
+    figs = out / "figures"
+    figs.mkdir()
+    a.frequency.write(figs)
+    for name in ("summary.json", "design_masses.csv", "completeness.csv"):
+        shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
+    if a.maxima_frequency is not None:
+        sub = figs / "annual_maxima"
+        sub.mkdir()
+        a.maxima_frequency.write(sub)
+    a.energy.write(figs)
+    for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv"):
+        if (figs / name).exists():
+            shutil.move(str(figs / name), str(out / name))
+    if a.result is not None:
+        _simulation_figures(a, figs)
+    write_mitigation_outputs(a.study, a.decision, figs)
+    for name in ("ranking.csv", "tornado.csv", "break_even.csv", "decision.json"):
+        shutil.move(str(figs / name), str(out / name))
+    a.timings["report"] = round(time.perf_counter() - t, 2)
+    write_json(a.summary(), out / "summary.json")
+    (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
+    _copy_inputs(a, out / "inputs")
+
+
+def _simulation_figures(a, figs):
+    import matplotlib.pyplot as plt
+
+    from simulation.plotting import plot_collector_distributions, plot_envelopes, plot_profile
+    res = a.result
+    ax = plot_profile(res)
+    ax.figure.savefig(figs / "profile_trajectories.png", dpi=110, bbox_inches="tight")
+    plt.close(ax.figure)
+    collector = a.site.hazard["collector"]
+    axes = plot_collector_distributions(res, collector)
+    axes[0][0].figure.tight_layout()
+    axes[0][0].figure.savefig(figs / "collector_distributions.png", dpi=100, bbox_inches="tight")
+    plt.close(axes[0][0].figure)
+    if res.scenario.settings.envelope_bins:
+        axes = plot_envelopes(res)
+        axes[0].figure.savefig(figs / "envelopes.png", dpi=100, bbox_inches="tight")
+        plt.close(axes[0].figure)
+
+
+def _copy_inputs(a: Assessment, dest: Path) -> None:
+    """Copy the site file and everything it names, with the version, seed and command, for exact reruns."""
+    dest.mkdir()
+    site = a.site
+    text = site.path.read_text(encoding="utf-8")
+    for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
+                       ("hazard", "velocities")):
+        rel = (site.inventory if table == "inventory" else site.hazard)[key]
+        if rel:
+            src = site.resolve(rel)
+            shutil.copy2(src, dest / src.name)
+            text = text.replace(f'"{rel}"', f'"{src.name}"').replace(f"'{rel}'", f"'{src.name}'")
+            side = src.with_suffix(".toml")
+            if table == "inventory" and side.exists():
+                shutil.copy2(side, dest / side.name)
+    (dest / site.path.name).write_text(text, encoding="utf-8")   # paths now point at the copies beside it
+    (dest / "run.json").write_text(json.dumps({
+        "riskrf_version": __version__, "seed": a.seed, "n_blocks": a.n_blocks, "site_file": site.path.name,
+        "command": " ".join(sys.argv), "python": platform.python_version(),
+        "rerun": f"riskrf assess {site.path.name} --seed {a.seed} -n {a.n_blocks} --out DIR"},
+        indent=2) + "\n", encoding="utf-8")

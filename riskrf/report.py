@@ -1,0 +1,197 @@
+"""The self-contained HTML report of an assessment (figures embedded, no network needed)."""
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import html
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from . import __version__
+from .risk import AGS2007_INDIVIDUAL_RISK
+
+CSS = """
+body{font-family:Georgia,'Times New Roman',serif;max-width:1100px;margin:2em auto;padding:0 1.5em;color:#222;
+line-height:1.45}
+h1{font-size:1.7em;border-bottom:2px solid #444;padding-bottom:.2em}h2{font-size:1.3em;margin-top:2em;
+border-bottom:1px solid #aaa}h3{font-size:1.05em}
+table{border-collapse:collapse;margin:.6em 0;font-size:.85em;font-family:Helvetica,Arial,sans-serif}
+th,td{border:1px solid #ccc;padding:.25em .5em;text-align:right}th{background:#eee}td:first-child,th:first-child
+{text-align:left}.box{background:#f4f7fb;border:1px solid #9ab;padding:.8em 1.2em;margin:1em 0}
+.warn{background:#fff6e5;border:1px solid #e0b060;padding:.6em 1.2em}figure{margin:1em 0;text-align:center}
+figure img{max-width:100%;height:auto;border:1px solid #ddd}figcaption{font-size:.85em;color:#555}
+.ok{color:#17692a;font-weight:bold}.fail{color:#a4161a;font-weight:bold}code{font-size:.9em}
+"""
+
+
+def _e(text) -> str:
+    return html.escape(str(text))
+
+
+def _table(df: pd.DataFrame, *, index=False, fmt="{:,.4g}") -> str:
+    def f(v):
+        if isinstance(v, (float, np.floating)):
+            return "" if np.isnan(v) else fmt.format(v)
+        return v
+    return df.map(f).to_html(index=index, escape=True, border=0)
+
+
+def _figure(path: Path, caption: str) -> str:
+    if not path.exists():
+        return ""
+    data = base64.b64encode(path.read_bytes()).decode("ascii")
+    return (f'<figure><img alt="{_e(caption)}" src="data:image/png;base64,{data}">'
+            f"<figcaption>{_e(caption)}</figcaption></figure>")
+
+
+def render_report(a, figs: Path) -> str:
+    """HTML of the hazard and mitigation report for assessment ``a`` (figures read from ``figs``)."""
+    site, inv, fr, gr = a.site, a.inventory, a.frequency, a.frequency.power_law
+    en, hz = a.energy, a.energy.hazard
+    ranking, cur = a.decision["ranking"], a.study.currency
+    best, second = ranking["option"].iloc[0], ranking["option"].iloc[1]
+    design = en.design.set_index("T_years")
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{_e(site.name)} - rock fall "
+             f"hazard and mitigation</title><style>{CSS}</style></head><body>",
+             f"<h1>Rock fall hazard and mitigation: {_e(site.name)}</h1>",
+             f"<p>{_e(site.description)}</p>",
+             f"<p><small>riskrf {__version__} &middot; seed {a.seed} &middot; {a.n_blocks:,} simulated blocks "
+             f"&middot; generated {_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; method after Wyllie "
+             f"(2014) <i>Rock Fall Engineering</i>, ch. 3-8</small></p>"]
+    verdicts = en.fence_verdicts()
+    e100 = design.loc[100.0] if 100.0 in design.index else None
+    e300 = design.loc[300.0] if 300.0 in design.index else None
+    summary = ["<div class='box'><b>Summary.</b><ul>",
+               f"<li>{inv.n_events} recorded falls in {inv.duration_years:.3g} years; power law b = {gr.b:.3f} "
+               f"± {gr.b_stderr:.3f} above {gr.m_min:,.4g} kg ({gr.rate_min:.3g} falls per year in the inventory).</li>",
+               f"<li>About {hz.arrival_rate:.3g} falls a year reach the barrier line "
+               f"(reach probability {hz.reach_probability:.3f}); 95 % of them carry less than "
+               f"{hz.energy_percentile(95)[0]:,.4g} kJ.</li>"]
+    for T, row in ((100, e100), (300, e300)):
+        if row is not None:
+            summary.append(f"<li>{T}-year impact energy: {row['energy_kj']:,.4g} kJ (95 % interval "
+                           f"{row['ci_low_kj']:,.4g} - {row['ci_high_kj']:,.4g} kJ).</li>")
+    for _, r in verdicts.iterrows():
+        cls = "ok" if r["adequate"] else "fail"
+        summary.append(f"<li>Fence {_e(r['fence'])}: <span class='{cls}'>"
+                       f"{'adequate' if r['adequate'] else 'not adequate'}</span>"
+                       f"{'' if r['adequate'] else ' (' + _e(r['failed checks']) + ')'}.</li>")
+    summary.append(f"<li>Lowest expected total cost: <b>{_e(best)}</b> "
+                   f"({ranking['expected_total_cost'].iloc[0]:,.0f} {_e(cur)}), then {_e(second)} "
+                   f"({ranking['expected_total_cost'].iloc[1]:,.0f} {_e(cur)}).</li></ul></div>")
+    parts += summary
+
+    # 1. Site and data
+    parts += ["<h2>1. Site and data</h2>", _table(inv.summary().reset_index().rename(columns={"index": "item"})),
+              "<h3>Completeness</h3><p>Falls per year and the smallest recorded size show whether recording "
+              "was consistent over the record.</p>", _table(inv.completeness().reset_index().head(60))]
+
+    # 2. Magnitude-frequency
+    comp = fr.comparison.reset_index()
+    parts += ["<h2>2. Magnitude-frequency relation (Wyllie 2014, 8.4.1)</h2>",
+              f"<p>log<sub>10</sub> N(&ge;m) = a &minus; b log<sub>10</sub> m, N per year, m in kg; "
+              f"{_e(gr.summary().loc['method', 'note'])}; completeness threshold m<sub>min</sub> by "
+              f"{'the Kolmogorov-Smirnov method (Clauset et al. 2009)' if gr.m_min_method == 'ks' else 'the user'}.</p>",
+              _table(gr.summary().reset_index()),
+              f"<p>Goodness of fit: KS distance {gr.ks_distance:.4f}; semiparametric bootstrap p = "
+              f"{fr.bootstrap_p:.3f} ({fr.n_bootstrap} replicates) &mdash; the power law is "
+              f"{'plausible' if (fr.bootstrap_p or 0) > 0.1 else 'questionable'} (p &gt; 0.1 needed).</p>",
+              _table(comp), _figure(figs / "magnitude_frequency.png", "Magnitude - cumulative frequency with the "
+                                                                      "fitted law and the interval of b"),
+              "<h3>Design masses</h3>", _table(fr.design_masses())]
+
+    # 3. Annual maxima
+    mf = fr if fr.gumbel is not None else a.maxima_frequency
+    parts.append("<h2>3. Extreme values of annual maxima (Wyllie 2014, 8.4.2)</h2>")
+    if mf is None or mf.gumbel is None:
+        parts.append("<p>Not fitted: the inventory has no dates, so there are no annual maxima, and the site "
+                     "file names no dated record (inventory.annual_maxima).</p>")
+    else:
+        sub = figs if mf is fr else figs / "annual_maxima"
+        d = mf.deviance or {}
+        preferred = ("Gumbel (the deviance test does not reject it)" if d.get("gumbel_adequate")
+                     else "GEV (the deviance test rejects the Gumbel)")
+        parts += [f"<p>Record used: <code>{_e(mf.inventory.source)}</code> &mdash; {_e(mf.inventory.site)}. "
+                  f"{mf.gumbel.data.size} annual maxima in {mf.gumbel.n_years} years; years without a fall "
+                  f"(p0 = {mf.gumbel.p_zero:.3f}) enter through the mixed model.</p>",
+                  _table(mf.gumbel.summary().reset_index())]
+        if mf.gev is not None:
+            parts += [_table(mf.gev.summary().reset_index()),
+                      f"<p>Deviance test Gumbel vs GEV: D = {d.get('deviance', np.nan):.3f}, p = "
+                      f"{d.get('p_value', np.nan):.3f}. Preferred model: <b>{preferred}</b>.</p>"]
+        parts += [_figure(sub / "gumbel_plot.png", "Gumbel probability plot"),
+                  _figure(sub / "return_levels.png", "Return levels of the annual maximum, with the law the power "
+                                                     "law implies")]
+
+    # 4. Simulation
+    parts.append("<h2>4. Trajectories at the barrier line (Wyllie 2014, ch. 3-7)</h2>")
+    if a.result is not None:
+        res = a.result
+        sc = res.scenario
+        parts += [f"<p>Scenario <b>{_e(sc.name)}</b>: {_e(sc.description)}</p>",
+                  _table(res.summary().reset_index().rename(columns={"index": "item"})),
+                  _figure(figs / "profile_trajectories.png", "Slope profile and a sample of trajectories"),
+                  _figure(figs / "collector_distributions.png", "Speed, bounce height and energy at the barrier "
+                                                                "line (of the simulated blocks)"),
+                  _figure(figs / "envelopes.png", "Envelopes along the slope")]
+    else:
+        parts.append(f"<p>{_e(hz.notes[0] if hz.notes else 'velocities from a file')}</p>")
+
+    # 5. Energy
+    parts += ["<h2>5. Impact energy hazard (Wyllie 2014, 8.1-8.3)</h2>",
+              "<p>&lambda;(E &gt; e) = rate of falls &times; P(reach) &times; P(E &gt; e), with the mass "
+              "distribution of the fitted power law and the simulated velocities (rotation included). "
+              "Intervals: seeded parametric bootstrap over b, the rate and the finite simulation.</p>",
+              _table(hz.summary().reset_index().rename(columns={"index": "item"})),
+              "<ul>" + "".join(f"<li>{_e(n)}</li>" for n in hz.notes) + "</ul>",
+              _figure(figs / "energy_exceedance.png", "Annual frequency of impacts above each energy"),
+              _figure(figs / "mass_velocity.png", "Masses and velocities with iso-energy lines"),
+              "<h3>Design energies</h3>", _table(en.design)]
+    if en.uni is not None:
+        u = en.uni
+        parts.append(f"<p>UNI 11211-4 design energy of the {en.design_T:g}-year block at the 95th-percentile "
+                     f"velocity: E<sub>k</sub> = {u.characteristic_energy_kj:,.4g} kJ, E<sub>d</sub> = "
+                     f"{u.design_energy_kj:,.4g} kJ with factors {_e(u.factors)}.</p>")
+
+    # 6. Fences
+    parts.append("<h2>6. Fence checks (ETAG 027 / EAD 340059: MEL, SEL = MEL/3)</h2>")
+    for name, table in en.fences.items():
+        parts += [f"<h3>{_e(name)}</h3>", _table(table)]
+
+    # 7. Risk
+    ir_limit = AGS2007_INDIVIDUAL_RISK["existing slope"]
+    risk = ranking[["option", "road_falls_per_year", "deaths_per_year", "individual_risk"]].copy()
+    risk["meets AGS 2007 1e-4/yr (existing slope)"] = risk["individual_risk"] <= ir_limit
+    parts += ["<h2>7. Risk to road users</h2>",
+              f"<p>Bunce et al. (1997): P(S:T) = N<sub>v</sub> L<sub>v</sub> / (24 &times; 1000 &times; "
+              f"V<sub>v</sub>) for {a.study.exposure.vehicles_per_day:,.0f} vehicles a day of "
+              f"{a.study.exposure.vehicle_length_m:g} m at {a.study.exposure.speed_kmh:g} km/h; a vehicle striking "
+              "a rock on the road; individual risk of a commuter (AGS 2007).</p>",
+              _table(risk, fmt="{:.3g}"), _figure(figs / "fn_curve.png", "F-N curves with Hong Kong GEO criteria")]
+
+    # 8. Decision
+    be = a.decision["break_even"]
+    parts += ["<h2>8. Mitigation decision (Wyllie 2014, 8.5.5)</h2>",
+              f"<p>Expected total cost = capital + present value of maintenance and repairs + present value of "
+              f"expected losses, over {a.study.economics.horizon_years:g} years at "
+              f"{a.study.economics.discount_rate:.1%} ({_e(cur)}).</p>",
+              _table(ranking.drop(columns=["kind"]), fmt="{:,.4g}"),
+              _figure(figs / "tree.png", "Decision tree; the optimal path in red"),
+              f"<h3>What would make {_e(second)} as good as {_e(best)}</h3>",
+              _table(be), _figure(figs / "tornado.png", "Tornado: the best option's expected total cost with each "
+                                                         "input halved and doubled")]
+
+    # 9. Assumptions
+    parts += ["<h2>9. Assumptions, defaults and warnings</h2><div class='warn'><ul>",
+              "<li>Lumped-mass trajectories of spheres; restitution and friction parameters are starting values "
+              "to be calibrated on site (Wyllie 2014, ch. 7).</li>",
+              "<li>Velocities are taken as independent of block mass; the rate and mass distribution come from the "
+              "fitted power law, applied at the barrier line"
+              + (f" with the rate scaled by {site.inventory['rate_scale']:g}" if site.inventory["rate_scale"] != 1
+                 else "") + ".</li>"]
+    parts += [f"<li>Default used: {_e(d)}</li>" for d in site.defaults_used]
+    parts += [f"<li>Warning: {_e(w)}</li>" for w in a.warnings]
+    parts.append("</ul></div></body></html>")
+    return "\n".join(parts)

@@ -1,0 +1,117 @@
+"""Site files: one TOML describing one assessment (inventory, slope, exposure, options, economics).
+
+Every field is documented in the README ("Site files").  Paths are relative to
+the site file.  Unknown fields are errors with a did-you-mean; optional fields
+left out take documented defaults, and :attr:`Site.defaults_used` lists them so
+the report can state them.  Everything is checked before any computing starts.
+"""
+from __future__ import annotations
+
+import difflib
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .mitigation import MitigationError, parse_mitigation
+
+
+class SiteError(ValueError):
+    """A site file is invalid; the message names the file and the field."""
+
+
+SITE_FIELDS = {
+    "site": {"name": None, "description": ""},
+    "inventory": {"path": None, "start": None, "end": None, "duration_years": None, "density_kg_m3": None,
+                  "m_min_kg": None, "m_max_kg": None, "rate_scale": 1.0, "annual_maxima": None},
+    "hazard": {"scenario": None, "velocities": None, "collector": "barrier", "road_collector": "road",
+               "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
+               "free_board_m": 0.5, "design_period_years": 100.0, "bootstrap": 300, "seed": 1},
+}
+MITIGATION_TABLES = ("traffic", "consequences", "economics", "options")
+
+
+@dataclass(frozen=True)
+class Site:
+    path: Path
+    name: str
+    description: str
+    inventory: dict
+    hazard: dict
+    mitigation: dict
+    defaults_used: tuple = field(default_factory=tuple)
+
+    def resolve(self, relative) -> Path:
+        return (self.path.parent / relative).resolve()
+
+
+def _unknown(key, allowed, where, source):
+    close = difflib.get_close_matches(key, list(allowed), n=1)
+    return SiteError(f"{source}: unknown field {where}{key!r}"
+                     + (f"; did you mean {close[0]!r}?" if close else f"; allowed: {', '.join(sorted(allowed))}"))
+
+
+def load_site(path) -> Site:
+    """Read and validate a site file; raises :class:`SiteError` before anything is computed."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"site file not found: {path}")
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise SiteError(f"{path}: not valid TOML: {exc}") from exc
+    allowed = set(SITE_FIELDS) | set(MITIGATION_TABLES)
+    for key in data:
+        if key not in allowed:
+            raise _unknown(key, allowed, "", path)
+    used = []
+    tables = {}
+    for table, fields in SITE_FIELDS.items():
+        given = data.get(table, {})
+        if not isinstance(given, dict):
+            raise SiteError(f"{path}: [{table}] must be a table")
+        for key in given:
+            if key not in fields:
+                raise _unknown(key, fields, f"{table}.", path)
+        merged = {}
+        for key, default in fields.items():
+            if key in given:
+                merged[key] = given[key]
+            else:
+                merged[key] = default
+                if default is not None:
+                    used.append(f"{table}.{key} = {default!r}")
+        tables[table] = merged
+    if tables["inventory"]["path"] is None:
+        raise SiteError(f"{path}: inventory.path is required (the rock fall inventory file)")
+    hz = tables["hazard"]
+    if (hz["scenario"] is None) == (hz["velocities"] is None):
+        raise SiteError(f"{path}: give exactly one of hazard.scenario (a slope scenario to simulate) or "
+                        "hazard.velocities (a velocity file)")
+    for key in ("n_blocks", "bootstrap"):
+        if not isinstance(hz[key], int) or hz[key] < 1:
+            raise SiteError(f"{path}: hazard.{key} = {hz[key]!r} must be a whole number >= 1")
+    if not isinstance(hz["fences_kj"], list) or not all(isinstance(v, (int, float)) and v > 0
+                                                        for v in hz["fences_kj"]):
+        raise SiteError(f"{path}: hazard.fences_kj = {hz['fences_kj']!r} must be a list of capacities > 0")
+    for key in ("fence_height_m", "free_board_m", "design_period_years"):
+        if not isinstance(hz[key], (int, float)) or hz[key] < 0:
+            raise SiteError(f"{path}: hazard.{key} = {hz[key]!r} must be a number >= 0")
+    inv = tables["inventory"]
+    if not isinstance(inv["rate_scale"], (int, float)) or not 0 < inv["rate_scale"] <= 1e6:
+        raise SiteError(f"{path}: inventory.rate_scale = {inv['rate_scale']!r} must be a number > 0")
+    for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
+                       ("hazard", "velocities")):
+        rel = tables[table][key]
+        if rel is not None and not (path.parent / rel).exists():
+            raise SiteError(f"{path}: {table}.{key} = {rel!r}: file not found ({(path.parent / rel).resolve()})")
+    mit = {k: data[k] for k in MITIGATION_TABLES if k in data}
+    try:
+        options, exposure, consequences, economics, mdefaults = parse_mitigation(mit, str(path))
+    except MitigationError as exc:
+        raise SiteError(str(exc)) from exc
+    used += list(mdefaults)
+    return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
+                description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
+                mitigation={"options": options, "exposure": exposure, "consequences": consequences,
+                            "economics": economics}, defaults_used=tuple(used))
