@@ -105,6 +105,16 @@ def load_site(path) -> Site:
         rel = tables[table][key]
         if rel is not None and not (path.parent / rel).exists():
             raise SiteError(f"{path}: {table}.{key} = {rel!r}: file not found ({(path.parent / rel).resolve()})")
+    if hz["scenario"] is not None:
+        import simulation
+        scenario = simulation.load_scenario(path.parent / hz["scenario"])
+        names = [c.name for c in scenario.collectors]
+        if hz["collector"] not in names:
+            raise SiteError(f"{path}: hazard.collector = {hz['collector']!r}: scenario {hz['scenario']!r} has no "
+                            f"collector named {hz['collector']!r}; its collectors are {names}")
+        if hz["road_collector"] not in names and "road_collector" in data.get("hazard", {}):
+            raise SiteError(f"{path}: hazard.road_collector = {hz['road_collector']!r}: scenario {hz['scenario']!r} "
+                            f"has no such collector; its collectors are {names}")
     mit = {k: data[k] for k in MITIGATION_TABLES if k in data}
     try:
         options, exposure, consequences, economics, mdefaults = parse_mitigation(mit, str(path))

@@ -1,0 +1,155 @@
+"""End to end: `riskrf assess` and `riskrf demo` (issue 6)."""
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import riskrf
+import simulation
+from riskrf.cli import main
+from riskrf.hazard import EnergyHazard
+from riskrf.site import SiteError, load_site
+
+from .conftest import ROOT
+
+SITE = ROOT / "riskrf" / "data" / "demo_site.toml"
+ARTIFACTS = ROOT / "tests" / "artifacts"
+
+
+def _site_copy(tmp_path, replace=None, drop=None):
+    """The demo site with absolute paths, optionally edited, in tmp_path."""
+    text = SITE.read_text()
+    data_dir = SITE.parent
+    for rel in ("lauterbrunnen_tls_2018.csv", "synthetic_corridor_1985_2024.csv",
+                "../../simulation/scenarios/road_cut_barrier.toml"):
+        text = text.replace(f'"{rel}"', f'"{(data_dir / rel).resolve()}"')
+    text = text.replace("n_blocks = 50000", "n_blocks = 6000").replace("bootstrap = 200", "bootstrap = 40")
+    for old, new in (replace or {}).items():
+        assert old in text, old
+        text = text.replace(old, new)
+    path = tmp_path / "site.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def assessed(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("assess")
+    site = _site_copy(tmp)
+    out = tmp / "out"
+    assert main(["assess", str(site), "--out", str(out)]) == 0
+    return site, out
+
+
+def test_assess_writes_everything(assessed):
+    site, out = assessed
+    for name in ("report.html", "summary.json", "ranking.csv", "design_energies.csv", "design_masses.csv",
+                 "break_even.csv", "tornado.csv", "fence_checks.csv", "inputs/run.json", "inputs/site.toml",
+                 "figures/energy_exceedance.png", "figures/tree.png", "figures/profile_trajectories.png"):
+        assert (out / name).exists(), name
+    run = json.loads((out / "inputs" / "run.json").read_text())
+    assert run["seed"] == 1 and run["riskrf_version"] == riskrf.__version__ and run["n_blocks"] == 6000
+    html = (out / "report.html").read_text()
+    assert "http://" not in html.replace("http://www.w3.org", "") and "https://" not in html   # no network needed
+    assert html.count("data:image/png;base64,") >= 10
+
+
+def test_summary_matches_the_modules(assessed):
+    site, out = assessed
+    s = json.loads((out / "summary.json").read_text())
+    inv = riskrf.read_inventory(SITE.parent / "lauterbrunnen_tls_2018.csv")
+    gr = riskrf.fit_gutenberg_richter(inv)
+    assert s["power_law"]["b"] == pytest.approx(gr.b) and s["power_law"]["m_min_kg"] == pytest.approx(gr.m_min)
+    # The hazard from the same seeded simulation, built directly with the modules:
+    grt = riskrf.fit_gutenberg_richter(inv, m_max=2.0e6)
+    sc = simulation.load_scenario(ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml")
+    res = simulation.run(sc, n=6000, seed=1)
+    hz = EnergyHazard.from_simulation(grt, res, "barrier", rate_per_year=0.05 * grt.rate_min)
+    assert s["hazard"]["arrivals_per_year"] == pytest.approx(hz.arrival_rate)
+    e = {row["T_years"]: row["energy_kj"] for row in s["design_energies"]}
+    np.testing.assert_allclose([e[100.0], e[300.0]], hz.energy_at_return_period([100, 300]), rtol=1e-9)
+    assert s["hazard"]["energy_p95_kj"] == pytest.approx(hz.energy_percentile(95)[0], rel=1e-9)
+    assert s["units"]["energy"] == "kJ" and s["units"]["money"] == "CHF"
+    assert s["best_option"] == s["ranking"][0]["option"]
+    assert "annual_maxima" in s and s["annual_maxima"]["deviance_test"]["p_value"] < 0.05
+
+
+def test_copied_inputs_rerun_to_the_same_numbers(assessed, tmp_path):
+    site, out = assessed
+    inputs = tmp_path / "inputs"
+    shutil.copytree(out / "inputs", inputs)
+    rerun = tmp_path / "rerun"
+    assert main(["assess", str(inputs / "site.toml"), "--out", str(rerun)]) == 0
+    a = json.loads((out / "summary.json").read_text())
+    b = json.loads((rerun / "summary.json").read_text())
+    assert a["design_energies"] == b["design_energies"] and a["ranking"] == b["ranking"]
+
+
+def test_report_in_headless_chromium(assessed):
+    """Open report.html in a real browser: no console errors, every figure has a size, save a screenshot."""
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    driver_path = shutil.which("chromedriver")
+    if not chromium or not driver_path:
+        pytest.skip("headless Chromium and chromedriver are not installed here (.ci/run installs them "
+                    "from Debian's chromium and chromium-driver packages)")
+    webdriver = pytest.importorskip("selenium.webdriver")
+    from selenium.webdriver.chrome.service import Service
+    site, out = assessed
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = chromium
+    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                "--disable-component-update", "--disable-sync", "--no-first-run", "--window-size=1280,2000"):
+        opts.add_argument(arg)
+    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    driver = webdriver.Chrome(service=Service(driver_path), options=opts)
+    try:
+        driver.get((out / "report.html").resolve().as_uri())
+        assert "rock fall hazard and mitigation" in driver.title
+        sizes = driver.execute_script(
+            "return Array.from(document.images).map(i => [i.complete, i.naturalWidth, i.naturalHeight, "
+            "i.getBoundingClientRect().width, i.getBoundingClientRect().height]);")
+        assert len(sizes) >= 10
+        assert all(c and w > 0 and h > 0 and rw > 0 and rh > 0 for c, w, h, rw, rh in sizes), sizes
+        errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+        assert errors == []
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        driver.save_screenshot(str(ARTIFACTS / "report.png"))
+        assert (ARTIFACTS / "report.png").stat().st_size > 10_000
+    finally:
+        driver.quit()
+
+
+@pytest.mark.parametrize("replace,match", [
+    ({"fence_height_m = 5.0": "fence_hieght_m = 5.0"}, "unknown field hazard.'fence_hieght_m'; did you mean "
+                                                         "'fence_height_m'"),
+    ({'lauterbrunnen_tls_2018.csv"': 'no_such_inventory.csv"'}, "inventory.path = .*no_such_inventory.csv.*file not "
+                                                                 "found"),
+    ({'capital_cost = 600000\n': ''}, "option 'catch ditch': missing field 'capital_cost'"),
+    ({'collector = "barrier"': 'collector = "fence line"'}, "has no collector named 'fence line'"),
+])
+def test_bad_site_files_fail_before_computing_and_leave_nothing(tmp_path, capsys, replace, match):
+    site = _site_copy(tmp_path, replace=replace)
+    out = tmp_path / "out"
+    rc = main(["assess", str(site), "--out", str(out)])
+    err = capsys.readouterr()
+    assert rc == 2
+    assert __import__("re").search(match, err.err), err.err
+    assert "[2/5]" not in err.out          # failed before the simulation started
+    assert not out.exists() and [p.name for p in tmp_path.iterdir()] == ["site.toml"]
+
+
+def test_missing_site_file(tmp_path, capsys):
+    assert main(["assess", str(tmp_path / "none.toml")]) == 2
+    assert "site file not found" in capsys.readouterr().err
+
+
+def test_user_text_is_escaped(tmp_path):
+    site = _site_copy(tmp_path, replace={'name = "Demo: road below a limestone rock wall"':
+                                         'name = "<script>alert(1)</script> & road"'})
+    from riskrf.report import _e
+    assert _e("<script>") == "&lt;script&gt;"
+    assert load_site(site).name.startswith("<script>")
