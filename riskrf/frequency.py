@@ -40,6 +40,7 @@ class FrequencyAnalysis:
     deviance: dict | None = None
     skipped: dict = field(default_factory=dict)
     warnings: tuple = ()
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def design_masses(self, T=DESIGN_RETURN_PERIODS, level: float = 0.95) -> pd.DataFrame:
         """Design masses [kg] by return period from each model, with intervals.
@@ -49,7 +50,12 @@ class FrequencyAnalysis:
         implies), ``Gumbel`` and ``GEV`` (annual maxima).  ``extrapolated`` marks
         return periods longer than twice the record.
         """
-        T = np.asarray(T, dtype=float)
+        key = (tuple(np.atleast_1d(T).tolist()), level)
+        if key not in self._cache:          # profile-likelihood intervals are worth computing once
+            self._cache[key] = self._design_masses(np.asarray(T, dtype=float), level)
+        return self._cache[key].copy()
+
+    def _design_masses(self, T, level):
         rows = []
         gr = self.power_law
         rho = self.inventory.density_kg_m3
