@@ -127,7 +127,7 @@ class FrequencyAnalysis:
                  f"{inv.period_source}); density {inv.density_kg_m3:g} kg/m3"
                  + (" (default)" if inv.density_is_default else ""), "",
                  "Power law  log10 N(>=m) = a - b log10 m   [N per year, m in kg]  (Wyllie 2014, 8.4.1)",
-                 f"  method   maximum likelihood (Aki 1965 / Clauset et al. 2009)" if gr.method == "mle" else
+                 "  method   maximum likelihood (Aki 1965 / Clauset et al. 2009)" if gr.method == "mle" else
                  "  method   least squares (practitioners' method)",
                  f"  b        {gr.b:.4f} ± {gr.b_stderr:.4f}  ({gr.level:.0%} interval {gr.b_ci[0]:.4f} - "
                  f"{gr.b_ci[1]:.4f}, {gr.b_ci_method.split(' (')[0]})",

@@ -61,8 +61,12 @@ def _normal(state):
 @njit(cache=True)
 def _seg_of(px, x):
     """Segment index under x by bisection (left segment at a vertex)."""
-    n = px.shape[0] - 1
-    lo, hi = 0, n - 1
+    return _seg_in(px, x, 0, px.shape[0] - 2)
+
+
+@njit(cache=True)
+def _seg_in(px, x, lo, hi):
+    """Segment index under x among segments lo..hi, by bisection."""
     while lo < hi:
         mid = (lo + hi + 1) // 2
         if px[mid] <= x:
@@ -81,8 +85,15 @@ def _ground(px, pz, x):
 @njit(cache=True)
 def _leaf_hit(px, pz, k, x0, z0, vx, vz, g):
     """Time > 0 at which the parabola comes down through segment k within its x-range, or inf."""
-    slope = (pz[k + 1] - pz[k]) / (px[k + 1] - px[k])
-    c0 = z0 - (pz[k] + slope * (x0 - px[k]))
+    return _span_hit(px, pz, k, k, x0, z0, vx, vz, g)
+
+
+@njit(cache=True)
+def _span_hit(px, pz, k0, k1, x0, z0, vx, vz, g):
+    """Time > 0 at which the parabola comes down through the line of segment k0 within the x-range of
+    segments k0..k1 (a straight run), or inf: the larger root of z(t) = line(x(t))."""
+    slope = (pz[k0 + 1] - pz[k0]) / (px[k0 + 1] - px[k0])
+    c0 = z0 - (pz[k0] + slope * (x0 - px[k0]))
     c1 = vz - slope * vx
     disc = c1 * c1 + 2.0 * g * c0
     if disc < 0.0:
@@ -92,7 +103,7 @@ def _leaf_hit(px, pz, k, x0, z0, vx, vz, g):
         return math.inf
     x = x0 + vx * t
     tol = 1e-9 * (1.0 + abs(x))
-    if x < px[k] - tol or x > px[k + 1] + tol:
+    if x < px[k0] - tol or x > px[k1 + 1] + tol:
         return math.inf
     return t
 
@@ -145,28 +156,11 @@ def _descend(px, pz, tree, root, root_lo, root_hi, x0, z0, vx, vz, g, xa_travel,
 
 @njit(cache=True)
 def _run_hit(px, pz, k0, k1, x0, z0, vx, vz, g):
-    """Like _leaf_hit for the straight run of segments k0..k1 (one line); returns (t, segment)."""
-    slope = (pz[k0 + 1] - pz[k0]) / (px[k0 + 1] - px[k0])
-    c0 = z0 - (pz[k0] + slope * (x0 - px[k0]))
-    c1 = vz - slope * vx
-    disc = c1 * c1 + 2.0 * g * c0
-    if disc < 0.0:
+    """_span_hit for a straight run k0..k1, with the segment hit: (t, segment) or (inf, -1)."""
+    t = _span_hit(px, pz, k0, k1, x0, z0, vx, vz, g)
+    if t == math.inf:
         return math.inf, -1
-    t = (c1 + math.sqrt(disc)) / g
-    if t <= 1e-12:
-        return math.inf, -1
-    x = x0 + vx * t
-    tol = 1e-9 * (1.0 + abs(x))
-    if x < px[k0] - tol or x > px[k1 + 1] + tol:
-        return math.inf, -1
-    lo, hi = k0, k1
-    while lo < hi:
-        mid = (lo + hi + 1) // 2
-        if px[mid] <= x:
-            lo = mid
-        else:
-            hi = mid - 1
-    return t, lo
+    return t, _seg_in(px, x0 + vx * t, k0, k1)
 
 
 @njit(cache=True)

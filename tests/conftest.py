@@ -10,3 +10,9 @@ INVENTORIES = ROOT / "inventories"
 @pytest.fixture
 def data_dir():
     return DATA
+
+from hypothesis import settings  # noqa: E402
+
+# Property tests draw the same examples on every run: CI results do not depend on chance.
+settings.register_profile("riskrf", derandomize=True, deadline=None)
+settings.load_profile("riskrf")

@@ -1,9 +1,6 @@
 """End to end: `riskrf assess` and `riskrf demo` (issue 6)."""
 import json
 import shutil
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,7 +9,7 @@ import riskrf
 import simulation
 from riskrf.cli import main
 from riskrf.hazard import EnergyHazard
-from riskrf.site import SiteError, load_site
+from riskrf.site import load_site
 
 from .conftest import ROOT
 

@@ -1,6 +1,5 @@
 """`riskrf simulate` (issue 3, item 6)."""
 import pandas as pd
-import pytest
 
 from riskrf.cli import main
 
