@@ -66,6 +66,10 @@ def render_report(a, figs: Path) -> str:
     summary = ["<div class='box'><b>Summary.</b><ul>",
                f"<li>{inv.n_events} recorded falls in {inv.duration_years:.3g} years; power law b = {gr.b:.3f} "
                f"± {gr.b_stderr:.3f} above {gr.m_min:,.4g} kg ({gr.rate_min:.3g} falls per year in the inventory).</li>",
+               (f"<li>For the hazard the law is refitted with the maximum credible block m<sub>max</sub> = "
+                f"{hz.mass.m_max:,.4g} kg (b = {hz.mass.b:.3f})"
+                + (f" and its rate scaled by {site.inventory['rate_scale']:g}" if site.inventory["rate_scale"] != 1
+                   else "") + ".</li>") if getattr(hz.mass, "m_max", None) else "",
                f"<li>About {hz.arrival_rate:.3g} falls a year reach the barrier line "
                f"(reach probability {hz.reach_probability:.3f}); 95 % of them carry less than "
                f"{hz.energy_percentile(95)[0]:,.4g} kJ.</li>"]

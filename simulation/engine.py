@@ -107,9 +107,11 @@ def run(scenario: Scenario, n: int = 10_000, seed=None, *, chunk_size: int = DEF
                  (("x", float), ("z", float), ("reason", np.int64), ("impacts", np.int64), ("t", float))}
     rows = []
     dropped = 0
-    started = time.perf_counter()
-    for lo in range(0, n, chunk_size):
-        hi = min(lo + chunk_size, n)
+    chunks = [(lo, min(lo + chunk_size, n)) for lo in range(0, n, chunk_size)]
+    started = None
+    for lo, hi in [(0, 0)] + chunks:     # an empty first call compiles (or loads) the kernel, untimed
+        if started is None and hi > 0:
+            started = time.perf_counter()
         m = hi - lo
         cap = max(4 * m * max(len(cols), 1), 16)
         r = {k: np.empty(cap, dtype=dt) for k, dt in
@@ -132,7 +134,7 @@ def run(scenario: Scenario, n: int = 10_000, seed=None, *, chunk_size: int = DEF
         k = int(r_count[0])
         rows.append({name: arr[:k].copy() for name, arr in r.items()})
         dropped += int(r_count[1])
-        if progress:
+        if progress and hi > 0:
             _progress_bar(hi, n, started, sys.stderr)
     elapsed = time.perf_counter() - started
     merged = {name: np.concatenate([c[name] for c in rows]) for name in rows[0]}
