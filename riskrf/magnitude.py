@@ -371,10 +371,6 @@ class GutenbergRichterFit:
         return pd.DataFrame(rows).set_index("alternative")
 
     # -- reporting ---------------------------------------------------------------
-    @property
-    def largest_observed(self) -> float:
-        return float(np.max(self.data)) if self.data is not None else np.nan
-
     def summary(self) -> pd.DataFrame:
         """Parameters with standard errors and intervals, and how they were obtained."""
         method = ("maximum likelihood (Aki 1965; Clauset et al. 2009)" + (", unbiased (n-1)/n" if self.unbiased else "")

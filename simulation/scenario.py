@@ -94,11 +94,6 @@ class Distribution:
         return (0.0 if p["sigma"] > 0 else p["median"]), p.get("max", math.inf if p["sigma"] > 0 else p["median"])
 
 
-    @property
-    def mean(self) -> float:
-        return float(np.mean(self.sample(np.random.default_rng(0), 20000))) if self.kind != "constant" \
-            else self.params["value"]
-
     def sample(self, rng: np.random.Generator, n: int) -> np.ndarray:
         p = self.params
         if self.kind == "constant":

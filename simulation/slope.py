@@ -83,11 +83,6 @@ class Profile:
     def n_segments(self) -> int:
         return self.x.size - 1
 
-    @property
-    def angles_rad(self) -> np.ndarray:
-        """Segment inclination, positive when the ground rises with x [rad]."""
-        return np.arctan2(np.diff(self.z), np.diff(self.x))
-
     def ground(self, x) -> np.ndarray:
         """Ground elevation at x [m] (linear between vertices)."""
         return np.interp(x, self.x, self.z)

@@ -81,6 +81,8 @@ def test_conditioning_on_mass_matches_independent_case_when_independent():
     m = MASS.rvs(200_000, random_state=rng)
     p = exceedance_probability([100, 500], MASS, PairedSamples(v, m))
     np.testing.assert_allclose(p, ENERGY.sf([100, 500]), rtol=0.03)
+    from_table = PairedSamples.from_collector(pd.DataFrame({"velocity_ms": v, "mass_kg": m}))
+    np.testing.assert_allclose(exceedance_probability([100, 500], MASS, from_table), p)
 
 
 @settings(max_examples=40, deadline=None)

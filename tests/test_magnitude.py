@@ -73,6 +73,8 @@ def test_frequency_methods_are_consistent():
     np.testing.assert_allclose(fit.mass_at_return_period(T), (10 ** fit.a * T) ** (1 / fit.b))
     # Frechet annual maximum: m_T = (10^a / -ln(1 - 1/T))^(1/b)   (domain-methods.md 1.1)
     np.testing.assert_allclose(fit.annual_max_return_level(T), (10 ** fit.a / -np.log(1 - 1 / T)) ** (1 / fit.b))
+    # exp(-N(>=m)) is the annual-maximum CDF; at its T-year level it equals 1 - 1/T.
+    np.testing.assert_allclose(fit.annual_max_cdf(fit.annual_max_return_level(T)), 1 - 1 / T)
     p = fit.probability_in(30, mT[1])
     assert p == pytest.approx(1 - np.exp(-30 / 50))
     lo, hi = fit.mass_at_return_period_ci(T)

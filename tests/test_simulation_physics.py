@@ -179,3 +179,12 @@ def test_impact_search_matches_brute_force(seed, n_seg):
         assert x[k] - 1e-9 <= x0 + vx * t <= x[k + 1] + 1e-9
     else:
         assert k == -1
+
+
+def test_with_barrier_turns_a_collector_into_a_fence():
+    sc = scenario([0, 200], [0, 0], seeder={"x": 0.0, "height_m": 20.0, "vx_ms": 10.0},
+                  collectors=[{"name": "line", "x": 10.0}])
+    fenced = sc.with_barrier("line", capacity_kj=1e9, height_m=100.0)
+    res = simulation.run(fenced, n=3, seed=1)
+    assert (res.collector("line")["outcome"] == "caught").all()
+    assert simulation.run(sc, n=3, seed=1).collector("line")["outcome"].eq("crossed").all()
