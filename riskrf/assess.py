@@ -126,6 +126,7 @@ class Assessment:
             "best_option": ranking["option"].iloc[0],
             "second_option": ranking["option"].iloc[1],
             "break_even": self.decision["break_even"].to_dict(orient="records"),
+            "value_of_information": self.decision["value_of_information"],
             "individual_risk_do_nothing": float(nothing["individual_risk"].iloc[0]) if len(nothing) else None,
             "defaults_used": list(self.site.defaults_used),
             "warnings": self.warnings,

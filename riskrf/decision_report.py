@@ -28,13 +28,18 @@ def study_report(study) -> dict:
             lines.append(f"  {r.parameter}: {r.current:,.4g} -> {r.break_even:,.4g} (x{r.factor:.3g})")
         else:
             lines.append(f"  {r.parameter}: {r.note}")
+    voi = study.value_of_information()
+    lines += ["", f"Value of perfect information about the fall rate (x0.5 / x1 / x2 with probabilities "
+                  f"1/4, 1/2, 1/4): {voi['evpi']:,.0f} {cur}; best option by rate: "
+                  + ", ".join(f"{k}: {v}" for k, v in voi["best_by_rate"].items())]
     lines += ["", "Tornado (best option's expected total cost with each input halved / doubled):"]
     for r in tornado.itertuples():
         lines.append(f"  {r.parameter:<40} {r.cost_at_low:>14,.0f} .. {r.cost_at_high:>14,.0f}   "
                      f"best: {r.best_at_low} / {r.best_at_high}")
     if study.defaults_used:
         lines += ["", "Defaults used: " + "; ".join(study.defaults_used)]
-    return {"ranking": ranking, "tornado": tornado, "break_even": be, "text": "\n".join(lines)}
+    return {"ranking": ranking, "tornado": tornado, "break_even": be, "value_of_information": voi,
+            "text": "\n".join(lines)}
 
 
 def write_mitigation_outputs(study, report, tmp) -> None:
@@ -50,6 +55,7 @@ def write_mitigation_outputs(study, report, tmp) -> None:
     tree = study.to_tree()
     write_json({"currency": study.currency, "ranking": report["ranking"], "break_even": report["break_even"],
                 "tornado": report["tornado"], "tree_value": tree.rollback().value,
+                "value_of_information": report["value_of_information"],
                 "defaults_used": list(study.defaults_used)}, tmp / "decision.json")
     ax = plot_tree(tree)
     ax.figure.savefig(tmp / "tree.png", dpi=110, bbox_inches="tight")

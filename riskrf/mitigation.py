@@ -285,6 +285,30 @@ class MitigationStudy:
                          "note": f"{b!r} ties with {a!r}" if be else "no tie within x0.001-x1000"})
         return pd.DataFrame(rows)
 
+    def value_of_information(self, factors=(0.5, 1.0, 2.0), weights=(0.25, 0.5, 0.25)) -> dict:
+        """Expected value of perfect information about the rate of falls.
+
+        The rate is uncertain by more than its Poisson error (the share of the source
+        above the road, completeness, changes with time); ``factors`` and ``weights``
+        give a discrete distribution of the true rate relative to the estimate
+        (default: half, as estimated, double with probabilities 1/4, 1/2, 1/4).  EVPI =
+        cost of the best option chosen now minus the expected cost of choosing after
+        learning the rate: the most a monitoring programme that settles it is worth.
+        """
+        f = np.asarray(factors, dtype=float)
+        w = np.asarray(weights, dtype=float)
+        if f.shape != w.shape or np.any(f <= 0) or np.any(w < 0) or abs(w.sum() - 1) > 1e-9:
+            raise MitigationError(f"value_of_information: factors {f.tolist()} must be > 0 and weights {w.tolist()} "
+                                  "non-negative, as many, summing to 1")
+        tables = [self._scaled("fall_rate", x).ranking().set_index("option")["expected_total_cost"] for x in f]
+        expected = sum(wi * t for wi, t in zip(w, tables))
+        now = expected.idxmin()
+        informed = float(sum(wi * t.min() for wi, t in zip(w, tables)))
+        return {"evpi": float(expected[now] - informed), "best_now": now,
+                "expected_cost_now": float(expected[now]), "expected_cost_informed": informed,
+                "best_by_rate": {f"x{x:g}": t.idxmin() for x, t in zip(f, tables)},
+                "factors": f.tolist(), "weights": w.tolist()}
+
     # ---- societal risk and tree --------------------------------------------------------
     def fn_curve(self, option: str) -> pd.DataFrame:
         opt = next((o for o in self.options if o.name == option), None)

@@ -186,6 +186,11 @@ def render_report(a, figs: Path) -> str:
               f"<h3>What would make {_e(second)} as good as {_e(best)}</h3>",
               _table(be), _figure(figs / "tornado.png", "Tornado: the best option's expected total cost with each "
                                                          "input halved and doubled")]
+    voi = a.decision["value_of_information"]
+    parts.append(f"<p>Value of perfect information about the rate of falls (true rate half, as estimated or "
+                 f"double the estimate, with probabilities 1/4, 1/2, 1/4): <b>{voi['evpi']:,.0f} {_e(cur)}</b> &mdash; "
+                 f"the most that monitoring which settles the rate is worth. Best option by rate: "
+                 + ", ".join(f"{_e(k)}: {_e(v)}" for k, v in voi["best_by_rate"].items()) + ".</p>")
 
     # 9. Assumptions
     parts += ["<h2>9. Assumptions, defaults and warnings</h2><div class='warn'><ul>",

@@ -121,3 +121,14 @@ def test_decide_command_on_a_tree_file(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "counteroffer 5 billion" in text and "EVPI of 'court'" in text
     assert (tmp_path / "t" / "tree.png").stat().st_size > 0
+
+
+def test_value_of_information_about_the_rate():
+    s = study()
+    voi = s.value_of_information()
+    tables = [s._scaled("fall_rate", f).ranking().set_index("option")["expected_total_cost"] for f in (0.5, 1, 2)]
+    expected = 0.25 * tables[0] + 0.5 * tables[1] + 0.25 * tables[2]
+    informed = 0.25 * tables[0].min() + 0.5 * tables[1].min() + 0.25 * tables[2].min()
+    assert voi["evpi"] == pytest.approx(expected.min() - informed) and voi["evpi"] >= 0
+    with pytest.raises(MitigationError, match="summing to 1"):
+        s.value_of_information(weights=(0.5, 0.5, 0.5))
