@@ -269,7 +269,10 @@ def cmd_demo(args) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="riskrf", description="Rock fall hazard, risk and mitigation decisions (after Wyllie 2014, "
-        "Rock Fall Engineering, chapters 3-8).", epilog=EPILOG)
+        "Rock Fall Engineering, chapters 3-8).  Start with 'riskrf demo' (the whole chain on a bundled site, "
+        "report in ./riskrf-demo/report.html), then copy riskrf/data/demo_site.toml, point it at your inventory "
+        "and slope, and run 'riskrf assess your_site.toml'.  Each step also runs alone: fit -> simulate -> "
+        "energy -> decide.", epilog=EPILOG)
     parser.add_argument("--version", action="version", version=f"riskrf {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
