@@ -210,6 +210,19 @@ def find_impact(px, pz, tree, n_leaves, run_first, run_last, x0, z0, vx, vz, g, 
 
 
 @njit(cache=True)
+def _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count, block, coll, t, vx, vz, w, h,
+                     outcome):
+    """Append one collector crossing; count it as dropped when the chunk's buffer is full."""
+    i = r_count[0]
+    if i < r_block.shape[0]:
+        r_block[i], r_coll[i], r_t[i] = block, coll, t
+        r_vx[i], r_vz[i], r_w[i], r_h[i], r_outcome[i] = vx, vz, w, h, outcome
+        r_count[0] = i + 1
+    else:
+        r_count[1] += 1
+
+
+@njit(cache=True)
 def _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, block, t, x, z, vx, vz, mode):
     i = pcount[0]
     if i < pb.shape[0]:
@@ -329,13 +342,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
                                 vxn, vzn, wn = vx * f, vzc * f, w * f
                         else:
                             outcome = BARRIER_OVER
-                    i = r_count[0]
-                    if i < r_block.shape[0]:
-                        r_block[i], r_coll[i], r_t[i] = bid, j, t_abs + tc
-                        r_vx[i], r_vz[i], r_w[i], r_h[i], r_outcome[i] = vx, vzc, w, h, outcome
-                        r_count[0] = i + 1
-                    else:
-                        r_count[1] += 1
+                    _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
+                                     bid, j, t_abs + tc, vx, vzc, w, h, outcome)
                     if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
                         if env_x.shape[0] > 0:
                             _envelope(env_x, env_acc, x, c_x[j], x, z, vx, vz, w, g, px, pz, mass, inertia, r,
@@ -474,13 +482,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
                 if not math.isnan(c_cap[j]):
                     e = (0.5 * mass * uc * uc + 0.5 * inertia * wc * wc) / 1000.0
                     outcome = BARRIER_CAUGHT if e <= c_cap[j] else BARRIER_THROUGH
-                i = r_count[0]
-                if i < r_block.shape[0]:
-                    r_block[i], r_coll[i], r_t[i] = bid, j, t_abs + tc
-                    r_vx[i], r_vz[i], r_w[i], r_h[i], r_outcome[i] = vxc, vzc, wc, 0.0, outcome
-                    r_count[0] = i + 1
-                else:
-                    r_count[1] += 1
+                _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
+                                 bid, j, t_abs + tc, vxc, vzc, wc, 0.0, outcome)
                 if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
                     if env_x.shape[0] > 0:
                         _envelope(env_x, env_acc, x, c_x[j], x, z, 0.0, 0.0, 0.0, g, px, pz, mass, inertia, r, u,
