@@ -21,7 +21,7 @@ import numpy as np
 from . import __version__
 from .energy_analysis import EnergyAnalysis, analyse_energy
 from .frequency import FrequencyAnalysis, analyse_inventory
-from .hazard import EnergyHazard
+from .hazard import EnergyHazard, inertia_factors
 from .inventory import Inventory, read_inventory
 from .magnitude import fit_gutenberg_richter
 from .mitigation import MitigationStudy
@@ -58,7 +58,8 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
         v = df["velocity_ms"].to_numpy(dtype=float)
         note = f"velocities: {len(df):,} samples from {velocities}"
         if "angular_velocity_rads" in df and "radius_m" in df:
-            v = np.sqrt(v ** 2 + 0.4 * (df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()) ** 2)
+            spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
+            v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
             note += "; rotational energy included"
         note += f"; reach probability {reach_probability:g} as given" + (
             " (default: every fall assumed to reach the line)" if reach_probability == 1.0 else "")

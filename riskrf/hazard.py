@@ -22,6 +22,11 @@ from .frequency import DESIGN_RETURN_PERIODS
 from .magnitude import GutenbergRichterFit
 from .validation import check_positive, check_probability_level, check_return_periods
 
+def inertia_factors(df) -> np.ndarray:
+    """I / (m r^2) of each block in a collector table (0.4, a sphere, when the table does not say)."""
+    return df["inertia_factor"].to_numpy(dtype=float) if "inertia_factor" in df else np.full(len(df), 0.4)
+
+
 _E_GRID = np.geomspace(1e-3, 1e12, 301)     # kJ: the grid on which hazard curves are inverted
 
 
@@ -34,9 +39,9 @@ class EnergyHazard:
     mass : mass model (usually a :class:`~riskrf.GutenbergRichterFit`)
     velocity : velocity model: samples [m/s], scipy distribution, VelocityFit or PairedSamples.
         With samples from a simulation the effective speed includes rotation:
-        v_eff^2 = v^2 + 0.4 (w r)^2, so that 1/2 m v_eff^2 is the total kinetic
-        energy (exact for a rolling sphere, whose surface speed w r does not
-        depend on its mass).
+        v_eff^2 = v^2 + k (w r)^2 (k = I / m r^2: 0.4 sphere, 0.5 cylinder), so that
+        1/2 m v_eff^2 is the total kinetic energy (exact for a rolling body, whose
+        surface speed w r does not depend on its mass).
     rate_per_year : falls per year described by the mass model (power law: falls >= m_min).
     reach_probability : P(a fall reaches the barrier line) (simulation).
     n_released : number of simulated blocks behind ``reach_probability`` (for its uncertainty).
@@ -76,10 +81,11 @@ class EnergyHazard:
                              "for the simulated release; check the scenario")
         v = df["velocity_ms"].to_numpy()
         if rotational:
-            v = np.sqrt(v ** 2 + 0.4 * (df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()) ** 2)
+            spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
+            v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
         velocity = PairedSamples(v, df["mass_kg"].to_numpy()) if condition_on_mass else v
         notes = (f"velocities: first crossings of {collector!r} by {len(df):,} of {result.n:,} simulated blocks"
-                 + ("; rotational energy included (v_eff^2 = v^2 + 0.4 (w r)^2)" if rotational else ""),)
+                 + ("; rotational energy included (v_eff^2 = v^2 + k (w r)^2)" if rotational else ""),)
         return cls(mass=mass, velocity=velocity, rate_per_year=float(rate_per_year),
                    reach_probability=len(df) / result.n, n_released=result.n,
                    heights_m=df["height_m"].to_numpy(), collector=collector, notes=notes)

@@ -35,17 +35,16 @@ def _material_arrays(scenario: Scenario):
 
 
 def seed_blocks(scenario: Scenario, n: int, seed) -> dict:
-    """Initial state of n blocks: position [m], velocity [m/s], spin [rad/s], mass [kg], radius [m]."""
+    """Initial state of n blocks: position [m], velocity [m/s], spin [rad/s], mass [kg], radius [m], I/(m r^2)."""
     sd = scenario.seeder
     ss = np.random.SeedSequence(seed)
     g_x, g_h, g_m, g_vx, g_vz, g_w = (np.random.default_rng(c) for c in ss.spawn(6))
     x = g_x.uniform(sd.x_low, sd.x_high, n) if sd.x_high > sd.x_low else np.full(n, sd.x_low)
     h = sd.height_m.sample(g_h, n)
     mass = sd.mass_kg.sample(g_m, n)
-    radius = (3.0 * mass / (4.0 * np.pi * sd.density_kg_m3)) ** (1.0 / 3.0)
     return {"x": x, "z": scenario.profile.ground(x) + h, "vx": sd.vx_ms.sample(g_vx, n),
             "vz": sd.vz_ms.sample(g_vz, n), "w": sd.angular_velocity_rads.sample(g_w, n),
-            "mass": mass, "radius": radius}
+            "mass": mass, "radius": sd.radius(mass), "inertia_factor": np.full(n, sd.inertia_factor)}
 
 
 def _progress_bar(done: int, total: int, started: float, stream) -> None:
@@ -121,6 +120,7 @@ def run(scenario: Scenario, n: int = 10_000, seed=None, *, chunk_size: int = DEF
         kernel.simulate(
             np.arange(lo, hi, dtype=np.int64), blocks["x"][lo:hi], blocks["z"][lo:hi], blocks["vx"][lo:hi],
             blocks["vz"][lo:hi], blocks["w"][lo:hi], blocks["mass"][lo:hi], blocks["radius"][lo:hi],
+            blocks["inertia_factor"][lo:hi],
             prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.material_index, prof.run_first, prof.run_last, **mats,
             c_x=c_x, c_cap=c_cap, c_h=c_h, env_x=env_x, env_acc=env_acc,
             g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,

@@ -27,7 +27,8 @@ Tangential laws (``ET_*`` codes)
 --------------------------------
 * ``ET_FRICTION``: the rough rotating sphere of Stronge (2000) as set out by
   Wyllie (2014, ch. 5): the normal impulse is m (1 + e_N)|v_n|; the tangential
-  impulse needed to stop slip is (2/7) m |slip| for a solid sphere (I = 2/5 m r^2).
+  impulse needed to stop slip is (2/7) m |slip| for a solid sphere (I = 2/5 m r^2),
+  |slip| / (1 + 1/k) m for a round body with I = k m r^2 (k = 1/2: cylinder, disc).
   If that is within mu (1 + e_N)|v_n| the contact sticks and the sphere leaves
   rolling with v_t' = 5/7 v_t + 2/7 r w, w' = v_t'/r; otherwise it slips
   throughout and friction mu (1 + e_N)|v_n| acts against the slip.
@@ -67,37 +68,49 @@ def normal_restitution(law, e_n, vn, vt):
 
 @njit(cache=True)
 def stronge_sphere(vn, vt, w, r, e_n, mu):
-    """Tangential velocity and spin after a rough impact of a solid sphere.
+    """Tangential velocity and spin after a rough impact of a solid sphere (I = 0.4 m r^2).
 
     Returns (vt_out, w_out, stuck).  ``vn`` < 0 is the incoming normal velocity.
     """
+    return stronge_body(vn, vt, w, r, e_n, mu, SPHERE_INERTIA)
+
+
+@njit(cache=True)
+def stronge_body(vn, vt, w, r, e_n, mu, k):
+    """Rough impact of a round body with inertia I = k m r^2 (k = 0.4 sphere, 0.5 cylinder or disc)."""
     pn = (1.0 + e_n) * (-vn)              # normal impulse per unit mass
     slip = vt - r * w
-    # Impulse per unit mass that brings the slip to zero: slip / (1 + 1/0.4) = 2/7 slip for a solid sphere.
-    p_stick = slip / (1.0 + 1.0 / SPHERE_INERTIA)
+    # Impulse per unit mass that brings the slip to zero: slip / (1 + 1/k) = 2/7 slip for a solid sphere.
+    p_stick = slip / (1.0 + 1.0 / k)
     if abs(p_stick) <= mu * pn:
-        vt_out = vt - p_stick             # = 5/7 vt + 2/7 r w
+        vt_out = vt - p_stick             # sphere: 5/7 vt + 2/7 r w
         return vt_out, vt_out / r, True
     pt = mu * pn if slip > 0 else -mu * pn
-    return vt - pt, w + pt / (SPHERE_INERTIA * r), False
+    return vt - pt, w + pt / (k * r), False
 
 
 @njit(cache=True)
 def impact(vn, vt, w, r, en_law, e_n, et_law, e_t, mu, allow_energy_gain):
+    """Outgoing (vn', vt', w', e_N used) of a solid sphere; see :func:`impact_body`."""
+    return impact_body(vn, vt, w, r, en_law, e_n, et_law, e_t, mu, allow_energy_gain, SPHERE_INERTIA)
+
+
+@njit(cache=True)
+def impact_body(vn, vt, w, r, en_law, e_n, et_law, e_t, mu, allow_energy_gain, k_inertia):
     """Outgoing (vn', vt', w', e_N used) for an incoming (vn < 0, vt, w) on a surface.
 
-    Kinetic energy per unit mass (translational + rotational, I = 0.4 m r^2)
+    Kinetic energy per unit mass (translational + rotational, I = k m r^2)
     never increases unless ``allow_energy_gain``.
     """
     en = normal_restitution(en_law, e_n, vn, vt)
     if et_law == ET_FRICTION:
-        vt2, w2, stuck = stronge_sphere(vn, vt, w, r, en, mu)
+        vt2, w2, stuck = stronge_body(vn, vt, w, r, en, mu, k_inertia)
     else:
         vt2 = e_t * vt
         w2 = e_t * w
     vn2 = -en * vn
     if not allow_energy_gain:
-        k = SPHERE_INERTIA * r * r
+        k = k_inertia * r * r
         e_in = vn * vn + vt * vt + k * w * w
         room = e_in - vt2 * vt2 - k * w2 * w2
         if room < 0.0:

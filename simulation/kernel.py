@@ -19,7 +19,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .impact import impact
+from .impact import impact_body
 
 # Stop reasons.
 RUNNING, STOPPED, LEFT_PROFILE, CAUGHT, MAX_EVENTS = 0, 1, 2, 3, 4
@@ -264,7 +264,7 @@ def _envelope(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass, inerti
 
 
 @njit(cache=True)
-def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
+def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
              px, pz, tree, n_leaves, seg_mat, run_first, run_last,
              m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
              m_roll, m_mu_ground, m_gain,
@@ -282,8 +282,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
     for b in range(block_ids.shape[0]):
         bid = block_ids[b]
         state[0] = key ^ (np.uint64(bid + 1) * _GOLDEN)
-        mass, r = bmass[b], bradius[b]
-        inertia = 0.4 * mass * r * r
+        mass, r, k_in = bmass[b], bradius[b], bk[b]
+        inertia = k_in * mass * r * r
         x, z, vx, vz, w = bx[b], bz[b], bvx[b], bvz[b], bw[b]
         t_abs = 0.0
         seg = _seg_of(px, x)
@@ -398,7 +398,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
                 phi = m_phi[mat] + (m_phi_std[mat] * _normal(state) if m_phi_std[mat] > 0 else 0.0)
                 mu = math.tan(math.radians(min(max(phi, 0.0), 89.0)))
                 if vn < 0.0:
-                    vn2, vt2, w, _ = impact(vn, vt, w, r, m_en_law[mat], en, m_et_law[mat], et, mu, gain)
+                    vn2, vt2, w, _ = impact_body(vn, vt, w, r, m_en_law[mat], en, m_et_law[mat], et, mu, gain, k_in)
                 else:
                     vn2, vt2 = 0.0, vt
                 vx = vt2 * math.cos(bp) - vn2 * math.sin(bp)
@@ -422,7 +422,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius,
             ls = math.sqrt(cosb_raw * cosb_raw + sinb_raw * sinb_raw)
             cosb, sinb = cosb_raw / ls, sinb_raw / ls
             mu = m_mu_ground[mat]
-            factor = 5.0 / 7.0 if m_roll[mat] else 1.0
+            factor = 1.0 / (1.0 + k_in) if m_roll[mat] else 1.0     # rolling sphere: 5/7
             if abs(v_along) < v_stop or v_along == 0.0:
                 if abs(sinb) <= mu * cosb:
                     reason = STOPPED

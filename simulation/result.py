@@ -43,7 +43,7 @@ class SimulationResult:
 
         Columns: ``block``, ``time_s``, ``velocity_ms``, ``vx_ms``, ``vz_ms``,
         ``angular_velocity_rads``, ``height_m`` (of the block centre above the
-        ground), ``mass_kg``, ``radius_m``, ``energy_translational_kj``,
+        ground), ``mass_kg``, ``radius_m``, ``inertia_factor`` (I / m r^2), ``energy_translational_kj``,
         ``energy_rotational_kj``, ``energy_kj`` (total), ``crossing_angle_deg``
         (below horizontal), ``outcome`` (crossed / caught / through / over).
         With ``first_only`` only each block's first crossing is kept.
@@ -54,12 +54,14 @@ class SimulationResult:
         vx, vz, w = self.crossings["vx"][sel], self.crossings["vz"][sel], self.crossings["w"][sel]
         mass = self.blocks["mass"][blk]
         radius = self.blocks["radius"][blk]
+        k_inertia = self.blocks["inertia_factor"][blk]
         v = np.hypot(vx, vz)
         e_t = 0.5 * mass * v ** 2 / 1000.0
-        e_r = 0.5 * 0.4 * mass * radius ** 2 * w ** 2 / 1000.0
+        e_r = 0.5 * k_inertia * mass * radius ** 2 * w ** 2 / 1000.0
         df = pd.DataFrame({
             "block": blk, "time_s": self.crossings["t"][sel], "velocity_ms": v, "vx_ms": vx, "vz_ms": vz,
             "angular_velocity_rads": w, "height_m": self.crossings["h"][sel], "mass_kg": mass, "radius_m": radius,
+            "inertia_factor": k_inertia,
             "energy_translational_kj": e_t, "energy_rotational_kj": e_r, "energy_kj": e_t + e_r,
             "crossing_angle_deg": np.degrees(np.arctan2(-vz, np.abs(vx))),
             "outcome": pd.Categorical.from_codes(self.crossings["outcome"][sel], [OUTCOMES[i] for i in range(4)]),

@@ -195,9 +195,17 @@ class Material:
                    allow_energy_gain=gain)
 
 
+#: I / (m r^2) of the block shapes: a solid sphere, and a solid cylinder (disc, wheel) rolling on its rim.
+INERTIA_FACTORS = {"sphere": 0.4, "cylinder": 0.5}
+
+
 @dataclass(frozen=True)
 class Seeder:
-    """Where blocks start: a point or a line (uniform in x) at ``height_m`` above the ground."""
+    """Where blocks start: a point or a line (uniform in x) at ``height_m`` above the ground.
+
+    ``shape`` "sphere" (radius from mass and density) or "cylinder" (a disc or
+    wheel rolling on its rim, length = ``aspect_ratio`` x diameter).
+    """
 
     x_low: float
     x_high: float
@@ -207,6 +215,18 @@ class Seeder:
     vx_ms: Distribution
     vz_ms: Distribution
     angular_velocity_rads: Distribution
+    shape: str = "sphere"
+    aspect_ratio: float = 1.0
+
+    def radius(self, mass):
+        """Radius [m] of blocks of the given masses [kg]."""
+        if self.shape == "cylinder":          # m = rho pi r^2 (2 r aspect)
+            return (mass / (2.0 * np.pi * self.density_kg_m3 * self.aspect_ratio)) ** (1.0 / 3.0)
+        return (3.0 * mass / (4.0 * np.pi * self.density_kg_m3)) ** (1.0 / 3.0)
+
+    @property
+    def inertia_factor(self) -> float:
+        return INERTIA_FACTORS[self.shape]
 
 
 @dataclass(frozen=True)
@@ -297,7 +317,10 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
 
     sd = data["seeder"]
     _check_keys(sd, {"type", "x", "height_m", "mass_kg", "density_kg_m3", "vx_ms", "vz_ms",
-                     "angular_velocity_rads"}, "seeder.", source)
+                     "angular_velocity_rads", "shape", "aspect_ratio"}, "seeder.", source)
+    shape = sd.get("shape", "sphere")
+    if shape not in INERTIA_FACTORS:
+        raise ScenarioError(f"{source}: seeder.shape = {shape!r} is not one of {sorted(INERTIA_FACTORS)}")
     kind = sd.get("type", "line" if isinstance(sd.get("x"), list) else "point")
     if kind not in ("point", "line"):
         raise ScenarioError(f"{source}: seeder.type = {kind!r} is not 'point' or 'line'")
@@ -324,7 +347,9 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
         vx_ms=Distribution.parse(sd.get("vx_ms", 0.0), "seeder.vx_ms", source, lo=-200, hi=200),
         vz_ms=Distribution.parse(sd.get("vz_ms", 0.0), "seeder.vz_ms", source, lo=-200, hi=200),
         angular_velocity_rads=Distribution.parse(sd.get("angular_velocity_rads", 0.0),
-                                                 "seeder.angular_velocity_rads", source, lo=-1e3, hi=1e3))
+                                                 "seeder.angular_velocity_rads", source, lo=-1e3, hi=1e3),
+        shape=shape, aspect_ratio=_number(sd.get("aspect_ratio", 1.0), "seeder.aspect_ratio", source, lo=0.01,
+                                          hi=100.0))
 
     collectors = []
     for i, c in enumerate(data.get("collectors", [])):

@@ -188,3 +188,25 @@ def test_with_barrier_turns_a_collector_into_a_fence():
     res = simulation.run(fenced, n=3, seed=1)
     assert (res.collector("line")["outcome"] == "caught").all()
     assert simulation.run(sc, n=3, seed=1).collector("line")["outcome"].eq("crossed").all()
+
+
+def test_rolling_cylinder_accelerates_at_two_thirds_g_sin_psi():
+    # A solid cylinder or disc (I = m r^2 / 2) rolling without slip: a = g sin(psi) / (1 + 1/2).
+    psi = math.radians(30.0)
+    sc = scenario([0.0, 100.0], [100.0 * math.tan(psi), 0.0],
+                  seeder={"x": 1e-9, "height_m": 0.0, "shape": "cylinder", "aspect_ratio": 0.5},
+                  material={"ground_motion": "roll", "ground_friction_angle_deg": 0.0},
+                  collectors=[{"name": "c", "x": 40.0}], settings={"stop_velocity_ms": 0.0})
+    row = simulation.run(sc, n=1, seed=1).collector("c").iloc[0]
+    s = 40.0 / math.cos(psi)
+    assert row["time_s"] == pytest.approx(math.sqrt(2 * s / (2.0 / 3.0 * G * math.sin(psi))), rel=1e-7)
+    # radius from m = rho pi r^2 (2 r x aspect ratio); rotational energy 1/2 (1/2 m r^2) w^2
+    r = (1000.0 / (2 * math.pi * 2650.0 * 0.5)) ** (1 / 3)
+    assert row["radius_m"] == pytest.approx(r) and row["inertia_factor"] == 0.5
+    assert row["energy_rotational_kj"] == pytest.approx(0.5 * row["energy_translational_kj"], rel=1e-9)
+
+
+def test_stronge_stick_for_a_cylinder():
+    from simulation.impact import stronge_body
+    vt2, w2, stuck = stronge_body(-10.0, 3.0, 2.0, 0.5, 0.3, 0.8, 0.5)
+    assert stuck and vt2 == pytest.approx(2 / 3 * 3.0 + 1 / 3 * 0.5 * 2.0)

@@ -73,6 +73,7 @@ def test_exceedance_reports_monte_carlo_interval():
     ({"materials": {"m": {"roughnes_m": 0.1}}}, "unknown field materials.m.'roughnes_m'; did you mean 'roughness_m'"),
     ({"seeder": {"x": 50.0, "mass_kg": 10}}, "seeder.x = 50 m is outside the profile"),
     ({"seeder": {"x": 1.0, "mass_kg": -10}}, "seeder.mass_kg = -10 is outside"),
+    ({"seeder": {"x": 1.0, "mass_kg": 10, "shape": "cube"}}, "seeder.shape = 'cube' is not one of"),
     ({"collectors": [{"name": "c", "x": 99}]}, "collectors\\[0\\].x = 99 m .* is outside the profile"),
     ({"collectors": [{"name": "c", "x": 5, "capacity_kj": 100}]}, "height_m is required for a barrier"),
 ])
