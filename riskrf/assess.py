@@ -26,6 +26,7 @@ from .inventory import Inventory, read_inventory
 from .magnitude import fit_gutenberg_richter
 from .mitigation import MitigationStudy
 from .outputs import write_json
+from .risk import fn_zone
 from .site import Site
 from .validation import RiskrfWarning
 
@@ -129,6 +130,7 @@ class Assessment:
             "break_even": self.decision["break_even"].to_dict(orient="records"),
             "value_of_information": self.decision["value_of_information"],
             "individual_risk_do_nothing": float(nothing["individual_risk"].iloc[0]) if len(nothing) else None,
+            "fn_zone": {o.name: fn_zone(self.study.fn_curve(o.name)) for o in self.study.options},
             "defaults_used": list(self.site.defaults_used),
             "warnings": self.warnings,
             "timings_s": self.timings,

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from . import __version__
-from .risk import AGS2007_INDIVIDUAL_RISK
+from .risk import AGS2007_INDIVIDUAL_RISK, fn_zone
 
 CSS = """
 body{font-family:Georgia,'Times New Roman',serif;max-width:1100px;margin:2em auto;padding:0 1.5em;color:#222;
@@ -82,6 +82,10 @@ def render_report(a, figs: Path) -> str:
         summary.append(f"<li>Fence {_e(r['fence'])}: <span class='{cls}'>"
                        f"{'adequate' if r['adequate'] else 'not adequate'}</span>"
                        f"{'' if r['adequate'] else ' (' + _e(r['failed checks']) + ')'}.</li>")
+    best_row = ranking.iloc[0]
+    summary.append(f"<li>With {_e(best)}: {best_row['road_falls_per_year']:.3g} falls reach the road a year; "
+                   f"individual risk {best_row['individual_risk']:.2g}/yr (AGS 2007 limit 1e-4); societal risk "
+                   f"{_e(fn_zone(a.study.fn_curve(best)))} against the Hong Kong GEO F-N lines.</li>")
     summary.append(f"<li>Lowest expected total cost: <b>{_e(best)}</b> "
                    f"({ranking['expected_total_cost'].iloc[0]:,.0f} {_e(cur)}), then {_e(second)} "
                    f"({ranking['expected_total_cost'].iloc[1]:,.0f} {_e(cur)}).</li></ul></div>")
@@ -168,6 +172,9 @@ def render_report(a, figs: Path) -> str:
     ir_limit = AGS2007_INDIVIDUAL_RISK["existing slope"]
     risk = ranking[["option", "road_falls_per_year", "deaths_per_year", "individual_risk"]].copy()
     risk["meets AGS 2007 1e-4/yr (existing slope)"] = risk["individual_risk"] <= ir_limit
+    fns = {o.name: a.study.fn_curve(o.name) for o in a.study.options}
+    risk["F(N>=1) [1/yr]"] = [float(fns[o]["F"].iloc[0]) if len(fns[o]) else 0.0 for o in risk["option"]]
+    risk["Hong Kong GEO F-N zone"] = [fn_zone(fns[o]) for o in risk["option"]]
     parts += ["<h2>7. Risk to road users</h2>",
               f"<p>Bunce et al. (1997): P(S:T) = N<sub>v</sub> L<sub>v</sub> / (24 &times; 1000 &times; "
               f"V<sub>v</sub>) for {a.study.exposure.vehicles_per_day:,.0f} vehicles a day of "

@@ -105,3 +105,18 @@ def pv_of_renewals(cost, life_years, horizon_years, rate):
     life = check_positive(life_years, "life_years")
     k = np.arange(1, int(np.floor((float(horizon_years) - 1e-9) / life)) + 1)
     return float(cost * np.sum((1.0 + float(rate)) ** -(k * life)))
+
+
+def fn_zone(fn: pd.DataFrame, lines: dict | None = None) -> str:
+    """Where an F-N curve lies against two criterion lines F = C / N^k (upper: unacceptable above,
+    lower: broadly acceptable below): "unacceptable", "ALARP" (between) or "broadly acceptable"."""
+    lines = HK_GEO_FN_LINES if lines is None else lines
+    (c_hi, k_hi), (c_lo, k_lo) = lines["unacceptable above"], lines["broadly acceptable below"]
+    if len(fn) == 0 or not np.any(fn["F"] > 0):
+        return "broadly acceptable"
+    N, F = fn["N"].to_numpy(dtype=float), fn["F"].to_numpy(dtype=float)
+    if np.any(F > c_hi / N ** k_hi):
+        return "unacceptable"
+    if np.any(F > c_lo / N ** k_lo):
+        return "ALARP"
+    return "broadly acceptable"

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 import riskrf
 from riskrf.decision import DecisionTree, TreeError
-from riskrf.risk import (fn_curve, individual_risk, probability_at_least_one_hit, pv_factor, pv_of_renewals,
+from riskrf.risk import (fn_curve, fn_zone, individual_risk, probability_at_least_one_hit, pv_factor, pv_of_renewals,
                          spatial_temporal_probability, stationary_rock_strike_probability, vehicle_occupant_fn)
 
 from .conftest import DATA
@@ -71,6 +71,10 @@ def test_fn_curves():
     assert list(fn["N"]) == [1, 3, 10] and fn["F"].tolist() == pytest.approx([1.12e-3, 1.2e-4, 2e-5])
     occ = vehicle_occupant_fn(0.01, 2, 0.5)
     assert occ["F"].tolist() == pytest.approx([0.01 * 0.75, 0.01 * 0.25])
+    # Hong Kong GEO lines through F = 1e-3 and 1e-5 at N = 1, slope -1:
+    assert fn_zone(fn_curve([(2e-3, 1)])) == "unacceptable"
+    assert fn_zone(fn_curve([(5e-4, 1), (2e-4, 3)])) == "ALARP"
+    assert fn_zone(fn_curve([(5e-6, 1), (1e-6, 3)])) == "broadly acceptable"
 
 
 def _random_tree(draw_rng, depth=0):
