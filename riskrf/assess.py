@@ -13,7 +13,7 @@ import shutil
 import sys
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -32,10 +32,12 @@ from .validation import RiskrfWarning
 
 
 def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, rate_scale: float = 1.0,
-                              scenario=None, velocities=None, collector: str = "barrier", n: int = 50_000,
-                              seed=1, reach_probability: float = 1.0, collector_given: bool = True,
-                              condition_on_mass: bool = False):
+                              scenario=None, velocities=None, collector: str | None = None, n: int = 50_000,
+                              seed=1, reach_probability: float = 1.0, condition_on_mass: bool = False):
     """Power-law fit of the inventory combined with simulated or given velocities.
+
+    ``collector`` names the barrier line: in a scenario it defaults to "barrier"; a
+    velocity file is filtered to that collector only when one is named.
 
     Returns (power-law fit, EnergyHazard, SimulationResult or None).
     """
@@ -50,12 +52,13 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
     result = None
     if scenario is not None:
         sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
+        collector = collector or "barrier"
         sc.collector_index(collector)
         result = simulation.run(sc, n=n, seed=seed)
         hazard = EnergyHazard.from_simulation(gr, result, collector, rate_per_year=rate,
                                               condition_on_mass=condition_on_mass)
     else:
-        df = read_velocities(velocities, collector=collector if collector_given else None)
+        df = read_velocities(velocities, collector=collector)
         v = df["velocity_ms"].to_numpy(dtype=float)
         note = f"velocities: {len(df):,} samples from {velocities}"
         if "angular_velocity_rads" in df and "radius_m" in df:
@@ -66,10 +69,10 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
             " (default: every fall assumed to reach the line)" if reach_probability == 1.0 else "")
         hazard = EnergyHazard(mass=gr, velocity=v, rate_per_year=rate, reach_probability=reach_probability,
                               heights_m=df["height_m"].to_numpy(dtype=float) if "height_m" in df else None,
-                              collector=collector, notes=(note,))
+                              collector=collector or "", notes=(note,))
     if rate_scale != 1.0:
-        hazard = EnergyHazard(**{**hazard.__dict__, "notes": hazard.notes + (
-            f"rate scaled by {rate_scale:g} (share of the inventoried source above this line)",)})
+        hazard = replace(hazard, notes=hazard.notes + (
+            f"rate scaled by {rate_scale:g} (share of the inventoried source above this line)",))
     return gr, hazard, result
 
 
@@ -208,8 +211,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                       warnings=notes, timings=timings)
 
 
-def write_assessment(a: Assessment, out: Path, log=print) -> None:
-    """Write every output of an assessment into ``out`` (an empty directory)."""
+def write_assessment(a: Assessment, out: Path, log=print) -> dict:
+    """Write every output of an assessment into ``out`` (an empty directory); returns the summary."""
     import matplotlib
     matplotlib.use("Agg")
 
@@ -238,9 +241,11 @@ def write_assessment(a: Assessment, out: Path, log=print) -> None:
     for name in ("ranking.csv", "tornado.csv", "break_even.csv", "decision.json"):
         shutil.move(str(figs / name), str(out / name))
     a.timings["report"] = round(time.perf_counter() - t, 2)
-    write_json(a.summary(), out / "summary.json")
+    summary = a.summary()
+    write_json(summary, out / "summary.json")
     (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
     _copy_inputs(a, out / "inputs")
+    return summary
 
 
 def _simulation_figures(a, figs):

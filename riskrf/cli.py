@@ -131,7 +131,7 @@ def build_energy_hazard(args, inventory):
     return energy_hazard_from_inputs(
         inventory, m_min=args.m_min, m_max=args.m_max, rate_scale=args.rate_scale, scenario=args.scenario,
         velocities=args.velocities, collector=args.collector, n=args.n, seed=args.seed,
-        reach_probability=args.reach_probability, collector_given=args.collector_given,
+        reach_probability=args.reach_probability,
         condition_on_mass=args.condition_on_mass)
 
 
@@ -180,14 +180,15 @@ def cmd_decide(args) -> int:
         print("\nOptimal policy:")
         for path, choice in rb.policy.items():
             print(f"  at {path}: {choice}")
-        for var in tree.variables():
-            print(f"  EVPI of {var!r}: {tree.evpi(var):.6g}")
+        evpi = {var: tree.evpi(var) for var in tree.variables()}
+        for var, value in evpi.items():
+            print(f"  EVPI of {var!r}: {value:.6g}")
         tornado = tree.tornado() if tree.parameters else None
         with atomic_output_dir(out) as tmp:
             ranking.to_csv(tmp / "ranking.csv", index=False)
             tree.risk_profile().to_csv(tmp / "risk_profiles.csv", index=False)
             write_json({"objective": tree.objective, "value": rb.value, "options": rb.option_values,
-                        "policy": rb.policy, "evpi": {v: tree.evpi(v) for v in tree.variables()}},
+                        "policy": rb.policy, "evpi": evpi},
                        tmp / "decision.json")
             ax = plot_tree(tree)
             ax.figure.savefig(tmp / "tree.png", dpi=110, bbox_inches="tight")
@@ -206,7 +207,7 @@ def cmd_decide(args) -> int:
     inv = _read(args, args.inventory)
     gr, hazard, result = build_energy_hazard(args, inv)
     from .assess import road_share
-    study = load_mitigation(args.options, hazard, road_share=road_share(result, args.collector, args.road_collector))
+    study = load_mitigation(args.options, hazard, road_share=road_share(result, hazard.collector, args.road_collector))
     report = study_report(study)
     print(report["text"])
     with atomic_output_dir(out) as tmp:
@@ -221,7 +222,9 @@ def _add_energy_arguments(p):
                    help="velocity samples at the barrier line (.csv/.parquet: a velocity_ms column, optionally "
                         "height_m, angular_velocity_rads, radius_m, collector; RocFall/RAMMS exports with columns "
                         "such as 'Translational Velocity (m/s)' and 'Bounce Height (m)' are recognised)")
-    p.add_argument("--collector", default="barrier", help="collector (barrier line) name (default 'barrier')")
+    p.add_argument("--collector", default=None,
+                   help="collector (barrier line) name (default 'barrier' in a scenario; a velocity file is "
+                        "filtered to it only when given)")
     p.add_argument("-n", type=int, default=100_000, help="blocks to simulate with --scenario (default 100,000)")
     p.add_argument("--reach-probability", type=float, default=1.0, metavar="P",
                    help="with --velocities: probability that a fall reaches the line (default 1)")
@@ -247,8 +250,7 @@ def cmd_assess(args) -> int:
     out = Path(args.out) if args.out else Path(f"{Path(args.site).stem}-assessment")
     assessment = run_assessment(site, seed=args.seed, n_blocks=args.n)
     with atomic_output_dir(out) as tmp:
-        write_assessment(assessment, tmp)
-    s = assessment.summary()
+        s = write_assessment(assessment, tmp)
     print(f"\nBest option: {s['best_option']} (then {s['second_option']}).")
     print(f"Report: {(out / 'report.html').resolve()}")
     return 0
@@ -372,8 +374,6 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    if getattr(args, "command", None) in ("energy", "assess", "decide"):
-        args.collector_given = "--collector" in (argv if argv is not None else sys.argv)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # every warning is reported in the printed summary instead

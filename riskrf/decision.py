@@ -218,11 +218,11 @@ class DecisionTree:
             return float(sign * ce)
 
         if self.root.type != "decision":
-            v = value(self.root)
-            return Rollback(v, {}, policy, self.objective)
+            return Rollback(value(self.root), {}, policy, self.objective)
         options = {b.name: self._net(b) + value(b.child) for b in self.root.branches}
-        v = value(self.root)
-        return Rollback(v, options, policy, self.objective)
+        best = better(options, key=options.get)
+        policy[self.root.path] = best
+        return Rollback(options[best], options, policy, self.objective)
 
     def ranking(self, **kwargs) -> pd.DataFrame:
         """Options of the top decision, best first, with their expected value and rank."""

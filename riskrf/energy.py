@@ -215,10 +215,10 @@ def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, 
     """
     e = _check_energies(energy_kj)
     check_choice(method, "method", ("quad", "mc"))
-    mm = mass_model(mass)
     if method == "mc":
         return exceedance_probability_mc(e, mass, velocity, angular_velocity=angular_velocity,
                                          density_kg_m3=density_kg_m3, n_samples=n_samples, seed=seed)[0]
+    mm = mass_model(mass)
     if isinstance(velocity, VelocityFit):
         velocity = velocity.dist
     if isinstance(velocity, PairedSamples):

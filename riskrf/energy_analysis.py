@@ -121,12 +121,10 @@ def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m: float = 5
     uni = None
     if isinstance(hazard.mass, GutenbergRichterFit) and design_T * hazard.rate_per_year > 1:
         block = float(hazard.mass.isf(1.0 / (design_T * hazard.rate_per_year)))   # the T-year block at this line
-        v95 = float(np.percentile(np.asarray(hazard.velocity if not hasattr(hazard.velocity, "velocity_ms")
-                                             else hazard.velocity.velocity_ms), 95)) \
-            if not hasattr(hazard.velocity, "pdf") else float(hazard.velocity.ppf(0.95))
+        v95 = hazard.velocity_percentile(UNI11211_FACTORS["velocity_percentile"])
         uni = uni11211_design_energy(block / density_kg_m3, density_kg_m3, v95, **(uni_factors or {}))
     return EnergyAnalysis(hazard=hazard, design=design, fences=checks, uni=uni, design_T=float(design_T),
                           density_kg_m3=density_kg_m3, seed=seed, n_bootstrap=int(n_bootstrap))
 
 
-__all__ = ["EnergyAnalysis", "analyse_energy", "UNI11211_FACTORS"]
+__all__ = ["EnergyAnalysis", "analyse_energy"]

@@ -102,6 +102,15 @@ class EnergyHazard:
             raise ValueError(f"percentiles must lie strictly between 0 and 100; got {q.tolist()}")
         return self._invert(1.0 - q / 100.0, scale=1.0)
 
+    def velocity_percentile(self, q) -> float:
+        """Velocity [m/s] not exceeded by q % of the falls reaching the line, whatever the velocity model."""
+        v = self.velocity
+        if isinstance(v, VelocityFit):
+            v = v.dist
+        if hasattr(v, "ppf"):
+            return float(v.ppf(q / 100.0))
+        return float(np.percentile(np.asarray(getattr(v, "velocity_ms", v), dtype=float), q))
+
     def height_percentile(self, q):
         """Bounce height [m] not exceeded by q % of the falls reaching the line (from simulated heights)."""
         if self.heights_m is None:

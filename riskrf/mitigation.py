@@ -244,9 +244,10 @@ class MitigationStudy:
 
         Returns (factor, value) or None if they do not cross within ``factor_range``.
         """
-        rank = self.ranking()
-        a = option_a or rank["option"].iloc[0]
-        b = option_b or rank["option"].iloc[1]
+        if option_a is None or option_b is None:
+            rank = self.ranking()["option"]
+            option_a, option_b = option_a or rank.iloc[0], option_b or rank.iloc[1]
+        a, b = option_a, option_b
 
         def diff(log_f):
             try:

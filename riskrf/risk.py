@@ -71,7 +71,8 @@ def fn_curve(scenarios) -> pd.DataFrame:
     """F-N curve from scenarios ``[(frequency_per_year, fatalities), ...]``: F(N) = sum f_i for N_i >= N."""
     arr = np.asarray(scenarios, dtype=float).reshape(-1, 2)
     if np.any(arr < 0):
-        raise ValueError("scenario frequencies and fatalities must be >= 0")
+        i = int(np.argmax(np.any(arr < 0, axis=1)))
+        raise ValueError(f"scenarios[{i}] = {tuple(arr[i])}: frequencies and fatalities must be >= 0")
     arr = arr[arr[:, 1] >= 1]
     if arr.size == 0:
         return pd.DataFrame({"N": [], "F": []})

@@ -23,7 +23,7 @@ SITE_FIELDS = {
     "site": {"name": None, "description": ""},
     "inventory": {"path": None, "start": None, "end": None, "duration_years": None, "density_kg_m3": None,
                   "m_min_kg": None, "m_max_kg": None, "rate_scale": 1.0, "annual_maxima": None},
-    "hazard": {"scenario": None, "velocities": None, "collector": "barrier", "road_collector": "road",
+    "hazard": {"scenario": None, "velocities": None, "collector": None, "road_collector": "road",
                "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
                "free_board_m": 0.5, "design_period_years": 100.0, "bootstrap": 300, "seed": 1},
 }
@@ -107,6 +107,9 @@ def load_site(path) -> Site:
             raise SiteError(f"{path}: {table}.{key} = {rel!r}: file not found ({(path.parent / rel).resolve()})")
     if hz["scenario"] is not None:
         import simulation
+        if hz["collector"] is None:
+            hz["collector"] = "barrier"
+            used.append("hazard.collector = 'barrier'")
         scenario = simulation.load_scenario(path.parent / hz["scenario"])
         names = [c.name for c in scenario.collectors]
         if hz["collector"] not in names:

@@ -3,8 +3,9 @@
 Events are impacts, segment ends during ground contact, collector crossings and
 stops.  Between events motion is exact: parabolic flight (no time stepping),
 constant-acceleration rolling or sliding along a straight segment.  The next
-impact segment is found by descending the profile's max-elevation tree
-(:mod:`simulation.slope`), so the cost per impact grows as log S, not S.
+impact segment is found by a finger search in the profile's chord-offset tree
+(:mod:`simulation.slope`), so the cost per impact grows as log d for a flight over d segments, not
+as the number of segments S.
 
 Random numbers come from a counter-based SplitMix64 stream keyed by (run seed,
 block index): a block's trajectory is the same whatever chunk it is run in.
@@ -167,10 +168,11 @@ def _run_hit(px, pz, k0, k1, x0, z0, vx, vz, g):
 def find_impact(px, pz, tree, n_leaves, run_first, run_last, x0, z0, vx, vz, g, seg_now, stack):
     """First (time, segment) where the flight from (x0, z0) meets the ground; segment -1 if it leaves.
 
-    Finger search in the max-elevation tree: test the current segment, then climb
-    from its leaf and descend only into sibling subtrees ahead of the block whose
-    highest ground the parabola can reach.  Cost O(log d) for a flight over d
-    segments, independent of the total number of segments.
+    The straight run the block leaves from is tested first (one line, O(1)); then a
+    finger search in the chord-offset tree (:mod:`simulation.slope`) climbs from the
+    current leaf and descends only into sibling subtrees ahead of the block whose
+    ground the parabola can reach.  Cost O(log d) for a flight over d segments,
+    independent of the total number of segments.
     """
     n_seg = px.shape[0] - 1
     if abs(vx) < 1e-12:
@@ -278,6 +280,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
     n_seg = px.shape[0] - 1
     state = np.empty(1, np.uint64)
     cross_t = np.empty(n_coll)
+    by_x = np.argsort(c_x)           # collectors in x order: the order of crossing along the motion
     stack = np.empty((3, 128), np.int64)
     for b in range(block_ids.shape[0]):
         bid = block_ids[b]
@@ -320,9 +323,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 cut = False
                 for j in range(n_coll):
                     cross_t[j] = (c_x[j] - x) / vx if abs(vx) > 1e-12 else -1.0
-                order = np.argsort(cross_t)
                 for jj in range(n_coll):
-                    j = order[jj]
+                    j = by_x[jj] if vx > 0 else by_x[n_coll - 1 - jj]
                     tc = cross_t[j]
                     if not (1e-12 < tc <= t_hit):
                         continue
@@ -464,9 +466,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             cut = False
             for j in range(n_coll):
                 cross_t[j] = direction * (c_x[j] - x) / cosb   # distance along the slope to the collector
-            order = np.argsort(cross_t)
             for jj in range(n_coll):
-                j = order[jj]
+                j = by_x[jj] if direction > 0 else by_x[n_coll - 1 - jj]
                 s_c = cross_t[j]
                 if not (1e-12 < s_c <= d_step):
                     continue

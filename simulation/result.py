@@ -151,7 +151,8 @@ class SimulationResult:
             rows["collector rows dropped (buffer full)"] = self.dropped_crossings
         for c in self.scenario.collectors:
             df = self.collector(c.name, first_only=True)
-            p, lo, hi = self.reach_probability(c.name)
+            p = len(df) / self.n
+            lo, hi = wilson_interval(len(df), self.n)
             rows[f"{c.name}: reach probability"] = f"{p:.4f} ({lo:.4f}-{hi:.4f})"
             if len(df):
                 for col, unit in (("velocity_ms", "m/s"), ("height_m", "m"), ("energy_kj", "kJ")):
