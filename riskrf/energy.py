@@ -242,7 +242,8 @@ def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, 
 def _integrate_velocity_dist(e, mm, vdist):
     p_pos = float(vdist.sf(0.0))
     if p_pos <= 0:
-        raise ValueError("the velocity model puts no probability on positive speeds")
+        raise ValueError(f"velocity model {getattr(getattr(vdist, 'dist', None), 'name', vdist)!r} puts no "
+                         "probability on positive speeds")
     lo = max(float(vdist.ppf(max(1e-15, 1 - p_pos + 1e-15))), 1e-6)
     hi = float(vdist.isf(1e-17))
     if not np.isfinite(hi):

@@ -202,7 +202,8 @@ class _AnnualMaximumFit:
         if method == "bootstrap":
             return self._bootstrap_ci(T, level, n_bootstrap, seed)
         if self.method != "mle":
-            raise ValueError("profile-likelihood intervals need a maximum-likelihood fit (method='mle')")
+            raise ValueError(f"this fit has method = {self.method!r}: profile-likelihood intervals need a "
+                             "maximum-likelihood fit (method='mle')")
         flat = np.atleast_1d(T).ravel()
         bounds = np.array([self._profile_ci(t, level) for t in flat])
         return bounds[:, 0].reshape(np.shape(T)), bounds[:, 1].reshape(np.shape(T))

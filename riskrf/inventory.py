@@ -441,7 +441,8 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
     # Record period.
     if start is not None or end is not None:
         if start is None or end is None:
-            raise ValueError("give both start and end of the record period, or duration_years")
+            raise ValueError(f"start = {start!r}, end = {end!r}: give both start and end of the record period, "
+                             "or duration_years")
         start, end = _as_date(start, "start"), _as_date(end, "end")
         period_source = "argument"
     elif duration_years is not None:

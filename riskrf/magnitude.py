@@ -317,7 +317,8 @@ class GutenbergRichterFit:
         from ._powerlaw_kernels import ks_scan
 
         if self.method != "mle":
-            raise ValueError("bootstrap_pvalue tests a maximum-likelihood fit; refit with method='mle'")
+            raise ValueError(f"this fit has method = {self.method!r}: bootstrap_pvalue tests a maximum-likelihood "
+                             "fit; refit with method='mle'")
         n_bootstrap = int(n_bootstrap)
         if n_bootstrap < 1:
             raise ValueError(f"n_bootstrap must be >= 1; got {n_bootstrap}")
