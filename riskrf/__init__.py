@@ -11,14 +11,22 @@ Public API (units: mass kg, volume m³, energy kJ, velocity m/s, time yr)::
 """
 __version__ = "0.1.0"
 
-from .decision import DecisionTree
-from .energy import exceedance_probability, fit_velocity
-from .extremes import (GEVFit, GumbelFit, encounter_probability, fit_gev, fit_gumbel, gumbel_frequency_factor,
-                       gumbel_reduced_variate, plotting_positions)
-from .frequency import FrequencyAnalysis, analyse_inventory
-from .hazard import EnergyHazard
+from .annual_hazard import EnergyHazard
+from .decision_tree import DecisionTree
+from .extremes import (
+                       GEVFit,
+                       GumbelFit,
+                       encounter_probability,
+                       fit_gev,
+                       fit_gumbel,
+                       gumbel_frequency_factor,
+                       gumbel_reduced_variate,
+                       plotting_positions,
+)
+from .frequency_study import FrequencyAnalysis, analyse_inventory
+from .impact_energy import exceedance_probability, fit_velocity
 from .inventory import DEFAULT_DENSITY_KG_M3, Inventory, read_inventory
-from .magnitude import GutenbergRichterFit, find_m_min, fit_gutenberg_richter
+from .power_law import GutenbergRichterFit, find_m_min, fit_gutenberg_richter
 from .validation import RiskrfWarning
 
 __all__ = [

@@ -19,14 +19,14 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .energy_analysis import EnergyAnalysis, analyse_energy
-from .frequency import FrequencyAnalysis, analyse_inventory
-from .hazard import EnergyHazard, inertia_factors
+from .annual_hazard import EnergyHazard, inertia_factors
+from .energy_study import EnergyAnalysis, analyse_energy
+from .frequency_study import FrequencyAnalysis, analyse_inventory
 from .inventory import Inventory, read_inventory
-from .magnitude import fit_gutenberg_richter
 from .mitigation import MitigationStudy
 from .outputs import write_json
-from .risk import fn_zone
+from .power_law import fit_gutenberg_richter
+from .road_risk import fn_zone
 from .site import Site
 from .validation import RiskrfWarning
 
@@ -149,7 +149,7 @@ class Assessment:
 
 def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None = None, log=print) -> Assessment:
     """Run the whole chain for a validated site, logging each stage with its duration."""
-    from .decision_report import study_report
+    from .report.mitigation_text import study_report
 
     seed = site.hazard["seed"] if seed is None else seed
     n_blocks = site.hazard["n_blocks"] if n_blocks is None else n_blocks
@@ -213,11 +213,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
 
 def write_assessment(a: Assessment, out: Path, log=print) -> dict:
     """Write every output of an assessment into ``out`` (an empty directory); returns the summary."""
-    import matplotlib
-    matplotlib.use("Agg")
-
-    from .decision_report import write_mitigation_outputs
-    from .report import render_report
+    from .report.html import render_report
+    from .report.mitigation_text import write_mitigation_outputs
 
     log("[5/5] writing the report, tables and figures")
     t = time.perf_counter()
@@ -249,23 +246,9 @@ def write_assessment(a: Assessment, out: Path, log=print) -> dict:
 
 
 def _simulation_figures(a, figs):
-    import matplotlib.pyplot as plt
-
-    from simulation.plotting import plot_collector_distributions, plot_envelopes, plot_profile
-    res = a.result
-    ax = plot_profile(res)
-    ax.figure.savefig(figs / "profile_trajectories.png", dpi=110, bbox_inches="tight")
-    plt.close(ax.figure)
+    from .report.files import write_simulation_figures
     collector = a.site.hazard["collector"]
-    axes = plot_collector_distributions(res, collector)
-    axes[0][0].figure.tight_layout()
-    axes[0][0].figure.savefig(figs / "collector_distributions.png", dpi=100, bbox_inches="tight")
-    plt.close(axes[0][0].figure)
-    if res.scenario.settings.envelope_bins:
-        axes = plot_envelopes(res)
-        axes[0].figure.savefig(figs / "envelopes.png", dpi=100, bbox_inches="tight")
-        plt.close(axes[0].figure)
-
+    write_simulation_figures(a.result, figs, [collector], file_names={collector: "collector_distributions.png"})
 
 def _copy_inputs(a: Assessment, dest: Path) -> None:
     """Copy the site file and everything it names, with the version, seed and command, for exact reruns."""

@@ -2,10 +2,10 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import warnings
 from pathlib import Path
-
 
 from . import __version__
 
@@ -44,7 +44,7 @@ def _read(args, path):
 
 
 def cmd_fit(args) -> int:
-    from .frequency import analyse_inventory
+    from .frequency_study import analyse_inventory
     from .outputs import atomic_output_dir
 
     inv = _read(args, args.inventory)
@@ -100,24 +100,9 @@ def cmd_simulate(args) -> int:
     if "outcome" in crossings:
         crossings["outcome"] = crossings["outcome"].astype(str)
     write_table(crossings, out)
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from simulation.plotting import plot_collector_distributions, plot_envelopes, plot_profile
+    from .report.files import write_simulation_figures
     with atomic_output_dir(figures) as tmp:
-        ax = plot_profile(result)
-        ax.figure.savefig(tmp / "profile_trajectories.png", dpi=120, bbox_inches="tight")
-        plt.close(ax.figure)
-        for c in scenario.collectors:
-            axes = plot_collector_distributions(result, c.name)
-            axes[0][0].figure.tight_layout()
-            axes[0][0].figure.savefig(tmp / f"collector_{c.name}.png", dpi=110, bbox_inches="tight")
-            plt.close(axes[0][0].figure)
-        if scenario.settings.envelope_bins:
-            axes = plot_envelopes(result)
-            axes[0].figure.savefig(tmp / "envelopes.png", dpi=110, bbox_inches="tight")
-            plt.close(axes[0].figure)
+        write_simulation_figures(result, tmp, [c.name for c in scenario.collectors])
         result.runout.to_csv(tmp / "runout.csv", index=False)
         result.envelopes.to_csv(tmp / "envelopes.csv", index=False)
     print(f"\nWrote {len(crossings):,} collector crossings to {out} and figures, runout.csv and "
@@ -136,7 +121,7 @@ def build_energy_hazard(args, inventory):
 
 
 def cmd_energy(args) -> int:
-    from .energy_analysis import analyse_energy
+    from .energy_study import analyse_energy
     from .outputs import atomic_output_dir
 
     inv = _read(args, args.inventory)
@@ -155,15 +140,12 @@ def cmd_energy(args) -> int:
 
 
 def cmd_decide(args) -> int:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .decision import DecisionTree
+    from .decision_tree import DecisionTree
     from .mitigation import load_mitigation
     from .outputs import atomic_output_dir, write_json
-    from .decision_report import study_report, write_mitigation_outputs
-    from .plotting_decision import plot_risk_profiles, plot_tornado, plot_tree
+    from .report.decision_figures import plot_risk_profiles, plot_tornado, plot_tree
+    from .report.files import save_figure
+    from .report.mitigation_text import study_report, write_mitigation_outputs
 
     if (args.tree is None) == (args.options is None):
         raise ValueError("give a decision tree file (riskrf decide TREE.json) or --options OPTIONS.toml with "
@@ -191,16 +173,13 @@ def cmd_decide(args) -> int:
                         "policy": rb.policy, "evpi": evpi},
                        tmp / "decision.json")
             ax = plot_tree(tree)
-            ax.figure.savefig(tmp / "tree.png", dpi=110, bbox_inches="tight")
-            plt.close(ax.figure)
+            save_figure(ax.figure, tmp / "tree.png")
             ax = plot_risk_profiles(tree.risk_profile())
-            ax.figure.savefig(tmp / "risk_profiles.png", dpi=110, bbox_inches="tight")
-            plt.close(ax.figure)
+            save_figure(ax.figure, tmp / "risk_profiles.png")
             if tornado is not None and len(tornado):
                 tornado.to_csv(tmp / "tornado.csv", index=False)
                 ax = plot_tornado(tornado)
-                ax.figure.savefig(tmp / "tornado.png", dpi=110, bbox_inches="tight")
-                plt.close(ax.figure)
+                save_figure(ax.figure, tmp / "tornado.png")
         print(f"\nWrote ranking.csv, decision.json and figures to {out}/")
         return 0
 
@@ -372,6 +351,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    # Figures are written to files: a non-interactive backend, unless the user chose one.
+    os.environ.setdefault("MPLBACKEND", "Agg")
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

@@ -33,7 +33,12 @@ import numpy as np
 import pandas as pd
 from scipy import optimize, stats
 
-from .validation import check_choice, check_probability_level, check_return_periods, warn
+from .validation import (
+    check_choice,
+    check_probability_level,
+    check_return_periods,
+    warn,
+)
 
 EULER_GAMMA = 0.5772156649015329
 

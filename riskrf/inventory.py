@@ -25,18 +25,18 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .units import DEFAULT_DENSITY_KG_M3, KG_PER_TONNE
 from .validation import check_positive, warn
 
 #: Rock density used when none is given [kg/m³] (a typical value for granite
 #: and limestone; Wyllie 2014 uses 2.6-2.7 t/m³).
-DEFAULT_DENSITY_KG_M3 = 2650.0
 
 _VOLUME_NAMES = {"volume", "vol", "v", "volume_m3", "vol_m3", "v_m3", "volum", "volumen"}
 _MASS_NAMES = {"mass", "masse", "m", "weight", "block_mass"}
 _DATE_NAMES = {"date", "datum", "event_date", "date_time", "datetime", "skreddato", "dato", "year", "jahr", "ar"}
 _LOCATION_NAMES = {"location", "chainage", "chainage_m", "station", "place", "site", "km", "stedsangivelse"}
 _NOTES_NAMES = {"notes", "note", "comment", "comments", "remarks", "bemerkung"}
-_MASS_UNITS = {"kg": 1.0, "t": 1000.0, "tonne": 1000.0, "tonnes": 1000.0, "tons": 1000.0}
+_MASS_UNITS = {"kg": 1.0, "t": KG_PER_TONNE, "tonne": KG_PER_TONNE, "tonnes": KG_PER_TONNE, "tons": KG_PER_TONNE}
 _VOLUME_UNITS = {"m3": 1.0, "dm3": 1e-3, "l": 1e-3, "litre": 1e-3, "cm3": 1e-6}
 
 

@@ -31,10 +31,18 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .energy import mass_model
-from .hazard import EnergyHazard
-from .risk import (individual_risk, pv_factor, pv_of_renewals, spatial_temporal_probability,
-                   stationary_rock_strike_probability, vehicle_occupant_fn)
+from .annual_hazard import EnergyHazard
+from .barriers import service_energy_level
+from .impact_energy import mass_model
+from .road_risk import (
+    individual_risk,
+    pv_factor,
+    pv_of_renewals,
+    spatial_temporal_probability,
+    stationary_rock_strike_probability,
+    vehicle_occupant_fn,
+)
+from .units import mass_for_energy_kg
 
 OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment")
 
@@ -144,9 +152,9 @@ class MitigationStudy:
         elif kind in ("fence", "attenuator"):
             v, h = self._paired_samples()
             over = h > option.height_m
-            through = mm.sf(2000.0 * option.capacity_kj / np.maximum(v * v, 1e-12))
+            through = mm.sf(mass_for_energy_kg(option.capacity_kj, v))
             passing = float(np.mean(np.where(over, 1.0, through)))
-            above_sel = mm.sf(2000.0 * option.capacity_kj / 3.0 / np.maximum(v * v, 1e-12))
+            above_sel = mm.sf(mass_for_energy_kg(service_energy_level(option.capacity_kj), v))
             held_above_sel = arrivals * float(np.mean(np.where(over, 0.0, above_sel - through)))
         elif kind == "shed":
             passing = float(hz.exceedance_probability(option.capacity_kj))
@@ -326,7 +334,7 @@ class MitigationStudy:
         road; branch costs are that outcome's cost times the discounted expected
         number of such falls over the horizon, so the rollback equals the ranking.
         """
-        from .decision import DecisionTree
+        from .decision_tree import DecisionTree
         ec, ex, co = self.economics, self.exposure, self.consequences
         pvf = pv_factor(ec.discount_rate, ec.horizon_years)
         p_st = spatial_temporal_probability(ex.vehicles_per_day, ex.vehicle_length_m, ex.speed_kmh)

@@ -41,11 +41,12 @@ import math
 
 from numba import njit
 
+from .units import SPHERE_INERTIA
+
 EN_CONSTANT, EN_WYLLIE, EN_VELOCITY = 0, 1, 2
 ET_FRICTION, ET_CONSTANT = 0, 1
 EN_WYLLIE_MAX = 2.5
 CRSP_VELOCITY_SCALE_MS = 9.144    # 30 ft/s (Pfeiffer & Bowen 1989)
-SPHERE_INERTIA = 0.4              # I / (m r^2) of a solid sphere
 
 
 @njit(cache=True)

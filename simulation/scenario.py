@@ -16,6 +16,7 @@ from scipy import stats
 
 from .impact import EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_FRICTION
 from .slope import Profile
+from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2
 
 
 class ScenarioError(ValueError):
@@ -196,7 +197,6 @@ class Material:
 
 
 #: I / (m r^2) of the block shapes: a solid sphere, and a solid cylinder (disc, wheel) rolling on its rim.
-INERTIA_FACTORS = {"sphere": 0.4, "cylinder": 0.5}
 
 
 @dataclass(frozen=True)
@@ -245,7 +245,7 @@ class Collector:
 
 @dataclass(frozen=True)
 class Settings:
-    gravity_ms2: float = 9.81
+    gravity_ms2: float = STANDARD_GRAVITY_MS2
     contact_velocity_ms: float = 0.5
     stop_velocity_ms: float = 0.05
     max_events: int = 5000
@@ -343,7 +343,7 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
         x_low=x_low, x_high=x_high,
         height_m=Distribution.parse(sd.get("height_m", 1.0), "seeder.height_m", source, lo=0.0, hi=1e4),
         mass_kg=Distribution.parse(sd["mass_kg"], "seeder.mass_kg", source, lo=0.0, hi=1e9, lo_open=True),
-        density_kg_m3=_number(sd.get("density_kg_m3", 2650.0), "seeder.density_kg_m3", source, lo=500, hi=6000),
+        density_kg_m3=_number(sd.get("density_kg_m3", DEFAULT_DENSITY_KG_M3), "seeder.density_kg_m3", source, lo=500, hi=6000),
         vx_ms=Distribution.parse(sd.get("vx_ms", 0.0), "seeder.vx_ms", source, lo=-200, hi=200),
         vz_ms=Distribution.parse(sd.get("vz_ms", 0.0), "seeder.vz_ms", source, lo=-200, hi=200),
         angular_velocity_rads=Distribution.parse(sd.get("angular_velocity_rads", 0.0),
@@ -375,7 +375,7 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
     st = data.get("settings", {})
     _check_keys(st, set(Settings.__dataclass_fields__), "settings.", source)
     settings = Settings(
-        gravity_ms2=_number(st.get("gravity_ms2", 9.81), "settings.gravity_ms2", source, lo=0.0, lo_open=True),
+        gravity_ms2=_number(st.get("gravity_ms2", STANDARD_GRAVITY_MS2), "settings.gravity_ms2", source, lo=0.0, lo_open=True),
         contact_velocity_ms=_number(st.get("contact_velocity_ms", 0.5), "settings.contact_velocity_ms", source,
                                     lo=0.0),
         stop_velocity_ms=_number(st.get("stop_velocity_ms", 0.05), "settings.stop_velocity_ms", source, lo=0.0),

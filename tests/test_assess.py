@@ -8,7 +8,7 @@ import pytest
 import riskrf
 import simulation
 from riskrf.cli import main
-from riskrf.hazard import EnergyHazard
+from riskrf.annual_hazard import EnergyHazard
 from riskrf.site import load_site
 
 from .conftest import ROOT
@@ -147,6 +147,6 @@ def test_missing_site_file(tmp_path, capsys):
 def test_user_text_is_escaped(tmp_path):
     site = _site_copy(tmp_path, replace={'name = "Demo: road below a limestone rock wall"':
                                          'name = "<script>alert(1)</script> & road"'})
-    from riskrf.report import _e
+    from riskrf.report.html import _e
     assert _e("<script>") == "&lt;script&gt;"
     assert load_site(site).name.startswith("<script>")

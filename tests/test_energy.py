@@ -7,10 +7,10 @@ from hypothesis import strategies as st
 from scipy import stats
 
 import riskrf
-from riskrf.energy import (PairedSamples, energy_quantile, exceedance_probability, exceedance_probability_mc,
+from riskrf.impact_energy import (PairedSamples, energy_quantile, exceedance_probability, exceedance_probability_mc,
                            fit_velocity)
-from riskrf.hazard import EnergyHazard
-from riskrf.standards import check_fence, service_energy_level, uni11211_design_energy
+from riskrf.annual_hazard import EnergyHazard
+from riskrf.barriers import check_fence, service_energy_level, uni11211_design_energy
 
 # domain-methods.md 3.1 (E16): median m 1000 kg (sigma_ln 0.8), median v 15 m/s (sigma_ln 0.2)
 # => E lognormal with median 112.5 kJ, sigma_ln 0.8944.

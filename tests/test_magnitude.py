@@ -88,7 +88,7 @@ def test_frequency_methods_are_consistent():
 def test_grenoble_law_return_periods():
     # Dussauge-Peisser et al. (2002) Grenoble law N(>=V) = 4.2 V^-0.41 per year (domain-methods.md E14):
     # N(>=1e4 m3) = 0.09622 (T = 10.39 yr); N(>=1e6) = 0.01456 (T = 68.67 yr); exact 100-yr annual max 2.47e6 m3.
-    from riskrf.magnitude import GutenbergRichterFit
+    from riskrf.power_law import GutenbergRichterFit
     law = GutenbergRichterFit(a=np.log10(4.2), b=0.41, b_stderr=0.0, b_ci=(0.41, 0.41), level=0.95, b_ci_method="",
                               m_min=1.0, m_max=None, rate_min=4.2, n_tail=1, n_total=1, duration_years=1.0,
                               method="mle", m_min_method="given", ks_distance=0.0, units="m3")
@@ -167,7 +167,7 @@ def test_ci_coverage_of_b_from_simulated_data():
 @settings(max_examples=40, deadline=None)
 @given(b=st.floats(0.2, 2.0), p=st.floats(1e-9, 1.0), m_max=st.one_of(st.none(), st.floats(1e3, 1e8)))
 def test_sf_isf_round_trip(b, p, m_max):
-    from riskrf.magnitude import _truncated_isf, _truncated_sf
+    from riskrf.power_law import _truncated_isf, _truncated_sf
     m = _truncated_isf(p, b, 1.0, m_max)
     assert _truncated_sf(m, b, 1.0, m_max) == pytest.approx(p, rel=1e-7, abs=1e-12)
 

@@ -4,10 +4,10 @@ import pytest
 from scipy import stats
 
 from riskrf.cli import main
-from riskrf.hazard import EnergyHazard
+from riskrf.annual_hazard import EnergyHazard
 from riskrf.mitigation import (Consequences, Economics, Exposure, MitigationError, MitigationStudy, Option,
                                parse_mitigation)
-from riskrf.risk import pv_factor, spatial_temporal_probability
+from riskrf.road_risk import pv_factor, spatial_temporal_probability
 
 from .conftest import INVENTORIES, ROOT
 from .test_simulation_run import BARRIER

@@ -32,7 +32,13 @@ import numpy as np
 import pandas as pd
 from scipy import optimize, stats
 
-from .validation import as_positive_array, check_choice, check_positive, check_probability_level, warn
+from .validation import (
+    as_positive_array,
+    check_choice,
+    check_positive,
+    check_probability_level,
+    warn,
+)
 
 #: Above this many distinct candidate thresholds the KS scan refines a grid of
 #: ranks instead of testing every value (see :func:`find_m_min`).
@@ -65,7 +71,7 @@ def find_m_min(masses, *, min_tail: int = 10, exhaustive: bool | None = None):
     -------
     (m_min, D, b) : threshold, its KS distance, and the exponent above it.
     """
-    from ._powerlaw_kernels import ks_scan
+    from ._power_law_kernels import ks_scan
 
     x = np.sort(as_positive_array(masses, "masses"))
     logx, suffix, first, last = _tail_arrays(x)
@@ -314,7 +320,7 @@ class GutenbergRichterFit:
         a plausible description (Clauset et al. 2009).  Replicates use
         ``SeedSequence(seed).spawn`` so results do not depend on chunking.
         """
-        from ._powerlaw_kernels import ks_scan
+        from ._power_law_kernels import ks_scan
 
         if self.method != "mle":
             raise ValueError(f"this fit has method = {self.method!r}: bootstrap_pvalue tests a maximum-likelihood "

@@ -43,12 +43,9 @@ def study_report(study) -> dict:
 
 
 def write_mitigation_outputs(study, report, tmp) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .outputs import write_json
-    from .plotting_decision import plot_fn, plot_tornado, plot_tree
+    from ..outputs import write_json
+    from .decision_figures import plot_fn, plot_tornado, plot_tree
+    from .files import save_figure
     report["ranking"].to_csv(tmp / "ranking.csv", index=False)
     report["tornado"].to_csv(tmp / "tornado.csv", index=False)
     report["break_even"].to_csv(tmp / "break_even.csv", index=False)
@@ -58,12 +55,9 @@ def write_mitigation_outputs(study, report, tmp) -> None:
                 "value_of_information": report["value_of_information"],
                 "defaults_used": list(study.defaults_used)}, tmp / "decision.json")
     ax = plot_tree(tree)
-    ax.figure.savefig(tmp / "tree.png", dpi=110, bbox_inches="tight")
-    plt.close(ax.figure)
+    save_figure(ax.figure, tmp / "tree.png")
     ax = plot_tornado(report["tornado"], currency=study.currency)
-    ax.figure.savefig(tmp / "tornado.png", dpi=110, bbox_inches="tight")
-    plt.close(ax.figure)
+    save_figure(ax.figure, tmp / "tornado.png")
     curves = {o.name: study.fn_curve(o.name) for o in study.options if o.kind != "realignment"}
     ax = plot_fn(curves)
-    ax.figure.savefig(tmp / "fn_curve.png", dpi=110, bbox_inches="tight")
-    plt.close(ax.figure)
+    save_figure(ax.figure, tmp / "fn_curve.png")

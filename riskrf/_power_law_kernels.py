@@ -1,6 +1,6 @@
 """Compiled inner loops of the power-law fit (Kolmogorov-Smirnov threshold scan).
 
-Kept apart from :mod:`riskrf.magnitude` so that the statistics read as
+Kept apart from :mod:`riskrf.power_law` so that the statistics read as
 statistics; these functions only evaluate sums over sorted samples.
 """
 from __future__ import annotations

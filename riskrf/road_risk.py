@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from .units import HOURS_PER_DAY, M_PER_KM
 from .validation import check_positive
 
 #: Tolerable annual individual risk of death (AGS 2007c) [R].
@@ -39,7 +40,7 @@ def spatial_temporal_probability(vehicles_per_day, vehicle_length_m, speed_kmh):
     n = check_positive(vehicles_per_day, "vehicles_per_day")
     length = check_positive(vehicle_length_m, "vehicle_length_m")
     v = check_positive(speed_kmh, "speed_kmh")
-    p = n * length / (24.0 * 1000.0 * v)
+    p = n * length / (HOURS_PER_DAY * M_PER_KM * v)
     if p >= 1:
         raise ValueError(f"P(S:T) = {p:.3g} >= 1: traffic of {n:g} vehicles/day at {v:g} km/h is continuous; "
                          "the formula no longer applies")
@@ -63,7 +64,7 @@ def stationary_rock_strike_probability(vehicles_per_day, hours_on_road, p_cannot
 def individual_risk(falls_per_year, trips_per_day, vehicle_length_m, speed_kmh, vulnerability):
     """Annual probability of death of one commuter: lambda x P(T:S) x V(D:T) (AGS 2007)."""
     p_ts = check_positive(trips_per_day, "trips_per_day") * check_positive(vehicle_length_m, "vehicle_length_m") \
-        / (24.0 * 1000.0 * check_positive(speed_kmh, "speed_kmh"))
+        / (HOURS_PER_DAY * M_PER_KM * check_positive(speed_kmh, "speed_kmh"))
     return float(falls_per_year) * p_ts * float(vulnerability)
 
 

@@ -16,15 +16,22 @@ import numpy as np
 import pandas as pd
 from scipy import optimize
 
-from .energy import PairedSamples, VelocityFit, exceedance_probability, mass_model
 from .extremes import _AnnualMaximumFit
-from .frequency import DESIGN_RETURN_PERIODS
-from .magnitude import GutenbergRichterFit
+from .frequency_study import DESIGN_RETURN_PERIODS
+from .impact_energy import (
+    PairedSamples,
+    VelocityFit,
+    exceedance_probability,
+    mass_model,
+)
+from .power_law import GutenbergRichterFit
+from .units import SPHERE_INERTIA
 from .validation import check_positive, check_probability_level, check_return_periods
+
 
 def inertia_factors(df) -> np.ndarray:
     """I / (m r^2) of each block in a collector table (0.4, a sphere, when the table does not say)."""
-    return df["inertia_factor"].to_numpy(dtype=float) if "inertia_factor" in df else np.full(len(df), 0.4)
+    return df["inertia_factor"].to_numpy(dtype=float) if "inertia_factor" in df else np.full(len(df), SPHERE_INERTIA)
 
 
 _E_GRID = np.geomspace(1e-3, 1e12, 301)     # kJ: the grid on which hazard curves are inverted

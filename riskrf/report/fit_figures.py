@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .extremes import gumbel_reduced_variate, plotting_positions
+from ..extremes import gumbel_reduced_variate, plotting_positions
+from ..units import mass_for_energy_kg
 
 
 def _axes(ax, figsize=(6.4, 4.8)):
@@ -140,7 +141,7 @@ def plot_energy_exceedance(hazard, ax=None, *, fences=(), level: float = 0.95, n
 def plot_mass_velocity(hazard, ax=None, *, energies=(100, 500, 1000, 2000, 5000, 10000), n_points: int = 3000,
                        seed=1):
     """Sampled masses and velocities of falls reaching the line, with iso-energy curves E = 1/2 m v^2."""
-    from .energy import mass_model
+    from ..impact_energy import mass_model
     ax = _axes(ax)
     rng = np.random.default_rng(seed)
     m = mass_model(hazard.mass).rvs(n_points, rng)
@@ -156,7 +157,7 @@ def plot_mass_velocity(hazard, ax=None, *, energies=(100, 500, 1000, 2000, 5000,
     ax.scatter(vs, m, s=3, alpha=0.3, color="0.3", label="sampled falls")
     vv = np.linspace(max(vs.min(), 0.5), vs.max() * 1.05, 100)
     for i, e in enumerate(energies):
-        ax.plot(vv, 2000.0 * e / vv ** 2, color=f"C{i % 10}", lw=1.2, label=f"{e:g} kJ")
+        ax.plot(vv, mass_for_energy_kg(e, vv), color=f"C{i % 10}", lw=1.2, label=f"{e:g} kJ")
     ax.set_yscale("log")
     ax.set_ylim(max(m.min() * 0.5, 1e-3), m.max() * 2)
     ax.set_xlabel("velocity at the barrier [m/s]")

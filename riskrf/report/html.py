@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import __version__
-from .risk import AGS2007_INDIVIDUAL_RISK, fn_zone
+from .. import __version__
+from ..road_risk import AGS2007_INDIVIDUAL_RISK, fn_zone
 
 CSS = """
 body{font-family:Georgia,'Times New Roman',serif;max-width:1100px;margin:2em auto;padding:0 1.5em;color:#222;

@@ -28,11 +28,11 @@ import pandas as pd
 from scipy import optimize, stats
 
 from .extremes import _AnnualMaximumFit
-from .magnitude import GutenbergRichterFit
+from .power_law import GutenbergRichterFit
+from .units import DEFAULT_DENSITY_KG_M3, J_PER_KJ, SPHERE_INERTIA
 from .validation import check_choice
 
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
-SPHERE_INERTIA = 0.4
 
 
 # ---------------------------------------------------------------- velocity models
@@ -195,7 +195,7 @@ def _check_energies(energy_kj):
     return e
 
 
-def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, density_kg_m3: float = 2650.0,
+def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
                            method: str = "quad", n_samples: int = 1_000_000, seed=None):
     """P(E > e) for one fall: the probability that its impact energy exceeds ``energy_kj``.
 
@@ -283,7 +283,7 @@ def _conditional_on_mass(e, mm, paired: PairedSamples):
     return np.clip(out, 0.0, 1.0).reshape(e.shape)
 
 
-def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=None, density_kg_m3: float = 2650.0,
+def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=None, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
                               n_samples: int = 1_000_000, seed=None, level: float = 0.95):
     """Monte Carlo estimate of P(E > e) with its Wilson interval: (p, lower, upper) arrays."""
     from simulation.result import wilson_interval
@@ -310,10 +310,10 @@ def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=Non
         v = samples[idx]
         if angular_velocity is not None:
             w = np.asarray(angular_velocity, dtype=float)[idx]
-    energy = 0.5 * m * v * v / 1000.0
+    energy = 0.5 * m * v * v / J_PER_KJ
     if w is not None:
         r = (3.0 * m / (4.0 * np.pi * density_kg_m3)) ** (1.0 / 3.0)
-        energy = energy + 0.5 * SPHERE_INERTIA * m * r * r * w * w / 1000.0
+        energy = energy + 0.5 * SPHERE_INERTIA * m * r * r * w * w / J_PER_KJ
     energy.sort()
     k = n_samples - np.searchsorted(energy, e.ravel(), side="right")
     lo, hi = wilson_interval(k, n_samples, level)

@@ -15,8 +15,8 @@ import pandas as pd
 
 from .extremes import MIN_MAXIMA, GEVFit, GumbelFit, fit_gev, fit_gumbel
 from .inventory import Inventory
-from .magnitude import GutenbergRichterFit, fit_gutenberg_richter
 from .outputs import write_json
+from .power_law import GutenbergRichterFit, fit_gutenberg_richter
 from .validation import RiskrfWarning
 
 #: Return periods of the design-mass table [yr].
@@ -169,36 +169,14 @@ class FrequencyAnalysis:
 
     def write(self, out_dir) -> list[Path]:
         """Write summary.json, design_masses.csv, completeness.csv and PNG figures into ``out_dir``."""
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        from .plotting import plot_gumbel, plot_magnitude_frequency, plot_return_levels
+        from .report.files import write_frequency_figures
 
         out = Path(out_dir)
-        written = []
         write_json(self.to_dict(), out / "summary.json")
         self.design_masses().to_csv(out / "design_masses.csv", index=False)
         self.inventory.completeness().to_csv(out / "completeness.csv")
-        written += [out / "summary.json", out / "design_masses.csv", out / "completeness.csv"]
-        ax = plot_magnitude_frequency(self.power_law)
-        ax.set_title("Magnitude - cumulative frequency")
-        ax.figure.savefig(out / "magnitude_frequency.png", dpi=120, bbox_inches="tight")
-        plt.close(ax.figure)
-        written.append(out / "magnitude_frequency.png")
-        if self.gumbel is not None:
-            ax = plot_gumbel(self.gumbel)
-            ax.set_title("Gumbel probability plot of annual maxima")
-            ax.figure.savefig(out / "gumbel_plot.png", dpi=120, bbox_inches="tight")
-            plt.close(ax.figure)
-            fits = {f"Gumbel ({self.gumbel.method})": self.gumbel}
-            if self.gev is not None:
-                fits["GEV"] = self.gev
-            ax = plot_return_levels(fits, power_law=self.power_law, maxima=self.maxima)
-            ax.set_title("Return levels of the annual maximum mass")
-            ax.figure.savefig(out / "return_levels.png", dpi=120, bbox_inches="tight")
-            plt.close(ax.figure)
-            written += [out / "gumbel_plot.png", out / "return_levels.png"]
+        written = [out / "summary.json", out / "design_masses.csv", out / "completeness.csv"]
+        written += write_frequency_figures(self, out)
         return written
 
 

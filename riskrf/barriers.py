@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from .units import J_PER_KJ, SEL_PER_MEL
 from .validation import check_positive
 
 #: ETAG 027 energy classes (MEL and SEL in kJ) [R: confirm against the EAD 340059 table].
@@ -41,7 +42,7 @@ UNI11211_FACTORS = {
 
 def service_energy_level(mel_kj):
     """SEL = MEL / 3 (ETAG 027) [kJ]."""
-    return check_positive(mel_kj, "mel_kj") / 3.0
+    return check_positive(mel_kj, "mel_kj") * SEL_PER_MEL
 
 
 @dataclass(frozen=True)
@@ -77,8 +78,8 @@ def uni11211_design_energy(volume_m3: float, density_kg_m3: float, velocity_ms: 
             raise ValueError(f"{name} = {value!r}: UNI 11211-4 partial factors lie between 1.0 and 2.0")
     m_d = vol * rho * gamma_VolF * gamma_gamma
     v_d = v * gamma_Tr * gamma_Dp
-    return UNI11211Design(characteristic_energy_kj=0.5 * vol * rho * v * v / 1000.0,
-                          design_energy_kj=0.5 * m_d * v_d * v_d / 1000.0, design_mass_kg=m_d,
+    return UNI11211Design(characteristic_energy_kj=0.5 * vol * rho * v * v / J_PER_KJ,
+                          design_energy_kj=0.5 * m_d * v_d * v_d / J_PER_KJ, design_mass_kg=m_d,
                           design_velocity_ms=v_d, factors=factors)
 
 
@@ -95,7 +96,7 @@ def check_fence(hazard, mel_kj: float, height_m: float, *, T: float = 100.0, fre
     """
     mel = check_positive(mel_kj, "mel_kj")
     H = check_positive(height_m, "height_m")
-    sel = mel / 3.0
+    sel = service_energy_level(mel)
     if design_energy is None:
         e_T = float(hazard.energy_at_return_period(T))
         lo, hi = hazard.energy_at_return_period_ci(T, n_bootstrap=n_bootstrap, seed=seed)

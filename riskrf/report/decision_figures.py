@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .plotting import _axes
-from .risk import HK_GEO_FN_LINES
+from ..road_risk import HK_GEO_FN_LINES
+from .fit_figures import _axes
 
 
 def _fmt(v):
@@ -42,7 +42,7 @@ def plot_tree(tree, ax=None, *, max_label: int = 28):
     better = min if tree.objective == "min" else max
 
     def value(node):
-        from .decision import _evaluate
+        from ..decision_tree import _evaluate
         if node.type == "terminal":
             v = _evaluate(node.value, tree.parameters, node.path)
         else:
@@ -71,7 +71,7 @@ def plot_tree(tree, ax=None, *, max_label: int = 28):
             label = b.name if len(b.name) <= max_label else b.name[:max_label - 1] + "…"
             extra = []
             if b.probability is not None:
-                from .decision import _evaluate
+                from ..decision_tree import _evaluate
                 extra.append(f"p={_evaluate(b.probability, tree.parameters, b.name):.3g}")
             net = tree._net(b)
             if net:

@@ -7,11 +7,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .frequency import DESIGN_RETURN_PERIODS
-from .hazard import EnergyHazard
-from .magnitude import GutenbergRichterFit
+from .annual_hazard import EnergyHazard
+from .barriers import UNI11211_FACTORS, check_fence, uni11211_design_energy
+from .frequency_study import DESIGN_RETURN_PERIODS
 from .outputs import write_json
-from .standards import UNI11211_FACTORS, check_fence, uni11211_design_energy
+from .power_law import GutenbergRichterFit
+from .units import DEFAULT_DENSITY_KG_M3
 
 
 @dataclass(frozen=True)
@@ -84,30 +85,17 @@ class EnergyAnalysis:
         return out
 
     def write(self, out_dir) -> None:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        from .plotting import plot_energy_exceedance, plot_mass_velocity
+        from .report.files import write_energy_figures
         out = Path(out_dir)
         write_json(self.to_dict(), out / "energy_summary.json")
         self.design.to_csv(out / "design_energies.csv", index=False)
         if self.fences:
             pd.concat([t.assign(fence=n) for n, t in self.fences.items()]).to_csv(out / "fence_checks.csv",
                                                                                 index=False)
-        caps = [float(n.split(" kJ")[0]) for n in self.fences]
-        ax = plot_energy_exceedance(self.hazard, fences=caps, n_bootstrap=min(self.n_bootstrap, 200), seed=self.seed)
-        ax.set_title("Impact energy at the barrier line")
-        ax.figure.savefig(out / "energy_exceedance.png", dpi=120, bbox_inches="tight")
-        plt.close(ax.figure)
-        ax = plot_mass_velocity(self.hazard, seed=self.seed)
-        ax.set_title("Mass and velocity of arriving falls")
-        ax.figure.savefig(out / "mass_velocity.png", dpi=120, bbox_inches="tight")
-        plt.close(ax.figure)
-
+        write_energy_figures(self, out, [float(n.split(" kJ")[0]) for n in self.fences])
 
 def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m: float = 5.0, free_board_m: float = 0.5,
-                   T=DESIGN_RETURN_PERIODS, design_T: float = 100.0, density_kg_m3: float = 2650.0,
+                   T=DESIGN_RETURN_PERIODS, design_T: float = 100.0, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
                    n_bootstrap: int = 300, seed=1, uni_factors: dict | None = None) -> EnergyAnalysis:
     """Design table, fence checks (each capacity in ``fences`` at ``fence_height_m``) and UNI 11211-4 energy."""
     T_all = np.union1d(np.asarray(T, dtype=float), [design_T])

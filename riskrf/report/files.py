@@ -1,0 +1,75 @@
+"""Figure files written by ``riskrf fit``, ``energy``, ``simulate``, ``decide`` and ``assess``.
+
+Figures are written as PNG at :data:`FIGURE_DPI` (sharp on screen and in print) and
+closed after writing; the plotting backend is never changed here (the command line
+selects a non-interactive one once, at start-up).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+FIGURE_DPI = 200
+
+
+def save_figure(fig, path, *, tight_layout: bool = False) -> Path:
+    """Write ``fig`` to ``path`` (PNG, :data:`FIGURE_DPI`) and close it; returns the path."""
+    import matplotlib.pyplot as plt
+    if tight_layout:
+        fig.tight_layout()
+    fig.savefig(path, dpi=FIGURE_DPI, bbox_inches="tight")
+    plt.close(fig)
+    return Path(path)
+
+
+def write_frequency_figures(analysis, out: Path) -> list[Path]:
+    """Magnitude-frequency, Gumbel and return-level figures of a :class:`~riskrf.FrequencyAnalysis`."""
+    from .fit_figures import plot_gumbel, plot_magnitude_frequency, plot_return_levels
+    ax = plot_magnitude_frequency(analysis.power_law)
+    ax.set_title("Magnitude - cumulative frequency")
+    written = [save_figure(ax.figure, out / "magnitude_frequency.png")]
+    if analysis.gumbel is not None:
+        ax = plot_gumbel(analysis.gumbel)
+        ax.set_title("Gumbel probability plot of annual maxima")
+        written.append(save_figure(ax.figure, out / "gumbel_plot.png"))
+        fits = {f"Gumbel ({analysis.gumbel.method})": analysis.gumbel}
+        if analysis.gev is not None:
+            fits["GEV"] = analysis.gev
+        ax = plot_return_levels(fits, power_law=analysis.power_law, maxima=analysis.maxima)
+        ax.set_title("Return levels of the annual maximum mass")
+        written.append(save_figure(ax.figure, out / "return_levels.png"))
+    return written
+
+
+def write_energy_figures(analysis, out: Path, fence_capacities_kj) -> list[Path]:
+    """Energy exceedance and mass-velocity figures of an energy study (``riskrf energy``)."""
+    from .fit_figures import plot_energy_exceedance, plot_mass_velocity
+    ax = plot_energy_exceedance(analysis.hazard, fences=list(fence_capacities_kj),
+                                n_bootstrap=min(analysis.n_bootstrap, 200), seed=analysis.seed)
+    ax.set_title("Impact energy at the barrier line")
+    written = [save_figure(ax.figure, out / "energy_exceedance.png")]
+    ax = plot_mass_velocity(analysis.hazard, seed=analysis.seed)
+    ax.set_title("Mass and velocity of arriving falls")
+    written.append(save_figure(ax.figure, out / "mass_velocity.png"))
+    return written
+
+
+def write_simulation_figures(result, out: Path, collectors, *, file_names=None) -> list[Path]:
+    """Profile with trajectories, one distribution figure per collector, and envelopes (when binned).
+
+    ``file_names`` maps a collector name to its file name (default ``collector_<name>.png``).
+    """
+    from simulation.plotting import (
+        plot_collector_distributions,
+        plot_envelopes,
+        plot_profile,
+    )
+    file_names = file_names or {}
+    written = [save_figure(plot_profile(result).figure, out / "profile_trajectories.png")]
+    for name in collectors:
+        axes = plot_collector_distributions(result, name)
+        written.append(save_figure(axes[0][0].figure, out / file_names.get(name, f"collector_{name}.png"),
+                                   tight_layout=True))
+    if result.scenario.settings.envelope_bins:
+        axes = plot_envelopes(result)
+        written.append(save_figure(axes[0].figure, out / "envelopes.png"))
+    return written

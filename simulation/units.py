@@ -1,0 +1,50 @@
+"""Named physical constants and unit factors shared by :mod:`simulation` and :mod:`riskrf`.
+
+One home for each number: energies are reported in kJ (barrier ratings are in kJ),
+masses in kg, lengths in m.  :mod:`riskrf.units` re-exports everything here.
+"""
+from __future__ import annotations
+
+J_PER_KJ = 1000.0
+"""Joules per kilojoule: E [kJ] = 1/2 m v^2 / J_PER_KJ with m in kg and v in m/s."""
+
+KG_PER_TONNE = 1000.0
+"""Kilograms per tonne."""
+
+STANDARD_GRAVITY_MS2 = 9.81
+"""Acceleration of gravity [m/s^2] used by default in trajectories and potential energies."""
+
+DEFAULT_DENSITY_KG_M3 = 2650.0
+"""Default rock density [kg/m^3] (quartz-rich rock; Wyllie 2014, table 1.1 gives 2,500-2,800 for
+most rock types).  Used when an inventory or scenario gives none, and always reported as a default."""
+
+SPHERE_INERTIA = 0.4
+"""I / (m r^2) of a solid sphere, 2/5."""
+
+CYLINDER_INERTIA = 0.5
+"""I / (m r^2) of a solid cylinder or disc rolling on its curved face, 1/2."""
+
+INERTIA_FACTORS = {"sphere": SPHERE_INERTIA, "cylinder": CYLINDER_INERTIA}
+"""I / (m r^2) by block shape."""
+
+
+def kinetic_energy_kj(mass_kg, speed_ms, angular_velocity_rads=0.0, radius_m=0.0, inertia_factor=SPHERE_INERTIA):
+    """Translational plus rotational kinetic energy [kJ]: (1/2 m v^2 + 1/2 k m r^2 w^2) / 1000.
+
+    Wyllie (2014) eq. 3.1 (translation) and eq. 3.2 (rotation, I = k m r^2).  Works on scalars
+    and NumPy arrays.
+    """
+    return 0.5 * mass_kg * (speed_ms * speed_ms
+                            + inertia_factor * radius_m * radius_m * angular_velocity_rads * angular_velocity_rads) \
+        / J_PER_KJ
+
+
+def mass_for_energy_kg(energy_kj, speed_ms):
+    """Mass [kg] whose translational kinetic energy at ``speed_ms`` is ``energy_kj``: m = 2 E / v^2.
+
+    The inverse of Wyllie (2014) eq. 3.1; the speed is floored at 1e-150 m/s so that v = 0 gives a huge
+    mass rather than a division error.  Works on scalars and NumPy arrays.
+    """
+    import numpy as np
+    v2 = np.maximum(np.asarray(speed_ms, dtype=float) ** 2, 1e-300)
+    return 2.0 * J_PER_KJ * energy_kj / v2
