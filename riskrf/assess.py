@@ -8,6 +8,7 @@ into a temporary directory that is moved into place only when complete.
 from __future__ import annotations
 
 import json
+import logging
 import platform
 import shutil
 import sys
@@ -29,6 +30,8 @@ from .power_law import fit_gutenberg_richter
 from .road_risk import fn_zone
 from .site import Site
 from .validation import RiskrfWarning
+
+logger = logging.getLogger("riskrf")
 
 
 def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, rate_scale: float = 1.0,
@@ -147,8 +150,10 @@ class Assessment:
         return out
 
 
-def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None = None, log=print) -> Assessment:
-    """Run the whole chain for a validated site, logging each stage with its duration."""
+def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None = None, log=None) -> Assessment:
+    """Run the whole chain for a validated site; each stage is logged (``logging`` logger ``riskrf``, level INFO,
+    or the callable ``log``) and timed in :attr:`Assessment.timings`."""
+    log = log or logger.info
     from .report.mitigation_text import study_report
 
     seed = site.hazard["seed"] if seed is None else seed
@@ -211,8 +216,9 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                       warnings=notes, timings=timings)
 
 
-def write_assessment(a: Assessment, out: Path, log=print) -> dict:
+def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     """Write every output of an assessment into ``out`` (an empty directory); returns the summary."""
+    log = log or logger.info
     from .report.html import render_report
     from .report.mitigation_text import write_mitigation_outputs
 

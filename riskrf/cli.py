@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import sys
 import warnings
@@ -230,7 +231,13 @@ def cmd_assess(args) -> int:
     assessment = run_assessment(site, seed=args.seed, n_blocks=args.n)
     with atomic_output_dir(out) as tmp:
         s = write_assessment(assessment, tmp)
-    print(f"\nBest option: {s['best_option']} (then {s['second_option']}).")
+    stages = ", ".join(f"{k} {v:.1f} s" for k, v in assessment.timings.items())
+    print(f"\nStage times: {stages}.")
+    if assessment.warnings:
+        print(f"{len(assessment.warnings)} warning(s), also listed in the report:")
+        for w in assessment.warnings:
+            print(f"  - {w}")
+    print(f"Best option: {s['best_option']} (then {s['second_option']}).")
     print(f"Report: {(out / 'report.html').resolve()}")
     return 0
 
@@ -353,6 +360,13 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     # Figures are written to files: a non-interactive backend, unless the user chose one.
     os.environ.setdefault("MPLBACKEND", "Agg")
+    # Library code logs its stages (logger "riskrf"); the command line shows them as plain lines.
+    handler = logging.StreamHandler(sys.stdout)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    logger = logging.getLogger("riskrf")
+    if not logger.handlers:
+        logger.addHandler(handler)
+    logger.setLevel(logging.INFO)
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

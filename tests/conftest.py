@@ -13,6 +13,8 @@ def data_dir():
 
 from hypothesis import settings  # noqa: E402
 
-# Property tests draw the same examples on every run: CI results do not depend on chance.
-settings.register_profile("riskrf", derandomize=True, deadline=None)
+# Property tests draw new examples on every run (a failure prints the seed and the example
+# to reproduce it: ``pytest --hypothesis-seed=N``); no deadline, since the first call of a
+# compiled kernel includes its compilation.
+settings.register_profile("riskrf", deadline=None, print_blob=True)
 settings.load_profile("riskrf")

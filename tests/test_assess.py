@@ -15,6 +15,8 @@ from .conftest import ROOT
 
 SITE = ROOT / "riskrf" / "data" / "demo_site.toml"
 ARTIFACTS = ROOT / "tests" / "artifacts"
+DEMO_NAME = "Demo: road below a limestone rock wall"
+HOSTILE_NAME = "<script>alert(1)</script> & road"
 
 
 def _site_copy(tmp_path, replace=None, drop=None):
@@ -36,7 +38,8 @@ def _site_copy(tmp_path, replace=None, drop=None):
 @pytest.fixture(scope="module")
 def assessed(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("assess")
-    site = _site_copy(tmp)
+    # One shared assessment for the whole module; its site name is hostile HTML, checked for escaping below.
+    site = _site_copy(tmp, replace={f'name = "{DEMO_NAME}"': f'name = "{HOSTILE_NAME}"'})
     out = tmp / "out"
     assert main(["assess", str(site), "--out", str(out)]) == 0
     return site, out
@@ -144,9 +147,10 @@ def test_missing_site_file(tmp_path, capsys):
     assert "site file not found" in capsys.readouterr().err
 
 
-def test_user_text_is_escaped(tmp_path):
-    site = _site_copy(tmp_path, replace={'name = "Demo: road below a limestone rock wall"':
-                                         'name = "<script>alert(1)</script> & road"'})
-    from riskrf.report.html import _e
-    assert _e("<script>") == "&lt;script&gt;"
-    assert load_site(site).name.startswith("<script>")
+def test_user_text_is_escaped(assessed):
+    """The site's name is user text: the rendered report shows it as text, never as markup."""
+    site, out = assessed
+    assert load_site(site).name == HOSTILE_NAME
+    html = (out / "report.html").read_text()
+    assert "&lt;script&gt;alert(1)&lt;/script&gt; &amp; road" in html
+    assert "<script>alert(1)" not in html
