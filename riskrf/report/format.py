@@ -1,0 +1,220 @@
+"""Formatting for people: numbers with sensible significant figures, money, human column headers,
+and an HTML document with a table of contents and numbered figures and tables.
+
+Numbers in a report carry only the figures their uncertainty supports: 2-3 significant
+figures for estimated quantities (an energy with a ±45 % interval is "300,000 kJ", not
+"3.044e+05 kJ"), whole units with thousands separators and the currency for money, and
+never Python's ``e+05`` notation.  Very small probabilities are written as
+"2.9 × 10⁻⁶".
+"""
+from __future__ import annotations
+
+import base64
+import html
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+def escape(text) -> str:
+    """HTML-escaped text of any value (user text is never markup)."""
+    return html.escape(str(text))
+
+
+def sig(x, digits: int = 3) -> str:
+    """``x`` to ``digits`` significant figures, with thousands separators and no exponent notation
+    between 10⁻³ and 10¹²; outside that range as "a.b × 10ⁿ".  NaN and None give an empty string.
+    """
+    if x is None:
+        return ""
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return str(x)
+    if math.isnan(v):
+        return ""
+    if math.isinf(v):
+        return "∞" if v > 0 else "−∞"
+    if v == 0:
+        return "0"
+    exponent = math.floor(math.log10(abs(v)))
+    if exponent < -3 or exponent >= 12:
+        mantissa = v / 10 ** exponent
+        m = f"{mantissa:.{max(digits - 1, 0)}f}".rstrip("0").rstrip(".")
+        if m in ("10", "-10"):                     # rounding carried over
+            m, exponent = m[:-1], exponent + 1
+        return f"{m} × 10{str(exponent).translate(_SUPERSCRIPT)}"
+    decimals = max(digits - 1 - exponent, 0)
+    if decimals:
+        text = f"{v:,.{decimals}f}".rstrip("0").rstrip(".")      # 0.50 -> 0.5: no false precision either way
+    else:
+        text = f"{round(v, -(exponent - digits + 1)):,.0f}"
+    return text.replace("-", "−") if text.startswith("-") else text
+
+
+def money(x, currency: str = "") -> str:
+    """Money for a manager: whole units with thousands separators and the currency, e.g. "1,250,000 CHF"."""
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return ""
+    text = f"{float(x):,.0f}".replace("-", "−")
+    return f"{text} {currency}".strip()
+
+
+def probability(p) -> str:
+    """A probability or annual frequency: 2 significant figures, powers of ten below 0.001."""
+    return sig(p, 2)
+
+
+_UNIT_SUFFIXES = [
+    ("_per_year", "[1/yr]"), ("_kj", "[kJ]"), ("_kg", "[kg]"), ("_m3", "[m³]"), ("_ms", "[m/s]"),
+    ("_rads", "[rad/s]"), ("_years", "[yr]"), ("_yr", "[yr]"), ("_deg", "[°]"), ("_kmh", "[km/h]"),
+    ("_m", "[m]"), ("_s", "[s]"), ("_pct", "[%]"),
+]
+_WORDS = {"ci": "CI", "sel": "SEL", "mel": "MEL", "mle": "MLE", "ks": "KS", "aic": "AIC", "fn": "F-N",
+          "uni": "UNI", "gev": "GEV", "bcr": "BCR", "pv": "PV", "evpi": "EVPI", "p05": "5 %", "p95": "95 %",
+          "p50": "median", "t": "T"}
+
+
+def human_header(name: str) -> str:
+    """A column name as a reader expects it: ``energy_kj`` -> "Energy [kJ]", ``T_years`` -> "T [yr]".
+
+    Names that already read as text (with spaces or brackets) are returned unchanged.
+    """
+    name = str(name)
+    if " " in name or "[" in name or "(" in name:
+        return name
+    unit = ""
+    low = name.lower()
+    for suffix, u in _UNIT_SUFFIXES:
+        if low.endswith(suffix) and len(low) > len(suffix):
+            name, unit = name[: -len(suffix)], u
+            break
+    words = [_WORDS.get(w.lower(), w) for w in re.split(r"_+", name) if w]
+    if not words:
+        return unit
+    text = " ".join(words)
+    text = text[0].upper() + text[1:]
+    return f"{text} {unit}".strip()
+
+
+def cell(value, *, digits: int = 3, money_columns: bool = False, currency: str = "") -> str:
+    """One table cell as text: numbers to ``digits`` significant figures (or money), booleans as yes/no,
+    dictionaries and lists as readable text."""
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if isinstance(value, (int, np.integer)) and not money_columns:
+        return f"{int(value):,}"
+    if isinstance(value, (float, np.floating, int, np.integer)):
+        return money(value, currency) if money_columns else sig(value, digits)
+    if isinstance(value, dict):
+        return "; ".join(f"{k}: {cell(v, digits=digits)}" for k, v in value.items())
+    if isinstance(value, (list, tuple)):
+        return ", ".join(cell(v, digits=digits) for v in value)
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return ""
+    return str(value)
+
+
+@dataclass
+class Document:
+    """An HTML document that numbers its figures and tables and builds its own table of contents.
+
+    ``section(title)`` starts a numbered section; ``table(...)`` and ``figure(...)`` return HTML and
+    the label ("Table 3", "Figure 5") to refer to from the text (``doc.next_table`` /
+    ``doc.next_figure`` give the label before the element is added).
+    """
+    title: str
+    parts: list = field(default_factory=list)
+    sections: list = field(default_factory=list)
+    n_tables: int = 0
+    n_figures: int = 0
+
+    @property
+    def next_table(self) -> str:
+        return f"Table {self.n_tables + 1}"
+
+    @property
+    def next_figure(self) -> str:
+        return f"Figure {self.n_figures + 1}"
+
+    def add(self, *fragments: str) -> None:
+        self.parts.extend(f for f in fragments if f)
+
+    def section(self, title: str) -> None:
+        number = len(self.sections) + 1
+        anchor = f"s{number}"
+        self.sections.append((anchor, f"{number}. {title}"))
+        self.parts.append(f"<h2 id='{anchor}'>{number}. {escape(title)}</h2>")
+
+    def table(self, df: pd.DataFrame, caption: str, *, digits: int = 3, money_columns=(), currency: str = "",
+              headers: dict | None = None, index: bool = False) -> str:
+        """A numbered table: human headers with units, numbers to ``digits`` significant figures,
+        ``money_columns`` as whole currency units."""
+        if df is None or len(df) == 0:
+            return ""
+        self.n_tables += 1
+        d = df.reset_index() if index else df
+        headers = headers or {}
+        cols = list(d.columns)
+        head = "".join(f"<th>{escape(headers.get(c, human_header(c)))}</th>" for c in cols)
+        rows = []
+        for rec in d.itertuples(index=False):
+            cells = []
+            for c, v in zip(cols, rec):
+                text = cell(v, digits=digits, money_columns=c in money_columns, currency=currency)
+                numeric = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
+                cells.append(f"<td class='{'num' if numeric else 'txt'}'>{escape(text)}</td>")
+            rows.append("<tr>" + "".join(cells) + "</tr>")
+        return (f"<div class='table'><table id='t{self.n_tables}'><caption>Table {self.n_tables}. "
+                f"{escape(caption)}</caption><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody>"
+                "</table></div>")
+
+    def figure(self, path: Path, caption: str) -> str:
+        """A numbered figure embedded as a data URI (the report needs no network); empty if the file is absent."""
+        path = Path(path)
+        if not path.exists():
+            return ""
+        self.n_figures += 1
+        data = base64.b64encode(path.read_bytes()).decode("ascii")
+        return (f"<figure id='f{self.n_figures}'><img alt='{escape(caption)}' src='data:image/png;base64,{data}'>"
+                f"<figcaption>Figure {self.n_figures}. {escape(caption)}</figcaption></figure>")
+
+    def render(self, *, header: str = "", footer: str = "") -> str:
+        """The whole page: head with viewport and print styles, title, table of contents, body."""
+        toc = "".join(f"<li><a href='#{a}'>{escape(t)}</a></li>" for a, t in self.sections)
+        return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+                "<meta name='viewport' content='width=device-width, initial-scale=1'>"
+                f"<title>{escape(self.title)}</title><style>{CSS}</style></head><body>"
+                f"{header}<nav class='toc'><b>Contents</b><ol>{toc}</ol></nav>" + "\n".join(self.parts)
+                + f"{footer}</body></html>")
+
+
+CSS = """
+body{font-family:Georgia,'Times New Roman',serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;
+line-height:1.45}
+h1{font-size:1.6em;border-bottom:2px solid #444;padding-bottom:.2em}
+h2{font-size:1.3em;margin-top:2em;border-bottom:1px solid #aaa}h3{font-size:1.05em}
+.table{overflow-x:auto;max-width:100%}
+table{border-collapse:collapse;margin:.6em 0;font-size:.85em;font-family:Helvetica,Arial,sans-serif}
+caption{caption-side:top;text-align:left;font-size:.95em;color:#333;padding:.2em 0;font-style:italic}
+th,td{border:1px solid #ccc;padding:.25em .5em}th{background:#eee;text-align:left;vertical-align:bottom}
+td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}td.txt{text-align:left}
+.box{background:#f4f7fb;border:1px solid #9ab;padding:.8em 1.2em;margin:1em 0}
+.warn{background:#fff6e5;border:1px solid #e0b060;padding:.6em 1.2em}
+figure{margin:1em 0;text-align:center}figure img{max-width:100%;height:auto;border:1px solid #ddd}
+figcaption{font-size:.85em;color:#555}.toc{border:1px solid #ccc;padding:.5em 1.2em;margin:1em 0;
+background:#fafafa}.toc ol{margin:.3em 0;padding-left:1.5em}
+.ok{color:#17692a;font-weight:bold}.fail{color:#a4161a;font-weight:bold}code{font-size:.9em;word-break:break-all}
+@media (max-width:600px){body{margin:1em auto;padding:0 .6em;font-size:15px}h1{font-size:1.3em}
+table{font-size:.75em}}
+@media print{@page{size:A4;margin:18mm 15mm}body{max-width:none;margin:0;padding:0;font-size:10.5pt}
+h2,h3{break-after:avoid;page-break-after:avoid}tr,figure,.box{break-inside:avoid;page-break-inside:avoid}
+thead{display:table-header-group}.toc{break-after:page}a{color:inherit;text-decoration:none}
+.table{overflow:visible}}
+"""
