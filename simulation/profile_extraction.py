@@ -135,7 +135,7 @@ class TerrainProfile:
     def project(self, points_xy) -> pd.DataFrame:
         """Distance along the polyline [m] and signed offset from it [m] of plan points.
 
-        The offset is positive to the left of the direction of travel.  Points
+        The offset (distance to the path) is positive to the left of the direction of travel.  Points
         are projected on the nearest polyline segment (the end segments are
         extended), so a stop point's ``distance_m`` is its horizontal runout as
         the 2-D profile sees it.
@@ -162,7 +162,7 @@ class TerrainProfile:
             best = np.where(better, dist, best)
             s_out = np.where(better, cum[i] + t * np.sqrt(L2[i]), s_out)
             cross = (d[i, 0] * r[:, 1] - d[i, 1] * r[:, 0]) / np.sqrt(L2[i])
-            off_out = np.where(better, cross, off_out)
+            off_out = np.where(better, np.copysign(dist, cross), off_out)
         return pd.DataFrame({"distance_m": s_out, "offset_m": off_out})
 
     def to_dict(self, decimals: int = 3) -> dict:
