@@ -216,7 +216,9 @@ def read_observed(path, *, column: str = "x_stop_m", select: dict | None = None)
         bad = pd.to_numeric(df[column], errors="coerce").isna()
         row = int(np.argmax(bad.to_numpy()))
         raise ValueError(f"{path}: column {column!r} is not numeric; row {row + 2} holds {df[column].iloc[row]!r}")
-    out = df.rename(columns={column: "x_stop_m"}).reset_index(drop=True)
+    out = df.rename(columns={column: "x_stop_m"})
+    if suffix not in (".parquet", ".xlsx", ".xls"):
+        out.index = out.index + 2            # row labels are the CSV file's line numbers (line 1 is the header)
     out.attrs["source"] = f"{path} (column {column!r})"
     return out
 
@@ -228,7 +230,7 @@ def _observed_frame(observed) -> tuple[pd.DataFrame, str]:
     if isinstance(observed, pd.DataFrame):
         if "x_stop_m" not in observed.columns:
             raise ValueError(f"observed DataFrame needs an 'x_stop_m' column [m]; columns are {list(observed.columns)}")
-        return observed.reset_index(drop=True), "observed DataFrame (column 'x_stop_m')"
+        return observed, "observed DataFrame (column 'x_stop_m')"
     if isinstance(observed, pd.Series):
         return pd.DataFrame({"x_stop_m": observed.to_numpy()}), "observed Series"
     try:
@@ -246,12 +248,13 @@ def _check_observed(df: pd.DataFrame, source: str, scenario: Scenario, collector
     bad = ~np.isfinite(x)
     if bad.any():
         i = int(np.argmax(bad))
-        raise ValueError(f"{source}: x_stop_m must be finite numbers in m; row {i} holds {df['x_stop_m'].iloc[i]!r}")
+        raise ValueError(f"{source}: x_stop_m must be finite numbers in m; row {df.index[i]} holds "
+                         f"{df['x_stop_m'].iloc[i]}")
     lo, hi = scenario.profile.x[0], scenario.profile.x[-1]
     out = (x < lo) | (x > hi)
     if out.any():
         i = int(np.argmax(out))
-        raise ValueError(f"{source}: x_stop_m = {x[i]:g} m (row {i}) is outside the profile of {scenario.source} "
+        raise ValueError(f"{source}: x_stop_m = {x[i]:g} m (row {df.index[i]}) is outside the profile of {scenario.source} "
                          f"[{lo:g}, {hi:g}] m")
     if x.size == 0:
         raise ValueError(f"{source}: no observed stops")
