@@ -204,3 +204,20 @@ def test_cli_calibrate_writes_outputs(tmp_path, capsys):
     rc = main(["calibrate", str(scen), str(obs), "--parameter", f"{FRICTION}=ten:40"])
     assert rc == 2 and "LOW and HIGH must be numbers" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+def test_collector_quantities_join_the_distance():
+    data = synthetic()
+    data["collectors"] = [{"name": "toe", "x": 35.0}]
+    truth = {FRICTION: 28.0}
+    res = simulation.run(simulation.scenario_from_dict(apply_parameters(data, truth)), n=40, seed=3, record_paths=0)
+    toe = res.collector("toe", first_only=True)
+    obs = pd.DataFrame({"x_stop_m": res.per_block["x"]})
+    obs["velocity_ms"] = np.nan
+    obs.loc[: len(toe) - 1, "velocity_ms"] = toe["velocity_ms"].to_numpy()
+    with pytest.raises(ValueError, match=r"columns \['velocity_ms'\] are collector quantities; name the collector"):
+        simulation.calibrate(data, obs, {FRICTION: (10, 40)}, n=20)
+    with pytest.raises(KeyError, match=r"no collector named 'tow'"):
+        simulation.calibrate(data, obs, {FRICTION: (10, 40)}, n=20, collector="tow")
+    cal = simulation.calibrate(data, obs, {FRICTION: (10, 40)}, n=200, collector="toe", maxiter=5, n_bootstrap=20)
+    assert cal.parameters[FRICTION] == pytest.approx(28.0, abs=4.0)
