@@ -484,7 +484,8 @@ def calibrate(scenario, observed, parameters: dict, *, n: int = 1000, seed=1, di
     n : int
         Simulated blocks per evaluation.
     seed : int
-        Seed of every evaluation (common random numbers) and of the optimiser and bootstrap.
+        Seed of every evaluation (common random numbers) and of the optimiser and bootstrap
+        (None: one is drawn and reported in ``Calibration.seed``).
     distance : {"wasserstein", "cvm"}
         Distance between simulated and observed distributions.
     collector : str, optional
@@ -504,6 +505,8 @@ def calibrate(scenario, observed, parameters: dict, *, n: int = 1000, seed=1, di
     for arg, v, lo in (("maxiter", maxiter, 1), ("popsize", popsize, 2), ("n_bootstrap", n_bootstrap, 0)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
             raise ValueError(f"{arg} must be a whole number >= {lo}; got {v!r}")
+    if seed is None:          # common random numbers need one seed for every evaluation: draw it once, report it
+        seed = int(np.random.SeedSequence().entropy)
     data, source = scenario_dict(scenario)
     base = scenario_from_dict(data, source=source)
     bounds = _check_parameters(data, parameters, source)
