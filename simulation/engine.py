@@ -47,6 +47,14 @@ def seed_blocks(scenario: Scenario, n: int, seed) -> dict:
             "mass": mass, "radius": sd.radius(mass), "inertia_factor": np.full(n, sd.inertia_factor)}
 
 
+def _merge_envelopes(total, chunk) -> None:
+    """Add one chunk's envelope accumulators: counts and sums add, maxima take the larger."""
+    for col in (0, 4, 5, 6):
+        total[:, col] += chunk[:, col]
+    for col in (1, 2, 3):
+        np.maximum(total[:, col], chunk[:, col], out=total[:, col])
+
+
 def _progress_bar(done: int, total: int, started: float, stream) -> None:
     frac = done / total
     bar = "#" * int(30 * frac)
@@ -100,12 +108,11 @@ def run(scenario: Scenario, n: int = 10_000, seed=None, *, chunk_size: int = DEF
     path_cap = max(n_paths * (st.max_events * 3 + 8), 1)
     paths = {k: np.empty(path_cap, dtype=dt) for k, dt in
              (("block", np.int64), ("t", float), ("x", float), ("z", float), ("vx", float), ("vz", float),
-              ("mode", np.int64))}
+              ("w", float), ("mode", np.int64), ("event", np.int64))}
     pcount = np.zeros(1, np.int64)
     per_block = {k: np.empty(n, dtype=dt) for k, dt in
                  (("x", float), ("z", float), ("reason", np.int64), ("impacts", np.int64), ("t", float))}
     rows = []
-    dropped = 0
     chunks = [(lo, min(lo + chunk_size, n)) for lo in range(0, n, chunk_size)]
     started = None
     for lo, hi in [(0, 0)] + chunks:     # an empty first call compiles (or loads) the kernel, untimed
@@ -113,32 +120,42 @@ def run(scenario: Scenario, n: int = 10_000, seed=None, *, chunk_size: int = DEF
             started = time.perf_counter()
         m = hi - lo
         cap = max(4 * m * max(len(cols), 1), 16)
-        r = {k: np.empty(cap, dtype=dt) for k, dt in
-             (("block", np.int64), ("coll", np.int64), ("t", float), ("vx", float), ("vz", float), ("w", float),
-              ("h", float), ("outcome", np.int64))}
-        r_count = np.zeros(2, np.int64)
-        kernel.simulate(
-            np.arange(lo, hi, dtype=np.int64), blocks["x"][lo:hi], blocks["z"][lo:hi], blocks["vx"][lo:hi],
-            blocks["vz"][lo:hi], blocks["w"][lo:hi], blocks["mass"][lo:hi], blocks["radius"][lo:hi],
-            blocks["inertia_factor"][lo:hi],
-            prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.material_index, prof.run_first, prof.run_last, **mats,
-            c_x=c_x, c_cap=c_cap, c_h=c_h, env_x=env_x, env_acc=env_acc,
-            g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
-            max_events=st.max_events, key=key, n_path_blocks=n_paths,
-            out_x=per_block["x"][lo:hi], out_z=per_block["z"][lo:hi], out_reason=per_block["reason"][lo:hi],
-            out_impacts=per_block["impacts"][lo:hi], out_t=per_block["t"][lo:hi],
-            r_block=r["block"], r_coll=r["coll"], r_t=r["t"], r_vx=r["vx"], r_vz=r["vz"], r_w=r["w"],
-            r_h=r["h"], r_outcome=r["outcome"], r_count=r_count,
-            pb=paths["block"], pt=paths["t"], pxs=paths["x"], pzs=paths["z"], pvx=paths["vx"], pvz=paths["vz"],
-            pmode=paths["mode"], pcount=pcount)
+        p_start = int(pcount[0])
+        while True:
+            # Every crossing is kept: when a chunk's buffer is too small the chunk is run again with the
+            # exact size needed (trajectories depend only on the seed and the block index, so the rerun
+            # gives the same numbers).
+            r = {k: np.empty(cap, dtype=dt) for k, dt in
+                 (("block", np.int64), ("coll", np.int64), ("t", float), ("vx", float), ("vz", float),
+                  ("w", float), ("h", float), ("outcome", np.int64))}
+            r_count = np.zeros(2, np.int64)
+            env_chunk = np.zeros_like(env_acc)
+            pcount[0] = p_start
+            kernel.simulate(
+                np.arange(lo, hi, dtype=np.int64), blocks["x"][lo:hi], blocks["z"][lo:hi], blocks["vx"][lo:hi],
+                blocks["vz"][lo:hi], blocks["w"][lo:hi], blocks["mass"][lo:hi], blocks["radius"][lo:hi],
+                blocks["inertia_factor"][lo:hi],
+                prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.material_index, prof.run_first, prof.run_last,
+                **mats, c_x=c_x, c_cap=c_cap, c_h=c_h, env_x=env_x, env_acc=env_chunk,
+                g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
+                max_events=st.max_events, key=key, n_path_blocks=n_paths,
+                out_x=per_block["x"][lo:hi], out_z=per_block["z"][lo:hi], out_reason=per_block["reason"][lo:hi],
+                out_impacts=per_block["impacts"][lo:hi], out_t=per_block["t"][lo:hi],
+                r_block=r["block"], r_coll=r["coll"], r_t=r["t"], r_vx=r["vx"], r_vz=r["vz"], r_w=r["w"],
+                r_h=r["h"], r_outcome=r["outcome"], r_count=r_count,
+                pb=paths["block"], pt=paths["t"], pxs=paths["x"], pzs=paths["z"], pvx=paths["vx"], pvz=paths["vz"],
+                pw=paths["w"], pmode=paths["mode"], pev=paths["event"], pcount=pcount)
+            if r_count[1] == 0:
+                break
+            cap = int(r_count[0] + r_count[1])
+        _merge_envelopes(env_acc, env_chunk)
         k = int(r_count[0])
         rows.append({name: arr[:k].copy() for name, arr in r.items()})
-        dropped += int(r_count[1])
         if progress and hi > 0:
             _progress_bar(hi, n, started, sys.stderr)
     elapsed = time.perf_counter() - started
     merged = {name: np.concatenate([c[name] for c in rows]) for name in rows[0]}
     k = int(pcount[0])
     return SimulationResult(scenario=scenario, n=n, seed=seed, blocks=blocks, per_block=per_block,
-                            crossings=merged, dropped_crossings=dropped, envelope_x=env_x, envelope_acc=env_acc,
+                            crossings=merged, envelope_x=env_x, envelope_acc=env_acc,
                             paths={name: arr[:k] for name, arr in paths.items()}, elapsed_s=elapsed)

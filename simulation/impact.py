@@ -19,9 +19,25 @@ Normal restitution laws (``EN_*`` codes)
 * ``EN_VELOCITY``: e_N / (1 + (|v_n| / 9.144 m/s)^2), the CRSP "scale by
   velocity" form (Pfeiffer & Bowen 1989; RocFall "scale Rn by velocity").
 
-Energy guard: whatever the law, the outgoing normal speed is finally capped so
-that the block's kinetic energy (translational + rotational) does not increase
-through the impact, unless ``allow_energy_gain`` is set.
+Spread of Wyllie's law: the scenario's ``std`` is added to the law's value at each
+impact (``e_n`` passed to :func:`normal_restitution` is then that deviation).
+
+Energy guard (unless ``allow_energy_gain``): no impact creates kinetic energy, and a
+shallow impact is never lossless.  Wyllie's e_N is kinematic (a ratio of normal speeds
+measured in the field, Wyllie 2014 section 5.3; Wyllie, IJRMMS 67: 170-180): it exceeds 1
+at shallow angles because the rebound is fed by the tangential motion (block shape and
+rotation).  So with Wyllie's law (or a typed e_N > 1) the normal impact itself returns only
+the share sin^2(theta_i) of its elastic part, min(e_N, 1)^2 v_n^2, where theta_i is the
+impact angle; the rest of the rebound e_N^2 v_n^2 is drawn from the tangential and rotational
+energy that the tangential law leaves, and if that is not enough the rebound is reduced.
+A steep impact therefore rebounds from its own normal energy as Wyllie measured (at 90 deg
+e_N = 0.19 exactly), while a grazing impact loses nearly all of 1/2 m v_n^2: a rolling block
+hopping at 17.9 deg (e_N = 1) loses sin^2 cos^2 = 8.6 % of its translational energy at every
+impact, and
+the loss is continuous in the angle.  This split is a modelling choice, stated as one.
+With a constant or velocity-scaled e_N <= 1 the laws dissipate by themselves (Stronge 2000)
+and the guard acts only on a tangential coefficient e_T > 1.  The energy out never exceeds
+the energy in.
 
 Tangential laws (``ET_*`` codes)
 --------------------------------
@@ -61,7 +77,7 @@ def normal_restitution(law, e_n, vn, vt):
     """Coefficient e_N for an impact with normal velocity vn (< 0) and tangential vt."""
     if law == EN_WYLLIE:
         angle = math.degrees(math.atan2(-vn, abs(vt)))
-        return wyllie_normal_restitution(angle)
+        return max(wyllie_normal_restitution(angle) + e_n, 0.0)     # e_n: this impact's deviation
     if law == EN_VELOCITY:
         return e_n / (1.0 + (vn / CRSP_VELOCITY_SCALE_MS) ** 2)
     return e_n
@@ -112,15 +128,22 @@ def impact_body(vn, vt, w, r, en_law, e_n, et_law, e_t, mu, allow_energy_gain, k
     vn2 = -en * vn
     if not allow_energy_gain:
         k = k_inertia * r * r
-        e_in = vn * vn + vt * vt + k * w * w
-        room = e_in - vt2 * vt2 - k * w2 * w2
+        e_in = vn * vn + vt * vt + k * w * w                 # twice the kinetic energy per unit mass
+        e_tan = vt2 * vt2 + k * w2 * w2
+        # Kinematic e_N (Wyllie's law, or a typed e_N > 1): the normal impact returns the share
+        # sin^2(theta_i) of its elastic part, the rest of the rebound comes from the tangential motion.
+        # Otherwise the laws themselves dissipate.
+        budget = e_in
+        if en_law == EN_WYLLIE or en > 1.0:
+            sin2 = vn * vn / max(vn * vn + vt * vt, 1e-300)
+            budget = e_in - vn * vn * (1.0 - min(en, 1.0) ** 2 * sin2)
+        room = budget - vn2 * vn2                             # energy left for the tangential state
         if room < 0.0:
-            # Only possible for ET_CONSTANT with e_T > 1: scale the tangential state down.
-            s = math.sqrt(e_in / (vt2 * vt2 + k * w2 * w2))
+            vn2 = math.sqrt(max(budget, 0.0))
+            en = vn2 / -vn if vn < 0 else 0.0
+            room = 0.0
+        if e_tan > room:
+            s = math.sqrt(room / e_tan)
             vt2 *= s
             w2 *= s
-            room = 0.0
-        if vn2 * vn2 > room:
-            vn2 = math.sqrt(room)
-            en = vn2 / -vn if vn < 0 else 0.0
     return vn2, vt2, w2, en

@@ -20,7 +20,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .impact import impact_body
+from .impact import EN_WYLLIE, impact_body
+from .units import J_PER_KJ
 
 # Stop reasons.
 RUNNING, STOPPED, LEFT_PROFILE, CAUGHT, MAX_EVENTS = 0, 1, 2, 3, 4
@@ -29,8 +30,14 @@ STOP_REASONS = {STOPPED: "stopped", LEFT_PROFILE: "left profile", CAUGHT: "caugh
 # Collector outcomes.
 CROSSED, BARRIER_CAUGHT, BARRIER_THROUGH, BARRIER_OVER = 0, 1, 2, 3
 OUTCOMES = {CROSSED: "crossed", BARRIER_CAUGHT: "caught", BARRIER_THROUGH: "through", BARRIER_OVER: "over"}
-# Path modes.
+# Path modes: the state after a recorded event.
 MODE_FLIGHT, MODE_CONTACT, MODE_STOP = 0, 1, 2
+# Recorded events (SimulationResult.events).
+(EV_RELEASE, EV_IMPACT, EV_TAKEOFF, EV_CONTACT, EV_VERTEX, EV_REST, EV_BARRIER, EV_STOP, EV_LEFT, EV_CAUGHT,
+ EV_LIMIT) = range(11)
+EVENTS = {EV_RELEASE: "release", EV_IMPACT: "impact", EV_TAKEOFF: "take-off", EV_CONTACT: "ground contact",
+          EV_VERTEX: "slope change", EV_REST: "momentary rest", EV_BARRIER: "through barrier", EV_STOP: "stop",
+          EV_LEFT: "left profile", EV_CAUGHT: "caught by barrier", EV_LIMIT: "event limit"}
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
@@ -101,6 +108,10 @@ def _span_hit(px, pz, k0, k1, x0, z0, vx, vz, g):
         return math.inf
     t = (c1 + math.sqrt(disc)) / g
     if t <= 1e-12:
+        # Starting on this line and moving into it (a flight that starts at a concave vertex, into the
+        # next segment): the impact is immediate, provided x0 lies within the span.
+        if c1 < 0.0 and abs(c0) <= 1e-9 * (1.0 + abs(z0)) and px[k0] - 1e-9 <= x0 <= px[k1 + 1] + 1e-9:
+            return 1e-12
         return math.inf
     x = x0 + vx * t
     tol = 1e-9 * (1.0 + abs(x))
@@ -214,7 +225,8 @@ def find_impact(px, pz, tree, n_leaves, run_first, run_last, x0, z0, vx, vz, g, 
 @njit(cache=True)
 def _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count, block, coll, t, vx, vz, w, h,
                      outcome):
-    """Append one collector crossing; count it as dropped when the chunk's buffer is full."""
+    """Append one collector crossing; when the chunk's buffer is full, count the row that did not fit
+    (the engine then runs the chunk again with a buffer of the exact size: no crossing is ever dropped)."""
     i = r_count[0]
     if i < r_block.shape[0]:
         r_block[i], r_coll[i], r_t[i] = block, coll, t
@@ -225,11 +237,40 @@ def _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_co
 
 
 @njit(cache=True)
-def _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, block, t, x, z, vx, vz, mode):
+def _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, block, t, x, z, vx, vz, w, mode, event):
+    """Append one event of a recorded block: state after the event, the mode that follows and the event code."""
     i = pcount[0]
     if i < pb.shape[0]:
-        pb[i], pt[i], pxs[i], pzs[i], pvx[i], pvz[i], pmode[i] = block, t, x, z, vx, vz, mode
+        pb[i], pt[i], pxs[i], pzs[i], pvx[i], pvz[i], pw[i] = block, t, x, z, vx, vz, w
+        pmode[i], pev[i] = mode, event
         pcount[0] = i + 1
+
+
+@njit(cache=True)
+def roll_on_speed(v_along, w, r, k):
+    """Speed [m/s] along the surface of a round body that starts rolling without slip.
+
+    Angular momentum about the contact point is conserved through the (slip-killing) transition:
+    m v r + k m r^2 w = (m r + k m r^2 / r) v'  =>  v' = (v + k r w) / (1 + k), w' = v' / r,
+    with I = k m r^2 (k = 2/5 sphere, 1/2 cylinder) and w > 0 meaning rolling in the +v direction.
+    Kinetic energy never increases through it (it falls by 1/2 m k (v - r w)^2 / (1 + k)).
+    """
+    return (v_along + k * r * w) / (1.0 + k)
+
+
+@njit(cache=True)
+def barrier_outcome(energy_kj, centre_height_m, radius_m, capacity_kj, height_m):
+    """Outcome of a block meeting a flexible barrier, and the share of its kinetic energy kept.
+
+    The block passes over when its lowest point (centre height minus radius) is above the barrier
+    height; otherwise the barrier holds it when the energy is within the capacity (MEL) and lets it
+    through with the excess energy (E - capacity) when not.  Returns (outcome, energy share kept).
+    """
+    if centre_height_m - radius_m > height_m:
+        return BARRIER_OVER, 1.0
+    if energy_kj <= capacity_kj:
+        return BARRIER_CAUGHT, 0.0
+    return BARRIER_THROUGH, (energy_kj - capacity_kj) / energy_kj
 
 
 @njit(cache=True)
@@ -255,7 +296,7 @@ def _envelope(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass, inerti
             v = math.sqrt(vx * vx + vzz * vzz)
             h = z0 + vz * t - 0.5 * g * t * t - _ground(px, pz, xc)
             wc = w
-        e = (0.5 * mass * v * v + 0.5 * inertia * wc * wc) / 1000.0
+        e = (0.5 * mass * v * v + 0.5 * inertia * wc * wc) / J_PER_KJ
         env_acc[i, 0] += 1.0
         env_acc[i, 1] = max(env_acc[i, 1], v)
         env_acc[i, 2] = max(env_acc[i, 2], h)
@@ -274,8 +315,14 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
              g, v_contact, v_stop, max_events, key, n_path_blocks,
              out_x, out_z, out_reason, out_impacts, out_t,
              r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
-             pb, pt, pxs, pzs, pvx, pvz, pmode, pcount):
-    """Run every block of a chunk; fill the per-block and per-crossing output arrays in place."""
+             pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount):
+    """Run every block of a chunk; fill the per-block and per-crossing output arrays in place.
+
+    Energy: between events motion is exact (flight conserves kinetic + potential energy; rolling
+    and sliding lose mu m g cos(beta) per metre); impacts, the transition to rolling
+    (:func:`roll_on_speed`), slope changes in contact (the normal component is lost) and barriers
+    only remove energy, unless a material sets ``allow_energy_gain``.
+    """
     n_coll = c_x.shape[0]
     n_seg = px.shape[0] - 1
     state = np.empty(1, np.uint64)
@@ -293,23 +340,31 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
         record = bid < n_path_blocks
         h0 = z - (pz[seg] + (pz[seg + 1] - pz[seg]) * (x - px[seg]) / (px[seg + 1] - px[seg]))
         contact = h0 <= 1e-9
+        if record:
+            _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
+                         MODE_CONTACT if contact else MODE_FLIGHT, EV_RELEASE)
         if contact:
             z = z - h0
             dxs, dzs = px[seg + 1] - px[seg], pz[seg + 1] - pz[seg]
             ls = math.sqrt(dxs * dxs + dzs * dzs)
             v_along = (vx * dxs + vz * dzs) / ls
+            if m_roll[seg_mat[seg]]:
+                v_along = roll_on_speed(v_along, w, r, k_in)
+                w = v_along / r
+            else:
+                w = 0.0
         else:
             v_along = 0.0
         reason = RUNNING
         impacts = 0
         events = 0
-        if record:
-            _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, vx, vz,
-                         MODE_CONTACT if contact else MODE_FLIGHT)
         while reason == RUNNING:
             events += 1
             if events > max_events:
                 reason = MAX_EVENTS
+                if record:
+                    _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
+                                 MODE_STOP, EV_LIMIT)
                 break
             if not contact:
                 t_hit, k = find_impact(px, pz, tree, n_leaves, run_first, run_last, x, z, vx, vz, g, seg, stack)
@@ -317,6 +372,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     contact = True
                     z = _ground(px, pz, x)
                     v_along = 0.0
+                    w = 0.0
                     continue
                 x_end = x + vx * t_hit
                 # Collector crossings on this flight, in time order; a barrier may cut the flight.
@@ -332,18 +388,10 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     vzc = vz - g * tc
                     h = zc - _ground(px, pz, c_x[j])
                     outcome = CROSSED
-                    vxn, vzn, wn = vx, vz, w
+                    keep = 1.0
                     if not math.isnan(c_cap[j]):
-                        if h <= c_h[j]:
-                            e = (0.5 * mass * (vx * vx + vzc * vzc) + 0.5 * inertia * w * w) / 1000.0
-                            if e <= c_cap[j]:
-                                outcome = BARRIER_CAUGHT
-                            else:
-                                outcome = BARRIER_THROUGH
-                                f = math.sqrt((e - c_cap[j]) / e)
-                                vxn, vzn, wn = vx * f, vzc * f, w * f
-                        else:
-                            outcome = BARRIER_OVER
+                        e = (0.5 * mass * (vx * vx + vzc * vzc) + 0.5 * inertia * w * w) / J_PER_KJ
+                        outcome, keep = barrier_outcome(e, h, r, c_cap[j], c_h[j])
                     _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
                                      bid, j, t_abs + tc, vx, vzc, w, h, outcome)
                     if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
@@ -353,14 +401,15 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                         t_abs += tc
                         x, z = c_x[j], zc
                         seg = _seg_of(px, x)
+                        f = math.sqrt(keep)
+                        vx, vz, w = vx * f, vzc * f, w * f
                         if outcome == BARRIER_CAUGHT:
                             z = _ground(px, pz, x)
                             reason = CAUGHT
-                        else:
-                            vx, vz, w = vxn, vzn, wn
                         if record:
-                            _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, zc, vx, vz,
-                                         MODE_STOP if reason == CAUGHT else MODE_FLIGHT)
+                            _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz,
+                                         w, MODE_STOP if reason == CAUGHT else MODE_FLIGHT,
+                                         EV_CAUGHT if reason == CAUGHT else EV_BARRIER)
                         cut = True
                         break
                 if cut:
@@ -375,7 +424,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 if k < 0:
                     reason = LEFT_PROFILE
                     if record:
-                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, vx, vz, MODE_STOP)
+                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
+                                     MODE_STOP, EV_LEFT)
                     break
                 seg = k
                 z = pz[k] + (pz[k + 1] - pz[k]) * (x - px[k]) / (px[k + 1] - px[k])
@@ -393,8 +443,11 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 vt = vx * math.cos(bp) + vz * math.sin(bp)
                 gain = m_gain[mat]
                 cap = 10.0 if gain else 1.0
-                en = min(max(m_en_mean[mat] + m_en_std[mat] * _normal(state), 0.0), cap) \
-                    if m_en_std[mat] > 0 else m_en_mean[mat]
+                if m_en_law[mat] == EN_WYLLIE:       # the law gives the value; the spread is a deviation
+                    en = m_en_std[mat] * _normal(state) if m_en_std[mat] > 0 else 0.0
+                else:
+                    en = min(max(m_en_mean[mat] + m_en_std[mat] * _normal(state), 0.0), cap) \
+                        if m_en_std[mat] > 0 else m_en_mean[mat]
                 et = min(max(m_et_mean[mat] + m_et_std[mat] * _normal(state), 0.0), cap) \
                     if m_et_std[mat] > 0 else m_et_mean[mat]
                 phi = m_phi[mat] + (m_phi_std[mat] * _normal(state) if m_phi_std[mat] > 0 else 0.0)
@@ -407,13 +460,22 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 vz = vt2 * math.sin(bp) + vn2 * math.cos(bp)
                 vn_true = -vx * math.sin(beta) + vz * math.cos(beta)
                 if record:
-                    _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, vx, vz, MODE_FLIGHT)
+                    _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
+                                 MODE_FLIGHT, EV_IMPACT)
                 if vn_true < v_contact:
+                    # Ground contact: the normal component is lost; a rolling material makes the block roll
+                    # without slip, conserving angular momentum about the contact point.
                     contact = True
                     v_along = vx * math.cos(beta) + vz * math.sin(beta)
+                    if m_roll[mat]:
+                        v_along = roll_on_speed(v_along, w, r, k_in)
+                        w = v_along / r
+                    else:
+                        w = 0.0
+                    vx, vz = v_along * math.cos(beta), v_along * math.sin(beta)
                     if record:
-                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z,
-                                     v_along * math.cos(beta), v_along * math.sin(beta), MODE_CONTACT)
+                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
+                                     MODE_CONTACT, EV_CONTACT)
                 continue
 
             # ---- ground contact on segment `seg`: roll or slide with constant acceleration ----
@@ -424,14 +486,15 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             ls = math.sqrt(cosb_raw * cosb_raw + sinb_raw * sinb_raw)
             cosb, sinb = cosb_raw / ls, sinb_raw / ls
             mu = m_mu_ground[mat]
-            factor = 1.0 / (1.0 + k_in) if m_roll[mat] else 1.0     # rolling sphere: 5/7
+            roll = m_roll[mat]
+            factor = 1.0 / (1.0 + k_in) if roll else 1.0     # rolling sphere: 5/7
             if abs(v_along) < v_stop or v_along == 0.0:
-                if abs(sinb) <= mu * cosb:
+                if abs(sinb) <= mu * cosb or _at_trough(px, pz, k, x):
                     reason = STOPPED
                     w = 0.0
                     if record:
-                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, 0.0, 0.0,
-                                     MODE_STOP)
+                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, 0.0, 0.0,
+                                     0.0, MODE_STOP, EV_STOP)
                     break
                 direction = -1.0 if sinb > 0 else 1.0
                 v_along = 0.0
@@ -459,6 +522,9 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     t_step = dist / u
                 else:
                     reason = STOPPED
+                    if record:
+                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, 0.0, 0.0,
+                                     0.0, MODE_STOP, EV_STOP)
                     break
                 d_step = dist
             x_new = x + direction * d_step * cosb
@@ -477,57 +543,60 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 else:
                     uc = math.sqrt(max(u * u + 2.0 * a_dir * s_c, 0.0))
                     tc = (uc - u) / a_dir
-                wc = direction * uc / r if m_roll[mat] else 0.0
+                wc = direction * uc / r if roll else 0.0
                 vxc, vzc = direction * uc * cosb, direction * uc * sinb
                 outcome = CROSSED
+                keep = 1.0
                 if not math.isnan(c_cap[j]):
-                    e = (0.5 * mass * uc * uc + 0.5 * inertia * wc * wc) / 1000.0
-                    outcome = BARRIER_CAUGHT if e <= c_cap[j] else BARRIER_THROUGH
+                    e = (0.5 * mass * uc * uc + 0.5 * inertia * wc * wc) / J_PER_KJ
+                    outcome, keep = barrier_outcome(e, 0.0, r, c_cap[j], c_h[j])
                 _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
                                  bid, j, t_abs + tc, vxc, vzc, wc, 0.0, outcome)
                 if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
                     if env_x.shape[0] > 0:
                         _envelope(env_x, env_acc, x, c_x[j], x, z, 0.0, 0.0, 0.0, g, px, pz, mass, inertia, r, u,
-                                  a_dir, direction, cosb, True, m_roll[mat])
+                                  a_dir, direction, cosb, True, roll)
                     t_abs += tc
                     x = c_x[j]
                     z = _ground(px, pz, x)
                     seg = min(max(_seg_of(px, x), min(k, k_far)), max(k, k_far))
+                    f = math.sqrt(keep)
+                    v_along = direction * uc * f
+                    w = wc * f
                     if outcome == BARRIER_CAUGHT:
                         reason = CAUGHT
-                    else:
-                        e_left = (e - c_cap[j]) / e
-                        v_along = direction * uc * math.sqrt(e_left)
                     if record:
-                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z,
-                                     v_along * cosb, v_along * sinb, MODE_STOP if reason == CAUGHT else MODE_CONTACT)
+                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z,
+                                     v_along * cosb, v_along * sinb, w, MODE_STOP if reason == CAUGHT else MODE_CONTACT,
+                                     EV_CAUGHT if reason == CAUGHT else EV_BARRIER)
                     cut = True
                     break
             if cut:
                 continue
             if env_x.shape[0] > 0:
                 _envelope(env_x, env_acc, x, x_new, x, z, 0.0, 0.0, 0.0, g, px, pz, mass, inertia, r, u, a_dir,
-                          direction, cosb, True, m_roll[mat])
+                          direction, cosb, True, roll)
             t_abs += t_step
             x = x_new
             z = pz[k] + (pz[k + 1] - pz[k]) * (x - px[k]) / (px[k + 1] - px[k])
-            w = direction * u_end / r if m_roll[mat] else 0.0
+            w = direction * u_end / r if roll else 0.0
             if stops_here:
                 v_along = 0.0
                 if k_far != k:
                     seg = min(max(_seg_of(px, x), min(k, k_far)), max(k, k_far))
                 if record:
-                    _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, 0.0, 0.0,
-                                 MODE_CONTACT)
+                    _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, 0.0, 0.0, 0.0,
+                                 MODE_CONTACT, EV_REST)
                 continue
             # Reached a vertex: next segment, or off the profile.
             k2 = k_far + 1 if direction > 0 else k_far - 1
             vxe, vze = direction * u_end * cosb, direction * u_end * sinb
-            if record:
-                _record_path(pb, pt, pxs, pzs, pvx, pvz, pmode, pcount, bid, t_abs, x, z, vxe, vze, MODE_CONTACT)
             if k2 < 0 or k2 >= n_seg:
                 reason = LEFT_PROFILE
                 vx, vz = vxe, vze
+                if record:
+                    _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vxe, vze, w,
+                                 MODE_STOP, EV_LEFT)
                 break
             c2x, c2z = px[k2 + 1] - px[k2], pz[k2 + 1] - pz[k2]
             l2 = math.sqrt(c2x * c2x + c2z * c2z)
@@ -536,7 +605,39 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 contact = False            # convex edge: the block takes off
                 vx, vz = vxe, vze
                 seg = k2
+                if record:
+                    _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
+                                 MODE_FLIGHT, EV_TAKEOFF)
             else:
+                # Concave edge: the velocity normal to the next segment is lost; a rolling block re-rolls
+                # conserving angular momentum about the new contact point.
                 seg = k2
                 v_along = vxe * cos2 + vze * sin2
+                if m_roll[seg_mat[k2]]:
+                    v_along = roll_on_speed(v_along, w, r, k_in)
+                    w = v_along / r
+                else:
+                    w = 0.0
+                if abs(v_along) < v_stop and _at_trough(px, pz, k2, x):
+                    v_along = 0.0         # at rest in a trough (V-notch): held by both flanks
+                if record:
+                    _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z,
+                                 v_along * cos2, v_along * sin2, w, MODE_CONTACT, EV_VERTEX)
         out_x[b], out_z[b], out_reason[b], out_impacts[b], out_t[b] = x, z, reason, impacts, t_abs
+
+
+@njit(cache=True)
+def _at_trough(px, pz, k, x):
+    """True when x is a vertex of segment k that is a local minimum of the profile (both neighbours rise
+    away from it): a block at rest there is held whatever the flank angles (the V-notch)."""
+    n_seg = px.shape[0] - 1
+    tol = 1e-9 * (1.0 + abs(x))
+    if abs(x - px[k]) <= tol:
+        i = k                       # vertex i joins segments i-1 and i
+    elif abs(x - px[k + 1]) <= tol:
+        i = k + 1
+    else:
+        return False
+    if i <= 0 or i >= n_seg:
+        return False
+    return pz[i - 1] > pz[i] and pz[i + 1] > pz[i]

@@ -7,7 +7,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from .kernel import MODE_FLIGHT, OUTCOMES, STOP_REASONS
+from .kernel import EVENTS, MODE_FLIGHT, OUTCOMES, STOP_REASONS
+from .units import J_PER_KJ
 
 
 def wilson_interval(k, n, level: float = 0.95):
@@ -31,7 +32,6 @@ class SimulationResult:
     blocks: dict = field(repr=False)
     per_block: dict = field(repr=False)
     crossings: dict = field(repr=False)
-    dropped_crossings: int = 0
     envelope_x: np.ndarray = field(repr=False, default=None)
     envelope_acc: np.ndarray = field(repr=False, default=None)
     paths: dict = field(repr=False, default=None)
@@ -56,8 +56,8 @@ class SimulationResult:
         radius = self.blocks["radius"][blk]
         k_inertia = self.blocks["inertia_factor"][blk]
         v = np.hypot(vx, vz)
-        e_t = 0.5 * mass * v ** 2 / 1000.0
-        e_r = 0.5 * k_inertia * mass * radius ** 2 * w ** 2 / 1000.0
+        e_t = 0.5 * mass * v ** 2 / J_PER_KJ
+        e_r = 0.5 * k_inertia * mass * radius ** 2 * w ** 2 / J_PER_KJ
         df = pd.DataFrame({
             "block": blk, "time_s": self.crossings["t"][sel], "velocity_ms": v, "vx_ms": vx, "vz_ms": vz,
             "angular_velocity_rads": w, "height_m": self.crossings["h"][sel], "mass_kg": mass, "radius_m": radius,
@@ -119,6 +119,46 @@ class SimulationResult:
                              "height_max_m": acc[:, 2], "height_mean_m": acc[:, 5] / n,
                              "energy_max_kj": acc[:, 3], "energy_mean_kj": acc[:, 6] / n})
 
+    def events(self, block: int) -> pd.DataFrame:
+        """The events of one recorded block in time order, with its energies.
+
+        One row per event: release, impact (state just after), take-off, ground contact, slope change,
+        momentary rest, collector crossing (``collector crossing: NAME``), through barrier, caught by
+        barrier, stop, left profile.  Columns ``t_s``, ``x_m``, ``z_m`` (the block's point, in the
+        profile's datum), ``vx_ms``, ``vz_ms``, ``angular_velocity_rads``, ``kinetic_energy_kj``
+        (1/2 m v^2 + 1/2 I w^2), ``potential_energy_kj`` (m g z), ``total_energy_kj``, ``event``.
+        Without ``allow_energy_gain`` the total never increases from one row to the next.
+        Blocks 0 .. ``record_paths`` - 1 of the run are recorded.
+        """
+        sel = self.paths["block"] == block
+        if not sel.any():
+            raise KeyError(f"block {block} was not recorded; run with record_paths > {block}")
+        ev = pd.DataFrame({"t_s": self.paths["t"][sel], "x_m": self.paths["x"][sel], "z_m": self.paths["z"][sel],
+                           "vx_ms": self.paths["vx"][sel], "vz_ms": self.paths["vz"][sel],
+                           "angular_velocity_rads": self.paths["w"][sel],
+                           "event": [EVENTS[int(e)] for e in self.paths["event"][sel]]})
+        crossings = []
+        for c in self.scenario.collectors:
+            df = self.collector(c.name)
+            df = df[df["block"] == block]
+            if len(df):
+                crossings.append(pd.DataFrame({
+                    "t_s": df["time_s"], "x_m": c.x, "z_m": self.scenario.profile.ground(c.x) + df["height_m"],
+                    "vx_ms": df["vx_ms"], "vz_ms": df["vz_ms"], "angular_velocity_rads": df["angular_velocity_rads"],
+                    "event": f"collector crossing: {c.name}"}))
+        if crossings:
+            ev = pd.concat(crossings + [ev], ignore_index=True).sort_values("t_s", kind="stable")  # crossing first at a tie
+        mass, radius = self.blocks["mass"][block], self.blocks["radius"][block]
+        k_inertia = self.blocks["inertia_factor"][block]
+        g = self.scenario.settings.gravity_ms2
+        ev["kinetic_energy_kj"] = (0.5 * mass * (ev["vx_ms"] ** 2 + ev["vz_ms"] ** 2)
+                                   + 0.5 * k_inertia * mass * radius ** 2 * ev["angular_velocity_rads"] ** 2) / J_PER_KJ
+        ev["potential_energy_kj"] = mass * g * ev["z_m"] / J_PER_KJ
+        ev["total_energy_kj"] = ev["kinetic_energy_kj"] + ev["potential_energy_kj"]
+        cols = ["t_s", "x_m", "z_m", "vx_ms", "vz_ms", "angular_velocity_rads", "kinetic_energy_kj",
+                "potential_energy_kj", "total_energy_kj", "event"]
+        return ev[cols].reset_index(drop=True)
+
     def path(self, block: int, dt: float = 0.01) -> pd.DataFrame:
         """Sampled path (x, z) of one of the recorded blocks, exact between events."""
         sel = self.paths["block"] == block
@@ -147,8 +187,6 @@ class SimulationResult:
                 "blocks per second": round(self.n / max(self.elapsed_s, 1e-9))}
         for reason, count in self.stop_reasons.items():
             rows[f"stopped: {reason}"] = int(count)
-        if self.dropped_crossings:
-            rows["collector rows dropped (buffer full)"] = self.dropped_crossings
         for c in self.scenario.collectors:
             df = self.collector(c.name, first_only=True)
             p = len(df) / self.n

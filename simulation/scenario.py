@@ -377,7 +377,7 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
     settings = Settings(
         gravity_ms2=_number(st.get("gravity_ms2", STANDARD_GRAVITY_MS2), "settings.gravity_ms2", source, lo=0.0, lo_open=True),
         contact_velocity_ms=_number(st.get("contact_velocity_ms", 0.5), "settings.contact_velocity_ms", source,
-                                    lo=0.0),
+                                    lo=0.0, lo_open=True),
         stop_velocity_ms=_number(st.get("stop_velocity_ms", 0.05), "settings.stop_velocity_ms", source, lo=0.0),
         max_events=int(_number(st.get("max_events", 5000), "settings.max_events", source, lo=1)),
         envelope_bins=int(_number(st.get("envelope_bins", 50), "settings.envelope_bins", source, lo=0, hi=10000)))
