@@ -104,7 +104,7 @@ def _split_maxima(maxima, zero_years: str, model: str):
         raise ValueError(f"maxima: {values.size} annual maxima (of {x.size} years) but a {model} fit needs at "
                          f"least {need}; a longer record is needed")
     if np.ptp(values) == 0:
-        raise ValueError(f"maxima: all {values.size} annual maxima equal {values[0]!r}: a {model} fit needs "
+        raise ValueError(f"maxima: all {values.size} annual maxima equal {float(values[0])!r}: a {model} fit needs "
                          "maxima that differ (its scale would be 0)")
     if values.size < 20:
         warn(f"only {values.size} annual maxima: return levels beyond about {2 * values.size} years are "
@@ -128,6 +128,11 @@ class _AnnualMaximumFit:
     data: np.ndarray = field(repr=False)
 
     # Subclasses define: params (tuple), _frozen(params), _nll(params), _fit_params(x), param_names.
+
+    def __post_init__(self):
+        scale = self.params[1]
+        if not (np.isfinite(scale) and scale > 0):
+            raise ValueError(f"scale = {float(scale)!r}: the scale of a {type(self).__name__} must be finite and > 0")
 
     @property
     def dist(self):
