@@ -615,7 +615,7 @@ def fit_gutenberg_richter(masses, duration_years=None, m_min=None, method: str =
     integer = _is_integer_valued(x)
     if discrete and not integer:
         i = int(np.argmax(x != np.round(x)))
-        raise ValueError(f"discrete=True needs integer data; masses[{i}] = {x[i]!r} is not an integer")
+        raise ValueError(f"discrete=True needs integer data; masses[{i}] = {float(x[i])!r} is not an integer")
     if m_min is None:
         m_min_method = "ks"
         if discrete:
