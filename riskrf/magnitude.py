@@ -514,7 +514,13 @@ class GutenbergRichterFit:
              "falls >= m_min per year (Poisson SE)"),
             ("n_tail", self.n_tail, np.nan, np.nan, np.nan, f"of {self.n_total} values"),
             ("duration_years", self.duration_years, np.nan, np.nan, np.nan, "record length"),
-            ("ks_distance", self.ks_distance, np.nan, np.nan, np.nan, "tail vs fitted law"),
+            ("ks_distance", self.ks_distance, np.nan, np.nan, np.nan,
+             "tail vs fitted law; " + ("integer data: CDFs compared at each value" if self.discrete else
+                                       {"clauset": "Clauset et al. (2009) statistic max|F(x_i) - (i-1)/n|",
+                                        "sup": "supremum distance (ties exact)"}[self.ks_statistic])),
+            ("discrete", float(self.discrete), np.nan, np.nan, np.nan,
+             "integer data, half-unit approximation (Clauset et al. 2009, eq. 3.7): m_min = x_min - 1/2"
+             if self.discrete else "continuous"),
             ("method", np.nan, np.nan, np.nan, np.nan, method),
         ]
         return pd.DataFrame(rows, columns=["parameter", "value", "stderr", "ci_low", "ci_high", "note"]
