@@ -108,6 +108,9 @@ def _split_maxima(maxima, zero_years: str, model: str):
     if values.size < need:
         raise ValueError(f"maxima: {values.size} annual maxima (of {x.size} years) but a {model} fit needs at "
                          f"least {need}; a longer record is needed")
+    if np.ptp(values) == 0:
+        raise ValueError(f"maxima: all {values.size} annual maxima equal {float(values[0])!r}: a {model} fit needs "
+                         "maxima that differ (its scale would be 0)")
     if values.size < 20:
         warn(f"only {values.size} annual maxima: return levels beyond about {2 * values.size} years are "
              "extrapolations with wide intervals")
@@ -130,6 +133,11 @@ class _AnnualMaximumFit:
     data: np.ndarray = field(repr=False)
 
     # Subclasses define: params (tuple), _frozen(params), _nll(params), _fit_params(x), param_names.
+
+    def __post_init__(self):
+        scale = self.params[1]
+        if not (np.isfinite(scale) and scale > 0):
+            raise ValueError(f"scale = {float(scale)!r}: the scale of a {type(self).__name__} must be finite and > 0")
 
     @property
     def dist(self):
@@ -254,47 +262,69 @@ class _AnnualMaximumFit:
         return np.quantile(levels, q, axis=0), np.quantile(levels, 1 - q, axis=0)
 
     def _profile_ci(self, T, level):
+        """Profile-likelihood interval of the T-year return level (Coles 2001, §3.3.3, fig. 3.3).
+
+        The model is reparametrised in terms of the return level z itself:
+        for each trial z the location follows from z and the free parameters
+        (``_profile_map``), and the free parameters are mapped so that every
+        point of the search space is feasible (for the GEV the scale is kept
+        above the value at which some observation would leave the support, see
+        :meth:`GEVFit._profile_map`).  The inner optimisation therefore never
+        starts from a point of zero likelihood, however far z lies from the
+        estimate.  The crossing of the chi-square cut is bracketed by doubling
+        steps away from the estimate and located by Brent's method.  An end of
+        the interval that is not reached within 2^60 standard errors is reported
+        as -inf or +inf (the data do not bound it at this level).
+        """
         crit = stats.chi2.ppf(level, 1) / 2
         best = -self._nll(self.params)
-        xhat = float(self._quantile(self.params, T))
-        free0 = np.asarray(self.params[1:], dtype=float)
+        q = (1.0 / float(T)) / (1 - self.p_zero)
+        xhat = float(self._isf_params(self.params, q))
+        cold = self._profile_start(xhat, q)
+        warm = {"u": cold}
 
-        warm = {"free": free0}
+        from ._extremes_kernels import profile_nll_min
 
-        unit = np.maximum(np.abs(free0), 0.1)  # optimise in units of the estimates: scale-free tolerances
+        x = np.ascontiguousarray(self.data, dtype=float)
+        ly = float(np.log(-np.log1p(-q)))
 
         def profile(z):
-            def nll_free(u):
-                free = u * unit
-                mu = z - (float(self._quantile(np.concatenate([[0.0], free]), T)))
-                return self._nll(np.concatenate([[mu], free]))
-            fun, x = np.inf, warm["free"]
-            for start in (warm["free"], free0):
-                res = optimize.minimize(nll_free, start / unit, method="Nelder-Mead",
-                                        options={"xatol": 1e-6, "fatol": 1e-7, "maxiter": 600})
-                if res.fun < fun:
-                    fun, x = res.fun, res.x * unit
-            if np.isfinite(fun):
-                warm["free"] = x
-            return best + max(fun, -best) - crit
+            """Profile log-likelihood at return level z minus the cut: > 0 inside the interval."""
+            fun, arg = np.inf, None
+            for start in (warm["u"], self._profile_start(z, q)):
+                f, u = profile_nll_min(self._profile_model, np.asarray(start, dtype=float), float(z), ly, x,
+                                       0.3, 1e-6, 1e-8, 4000)
+                if f < fun:
+                    fun, arg = f, u
+                if np.isfinite(fun) and start is warm["u"] and crit - best - fun > 0.5:
+                    break           # clearly inside the interval: the second start cannot change the sign
+            if arg is not None:
+                warm["u"] = arg
+            return crit - best - fun     # -fun is the profile log-likelihood
 
-        se = float(np.sqrt(self._return_level_variance(T))) if self.cov is not None else abs(xhat) * 0.1
+        try:
+            se = float(np.sqrt(self._return_level_variance(T)))
+        except (ValueError, FloatingPointError):
+            se = np.nan
+        if not np.isfinite(se) or se <= 0:
+            se = max(abs(xhat), 1.0) * 0.1
         out = []
         for sign in (-1.0, 1.0):
-            warm["free"] = free0
-            step, edge = se, xhat
-            for _ in range(60):
+            warm["u"] = cold
+            inner, step = xhat, se / 4.0
+            for _ in range(64):
                 edge = xhat + sign * step
-                if profile(edge) > 0:
+                if -profile(edge) > 0:
                     break
-                step *= 2.0
+                inner, step = edge, step * 2.0
             else:
-                out.append(np.nan)
+                out.append(sign * np.inf)
                 continue
-            inner = xhat + sign * (step / 2.0 if step > se else 0.0)
             lo, hi = sorted((inner, edge))
+            warm["u"] = cold
             try:
-                out.append(optimize.brentq(profile, lo, hi, xtol=1e-6 * max(1e-3, abs(xhat)), rtol=1e-7))
+                out.append(optimize.brentq(lambda z: -profile(z), lo, hi,
+                                           xtol=1e-7 * max(abs(lo), abs(hi), 1e-3), rtol=1e-6))
             except ValueError:
                 out.append(np.nan)
         return out
@@ -330,6 +360,18 @@ class GumbelFit(_AnnualMaximumFit):
     def _isf_params(params, q):
         """x exceeded with probability q: loc - scale ln(-ln(1 - q))."""
         return params[0] - params[1] * np.log(-np.log1p(-q))
+
+    _profile_model = 0      # Gumbel in riskrf._extremes_kernels.profile_nll
+
+    def _profile_map(self, z, q, u):
+        """(loc, scale) with return level z at exceedance probability q; u = (ln scale,)."""
+        if not abs(u[0]) < 700:
+            return (z, -1.0)
+        sigma = np.exp(u[0])
+        return (z + sigma * np.log(-np.log1p(-q)), sigma)
+
+    def _profile_start(self, z, q):
+        return np.array([np.log(self.scale)])
 
     def _nll(self, params):
         if params[1] <= 0:
@@ -393,6 +435,36 @@ class GEVFit(_AnnualMaximumFit):
             return mu - sigma * np.log(y)
         return mu + sigma / xi * (y ** (-xi) - 1.0)
 
+    def _scale_floor(self, z, q, xi):
+        """Smallest scale for which every observation lies inside the support when the
+        return level is z: sigma y^-xi + xi (x_i - z) > 0 for all i, y = -ln(1 - q)."""
+        y = -np.log1p(-q)
+        reach = max(0.0, xi * (z - self.data.min()), xi * (z - self.data.max()))
+        return reach * y ** xi
+
+    _profile_model = 1      # GEV in riskrf._extremes_kernels.profile_nll
+
+    def _profile_map(self, z, q, u):
+        """(mu, sigma, xi) with return level z at exceedance probability q.
+
+        u = (xi, t) with sigma = floor(z, xi) + e^t: every u is a feasible point,
+        so the profile search can start anywhere (Coles 2001, §3.3.3 reparametrises
+        the GEV by z_p in the same way, eq. 3.4 solved for mu).
+        """
+        xi, t = float(u[0]), float(u[1])
+        if not (abs(xi) < 20 and abs(t) < 700):
+            return (z, -1.0, xi)
+        sigma = self._scale_floor(z, q, xi) + np.exp(t)
+        ly = np.log(-np.log1p(-q))
+        mu = z + sigma * ly if abs(xi) < 1e-9 else z - sigma * np.expm1(-xi * ly) / xi
+        return (mu, sigma, xi)
+
+    def _profile_start(self, z, q):
+        xi = float(np.clip(self.shape, -0.9, 3.0))
+        floor = self._scale_floor(z, q, xi)
+        gap = max(self.scale - floor, 0.5 * floor, 1e-6 * abs(self.scale))
+        return np.array([xi, np.log(gap)])
+
     def _nll(self, params):
         return _gev_nll(params, self.data)
 
@@ -439,16 +511,25 @@ def _gev_nll(params, x):
 
 
 def _fit_gev_mle(x):
+    """GEV maximum likelihood: a compiled Nelder-Mead search from the L-moment Gumbel fit with
+    shapes 0.1, -0.1 and 0.3, in coordinates standardised by that fit; the best is kept."""
+    from ._extremes_kernels import profile_nll_min
+
     loc0, scale0 = _gumbel_lmoments(x)
-    best = None
+    if not scale0 > 0:
+        raise ValueError(f"maxima: the annual maxima have no spread (all equal to {x[0]:.6g}); "
+                         "a GEV needs a positive scale")
+    xs = np.ascontiguousarray(x, dtype=float)
+    best, arg = np.inf, None
     for xi0 in (0.1, -0.1, 0.3):
-        res = optimize.minimize(lambda p: _gev_nll(p, x), [loc0, scale0, xi0], method="Nelder-Mead",
-                                options={"xatol": 1e-10, "fatol": 1e-12, "maxiter": 20000, "maxfev": 40000})
-        if np.isfinite(res.fun) and (best is None or res.fun < best.fun):
-            best = res
-    if best is None:
+        u = np.array([0.0, 0.0, xi0])
+        for _ in range(3):          # restart from the optimum: Nelder-Mead can stall on a ridge
+            f, u = profile_nll_min(2, u, float(loc0), float(scale0), xs, 0.3, 1e-10, 1e-12, 20000)
+        if f < best:
+            best, arg = f, u
+    if arg is None or not np.isfinite(best):
         raise RuntimeError("GEV maximum likelihood did not converge")
-    return tuple(float(v) for v in best.x)
+    return (float(loc0 + scale0 * arg[0]), float(scale0 * np.exp(arg[1])), float(arg[2]))
 
 
 def fit_gumbel(maxima, method: str = "mle", *, zero_years: str = "mixed", level: float = 0.95) -> GumbelFit:

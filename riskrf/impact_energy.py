@@ -15,9 +15,13 @@ the mass of each block, to condition on mass).
 
 The default ``method="quad"`` integrates in log space: Gauss-Legendre panels on
 ln v for a parametric velocity, an exact average over velocity samples, or
-panels on ln P(M > m) when conditioning on mass.  It is accurate to about 1e-6
-relative down to probabilities of 1e-8 (tested against the exact lognormal case)
-and takes milliseconds.  ``method="mc"`` samples instead, for cross-checks.
+panels on ln P(M > m) when conditioning on mass.  Panels are split where the
+integrand has a kink (the energy at which a given speed needs exactly m_min or
+m_max of a truncated power law).  With a parametric velocity it is accurate to
+about 1e-6 relative down to probabilities of 1e-8: tested against the exact
+lognormal case and the exact truncated-power-law x lognormal-velocity case
+(measured 1e-9 or better there; 2e-5 before the split).  It takes a fraction of
+a millisecond per energy.  ``method="mc"`` samples instead, for cross-checks.
 """
 from __future__ import annotations
 
@@ -249,16 +253,36 @@ def _integrate_velocity_dist(e, mm, vdist):
     if not np.isfinite(hi):
         hi = float(vdist.isf(1e-12))
     edges = np.linspace(np.log(lo), np.log(hi), 513)
+    v, dens = _gl_panels(edges, vdist, p_pos)
+    dens = dens.reshape(512, -1)
+    v = v.reshape(512, -1)
+    # P(M > 2000 e / v^2) has a kink where 2000 e / v^2 crosses an end of the mass model's support
+    # (m_min and m_max of a truncated power law): a Gauss-Legendre panel straddling it converges
+    # only slowly (1e-5 relative error measured), so such a panel is split at the kink.
+    ends = np.array([m for m in mm.support if np.isfinite(m) and m > 0], dtype=float)
+    out = np.empty(e.size)
+    for i, ei in enumerate(e.ravel()):
+        total = np.sum(dens * mm.sf(2000.0 * ei / (v * v)), axis=1)
+        if ends.size and ei > 0:
+            kinks = 0.5 * np.log(2000.0 * ei / ends)
+            kinks = kinks[(kinks > edges[0]) & (kinks < edges[-1])]
+            for j in np.unique(np.searchsorted(edges, kinks) - 1):
+                sub = np.union1d(edges[j:j + 2], kinks)
+                sub = sub[(sub >= edges[j]) & (sub <= edges[j + 1])]
+                vs, ds = _gl_panels(sub, vdist, p_pos)
+                total[j] = np.sum(ds * mm.sf(2000.0 * ei / (vs * vs)))
+        out[i] = np.sum(total)
+    return np.clip(out, 0.0, 1.0).reshape(e.shape)
+
+
+def _gl_panels(edges, vdist, p_pos):
+    """Nodes v [m/s] and weights f_V(v) v dw / P(V > 0) of 8-point Gauss-Legendre panels on ln v."""
     half = 0.5 * np.diff(edges)
     mid = 0.5 * (edges[:-1] + edges[1:])
     u = (mid[:, None] + half[:, None] * _GL_NODES[None, :]).ravel()
     wts = (half[:, None] * _GL_WEIGHTS[None, :]).ravel()
     v = np.exp(u)
-    dens = vdist.pdf(v) * v * wts / p_pos
-    out = np.empty(e.size)
-    for i, ei in enumerate(e.ravel()):
-        out[i] = np.sum(dens * mm.sf(2000.0 * ei / (v * v)))
-    return np.clip(out, 0.0, 1.0).reshape(e.shape)
+    return v, vdist.pdf(v) * v * wts / p_pos
 
 
 def _conditional_on_mass(e, mm, paired: PairedSamples):

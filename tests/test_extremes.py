@@ -1,4 +1,6 @@
 """Gumbel and GEV fits of annual maxima against published values (issue 2, item 4)."""
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -151,3 +153,107 @@ def test_return_levels_monotone_in_T(seed):
     T = np.array([2, 5, 10, 100, 1000])
     for fit in (fit_gumbel(x), fit_gev(x)):
         assert np.all(np.diff(fit.return_level(T)) > 0)
+
+
+# ---------------------------------------------------------------- issue 10: profile interval, degenerate samples
+SYNTHETIC = Path(__file__).resolve().parents[1] / "riskrf" / "data" / "synthetic_corridor_1985_2024.csv"
+
+
+def _brute_gev_profile_loglik(x, z, q):
+    """Profile log-likelihood of the GEV at return level z, computed independently of riskrf.
+
+    Coles (2001) eq. 3.7 written out; mu is eliminated by eq. 3.4.  For each shape on a grid
+    (xi in [-0.9, 4], 99 points) the scale is scanned on a grid of 451 log-offsets above the
+    smallest scale that keeps every observation in the support, then refined by bounded
+    Brent searches (scipy ``minimize_scalar``) in sigma and then in xi.
+    """
+    from scipy import optimize
+    y = -np.log1p(-q)
+
+    def gev_ll(mu, s, xi):
+        t = 1 + xi * (x[:, None] - mu) / s
+        with np.errstate(all="ignore"):
+            v = -np.log(s) - (1 + 1 / xi) * np.log(t) - t ** (-1 / xi)
+        return np.where((t > 0).all(0), np.where(np.isfinite(v), v, -np.inf).sum(0), -np.inf)
+
+    def best_over_sigma(xi):
+        xi = xi if abs(xi) > 1e-6 else 1e-6
+        floor = max(0.0, np.max(xi * (z - x)) * y ** xi)
+        lead = np.log(floor) if floor > 0 else np.log(np.ptp(x))
+
+        def ll(d):
+            s = floor + np.exp(lead + np.atleast_1d(d))
+            return gev_ll(z - s * (y ** (-xi) - 1) / xi, s, xi)
+        grid = np.linspace(-30, 15, 451)
+        vals = ll(grid)
+        k = int(np.argmax(vals))
+        r = optimize.minimize_scalar(lambda d: -ll(d)[0], bounds=(grid[max(k - 1, 0)], grid[min(k + 1, 450)]),
+                                     method="bounded", options={"xatol": 1e-10})
+        return max(-r.fun, vals[k])
+    xis = np.linspace(-0.9, 4.0, 99)
+    vals = np.array([best_over_sigma(xi) for xi in xis])
+    k = int(np.argmax(vals))
+    r = optimize.minimize_scalar(lambda xi: -best_over_sigma(xi), bounds=(xis[max(k - 1, 0)], xis[min(k + 1, 98)]),
+                                 method="bounded", options={"xatol": 1e-8})
+    return max(-r.fun, vals[k])
+
+
+def test_gev_profile_interval_heavy_tail_matches_independent_profile():
+    # The shipped SYNTHETIC corridor record (riskrf/data, xi-hat = 1.94): before the fix the 100-year
+    # interval was [2.63e6, 6.58e7] kg while the profile crosses the 95 % cut near 1.77e9 kg (issue 10).
+    from riskrf import read_inventory
+    with pytest.warns(Warning):
+        maxima = read_inventory(SYNTHETIC).annual_maxima()
+    gev = fit_gev(maxima)
+    assert gev.shape > 1.5
+    lo, hi = (float(v) for v in gev.return_level_ci(100))
+    q = 0.01 / (1 - gev.p_zero)
+    cut = gev.loglik - stats.chi2.ppf(0.95, 1) / 2
+    for limit, inward in ((lo, 1.01), (hi, 0.99)):
+        assert _brute_gev_profile_loglik(gev.data, limit, q) == pytest.approx(cut, abs=2e-3)
+        assert _brute_gev_profile_loglik(gev.data, limit * inward, q) > cut          # inside the interval
+        assert _brute_gev_profile_loglik(gev.data, limit / inward, q) < cut          # outside
+    assert hi > 1e9
+
+
+def test_gev_profile_interval_coverage_seeded():
+    # xi = 0.5, n = 40, 100-year level: the cut-off interval covered 0.59 of 0.95 (issue 10).
+    true = stats.genextreme(-0.5, loc=100.0, scale=20.0)
+    z100 = true.isf(0.01)
+    rng = np.random.default_rng(2026)
+    hits = 0
+    for _ in range(200):
+        lo, hi = fit_gev(true.rvs(size=40, random_state=rng)).return_level_ci(100)
+        hits += lo <= z100 <= hi
+    assert hits / 200 >= 0.9
+
+
+def test_gumbel_profile_interval_matches_chi_square_cut():
+    g = fit_gumbel(PORT_PIRIE)
+    lo, hi = (float(v) for v in g.return_level_ci(100))
+    # Independent: maximise the Gumbel log-likelihood over sigma with mu = z + sigma ln(-ln(1 - 1/T)).
+    from scipy import optimize
+    ly = np.log(-np.log1p(-0.01))
+
+    def prof(z):
+        r = optimize.minimize_scalar(lambda ls: -stats.gumbel_r.logpdf(PORT_PIRIE, z + np.exp(ls) * ly,
+                                                                       np.exp(ls)).sum(),
+                                     bounds=(np.log(1e-3), np.log(10.0)), method="bounded",
+                                     options={"xatol": 1e-12})
+        return -r.fun
+    cut = g.loglik - stats.chi2.ppf(0.95, 1) / 2
+    assert prof(lo) == pytest.approx(cut, abs=1e-4) and prof(hi) == pytest.approx(cut, abs=1e-4)
+    assert lo < g.return_level(100) < hi
+
+
+@pytest.mark.parametrize("fit", [fit_gumbel, fit_gev])
+def test_constant_maxima_raise_naming_the_value(fit):
+    with pytest.raises(ValueError, match=r"maxima: all 12 annual maxima equal 5\.0"):
+        fit([5.0] * 12)
+
+
+def test_direct_construction_with_zero_scale_raises():
+    from riskrf.extremes import GEVFit
+    with pytest.raises(ValueError, match=r"scale = 0\.0: the scale of a GEVFit must be finite and > 0"):
+        GEVFit(p_zero=0.0, n_years=10, method="mle", level=0.95, cov=None, data=np.arange(10.0),
+               loc=1.0, scale=0.0, shape=0.1)
