@@ -1,50 +1,80 @@
-"""Mitigation options ranked by expected total cost (Wyllie 2014, 8.5.5; Wyllie, McCammon & Brumund 1980).
+"""Mitigation options ranked by expected total cost, with uncertainty and a recommendation.
 
-    expected total cost = capital + PV(renewals) + PV(maintenance + repairs) + PV(expected losses)
+    expected total cost = capital + PV(renewals) + PV(maintenance, repairs, replacements) + PV(expected losses)
 
-Each option leaves a residual hazard, the falls that still reach the road each
-year, built from the energy hazard at the barrier line:
+(Wyllie 2014, 8.5.5; Wyllie, McCammon & Brumund 1980.)  Each option is a
+transformation of the site (CLIMADA's measures: a measure changes the hazard, the
+exposure or the vulnerability; one engine computes the losses):
 
-* ``none`` (do nothing): every arriving fall;
-* ``scaling`` (scaling and bolting): the rate of falls cut by ``rate_reduction``;
-* ``ditch``: retains a share ``retention`` of arriving falls, or every fall up to ``max_mass_kg``;
-* ``fence`` / ``attenuator`` (``capacity_kj``, ``height_m``): falls passing over
-  (bounce height above the fence) or through (energy above the capacity), from the
-  simulated heights and velocities paired block by block; impacts it holds above
-  its service energy (MEL/3) cost a repair each;
-* ``shed`` (``capacity_kj``): falls with energy above its capacity;
-* ``realignment``: removes the exposure.
+* ``none``: the site as it is;
+* ``scaling`` (scaling and bolting): removes the release of blocks between ``min_mass_kg``
+  and ``max_mass_kg`` from the source zone ``zone_x_m`` (the share of the release line it
+  covers follows from the scenario's seeder);
+* ``ditch``: a catchment dug into the profile (``x_m``, ``width_m``, ``depth_m``); its
+  retention is derived by re-simulating the scenario with the new profile;
+* ``fence`` / ``attenuator``: a barrier line (``capacity_kj`` = MEL, ``height_m``) at the
+  barrier collector; falls pass over (simulated bounce height above the fence) or through
+  (energy above MEL, from the simulated velocities and the mass model, block by block);
+* ``shed``: covers ``covered_length_m`` of the exposed road (``traffic.exposed_length_m``)
+  with a capacity ``capacity_kj``;
+* ``realignment``: moves the road to ``road_x_m`` on the profile (share of falls still
+  reaching it from the simulated run-out), or away from the slope altogether;
+* ``combined``: several of the above (``options = [...]``) in series, each acting on the
+  falls the previous ones let through, costs added: no double counting.
 
-Losses per fall reaching the road: a moving vehicle at the impact point (Bunce et
-al. 1997, P(S:T)), a vehicle striking a rock left on the road, occupants killed
-with the given vulnerabilities at the value of a statistical life, vehicle
-damage, and closure and clean-up costs.  All inputs come from a TOML file
-documented in the README ("Mitigation files").
+Damage states (fences, attenuators, sheds): an impact between SEL = MEL/3 and MEL is
+held and costs ``repair_cost_per_impact``; an impact above MEL destroys the structure,
+passes, costs ``replacement_cost`` (default: the capital cost) and leaves the road
+unprotected for ``repair_days`` (ASSUMPTION, default 30 days for fences, 180 for sheds),
+during which every fall passes.  With destructive impacts at rate lambda_d the share of
+time out of service is lambda_d t_r / (1 + lambda_d t_r) (alternating renewal process).
+
+A typed ``retention`` (ditch, fence) or ``rate_reduction`` (scaling) replaces the derived
+effect; it is then an assumption and says so in every output.
+
+Road losses per fall reaching the road, for falls of every size (the power law above
+m_min and the inventory's own smaller falls below it): a moving vehicle at the impact
+point (Bunce et al. 1997), a vehicle striking the rock lying on the road, deaths with a
+vulnerability that depends on block mass (see :mod:`riskrf.road_risk`), vehicle damage,
+closure and clean-up.  All inputs come from a TOML file (README, "Mitigation files").
 """
 from __future__ import annotations
 
 import difflib
 import tomllib
 from dataclasses import dataclass, field, fields, replace
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from .annual_hazard import EnergyHazard
-from .barriers import service_energy_level
+from .economics import pv_factor, renewal_factor
 from .impact_energy import mass_model
+from .measures import (Ditch, MeasureError, SimulationContext, road_crossings, runout_beyond, scenario_with_ditches,
+                       seeder_share)
+from .power_law import GutenbergRichterFit
 from .road_risk import (
-    individual_risk,
-    pv_factor,
-    pv_of_renewals,
+    AGS2007_INDIVIDUAL_RISK,
+    VULNERABILITY_DIRECT_BY_MASS,
+    VULNERABILITY_STRIKE_BY_MASS,
+    commuter_passage_probability,
+    commuter_strike_probability,
+    fn_zone,
+    occupancy_distribution,
+    occupant_fn,
     spatial_temporal_probability,
     stationary_rock_strike_probability,
-    vehicle_occupant_fn,
+    vulnerability_by_mass,
 )
-from .units import mass_for_energy_kg
+from .units import DAYS_PER_YEAR, SEL_PER_MEL
 
-OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment")
+OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "combined")
+BARRIER_KINDS = ("fence", "attenuator", "shed")
+#: Days a destroyed structure stays out of service (ASSUMPTION; override with ``repair_days``).
+DEFAULT_REPAIR_DAYS = {"fence": 30.0, "attenuator": 30.0, "shed": 180.0}
+MASS_BINS = 120
 
 
 class MitigationError(ValueError):
@@ -63,15 +93,20 @@ class Exposure:
     hours_rock_on_road: float = 0.5
     p_cannot_stop: float = 0.002
     share_stopping_on_road: float = 0.3
+    exposed_length_m: float = 100.0
+    occupants_distribution: dict | None = None
 
 
 @dataclass(frozen=True)
 class Consequences:
-    """Costs of consequences (in ``currency``) and vulnerabilities (probability of death)."""
+    """Costs of consequences (in ``currency``) and vulnerabilities (probability of death).
+
+    A vulnerability is a number or pairs (mass_kg, probability) interpolated in log mass.
+    """
 
     value_of_statistical_life: float = 5.0e6
-    vulnerability_moving_vehicle: float = 0.5
-    vulnerability_striking_rock: float = 0.1
+    vulnerability_moving_vehicle: object = VULNERABILITY_DIRECT_BY_MASS
+    vulnerability_striking_rock: object = VULNERABILITY_STRIKE_BY_MASS
     vehicle_damage: float = 25000.0
     closure_days_per_fall: float = 0.5
     closure_cost_per_day: float = 20000.0
@@ -86,36 +121,155 @@ class Economics:
 
 
 @dataclass(frozen=True)
+class Criteria:
+    """Tolerability: individual risk of the person most at risk [1/yr] and the societal (F-N) diagram."""
+
+    individual_risk_per_year: float = AGS2007_INDIVIDUAL_RISK["existing slope"]
+    fn_diagram: str = "Hong Kong GEO Report 75 (1998)"
+
+
+@dataclass(frozen=True)
+class Uncertainty:
+    """Epistemic inputs sampled jointly (uniform within the stated ranges; m_max log-uniform).
+
+    ``rate_factor``: the rate of falls relative to the estimate (e.g. the share of the source above the
+    road); ``vulnerability_factor`` multiplies both vulnerability curves.  The power law's b and rate are
+    sampled from their sampling laws (b x Gamma(n)/n, rate x Gamma(n)/n) and derived retentions from their
+    Monte Carlo law (Beta) unless switched off.
+    """
+
+    samples: int = 1000
+    seed: int = 1
+    rate_factor: tuple = (1.0, 1.0)
+    m_max_kg: tuple | None = None
+    value_of_statistical_life: tuple | None = None
+    vulnerability_factor: tuple = (1.0, 1.0)
+    vehicles_per_day: tuple | None = None
+    discount_rate: tuple | None = None
+    sample_power_law: bool = True
+    sample_retention: bool = True
+
+
+@dataclass(frozen=True)
 class Option:
     name: str
     kind: str
-    capital_cost: float
+    capital_cost: float = 0.0
     annual_maintenance: float = 0.0
     life_years: float | None = None
     repair_cost_per_impact: float = 0.0
+    replacement_cost: float | None = None
+    repair_days: float | None = None
     rate_reduction: float | None = None
     retention: float | None = None
-    max_mass_kg: float | None = None
+    x_m: float | None = None
+    width_m: float | None = None
+    depth_m: float | None = None
+    inner_slope_hv: float | None = None
+    outer_slope_hv: float | None = None
+    material: str | None = None
     capacity_kj: float | None = None
     height_m: float | None = None
+    min_mass_kg: float | None = None
+    max_mass_kg: float | None = None
+    zone_x_m: tuple | None = None
+    covered_length_m: float | None = None
+    road_x_m: float | None = None
+    options: tuple = ()
+    capital_cost_range: tuple | None = None
+    annual_maintenance_range: tuple | None = None
+    retention_range: tuple | None = None
+    rate_reduction_range: tuple | None = None
     description: str = ""
+
+    @property
+    def typed(self) -> bool:
+        """Does a typed effectiveness (an assumption) replace the derived one?"""
+        return self.retention is not None or self.rate_reduction is not None
+
+    def describe(self) -> str:
+        """What the option is and assumes, in words."""
+        k = self.kind
+        if k == "none":
+            text = "the site as it is"
+        elif k == "scaling":
+            if self.rate_reduction is not None:
+                text = f"scaling and bolting; ASSUMED to prevent {self.rate_reduction:.0%} of falls (typed)"
+            else:
+                size = (f"{self.min_mass_kg or 0:,.0f}-{self.max_mass_kg:,.0f} kg" if self.max_mass_kg
+                        else f"above {self.min_mass_kg:,.0f} kg" if self.min_mass_kg else "of every size")
+                zone = f" from x = {self.zone_x_m[0]:g}-{self.zone_x_m[1]:g} m" if self.zone_x_m else ""
+                text = f"scaling and bolting: removes the release of blocks {size}{zone}"
+        elif k == "ditch":
+            if self.retention is not None:
+                text = f"catchment ditch; ASSUMED to retain {self.retention:.0%} of falls (typed)"
+            else:
+                text = (f"catchment ditch {self.width_m:g} m wide and {self.depth_m:g} m deep from x = {self.x_m:g} m; "
+                        "retention derived by simulation")
+        elif k in ("fence", "attenuator"):
+            text = (f"{k} of {self.capacity_kj:,.0f} kJ (MEL), {self.height_m:g} m high"
+                    + (f" at x = {self.x_m:g} m" if self.x_m is not None else " at the barrier line")
+                    + (f"; ASSUMED to retain {self.retention:.0%} (typed)" if self.retention is not None
+                       else "; passing falls from simulated heights and energies")
+                    + f"; out of service {self.repair_days:g} days after an impact above MEL (assumption)")
+        elif k == "shed":
+            text = (f"rock shed of {self.capacity_kj:,.0f} kJ over "
+                    + (f"{self.covered_length_m:g} m of road" if self.covered_length_m else "the exposed road")
+                    + f"; out of service {self.repair_days:g} days after an impact above capacity (assumption)")
+        elif k == "realignment":
+            text = (f"road moved to x = {self.road_x_m:g} m" if self.road_x_m is not None
+                    else "road moved away from the slope (no exposure)")
+        else:
+            text = "combination of " + " + ".join(self.options)
+        return (self.description + ": " if self.description else "") + text
 
 
 @dataclass(frozen=True)
 class OptionResult:
+    """Central-value results of one option (rates per year, money in the study currency)."""
+
     option: Option
     road_falls_per_year: float
-    held_impacts_above_sel_per_year: float
+    repairs_per_year: float
+    replacements_per_year: float
     vehicle_hits_per_year: float
     rock_strikes_per_year: float
     deaths_per_year: float
     expected_annual_loss: float
     individual_risk: float
+    retention: float | None
+    effectiveness: float
+
+    @property
+    def held_impacts_above_sel_per_year(self) -> float:
+        return self.repairs_per_year
+
+
+@dataclass(frozen=True)
+class _Stage:
+    """One element acting on the falls in series (see ``_chain``)."""
+
+    kind: str                  # "release", "ditch", "barrier", "exposure"
+    option: str
+    multiplier: np.ndarray | None = None      # release: per mass bin
+    param: str | None = None                  # parameter holding a sampled retention / rate reduction
+    passing: np.ndarray | None = None         # barrier: per mass bin, working structure
+    held_sel: np.ndarray | None = None
+    destroy: np.ndarray | None = None
+    coverage: float = 1.0
+    after_road: bool = False
+    factor: float = 1.0                       # exposure
 
 
 @dataclass(frozen=True)
 class MitigationStudy:
-    """A hazard at the barrier line, the road exposure, consequences, economics and options."""
+    """A hazard at the barrier line, the road exposure, consequences, economics and options.
+
+    ``context`` (a :class:`~riskrf.measures.SimulationContext`) is the slope model used to
+    derive the options' effects; ``reference`` the simulation behind the hazard (road
+    velocities, run-out).  ``small_fall_masses_kg`` and ``small_falls_per_year``: the
+    inventory's falls below the power law's m_min (already scaled to this site).
+    """
 
     hazard: EnergyHazard
     options: tuple
@@ -125,9 +279,70 @@ class MitigationStudy:
     road_share: float = 1.0            # P(reaches the road | reaches the barrier line)
     source: str = "<dict>"
     defaults_used: tuple = field(default_factory=tuple)
+    context: SimulationContext | None = None
+    reference: object = None
+    small_fall_masses_kg: np.ndarray | None = field(default=None, repr=False)
+    small_falls_per_year: float = 0.0
+    uncertainty: Uncertainty = Uncertainty()
+    criteria: Criteria = Criteria()
 
-    # ---- residual hazard ---------------------------------------------------------------
-    def _paired_samples(self):
+    def __post_init__(self):
+        _check_combinations(self.options, self.source)
+
+    @property
+    def currency(self) -> str:
+        return self.consequences.currency
+
+    def option(self, name: str) -> Option:
+        opt = next((o for o in self.options if o.name == name), None)
+        if opt is None:
+            raise MitigationError(f"no option named {name!r}; options are {[o.name for o in self.options]}")
+        return opt
+
+    # ---- mass grid ----------------------------------------------------------------------
+    @cached_property
+    def _grid(self):
+        """Mass bins [kg]: edges, representative masses, and the fixed small-fall histogram."""
+        mm = mass_model(self.hazard.mass)
+        gr = self.hazard.mass if isinstance(self.hazard.mass, GutenbergRichterFit) else None
+        lo_candidates = [float(mm.isf(1 - 1e-9))] if gr is None else [gr.m_min]
+        if self.small_fall_masses_kg is not None and len(self.small_fall_masses_kg):
+            lo_candidates.append(float(np.min(self.small_fall_masses_kg)))
+        lo = 0.999 * min(lo_candidates)
+        if gr is not None:
+            tops = [gr.m_max or gr.m_min * 1e6]
+            if self.uncertainty.m_max_kg:
+                tops.append(self.uncertainty.m_max_kg[1])
+            hi = max(tops)
+        else:
+            hi = float(mm.isf(1e-9))
+        edges = np.geomspace(lo, hi, MASS_BINS + 1)
+        mid = np.sqrt(edges[:-1] * edges[1:])
+        small = np.zeros(MASS_BINS)
+        if self.small_fall_masses_kg is not None and len(self.small_fall_masses_kg) and self.small_falls_per_year > 0:
+            small = np.histogram(np.clip(self.small_fall_masses_kg, lo, hi), edges)[0].astype(float)
+            small /= small.sum()
+        return edges, mid, small
+
+    def _mass_pmf(self, b=None, m_max=None):
+        """Probability of each mass bin for one fall of at least m_min; arrays (S, J) for sampled b, m_max."""
+        edges = self._grid[0]
+        m = self.hazard.mass
+        if isinstance(m, GutenbergRichterFit) and b is not None:
+            b = np.atleast_1d(b)[:, None]
+            top = np.atleast_1d(m_max if m_max is not None else np.inf)[:, None]
+            z = np.clip(edges[None, :], m.m_min, top)
+            with np.errstate(divide="ignore"):
+                t = np.where(np.isfinite(top), top ** -b, 0.0)
+            sf = (z ** -b - t) / (m.m_min ** -b - t)
+            sf[:, -1] = 0.0                                     # the last bin takes the tail
+            return np.clip(-np.diff(sf, axis=1), 0.0, None)
+        sf = mass_model(m).sf(edges)
+        sf[-1] = 0.0
+        return np.clip(-np.diff(sf), 0.0, None)[None, :]
+
+    # ---- option effects (derived once) --------------------------------------------------
+    def _samples_barrier(self):
         v = self.hazard.velocity
         v = np.asarray(getattr(v, "velocity_ms", v), dtype=float)
         h = self.hazard.heights_m
@@ -136,238 +351,711 @@ class MitigationStudy:
                                   "bounce heights (build the hazard with EnergyHazard.from_simulation)")
         return v, np.asarray(h, dtype=float)
 
-    def evaluate(self, option: Option) -> OptionResult:
-        hz = self.hazard
-        arrivals = hz.arrival_rate            # falls per year at the barrier line
-        mm = mass_model(hz.mass)
-        held_above_sel = 0.0
-        kind = option.kind
-        if kind == "none":
-            passing = 1.0
-        elif kind == "scaling":
-            passing = 1.0 - option.rate_reduction
-        elif kind == "ditch":
-            passing = (1.0 - option.retention) if option.retention is not None \
-                else float(mm.sf(option.max_mass_kg))
-        elif kind in ("fence", "attenuator"):
-            v, h = self._paired_samples()
-            over = h > option.height_m
-            through = mm.sf(mass_for_energy_kg(option.capacity_kj, v))
-            passing = float(np.mean(np.where(over, 1.0, through)))
-            above_sel = mm.sf(mass_for_energy_kg(service_energy_level(option.capacity_kj), v))
-            held_above_sel = arrivals * float(np.mean(np.where(over, 0.0, above_sel - through)))
-        elif kind == "shed":
-            passing = float(hz.exceedance_probability(option.capacity_kj))
-        else:   # realignment
-            passing = 0.0
-        road = arrivals * passing * self.road_share
-        ex, co = self.exposure, self.consequences
-        p_st = spatial_temporal_probability(ex.vehicles_per_day, ex.vehicle_length_m, ex.speed_kmh)
-        hits = road * p_st
-        strikes = road * ex.share_stopping_on_road * stationary_rock_strike_probability(
-            ex.vehicles_per_day, ex.hours_rock_on_road, ex.p_cannot_stop)
-        deaths = ex.occupants_per_vehicle * (hits * co.vulnerability_moving_vehicle
-                                             + strikes * co.vulnerability_striking_rock)
-        eal = (deaths * co.value_of_statistical_life + (hits + strikes) * co.vehicle_damage
-               + road * (co.closure_days_per_fall * co.closure_cost_per_day + co.cleanup_cost_per_fall))
-        ir = individual_risk(road, ex.commuter_trips_per_day, ex.vehicle_length_m, ex.speed_kmh,
-                             co.vulnerability_moving_vehicle)
-        return OptionResult(option, road, held_above_sel, hits, strikes, deaths, eal, ir)
+    def _samples_at(self, collector: str):
+        """Effective velocities [m/s] and heights [m] at a collector of the reference simulation."""
+        from .annual_hazard import inertia_factors
+        df = self.reference.collector(collector, first_only=True)
+        v = df["velocity_ms"].to_numpy()
+        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
+        return np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2), df["height_m"].to_numpy()
 
-    # ---- ranking ---------------------------------------------------------------------
-    def ranking(self) -> pd.DataFrame:
-        """The ranking table: costs, expected losses, residual hazard, risk, benefit-cost ratio, rank."""
-        ec = self.economics
-        pvf = pv_factor(ec.discount_rate, ec.horizon_years)
-        rows = []
+    def _barrier_stage(self, opt: Option) -> _Stage:
+        mid = self._grid[1]
+        cap = opt.capacity_kj
+        if opt.kind == "shed":
+            if self.reference is not None and self.context is not None and \
+                    self.context.road_collector in [c.name for c in self.reference.scenario.collectors]:
+                v, h = self._samples_at(self.context.road_collector)
+            else:
+                v, h = self._samples_barrier()
+            over = np.zeros(v.size, dtype=bool)
+            coverage = min(opt.covered_length_m / self.exposure.exposed_length_m, 1.0) if opt.covered_length_m \
+                else 1.0
+        else:
+            if opt.x_m is not None:
+                v, h = self._fence_samples_at(opt)
+            else:
+                v, h = self._samples_barrier()
+            over = h > opt.height_m
+            coverage = 1.0
+        # energies of every (block, mass bin) pair [kJ]: E = 1/2 m v^2
+        e = 0.5 * mid[None, :] * (v ** 2)[:, None] / 1000.0
+        working = ~over[:, None]
+        through = working & (e > cap)
+        passing = np.mean(over[:, None] | through, axis=0)
+        held_sel = np.mean(working & (e > cap * SEL_PER_MEL) & (e <= cap), axis=0)
+        destroy = np.mean(through, axis=0)
+        return _Stage("barrier", opt.name, passing=passing, held_sel=held_sel, destroy=destroy, coverage=coverage,
+                      after_road=opt.kind == "shed",
+                      param=f"retention:{opt.name}" if opt.retention is not None else None)
+
+    def _fence_samples_at(self, opt: Option):
+        import simulation.scenario as sc_mod
+        ctx = self._need_context(opt, "x_m")
+        prof = ctx.scenario.profile
+        if not prof.x[0] < opt.x_m < prof.x[-1]:
+            raise MitigationError(f"{self.source}: option {opt.name!r}: x_m = {opt.x_m:g} m is outside the profile "
+                                  f"({prof.x[0]:g}, {prof.x[-1]:g}) m")
+        col = sc_mod.Collector(f"{opt.name} line", float(opt.x_m))
+        res = ctx.run(replace(ctx.scenario, collectors=ctx.scenario.collectors + (col,)))
+        from .annual_hazard import inertia_factors
+        df = res.collector(col.name, first_only=True)
+        v = df["velocity_ms"].to_numpy()
+        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
+        return np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2), df["height_m"].to_numpy()
+
+    def _need_context(self, opt, fld):
+        if self.context is None:
+            raise MitigationError(f"{self.source}: option {opt.name!r}: {fld} needs the slope scenario to derive its "
+                                  "effect (run with a scenario, or type an effectiveness as an assumption)")
+        return self.context
+
+    @cached_property
+    def _reference_road_blocks(self):
+        ctx = self.context
+        return road_crossings(ctx.run(ctx.scenario), ctx.road_collector)
+
+    def _ditch_retention(self, ditches, label: str):
+        """Share of the falls that would reach the road that the ditches stop, and its Monte Carlo Beta law."""
+        ctx = self.context
+        base = self._reference_road_blocks
+        try:
+            sc = scenario_with_ditches(ctx.scenario, ditches, where=self.source, road_collector=ctx.road_collector)
+        except (MeasureError, ValueError) as exc:
+            raise MitigationError(str(exc)) from exc
+        kept = road_crossings(ctx.run(sc), ctx.road_collector)
+        k_b = base.size
+        if k_b == 0:
+            return 0.0, (0.5, 0.5)
+        stopped = int(np.setdiff1d(base, kept).size)
+        extra = int(np.setdiff1d(kept, base).size)       # deflected onto the road by the ditch
+        r = max(stopped - extra, 0)
+        return r / k_b, (r + 0.5, k_b - r + 0.5)
+
+    @cached_property
+    def _derived(self) -> dict:
+        """Derived ditch retentions: key -> (retention, Beta law parameters); filled by ``_effects``."""
+        return {}
+
+    @cached_property
+    def _effects(self) -> dict:
+        """Per option: the chain of stages in series, the derived retention laws, component options."""
+        out = {}
         for opt in self.options:
-            r = self.evaluate(opt)
-            renew = pv_of_renewals(opt.capital_cost, opt.life_years, ec.horizon_years, ec.discount_rate) \
-                if opt.life_years else 0.0
-            pv_maint = pvf * (opt.annual_maintenance + r.held_impacts_above_sel_per_year * opt.repair_cost_per_impact)
-            pv_loss = pvf * r.expected_annual_loss
-            rows.append({"option": opt.name, "kind": opt.kind, "capital": opt.capital_cost + renew,
-                         "pv_maintenance": pv_maint, "pv_expected_loss": pv_loss,
-                         "expected_total_cost": opt.capital_cost + renew + pv_maint + pv_loss,
-                         "road_falls_per_year": r.road_falls_per_year, "deaths_per_year": r.deaths_per_year,
-                         "individual_risk": r.individual_risk})
+            comps = [self.option(n) for n in opt.options] if opt.kind == "combined" else [opt]
+            out[opt.name] = (self._chain(opt, comps), comps)
+        return out
+
+    def _chain(self, opt: Option, comps) -> list:
+        mid = self._grid[1]
+        stages = []
+        for c in comps:
+            if c.kind == "scaling":
+                if c.rate_reduction is not None:
+                    stages.append(_Stage("release", c.name, param=f"rate_reduction:{c.name}"))
+                else:
+                    share = 1.0
+                    if c.zone_x_m is not None:
+                        ctx = self._need_context(c, "zone_x_m")
+                        try:
+                            share = seeder_share(ctx.scenario, c.zone_x_m, f"{self.source}: option {c.name!r}")
+                        except MeasureError as exc:
+                            raise MitigationError(str(exc)) from exc
+                    lo, hi = c.min_mass_kg or 0.0, c.max_mass_kg or np.inf
+                    inside = (mid >= lo) & (mid <= hi)
+                    stages.append(_Stage("release", c.name, multiplier=1.0 - share * inside))
+        ditches = [c for c in comps if c.kind == "ditch"]
+        typed = [c for c in ditches if c.retention is not None]
+        for c in typed:
+            stages.append(_Stage("ditch", c.name, param=f"retention:{c.name}"))
+        geo = [c for c in ditches if c.retention is None]
+        if geo:
+            self._need_context(geo[0], "x_m")
+            ds = [Ditch(c.x_m, c.width_m, c.depth_m, c.inner_slope_hv or 0.25,
+                        1.0 if c.outer_slope_hv is None else c.outer_slope_hv, c.material, c.name) for c in geo]
+            key = "+".join(c.name for c in geo)
+            if key not in self._derived:
+                self._derived[key] = self._ditch_retention(ds, key)
+            stages.append(_Stage("ditch", key, param=f"retention:{key}"))
+        for c in comps:
+            if c.kind in ("fence", "attenuator"):
+                stages.append(self._barrier_stage(c))
+        for c in comps:
+            if c.kind == "shed":
+                stages.append(self._barrier_stage(c))
+        for c in comps:
+            if c.kind == "realignment":
+                if c.road_x_m is None:
+                    factor = 0.0
+                else:
+                    ctx = self._need_context(c, "road_x_m")
+                    prof = ctx.scenario.profile
+                    if not prof.x[0] < c.road_x_m < prof.x[-1]:
+                        raise MitigationError(f"{self.source}: option {c.name!r}: road_x_m = {c.road_x_m:g} m is "
+                                              f"outside the profile ({prof.x[0]:g}, {prof.x[-1]:g}) m")
+                    ref = self.reference if self.reference is not None else ctx.run(ctx.scenario)
+                    road_x = ref.scenario.collectors[ref.scenario.collector_index(ctx.road_collector)].x
+                    now = runout_beyond(ref, road_x).sum()
+                    factor = float(runout_beyond(ref, c.road_x_m).sum() / now) if now else 0.0
+                stages.append(_Stage("exposure", c.name, factor=min(factor, 1.0)))
+        return stages
+
+    # ---- parameters -----------------------------------------------------------------------
+    def central_parameters(self) -> dict:
+        """Every input the engine varies, at its central value (names used by tornado and break-even)."""
+        self._effects
+        hz, ex, co, ec = self.hazard, self.exposure, self.consequences, self.economics
+        p = {"rate_factor": 1.0, "value_of_statistical_life": co.value_of_statistical_life,
+             "vulnerability_factor": 1.0, "vehicles_per_day": ex.vehicles_per_day,
+             "discount_rate": ec.discount_rate}
+        if isinstance(hz.mass, GutenbergRichterFit):
+            p["b"] = float(hz.mass.b)
+            p["rate_sampling_factor"] = 1.0
+            if hz.mass.m_max is not None:
+                p["m_max_kg"] = float(hz.mass.m_max)
+        for o in self.options:
+            if o.kind == "combined":
+                continue
+            p[f"capital_cost:{o.name}"] = o.capital_cost
+            p[f"annual_maintenance:{o.name}"] = o.annual_maintenance
+            if o.rate_reduction is not None:
+                p[f"rate_reduction:{o.name}"] = o.rate_reduction
+            if o.retention is not None:
+                p[f"retention:{o.name}"] = o.retention
+            if o.kind in BARRIER_KINDS:
+                p[f"repair_days:{o.name}"] = self._repair_days(o)
+        for key, (ret, _) in self._derived.items():
+            p[f"retention:{key}"] = ret
+        return p
+
+    def _repair_days(self, o):
+        return DEFAULT_REPAIR_DAYS[o.kind] if o.repair_days is None else o.repair_days
+
+    def parameter_ranges(self) -> dict:
+        """name -> (low, high, how): the range each uncertain input is sampled over (and the tornado uses)."""
+        from scipy import stats
+        u = self.uncertainty
+        c = self.central_parameters()
+        out = {}
+        hz = self.hazard
+        if "b" in c and u.sample_power_law:
+            n = hz.mass.n_tail
+            g = stats.gamma(n, scale=1.0 / n)
+            out["b"] = (c["b"] * g.ppf(0.05), c["b"] * g.ppf(0.95), "b x Gamma(n)/n (sampling law of the MLE)")
+            out["rate_sampling_factor"] = (g.ppf(0.05), g.ppf(0.95), "Gamma(n)/n (Poisson count of the record)")
+        if u.rate_factor != (1.0, 1.0):
+            out["rate_factor"] = (*u.rate_factor, "uniform, stated (share of the source above the road)")
+        if u.m_max_kg and "m_max_kg" in c:
+            out["m_max_kg"] = (*u.m_max_kg, "log-uniform, stated")
+        for name in ("value_of_statistical_life", "vehicles_per_day", "discount_rate"):
+            if getattr(u, name):
+                out[name] = (*getattr(u, name), "uniform, stated")
+        if u.vulnerability_factor != (1.0, 1.0):
+            out["vulnerability_factor"] = (*u.vulnerability_factor, "uniform, stated")
+        for o in self.options:
+            for fld, rng_name in (("capital_cost", "capital_cost_range"), ("annual_maintenance",
+                                                                            "annual_maintenance_range"),
+                                  ("retention", "retention_range"), ("rate_reduction", "rate_reduction_range")):
+                rng = getattr(o, rng_name)
+                if rng is not None and f"{fld}:{o.name}" in c:
+                    out[f"{fld}:{o.name}"] = (*rng, "uniform, stated" + (" (typed effectiveness: assumption)"
+                                                                         if fld in ("retention", "rate_reduction")
+                                                                         else ""))
+        if u.sample_retention:
+            for key, (_, (a, b)) in self._derived.items():
+                d = stats.beta(a, b)
+                out[f"retention:{key}"] = (float(d.ppf(0.05)), float(d.ppf(0.95)),
+                                           "Beta (Monte Carlo error of the derived retention)")
+        return out
+
+    def sample_parameters(self, n: int | None = None, seed=None) -> dict:
+        """Joint samples of every uncertain input (arrays of length n), the rest at central values."""
+        from scipy import stats
+        u = self.uncertainty
+        n = int(u.samples if n is None else n)
+        rng = np.random.default_rng(u.seed if seed is None else seed)
+        c = self.central_parameters()
+        ranges = self.parameter_ranges()
+        out = {k: np.full(n, float(v)) for k, v in c.items()}
+        for name in sorted(ranges):            # fixed order: same seed, same samples
+            lo, hi, how = ranges[name]
+            if name in ("b", "rate_sampling_factor"):
+                g = rng.gamma(self.hazard.mass.n_tail, size=n) / self.hazard.mass.n_tail
+                out[name] = c[name] * g if name == "b" else g
+            elif name.startswith("retention:") and "Beta" in how:
+                key = name.split(":", 1)[1]
+                a, b = self._derived[key][1]
+                out[name] = stats.beta(a, b).ppf(rng.uniform(size=n))
+            elif "log-uniform" in how:
+                out[name] = np.exp(rng.uniform(np.log(lo), np.log(hi), n))
+            else:
+                out[name] = rng.uniform(lo, hi, n)
+        return out
+
+    # ---- the loss engine ---------------------------------------------------------------------
+    def _evaluate(self, P: dict, *, per_bin: bool = False) -> dict:
+        """The one loss engine: every option for parameter arrays ``P`` (length S); arrays (S, K)."""
+        effects = self._effects
+        edges, mid, small_pmf = self._grid
+        S = len(next(iter(P.values())))
+        hz, ex, co, ec = self.hazard, self.exposure, self.consequences, self.economics
+        rate = hz.rate_per_year * P["rate_factor"] * P.get("rate_sampling_factor", 1.0)
+        pmf = self._mass_pmf(P.get("b"), P.get("m_max_kg")) if "b" in P else self._mass_pmf()
+        lam = rate[:, None] * pmf + (self.small_falls_per_year * P["rate_factor"])[:, None] * small_pmf[None, :]
+        arrivals = lam * hz.reach_probability                                      # (S, J) at the barrier line
+        p_st = np.broadcast_to(spatial_temporal_probability(P["vehicles_per_day"], ex.vehicle_length_m,
+                                                            ex.speed_kmh), (S,))
+        p_strike = ex.share_stopping_on_road * np.broadcast_to(stationary_rock_strike_probability(
+            P["vehicles_per_day"], ex.hours_rock_on_road, ex.p_cannot_stop), (S,))
+        vf = P["vulnerability_factor"][:, None]
+        v_d = np.minimum(vulnerability_by_mass(mid, co.vulnerability_moving_vehicle)[None, :] * vf, 1.0)
+        v_s = np.minimum(vulnerability_by_mass(mid, co.vulnerability_striking_rock)[None, :] * vf, 1.0)
+        k_occ, p_occ = occupancy_distribution(ex.occupants_per_vehicle, ex.occupants_distribution)
+        occ = float(np.dot(k_occ, p_occ))
+        p_ts = commuter_passage_probability(ex.commuter_trips_per_day, ex.vehicle_length_m, ex.speed_kmh)
+        p_cs = ex.share_stopping_on_road * commuter_strike_probability(ex.commuter_trips_per_day,
+                                                                       ex.hours_rock_on_road, ex.p_cannot_stop)
+        r = P["discount_rate"]
+        pvf = np.broadcast_to(pv_factor(r, ec.horizon_years), (S,))
+        per_fall_cost = co.closure_days_per_fall * co.closure_cost_per_day + co.cleanup_cost_per_fall
+        names = [o.name for o in self.options]
+        K = len(names)
+        res = {k: np.zeros((S, K)) for k in ("capital", "pv_renewals", "pv_maintenance", "pv_expected_loss",
+                                              "total", "road", "hits", "strikes", "deaths", "eal", "ir",
+                                              "repairs", "replacements", "retention", "effectiveness")}
+        road_bins = np.zeros((S, K, mid.size)) if per_bin else None
+        base_road = arrivals.sum(axis=1) * self.road_share
+        for k, opt in enumerate(self.options):
+            stages, comps = effects[opt.name]
+            x = arrivals.copy()
+            stopped_by_structures = np.zeros(S)
+            before_structures = None
+            maint = np.zeros(S)
+            capital = np.zeros(S)
+            renew = np.zeros(S)
+            repairs = np.zeros(S)
+            replacements = np.zeros(S)
+            repair_money = np.zeros(S)
+            for c in comps:
+                kc = P[f"capital_cost:{c.name}"]
+                capital += kc
+                maint += P[f"annual_maintenance:{c.name}"]
+                if c.life_years:
+                    renew += kc * renewal_factor(c.life_years, ec.horizon_years, r)
+            on_road = False
+            for st in stages:
+                if st.after_road and not on_road:
+                    x = x * self.road_share
+                    on_road = True
+                if st.kind == "release":
+                    x = x * (st.multiplier[None, :] if st.multiplier is not None else (1.0 - P[st.param])[:, None])
+                    continue
+                if before_structures is None:
+                    before_structures = x.sum(axis=1) * (1.0 if on_road else self.road_share)
+                if st.kind == "ditch":
+                    x = x * (1.0 - P[st.param])[:, None]
+                elif st.kind == "barrier":
+                    c = self.option(st.option)
+                    tau = P[f"repair_days:{c.name}"] / DAYS_PER_YEAR
+                    reach = x * st.coverage
+                    lam_d = (reach * st.destroy[None, :]).sum(axis=1)
+                    down = lam_d * tau / (1.0 + lam_d * tau)
+                    held = (reach * st.held_sel[None, :]).sum(axis=1) * (1.0 - down)
+                    destroyed = lam_d * (1.0 - down)
+                    repairs += held
+                    replacements += destroyed
+                    repair_money += held * c.repair_cost_per_impact + destroyed * (
+                        P[f"capital_cost:{c.name}"] if c.replacement_cost is None else c.replacement_cost)
+                    working = st.passing[None, :] if st.param is None else (1.0 - P[st.param])[:, None]
+                    passing = down[:, None] + (1.0 - down[:, None]) * working
+                    x = x * (1.0 - st.coverage) + reach * passing
+                elif st.kind == "exposure":
+                    x = x * st.factor
+            if not on_road:
+                x = x * self.road_share
+            road = x.sum(axis=1)
+            if before_structures is not None and any(s.kind in ("ditch", "barrier") for s in stages):
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    stopped_by_structures = np.where(before_structures > 0, 1.0 - road / before_structures, 0.0)
+                    if any(s.kind == "exposure" for s in stages):
+                        stopped_by_structures = np.full(S, np.nan)
+            else:
+                stopped_by_structures = np.full(S, np.nan)
+            hits = x * p_st[:, None]
+            strikes = x * p_strike[:, None]
+            deaths = occ * ((hits * v_d).sum(axis=1) + (strikes * v_s).sum(axis=1))
+            eal = deaths * P["value_of_statistical_life"] + (hits.sum(axis=1) + strikes.sum(axis=1)) \
+                * co.vehicle_damage + road * per_fall_cost
+            ir = (x * (p_ts * v_d + p_cs * v_s)).sum(axis=1)
+            pv_m = pvf * (maint + repair_money)
+            pv_l = pvf * eal
+            for key, val in (("capital", capital), ("pv_renewals", renew), ("pv_maintenance", pv_m),
+                             ("pv_expected_loss", pv_l), ("total", capital + renew + pv_m + pv_l), ("road", road),
+                             ("hits", hits.sum(axis=1)), ("strikes", strikes.sum(axis=1)), ("deaths", deaths),
+                             ("eal", eal), ("ir", ir), ("repairs", repairs), ("replacements", replacements),
+                             ("retention", stopped_by_structures)):
+                res[key][:, k] = val
+            with np.errstate(invalid="ignore", divide="ignore"):
+                res["effectiveness"][:, k] = np.where(base_road > 0, 1.0 - road / base_road, 0.0)
+            if per_bin:
+                road_bins[:, k, :] = x
+        res["names"] = names
+        if per_bin:
+            res["road_bins"] = road_bins
+            res["p_st"], res["p_strike"], res["v_d"], res["v_s"] = p_st, p_strike, v_d, v_s
+        return res
+
+    def _central(self, overrides: dict | None = None, **kw) -> dict:
+        P = {k: np.array([float(v)]) for k, v in self.central_parameters().items()}
+        for k, v in (overrides or {}).items():
+            if k not in P:
+                raise MitigationError(f"unknown parameter {k!r}; parameters are {sorted(P)}")
+            P[k] = np.atleast_1d(np.asarray(v, dtype=float))
+            n = P[k].size
+        if overrides:
+            P = {k: np.broadcast_to(v, (n,)) if v.size == 1 else v for k, v in P.items()}
+        return self._evaluate(P, **kw)
+
+    @cached_property
+    def _central_result(self):
+        return self._central(per_bin=True)
+
+    def evaluate(self, option: Option | str) -> OptionResult:
+        """Central-value results of one option."""
+        opt = self.option(option if isinstance(option, str) else option.name)
+        r = self._central_result
+        k = r["names"].index(opt.name)
+        ret = float(r["retention"][0, k])
+        return OptionResult(opt, float(r["road"][0, k]), float(r["repairs"][0, k]), float(r["replacements"][0, k]),
+                            float(r["hits"][0, k]), float(r["strikes"][0, k]), float(r["deaths"][0, k]),
+                            float(r["eal"][0, k]), float(r["ir"][0, k]), None if np.isnan(ret) else ret,
+                            float(r["effectiveness"][0, k]))
+
+    # ---- uncertainty ----------------------------------------------------------------------------
+    @cached_property
+    def uncertain(self) -> dict:
+        """Joint samples: total cost per sample and option (S, K) and the derived statistics per option."""
+        P = self.sample_parameters()
+        r = self._evaluate(P)
+        total = r["total"]
+        best = np.argmin(total, axis=1)
+        K = total.shape[1]
+        p_best = np.bincount(best, minlength=K) / total.shape[0]
+        regret = (total - total.min(axis=1, keepdims=True)).mean(axis=0)
+        ir_ok = (r["ir"] <= self.criteria.individual_risk_per_year).mean(axis=0)
+        return {"names": r["names"], "total": total, "mean": total.mean(axis=0),
+                "p05": np.percentile(total, 5, axis=0), "p95": np.percentile(total, 95, axis=0),
+                "probability_best": p_best, "expected_regret": regret, "probability_meets_individual_risk": ir_ok,
+                "evpi": max(float(total.mean(axis=0).min() - total.min(axis=1).mean()), 0.0),
+                "samples": total.shape[0]}
+
+    # ---- societal risk -------------------------------------------------------------------------
+    def fn_curve(self, option: str) -> pd.DataFrame:
+        """F-N curve of an option: direct hits and strikes on fallen rocks, every block size, occupants as a
+        distribution, N = 1 ... largest occupancy."""
+        opt = self.option(option)
+        r = self._central_result
+        k = r["names"].index(opt.name)
+        x = r["road_bins"][0, k]
+        freq = np.concatenate([x * r["p_st"][0], x * r["p_strike"][0]])
+        vul = np.concatenate([r["v_d"][0], r["v_s"][0]])
+        kk, pk = occupancy_distribution(self.exposure.occupants_per_vehicle, self.exposure.occupants_distribution)
+        return occupant_fn(freq, vul, kk, pk)
+
+    # ---- ranking ---------------------------------------------------------------------------
+    def ranking(self) -> pd.DataFrame:
+        """Options ranked by expected total cost (mean over the joint samples), with the central-value
+        breakdown, 5-95 % of the total, probability of being cheapest, expected regret and road-user risk."""
+        r = self._central_result
+        u = self.uncertain
+        rows = []
+        for k, opt in enumerate(self.options):
+            fn = self.fn_curve(opt.name)
+            ret = r["retention"][0, k]
+            rows.append({
+                "option": opt.name, "kind": opt.kind,
+                "capital": r["capital"][0, k], "pv_renewals": r["pv_renewals"][0, k],
+                "pv_maintenance": r["pv_maintenance"][0, k], "pv_expected_loss": r["pv_expected_loss"][0, k],
+                "cost_at_central_values": r["total"][0, k],
+                "expected_total_cost": u["mean"][k], "cost_p05": u["p05"][k], "cost_p95": u["p95"][k],
+                "probability_best": u["probability_best"][k], "expected_regret": u["expected_regret"][k],
+                "road_falls_per_year": r["road"][0, k], "retention": None if np.isnan(ret) else float(ret),
+                "effectiveness": r["effectiveness"][0, k],
+                "effect_basis": self._basis(opt),
+                "repairs_per_year": r["repairs"][0, k], "replacements_per_year": r["replacements"][0, k],
+                "deaths_per_year": r["deaths"][0, k], "individual_risk": r["ir"][0, k],
+                "probability_meets_individual_risk": u["probability_meets_individual_risk"][k],
+                "fn_zone": fn_zone(fn), "F_N1_per_year": float(fn["F"].iloc[0]) if len(fn) else 0.0})
         df = pd.DataFrame(rows)
         base = df[df["kind"] == "none"]
         if len(base):
             b = base.iloc[0]
-            spend = df["capital"] + df["pv_maintenance"] - (b["capital"] + b["pv_maintenance"])
+            spend = df["capital"] + df["pv_renewals"] + df["pv_maintenance"] \
+                - (b["capital"] + b["pv_renewals"] + b["pv_maintenance"])
             saved = b["pv_expected_loss"] - df["pv_expected_loss"]
             with np.errstate(divide="ignore", invalid="ignore"):
                 df["benefit_cost_ratio"] = np.where(spend > 0, saved / spend, np.nan)
-        df = df.sort_values("expected_total_cost").reset_index(drop=True)
+                df["deaths_avoided_per_million"] = np.where(
+                    spend > 0, (b["deaths_per_year"] - df["deaths_per_year"]) * self.economics.horizon_years
+                    / spend * 1e6, np.nan)
+        df["meets_criteria"] = [self._meets(row) for _, row in df.iterrows()]
+        df = df.sort_values("expected_total_cost", kind="stable").reset_index(drop=True)
         df["rank"] = np.arange(1, len(df) + 1)
         return df
+
+    def _basis(self, opt: Option) -> str:
+        comps = [self.option(n) for n in opt.options] if opt.kind == "combined" else [opt]
+        typed = [c.name for c in comps if c.typed]
+        if typed:
+            return "ASSUMPTION: typed effectiveness (" + ", ".join(typed) + ")"
+        if opt.kind == "none":
+            return "-"
+        if all(c.kind == "realignment" and c.road_x_m is None for c in comps):
+            return "geometry: the road leaves the slope"
+        return "derived (simulation and site geometry)"
+
+    def _meets(self, row) -> bool:
+        return bool(row["individual_risk"] <= self.criteria.individual_risk_per_year
+                    and row["fn_zone"] in ("ALARP", "broadly acceptable"))
 
     def best(self) -> str:
         return self.ranking()["option"].iloc[0]
 
-    # ---- sensitivity -------------------------------------------------------------------
-    def _scaled(self, parameter: str, factor: float) -> "MitigationStudy":
-        """A copy with one input multiplied by ``factor`` (parameters of tornado() and break_even())."""
-        if parameter == "fall_rate":
-            return replace(self, hazard=replace(self.hazard, rate_per_year=self.hazard.rate_per_year * factor))
-        if parameter in {f.name for f in fields(Exposure)}:
-            return replace(self, exposure=replace(self.exposure, **{parameter: getattr(self.exposure, parameter)
-                                                                     * factor}))
-        if parameter in {f.name for f in fields(Consequences)} - {"currency"}:
-            return replace(self, consequences=replace(self.consequences,
-                                                      **{parameter: getattr(self.consequences, parameter) * factor}))
-        if parameter in ("discount_rate", "horizon_years"):
-            return replace(self, economics=replace(self.economics,
-                                                   **{parameter: getattr(self.economics, parameter) * factor}))
-        if parameter.startswith("capital_cost:"):
-            name = parameter.split(":", 1)[1]
-            opts = tuple(replace(o, capital_cost=o.capital_cost * factor) if o.name == name else o
-                         for o in self.options)
-            return replace(self, options=opts)
-        raise MitigationError(f"unknown sensitivity parameter {parameter!r}")
+    def recommendation(self, ranking: pd.DataFrame | None = None) -> dict:
+        """The cheapest option meeting the tolerability criteria, else the one reducing risk most per unit cost,
+        with the reasoning in plain words."""
+        t = self.ranking() if ranking is None else ranking
+        cur = self.currency
+        lim = self.criteria.individual_risk_per_year
+        ok = t[t["meets_criteria"]]
+        cheapest = t.iloc[0]
+        if len(ok):
+            rec = ok.iloc[0]
+            why = (f"{rec['option']} is the cheapest option that meets the tolerability criteria (individual risk "
+                   f"{rec['individual_risk']:.2g}/yr against {lim:.0e}/yr; societal risk {rec['fn_zone']} on the "
+                   f"{self.criteria.fn_diagram} F-N diagram). Its expected total cost is {rec['expected_total_cost']:,.0f} "
+                   f"{cur} (5-95 %: {rec['cost_p05']:,.0f}-{rec['cost_p95']:,.0f}); it is the cheapest in "
+                   f"{rec['probability_best']:.0%} of the joint samples.")
+            if rec["option"] != cheapest["option"]:
+                why += (f" {cheapest['option']} would cost less ({cheapest['expected_total_cost']:,.0f} {cur}) but "
+                        f"leaves the risk intolerable (individual risk {cheapest['individual_risk']:.2g}/yr, "
+                        f"societal {cheapest['fn_zone']}).")
+            basis = "cheapest tolerable option"
+        else:
+            cand = t[t["kind"] != "none"].dropna(subset=["deaths_avoided_per_million"])
+            cand = cand[cand["deaths_avoided_per_million"] > 0]
+            if len(cand) == 0:
+                rec, basis = cheapest, "lowest expected total cost (no option reduces the risk)"
+                why = f"No option meets the criteria or reduces the risk; {rec['option']} costs least."
+            else:
+                rec = cand.sort_values("deaths_avoided_per_million", ascending=False).iloc[0]
+                basis = "largest risk reduction per unit cost (no option meets the criteria)"
+                why = (f"No option meets the tolerability criteria (individual risk {lim:.0e}/yr and the F-N "
+                       f"diagram). {rec['option']} reduces the risk most per unit cost: "
+                       f"{rec['deaths_avoided_per_million']:.3g} statistical lives saved over "
+                       f"{self.economics.horizon_years:g} years per million {cur} spent; residual individual risk "
+                       f"{rec['individual_risk']:.2g}/yr.")
+        if "ASSUMPTION" in str(rec["effect_basis"]):
+            why += f" Note: its effectiveness is typed, not derived ({rec['effect_basis']})."
+        return {"option": str(rec["option"]), "basis": basis, "reason": why,
+                "expected_total_cost": float(rec["expected_total_cost"]),
+                "probability_best": float(rec["probability_best"])}
 
+    # ---- sensitivity ---------------------------------------------------------------------------
     def sensitivity_parameters(self) -> list:
-        return ["fall_rate", "value_of_statistical_life", "vehicles_per_day", "vulnerability_moving_vehicle",
-                "discount_rate"] + [f"capital_cost:{o.name}" for o in self.options if o.capital_cost > 0]
+        """Every input that can change the order: all engine parameters with an effect."""
+        return list(self.central_parameters())
 
-    def tornado(self, low: float = 0.5, high: float = 2.0) -> pd.DataFrame:
-        """Swing of the lowest expected total cost as each input is multiplied by ``low`` and ``high``."""
-        base = self.ranking()["expected_total_cost"].iloc[0]
+    def _tornado_range(self, name, value):
+        ranges = self.parameter_ranges()
+        if name in ranges:
+            return ranges[name][0], ranges[name][1], ranges[name][2]
+        if name.startswith(("retention:", "rate_reduction:")):
+            return max(value - 0.2, 0.0), min(value + 0.2, 1.0), "+-0.2 (no range stated)"
+        if name == "discount_rate":
+            return value * 0.5, min(value * 2, 0.2), "x0.5 / x2 (no range stated)"
+        return value * 0.5, value * 2.0, "x0.5 / x2 (no range stated)"
+
+    def tornado(self) -> pd.DataFrame:
+        """Lowest expected total cost (central values) as each input moves over its stated range (or x0.5/x2),
+        with the best option at each end; sorted by swing."""
+        c = self.central_parameters()
+        base_r = self._central_result
+        base = float(base_r["total"][0].min())
+        names = base_r["names"]
         rows = []
-        for p in self.sensitivity_parameters():
-            lo_rank, hi_rank = self._scaled(p, low).ranking(), self._scaled(p, high).ranking()
-            rows.append({"parameter": p, "factor_low": low, "factor_high": high,
-                         "cost_at_low": lo_rank["expected_total_cost"].iloc[0],
-                         "cost_at_high": hi_rank["expected_total_cost"].iloc[0],
-                         "best_at_low": lo_rank["option"].iloc[0], "best_at_high": hi_rank["option"].iloc[0],
+        for p, v in c.items():
+            lo, hi, how = self._tornado_range(p, v)
+            if lo == hi:
+                continue                     # e.g. a zero cost: nothing to vary
+            t = self._central({p: [lo, hi]})["total"]
+            rows.append({"parameter": p, "low": lo, "high": hi, "range": how,
+                         "cost_at_low": t[0].min(), "cost_at_high": t[1].min(),
+                         "best_at_low": names[int(np.argmin(t[0]))], "best_at_high": names[int(np.argmin(t[1]))],
                          "base": base})
         df = pd.DataFrame(rows)
+        best = names[int(np.argmin(base_r["total"][0]))]
+        df["changes_best"] = (df["best_at_low"] != best) | (df["best_at_high"] != best)
         df["swing"] = (df["cost_at_high"] - df["cost_at_low"]).abs()
-        return df.sort_values("swing", ascending=False).reset_index(drop=True)
+        return df.sort_values(["changes_best", "swing"], ascending=[False, False]).reset_index(drop=True)
 
-    def break_even(self, parameter: str, *, option_a: str | None = None, option_b: str | None = None,
-                   factor_range=(1e-3, 1e3)):
-        """Multiplier of ``parameter`` at which the best and second options (or a and b) cost the same.
+    def _bracket(self, name, value):
+        if name.startswith(("retention:", "rate_reduction:")):
+            return 0.0, 1.0, False
+        if name == "b":
+            return 0.2, 3.0, False
+        if name == "discount_rate":
+            return 0.0, 0.3, False
+        if name == "vulnerability_factor":
+            return 1e-3, 1e3, True
+        return max(value, 1.0) * 1e-3 if value > 0 else 0.0, max(value, 1.0) * 1e3, True
 
-        Returns (factor, value) or None if they do not cross within ``factor_range``.
-        """
-        if option_a is None or option_b is None:
-            rank = self.ranking()["option"]
-            option_a, option_b = option_a or rank.iloc[0], option_b or rank.iloc[1]
-        a, b = option_a, option_b
+    def break_even(self, parameter: str, *, option_a: str | None = None, option_b: str | None = None):
+        """Value of ``parameter`` (others central) at which options a and b (default: the two cheapest at
+        central values) cost the same; None if they do not tie within the searched range."""
+        r = self._central_result
+        names = r["names"]
+        order = np.argsort(r["total"][0], kind="stable")
+        a = option_a or names[order[0]]
+        b = option_b or names[order[1]]
+        ia, ib = names.index(a), names.index(b)
+        c = self.central_parameters()
+        if parameter not in c:
+            raise MitigationError(f"unknown sensitivity parameter {parameter!r}; parameters are {sorted(c)}")
+        lo, hi, log = self._bracket(parameter, c[parameter])
+        grid = np.geomspace(max(lo, 1e-12), hi, 161) if log else np.linspace(lo, hi, 161)
+        try:
+            t = self._central({parameter: grid})["total"]
+        except ValueError:
+            return None
+        d = t[:, ia] - t[:, ib]
+        cross = np.nonzero(np.sign(d[:-1]) * np.sign(d[1:]) < 0)[0]
+        if cross.size == 0:
+            return None
+        # the crossing nearest the current value
+        j = cross[np.argmin(np.abs(grid[cross] - c[parameter]))]
+        from scipy.optimize import brentq
 
-        def diff(log_f):
-            try:
-                t = self._scaled(parameter, float(np.exp(log_f))).ranking().set_index("option")
-            except ValueError:          # e.g. traffic so dense that P(S:T) >= 1: outside the model
-                return np.nan
-            return t["expected_total_cost"][a] - t["expected_total_cost"][b]
-        lo, hi = np.log(factor_range[0]), np.log(factor_range[1])
-        grid = np.linspace(lo, hi, 61)
-        vals = [diff(g) for g in grid]
-        for g0, g1, v0, v1 in zip(grid[:-1], grid[1:], vals[:-1], vals[1:]):
-            if np.isfinite(v0) and np.isfinite(v1) and np.sign(v0) != np.sign(v1):
-                from scipy.optimize import brentq
-                f = float(np.exp(brentq(diff, g0, g1, xtol=1e-10)))
-                return f, self._parameter_value(parameter) * f
-        return None
-
-    def _parameter_value(self, parameter: str) -> float:
-        if parameter == "fall_rate":
-            return self.hazard.rate_per_year
-        for obj in (self.exposure, self.consequences, self.economics):
-            if hasattr(obj, parameter):
-                return float(getattr(obj, parameter))
-        name = parameter.split(":", 1)[1]
-        return next(o.capital_cost for o in self.options if o.name == name)
+        def diff(x):
+            tt = self._central({parameter: [x]})["total"][0]
+            return tt[ia] - tt[ib]
+        x = float(brentq(diff, grid[j], grid[j + 1], xtol=1e-12 * max(abs(grid[j + 1]), 1.0)))
+        return x / c[parameter] if c[parameter] else np.nan, x
 
     def break_even_table(self) -> pd.DataFrame:
-        """For every sensitivity parameter: the value at which the second option would tie with the best."""
-        rank = self.ranking()
-        a, b = rank["option"].iloc[0], rank["option"].iloc[1]
+        """For every input: the value at which the second-cheapest option would tie with the cheapest, and
+        whether that value lies inside the stated range."""
+        r = self._central_result
+        order = np.argsort(r["total"][0], kind="stable")
+        a, b = r["names"][order[0]], r["names"][order[1]]
+        ranges = self.parameter_ranges()
         rows = []
-        for p in self.sensitivity_parameters():
+        for p, v in self.central_parameters().items():
             be = self.break_even(p, option_a=a, option_b=b)
-            rows.append({"parameter": p, "current": self._parameter_value(p),
-                         "break_even": be[1] if be else np.nan, "factor": be[0] if be else np.nan,
-                         "note": f"{b!r} ties with {a!r}" if be else "no tie within x0.001-x1000"})
+            lo, hi = (ranges[p][0], ranges[p][1]) if p in ranges else (np.nan, np.nan)
+            inside = bool(be is not None and p in ranges and lo <= be[1] <= hi)
+            rows.append({"parameter": p, "current": v, "break_even": be[1] if be else np.nan,
+                         "factor": be[0] if be else np.nan, "range_low": lo, "range_high": hi,
+                         "within_stated_range": inside,
+                         "note": f"{b!r} ties with {a!r}" if be else "no tie within the searched range"})
         return pd.DataFrame(rows)
 
     def value_of_information(self, factors=(0.5, 1.0, 2.0), weights=(0.25, 0.5, 0.25)) -> dict:
-        """Expected value of perfect information about the rate of falls.
-
-        The rate is uncertain by more than its Poisson error (the share of the source
-        above the road, completeness, changes with time); ``factors`` and ``weights``
-        give a discrete distribution of the true rate relative to the estimate
-        (default: half, as estimated, double with probabilities 1/4, 1/2, 1/4).  EVPI =
-        cost of the best option chosen now minus the expected cost of choosing after
-        learning the rate: the most a monitoring programme that settles it is worth.
-        """
+        """Expected value of perfect information about the rate of falls (``factors`` x the estimate with
+        ``weights``), and about every sampled input at once (from the joint samples)."""
         f = np.asarray(factors, dtype=float)
         w = np.asarray(weights, dtype=float)
         if f.shape != w.shape or np.any(f <= 0) or np.any(w < 0) or abs(w.sum() - 1) > 1e-9:
             raise MitigationError(f"value_of_information: factors {f.tolist()} must be > 0 and weights {w.tolist()} "
                                   "non-negative, as many, summing to 1")
-        tables = [self._scaled("fall_rate", x).ranking().set_index("option")["expected_total_cost"] for x in f]
-        expected = sum(wi * t for wi, t in zip(w, tables))
-        now = expected.idxmin()
-        informed = float(sum(wi * t.min() for wi, t in zip(w, tables)))
-        return {"evpi": float(expected[now] - informed), "best_now": now,
+        r = self._central({"rate_factor": f})
+        t = r["total"]
+        names = r["names"]
+        expected = w @ t
+        now = int(np.argmin(expected))
+        informed = float(w @ t.min(axis=1))
+        return {"evpi": float(expected[now] - informed), "best_now": names[now],
                 "expected_cost_now": float(expected[now]), "expected_cost_informed": informed,
-                "best_by_rate": {f"x{x:g}": t.idxmin() for x, t in zip(f, tables)},
-                "factors": f.tolist(), "weights": w.tolist()}
+                "best_by_rate": {f"x{x:g}": names[int(np.argmin(row))] for x, row in zip(f, t)},
+                "factors": f.tolist(), "weights": w.tolist(),
+                "evpi_all_sampled_inputs": self.uncertain["evpi"]}
 
-    # ---- societal risk and tree --------------------------------------------------------
-    def fn_curve(self, option: str) -> pd.DataFrame:
-        opt = next((o for o in self.options if o.name == option), None)
-        if opt is None:
-            raise MitigationError(f"no option named {option!r}; options are {[o.name for o in self.options]}")
-        r = self.evaluate(opt)
-        return vehicle_occupant_fn(r.vehicle_hits_per_year, self.exposure.occupants_per_vehicle,
-                                   self.consequences.vulnerability_moving_vehicle)
-
+    # ---- decision tree -------------------------------------------------------------------------
     def to_tree(self):
-        """The decision tree of this study (costs in present value), for rollback, diagrams and EVPI.
+        """The decision tree of this study at central values (costs in present value), from the same engine.
 
-        Under each option, a chance node gives the outcome of one fall reaching the
-        road; branch costs are that outcome's cost times the discounted expected
-        number of such falls over the horizon, so the rollback equals the ranking.
+        Under each option a chance node gives the outcome of one fall reaching the road;
+        branch costs are that outcome's mean cost (over the sizes reaching the road) times
+        the discounted expected number of such falls, so the rollback equals the central
+        cost of the ranking.
         """
         from .decision_tree import DecisionTree
+        r = self._central_result
         ec, ex, co = self.economics, self.exposure, self.consequences
         pvf = pv_factor(ec.discount_rate, ec.horizon_years)
-        p_st = spatial_temporal_probability(ex.vehicles_per_day, ex.vehicle_length_m, ex.speed_kmh)
-        p_strike = ex.share_stopping_on_road * stationary_rock_strike_probability(
-            ex.vehicles_per_day, ex.hours_rock_on_road, ex.p_cannot_stop)
+        k_occ, p_occ = occupancy_distribution(ex.occupants_per_vehicle, ex.occupants_distribution)
+        occ = float(np.dot(k_occ, p_occ))
+        p_st, p_strike = float(r["p_st"][0]), float(r["p_strike"][0])
         per_fall = co.closure_days_per_fall * co.closure_cost_per_day + co.cleanup_cost_per_fall
-        ranking = self.ranking().set_index("option")
         branches = []
-        for opt in self.options:
-            r = self.evaluate(opt)
-            n_pv = pvf * r.road_falls_per_year
-            row = ranking.loc[opt.name]
+        for k, opt in enumerate(self.options):
+            x = r["road_bins"][0, k]
+            road = x.sum()
+            n_pv = pvf * road
+            vd = float(np.dot(x, r["v_d"][0]) / road) if road > 0 else 0.0
+            vs = float(np.dot(x, r["v_s"][0]) / road) if road > 0 else 0.0
             outcomes = [
                 {"name": "vehicle hit", "probability": p_st,
-                 "cost": n_pv * (per_fall + co.vehicle_damage + ex.occupants_per_vehicle
-                                 * co.vulnerability_moving_vehicle * co.value_of_statistical_life)},
+                 "cost": n_pv * (per_fall + co.vehicle_damage + occ * vd * co.value_of_statistical_life)},
                 {"name": "vehicle strikes rock on road", "probability": p_strike,
-                 "cost": n_pv * (per_fall + co.vehicle_damage + ex.occupants_per_vehicle
-                                 * co.vulnerability_striking_rock * co.value_of_statistical_life)},
+                 "cost": n_pv * (per_fall + co.vehicle_damage + occ * vs * co.value_of_statistical_life)},
                 {"name": "closure and clean-up only", "probability": 1 - p_st - p_strike, "cost": n_pv * per_fall}]
-            branches.append({"name": opt.name, "cost": float(row["capital"] + row["pv_maintenance"]),
+            branches.append({"name": opt.name, "cost": float(r["capital"][0, k] + r["pv_renewals"][0, k]
+                                                             + r["pv_maintenance"][0, k]),
                              "child": {"type": "chance", "name": "each fall reaching the road",
                                        "branches": outcomes}})
         return DecisionTree.from_dict({"type": "decision", "name": "mitigation", "objective": "min",
                                        "branches": branches}, source=self.source)
 
-    @property
-    def currency(self) -> str:
-        return self.consequences.currency
+    def options_table(self) -> pd.DataFrame:
+        """What each option is and assumes, and its effect as used."""
+        r = self._central_result
+        rows = []
+        for k, o in enumerate(self.options):
+            ret = r["retention"][0, k]
+            rows.append({"option": o.name, "kind": o.kind, "what it is and assumes": o.describe(),
+                         "retention": None if np.isnan(ret) else float(ret),
+                         "effectiveness": float(r["effectiveness"][0, k]), "effect_basis": self._basis(o)})
+        return pd.DataFrame(rows)
 
 
-def _table(data: dict, cls, where: str, source: str, used: list):
+# ---- parsing -------------------------------------------------------------------------------------
+NUMBER_FIELDS = ("capital_cost", "annual_maintenance", "life_years", "repair_cost_per_impact", "replacement_cost",
+                 "repair_days", "rate_reduction", "retention", "x_m", "width_m", "depth_m", "inner_slope_hv",
+                 "outer_slope_hv", "capacity_kj", "height_m", "min_mass_kg", "max_mass_kg", "covered_length_m",
+                 "road_x_m")
+RANGE_FIELDS = ("capital_cost_range", "annual_maintenance_range", "retention_range", "rate_reduction_range",
+                "zone_x_m")
+
+
+def _range(v, where: str, *, share: bool = False):
+    if not (isinstance(v, (list, tuple)) and len(v) == 2 and all(isinstance(x, (int, float))
+                                                                 and not isinstance(x, bool) for x in v)):
+        raise MitigationError(f"{where} = {v!r} must be [low, high]")
+    lo, hi = float(v[0]), float(v[1])
+    if not (np.isfinite(lo) and np.isfinite(hi)) or lo < 0:
+        raise MitigationError(f"{where} = {v!r}: values must be finite numbers >= 0")
+    if lo > hi:
+        raise MitigationError(f"{where} = {v!r}: low {lo:g} is greater than high {hi:g}")
+    if share and hi > 1:
+        raise MitigationError(f"{where} = {v!r} is a share and must lie in [0, 1]")
+    return lo, hi
+
+
+def _table(data: dict, cls, where: str, source: str, used: list, special=()):
     names = {f.name for f in fields(cls)}
+    if not isinstance(data, dict):
+        raise MitigationError(f"{source}: [{where}] must be a table")
     unknown = set(data) - names
     if unknown:
         key = sorted(unknown)[0]
@@ -377,11 +1065,29 @@ def _table(data: dict, cls, where: str, source: str, used: list):
     for f in fields(cls):
         if f.name not in data:
             used.append(f"{where}.{f.name} = {getattr(cls(), f.name)!r} (default)")
-        elif f.name != "currency":
+        elif f.name in special:
+            continue
+        elif f.name != "currency" and f.type not in ("bool",):
             v = data[f.name]
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or v < 0:
                 raise MitigationError(f"{source}: {where}.{f.name} = {v!r} must be a number >= 0")
-    return cls(**data)
+    return data
+
+
+def _vulnerability(v, where):
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        if not 0 <= v <= 1:
+            raise MitigationError(f"{where} = {v!r} must be a probability in [0, 1]")
+        return float(v)
+    try:
+        arr = np.asarray(v, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.empty((0,))
+    if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1 or np.any(arr[:, 0] <= 0) \
+            or np.any((arr[:, 1] < 0) | (arr[:, 1] > 1)) or np.any(np.diff(arr[:, 0]) <= 0):
+        raise MitigationError(f"{where} = {v!r} must be a probability or [[mass_kg, probability], ...] with "
+                              "increasing masses > 0 and probabilities in [0, 1]")
+    return tuple(map(tuple, arr.tolist()))
 
 
 def parse_option(spec: dict, i: int, source: str) -> Option:
@@ -402,44 +1108,166 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
     kind = spec.get("kind")
     if kind not in OPTION_KINDS:
         raise MitigationError(f"{source}: {where}: kind = {kind!r} is not one of {', '.join(OPTION_KINDS)}")
-    if "capital_cost" not in spec:
+    if "capital_cost" not in spec and kind != "combined":
         raise MitigationError(f"{source}: {where}: missing field 'capital_cost' (use 0 for none)")
-    for key in ("capital_cost", "annual_maintenance", "life_years", "repair_cost_per_impact", "rate_reduction",
-                "retention", "max_mass_kg", "capacity_kj", "height_m"):
+    for key in NUMBER_FIELDS:
         v = spec.get(key)
         if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or v < 0):
             raise MitigationError(f"{source}: {where}: {key} = {v!r} must be a number >= 0")
-    need = {"scaling": ("rate_reduction",), "fence": ("capacity_kj", "height_m"),
-            "attenuator": ("capacity_kj", "height_m"), "shed": ("capacity_kj",)}.get(kind, ())
-    for key in need:
-        if spec.get(key) is None:
-            raise MitigationError(f"{source}: {where}: a {kind} needs {key}")
+    vals = {k: (float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else v) for k, v in spec.items()}
+    for key in RANGE_FIELDS:
+        if key in spec:
+            vals[key] = _range(spec[key], f"{source}: {where}: {key}",
+                               share=key in ("retention_range", "rate_reduction_range"))
     for key in ("rate_reduction", "retention"):
         if spec.get(key) is not None and spec[key] > 1:
             raise MitigationError(f"{source}: {where}: {key} = {spec[key]!r} is a share and must lie in [0, 1]")
-    if kind == "ditch" and (spec.get("retention") is None) == (spec.get("max_mass_kg") is None):
-        raise MitigationError(f"{source}: {where}: a ditch needs exactly one of retention or max_mass_kg")
+    need = {"fence": ("capacity_kj", "height_m"), "attenuator": ("capacity_kj", "height_m"),
+            "shed": ("capacity_kj",)}.get(kind, ())
+    for key in need:
+        if spec.get(key) is None:
+            raise MitigationError(f"{source}: {where}: a {kind} needs {key}")
+    if kind == "ditch" and spec.get("retention") is None:
+        for key in ("x_m", "width_m", "depth_m"):
+            if spec.get(key) is None:
+                raise MitigationError(f"{source}: {where}: a ditch needs {key} (its geometry; its retention is "
+                                      "derived by simulation) or a typed retention (an assumption)")
+    if kind == "scaling" and spec.get("rate_reduction") is None and not any(
+            spec.get(k) is not None for k in ("min_mass_kg", "max_mass_kg", "zone_x_m")):
+        raise MitigationError(f"{source}: {where}: scaling needs the blocks it removes (min_mass_kg, max_mass_kg "
+                              "and/or zone_x_m) or a typed rate_reduction (an assumption)")
+    if spec.get("min_mass_kg") is not None and spec.get("max_mass_kg") is not None \
+            and spec["min_mass_kg"] > spec["max_mass_kg"]:
+        raise MitigationError(f"{source}: {where}: min_mass_kg = {spec['min_mass_kg']!r} is greater than "
+                              f"max_mass_kg = {spec['max_mass_kg']!r}")
+    if spec.get("retention_range") is not None and spec.get("retention") is None:
+        raise MitigationError(f"{source}: {where}: retention_range needs a typed retention (a derived retention "
+                              "carries its own Monte Carlo uncertainty)")
+    if spec.get("rate_reduction_range") is not None and spec.get("rate_reduction") is None:
+        raise MitigationError(f"{source}: {where}: rate_reduction_range needs a typed rate_reduction")
+    for fld in ("capital_cost", "annual_maintenance", "retention", "rate_reduction"):
+        rng = vals.get(f"{fld}_range")
+        if rng is not None and spec.get(fld) is not None and not rng[0] <= spec[fld] <= rng[1]:
+            raise MitigationError(f"{source}: {where}: {fld} = {spec[fld]!r} lies outside {fld}_range = "
+                                  f"{list(rng)}")
     if spec.get("life_years") == 0:
         raise MitigationError(f"{source}: {where}: life_years must be > 0")
-    return Option(**{k: (float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else v)
-                     for k, v in spec.items()})
+    if kind == "combined":
+        comps = spec.get("options")
+        if not isinstance(comps, list) or len(comps) < 2 or not all(isinstance(c, str) for c in comps):
+            raise MitigationError(f"{source}: {where}: a combined option needs options = [\"name\", \"name\", ...] "
+                                  "(two or more)")
+        extra = {k for k in spec if k not in ("name", "kind", "options", "description")}
+        if extra:
+            raise MitigationError(f"{source}: {where}: a combined option takes its costs and effects from its "
+                                  f"components; remove {sorted(extra)}")
+        vals["options"] = tuple(comps)
+    elif "options" in spec:
+        raise MitigationError(f"{source}: {where}: options = ... is only for kind = 'combined'")
+    if kind in BARRIER_KINDS and vals.get("repair_days") is None:
+        vals["repair_days"] = DEFAULT_REPAIR_DAYS[kind]
+    return Option(**vals)
+
+
+def _check_combinations(options, source):
+    names = [o.name for o in options]
+    for o in options:
+        if o.kind != "combined":
+            continue
+        for c in o.options:
+            if c not in names:
+                close = difflib.get_close_matches(c, names, n=1)
+                raise MitigationError(f"{source}: option {o.name!r}: options names unknown option {c!r}"
+                                      + (f"; did you mean {close[0]!r}?" if close else f"; options are {names}"))
+            comp = options[names.index(c)]
+            if comp.kind in ("combined", "none"):
+                raise MitigationError(f"{source}: option {o.name!r}: component {c!r} is of kind {comp.kind!r}; "
+                                      "combine measures only")
+        if len(set(o.options)) != len(o.options):
+            raise MitigationError(f"{source}: option {o.name!r}: options lists a component twice")
+        ditches = [options[names.index(c)] for c in o.options if options[names.index(c)].kind == "ditch"
+                   and options[names.index(c)].retention is None]
+        try:
+            from .measures import check_ditches_disjoint
+            check_ditches_disjoint([Ditch(d.x_m, d.width_m, d.depth_m, option=d.name) for d in ditches],
+                                   f"{source}: option {o.name!r}")
+        except MeasureError as exc:
+            raise MitigationError(str(exc)) from exc
+
+
+def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
+    allowed = {f.name for f in fields(Uncertainty)}
+    if not isinstance(data, dict):
+        raise MitigationError(f"{source}: [uncertainty] must be a table")
+    for key in data:
+        if key not in allowed:
+            close = difflib.get_close_matches(key, allowed, n=1)
+            raise MitigationError(f"{source}: unknown field uncertainty.{key}"
+                                  + (f"; did you mean {close[0]!r}?" if close else f"; allowed: {sorted(allowed)}"))
+    vals = {}
+    for key, v in data.items():
+        w = f"{source}: uncertainty.{key}"
+        if key in ("samples", "seed"):
+            if isinstance(v, bool) or not isinstance(v, int) or v < (1 if key == "samples" else 0):
+                raise MitigationError(f"{w} = {v!r} must be a whole number {'>= 1' if key == 'samples' else '>= 0'}")
+            vals[key] = v
+        elif key in ("sample_power_law", "sample_retention"):
+            if not isinstance(v, bool):
+                raise MitigationError(f"{w} = {v!r} must be true or false")
+            vals[key] = v
+        else:
+            lo, hi = _range(v, w)
+            if key in ("rate_factor", "m_max_kg", "vehicles_per_day", "value_of_statistical_life",
+                       "vulnerability_factor") and lo <= 0:
+                raise MitigationError(f"{w} = {v!r}: low must be > 0")
+            if key == "discount_rate" and hi >= 1:
+                raise MitigationError(f"{w} = {v!r}: rates lie below 1 (e.g. [0.01, 0.05])")
+            vals[key] = (lo, hi)
+    for f in fields(Uncertainty):
+        if f.name not in vals:
+            used.append(f"uncertainty.{f.name} = {getattr(Uncertainty(), f.name)!r} (default)")
+    return Uncertainty(**vals)
 
 
 def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
-    """Validate a mitigation table: returns (options, exposure, consequences, economics, defaults_used)."""
-    allowed = {"options", "traffic", "consequences", "economics"}
+    """Validate a mitigation table: returns (options, exposure, consequences, economics, defaults_used,
+    uncertainty, criteria)."""
+    allowed = {"options", "traffic", "consequences", "economics", "uncertainty", "criteria"}
     for key in data:
         if key not in allowed:
             close = difflib.get_close_matches(key, allowed, n=1)
             raise MitigationError(f"{source}: unknown table [{key}]" + (f"; did you mean [{close[0]}]?" if close
                                                                        else f"; allowed: {sorted(allowed)}"))
     used: list = []
-    exposure = _table(data.get("traffic", {}), Exposure, "traffic", source, used)
-    consequences = _table(data.get("consequences", {}), Consequences, "consequences", source, used)
-    economics = _table(data.get("economics", {}), Economics, "economics", source, used)
+    tr = dict(_table(data.get("traffic", {}), Exposure, "traffic", source, used,
+                     special=("occupants_distribution",)))
+    if "occupants_distribution" in tr:
+        try:
+            occupancy_distribution(tr.get("occupants_per_vehicle", 1.5), tr["occupants_distribution"])
+        except (ValueError, TypeError) as exc:
+            raise MitigationError(f"{source}: traffic.{exc}") from exc
+    if tr.get("occupants_per_vehicle", 1.5) < 1:
+        raise MitigationError(f"{source}: traffic.occupants_per_vehicle = {tr['occupants_per_vehicle']!r} must be "
+                              ">= 1 (the driver)")
+    exposure = Exposure(**tr)
+    cq = dict(_table(data.get("consequences", {}), Consequences, "consequences", source, used,
+                     special=("vulnerability_moving_vehicle", "vulnerability_striking_rock")))
+    for key in ("vulnerability_moving_vehicle", "vulnerability_striking_rock"):
+        if key in cq:
+            cq[key] = _vulnerability(cq[key], f"{source}: consequences.{key}")
+    consequences = Consequences(**cq)
+    for key in ("vulnerability_moving_vehicle", "vulnerability_striking_rock"):
+        if key not in cq:
+            used[-1:] = used[-1:]
+            used.append(f"consequences.{key}: ASSUMPTION size-dependent curve {getattr(consequences, key)} "
+                        "(mass_kg, probability of death)")
+    economics = Economics(**_table(data.get("economics", {}), Economics, "economics", source, used))
     if economics.discount_rate >= 1:
         raise MitigationError(f"{source}: economics.discount_rate = {economics.discount_rate!r} must be a rate "
                               "below 1 (e.g. 0.03)")
+    criteria = Criteria(**_table(data.get("criteria", {}), Criteria, "criteria", source, used,
+                                 special=("fn_diagram",)))
+    uncertainty = _uncertainty(data.get("uncertainty", {}), source, used)
     specs = data.get("options", [])
     if not isinstance(specs, list) or len(specs) < 2:
         raise MitigationError(f"{source}: [[options]] needs at least two options to compare")
@@ -448,11 +1276,23 @@ def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
     dup = {n for n in names if names.count(n) > 1}
     if dup:
         raise MitigationError(f"{source}: duplicate option name(s) {sorted(dup)}")
-    return options, exposure, consequences, economics, tuple(used)
+    _check_combinations(options, source)
+    return options, exposure, consequences, economics, tuple(used), uncertainty, criteria
 
 
-def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0) -> MitigationStudy:
-    """Read a mitigation TOML file and combine it with an energy hazard."""
+def study_inputs(data: dict, source: str) -> dict:
+    """Keyword arguments of :class:`MitigationStudy` from a parsed mitigation (or site) table."""
+    options, exposure, consequences, economics, used, uncertainty, criteria = parse_mitigation(data, source)
+    return {"options": options, "exposure": exposure, "consequences": consequences, "economics": economics,
+            "defaults_used": used, "uncertainty": uncertainty, "criteria": criteria}
+
+
+def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0, **kw) -> MitigationStudy:
+    """Read a mitigation TOML file (a site file works too) and combine it with an energy hazard.
+
+    Keyword arguments (``context``, ``reference``, ``small_fall_masses_kg``, ``small_falls_per_year``)
+    pass to :class:`MitigationStudy`.
+    """
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"mitigation file not found: {path}")
@@ -462,6 +1302,5 @@ def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0) -> M
         except tomllib.TOMLDecodeError as exc:
             raise MitigationError(f"{path}: not valid TOML: {exc}") from exc
     data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard")}   # a site file works too
-    options, exposure, consequences, economics, used = parse_mitigation(data, str(path))
-    return MitigationStudy(hazard=hazard, options=options, exposure=exposure, consequences=consequences,
-                           economics=economics, road_share=road_share, source=str(path), defaults_used=used)
+    return MitigationStudy(hazard=hazard, road_share=road_share, source=str(path), **study_inputs(data, str(path)),
+                           **kw)

@@ -8,7 +8,8 @@ from hypothesis import strategies as st
 
 import riskrf
 from riskrf.decision_tree import DecisionTree, TreeError
-from riskrf.road_risk import (fn_curve, fn_zone, individual_risk, probability_at_least_one_hit, pv_factor, pv_of_renewals,
+from riskrf.economics import pv_factor, pv_of_renewals
+from riskrf.road_risk import (fn_curve, fn_zone, individual_risk, probability_at_least_one_hit,
                          spatial_temporal_probability, stationary_rock_strike_probability, vehicle_occupant_fn)
 
 from .conftest import DATA
