@@ -68,7 +68,8 @@ from .road_risk import (
     stationary_rock_strike_probability,
     vulnerability_by_mass,
 )
-from .units import DAYS_PER_YEAR, SEL_PER_MEL
+from .barriers import damage_state_shares, out_of_service_share
+from .units import kinetic_energy_kj
 
 OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "combined")
 BARRIER_KINDS = ("fence", "attenuator", "shed")
@@ -378,13 +379,9 @@ class MitigationStudy:
                 v, h = self._samples_barrier()
             over = h > opt.height_m
             coverage = 1.0
-        # energies of every (block, mass bin) pair [kJ]: E = 1/2 m v^2
-        e = 0.5 * mid[None, :] * (v ** 2)[:, None] / 1000.0
-        working = ~over[:, None]
-        through = working & (e > cap)
-        passing = np.mean(over[:, None] | through, axis=0)
-        held_sel = np.mean(working & (e > cap * SEL_PER_MEL) & (e <= cap), axis=0)
-        destroy = np.mean(through, axis=0)
+        # energies of every (block, mass bin) pair [kJ]: E = 1/2 m v^2; damage states from riskrf.barriers
+        e = kinetic_energy_kj(mid[None, :], v[:, None])
+        passing, held_sel, destroy = damage_state_shares(e, over, cap)
         return _Stage("barrier", opt.name, passing=passing, held_sel=held_sel, destroy=destroy, coverage=coverage,
                       after_road=opt.kind == "shed",
                       param=f"retention:{opt.name}" if opt.retention is not None else None)
@@ -656,10 +653,9 @@ class MitigationStudy:
                     x = x * (1.0 - P[st.param])[:, None]
                 elif st.kind == "barrier":
                     c = self.option(st.option)
-                    tau = P[f"repair_days:{c.name}"] / DAYS_PER_YEAR
                     reach = x * st.coverage
                     lam_d = (reach * st.destroy[None, :]).sum(axis=1)
-                    down = lam_d * tau / (1.0 + lam_d * tau)
+                    down = out_of_service_share(lam_d, P[f"repair_days:{c.name}"])
                     held = (reach * st.held_sel[None, :]).sum(axis=1) * (1.0 - down)
                     destroyed = lam_d * (1.0 - down)
                     repairs += held
