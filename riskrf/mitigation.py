@@ -830,12 +830,18 @@ class MitigationStudy:
             why = (f"{rec['option']} is the cheapest option that meets the tolerability criteria (individual risk "
                    f"{rec['individual_risk']:.2g}/yr against {lim:.0e}/yr; societal risk {rec['fn_zone']} on the "
                    f"{self.criteria.fn_diagram} F-N diagram). Its expected total cost is {rec['expected_total_cost']:,.0f} "
-                   f"{cur} (5-95 %: {rec['cost_p05']:,.0f}-{rec['cost_p95']:,.0f}); it is the cheapest in "
-                   f"{rec['probability_best']:.0%} of the joint samples.")
+                   f"{cur} (5-95 %: {rec['cost_p05']:,.0f} to {rec['cost_p95']:,.0f} {cur}).")
             if rec["option"] != cheapest["option"]:
-                why += (f" {cheapest['option']} would cost less ({cheapest['expected_total_cost']:,.0f} {cur}) but "
-                        f"leaves the risk intolerable (individual risk {cheapest['individual_risk']:.2g}/yr, "
-                        f"societal {cheapest['fn_zone']}).")
+                intolerable = t[(t["expected_total_cost"] < rec["expected_total_cost"])]
+                why += (f" Cheaper options leave the risk intolerable: {cheapest['option']} costs least "
+                        f"({cheapest['expected_total_cost']:,.0f} {cur}, the cheapest in "
+                        f"{cheapest['probability_best']:.0%} of the joint samples) but leaves individual risk "
+                        f"{cheapest['individual_risk']:.2g}/yr and societal risk {cheapest['fn_zone']}"
+                        + (f"; so do {', '.join(intolerable['option'].iloc[1:])}" if len(intolerable) > 1 else "")
+                        + f". Meeting the criteria costs {rec['expected_total_cost'] - cheapest['expected_total_cost']:,.0f} "
+                        f"{cur} more in expectation.")
+            else:
+                why += f" It is also the cheapest overall, in {rec['probability_best']:.0%} of the joint samples."
             basis = "cheapest tolerable option"
         else:
             cand = t[t["kind"] != "none"].dropna(subset=["deaths_avoided_per_million"])

@@ -194,8 +194,10 @@ def render_report(a, figs: Path) -> str:
     money_cols = ("capital", "pv_renewals", "pv_maintenance", "pv_expected_loss", "expected_total_cost", "cost_p05",
                   "cost_p95", "expected_regret")
 
+    from .format import money
+
     def _money(v):
-        return "" if v is None or pd.isna(v) else f"{cur} {v:,.0f}"
+        return "" if v is None or pd.isna(v) else money(v, cur)
     costs = pd.DataFrame({
         "rank": ranking["rank"], "option": ranking["option"],
         "expected total cost": ranking["expected_total_cost"].map(_money),

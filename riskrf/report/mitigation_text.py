@@ -4,12 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-
-def money(v, currency: str = "") -> str:
-    """Money for a manager: whole units, thousands separators, currency."""
-    if v is None or (isinstance(v, float) and np.isnan(v)):
-        return ""
-    return f"{currency} {v:,.0f}".strip()
+from .format import money  # noqa: F401  (money for a manager: "1,250,000 CHF")
 
 
 def option_entries(study, ranking: pd.DataFrame) -> list:
