@@ -164,3 +164,45 @@ def runout_beyond(result, x_m: float) -> np.ndarray:
     """Boolean per block: did it travel past x [m] (stopped beyond it or left the profile)?"""
     ro = result.runout
     return (ro["x_stop_m"].to_numpy() > x_m) | (ro["reason"].astype(str).to_numpy() == "left profile")
+
+
+#: Material parameters that can be uncertain, as written in a scenario file -> field of simulation.scenario.Material.
+MATERIAL_FIELDS = {"normal_restitution.mean": "en_mean", "normal_restitution.std": "en_std",
+                   "tangential.mean": "et_mean", "tangential.friction_angle_deg": "friction_deg",
+                   "roughness_m": "roughness_m", "ground_friction_angle_deg": "ground_friction_deg"}
+
+
+def _material_path(scenario, path: str, where: str):
+    name, _, fld = path.partition(".")
+    names = [m.name for m in scenario.materials]
+    if name not in names:
+        raise MeasureError(f"{where}: {path!r}: no material {name!r} in scenario {scenario.name!r} "
+                           f"({', '.join(names)})")
+    if fld not in MATERIAL_FIELDS:
+        raise MeasureError(f"{where}: {path!r}: {fld!r} is not one of {', '.join(MATERIAL_FIELDS)}")
+    return names.index(name), MATERIAL_FIELDS[fld]
+
+
+def material_value(scenario, path: str, where: str = "materials"):
+    """Current value of a material parameter "material.field" (e.g. "talus.ground_friction_angle_deg")."""
+    i, attr = _material_path(scenario, path, where)
+    return float(getattr(scenario.materials[i], attr))
+
+
+def scenario_with_materials(scenario, values: dict, where: str = "materials"):
+    """A copy of ``scenario`` with material parameters {"material.field": value} replaced."""
+    mats = list(scenario.materials)
+    for path, v in values.items():
+        i, attr = _material_path(scenario, path, where)
+        mats[i] = replace(mats[i], **{attr: float(v)})
+    return replace(scenario, materials=tuple(mats))
+
+
+def effective_samples(result, collector: str):
+    """Effective speeds [m/s] (rotation included: v^2 + k (w r)^2) and bounce heights [m] of the first
+    crossings of ``collector``."""
+    df = result.collector(collector, first_only=True)
+    v = df["velocity_ms"].to_numpy()
+    k = df["inertia_factor"].to_numpy() if "inertia_factor" in df else np.full(len(df), 0.4)
+    spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
+    return np.sqrt(v ** 2 + k * spin ** 2), df["height_m"].to_numpy()

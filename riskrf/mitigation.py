@@ -52,8 +52,8 @@ import pandas as pd
 from .annual_hazard import EnergyHazard
 from .economics import pv_factor, renewal_factor
 from .impact_energy import mass_model
-from .measures import (Ditch, MeasureError, SimulationContext, road_crossings, runout_beyond, scenario_with_ditches,
-                       seeder_share)
+from .measures import (Ditch, MeasureError, SimulationContext, effective_samples, material_value, road_crossings,
+                       runout_beyond, scenario_with_ditches, scenario_with_materials, seeder_share)
 from .power_law import GutenbergRichterFit
 from .road_risk import (
     AGS2007_INDIVIDUAL_RISK,
@@ -136,7 +136,11 @@ class Uncertainty:
     ``rate_factor``: the rate of falls relative to the estimate (e.g. the share of the source above the
     road); ``vulnerability_factor`` multiplies both vulnerability curves.  The power law's b and rate are
     sampled from their sampling laws (b x Gamma(n)/n, rate x Gamma(n)/n) and derived retentions from their
-    Monte Carlo law (Beta) unless switched off.
+    Monte Carlo law (Beta) unless switched off.  ``materials`` gives ranges of slope material parameters
+    ("talus.ground_friction_angle_deg" = [20, 30]); the scenario is re-simulated for ``material_draws``
+    joint draws (and once at each end of each range, for the tornado) and every sample uses one of the
+    draws: reach probability, velocities and heights at the barrier, the road share and every derived
+    retention change with it.
     """
 
     samples: int = 1000
@@ -149,6 +153,8 @@ class Uncertainty:
     discount_rate: tuple | None = None
     sample_power_law: bool = True
     sample_retention: bool = True
+    materials: dict = field(default_factory=dict)    # {"material.field": (low, high)} of the slope scenario
+    material_draws: int = 8
 
 
 @dataclass(frozen=True)
@@ -259,7 +265,7 @@ class _Stage:
     destroy: np.ndarray | None = None
     coverage: float = 1.0
     after_road: bool = False
-    factor: float = 1.0                       # exposure
+    factor: object = 0.0                      # exposure: share per slope model; ditch: retention shift per model
 
 
 @dataclass(frozen=True)
@@ -342,51 +348,87 @@ class MitigationStudy:
         sf[-1] = 0.0
         return np.clip(-np.diff(sf), 0.0, None)[None, :]
 
-    # ---- option effects (derived once) --------------------------------------------------
-    def _samples_barrier(self):
+    # ---- slope models: the reference and the material-parameter variants ------------------
+    @cached_property
+    def _models(self) -> list:
+        """Slope models behind the derived effects: [0] the reference (the hazard's own simulation), then the
+        joint material draws, then one low and one high variant per uncertain material parameter (tornado)."""
+        models = [self._reference_model()]
+        u = self.uncertainty
+        if u.materials and self.context is not None:
+            ctx = self.context
+            rng = np.random.default_rng(np.random.SeedSequence([u.seed, 13]))
+            names = sorted(u.materials)
+            for _ in range(u.material_draws):
+                vals = {n: float(rng.uniform(*u.materials[n])) for n in names}
+                models.append(self._simulated_model(vals))
+            central = {n: material_value(ctx.scenario, n) for n in names}
+            for n in names:
+                for end, v in (("low", u.materials[n][0]), ("high", u.materials[n][1])):
+                    models.append(self._simulated_model({**central, n: v}, label=f"{n} {end}"))
+        return models
+
+    def _reference_model(self) -> dict:
         v = self.hazard.velocity
         v = np.asarray(getattr(v, "velocity_ms", v), dtype=float)
         h = self.hazard.heights_m
-        if h is None or len(h) != len(v):
-            raise MitigationError(f"{self.source}: fences and attenuators need simulated velocities paired with "
-                                  "bounce heights (build the hazard with EnergyHazard.from_simulation)")
-        return v, np.asarray(h, dtype=float)
+        ctx = self.context
+        m = {"label": "reference", "values": {}, "barrier": (v, None if h is None else np.asarray(h, dtype=float)),
+             "reach": float(self.hazard.reach_probability), "road_share": float(self.road_share),
+             "scenario": None if ctx is None else ctx.scenario, "result": self.reference}
+        if self.reference is not None and ctx is not None and \
+                ctx.road_collector in [c.name for c in self.reference.scenario.collectors]:
+            m["road"] = effective_samples(self.reference, ctx.road_collector)
+        return m
 
-    def _samples_at(self, collector: str):
-        """Effective velocities [m/s] and heights [m] at a collector of the reference simulation."""
-        from .annual_hazard import inertia_factors
-        df = self.reference.collector(collector, first_only=True)
-        v = df["velocity_ms"].to_numpy()
-        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
-        return np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2), df["height_m"].to_numpy()
+    def _simulated_model(self, values: dict, label: str = "draw") -> dict:
+        ctx = self.context
+        sc = scenario_with_materials(ctx.scenario, values, where=f"{self.source}: uncertainty.materials")
+        res = ctx.run(sc)
+        v, h = effective_samples(res, ctx.barrier_collector)
+        reach = max(v.size, 1) / res.n
+        road = effective_samples(res, ctx.road_collector)
+        share = min(road[0].size / v.size, 1.0) if v.size else 1.0
+        return {"label": label, "values": values, "barrier": (v, h), "road": road, "reach": reach,
+                "road_share": share, "scenario": sc, "result": res}
 
+    @cached_property
+    def _model_arrays(self):
+        """Reach probability at the barrier line and P(road | barrier) per slope model."""
+        ms = self._models
+        return (np.array([m["reach"] for m in ms]), np.array([m["road_share"] for m in ms]))
+
+    def material_models(self) -> pd.DataFrame:
+        """The slope models used: material values, reach probability and road share of each."""
+        return pd.DataFrame([{"model": i, "label": m["label"], **m["values"], "reach_probability": m["reach"],
+                              "road_share": m["road_share"]} for i, m in enumerate(self._models)])
+
+    # ---- option effects (derived once per slope model) --------------------------------------
     def _barrier_stage(self, opt: Option) -> _Stage:
         mid = self._grid[1]
         cap = opt.capacity_kj
-        if opt.kind == "shed":
-            if self.reference is not None and self.context is not None and \
-                    self.context.road_collector in [c.name for c in self.reference.scenario.collectors]:
-                v, h = self._samples_at(self.context.road_collector)
+        out = []
+        for m in self._models:
+            if opt.kind == "shed":
+                v, h = m.get("road", m["barrier"])
+                over = np.zeros(v.size, dtype=bool)
             else:
-                v, h = self._samples_barrier()
-            over = np.zeros(v.size, dtype=bool)
-            coverage = min(opt.covered_length_m / self.exposure.exposed_length_m, 1.0) if opt.covered_length_m \
-                else 1.0
-        else:
-            if opt.x_m is not None:
-                v, h = self._fence_samples_at(opt)
-            else:
-                v, h = self._samples_barrier()
-            over = h > opt.height_m
-            coverage = 1.0
-        # energies of every (block, mass bin) pair [kJ]: E = 1/2 m v^2; damage states from riskrf.barriers
-        e = kinetic_energy_kj(mid[None, :], v[:, None])
-        passing, held_sel, destroy = damage_state_shares(e, over, cap)
+                v, h = self._fence_samples_at(opt, m) if opt.x_m is not None else m["barrier"]
+                if h is None or len(h) != len(v):
+                    raise MitigationError(f"{self.source}: option {opt.name!r}: fences and attenuators need simulated "
+                                          "velocities paired with bounce heights (a scenario, or a velocity file with "
+                                          "height_m)")
+                over = h > opt.height_m
+            # energies of every (block, mass bin) pair [kJ]: E = 1/2 m v^2; damage states from riskrf.barriers
+            out.append(damage_state_shares(kinetic_energy_kj(mid[None, :], v[:, None]), over, cap))
+        passing, held_sel, destroy = (np.array([o[i] for o in out]) for i in range(3))
+        coverage = min(opt.covered_length_m / self.exposure.exposed_length_m, 1.0) \
+            if opt.kind == "shed" and opt.covered_length_m else 1.0
         return _Stage("barrier", opt.name, passing=passing, held_sel=held_sel, destroy=destroy, coverage=coverage,
                       after_road=opt.kind == "shed",
                       param=f"retention:{opt.name}" if opt.retention is not None else None)
 
-    def _fence_samples_at(self, opt: Option):
+    def _fence_samples_at(self, opt: Option, model: dict):
         import simulation.scenario as sc_mod
         ctx = self._need_context(opt, "x_m")
         prof = ctx.scenario.profile
@@ -394,12 +436,9 @@ class MitigationStudy:
             raise MitigationError(f"{self.source}: option {opt.name!r}: x_m = {opt.x_m:g} m is outside the profile "
                                   f"({prof.x[0]:g}, {prof.x[-1]:g}) m")
         col = sc_mod.Collector(f"{opt.name} line", float(opt.x_m))
-        res = ctx.run(replace(ctx.scenario, collectors=ctx.scenario.collectors + (col,)))
-        from .annual_hazard import inertia_factors
-        df = res.collector(col.name, first_only=True)
-        v = df["velocity_ms"].to_numpy()
-        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
-        return np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2), df["height_m"].to_numpy()
+        sc = model["scenario"]
+        res = ctx.run(replace(sc, collectors=sc.collectors + (col,)))
+        return effective_samples(res, col.name)
 
     def _need_context(self, opt, fld):
         if self.context is None:
@@ -412,12 +451,13 @@ class MitigationStudy:
         ctx = self.context
         return road_crossings(ctx.run(ctx.scenario), ctx.road_collector)
 
-    def _ditch_retention(self, ditches, label: str):
-        """Share of the falls that would reach the road that the ditches stop, and its Monte Carlo Beta law."""
+    def _ditch_retention(self, ditches, model: dict, index: int):
+        """Share of the falls that would reach the road that the ditches stop (common random numbers), and its
+        Monte Carlo Beta law."""
         ctx = self.context
-        base = self._reference_road_blocks
+        base = self._reference_road_blocks if index == 0 else road_crossings(model["result"], ctx.road_collector)
         try:
-            sc = scenario_with_ditches(ctx.scenario, ditches, where=self.source, road_collector=ctx.road_collector)
+            sc = scenario_with_ditches(model["scenario"], ditches, where=self.source, road_collector=ctx.road_collector)
         except (MeasureError, ValueError) as exc:
             raise MitigationError(str(exc)) from exc
         kept = road_crossings(ctx.run(sc), ctx.road_collector)
@@ -431,12 +471,13 @@ class MitigationStudy:
 
     @cached_property
     def _derived(self) -> dict:
-        """Derived ditch retentions: key -> (retention, Beta law parameters); filled by ``_effects``."""
+        """Derived ditch retentions: key -> (retention of the reference model, Beta law, retention per model);
+        filled by ``_effects``."""
         return {}
 
     @cached_property
     def _effects(self) -> dict:
-        """Per option: the chain of stages in series, the derived retention laws, component options."""
+        """Per option: the chain of stages in series and its component options."""
         out = {}
         for opt in self.options:
             comps = [self.option(n) for n in opt.options] if opt.kind == "combined" else [opt]
@@ -472,8 +513,10 @@ class MitigationStudy:
                         1.0 if c.outer_slope_hv is None else c.outer_slope_hv, c.material, c.name) for c in geo]
             key = "+".join(c.name for c in geo)
             if key not in self._derived:
-                self._derived[key] = self._ditch_retention(ds, key)
-            stages.append(_Stage("ditch", key, param=f"retention:{key}"))
+                per_model = [self._ditch_retention(ds, m, i) for i, m in enumerate(self._models)]
+                self._derived[key] = (per_model[0][0], per_model[0][1], np.array([r for r, _ in per_model]))
+            stages.append(_Stage("ditch", key, param=f"retention:{key}",
+                                 factor=self._derived[key][2] - self._derived[key][0]))
         for c in comps:
             if c.kind in ("fence", "attenuator"):
                 stages.append(self._barrier_stage(c))
@@ -483,18 +526,21 @@ class MitigationStudy:
         for c in comps:
             if c.kind == "realignment":
                 if c.road_x_m is None:
-                    factor = 0.0
+                    factor = np.zeros(len(self._models))
                 else:
                     ctx = self._need_context(c, "road_x_m")
                     prof = ctx.scenario.profile
                     if not prof.x[0] < c.road_x_m < prof.x[-1]:
                         raise MitigationError(f"{self.source}: option {c.name!r}: road_x_m = {c.road_x_m:g} m is "
                                               f"outside the profile ({prof.x[0]:g}, {prof.x[-1]:g}) m")
-                    ref = self.reference if self.reference is not None else ctx.run(ctx.scenario)
-                    road_x = ref.scenario.collectors[ref.scenario.collector_index(ctx.road_collector)].x
-                    now = runout_beyond(ref, road_x).sum()
-                    factor = float(runout_beyond(ref, c.road_x_m).sum() / now) if now else 0.0
-                stages.append(_Stage("exposure", c.name, factor=min(factor, 1.0)))
+                    factor = []
+                    for m in self._models:
+                        ref = m["result"] if m["result"] is not None else ctx.run(ctx.scenario)
+                        road_x = ref.scenario.collectors[ref.scenario.collector_index(ctx.road_collector)].x
+                        now = runout_beyond(ref, road_x).sum()
+                        factor.append(min(float(runout_beyond(ref, c.road_x_m).sum() / now), 1.0) if now else 0.0)
+                    factor = np.array(factor)
+                stages.append(_Stage("exposure", c.name, factor=factor))
         return stages
 
     # ---- parameters -----------------------------------------------------------------------
@@ -521,8 +567,9 @@ class MitigationStudy:
                 p[f"retention:{o.name}"] = o.retention
             if o.kind in BARRIER_KINDS:
                 p[f"repair_days:{o.name}"] = self._repair_days(o)
-        for key, (ret, _) in self._derived.items():
+        for key, (ret, _, _) in self._derived.items():
             p[f"retention:{key}"] = ret
+        p["material_draw"] = 0.0           # index of the slope model (0: the reference simulation)
         return p
 
     def _repair_days(self, o):
@@ -558,8 +605,11 @@ class MitigationStudy:
                     out[f"{fld}:{o.name}"] = (*rng, "uniform, stated" + (" (typed effectiveness: assumption)"
                                                                          if fld in ("retention", "rate_reduction")
                                                                          else ""))
+        if u.materials and self.context is not None:
+            for path, (lo, hi) in sorted(u.materials.items()):
+                out[f"material:{path}"] = (lo, hi, f"uniform, stated; {u.material_draws} joint re-simulations")
         if u.sample_retention:
-            for key, (_, (a, b)) in self._derived.items():
+            for key, (_, (a, b), _) in self._derived.items():
                 d = stats.beta(a, b)
                 out[f"retention:{key}"] = (float(d.ppf(0.05)), float(d.ppf(0.95)),
                                            "Beta (Monte Carlo error of the derived retention)")
@@ -574,19 +624,24 @@ class MitigationStudy:
         c = self.central_parameters()
         ranges = self.parameter_ranges()
         out = {k: np.full(n, float(v)) for k, v in c.items()}
+        n_draws = self.uncertainty.material_draws if any(k.startswith("material:") for k in ranges) else 0
         for name in sorted(ranges):            # fixed order: same seed, same samples
             lo, hi, how = ranges[name]
+            if name.startswith("material:"):
+                continue
             if name in ("b", "rate_sampling_factor"):
                 g = rng.gamma(self.hazard.mass.n_tail, size=n) / self.hazard.mass.n_tail
                 out[name] = c[name] * g if name == "b" else g
             elif name.startswith("retention:") and "Beta" in how:
                 key = name.split(":", 1)[1]
                 a, b = self._derived[key][1]
-                out[name] = stats.beta(a, b).ppf(rng.uniform(size=n))
+                out[name] = stats.beta(a, b).ppf(rng.uniform(size=n))   # shifted per slope model in the engine
             elif "log-uniform" in how:
                 out[name] = np.exp(rng.uniform(np.log(lo), np.log(hi), n))
             else:
                 out[name] = rng.uniform(lo, hi, n)
+        if n_draws:
+            out["material_draw"] = rng.integers(1, n_draws + 1, n).astype(float)
         return out
 
     # ---- the loss engine ---------------------------------------------------------------------
@@ -596,10 +651,13 @@ class MitigationStudy:
         edges, mid, small_pmf = self._grid
         S = len(next(iter(P.values())))
         hz, ex, co, ec = self.hazard, self.exposure, self.consequences, self.economics
+        d = P["material_draw"].astype(int) if "material_draw" in P else np.zeros(S, dtype=int)
+        reach_m, share_m = self._model_arrays
+        road_share = share_m[d]                                                     # (S,)
         rate = hz.rate_per_year * P["rate_factor"] * P.get("rate_sampling_factor", 1.0)
         pmf = self._mass_pmf(P.get("b"), P.get("m_max_kg")) if "b" in P else self._mass_pmf()
         lam = rate[:, None] * pmf + (self.small_falls_per_year * P["rate_factor"])[:, None] * small_pmf[None, :]
-        arrivals = lam * hz.reach_probability                                      # (S, J) at the barrier line
+        arrivals = lam * reach_m[d][:, None]                                       # (S, J) at the barrier line
         p_st = np.broadcast_to(spatial_temporal_probability(P["vehicles_per_day"], ex.vehicle_length_m,
                                                             ex.speed_kmh), (S,))
         p_strike = ex.share_stopping_on_road * np.broadcast_to(stationary_rock_strike_probability(
@@ -621,7 +679,7 @@ class MitigationStudy:
                                               "total", "road", "hits", "strikes", "deaths", "eal", "ir",
                                               "repairs", "replacements", "retention", "effectiveness")}
         road_bins = np.zeros((S, K, mid.size)) if per_bin else None
-        base_road = arrivals.sum(axis=1) * self.road_share
+        base_road = arrivals.sum(axis=1) * road_share
         for k, opt in enumerate(self.options):
             stages, comps = effects[opt.name]
             x = arrivals.copy()
@@ -642,33 +700,34 @@ class MitigationStudy:
             on_road = False
             for st in stages:
                 if st.after_road and not on_road:
-                    x = x * self.road_share
+                    x = x * road_share[:, None]
                     on_road = True
                 if st.kind == "release":
                     x = x * (st.multiplier[None, :] if st.multiplier is not None else (1.0 - P[st.param])[:, None])
                     continue
                 if before_structures is None:
-                    before_structures = x.sum(axis=1) * (1.0 if on_road else self.road_share)
+                    before_structures = x.sum(axis=1) * (1.0 if on_road else road_share)
                 if st.kind == "ditch":
-                    x = x * (1.0 - P[st.param])[:, None]
+                    ret = P[st.param] + (st.factor[d] if isinstance(st.factor, np.ndarray) else 0.0)
+                    x = x * (1.0 - np.clip(ret, 0.0, 1.0))[:, None]
                 elif st.kind == "barrier":
                     c = self.option(st.option)
                     reach = x * st.coverage
-                    lam_d = (reach * st.destroy[None, :]).sum(axis=1)
+                    lam_d = (reach * st.destroy[d]).sum(axis=1)
                     down = out_of_service_share(lam_d, P[f"repair_days:{c.name}"])
-                    held = (reach * st.held_sel[None, :]).sum(axis=1) * (1.0 - down)
+                    held = (reach * st.held_sel[d]).sum(axis=1) * (1.0 - down)
                     destroyed = lam_d * (1.0 - down)
                     repairs += held
                     replacements += destroyed
                     repair_money += held * c.repair_cost_per_impact + destroyed * (
                         P[f"capital_cost:{c.name}"] if c.replacement_cost is None else c.replacement_cost)
-                    working = st.passing[None, :] if st.param is None else (1.0 - P[st.param])[:, None]
+                    working = st.passing[d] if st.param is None else (1.0 - P[st.param])[:, None]
                     passing = down[:, None] + (1.0 - down[:, None]) * working
                     x = x * (1.0 - st.coverage) + reach * passing
                 elif st.kind == "exposure":
-                    x = x * st.factor
+                    x = x * st.factor[d][:, None]
             if not on_road:
-                x = x * self.road_share
+                x = x * road_share[:, None]
             road = x.sum(axis=1)
             if before_structures is not None and any(s.kind in ("ditch", "barrier") for s in stages):
                 with np.errstate(invalid="ignore", divide="ignore"):
@@ -880,18 +939,32 @@ class MitigationStudy:
 
     def tornado(self) -> pd.DataFrame:
         """Lowest expected total cost (central values) as each input moves over its stated range (or x0.5/x2),
-        with the best option at each end; sorted by swing."""
+        with the best option at each end, whether the best or the whole order changes; inputs that change the
+        best first, then those that change the order, each by swing.  Material parameters are re-simulated at
+        both ends of their ranges."""
         c = self.central_parameters()
         base_r = self._central_result
         base = float(base_r["total"][0].min())
         names = base_r["names"]
         rows = []
-        for p, v in c.items():
-            lo, hi, how = self._tornado_range(p, v)
-            if lo == hi:
-                continue                     # e.g. a zero cost: nothing to vary
-            t = self._central({p: [lo, hi]})["total"]
+        items = [(p, v) for p, v in c.items() if p != "material_draw"]
+        labels = [m["label"] for m in self._models]
+        for name, (lo, hi, how) in self.parameter_ranges().items():
+            if name.startswith("material:"):
+                path = name.split(":", 1)[1]
+                items.append((name, (labels.index(f"{path} low"), labels.index(f"{path} high"), lo, hi, how)))
+        for p, v in items:
+            if p.startswith("material:"):
+                i_lo, i_hi, lo, hi, how = v
+                t = self._central({"material_draw": [i_lo, i_hi]})["total"]
+            else:
+                lo, hi, how = self._tornado_range(p, v)
+                if lo == hi:
+                    continue                     # e.g. a zero cost: nothing to vary
+                t = self._central({p: [lo, hi]})["total"]
+            order = list(np.argsort(base_r["total"][0], kind="stable"))
             rows.append({"parameter": p, "low": lo, "high": hi, "range": how,
+                         "changes_order": any(list(np.argsort(row, kind="stable")) != order for row in t),
                          "cost_at_low": t[0].min(), "cost_at_high": t[1].min(),
                          "best_at_low": names[int(np.argmin(t[0]))], "best_at_high": names[int(np.argmin(t[1]))],
                          "base": base})
@@ -899,7 +972,8 @@ class MitigationStudy:
         best = names[int(np.argmin(base_r["total"][0]))]
         df["changes_best"] = (df["best_at_low"] != best) | (df["best_at_high"] != best)
         df["swing"] = (df["cost_at_high"] - df["cost_at_low"]).abs()
-        return df.sort_values(["changes_best", "swing"], ascending=[False, False]).reset_index(drop=True)
+        return df.sort_values(["changes_best", "changes_order", "swing"], ascending=[False, False, False]
+                              ).reset_index(drop=True)
 
     def _bracket(self, name, value):
         if name.startswith(("retention:", "rate_reduction:")):
@@ -953,6 +1027,8 @@ class MitigationStudy:
         ranges = self.parameter_ranges()
         rows = []
         for p, v in self.central_parameters().items():
+            if p == "material_draw":
+                continue                 # material parameters: re-simulated at the ends of their ranges (tornado)
             be = self.break_even(p, option_a=a, option_b=b)
             lo, hi = (ranges[p][0], ranges[p][1]) if p in ranges else (np.nan, np.nan)
             inside = bool(be is not None and p in ranges and lo <= be[1] <= hi)
@@ -1209,10 +1285,22 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
     vals = {}
     for key, v in data.items():
         w = f"{source}: uncertainty.{key}"
-        if key in ("samples", "seed"):
-            if isinstance(v, bool) or not isinstance(v, int) or v < (1 if key == "samples" else 0):
-                raise MitigationError(f"{w} = {v!r} must be a whole number {'>= 1' if key == 'samples' else '>= 0'}")
+        if key in ("samples", "seed", "material_draws"):
+            if isinstance(v, bool) or not isinstance(v, int) or v < (0 if key == "seed" else 1):
+                raise MitigationError(f"{w} = {v!r} must be a whole number {'>= 0' if key == 'seed' else '>= 1'}")
             vals[key] = v
+        elif key == "materials":
+            if not isinstance(v, dict):
+                raise MitigationError(f"{w} must be a table of \"material.parameter\" = [low, high]")
+            mats = {}
+            for path, rng in v.items():
+                name, _, fld = str(path).partition(".")
+                from .measures import MATERIAL_FIELDS
+                if not name or fld not in MATERIAL_FIELDS:
+                    raise MitigationError(f"{w}: {path!r} must be \"material.parameter\" with parameter one of "
+                                          f"{', '.join(MATERIAL_FIELDS)}")
+                mats[str(path)] = _range(rng, f"{w}.{path}")
+            vals[key] = mats
         elif key in ("sample_power_law", "sample_retention"):
             if not isinstance(v, bool):
                 raise MitigationError(f"{w} = {v!r} must be true or false")

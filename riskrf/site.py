@@ -134,17 +134,22 @@ def load_site(path) -> Site:
         raise SiteError(str(exc)) from exc
     used += list(mitigation.pop("defaults_used"))
     if hz["scenario"] is not None:
-        _check_option_geometry(mitigation["options"], scenario, hz, path)
+        _check_option_geometry(mitigation["options"], scenario, hz, path, mitigation["uncertainty"])
     return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
                 description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
                 mitigation=mitigation, defaults_used=tuple(used))
 
 
-def _check_option_geometry(options, scenario, hz, path):
+def _check_option_geometry(options, scenario, hz, path, uncertainty=None):
     """Option geometry against the scenario, before anything is computed: positions inside the profile,
-    ditches that fit, scaling zones inside the release zone."""
-    from .measures import Ditch, MeasureError, ditch_profile, seeder_share
+    ditches that fit, scaling zones inside the release zone, uncertain material parameters that exist."""
+    from .measures import Ditch, MeasureError, ditch_profile, material_value, seeder_share
     prof = scenario.profile
+    for p in (uncertainty.materials if uncertainty is not None else {}):
+        try:
+            material_value(scenario, p, f"{path}: uncertainty.materials")
+        except MeasureError as exc:
+            raise SiteError(str(exc)) from exc
     for o in options:
         where = f"{path}: option {o.name!r}"
         for fld in ("x_m", "road_x_m"):

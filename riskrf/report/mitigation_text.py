@@ -85,13 +85,16 @@ def study_report(study) -> dict:
     for r in tornado.itertuples():
         lines.append(f"  {r.parameter:<38} {r.low:>12,.4g} .. {r.high:<12,.4g} cost {r.cost_at_low:>14,.0f} .. "
                      f"{r.cost_at_high:>14,.0f}   best: {r.best_at_low} / {r.best_at_high}"
-                     + ("  CHANGES THE BEST" if r.changes_best else ""))
+                     + ("  CHANGES THE BEST" if r.changes_best else "  changes the order" if r.changes_order
+                        else ""))
     if study.defaults_used:
         lines += ["", "Defaults used: " + "; ".join(study.defaults_used)]
+    not_sampled = ["fragmentation (no fragmentation model)"]
+    if not any(k.startswith("material:") for k in ranges):
+        not_sampled.insert(0, "slope material parameters (no [uncertainty.materials] ranges given)")
     uncertainty = {"samples": u.samples, "seed": u.seed,
                    "inputs": {k: {"low": lo, "high": hi, "law": how} for k, (lo, hi, how) in ranges.items()},
-                   "not_sampled": ["simulation material parameters (no calibration in the site file)",
-                                   "fragmentation"]}
+                   "not_sampled": not_sampled}
     return {"ranking": ranking, "tornado": tornado, "break_even": be, "value_of_information": voi,
             "recommendation": rec, "options": option_entries(study, ranking), "uncertainty": uncertainty,
             "options_table": study.options_table(), "text": "\n".join(lines)}
