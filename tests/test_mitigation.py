@@ -327,3 +327,34 @@ def test_parse_option_ranges_and_overrides():
     with pytest.raises(MitigationError, match="option 'd': retention = 0.9 lies outside retention_range"):
         parse_option({"name": "d", "kind": "ditch", "capital_cost": 5, "retention": 0.9,
                       "retention_range": [0.2, 0.6]}, 0, "f.toml")
+
+
+def test_material_parameters_are_resimulated_jointly_and_at_the_ends_of_their_ranges():
+    opts = (Option("nothing", "none"), Option("ditch", "ditch", 1e5, x_m=31.0, width_m=8.0, depth_m=1.0,
+                                               material="gravel"),
+            Option("fence", "fence", 5e5, capacity_kj=2000, height_m=3, repair_days=30))
+    sc = simulation.scenario_from_dict(TOE)
+    s = MitigationStudy(hazard=HAZ, options=opts, consequences=CONSTANT_V,
+                        uncertainty=Uncertainty(samples=100, material_draws=3,
+                                                materials={"gravel.ground_friction_angle_deg": (20.0, 45.0)}),
+                        context=SimulationContext(sc, n_blocks=1000, seed=3))
+    models = s.material_models()
+    assert len(models) == 1 + 3 + 2
+    assert models["label"].tolist()[-2:] == ["gravel.ground_friction_angle_deg low",
+                                             "gravel.ground_friction_angle_deg high"]
+    s.central_parameters()
+    per_model = s._derived["ditch"][2]
+    assert per_model.shape == (6,) and np.ptp(per_model) > 0        # the derived retention changes with the floor
+    P = s.sample_parameters()
+    assert set(np.unique(P["material_draw"])) <= {1.0, 2.0, 3.0}
+    tornado = s.tornado()
+    assert "material:gravel.ground_friction_angle_deg" in set(tornado["parameter"])
+    assert s.ranking()["probability_best"].sum() == pytest.approx(1.0)
+
+
+def test_bad_material_uncertainty_names_the_field():
+    with pytest.raises(MitigationError, match=r"uncertainty.materials: 'talus.friction' must be"):
+        parse_mitigation({"uncertainty": {"materials": {"talus.friction": [1, 2]}}, "options": []}, "s.toml")
+    with pytest.raises(MitigationError, match=r"uncertainty.materials.talus.roughness_m = \[0.3, 0.1\]: low 0.3 is "
+                                              "greater than high 0.1"):
+        parse_mitigation({"uncertainty": {"materials": {"talus.roughness_m": [0.3, 0.1]}}, "options": []}, "s.toml")
