@@ -358,3 +358,15 @@ def test_bad_material_uncertainty_names_the_field():
     with pytest.raises(MitigationError, match=r"uncertainty.materials.talus.roughness_m = \[0.3, 0.1\]: low 0.3 is "
                                               "greater than high 0.1"):
         parse_mitigation({"uncertainty": {"materials": {"talus.roughness_m": [0.3, 0.1]}}, "options": []}, "s.toml")
+
+
+def test_fence_at_another_position_and_realignment_are_derived_from_simulation():
+    opts = (Option("nothing", "none"), Option("fence", "fence", 5e5, capacity_kj=2000, height_m=3.0, x_m=45.0,
+                                               repair_days=30),
+            Option("move", "realignment", 1e6, road_x_m=75.0))
+    s = _toe_study(opts)
+    res = s.context.run(s.context.scenario)
+    from riskrf.measures import runout_beyond
+    expected = runout_beyond(res, 75.0).sum() / runout_beyond(res, 60.0).sum()
+    assert s.evaluate("move").effectiveness == pytest.approx(1 - expected, abs=1e-12)
+    assert 0 < s.evaluate("fence").retention <= 1
