@@ -888,8 +888,9 @@ class MitigationStudy:
             rec = ok.iloc[0]
             why = (f"{rec['option']} is the cheapest option that meets the tolerability criteria (individual risk "
                    f"{rec['individual_risk']:.2g}/yr against {lim:.0e}/yr; societal risk {rec['fn_zone']} on the "
-                   f"{self.criteria.fn_diagram} F-N diagram). Its expected total cost is {rec['expected_total_cost']:,.0f} "
-                   f"{cur} (5-95 %: {rec['cost_p05']:,.0f} to {rec['cost_p95']:,.0f} {cur}).")
+                   f"{self.criteria.fn_diagram} F-N diagram). Its expected total cost is "
+                   f"{rec['expected_total_cost']:,.0f} {cur} (5-95 %: {rec['cost_p05']:,.0f} to "
+                   f"{rec['cost_p95']:,.0f} {cur}).")
             if rec["option"] != cheapest["option"]:
                 intolerable = t[(t["expected_total_cost"] < rec["expected_total_cost"])]
                 why += (f" Cheaper options leave the risk intolerable: {cheapest['option']} costs least "
@@ -897,8 +898,9 @@ class MitigationStudy:
                         f"{cheapest['probability_best']:.0%} of the joint samples) but leaves individual risk "
                         f"{cheapest['individual_risk']:.2g}/yr and societal risk {cheapest['fn_zone']}"
                         + (f"; so do {', '.join(intolerable['option'].iloc[1:])}" if len(intolerable) > 1 else "")
-                        + f". Meeting the criteria costs {rec['expected_total_cost'] - cheapest['expected_total_cost']:,.0f} "
-                        f"{cur} more in expectation.")
+                        + f". Meeting the criteria costs "
+                        f"{rec['expected_total_cost'] - cheapest['expected_total_cost']:,.0f} {cur} more in "
+                        "expectation.")
             else:
                 why += f" It is also the cheapest overall, in {rec['probability_best']:.0%} of the joint samples."
             basis = "cheapest tolerable option"

@@ -191,8 +191,6 @@ def render_report(a, figs: Path) -> str:
     be = a.decision["break_even"]
     rec = a.decision["recommendation"]
     unc = a.decision["uncertainty"]
-    money_cols = ("capital", "pv_renewals", "pv_maintenance", "pv_expected_loss", "expected_total_cost", "cost_p05",
-                  "cost_p95", "expected_regret")
 
     from .format import money
 

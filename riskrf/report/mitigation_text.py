@@ -25,7 +25,8 @@ def option_entries(study, ranking: pd.DataFrame) -> list:
              "deaths_per_year": float(r["deaths_per_year"]), "fn_zone": r["fn_zone"],
              "meets_criteria": bool(r["meets_criteria"]), "effectiveness": float(r["effectiveness"]),
              "effect_basis": r["effect_basis"],
-             "repairs_per_year": float(r["repairs_per_year"]), "replacements_per_year": float(r["replacements_per_year"])}
+             "repairs_per_year": float(r["repairs_per_year"]),
+             "replacements_per_year": float(r["replacements_per_year"])}
         if r["retention"] is not None and not pd.isna(r["retention"]):
             e["retention"] = float(r["retention"])
         out.append(e)
@@ -64,7 +65,6 @@ def study_report(study) -> dict:
     lines += ["", f"RECOMMENDATION: {rec['option']} ({rec['basis']}).", "  " + rec["reason"], "",
               "Uncertain inputs sampled jointly: " + "; ".join(f"{k} {lo:.4g}-{hi:.4g} ({how})"
                                                                 for k, (lo, hi, how) in ranges.items())]
-    a, b = ranking["option"].iloc[0], ranking["option"].iloc[1]
     r0 = study._central_result
     order = np.argsort(r0["total"][0], kind="stable")
     ca, cb = r0["names"][order[0]], r0["names"][order[1]]
