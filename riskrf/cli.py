@@ -239,7 +239,8 @@ def cmd_assess(args) -> int:
         print(f"{len(assessment.warnings)} warning(s), also listed in the report:")
         for w in assessment.warnings:
             print(f"  - {w}")
-    print(f"Best option: {s['best_option']} (then {s['second_option']}).")
+    print(f"Lowest expected total cost: {s['best_option']} (then {s['second_option']}).")
+    print(f"Recommendation: {s['recommendation']['option']} ({s['recommendation']['basis']}).")
     print(f"Report: {(out / 'report.html').resolve()}")
     return 0
 
