@@ -257,6 +257,71 @@ def cmd_demo(args) -> int:
         return cmd_assess(args)
 
 
+def cmd_calibrate(args) -> int:
+    import simulation
+    from simulation.calibration import read_observed
+
+    from .outputs import atomic_output_dir, write_json
+
+    parameters = {}
+    for item in args.parameter or []:
+        name, sep, rng = item.partition("=")
+        low, sep2, high = rng.partition(":")
+        if not (sep and sep2 and name):
+            raise ValueError(f"--parameter {item!r}: use NAME=LOW:HIGH, e.g. "
+                             "materials.talus.ground_friction_angle_deg=15:40")
+        try:
+            parameters[name] = (float(low), float(high))
+        except ValueError:
+            raise ValueError(f"--parameter {item!r}: LOW and HIGH must be numbers; got {low!r} and {high!r}") from None
+    if not parameters:
+        raise ValueError("give at least one --parameter NAME=LOW:HIGH")
+    select = {}
+    for item in args.select or []:
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise ValueError(f"--select {item!r}: use COLUMN=VALUE, e.g. profile=P1")
+        select[key] = value
+    observed = read_observed(args.observed, column=args.column, select=select)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        cal = simulation.calibrate(args.scenario, observed, parameters, n=args.n, seed=args.seed,
+                                   distance=args.distance, collector=args.collector, maxiter=args.maxiter,
+                                   n_bootstrap=args.bootstrap)
+    for w in caught:
+        if str(w.message) not in cal.notes:
+            print(f"warning: {w.message}")
+    print(f"Calibrated {args.scenario} to {observed.attrs['source']}"
+          + (f" rows {select}" if select else "") + f": {cal.observed.size} observed stops, {args.n:,} simulated "
+          f"blocks per evaluation (seed {args.seed}), {len(cal.evaluations)} evaluations, distance {cal.distance_name}")
+    print(cal.summary().to_string(float_format=lambda v: f"{v:.4g}"))
+    print()
+    print(cal.comparison().to_string(float_format=lambda v: f"{v:.4g}"))
+    for note in cal.notes:
+        print(f"note: {note}")
+    out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-calibration")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    with atomic_output_dir(out) as tmp:
+        (tmp / f"{Path(args.scenario).stem}_calibrated.toml").write_text(cal.to_toml())
+        cal.summary().to_csv(tmp / "parameters.csv")
+        cal.comparison().to_csv(tmp / "comparison.csv")
+        cal.bootstrap.to_csv(tmp / "bootstrap.csv", index=False)
+        cal.evaluations.to_csv(tmp / "evaluations.csv", index=False)
+        write_json({"parameters": cal.parameters, "bounds": cal.bounds,
+                                              "n": cal.n, "seed": cal.seed, "distance": cal.distance_name,
+                                              "objective": cal.distance, "objective_initial": cal.distance_initial,
+                                              "observed": cal.observed_source, "select": select,
+                    "notes": list(cal.notes)}, tmp / "calibration.json")
+        ax = cal.plot()
+        ax.figure.savefig(tmp / "runout_observed_vs_simulated.png", dpi=120, bbox_inches="tight")
+        plt.close(ax.figure)
+    print(f"\nWrote the calibrated scenario, parameters.csv, comparison.csv, bootstrap.csv, evaluations.csv, "
+          f"calibration.json and runout_observed_vs_simulated.png to {out}/")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="riskrf", description="Rock fall hazard, risk and mitigation decisions (after Wyllie 2014, "
@@ -359,6 +424,29 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=None, help="random seed (default 1)")
     p.add_argument("-n", type=int, default=None, help="simulated blocks (default 50,000)")
     p.set_defaults(func=cmd_demo)
+
+    p = sub.add_parser("calibrate", help="fit scenario material parameters to observed stop points",
+                       description="Fit scenario values named by dotted paths (e.g. "
+                       "materials.talus.ground_friction_angle_deg) within bounds so that simulated stop positions "
+                       "match observed ones (1-Wasserstein distance, common random numbers, differential evolution, "
+                       "bootstrap intervals; see the README section 'Calibration').  Writes the calibrated scenario "
+                       "TOML, parameter and comparison tables and a figure.", epilog=EPILOG)
+    p.add_argument("scenario", help="scenario TOML file")
+    p.add_argument("observed", help="observed stops: CSV/Parquet/XLSX with an x_stop_m column [m along the profile]")
+    p.add_argument("--parameter", action="append", metavar="NAME=LOW:HIGH",
+                   help="dotted scenario path and bounds; repeat for several")
+    p.add_argument("--select", action="append", metavar="COLUMN=VALUE",
+                   help="use only rows of the observed file with this value (e.g. profile=P1); repeatable")
+    p.add_argument("--column", default="x_stop_m", help="column of stop positions in m (default x_stop_m)")
+    p.add_argument("--collector", default=None, help="collector where observed velocity_ms/height_m columns apply")
+    p.add_argument("--distance", choices=("wasserstein", "cvm"), default="wasserstein",
+                   help="distance between distributions (default wasserstein)")
+    p.add_argument("-n", type=int, default=1000, help="simulated blocks per evaluation (default 1,000)")
+    p.add_argument("--seed", type=int, default=1, help="random seed of every evaluation (default 1)")
+    p.add_argument("--maxiter", type=int, default=20, help="differential-evolution generations (default 20)")
+    p.add_argument("--bootstrap", type=int, default=200, help="bootstrap replicates (default 200; 0 to skip)")
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <scenario>-calibration)")
+    p.set_defaults(func=cmd_calibrate)
     return parser
 
 

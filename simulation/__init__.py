@@ -13,3 +13,10 @@ from .scenario import Scenario, ScenarioError, load_scenario, scenario_from_dict
 
 __all__ = ["Scenario", "ScenarioError", "SimulationResult", "load_scenario", "run", "scenario_from_dict",
            "wilson_interval"]
+
+# Calibration to observed stop points and profiles extracted from 3-D terrain (issue 9).
+from .calibration import Calibration, CalibrationWarning, calibrate, read_observed  # noqa: E402
+from .profile_extraction import TerrainProfile, profile_from_points, read_stl  # noqa: E402
+
+__all__ += ["Calibration", "CalibrationWarning", "TerrainProfile", "calibrate", "profile_from_points", "read_observed",
+            "read_stl"]
