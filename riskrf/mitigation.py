@@ -140,7 +140,9 @@ class Uncertainty:
     ("talus.ground_friction_angle_deg" = [20, 30]); the scenario is re-simulated for ``material_draws``
     joint draws (and once at each end of each range, for the tornado) and every sample uses one of the
     draws: reach probability, velocities and heights at the barrier, the road share and every derived
-    retention change with it.
+    retention change with it.  ``calibration`` (the ``bootstrap.csv`` of ``riskrf calibrate``: one row
+    of re-fitted parameters per replicate) gives the material draws instead: rows drawn jointly, so the
+    correlation the calibration found is kept; the tornado uses its 5 % and 95 % quantiles.
     """
 
     samples: int = 1000
@@ -155,6 +157,8 @@ class Uncertainty:
     sample_retention: bool = True
     materials: dict = field(default_factory=dict)    # {"material.field": (low, high)} of the slope scenario
     material_draws: int = 8
+    calibration: object = field(default=None, repr=False)   # DataFrame: joint draws of a calibration's bootstrap
+    calibration_source: str = ""
 
 
 @dataclass(frozen=True)
@@ -355,18 +359,39 @@ class MitigationStudy:
         joint material draws, then one low and one high variant per uncertain material parameter (tornado)."""
         models = [self._reference_model()]
         u = self.uncertainty
-        if u.materials and self.context is not None:
+        ranges = self._material_ranges()
+        if ranges and self.context is not None:
             ctx = self.context
             rng = np.random.default_rng(np.random.SeedSequence([u.seed, 13]))
-            names = sorted(u.materials)
-            for _ in range(u.material_draws):
-                vals = {n: float(rng.uniform(*u.materials[n])) for n in names}
+            names = sorted(ranges)
+            if u.calibration is not None:
+                rows = u.calibration
+                pick = rng.choice(len(rows), size=u.material_draws, replace=len(rows) < u.material_draws)
+                draws = [{n: float(rows.iloc[i][f"materials.{n}"]) for n in names} for i in pick]
+            else:
+                draws = [{n: float(rng.uniform(*ranges[n][:2])) for n in names} for _ in range(u.material_draws)]
+            for vals in draws:
                 models.append(self._simulated_model(vals))
             central = {n: material_value(ctx.scenario, n) for n in names}
             for n in names:
-                for end, v in (("low", u.materials[n][0]), ("high", u.materials[n][1])):
+                for end, v in (("low", ranges[n][0]), ("high", ranges[n][1])):
                     models.append(self._simulated_model({**central, n: v}, label=f"{n} {end}"))
         return models
+
+    def _material_ranges(self) -> dict:
+        """"material.field" -> (low, high, how) of the uncertain slope material parameters."""
+        u = self.uncertainty
+        if u.calibration is not None:
+            out = {}
+            for col in u.calibration.columns:
+                x = u.calibration[col].to_numpy(dtype=float)
+                out[col.removeprefix("materials.")] = (float(np.quantile(x, 0.05)), float(np.quantile(x, 0.95)),
+                                                       f"joint rows of the calibration bootstrap {u.calibration_source} "
+                                                       f"({len(x)} replicates; 5-95 %); {u.material_draws} "
+                                                       "re-simulations")
+            return out
+        return {k: (lo, hi, f"uniform, stated; {u.material_draws} joint re-simulations")
+                for k, (lo, hi) in u.materials.items()}
 
     def _reference_model(self) -> dict:
         v = self.hazard.velocity
@@ -605,9 +630,9 @@ class MitigationStudy:
                     out[f"{fld}:{o.name}"] = (*rng, "uniform, stated" + (" (typed effectiveness: assumption)"
                                                                          if fld in ("retention", "rate_reduction")
                                                                          else ""))
-        if u.materials and self.context is not None:
-            for path, (lo, hi) in sorted(u.materials.items()):
-                out[f"material:{path}"] = (lo, hi, f"uniform, stated; {u.material_draws} joint re-simulations")
+        if self.context is not None:
+            for path, rng in sorted(self._material_ranges().items()):
+                out[f"material:{path}"] = rng
         if u.sample_retention:
             for key, (_, (a, b), _) in self._derived.items():
                 d = stats.beta(a, b)
@@ -1276,7 +1301,7 @@ def _check_combinations(options, source):
 
 
 def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
-    allowed = {f.name for f in fields(Uncertainty)}
+    allowed = ({f.name for f in fields(Uncertainty)} - {"calibration", "calibration_source"}) | {"calibration_bootstrap"}
     if not isinstance(data, dict):
         raise MitigationError(f"{source}: [uncertainty] must be a table")
     for key in data:
@@ -1303,6 +1328,26 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
                                           f"{', '.join(MATERIAL_FIELDS)}")
                 mats[str(path)] = _range(rng, f"{w}.{path}")
             vals[key] = mats
+        elif key == "calibration_bootstrap":
+            base = Path(source).parent if Path(source).is_file() else Path(".")
+            path = base / str(v)
+            if not path.is_file():
+                raise MitigationError(f"{w} = {v!r}: file not found ({path.resolve()}); give the bootstrap.csv "
+                                      "written by riskrf calibrate")
+            df = pd.read_csv(path)
+            from .measures import MATERIAL_FIELDS
+            if len(df) < 2:
+                raise MitigationError(f"{w} = {v!r}: needs at least 2 bootstrap rows; got {len(df)}")
+            for col in df.columns:
+                parts = col.split(".", 2)
+                if len(parts) != 3 or parts[0] != "materials" or parts[2] not in MATERIAL_FIELDS:
+                    raise MitigationError(f"{w} = {v!r}: column {col!r} is not a material parameter "
+                                          "(materials.NAME.FIELD with FIELD one of "
+                                          f"{', '.join(MATERIAL_FIELDS)})")
+                if not np.all(np.isfinite(pd.to_numeric(df[col], errors="coerce"))):
+                    raise MitigationError(f"{w} = {v!r}: column {col!r} has values that are not finite numbers")
+            vals["calibration"] = df.astype(float)
+            vals["calibration_source"] = str(v)
         elif key in ("sample_power_law", "sample_retention"):
             if not isinstance(v, bool):
                 raise MitigationError(f"{w} = {v!r} must be true or false")
@@ -1315,7 +1360,11 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
             if key == "discount_rate" and hi >= 1:
                 raise MitigationError(f"{w} = {v!r}: rates lie below 1 (e.g. [0.01, 0.05])")
             vals[key] = (lo, hi)
+    if vals.get("calibration") is not None and vals.get("materials"):
+        raise MitigationError(f"{source}: give uncertainty.materials or uncertainty.calibration_bootstrap, not both")
     for f in fields(Uncertainty):
+        if f.name in ("calibration", "calibration_source"):
+            continue
         if f.name not in vals:
             used.append(f"uncertainty.{f.name} = {getattr(Uncertainty(), f.name)!r} (default)")
     return Uncertainty(**vals)

@@ -145,7 +145,10 @@ def _check_option_geometry(options, scenario, hz, path, uncertainty=None):
     ditches that fit, scaling zones inside the release zone, uncertain material parameters that exist."""
     from .measures import Ditch, MeasureError, ditch_profile, material_value, seeder_share
     prof = scenario.profile
-    for p in (uncertainty.materials if uncertainty is not None else {}):
+    paths = list(uncertainty.materials) if uncertainty is not None else []
+    if uncertainty is not None and uncertainty.calibration is not None:
+        paths += [c.removeprefix("materials.") for c in uncertainty.calibration.columns]
+    for p in paths:
         try:
             material_value(scenario, p, f"{path}: uncertainty.materials")
         except MeasureError as exc:

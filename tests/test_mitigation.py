@@ -373,3 +373,30 @@ def test_fence_at_another_position_and_realignment_are_derived_from_simulation()
     expected = runout_beyond(res, 75.0).sum() / runout_beyond(res, 60.0).sum()
     assert s.evaluate("move").effectiveness == pytest.approx(1 - expected, abs=1e-12)
     assert 0 < s.evaluate("fence").retention <= 1
+
+
+def test_material_draws_from_a_calibration_bootstrap(tmp_path):
+    import pandas as pd
+    boot = pd.DataFrame({"materials.gravel.ground_friction_angle_deg": [22.0, 25.0, 30.0, 41.0, 44.0],
+                         "materials.gravel.roughness_m": [0.05, 0.08, 0.1, 0.12, 0.2]})
+    (tmp_path / "bootstrap.csv").write_text(boot.to_csv(index=False))
+    site = tmp_path / "options.toml"
+    site.write_text("")
+    data = {"uncertainty": {"calibration_bootstrap": "bootstrap.csv", "material_draws": 4, "samples": 50},
+            "options": [{"name": "nothing", "kind": "none", "capital_cost": 0},
+                        {"name": "ditch", "kind": "ditch", "capital_cost": 1e5, "x_m": 31.0, "width_m": 8.0,
+                         "depth_m": 1.0, "material": "gravel"}]}
+    opts, ex, co, ec, used, unc, crit = parse_mitigation(data, str(site))
+    sc = simulation.scenario_from_dict(TOE)
+    s = MitigationStudy(hazard=HAZ, options=opts, consequences=CONSTANT_V, uncertainty=unc,
+                        context=SimulationContext(sc, n_blocks=500, seed=3))
+    m = s.material_models()
+    draws = m[m["label"] == "draw"][["gravel.ground_friction_angle_deg", "gravel.roughness_m"]]
+    rows = set(map(tuple, boot.to_numpy()))
+    assert len(draws) == 4 and all(tuple(r) in rows for r in draws.to_numpy())   # joint rows, correlation kept
+    ranges = s.parameter_ranges()
+    assert ranges["material:gravel.roughness_m"][0] == pytest.approx(np.quantile(boot.iloc[:, 1], 0.05))
+    bad = boot.rename(columns={"materials.gravel.roughness_m": "seeder.height_m"})
+    (tmp_path / "bootstrap.csv").write_text(bad.to_csv(index=False))
+    with pytest.raises(MitigationError, match="column 'seeder.height_m' is not a material parameter"):
+        parse_mitigation(data, str(site))
