@@ -477,27 +477,43 @@ class MitigationStudy:
         return road_crossings(ctx.run(ctx.scenario), ctx.road_collector)
 
     def _ditch_retention(self, ditches, model: dict, index: int):
-        """Share of the falls that would reach the road that the ditches stop (common random numbers), and its
-        Monte Carlo Beta law."""
+        """Share of the falls that would reach the road that the ditches stop (common random numbers): overall,
+        its Monte Carlo Beta law, and by block mass (5 strata of the simulated masses, interpolated in log mass
+        onto the mass grid and held constant beyond the simulated range)."""
         ctx = self.context
-        base = self._reference_road_blocks if index == 0 else road_crossings(model["result"], ctx.road_collector)
+        base_res = ctx.run(ctx.scenario) if index == 0 else model["result"]
+        base = self._reference_road_blocks if index == 0 else road_crossings(base_res, ctx.road_collector)
         try:
             sc = scenario_with_ditches(model["scenario"], ditches, where=self.source, road_collector=ctx.road_collector)
         except (MeasureError, ValueError) as exc:
             raise MitigationError(str(exc)) from exc
         kept = road_crossings(ctx.run(sc), ctx.road_collector)
+        mid = self._grid[1]
         k_b = base.size
         if k_b == 0:
-            return 0.0, (0.5, 0.5)
-        stopped = int(np.setdiff1d(base, kept).size)
-        extra = int(np.setdiff1d(kept, base).size)       # deflected onto the road by the ditch
-        r = max(stopped - extra, 0)
-        return r / k_b, (r + 0.5, k_b - r + 0.5)
+            return 0.0, (0.5, 0.5), np.zeros(mid.size)
+        mass = base_res.blocks["mass"]
+        reached = np.zeros(mass.size, dtype=bool)
+        reached[base] = True
+        now = np.zeros(mass.size, dtype=bool)
+        now[kept] = True
+        stopped, extra = reached & ~now, now & ~reached        # extra: deflected onto the road by the ditch
+        r = max(int(stopped.sum()) - int(extra.sum()), 0)
+        edges = np.quantile(mass[reached], np.linspace(0, 1, 6))
+        centres, rets = [], []
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            s = (mass >= lo) & (mass <= hi)
+            n_s = int((reached & s).sum())
+            if n_s:
+                centres.append(float(np.median(mass[reached & s])))
+                rets.append(max(int((stopped & s).sum()) - int((extra & s).sum()), 0) / n_s)
+        by_mass = np.interp(np.log(mid), np.log(centres), rets) if centres else np.full(mid.size, r / k_b)
+        return r / k_b, (r + 0.5, k_b - r + 0.5), by_mass
 
     @cached_property
     def _derived(self) -> dict:
-        """Derived ditch retentions: key -> (retention of the reference model, Beta law, retention per model);
-        filled by ``_effects``."""
+        """Derived ditch retentions: key -> (overall retention of the reference model, its Beta law, overall
+        retention per slope model, retention by mass bin per slope model); filled by ``_effects``."""
         return {}
 
     @cached_property
@@ -539,9 +555,11 @@ class MitigationStudy:
             key = "+".join(c.name for c in geo)
             if key not in self._derived:
                 per_model = [self._ditch_retention(ds, m, i) for i, m in enumerate(self._models)]
-                self._derived[key] = (per_model[0][0], per_model[0][1], np.array([r for r, _ in per_model]))
+                self._derived[key] = (per_model[0][0], per_model[0][1], np.array([r for r, _, _ in per_model]),
+                                      np.array([b for _, _, b in per_model]))
+            # retention by mass bin and slope model, as a shift from the overall reference retention (the parameter)
             stages.append(_Stage("ditch", key, param=f"retention:{key}",
-                                 factor=self._derived[key][2] - self._derived[key][0]))
+                                 factor=self._derived[key][3] - self._derived[key][0]))
         for c in comps:
             if c.kind in ("fence", "attenuator"):
                 stages.append(self._barrier_stage(c))
@@ -592,7 +610,7 @@ class MitigationStudy:
                 p[f"retention:{o.name}"] = o.retention
             if o.kind in BARRIER_KINDS:
                 p[f"repair_days:{o.name}"] = self._repair_days(o)
-        for key, (ret, _, _) in self._derived.items():
+        for key, (ret, _, _, _) in self._derived.items():
             p[f"retention:{key}"] = ret
         p["material_draw"] = 0.0           # index of the slope model (0: the reference simulation)
         return p
@@ -634,7 +652,7 @@ class MitigationStudy:
             for path, rng in sorted(self._material_ranges().items()):
                 out[f"material:{path}"] = rng
         if u.sample_retention:
-            for key, (_, (a, b), _) in self._derived.items():
+            for key, (_, (a, b), _, _) in self._derived.items():
                 d = stats.beta(a, b)
                 out[f"retention:{key}"] = (float(d.ppf(0.05)), float(d.ppf(0.95)),
                                            "Beta (Monte Carlo error of the derived retention)")
@@ -733,8 +751,8 @@ class MitigationStudy:
                 if before_structures is None:
                     before_structures = x.sum(axis=1) * (1.0 if on_road else road_share)
                 if st.kind == "ditch":
-                    ret = P[st.param] + (st.factor[d] if isinstance(st.factor, np.ndarray) else 0.0)
-                    x = x * (1.0 - np.clip(ret, 0.0, 1.0))[:, None]
+                    ret = P[st.param][:, None] + (st.factor[d] if isinstance(st.factor, np.ndarray) else 0.0)
+                    x = x * (1.0 - np.clip(ret, 0.0, 1.0))
                 elif st.kind == "barrier":
                     c = self.option(st.option)
                     reach = x * st.coverage
