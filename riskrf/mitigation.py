@@ -472,16 +472,20 @@ class MitigationStudy:
         return self.context
 
     @cached_property
+    def _reference_run(self):
+        """The unmodified scenario with the re-simulation blocks and seed (the common random numbers)."""
+        return self.context.run(self.context.scenario)
+
+    @cached_property
     def _reference_road_blocks(self):
-        ctx = self.context
-        return road_crossings(ctx.run(ctx.scenario), ctx.road_collector)
+        return road_crossings(self._reference_run, self.context.road_collector)
 
     def _ditch_retention(self, ditches, model: dict, index: int):
         """Share of the falls that would reach the road that the ditches stop (common random numbers): overall,
         its Monte Carlo Beta law, and by block mass (5 strata of the simulated masses, interpolated in log mass
         onto the mass grid and held constant beyond the simulated range)."""
         ctx = self.context
-        base_res = ctx.run(ctx.scenario) if index == 0 else model["result"]
+        base_res = self._reference_run if index == 0 else model["result"]
         base = self._reference_road_blocks if index == 0 else road_crossings(base_res, ctx.road_collector)
         try:
             sc = scenario_with_ditches(model["scenario"], ditches, where=self.source, road_collector=ctx.road_collector)
@@ -578,7 +582,7 @@ class MitigationStudy:
                                               f"outside the profile ({prof.x[0]:g}, {prof.x[-1]:g}) m")
                     factor = []
                     for m in self._models:
-                        ref = m["result"] if m["result"] is not None else ctx.run(ctx.scenario)
+                        ref = m["result"] if m["result"] is not None else self._reference_run
                         road_x = ref.scenario.collectors[ref.scenario.collector_index(ctx.road_collector)].x
                         now = runout_beyond(ref, road_x).sum()
                         factor.append(min(float(runout_beyond(ref, c.road_x_m).sum() / now), 1.0) if now else 0.0)
