@@ -232,7 +232,12 @@ def render_report(a, figs: Path) -> str:
               "<h3>What would make the runner-up as good (break-even)</h3>",
               _table(be[np.isfinite(be["break_even"])], fmt="{:,.4g}"),
               _figure(figs / "tornado.png", "Tornado: the lowest expected total cost as each input moves over its "
-                                            "stated range (x0.5 / x2 where none is stated)")]
+                                            "stated range (x0.5 / x2 where none is stated); the 15 inputs that change "
+                                            "the best option or the order first, then by swing"),
+              "<h3>Inputs that change the best option or the order</h3>",
+              _table(a.decision["tornado"].loc[a.decision["tornado"]["changes_order"],
+                                               ["parameter", "low", "high", "range", "best_at_low", "best_at_high",
+                                                "changes_best"]], fmt="{:,.4g}")]
     voi = a.decision["value_of_information"]
     parts.append(f"<p>Value of perfect information about the rate of falls (true rate half, as estimated or "
                  f"double the estimate, with probabilities 1/4, 1/2, 1/4): <b>{_money(voi['evpi'])}</b>; about all "

@@ -115,7 +115,7 @@ def write_mitigation_outputs(study, report, tmp) -> None:
                 "defaults_used": list(study.defaults_used)}, tmp / "decision.json")
     ax = plot_tree(tree)
     save_figure(ax.figure, tmp / "tree.png")
-    ax = plot_tornado(report["tornado"], currency=study.currency)
+    ax = plot_tornado(report["tornado"].head(15), currency=study.currency)   # the 15 inputs that matter most
     save_figure(ax.figure, tmp / "tornado.png")
     curves = {o.name: study.fn_curve(o.name) for o in study.options}
     ax = plot_fn(curves)
