@@ -111,8 +111,19 @@ class Consequences:
     vehicle_damage: float = 25000.0
     closure_days_per_fall: float = 0.5
     closure_cost_per_day: float = 20000.0
+    detour_hours: float = 0.0
+    value_of_time_per_hour: float = 0.0
     cleanup_cost_per_fall: float = 3000.0
     currency: str = "CHF"
+
+
+def closure_cost_per_fall(co: "Consequences", vehicles_per_day):
+    """Cost of one fall reaching the road besides injuries and vehicle damage [currency]: the agency's closure
+    cost per day and the road users' delay (each of the vehicles_per_day x closure days detours for
+    ``detour_hours`` at ``value_of_time_per_hour``), plus clean-up."""
+    days = co.closure_days_per_fall
+    return days * co.closure_cost_per_day + days * np.asarray(vehicles_per_day, dtype=float) * co.detour_hours \
+        * co.value_of_time_per_hour + co.cleanup_cost_per_fall
 
 
 @dataclass(frozen=True)
@@ -719,7 +730,7 @@ class MitigationStudy:
                                                                        ex.hours_rock_on_road, ex.p_cannot_stop)
         r = P["discount_rate"]
         pvf = np.broadcast_to(pv_factor(r, ec.horizon_years), (S,))
-        per_fall_cost = co.closure_days_per_fall * co.closure_cost_per_day + co.cleanup_cost_per_fall
+        per_fall_cost = np.broadcast_to(closure_cost_per_fall(co, P["vehicles_per_day"]), (S,))
         names = [o.name for o in self.options]
         K = len(names)
         res = {k: np.zeros((S, K)) for k in ("capital", "pv_renewals", "pv_maintenance", "pv_expected_loss",
@@ -1123,7 +1134,7 @@ class MitigationStudy:
         k_occ, p_occ = occupancy_distribution(ex.occupants_per_vehicle, ex.occupants_distribution)
         occ = float(np.dot(k_occ, p_occ))
         p_st, p_strike = float(r["p_st"][0]), float(r["p_strike"][0])
-        per_fall = co.closure_days_per_fall * co.closure_cost_per_day + co.cleanup_cost_per_fall
+        per_fall = float(closure_cost_per_fall(co, ex.vehicles_per_day))
         branches = []
         for k, opt in enumerate(self.options):
             x = r["road_bins"][0, k]

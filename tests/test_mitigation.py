@@ -400,3 +400,12 @@ def test_material_draws_from_a_calibration_bootstrap(tmp_path):
     (tmp_path / "bootstrap.csv").write_text(bad.to_csv(index=False))
     with pytest.raises(MitigationError, match="column 'seeder.height_m' is not a material parameter"):
         parse_mitigation(data, str(site))
+
+
+def test_road_user_delay_from_closures_enters_the_expected_loss():
+    base = study().evaluate("nothing").expected_annual_loss
+    co = Consequences(vulnerability_moving_vehicle=0.5, vulnerability_striking_rock=0.1, detour_hours=0.25,
+                      value_of_time_per_hour=20.0)
+    delayed = study(consequences=co).evaluate("nothing").expected_annual_loss
+    # 1 fall a year on the road x 0.5 closed days x 5,000 vehicles/day x 0.25 h x 20 per hour
+    assert delayed - base == pytest.approx(1.0 * 0.5 * 5000 * 0.25 * 20.0, rel=1e-6)
