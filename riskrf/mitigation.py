@@ -849,18 +849,40 @@ class MitigationStudy:
     def uncertain(self) -> dict:
         """Joint samples: total cost per sample and option (S, K) and the derived statistics per option."""
         P = self.sample_parameters()
-        r = self._evaluate(P)
+        r = self._evaluate(P, per_bin=True)
         total = r["total"]
         best = np.argmin(total, axis=1)
         K = total.shape[1]
         p_best = np.bincount(best, minlength=K) / total.shape[0]
         regret = (total - total.min(axis=1, keepdims=True)).mean(axis=0)
-        ir_ok = (r["ir"] <= self.criteria.individual_risk_per_year).mean(axis=0)
+        ir_ok = r["ir"] <= self.criteria.individual_risk_per_year
+        fn_ok = self._fn_tolerable(r)
         return {"names": r["names"], "total": total, "mean": total.mean(axis=0),
+                "probability_meets_criteria": (ir_ok & fn_ok).mean(axis=0),
                 "p05": np.percentile(total, 5, axis=0), "p95": np.percentile(total, 95, axis=0),
-                "probability_best": p_best, "expected_regret": regret, "probability_meets_individual_risk": ir_ok,
+                "probability_best": p_best, "expected_regret": regret,
+                "probability_meets_individual_risk": ir_ok.mean(axis=0),
                 "evpi": max(float(total.mean(axis=0).min() - total.min(axis=1).mean()), 0.0),
                 "samples": total.shape[0]}
+
+    def _fn_tolerable(self, r) -> np.ndarray:
+        """Per sample and option: is the F-N curve outside the GEO "unacceptable" region (N <= 1,000 here, the
+        occupancy of one vehicle)?  The same F(N) as :meth:`fn_curve`, for every joint sample at once."""
+        from scipy import stats
+
+        from .road_risk import HK_GEO_FN_LINES
+        kk, pk = occupancy_distribution(self.exposure.occupants_per_vehicle, self.exposure.occupants_distribution)
+        Ns = np.arange(1, int(kk.max()) + 1)
+        c_hi, k_hi = HK_GEO_FN_LINES["unacceptable above"]
+
+        def share(v):                     # (S, J) -> (S, J, N): P(N' >= n) with occupants as a distribution
+            sf = stats.binom.sf(Ns[None, None, None, :] - 1, kk[None, None, :, None], v[:, :, None, None])
+            return np.einsum("sjkn,k->sjn", sf, pk)
+        a_d, a_s = share(r["v_d"]), share(r["v_s"])
+        x = r["road_bins"]                                             # (S, K, J)
+        F = np.einsum("skj,sjn->skn", x * r["p_st"][:, None, None], a_d) \
+            + np.einsum("skj,sjn->skn", x * r["p_strike"][:, None, None], a_s)
+        return ~np.any(F > c_hi / Ns[None, None, :] ** k_hi, axis=2)
 
     # ---- societal risk -------------------------------------------------------------------------
     def fn_curve(self, option: str) -> pd.DataFrame:
@@ -898,6 +920,7 @@ class MitigationStudy:
                 "repairs_per_year": r["repairs"][0, k], "replacements_per_year": r["replacements"][0, k],
                 "deaths_per_year": r["deaths"][0, k], "individual_risk": r["ir"][0, k],
                 "probability_meets_individual_risk": u["probability_meets_individual_risk"][k],
+                "probability_meets_criteria": u["probability_meets_criteria"][k],
                 "fn_zone": fn_zone(fn), "F_N1_per_year": float(fn["F"].iloc[0]) if len(fn) else 0.0})
         df = pd.DataFrame(rows)
         base = df[df["kind"] == "none"]
@@ -948,7 +971,8 @@ class MitigationStudy:
                    f"{rec['individual_risk']:.2g}/yr against {lim:.0e}/yr; societal risk {rec['fn_zone']} on the "
                    f"{self.criteria.fn_diagram} F-N diagram). Its expected total cost is "
                    f"{rec['expected_total_cost']:,.0f} {cur} (5-95 %: {rec['cost_p05']:,.0f} to "
-                   f"{rec['cost_p95']:,.0f} {cur}).")
+                   f"{rec['cost_p95']:,.0f} {cur}); it meets them in {rec['probability_meets_criteria']:.0%} of the "
+                   "joint samples of the uncertain inputs.")
             if rec["option"] != cheapest["option"]:
                 intolerable = t[(t["expected_total_cost"] < rec["expected_total_cost"])]
                 why += (f" Cheaper options leave the risk intolerable: {cheapest['option']} costs least "

@@ -409,3 +409,13 @@ def test_road_user_delay_from_closures_enters_the_expected_loss():
     delayed = study(consequences=co).evaluate("nothing").expected_annual_loss
     # 1 fall a year on the road x 0.5 closed days x 5,000 vehicles/day x 0.25 h x 20 per hour
     assert delayed - base == pytest.approx(1.0 * 0.5 * 5000 * 0.25 * 20.0, rel=1e-6)
+
+
+def test_probability_meeting_the_criteria_uses_the_same_fn_as_the_curve():
+    s = study()
+    r = s._central(per_bin=True)
+    ok = s._fn_tolerable(r)[0]
+    for k, name in enumerate(r["names"]):
+        assert bool(ok[k]) == (fn_zone(s.fn_curve(name)) != "unacceptable")
+    t = s.ranking()
+    assert t["probability_meets_criteria"].between(0, 1).all()

@@ -205,7 +205,8 @@ def render_report(a, figs: Path) -> str:
         "capital": ranking["capital"].map(_money), "renewals (PV)": ranking["pv_renewals"].map(_money),
         "maintenance, repairs, replacements (PV)": ranking["pv_maintenance"].map(_money),
         "expected losses (PV)": ranking["pv_expected_loss"].map(_money),
-        "meets criteria": ranking["meets_criteria"].map(lambda v: "yes" if v else "no")})
+        "meets criteria": ranking["meets_criteria"].map(lambda v: "yes" if v else "no"),
+        "meets them in (share of samples)": ranking["probability_meets_criteria"].map(lambda v: f"{v:.0%}")})
     opts = a.decision["options_table"].copy()
     opts["retention"] = opts["retention"].map(lambda v: "" if v is None or pd.isna(v) else f"{v:.0%}")
     opts["effectiveness"] = opts["effectiveness"].map(lambda v: f"{v:.0%}")

@@ -23,7 +23,9 @@ def option_entries(study, ranking: pd.DataFrame) -> list:
              "road_falls_per_year": float(r["road_falls_per_year"]),
              "individual_risk_per_year": float(r["individual_risk"]),
              "deaths_per_year": float(r["deaths_per_year"]), "fn_zone": r["fn_zone"],
-             "meets_criteria": bool(r["meets_criteria"]), "effectiveness": float(r["effectiveness"]),
+             "meets_criteria": bool(r["meets_criteria"]),
+             "probability_meets_criteria": float(r["probability_meets_criteria"]),
+             "effectiveness": float(r["effectiveness"]),
              "effect_basis": r["effect_basis"],
              "repairs_per_year": float(r["repairs_per_year"]),
              "replacements_per_year": float(r["replacements_per_year"])}
