@@ -419,3 +419,22 @@ def test_probability_meeting_the_criteria_uses_the_same_fn_as_the_curve():
         assert bool(ok[k]) == (fn_zone(s.fn_curve(name)) != "unacceptable")
     t = s.ranking()
     assert t["probability_meets_criteria"].between(0, 1).all()
+
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+@settings(max_examples=15)
+@given(cap=st.floats(100.0, 50_000.0), height=st.floats(0.5, 10.0), rr=st.floats(0.0, 1.0),
+       repair=st.floats(1.0, 365.0))
+def test_property_structures_only_remove_falls_and_combinations_compose(cap, height, rr, repair):
+    opts = (Option("nothing", "none"), Option("scale", "scaling", 1.0, rate_reduction=rr),
+            Option("fence", "fence", 1.0, capacity_kj=cap, height_m=height, repair_days=repair),
+            Option("both", "combined", options=("scale", "fence")))
+    s = study(opts)
+    none, scale, fence, both = (s.evaluate(n).road_falls_per_year for n in ("nothing", "scale", "fence", "both"))
+    assert fence <= none * (1 + 1e-12) and both <= min(scale, fence) * (1 + 1e-12) + 1e-15
+    # scaling acts on the release only, so the fence in series sees (1 - rr) of the falls
+    assert scale == pytest.approx(none * (1 - rr), rel=1e-9, abs=1e-15)
+    assert s.uncertain["probability_best"].sum() == pytest.approx(1.0)
