@@ -707,17 +707,11 @@ class MitigationStudy:
     def _fn_tolerable(self, r) -> np.ndarray:
         """Per sample and option: is the F-N curve outside the GEO "unacceptable" region (N <= 1,000 here, the
         occupancy of one vehicle)?  The same F(N) as :meth:`fn_curve`, for every joint sample at once."""
-        from scipy import stats
-
-        from .road_risk import HK_GEO_FN_LINES
+        from .road_risk import HK_GEO_FN_LINES, share_with_at_least
         kk, pk = occupancy_distribution(self.exposure.occupants_per_vehicle, self.exposure.occupants_distribution)
         Ns = np.arange(1, int(kk.max()) + 1)
         c_hi, k_hi = HK_GEO_FN_LINES["unacceptable above"]
-
-        def share(v):                     # (S, J) -> (S, J, N): P(N' >= n) with occupants as a distribution
-            sf = stats.binom.sf(Ns[None, None, None, :] - 1, kk[None, None, :, None], v[:, :, None, None])
-            return np.einsum("sjkn,k->sjn", sf, pk)
-        a_d, a_s = share(r["v_d"]), share(r["v_s"])
+        a_d, a_s = share_with_at_least(r["v_d"], kk, pk), share_with_at_least(r["v_s"], kk, pk)   # (S, J, N)
         x = r["road_bins"]                                             # (S, K, J)
         F = np.einsum("skj,sjn->skn", x * r["p_st"][:, None, None], a_d) \
             + np.einsum("skj,sjn->skn", x * r["p_strike"][:, None, None], a_s)

@@ -156,6 +156,27 @@ def occupancy_distribution(mean_occupants: float, pmf: dict | None = None, max_o
     return k, p / p.sum()
 
 
+def share_with_at_least(vulnerabilities, occupants_k, occupants_p, max_n: int | None = None) -> np.ndarray:
+    """P(N >= n) for n = 1 ... max_n deaths in one vehicle: K occupants ~ ``occupants_p`` over ``occupants_k``,
+    each dying independently with probability v, N | K ~ Binomial(K, v).  Shape: vulnerabilities.shape + (max_n,).
+
+    Exact binomial sums (pmf C(k, i) v^i (1 - v)^(k - i)), vectorised over any array of vulnerabilities.
+    """
+    from math import comb
+    v = np.asarray(vulnerabilities, dtype=float)[..., None]
+    k_all = np.asarray(occupants_k, dtype=int)
+    p_all = np.asarray(occupants_p, dtype=float)
+    max_n = int(k_all.max()) if max_n is None else int(max_n)
+    out = np.zeros(v.shape[:-1] + (max_n,))
+    for k, pk in zip(k_all, p_all):
+        i = np.arange(k + 1)
+        pmf = np.array([comb(int(k), int(j)) for j in i]) * v ** i * (1.0 - v) ** (k - i)
+        tail = np.cumsum(pmf[..., ::-1], axis=-1)[..., ::-1]          # tail[..., n] = P(N >= n)
+        m = min(max_n, int(k))
+        out[..., :m] += pk * tail[..., 1:m + 1]
+    return out
+
+
 def occupant_fn(frequencies, vulnerabilities, occupants_k, occupants_p) -> pd.DataFrame:
     """F-N curve of vehicle accidents with occupants as a distribution.
 
@@ -169,9 +190,7 @@ def occupant_fn(frequencies, vulnerabilities, occupants_k, occupants_p) -> pd.Da
     k = np.asarray(occupants_k, dtype=int)
     pk = np.asarray(occupants_p, dtype=float)
     Ns = np.arange(1, int(k.max()) + 1)
-    # sf[n, k, s] = P(Binomial(k, v_s) >= n)
-    sf = stats.binom.sf(Ns[:, None, None] - 1, k[None, :, None], v[None, None, :])
-    F = np.einsum("nks,k,s->n", sf, pk, f)
+    F = f @ share_with_at_least(v, k, pk)
     return pd.DataFrame({"N": Ns.astype(float), "F": F})
 
 
