@@ -27,7 +27,6 @@ from .inventory import Inventory, read_inventory
 from .mitigation import MitigationStudy
 from .outputs import write_json
 from .power_law import fit_gutenberg_richter
-from .road_risk import fn_zone
 from .site import Site
 from .validation import RiskrfWarning
 
@@ -87,6 +86,40 @@ def road_share(result, barrier: str, road: str | None) -> float:
     return min(result.reach_probability(road)[0] / b, 1.0) if b > 0 else 1.0
 
 
+def study_context(result, barrier: str, road: str | None, option_blocks: int, seed, inventory, hazard,
+                  rate_scale: float = 1.0) -> dict:
+    """The slope model and small falls a :class:`MitigationStudy` needs to derive option effects.
+
+    Falls below the power law's m_min: the inventory's own (their masses, and their count
+    over the record scaled by ``rate_scale``), so that every size that reaches the road counts.
+    """
+    from .measures import SimulationContext
+    out = {}
+    if result is not None:
+        names = [c.name for c in result.scenario.collectors]
+        out["context"] = SimulationContext(result.scenario, barrier_collector=barrier,
+                                           road_collector=road if road in names else barrier,
+                                           n_blocks=int(option_blocks), seed=int(seed))
+        out["reference"] = result
+    m_min = getattr(hazard.mass, "m_min", None)
+    if m_min is not None and inventory is not None:
+        small = inventory.masses[inventory.masses < m_min]
+        out["small_fall_masses_kg"] = small
+        out["small_falls_per_year"] = small.size / inventory.duration_years * rate_scale
+    return out
+
+
+def fence_checks_from_site(site) -> tuple:
+    """(capacities kJ, heights m) of the fences to check: those of the site's fence and attenuator options
+    (each at its own height), else hazard.fences_kj at hazard.fence_height_m."""
+    opts = [o for o in site.mitigation["options"] if o.kind in ("fence", "attenuator") and o.x_m is None]
+    if opts:
+        return tuple(o.capacity_kj for o in opts), tuple(o.height_m for o in opts)
+    fh = site.hazard["fence_height_m"]
+    caps = tuple(site.hazard["fences_kj"])
+    return caps, tuple(fh) if isinstance(fh, list) else tuple([fh] * len(caps))
+
+
 @dataclass
 class Assessment:
     site: Site
@@ -131,12 +164,15 @@ class Assessment:
             "design_energies": self.energy.design.to_dict(orient="records"),
             "fences": self.energy.fence_verdicts().to_dict(orient="records"),
             "ranking": ranking.to_dict(orient="records"),
+            "options": self.decision["options"],
+            "recommendation": self.decision["recommendation"],
+            "uncertainty": self.decision["uncertainty"],
             "best_option": ranking["option"].iloc[0],
             "second_option": ranking["option"].iloc[1],
             "break_even": self.decision["break_even"].to_dict(orient="records"),
             "value_of_information": self.decision["value_of_information"],
             "individual_risk_do_nothing": float(nothing["individual_risk"].iloc[0]) if len(nothing) else None,
-            "fn_zone": {o.name: fn_zone(self.study.fn_curve(o.name)) for o in self.study.options},
+            "fn_zone": dict(zip(ranking["option"], ranking["fn_zone"])),
             "defaults_used": list(self.site.defaults_used),
             "warnings": self.warnings,
             "timings_s": self.timings,
@@ -188,7 +224,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         timings["simulation"] = round(time.perf_counter() - t, 2)
 
         t = stage(3, "computing the impact-energy hazard, design energies and fence checks")
-        energy = analyse_energy(hazard, fences=tuple(hz_cfg["fences_kj"]), fence_height_m=hz_cfg["fence_height_m"],
+        fences, heights = fence_checks_from_site(site)
+        energy = analyse_energy(hazard, fences=fences, fence_height_m=heights,
                                 free_board_m=hz_cfg["free_board_m"], design_T=hz_cfg["design_period_years"],
                                 density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed)
         timings["energy"] = round(time.perf_counter() - t, 2)
@@ -196,7 +233,11 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
         share = road_share(result, hz_cfg["collector"], hz_cfg["road_collector"])
         study = MitigationStudy(hazard=hazard, road_share=share, source=str(site.path),
-                                defaults_used=site.defaults_used, **site.mitigation)
+                                defaults_used=site.defaults_used,
+                                **study_context(result, hz_cfg["collector"], hz_cfg["road_collector"],
+                                                hz_cfg["option_blocks"], seed, inventory, hazard,
+                                                inv_cfg["rate_scale"]),
+                                **site.mitigation)
         decision = study_report(study)
         timings["decision"] = round(time.perf_counter() - t, 2)
     notes = []

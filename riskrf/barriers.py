@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .units import J_PER_KJ, SEL_PER_MEL
+from .units import DAYS_PER_YEAR, J_PER_KJ, SEL_PER_MEL
 from .validation import check_positive
 
 #: ETAG 027 energy classes (MEL and SEL in kJ) [R: confirm against the EAD 340059 table].
@@ -117,3 +117,79 @@ def check_fence(hazard, mel_kj: float, height_m: float, *, T: float = 100.0, fre
                      "note": f"{over:.1%} of arriving falls pass over (centre above the fence)"})
     table = pd.DataFrame(rows)
     return table
+
+
+# ---- damage states of a barrier in service (fences, attenuators, sheds) ------------------------------
+#: Outcome of one fall at a barrier: passes over it, held without damage (E <= SEL), held with damage that
+#: costs a repair (SEL < E <= MEL), breaks through and destroys it (E > MEL), or passes while it is out of service.
+OUTCOMES = ("over", "held", "held, repair", "destroyed", "passed, out of service")
+
+
+def damage_state_shares(energy_kj, over, mel_kj: float):
+    """Shares of falls per column of ``energy_kj`` (rows: simulated blocks; columns e.g. mass classes) that pass
+    over (``over``, per row), are held below SEL, held between SEL and MEL, or break through above MEL.
+
+    Returns (passing, held_repair, destroyed), each a share per column; passing = over + destroyed.
+    """
+    e = np.asarray(energy_kj, dtype=float)
+    over = np.asarray(over, dtype=bool).reshape(-1, *([1] * (e.ndim - 1)))
+    mel = check_positive(mel_kj, "mel_kj")
+    working = ~over
+    through = working & (e > mel)
+    held_repair = working & (e > service_energy_level(mel)) & (e <= mel)
+    return np.mean(over | through, axis=0), np.mean(held_repair, axis=0), np.mean(through, axis=0)
+
+
+def out_of_service_share(destructive_rate_per_year, repair_days):
+    """Long-run share of time a barrier is out of service: lambda t / (1 + lambda t).
+
+    Impacts above MEL arrive at ``destructive_rate_per_year`` while it works (Poisson); each
+    leaves it down for ``repair_days`` (an assumption stated with the results), during which
+    it takes no impacts: an alternating renewal process with mean up time 1/lambda.
+    """
+    lam = np.asarray(destructive_rate_per_year, dtype=float)
+    t = np.asarray(repair_days, dtype=float) / DAYS_PER_YEAR
+    return lam * t / (1.0 + lam * t)
+
+
+def barrier_history(times_years, energies_kj, heights_m, *, mel_kj: float, height_m: float | None = None,
+                    repair_days: float, repair_cost: float = 0.0, replacement_cost: float = 0.0) -> pd.DataFrame:
+    """Falls at one barrier in time order with the damage-state model: what happened to each and what it cost.
+
+    A fall passes over when its bounce height exceeds ``height_m`` (None: a shed roof,
+    nothing passes over); while the barrier works a fall with energy above MEL destroys
+    it, passes and costs ``replacement_cost``, and the barrier is out of service for
+    ``repair_days`` so every later fall in that time passes; a fall between SEL = MEL/3
+    and MEL is held and costs ``repair_cost``; below SEL it is held at no cost.
+    """
+    t = np.asarray(times_years, dtype=float)
+    e = np.asarray(energies_kj, dtype=float)
+    h = np.zeros_like(e) if heights_m is None else np.asarray(heights_m, dtype=float)
+    if not (t.shape == e.shape == h.shape):
+        raise ValueError(f"times_years, energies_kj and heights_m need the same length; got {t.size}, {e.size}, "
+                         f"{h.size}")
+    if np.any(np.diff(t) < 0):
+        raise ValueError("times_years must be in increasing order")
+    mel = check_positive(mel_kj, "mel_kj")
+    sel = service_energy_level(mel)
+    back_in_service = -np.inf
+    outcome, cost = [], []
+    for ti, ei, hi in zip(t, e, h):
+        if ti < back_in_service:
+            outcome.append("passed, out of service")
+            cost.append(0.0)
+        elif height_m is not None and hi > height_m:
+            outcome.append("over")
+            cost.append(0.0)
+        elif ei > mel:
+            outcome.append("destroyed")
+            cost.append(float(replacement_cost))
+            back_in_service = ti + float(repair_days) / DAYS_PER_YEAR
+        elif ei > sel:
+            outcome.append("held, repair")
+            cost.append(float(repair_cost))
+        else:
+            outcome.append("held")
+            cost.append(0.0)
+    return pd.DataFrame({"time_years": t, "energy_kj": e, "height_m": h, "outcome": outcome, "cost": cost,
+                         "passes": [o in ("over", "destroyed", "passed, out of service") for o in outcome]})

@@ -186,8 +186,10 @@ def cmd_decide(args) -> int:
 
     inv = _read(args, args.inventory)
     gr, hazard, result = build_energy_hazard(args, inv)
-    from .assess import road_share
-    study = load_mitigation(args.options, hazard, road_share=road_share(result, hazard.collector, args.road_collector))
+    from .assess import road_share, study_context
+    study = load_mitigation(args.options, hazard, road_share=road_share(result, hazard.collector, args.road_collector),
+                            **study_context(result, hazard.collector, args.road_collector, args.option_blocks,
+                                            args.seed, inv, hazard, args.rate_scale))
     report = study_report(study)
     print(report["text"])
     with atomic_output_dir(out) as tmp:
@@ -237,7 +239,8 @@ def cmd_assess(args) -> int:
         print(f"{len(assessment.warnings)} warning(s), also listed in the report:")
         for w in assessment.warnings:
             print(f"  - {w}")
-    print(f"Best option: {s['best_option']} (then {s['second_option']}).")
+    print(f"Lowest expected total cost: {s['best_option']} (then {s['second_option']}).")
+    print(f"Recommendation: {s['recommendation']['option']} ({s['recommendation']['basis']}).")
     print(f"Report: {(out / 'report.html').resolve()}")
     return 0
 
@@ -388,6 +391,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("tree", nargs="?", default=None, help="decision tree file (.json or .toml)")
     p.add_argument("--options", default=None, metavar="TOML", help="mitigation options file")
     p.add_argument("--inventory", default=None, help="inventory file (with --options)")
+    p.add_argument("--option-blocks", type=int, default=20_000, metavar="N",
+                   help="blocks per re-simulation deriving an option's effect (ditch profiles; default 20,000)")
     p.add_argument("--road-collector", default="road",
                    help="collector at the road: P(road | barrier) from the simulation (default 'road')")
     p.add_argument("--risk-tolerance", type=float, default=None,

@@ -104,6 +104,7 @@ class Rollback:
     option_values: dict             # top-level decision: branch name -> value
     policy: dict                    # decision node path -> chosen branch
     objective: str
+    node_values: dict = field(default_factory=dict)   # node path -> rolled-back value (for diagrams)
 
 
 class DecisionTree:
@@ -187,10 +188,16 @@ class DecisionTree:
         the value of perfect information).
         """
         policy = {}
+        node_values = {}
         better = min if self.objective == "min" else max
         sign = 1.0 if self.objective == "max" else -1.0     # values are payoffs for max, costs for min
 
         def value(node):
+            v = _value(node)
+            node_values[node.path] = v
+            return v
+
+        def _value(node):
             if node.type == "terminal":
                 return _evaluate(node.value, self.parameters, f"{node.path}: value")
             vals = [self._net(b) + value(b.child) for b in node.branches]
@@ -218,11 +225,12 @@ class DecisionTree:
             return float(sign * ce)
 
         if self.root.type != "decision":
-            return Rollback(value(self.root), {}, policy, self.objective)
+            return Rollback(value(self.root), {}, policy, self.objective, node_values)
         options = {b.name: self._net(b) + value(b.child) for b in self.root.branches}
         best = better(options, key=options.get)
         policy[self.root.path] = best
-        return Rollback(options[best], options, policy, self.objective)
+        node_values[self.root.path] = options[best]
+        return Rollback(options[best], options, policy, self.objective, node_values)
 
     def ranking(self, **kwargs) -> pd.DataFrame:
         """Options of the top decision, best first, with their expected value and rank."""

@@ -94,18 +94,22 @@ class EnergyAnalysis:
                                                                                 index=False)
         write_energy_figures(self, out, [float(n.split(" kJ")[0]) for n in self.fences])
 
-def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m: float = 5.0, free_board_m: float = 0.5,
+def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_board_m: float = 0.5,
                    T=DESIGN_RETURN_PERIODS, design_T: float = 100.0, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
                    n_bootstrap: int = 300, seed=1, uni_factors: dict | None = None) -> EnergyAnalysis:
-    """Design table, fence checks (each capacity in ``fences`` at ``fence_height_m``) and UNI 11211-4 energy."""
+    """Design table, fence checks (each capacity in ``fences`` at ``fence_height_m``: one height [m] for all, or
+    one per fence) and UNI 11211-4 energy."""
     T_all = np.union1d(np.asarray(T, dtype=float), [design_T])
     table = hazard.design_table(T_all, n_bootstrap=n_bootstrap, seed=seed)
     row = table.loc[table["T_years"] == design_T].iloc[0]
     e_design = (float(row["energy_kj"]), float(row["ci_low_kj"]), float(row["ci_high_kj"]))
     design = table.loc[table["T_years"].isin(np.asarray(T, dtype=float))].reset_index(drop=True)
-    checks = {f"{cap:g} kJ / {fence_height_m:g} m": check_fence(hazard, cap, fence_height_m, T=design_T,
-                                                                 free_board_m=free_board_m, design_energy=e_design)
-              for cap in fences}
+    heights = list(fence_height_m) if np.ndim(fence_height_m) else [fence_height_m] * len(fences)
+    if len(heights) != len(fences):
+        raise ValueError(f"fence_height_m = {fence_height_m!r}: give one height or one per fence ({len(fences)})")
+    checks = {f"{cap:g} kJ / {h:g} m": check_fence(hazard, cap, h, T=design_T, free_board_m=free_board_m,
+                                                    design_energy=e_design)
+              for cap, h in zip(fences, heights)}
     uni = None
     if isinstance(hazard.mass, GutenbergRichterFit) and design_T * hazard.rate_per_year > 1:
         block = float(hazard.mass.isf(1.0 / (design_T * hazard.rate_per_year)))   # the T-year block at this line

@@ -1,121 +1,137 @@
-"""Mitigation options ranked by expected total cost (Wyllie 2014, 8.5.5; Wyllie, McCammon & Brumund 1980).
+"""Mitigation options ranked by expected total cost, with uncertainty and a recommendation.
 
-    expected total cost = capital + PV(renewals) + PV(maintenance + repairs) + PV(expected losses)
+    expected total cost = capital + PV(renewals) + PV(maintenance, repairs, replacements) + PV(expected losses)
 
-Each option leaves a residual hazard, the falls that still reach the road each
-year, built from the energy hazard at the barrier line:
+(Wyllie 2014, 8.5.5; Wyllie, McCammon & Brumund 1980.)  Each option is a
+transformation of the site (CLIMADA's measures: a measure changes the hazard, the
+exposure or the vulnerability; one engine computes the losses):
 
-* ``none`` (do nothing): every arriving fall;
-* ``scaling`` (scaling and bolting): the rate of falls cut by ``rate_reduction``;
-* ``ditch``: retains a share ``retention`` of arriving falls, or every fall up to ``max_mass_kg``;
-* ``fence`` / ``attenuator`` (``capacity_kj``, ``height_m``): falls passing over
-  (bounce height above the fence) or through (energy above the capacity), from the
-  simulated heights and velocities paired block by block; impacts it holds above
-  its service energy (MEL/3) cost a repair each;
-* ``shed`` (``capacity_kj``): falls with energy above its capacity;
-* ``realignment``: removes the exposure.
+* ``none``: the site as it is;
+* ``scaling`` (scaling and bolting): removes the release of blocks between ``min_mass_kg``
+  and ``max_mass_kg`` from the source zone ``zone_x_m`` (the share of the release line it
+  covers follows from the scenario's seeder);
+* ``ditch``: a catchment dug into the profile (``x_m``, ``width_m``, ``depth_m``); its
+  retention is derived by re-simulating the scenario with the new profile;
+* ``fence`` / ``attenuator``: a barrier line (``capacity_kj`` = MEL, ``height_m``) at the
+  barrier collector; falls pass over (simulated bounce height above the fence) or through
+  (energy above MEL, from the simulated velocities and the mass model, block by block);
+* ``shed``: covers ``covered_length_m`` of the exposed road (``traffic.exposed_length_m``)
+  with a capacity ``capacity_kj``;
+* ``realignment``: moves the road to ``road_x_m`` on the profile (share of falls still
+  reaching it from the simulated run-out), or away from the slope altogether;
+* ``combined``: several of the above (``options = [...]``) in series, each acting on the
+  falls the previous ones let through, costs added: no double counting.
 
-Losses per fall reaching the road: a moving vehicle at the impact point (Bunce et
-al. 1997, P(S:T)), a vehicle striking a rock left on the road, occupants killed
-with the given vulnerabilities at the value of a statistical life, vehicle
-damage, and closure and clean-up costs.  All inputs come from a TOML file
-documented in the README ("Mitigation files").
+Damage states (fences, attenuators, sheds): an impact between SEL = MEL/3 and MEL is
+held and costs ``repair_cost_per_impact``; an impact above MEL destroys the structure,
+passes, costs ``replacement_cost`` (default: the capital cost) and leaves the road
+unprotected for ``repair_days`` (ASSUMPTION, default 30 days for fences, 180 for sheds),
+during which every fall passes.  With destructive impacts at rate lambda_d the share of
+time out of service is lambda_d t_r / (1 + lambda_d t_r) (alternating renewal process).
+
+A typed ``retention`` (ditch, fence) or ``rate_reduction`` (scaling) replaces the derived
+effect; it is then an assumption and says so in every output.
+
+Road losses per fall reaching the road, for falls of every size (the power law above
+m_min and the inventory's own smaller falls below it): a moving vehicle at the impact
+point (Bunce et al. 1997), a vehicle striking the rock lying on the road, deaths with a
+vulnerability that depends on block mass (see :mod:`riskrf.road_risk`), vehicle damage,
+closure and clean-up.  All inputs come from a TOML file (README, "Mitigation files").
 """
 from __future__ import annotations
 
-import difflib
 import tomllib
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from .annual_hazard import EnergyHazard
-from .barriers import service_energy_level
+from .economics import pv_factor, renewal_factor
 from .impact_energy import mass_model
+from .measures import (Ditch, MeasureError, SimulationContext, effective_samples, material_value, road_crossings,
+                       runout_beyond, scenario_with_ditches, scenario_with_materials, seeder_share)
+from .power_law import GutenbergRichterFit
 from .road_risk import (
-    individual_risk,
-    pv_factor,
-    pv_of_renewals,
+    commuter_passage_probability,
+    commuter_strike_probability,
+    fn_zone,
+    occupancy_distribution,
+    occupant_fn,
     spatial_temporal_probability,
     stationary_rock_strike_probability,
-    vehicle_occupant_fn,
+    vulnerability_by_mass,
 )
-from .units import mass_for_energy_kg
+from .barriers import damage_state_shares, out_of_service_share
+from .units import kinetic_energy_kj
 
-OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment")
-
-
-class MitigationError(ValueError):
-    """A mitigation file or option is invalid; the message names the option and field."""
-
-
-@dataclass(frozen=True)
-class Exposure:
-    """Traffic on the exposed road section."""
-
-    vehicles_per_day: float = 4000.0
-    vehicle_length_m: float = 5.0
-    speed_kmh: float = 80.0
-    occupants_per_vehicle: float = 1.5
-    commuter_trips_per_day: float = 2.0
-    hours_rock_on_road: float = 0.5
-    p_cannot_stop: float = 0.002
-    share_stopping_on_road: float = 0.3
-
-
-@dataclass(frozen=True)
-class Consequences:
-    """Costs of consequences (in ``currency``) and vulnerabilities (probability of death)."""
-
-    value_of_statistical_life: float = 5.0e6
-    vulnerability_moving_vehicle: float = 0.5
-    vulnerability_striking_rock: float = 0.1
-    vehicle_damage: float = 25000.0
-    closure_days_per_fall: float = 0.5
-    closure_cost_per_day: float = 20000.0
-    cleanup_cost_per_fall: float = 3000.0
-    currency: str = "CHF"
-
-
-@dataclass(frozen=True)
-class Economics:
-    discount_rate: float = 0.03
-    horizon_years: float = 50.0
-
-
-@dataclass(frozen=True)
-class Option:
-    name: str
-    kind: str
-    capital_cost: float
-    annual_maintenance: float = 0.0
-    life_years: float | None = None
-    repair_cost_per_impact: float = 0.0
-    rate_reduction: float | None = None
-    retention: float | None = None
-    max_mass_kg: float | None = None
-    capacity_kj: float | None = None
-    height_m: float | None = None
-    description: str = ""
+from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.mitigation)
+    BARRIER_KINDS,
+    DEFAULT_REPAIR_DAYS,
+    MASS_BINS,
+    OPTION_KINDS,
+    Consequences,
+    Criteria,
+    Economics,
+    Exposure,
+    MitigationError,
+    Option,
+    Uncertainty,
+    _check_combinations,
+    closure_cost_per_fall,
+    parse_mitigation,
+    parse_option,
+)
 
 
 @dataclass(frozen=True)
 class OptionResult:
+    """Central-value results of one option (rates per year, money in the study currency)."""
+
     option: Option
     road_falls_per_year: float
-    held_impacts_above_sel_per_year: float
+    repairs_per_year: float
+    replacements_per_year: float
     vehicle_hits_per_year: float
     rock_strikes_per_year: float
     deaths_per_year: float
     expected_annual_loss: float
     individual_risk: float
+    retention: float | None
+    effectiveness: float
+
+    @property
+    def held_impacts_above_sel_per_year(self) -> float:
+        return self.repairs_per_year
+
+
+@dataclass(frozen=True)
+class _Stage:
+    """One element acting on the falls in series (see ``_chain``)."""
+
+    kind: str                  # "release", "ditch", "barrier", "exposure"
+    option: str
+    multiplier: np.ndarray | None = None      # release: per mass bin
+    param: str | None = None                  # parameter holding a sampled retention / rate reduction
+    passing: np.ndarray | None = None         # barrier: per mass bin, working structure
+    held_sel: np.ndarray | None = None
+    destroy: np.ndarray | None = None
+    coverage: float = 1.0
+    after_road: bool = False
+    factor: object = 0.0                      # exposure: share per slope model; ditch: retention shift per model
 
 
 @dataclass(frozen=True)
 class MitigationStudy:
-    """A hazard at the barrier line, the road exposure, consequences, economics and options."""
+    """A hazard at the barrier line, the road exposure, consequences, economics and options.
+
+    ``context`` (a :class:`~riskrf.measures.SimulationContext`) is the slope model used to
+    derive the options' effects; ``reference`` the simulation behind the hazard (road
+    velocities, run-out).  ``small_fall_masses_kg`` and ``small_falls_per_year``: the
+    inventory's falls below the power law's m_min (already scaled to this site).
+    """
 
     hazard: EnergyHazard
     options: tuple
@@ -125,334 +141,902 @@ class MitigationStudy:
     road_share: float = 1.0            # P(reaches the road | reaches the barrier line)
     source: str = "<dict>"
     defaults_used: tuple = field(default_factory=tuple)
+    context: SimulationContext | None = None
+    reference: object = None
+    small_fall_masses_kg: np.ndarray | None = field(default=None, repr=False)
+    small_falls_per_year: float = 0.0
+    uncertainty: Uncertainty = Uncertainty()
+    criteria: Criteria = Criteria()
 
-    # ---- residual hazard ---------------------------------------------------------------
-    def _paired_samples(self):
-        v = self.hazard.velocity
-        v = np.asarray(getattr(v, "velocity_ms", v), dtype=float)
-        h = self.hazard.heights_m
-        if h is None or len(h) != len(v):
-            raise MitigationError(f"{self.source}: fences and attenuators need simulated velocities paired with "
-                                  "bounce heights (build the hazard with EnergyHazard.from_simulation)")
-        return v, np.asarray(h, dtype=float)
-
-    def evaluate(self, option: Option) -> OptionResult:
-        hz = self.hazard
-        arrivals = hz.arrival_rate            # falls per year at the barrier line
-        mm = mass_model(hz.mass)
-        held_above_sel = 0.0
-        kind = option.kind
-        if kind == "none":
-            passing = 1.0
-        elif kind == "scaling":
-            passing = 1.0 - option.rate_reduction
-        elif kind == "ditch":
-            passing = (1.0 - option.retention) if option.retention is not None \
-                else float(mm.sf(option.max_mass_kg))
-        elif kind in ("fence", "attenuator"):
-            v, h = self._paired_samples()
-            over = h > option.height_m
-            through = mm.sf(mass_for_energy_kg(option.capacity_kj, v))
-            passing = float(np.mean(np.where(over, 1.0, through)))
-            above_sel = mm.sf(mass_for_energy_kg(service_energy_level(option.capacity_kj), v))
-            held_above_sel = arrivals * float(np.mean(np.where(over, 0.0, above_sel - through)))
-        elif kind == "shed":
-            passing = float(hz.exceedance_probability(option.capacity_kj))
-        else:   # realignment
-            passing = 0.0
-        road = arrivals * passing * self.road_share
-        ex, co = self.exposure, self.consequences
-        p_st = spatial_temporal_probability(ex.vehicles_per_day, ex.vehicle_length_m, ex.speed_kmh)
-        hits = road * p_st
-        strikes = road * ex.share_stopping_on_road * stationary_rock_strike_probability(
-            ex.vehicles_per_day, ex.hours_rock_on_road, ex.p_cannot_stop)
-        deaths = ex.occupants_per_vehicle * (hits * co.vulnerability_moving_vehicle
-                                             + strikes * co.vulnerability_striking_rock)
-        eal = (deaths * co.value_of_statistical_life + (hits + strikes) * co.vehicle_damage
-               + road * (co.closure_days_per_fall * co.closure_cost_per_day + co.cleanup_cost_per_fall))
-        ir = individual_risk(road, ex.commuter_trips_per_day, ex.vehicle_length_m, ex.speed_kmh,
-                             co.vulnerability_moving_vehicle)
-        return OptionResult(option, road, held_above_sel, hits, strikes, deaths, eal, ir)
-
-    # ---- ranking ---------------------------------------------------------------------
-    def ranking(self) -> pd.DataFrame:
-        """The ranking table: costs, expected losses, residual hazard, risk, benefit-cost ratio, rank."""
-        ec = self.economics
-        pvf = pv_factor(ec.discount_rate, ec.horizon_years)
-        rows = []
-        for opt in self.options:
-            r = self.evaluate(opt)
-            renew = pv_of_renewals(opt.capital_cost, opt.life_years, ec.horizon_years, ec.discount_rate) \
-                if opt.life_years else 0.0
-            pv_maint = pvf * (opt.annual_maintenance + r.held_impacts_above_sel_per_year * opt.repair_cost_per_impact)
-            pv_loss = pvf * r.expected_annual_loss
-            rows.append({"option": opt.name, "kind": opt.kind, "capital": opt.capital_cost + renew,
-                         "pv_maintenance": pv_maint, "pv_expected_loss": pv_loss,
-                         "expected_total_cost": opt.capital_cost + renew + pv_maint + pv_loss,
-                         "road_falls_per_year": r.road_falls_per_year, "deaths_per_year": r.deaths_per_year,
-                         "individual_risk": r.individual_risk})
-        df = pd.DataFrame(rows)
-        base = df[df["kind"] == "none"]
-        if len(base):
-            b = base.iloc[0]
-            spend = df["capital"] + df["pv_maintenance"] - (b["capital"] + b["pv_maintenance"])
-            saved = b["pv_expected_loss"] - df["pv_expected_loss"]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                df["benefit_cost_ratio"] = np.where(spend > 0, saved / spend, np.nan)
-        df = df.sort_values("expected_total_cost").reset_index(drop=True)
-        df["rank"] = np.arange(1, len(df) + 1)
-        return df
-
-    def best(self) -> str:
-        return self.ranking()["option"].iloc[0]
-
-    # ---- sensitivity -------------------------------------------------------------------
-    def _scaled(self, parameter: str, factor: float) -> "MitigationStudy":
-        """A copy with one input multiplied by ``factor`` (parameters of tornado() and break_even())."""
-        if parameter == "fall_rate":
-            return replace(self, hazard=replace(self.hazard, rate_per_year=self.hazard.rate_per_year * factor))
-        if parameter in {f.name for f in fields(Exposure)}:
-            return replace(self, exposure=replace(self.exposure, **{parameter: getattr(self.exposure, parameter)
-                                                                     * factor}))
-        if parameter in {f.name for f in fields(Consequences)} - {"currency"}:
-            return replace(self, consequences=replace(self.consequences,
-                                                      **{parameter: getattr(self.consequences, parameter) * factor}))
-        if parameter in ("discount_rate", "horizon_years"):
-            return replace(self, economics=replace(self.economics,
-                                                   **{parameter: getattr(self.economics, parameter) * factor}))
-        if parameter.startswith("capital_cost:"):
-            name = parameter.split(":", 1)[1]
-            opts = tuple(replace(o, capital_cost=o.capital_cost * factor) if o.name == name else o
-                         for o in self.options)
-            return replace(self, options=opts)
-        raise MitigationError(f"unknown sensitivity parameter {parameter!r}")
-
-    def sensitivity_parameters(self) -> list:
-        return ["fall_rate", "value_of_statistical_life", "vehicles_per_day", "vulnerability_moving_vehicle",
-                "discount_rate"] + [f"capital_cost:{o.name}" for o in self.options if o.capital_cost > 0]
-
-    def tornado(self, low: float = 0.5, high: float = 2.0) -> pd.DataFrame:
-        """Swing of the lowest expected total cost as each input is multiplied by ``low`` and ``high``."""
-        base = self.ranking()["expected_total_cost"].iloc[0]
-        rows = []
-        for p in self.sensitivity_parameters():
-            lo_rank, hi_rank = self._scaled(p, low).ranking(), self._scaled(p, high).ranking()
-            rows.append({"parameter": p, "factor_low": low, "factor_high": high,
-                         "cost_at_low": lo_rank["expected_total_cost"].iloc[0],
-                         "cost_at_high": hi_rank["expected_total_cost"].iloc[0],
-                         "best_at_low": lo_rank["option"].iloc[0], "best_at_high": hi_rank["option"].iloc[0],
-                         "base": base})
-        df = pd.DataFrame(rows)
-        df["swing"] = (df["cost_at_high"] - df["cost_at_low"]).abs()
-        return df.sort_values("swing", ascending=False).reset_index(drop=True)
-
-    def break_even(self, parameter: str, *, option_a: str | None = None, option_b: str | None = None,
-                   factor_range=(1e-3, 1e3)):
-        """Multiplier of ``parameter`` at which the best and second options (or a and b) cost the same.
-
-        Returns (factor, value) or None if they do not cross within ``factor_range``.
-        """
-        if option_a is None or option_b is None:
-            rank = self.ranking()["option"]
-            option_a, option_b = option_a or rank.iloc[0], option_b or rank.iloc[1]
-        a, b = option_a, option_b
-
-        def diff(log_f):
-            try:
-                t = self._scaled(parameter, float(np.exp(log_f))).ranking().set_index("option")
-            except ValueError:          # e.g. traffic so dense that P(S:T) >= 1: outside the model
-                return np.nan
-            return t["expected_total_cost"][a] - t["expected_total_cost"][b]
-        lo, hi = np.log(factor_range[0]), np.log(factor_range[1])
-        grid = np.linspace(lo, hi, 61)
-        vals = [diff(g) for g in grid]
-        for g0, g1, v0, v1 in zip(grid[:-1], grid[1:], vals[:-1], vals[1:]):
-            if np.isfinite(v0) and np.isfinite(v1) and np.sign(v0) != np.sign(v1):
-                from scipy.optimize import brentq
-                f = float(np.exp(brentq(diff, g0, g1, xtol=1e-10)))
-                return f, self._parameter_value(parameter) * f
-        return None
-
-    def _parameter_value(self, parameter: str) -> float:
-        if parameter == "fall_rate":
-            return self.hazard.rate_per_year
-        for obj in (self.exposure, self.consequences, self.economics):
-            if hasattr(obj, parameter):
-                return float(getattr(obj, parameter))
-        name = parameter.split(":", 1)[1]
-        return next(o.capital_cost for o in self.options if o.name == name)
-
-    def break_even_table(self) -> pd.DataFrame:
-        """For every sensitivity parameter: the value at which the second option would tie with the best."""
-        rank = self.ranking()
-        a, b = rank["option"].iloc[0], rank["option"].iloc[1]
-        rows = []
-        for p in self.sensitivity_parameters():
-            be = self.break_even(p, option_a=a, option_b=b)
-            rows.append({"parameter": p, "current": self._parameter_value(p),
-                         "break_even": be[1] if be else np.nan, "factor": be[0] if be else np.nan,
-                         "note": f"{b!r} ties with {a!r}" if be else "no tie within x0.001-x1000"})
-        return pd.DataFrame(rows)
-
-    def value_of_information(self, factors=(0.5, 1.0, 2.0), weights=(0.25, 0.5, 0.25)) -> dict:
-        """Expected value of perfect information about the rate of falls.
-
-        The rate is uncertain by more than its Poisson error (the share of the source
-        above the road, completeness, changes with time); ``factors`` and ``weights``
-        give a discrete distribution of the true rate relative to the estimate
-        (default: half, as estimated, double with probabilities 1/4, 1/2, 1/4).  EVPI =
-        cost of the best option chosen now minus the expected cost of choosing after
-        learning the rate: the most a monitoring programme that settles it is worth.
-        """
-        f = np.asarray(factors, dtype=float)
-        w = np.asarray(weights, dtype=float)
-        if f.shape != w.shape or np.any(f <= 0) or np.any(w < 0) or abs(w.sum() - 1) > 1e-9:
-            raise MitigationError(f"value_of_information: factors {f.tolist()} must be > 0 and weights {w.tolist()} "
-                                  "non-negative, as many, summing to 1")
-        tables = [self._scaled("fall_rate", x).ranking().set_index("option")["expected_total_cost"] for x in f]
-        expected = sum(wi * t for wi, t in zip(w, tables))
-        now = expected.idxmin()
-        informed = float(sum(wi * t.min() for wi, t in zip(w, tables)))
-        return {"evpi": float(expected[now] - informed), "best_now": now,
-                "expected_cost_now": float(expected[now]), "expected_cost_informed": informed,
-                "best_by_rate": {f"x{x:g}": t.idxmin() for x, t in zip(f, tables)},
-                "factors": f.tolist(), "weights": w.tolist()}
-
-    # ---- societal risk and tree --------------------------------------------------------
-    def fn_curve(self, option: str) -> pd.DataFrame:
-        opt = next((o for o in self.options if o.name == option), None)
-        if opt is None:
-            raise MitigationError(f"no option named {option!r}; options are {[o.name for o in self.options]}")
-        r = self.evaluate(opt)
-        return vehicle_occupant_fn(r.vehicle_hits_per_year, self.exposure.occupants_per_vehicle,
-                                   self.consequences.vulnerability_moving_vehicle)
-
-    def to_tree(self):
-        """The decision tree of this study (costs in present value), for rollback, diagrams and EVPI.
-
-        Under each option, a chance node gives the outcome of one fall reaching the
-        road; branch costs are that outcome's cost times the discounted expected
-        number of such falls over the horizon, so the rollback equals the ranking.
-        """
-        from .decision_tree import DecisionTree
-        ec, ex, co = self.economics, self.exposure, self.consequences
-        pvf = pv_factor(ec.discount_rate, ec.horizon_years)
-        p_st = spatial_temporal_probability(ex.vehicles_per_day, ex.vehicle_length_m, ex.speed_kmh)
-        p_strike = ex.share_stopping_on_road * stationary_rock_strike_probability(
-            ex.vehicles_per_day, ex.hours_rock_on_road, ex.p_cannot_stop)
-        per_fall = co.closure_days_per_fall * co.closure_cost_per_day + co.cleanup_cost_per_fall
-        ranking = self.ranking().set_index("option")
-        branches = []
-        for opt in self.options:
-            r = self.evaluate(opt)
-            n_pv = pvf * r.road_falls_per_year
-            row = ranking.loc[opt.name]
-            outcomes = [
-                {"name": "vehicle hit", "probability": p_st,
-                 "cost": n_pv * (per_fall + co.vehicle_damage + ex.occupants_per_vehicle
-                                 * co.vulnerability_moving_vehicle * co.value_of_statistical_life)},
-                {"name": "vehicle strikes rock on road", "probability": p_strike,
-                 "cost": n_pv * (per_fall + co.vehicle_damage + ex.occupants_per_vehicle
-                                 * co.vulnerability_striking_rock * co.value_of_statistical_life)},
-                {"name": "closure and clean-up only", "probability": 1 - p_st - p_strike, "cost": n_pv * per_fall}]
-            branches.append({"name": opt.name, "cost": float(row["capital"] + row["pv_maintenance"]),
-                             "child": {"type": "chance", "name": "each fall reaching the road",
-                                       "branches": outcomes}})
-        return DecisionTree.from_dict({"type": "decision", "name": "mitigation", "objective": "min",
-                                       "branches": branches}, source=self.source)
+    def __post_init__(self):
+        _check_combinations(self.options, self.source)
 
     @property
     def currency(self) -> str:
         return self.consequences.currency
 
+    def option(self, name: str) -> Option:
+        opt = next((o for o in self.options if o.name == name), None)
+        if opt is None:
+            raise MitigationError(f"no option named {name!r}; options are {[o.name for o in self.options]}")
+        return opt
 
-def _table(data: dict, cls, where: str, source: str, used: list):
-    names = {f.name for f in fields(cls)}
-    unknown = set(data) - names
-    if unknown:
-        key = sorted(unknown)[0]
-        close = difflib.get_close_matches(key, names, n=1)
-        raise MitigationError(f"{source}: unknown field {where}.{key}" + (f"; did you mean {close[0]!r}?" if close
-                                                                         else f"; allowed: {sorted(names)}"))
-    for f in fields(cls):
-        if f.name not in data:
-            used.append(f"{where}.{f.name} = {getattr(cls(), f.name)!r} (default)")
-        elif f.name != "currency":
-            v = data[f.name]
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or v < 0:
-                raise MitigationError(f"{source}: {where}.{f.name} = {v!r} must be a number >= 0")
-    return cls(**data)
+    # ---- mass grid ----------------------------------------------------------------------
+    @cached_property
+    def _grid(self):
+        """Mass bins [kg]: edges, representative masses, and the fixed small-fall histogram."""
+        mm = mass_model(self.hazard.mass)
+        gr = self.hazard.mass if isinstance(self.hazard.mass, GutenbergRichterFit) else None
+        lo_candidates = [float(mm.isf(1 - 1e-9))] if gr is None else [gr.m_min]
+        if self.small_fall_masses_kg is not None and len(self.small_fall_masses_kg):
+            lo_candidates.append(float(np.min(self.small_fall_masses_kg)))
+        lo = 0.999 * min(lo_candidates)
+        if gr is not None:
+            tops = [gr.m_max or gr.m_min * 1e6]
+            if self.uncertainty.m_max_kg:
+                tops.append(self.uncertainty.m_max_kg[1])
+            hi = max(tops)
+        else:
+            hi = float(mm.isf(1e-9))
+        edges = np.geomspace(lo, hi, MASS_BINS + 1)
+        mid = np.sqrt(edges[:-1] * edges[1:])
+        small = np.zeros(MASS_BINS)
+        if self.small_fall_masses_kg is not None and len(self.small_fall_masses_kg) and self.small_falls_per_year > 0:
+            small = np.histogram(np.clip(self.small_fall_masses_kg, lo, hi), edges)[0].astype(float)
+            small /= small.sum()
+        return edges, mid, small
+
+    def _mass_pmf(self, b=None, m_max=None):
+        """Probability of each mass bin for one fall of at least m_min; arrays (S, J) for sampled b, m_max."""
+        edges = self._grid[0]
+        m = self.hazard.mass
+        if isinstance(m, GutenbergRichterFit) and b is not None:
+            b = np.atleast_1d(b)[:, None]
+            top = np.atleast_1d(m_max if m_max is not None else np.inf)[:, None]
+            z = np.clip(edges[None, :], m.m_min, top)
+            with np.errstate(divide="ignore"):
+                t = np.where(np.isfinite(top), top ** -b, 0.0)
+            sf = (z ** -b - t) / (m.m_min ** -b - t)
+            sf[:, -1] = 0.0                                     # the last bin takes the tail
+            return np.clip(-np.diff(sf, axis=1), 0.0, None)
+        sf = mass_model(m).sf(edges)
+        sf[-1] = 0.0
+        return np.clip(-np.diff(sf), 0.0, None)[None, :]
+
+    # ---- slope models: the reference and the material-parameter variants ------------------
+    @cached_property
+    def _models(self) -> list:
+        """Slope models behind the derived effects: [0] the reference (the hazard's own simulation), then the
+        joint material draws, then one low and one high variant per uncertain material parameter (tornado)."""
+        models = [self._reference_model()]
+        u = self.uncertainty
+        ranges = self._material_ranges()
+        if ranges and self.context is not None:
+            ctx = self.context
+            rng = np.random.default_rng(np.random.SeedSequence([u.seed, 13]))
+            names = sorted(ranges)
+            if u.calibration is not None:
+                rows = u.calibration
+                pick = rng.choice(len(rows), size=u.material_draws, replace=len(rows) < u.material_draws)
+                draws = [{n: float(rows.iloc[i][f"materials.{n}"]) for n in names} for i in pick]
+            else:
+                draws = [{n: float(rng.uniform(*ranges[n][:2])) for n in names} for _ in range(u.material_draws)]
+            for vals in draws:
+                models.append(self._simulated_model(vals))
+            central = {n: material_value(ctx.scenario, n) for n in names}
+            for n in names:
+                for end, v in (("low", ranges[n][0]), ("high", ranges[n][1])):
+                    models.append(self._simulated_model({**central, n: v}, label=f"{n} {end}"))
+        return models
+
+    def _material_ranges(self) -> dict:
+        """"material.field" -> (low, high, how) of the uncertain slope material parameters."""
+        u = self.uncertainty
+        if u.calibration is not None:
+            out = {}
+            for col in u.calibration.columns:
+                x = u.calibration[col].to_numpy(dtype=float)
+                how = (f"joint rows of the calibration bootstrap {u.calibration_source} ({len(x)} replicates; "
+                       f"5-95 %); {u.material_draws} re-simulations")
+                out[col.removeprefix("materials.")] = (float(np.quantile(x, 0.05)), float(np.quantile(x, 0.95)), how)
+            return out
+        return {k: (lo, hi, f"uniform, stated; {u.material_draws} joint re-simulations")
+                for k, (lo, hi) in u.materials.items()}
+
+    def _reference_model(self) -> dict:
+        v = self.hazard.velocity
+        v = np.asarray(getattr(v, "velocity_ms", v), dtype=float)
+        h = self.hazard.heights_m
+        ctx = self.context
+        m = {"label": "reference", "values": {}, "barrier": (v, None if h is None else np.asarray(h, dtype=float)),
+             "reach": float(self.hazard.reach_probability), "road_share": float(self.road_share),
+             "scenario": None if ctx is None else ctx.scenario, "result": self.reference}
+        if self.reference is not None and ctx is not None and \
+                ctx.road_collector in [c.name for c in self.reference.scenario.collectors]:
+            m["road"] = effective_samples(self.reference, ctx.road_collector)
+        return m
+
+    def _simulated_model(self, values: dict, label: str = "draw") -> dict:
+        ctx = self.context
+        sc = scenario_with_materials(ctx.scenario, values, where=f"{self.source}: uncertainty.materials")
+        res = ctx.run(sc)
+        v, h = effective_samples(res, ctx.barrier_collector)
+        reach = max(v.size, 1) / res.n
+        road = effective_samples(res, ctx.road_collector)
+        share = min(road[0].size / v.size, 1.0) if v.size else 1.0
+        return {"label": label, "values": values, "barrier": (v, h), "road": road, "reach": reach,
+                "road_share": share, "scenario": sc, "result": res}
+
+    @cached_property
+    def _model_arrays(self):
+        """Reach probability at the barrier line and P(road | barrier) per slope model."""
+        ms = self._models
+        return (np.array([m["reach"] for m in ms]), np.array([m["road_share"] for m in ms]))
+
+    def material_models(self) -> pd.DataFrame:
+        """The slope models used: material values, reach probability and road share of each."""
+        return pd.DataFrame([{"model": i, "label": m["label"], **m["values"], "reach_probability": m["reach"],
+                              "road_share": m["road_share"]} for i, m in enumerate(self._models)])
+
+    # ---- option effects (derived once per slope model) --------------------------------------
+    def _barrier_stage(self, opt: Option) -> _Stage:
+        mid = self._grid[1]
+        cap = opt.capacity_kj
+        out = []
+        for m in self._models:
+            if opt.kind == "shed":
+                v, h = m.get("road", m["barrier"])
+                over = np.zeros(v.size, dtype=bool)
+            else:
+                v, h = self._fence_samples_at(opt, m) if opt.x_m is not None else m["barrier"]
+                if h is None or len(h) != len(v):
+                    raise MitigationError(f"{self.source}: option {opt.name!r}: fences and attenuators need simulated "
+                                          "velocities paired with bounce heights (a scenario, or a velocity file with "
+                                          "height_m)")
+                over = h > opt.height_m
+            # energies of every (block, mass bin) pair [kJ]: E = 1/2 m v^2; damage states from riskrf.barriers
+            out.append(damage_state_shares(kinetic_energy_kj(mid[None, :], v[:, None]), over, cap))
+        passing, held_sel, destroy = (np.array([o[i] for o in out]) for i in range(3))
+        coverage = min(opt.covered_length_m / self.exposure.exposed_length_m, 1.0) \
+            if opt.kind == "shed" and opt.covered_length_m else 1.0
+        return _Stage("barrier", opt.name, passing=passing, held_sel=held_sel, destroy=destroy, coverage=coverage,
+                      after_road=opt.kind == "shed",
+                      param=f"retention:{opt.name}" if opt.retention is not None else None)
+
+    def _fence_samples_at(self, opt: Option, model: dict):
+        import simulation.scenario as sc_mod
+        ctx = self._need_context(opt, "x_m")
+        prof = ctx.scenario.profile
+        if not prof.x[0] < opt.x_m < prof.x[-1]:
+            raise MitigationError(f"{self.source}: option {opt.name!r}: x_m = {opt.x_m:g} m is outside the profile "
+                                  f"({prof.x[0]:g}, {prof.x[-1]:g}) m")
+        col = sc_mod.Collector(f"{opt.name} line", float(opt.x_m))
+        sc = model["scenario"]
+        res = ctx.run(replace(sc, collectors=sc.collectors + (col,)))
+        return effective_samples(res, col.name)
+
+    def _need_context(self, opt, fld):
+        if self.context is None:
+            raise MitigationError(f"{self.source}: option {opt.name!r}: {fld} needs the slope scenario to derive its "
+                                  "effect (run with a scenario, or type an effectiveness as an assumption)")
+        return self.context
+
+    @cached_property
+    def _reference_run(self):
+        """The unmodified scenario with the re-simulation blocks and seed (the common random numbers)."""
+        return self.context.run(self.context.scenario)
+
+    @cached_property
+    def _reference_road_blocks(self):
+        return road_crossings(self._reference_run, self.context.road_collector)
+
+    def _ditch_retention(self, ditches, model: dict, index: int):
+        """Share of the falls that would reach the road that the ditches stop (common random numbers): overall,
+        its Monte Carlo Beta law, and by block mass (5 strata of the simulated masses, interpolated in log mass
+        onto the mass grid and held constant beyond the simulated range)."""
+        ctx = self.context
+        base_res = self._reference_run if index == 0 else model["result"]
+        base = self._reference_road_blocks if index == 0 else road_crossings(base_res, ctx.road_collector)
+        try:
+            sc = scenario_with_ditches(model["scenario"], ditches, where=self.source, road_collector=ctx.road_collector)
+        except (MeasureError, ValueError) as exc:
+            raise MitigationError(str(exc)) from exc
+        kept = road_crossings(ctx.run(sc), ctx.road_collector)
+        mid = self._grid[1]
+        k_b = base.size
+        if k_b == 0:
+            return 0.0, (0.5, 0.5), np.zeros(mid.size)
+        mass = base_res.blocks["mass"]
+        reached = np.zeros(mass.size, dtype=bool)
+        reached[base] = True
+        now = np.zeros(mass.size, dtype=bool)
+        now[kept] = True
+        stopped, extra = reached & ~now, now & ~reached        # extra: deflected onto the road by the ditch
+        r = max(int(stopped.sum()) - int(extra.sum()), 0)
+        edges = np.quantile(mass[reached], np.linspace(0, 1, 6))
+        centres, rets = [], []
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            s = (mass >= lo) & (mass <= hi)
+            n_s = int((reached & s).sum())
+            if n_s:
+                centres.append(float(np.median(mass[reached & s])))
+                rets.append(max(int((stopped & s).sum()) - int((extra & s).sum()), 0) / n_s)
+        by_mass = np.interp(np.log(mid), np.log(centres), rets) if centres else np.full(mid.size, r / k_b)
+        return r / k_b, (r + 0.5, k_b - r + 0.5), by_mass
+
+    @cached_property
+    def _derived(self) -> dict:
+        """Derived ditch retentions: key -> (overall retention of the reference model, its Beta law, overall
+        retention per slope model, retention by mass bin per slope model); filled by ``_effects``."""
+        return {}
+
+    @cached_property
+    def _effects(self) -> dict:
+        """Per option: the chain of stages in series and its component options."""
+        out = {}
+        for opt in self.options:
+            comps = [self.option(n) for n in opt.options] if opt.kind == "combined" else [opt]
+            out[opt.name] = (self._chain(opt, comps), comps)
+        return out
+
+    def _chain(self, opt: Option, comps) -> list:
+        mid = self._grid[1]
+        stages = []
+        for c in comps:
+            if c.kind == "scaling":
+                if c.rate_reduction is not None:
+                    stages.append(_Stage("release", c.name, param=f"rate_reduction:{c.name}"))
+                else:
+                    share = 1.0
+                    if c.zone_x_m is not None:
+                        ctx = self._need_context(c, "zone_x_m")
+                        try:
+                            share = seeder_share(ctx.scenario, c.zone_x_m, f"{self.source}: option {c.name!r}")
+                        except MeasureError as exc:
+                            raise MitigationError(str(exc)) from exc
+                    lo, hi = c.min_mass_kg or 0.0, c.max_mass_kg or np.inf
+                    inside = (mid >= lo) & (mid <= hi)
+                    stages.append(_Stage("release", c.name, multiplier=1.0 - share * inside))
+        ditches = [c for c in comps if c.kind == "ditch"]
+        typed = [c for c in ditches if c.retention is not None]
+        for c in typed:
+            stages.append(_Stage("ditch", c.name, param=f"retention:{c.name}"))
+        geo = [c for c in ditches if c.retention is None]
+        if geo:
+            self._need_context(geo[0], "x_m")
+            ds = [Ditch(c.x_m, c.width_m, c.depth_m, c.inner_slope_hv or 0.25,
+                        1.0 if c.outer_slope_hv is None else c.outer_slope_hv, c.material, c.name) for c in geo]
+            key = "+".join(c.name for c in geo)
+            if key not in self._derived:
+                per_model = [self._ditch_retention(ds, m, i) for i, m in enumerate(self._models)]
+                self._derived[key] = (per_model[0][0], per_model[0][1], np.array([r for r, _, _ in per_model]),
+                                      np.array([b for _, _, b in per_model]))
+            # retention by mass bin and slope model, as a shift from the overall reference retention (the parameter)
+            stages.append(_Stage("ditch", key, param=f"retention:{key}",
+                                 factor=self._derived[key][3] - self._derived[key][0]))
+        for c in comps:
+            if c.kind in ("fence", "attenuator"):
+                stages.append(self._barrier_stage(c))
+        for c in comps:
+            if c.kind == "shed":
+                stages.append(self._barrier_stage(c))
+        for c in comps:
+            if c.kind == "realignment":
+                if c.road_x_m is None:
+                    factor = np.zeros(len(self._models))
+                else:
+                    ctx = self._need_context(c, "road_x_m")
+                    prof = ctx.scenario.profile
+                    if not prof.x[0] < c.road_x_m < prof.x[-1]:
+                        raise MitigationError(f"{self.source}: option {c.name!r}: road_x_m = {c.road_x_m:g} m is "
+                                              f"outside the profile ({prof.x[0]:g}, {prof.x[-1]:g}) m")
+                    factor = []
+                    for m in self._models:
+                        ref = m["result"] if m["result"] is not None else self._reference_run
+                        road_x = ref.scenario.collectors[ref.scenario.collector_index(ctx.road_collector)].x
+                        now = runout_beyond(ref, road_x).sum()
+                        factor.append(min(float(runout_beyond(ref, c.road_x_m).sum() / now), 1.0) if now else 0.0)
+                    factor = np.array(factor)
+                stages.append(_Stage("exposure", c.name, factor=factor))
+        return stages
+
+    # ---- parameters -----------------------------------------------------------------------
+    def central_parameters(self) -> dict:
+        """Every input the engine varies, at its central value (names used by tornado and break-even)."""
+        self._effects
+        hz, ex, co, ec = self.hazard, self.exposure, self.consequences, self.economics
+        p = {"rate_factor": 1.0, "value_of_statistical_life": co.value_of_statistical_life,
+             "vulnerability_factor": 1.0, "vehicles_per_day": ex.vehicles_per_day,
+             "discount_rate": ec.discount_rate}
+        if isinstance(hz.mass, GutenbergRichterFit):
+            p["b"] = float(hz.mass.b)
+            p["rate_sampling_factor"] = 1.0
+            if hz.mass.m_max is not None:
+                p["m_max_kg"] = float(hz.mass.m_max)
+        for o in self.options:
+            if o.kind == "combined":
+                continue
+            p[f"capital_cost:{o.name}"] = o.capital_cost
+            p[f"annual_maintenance:{o.name}"] = o.annual_maintenance
+            if o.rate_reduction is not None:
+                p[f"rate_reduction:{o.name}"] = o.rate_reduction
+            if o.retention is not None:
+                p[f"retention:{o.name}"] = o.retention
+            if o.kind in BARRIER_KINDS:
+                p[f"repair_days:{o.name}"] = self._repair_days(o)
+        for key, (ret, _, _, _) in self._derived.items():
+            p[f"retention:{key}"] = ret
+        p["material_draw"] = 0.0           # index of the slope model (0: the reference simulation)
+        return p
+
+    def _repair_days(self, o):
+        return DEFAULT_REPAIR_DAYS[o.kind] if o.repair_days is None else o.repair_days
+
+    def parameter_ranges(self) -> dict:
+        """name -> (low, high, how): the range each uncertain input is sampled over (and the tornado uses)."""
+        from scipy import stats
+        u = self.uncertainty
+        c = self.central_parameters()
+        out = {}
+        hz = self.hazard
+        if "b" in c and u.sample_power_law:
+            n = hz.mass.n_tail
+            g = stats.gamma(n, scale=1.0 / n)
+            out["b"] = (c["b"] * g.ppf(0.05), c["b"] * g.ppf(0.95), "b x Gamma(n)/n (sampling law of the MLE)")
+            out["rate_sampling_factor"] = (g.ppf(0.05), g.ppf(0.95), "Gamma(n)/n (Poisson count of the record)")
+        if u.rate_factor != (1.0, 1.0):
+            out["rate_factor"] = (*u.rate_factor, "uniform, stated (share of the source above the road)")
+        if u.m_max_kg and "m_max_kg" in c:
+            out["m_max_kg"] = (*u.m_max_kg, "log-uniform, stated")
+        for name in ("value_of_statistical_life", "vehicles_per_day", "discount_rate"):
+            if getattr(u, name):
+                out[name] = (*getattr(u, name), "uniform, stated")
+        if u.vulnerability_factor != (1.0, 1.0):
+            out["vulnerability_factor"] = (*u.vulnerability_factor, "uniform, stated")
+        for o in self.options:
+            for fld, rng_name in (("capital_cost", "capital_cost_range"), ("annual_maintenance",
+                                                                            "annual_maintenance_range"),
+                                  ("retention", "retention_range"), ("rate_reduction", "rate_reduction_range")):
+                rng = getattr(o, rng_name)
+                if rng is not None and f"{fld}:{o.name}" in c:
+                    out[f"{fld}:{o.name}"] = (*rng, "uniform, stated" + (" (typed effectiveness: assumption)"
+                                                                         if fld in ("retention", "rate_reduction")
+                                                                         else ""))
+        if self.context is not None:
+            for path, rng in sorted(self._material_ranges().items()):
+                out[f"material:{path}"] = rng
+        if u.sample_retention:
+            for key, (_, (a, b), _, _) in self._derived.items():
+                d = stats.beta(a, b)
+                out[f"retention:{key}"] = (float(d.ppf(0.05)), float(d.ppf(0.95)),
+                                           "Beta (Monte Carlo error of the derived retention)")
+        return out
+
+    def sample_parameters(self, n: int | None = None, seed=None) -> dict:
+        """Joint samples of every uncertain input (arrays of length n), the rest at central values."""
+        from scipy import stats
+        u = self.uncertainty
+        n = int(u.samples if n is None else n)
+        rng = np.random.default_rng(u.seed if seed is None else seed)
+        c = self.central_parameters()
+        ranges = self.parameter_ranges()
+        out = {k: np.full(n, float(v)) for k, v in c.items()}
+        n_draws = self.uncertainty.material_draws if any(k.startswith("material:") for k in ranges) else 0
+        for name in sorted(ranges):            # fixed order: same seed, same samples
+            lo, hi, how = ranges[name]
+            if name.startswith("material:"):
+                continue
+            if name in ("b", "rate_sampling_factor"):
+                g = rng.gamma(self.hazard.mass.n_tail, size=n) / self.hazard.mass.n_tail
+                out[name] = c[name] * g if name == "b" else g
+            elif name.startswith("retention:") and "Beta" in how:
+                key = name.split(":", 1)[1]
+                a, b = self._derived[key][1]
+                out[name] = stats.beta(a, b).ppf(rng.uniform(size=n))   # shifted per slope model in the engine
+            elif "log-uniform" in how:
+                out[name] = np.exp(rng.uniform(np.log(lo), np.log(hi), n))
+            else:
+                out[name] = rng.uniform(lo, hi, n)
+        if n_draws:
+            out["material_draw"] = rng.integers(1, n_draws + 1, n).astype(float)
+        return out
+
+    # ---- the loss engine ---------------------------------------------------------------------
+    def _evaluate(self, P: dict, *, per_bin: bool = False) -> dict:
+        """The one loss engine: every option for parameter arrays ``P`` (length S); arrays (S, K)."""
+        effects = self._effects
+        edges, mid, small_pmf = self._grid
+        S = len(next(iter(P.values())))
+        hz, ex, co, ec = self.hazard, self.exposure, self.consequences, self.economics
+        d = P["material_draw"].astype(int) if "material_draw" in P else np.zeros(S, dtype=int)
+        reach_m, share_m = self._model_arrays
+        road_share = share_m[d]                                                     # (S,)
+        rate = hz.rate_per_year * P["rate_factor"] * P.get("rate_sampling_factor", 1.0)
+        pmf = self._mass_pmf(P.get("b"), P.get("m_max_kg")) if "b" in P else self._mass_pmf()
+        lam = rate[:, None] * pmf + (self.small_falls_per_year * P["rate_factor"])[:, None] * small_pmf[None, :]
+        arrivals = lam * reach_m[d][:, None]                                       # (S, J) at the barrier line
+        p_st = np.broadcast_to(spatial_temporal_probability(P["vehicles_per_day"], ex.vehicle_length_m,
+                                                            ex.speed_kmh), (S,))
+        p_strike = ex.share_stopping_on_road * np.broadcast_to(stationary_rock_strike_probability(
+            P["vehicles_per_day"], ex.hours_rock_on_road, ex.p_cannot_stop), (S,))
+        vf = P["vulnerability_factor"][:, None]
+        v_d = np.minimum(vulnerability_by_mass(mid, co.vulnerability_moving_vehicle)[None, :] * vf, 1.0)
+        v_s = np.minimum(vulnerability_by_mass(mid, co.vulnerability_striking_rock)[None, :] * vf, 1.0)
+        k_occ, p_occ = occupancy_distribution(ex.occupants_per_vehicle, ex.occupants_distribution)
+        occ = float(np.dot(k_occ, p_occ))
+        p_ts = commuter_passage_probability(ex.commuter_trips_per_day, ex.vehicle_length_m, ex.speed_kmh)
+        p_cs = ex.share_stopping_on_road * commuter_strike_probability(ex.commuter_trips_per_day,
+                                                                       ex.hours_rock_on_road, ex.p_cannot_stop)
+        r = P["discount_rate"]
+        pvf = np.broadcast_to(pv_factor(r, ec.horizon_years), (S,))
+        per_fall_cost = np.broadcast_to(closure_cost_per_fall(co, P["vehicles_per_day"]), (S,))
+        names = [o.name for o in self.options]
+        K = len(names)
+        res = {k: np.zeros((S, K)) for k in ("capital", "pv_renewals", "pv_maintenance", "pv_expected_loss",
+                                              "total", "road", "hits", "strikes", "deaths", "eal", "ir",
+                                              "repairs", "replacements", "retention", "effectiveness")}
+        road_bins = np.zeros((S, K, mid.size)) if per_bin else None
+        base_road = arrivals.sum(axis=1) * road_share
+        for k, opt in enumerate(self.options):
+            stages, comps = effects[opt.name]
+            x = arrivals.copy()
+            stopped_by_structures = np.zeros(S)
+            before_structures = None
+            maint = np.zeros(S)
+            capital = np.zeros(S)
+            renew = np.zeros(S)
+            repairs = np.zeros(S)
+            replacements = np.zeros(S)
+            repair_money = np.zeros(S)
+            for c in comps:
+                kc = P[f"capital_cost:{c.name}"]
+                capital += kc
+                maint += P[f"annual_maintenance:{c.name}"]
+                if c.life_years:
+                    renew += kc * renewal_factor(c.life_years, ec.horizon_years, r)
+            on_road = False
+            for st in stages:
+                if st.after_road and not on_road:
+                    x = x * road_share[:, None]
+                    on_road = True
+                if st.kind == "release":
+                    x = x * (st.multiplier[None, :] if st.multiplier is not None else (1.0 - P[st.param])[:, None])
+                    continue
+                if before_structures is None:
+                    before_structures = x.sum(axis=1) * (1.0 if on_road else road_share)
+                if st.kind == "ditch":
+                    ret = P[st.param][:, None] + (st.factor[d] if isinstance(st.factor, np.ndarray) else 0.0)
+                    x = x * (1.0 - np.clip(ret, 0.0, 1.0))
+                elif st.kind == "barrier":
+                    c = self.option(st.option)
+                    reach = x * st.coverage
+                    lam_d = (reach * st.destroy[d]).sum(axis=1)
+                    down = out_of_service_share(lam_d, P[f"repair_days:{c.name}"])
+                    held = (reach * st.held_sel[d]).sum(axis=1) * (1.0 - down)
+                    destroyed = lam_d * (1.0 - down)
+                    repairs += held
+                    replacements += destroyed
+                    repair_money += held * c.repair_cost_per_impact + destroyed * (
+                        P[f"capital_cost:{c.name}"] if c.replacement_cost is None else c.replacement_cost)
+                    working = st.passing[d] if st.param is None else (1.0 - P[st.param])[:, None]
+                    passing = down[:, None] + (1.0 - down[:, None]) * working
+                    x = x * (1.0 - st.coverage) + reach * passing
+                elif st.kind == "exposure":
+                    x = x * st.factor[d][:, None]
+            if not on_road:
+                x = x * road_share[:, None]
+            road = x.sum(axis=1)
+            if before_structures is not None and any(s.kind in ("ditch", "barrier") for s in stages):
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    stopped_by_structures = np.where(before_structures > 0, 1.0 - road / before_structures, 0.0)
+                    if any(s.kind == "exposure" for s in stages):
+                        stopped_by_structures = np.full(S, np.nan)
+            else:
+                stopped_by_structures = np.full(S, np.nan)
+            hits = x * p_st[:, None]
+            strikes = x * p_strike[:, None]
+            deaths = occ * ((hits * v_d).sum(axis=1) + (strikes * v_s).sum(axis=1))
+            eal = deaths * P["value_of_statistical_life"] + (hits.sum(axis=1) + strikes.sum(axis=1)) \
+                * co.vehicle_damage + road * per_fall_cost
+            ir = (x * (p_ts * v_d + p_cs * v_s)).sum(axis=1)
+            pv_m = pvf * (maint + repair_money)
+            pv_l = pvf * eal
+            for key, val in (("capital", capital), ("pv_renewals", renew), ("pv_maintenance", pv_m),
+                             ("pv_expected_loss", pv_l), ("total", capital + renew + pv_m + pv_l), ("road", road),
+                             ("hits", hits.sum(axis=1)), ("strikes", strikes.sum(axis=1)), ("deaths", deaths),
+                             ("eal", eal), ("ir", ir), ("repairs", repairs), ("replacements", replacements),
+                             ("retention", stopped_by_structures)):
+                res[key][:, k] = val
+            with np.errstate(invalid="ignore", divide="ignore"):
+                res["effectiveness"][:, k] = np.where(base_road > 0, 1.0 - road / base_road, 0.0)
+            if per_bin:
+                road_bins[:, k, :] = x
+        res["names"] = names
+        if per_bin:
+            res["road_bins"] = road_bins
+            res["p_st"], res["p_strike"], res["v_d"], res["v_s"] = p_st, p_strike, v_d, v_s
+        return res
+
+    def _central(self, overrides: dict | None = None, **kw) -> dict:
+        P = {k: np.array([float(v)]) for k, v in self.central_parameters().items()}
+        for k, v in (overrides or {}).items():
+            if k not in P:
+                raise MitigationError(f"unknown parameter {k!r}; parameters are {sorted(P)}")
+            P[k] = np.atleast_1d(np.asarray(v, dtype=float))
+            n = P[k].size
+        if overrides:
+            P = {k: np.broadcast_to(v, (n,)) if v.size == 1 else v for k, v in P.items()}
+        return self._evaluate(P, **kw)
+
+    @cached_property
+    def _central_result(self):
+        return self._central(per_bin=True)
+
+    def evaluate(self, option: Option | str) -> OptionResult:
+        """Central-value results of one option."""
+        opt = self.option(option if isinstance(option, str) else option.name)
+        r = self._central_result
+        k = r["names"].index(opt.name)
+        ret = float(r["retention"][0, k])
+        return OptionResult(opt, float(r["road"][0, k]), float(r["repairs"][0, k]), float(r["replacements"][0, k]),
+                            float(r["hits"][0, k]), float(r["strikes"][0, k]), float(r["deaths"][0, k]),
+                            float(r["eal"][0, k]), float(r["ir"][0, k]), None if np.isnan(ret) else ret,
+                            float(r["effectiveness"][0, k]))
+
+    # ---- uncertainty ----------------------------------------------------------------------------
+    @cached_property
+    def uncertain(self) -> dict:
+        """Joint samples: total cost per sample and option (S, K) and the derived statistics per option."""
+        P = self.sample_parameters()
+        r = self._evaluate(P, per_bin=True)
+        total = r["total"]
+        best = np.argmin(total, axis=1)
+        K = total.shape[1]
+        p_best = np.bincount(best, minlength=K) / total.shape[0]
+        regret = (total - total.min(axis=1, keepdims=True)).mean(axis=0)
+        ir_ok = r["ir"] <= self.criteria.individual_risk_per_year
+        fn_ok = self._fn_tolerable(r)
+        return {"names": r["names"], "total": total, "mean": total.mean(axis=0),
+                "probability_meets_criteria": (ir_ok & fn_ok).mean(axis=0),
+                "p05": np.percentile(total, 5, axis=0), "p95": np.percentile(total, 95, axis=0),
+                "probability_best": p_best, "expected_regret": regret,
+                "probability_meets_individual_risk": ir_ok.mean(axis=0),
+                "evpi": max(float(total.mean(axis=0).min() - total.min(axis=1).mean()), 0.0),
+                "samples": total.shape[0]}
+
+    def _fn_tolerable(self, r) -> np.ndarray:
+        """Per sample and option: is the F-N curve outside the GEO "unacceptable" region (N <= 1,000 here, the
+        occupancy of one vehicle)?  The same F(N) as :meth:`fn_curve`, for every joint sample at once."""
+        from .road_risk import HK_GEO_FN_LINES, share_with_at_least
+        kk, pk = occupancy_distribution(self.exposure.occupants_per_vehicle, self.exposure.occupants_distribution)
+        Ns = np.arange(1, int(kk.max()) + 1)
+        c_hi, k_hi = HK_GEO_FN_LINES["unacceptable above"]
+        a_d, a_s = share_with_at_least(r["v_d"], kk, pk), share_with_at_least(r["v_s"], kk, pk)   # (S, J, N)
+        x = r["road_bins"]                                             # (S, K, J)
+        F = np.einsum("skj,sjn->skn", x * r["p_st"][:, None, None], a_d) \
+            + np.einsum("skj,sjn->skn", x * r["p_strike"][:, None, None], a_s)
+        return ~np.any(F > c_hi / Ns[None, None, :] ** k_hi, axis=2)
+
+    # ---- societal risk -------------------------------------------------------------------------
+    def fn_curve(self, option: str) -> pd.DataFrame:
+        """F-N curve of an option: direct hits and strikes on fallen rocks, every block size, occupants as a
+        distribution, N = 1 ... largest occupancy."""
+        opt = self.option(option)
+        r = self._central_result
+        k = r["names"].index(opt.name)
+        x = r["road_bins"][0, k]
+        freq = np.concatenate([x * r["p_st"][0], x * r["p_strike"][0]])
+        vul = np.concatenate([r["v_d"][0], r["v_s"][0]])
+        kk, pk = occupancy_distribution(self.exposure.occupants_per_vehicle, self.exposure.occupants_distribution)
+        return occupant_fn(freq, vul, kk, pk)
+
+    # ---- ranking ---------------------------------------------------------------------------
+    def ranking(self) -> pd.DataFrame:
+        """Options ranked by expected total cost (mean over the joint samples), with the central-value
+        breakdown, 5-95 % of the total, probability of being cheapest, expected regret and road-user risk."""
+        r = self._central_result
+        u = self.uncertain
+        rows = []
+        for k, opt in enumerate(self.options):
+            fn = self.fn_curve(opt.name)
+            ret = r["retention"][0, k]
+            rows.append({
+                "option": opt.name, "kind": opt.kind,
+                "capital": r["capital"][0, k], "pv_renewals": r["pv_renewals"][0, k],
+                "pv_maintenance": r["pv_maintenance"][0, k], "pv_expected_loss": r["pv_expected_loss"][0, k],
+                "cost_at_central_values": r["total"][0, k],
+                "expected_total_cost": u["mean"][k], "cost_p05": u["p05"][k], "cost_p95": u["p95"][k],
+                "probability_best": u["probability_best"][k], "expected_regret": u["expected_regret"][k],
+                "road_falls_per_year": r["road"][0, k], "retention": None if np.isnan(ret) else float(ret),
+                "effectiveness": r["effectiveness"][0, k],
+                "effect_basis": self._basis(opt),
+                "repairs_per_year": r["repairs"][0, k], "replacements_per_year": r["replacements"][0, k],
+                "deaths_per_year": r["deaths"][0, k], "individual_risk": r["ir"][0, k],
+                "probability_meets_individual_risk": u["probability_meets_individual_risk"][k],
+                "probability_meets_criteria": u["probability_meets_criteria"][k],
+                "fn_zone": fn_zone(fn), "F_N1_per_year": float(fn["F"].iloc[0]) if len(fn) else 0.0})
+        df = pd.DataFrame(rows)
+        base = df[df["kind"] == "none"]
+        if len(base):
+            b = base.iloc[0]
+            spend = df["capital"] + df["pv_renewals"] + df["pv_maintenance"] \
+                - (b["capital"] + b["pv_renewals"] + b["pv_maintenance"])
+            saved = b["pv_expected_loss"] - df["pv_expected_loss"]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                df["benefit_cost_ratio"] = np.where(spend > 0, saved / spend, np.nan)
+                df["deaths_avoided_per_million"] = np.where(
+                    spend > 0, (b["deaths_per_year"] - df["deaths_per_year"]) * self.economics.horizon_years
+                    / spend * 1e6, np.nan)
+        df["meets_criteria"] = [self._meets(row) for _, row in df.iterrows()]
+        df = df.sort_values("expected_total_cost", kind="stable").reset_index(drop=True)
+        df["rank"] = np.arange(1, len(df) + 1)
+        return df
+
+    def _basis(self, opt: Option) -> str:
+        comps = [self.option(n) for n in opt.options] if opt.kind == "combined" else [opt]
+        typed = [c.name for c in comps if c.typed]
+        if typed:
+            return "ASSUMPTION: typed effectiveness (" + ", ".join(typed) + ")"
+        if opt.kind == "none":
+            return "-"
+        if all(c.kind == "realignment" and c.road_x_m is None for c in comps):
+            return "geometry: the road leaves the slope"
+        return "derived (simulation and site geometry)"
+
+    def _meets(self, row) -> bool:
+        return bool(row["individual_risk"] <= self.criteria.individual_risk_per_year
+                    and row["fn_zone"] in ("ALARP", "broadly acceptable"))
+
+    def best(self) -> str:
+        return self.ranking()["option"].iloc[0]
+
+    def recommendation(self, ranking: pd.DataFrame | None = None) -> dict:
+        """The cheapest option meeting the tolerability criteria, else the one reducing risk most per unit cost,
+        with the reasoning in plain words."""
+        t = self.ranking() if ranking is None else ranking
+        cur = self.currency
+        lim = self.criteria.individual_risk_per_year
+        ok = t[t["meets_criteria"]]
+        cheapest = t.iloc[0]
+        if len(ok):
+            rec = ok.iloc[0]
+            why = (f"{rec['option']} is the cheapest option that meets the tolerability criteria (individual risk "
+                   f"{rec['individual_risk']:.2g}/yr against {lim:.0e}/yr; societal risk {rec['fn_zone']} on the "
+                   f"{self.criteria.fn_diagram} F-N diagram). Its expected total cost is "
+                   f"{rec['expected_total_cost']:,.0f} {cur} (5-95 %: {rec['cost_p05']:,.0f} to "
+                   f"{rec['cost_p95']:,.0f} {cur}); it meets them in {rec['probability_meets_criteria']:.0%} of the "
+                   "joint samples of the uncertain inputs.")
+            if rec["option"] != cheapest["option"]:
+                intolerable = t[(t["expected_total_cost"] < rec["expected_total_cost"])]
+                why += (f" Cheaper options leave the risk intolerable: {cheapest['option']} costs least "
+                        f"({cheapest['expected_total_cost']:,.0f} {cur}, the cheapest in "
+                        f"{cheapest['probability_best']:.0%} of the joint samples) but leaves individual risk "
+                        f"{cheapest['individual_risk']:.2g}/yr and societal risk {cheapest['fn_zone']}"
+                        + (f"; so do {', '.join(intolerable['option'].iloc[1:])}" if len(intolerable) > 1 else "")
+                        + f". Meeting the criteria costs "
+                        f"{rec['expected_total_cost'] - cheapest['expected_total_cost']:,.0f} {cur} more in "
+                        "expectation.")
+            else:
+                why += f" It is also the cheapest overall, in {rec['probability_best']:.0%} of the joint samples."
+            basis = "cheapest tolerable option"
+        else:
+            cand = t[t["kind"] != "none"].dropna(subset=["deaths_avoided_per_million"])
+            cand = cand[cand["deaths_avoided_per_million"] > 0]
+            if len(cand) == 0:
+                rec, basis = cheapest, "lowest expected total cost (no option reduces the risk)"
+                why = f"No option meets the criteria or reduces the risk; {rec['option']} costs least."
+            else:
+                rec = cand.sort_values("deaths_avoided_per_million", ascending=False).iloc[0]
+                basis = "largest risk reduction per unit cost (no option meets the criteria)"
+                why = (f"No option meets the tolerability criteria (individual risk {lim:.0e}/yr and the F-N "
+                       f"diagram). {rec['option']} reduces the risk most per unit cost: "
+                       f"{rec['deaths_avoided_per_million']:.3g} statistical lives saved over "
+                       f"{self.economics.horizon_years:g} years per million {cur} spent; residual individual risk "
+                       f"{rec['individual_risk']:.2g}/yr.")
+        if "ASSUMPTION" in str(rec["effect_basis"]):
+            why += f" Note: its effectiveness is typed, not derived ({rec['effect_basis']})."
+        return {"option": str(rec["option"]), "basis": basis, "reason": why,
+                "expected_total_cost": float(rec["expected_total_cost"]),
+                "probability_best": float(rec["probability_best"])}
+
+    # ---- sensitivity ---------------------------------------------------------------------------
+    def sensitivity_parameters(self) -> list:
+        """Every input that can change the order: all engine parameters with an effect."""
+        return list(self.central_parameters())
+
+    def _tornado_range(self, name, value):
+        ranges = self.parameter_ranges()
+        if name in ranges:
+            return ranges[name][0], ranges[name][1], ranges[name][2]
+        if name.startswith(("retention:", "rate_reduction:")):
+            return max(value - 0.2, 0.0), min(value + 0.2, 1.0), "+-0.2 (no range stated)"
+        if name == "discount_rate":
+            return value * 0.5, min(value * 2, 0.2), "x0.5 / x2 (no range stated)"
+        return value * 0.5, value * 2.0, "x0.5 / x2 (no range stated)"
+
+    def tornado(self) -> pd.DataFrame:
+        """Lowest expected total cost (central values) as each input moves over its stated range (or x0.5/x2),
+        with the best option at each end, whether the best or the whole order changes; inputs that change the
+        best first, then those that change the order, each by swing.  Material parameters are re-simulated at
+        both ends of their ranges."""
+        c = self.central_parameters()
+        base_r = self._central_result
+        base = float(base_r["total"][0].min())
+        names = base_r["names"]
+        rows = []
+        items = [(p, v) for p, v in c.items() if p != "material_draw"]
+        labels = [m["label"] for m in self._models]
+        for name, (lo, hi, how) in self.parameter_ranges().items():
+            if name.startswith("material:"):
+                path = name.split(":", 1)[1]
+                items.append((name, (labels.index(f"{path} low"), labels.index(f"{path} high"), lo, hi, how)))
+        for p, v in items:
+            if p.startswith("material:"):
+                i_lo, i_hi, lo, hi, how = v
+                t = self._central({"material_draw": [i_lo, i_hi]})["total"]
+            else:
+                lo, hi, how = self._tornado_range(p, v)
+                if lo == hi:
+                    continue                     # e.g. a zero cost: nothing to vary
+                t = self._central({p: [lo, hi]})["total"]
+            order = list(np.argsort(base_r["total"][0], kind="stable"))
+            rows.append({"parameter": p, "low": lo, "high": hi, "range": how,
+                         "changes_order": any(list(np.argsort(row, kind="stable")) != order for row in t),
+                         "cost_at_low": t[0].min(), "cost_at_high": t[1].min(),
+                         "best_at_low": names[int(np.argmin(t[0]))], "best_at_high": names[int(np.argmin(t[1]))],
+                         "base": base})
+        df = pd.DataFrame(rows)
+        best = names[int(np.argmin(base_r["total"][0]))]
+        df["changes_best"] = (df["best_at_low"] != best) | (df["best_at_high"] != best)
+        df["swing"] = (df["cost_at_high"] - df["cost_at_low"]).abs()
+        return df.sort_values(["changes_best", "changes_order", "swing"], ascending=[False, False, False]
+                              ).reset_index(drop=True)
+
+    def _bracket(self, name, value):
+        if name.startswith(("retention:", "rate_reduction:")):
+            return 0.0, 1.0, False
+        if name == "b":
+            return 0.2, 3.0, False
+        if name == "discount_rate":
+            return 0.0, 0.3, False
+        if name == "vulnerability_factor":
+            return 1e-3, 1e3, True
+        return max(value, 1.0) * 1e-3 if value > 0 else 0.0, max(value, 1.0) * 1e3, True
+
+    def break_even(self, parameter: str, *, option_a: str | None = None, option_b: str | None = None):
+        """Value of ``parameter`` (others central) at which options a and b (default: the two cheapest at
+        central values) cost the same; None if they do not tie within the searched range."""
+        r = self._central_result
+        names = r["names"]
+        order = np.argsort(r["total"][0], kind="stable")
+        a = option_a or names[order[0]]
+        b = option_b or names[order[1]]
+        ia, ib = names.index(a), names.index(b)
+        c = self.central_parameters()
+        if parameter not in c:
+            raise MitigationError(f"unknown sensitivity parameter {parameter!r}; parameters are {sorted(c)}")
+        lo, hi, log = self._bracket(parameter, c[parameter])
+        grid = np.geomspace(max(lo, 1e-12), hi, 161) if log else np.linspace(lo, hi, 161)
+        try:
+            t = self._central({parameter: grid})["total"]
+        except ValueError:
+            return None
+        d = t[:, ia] - t[:, ib]
+        cross = np.nonzero(np.sign(d[:-1]) * np.sign(d[1:]) < 0)[0]
+        if cross.size == 0:
+            return None
+        # the crossing nearest the current value
+        j = cross[np.argmin(np.abs(grid[cross] - c[parameter]))]
+        from scipy.optimize import brentq
+
+        def diff(x):
+            tt = self._central({parameter: [x]})["total"][0]
+            return tt[ia] - tt[ib]
+        x = float(brentq(diff, grid[j], grid[j + 1], xtol=1e-12 * max(abs(grid[j + 1]), 1.0)))
+        return x / c[parameter] if c[parameter] else np.nan, x
+
+    def break_even_table(self) -> pd.DataFrame:
+        """For every input: the value at which the second-cheapest option would tie with the cheapest, and
+        whether that value lies inside the stated range."""
+        r = self._central_result
+        order = np.argsort(r["total"][0], kind="stable")
+        a, b = r["names"][order[0]], r["names"][order[1]]
+        ranges = self.parameter_ranges()
+        rows = []
+        for p, v in self.central_parameters().items():
+            if p == "material_draw":
+                continue                 # material parameters: re-simulated at the ends of their ranges (tornado)
+            be = self.break_even(p, option_a=a, option_b=b)
+            lo, hi = (ranges[p][0], ranges[p][1]) if p in ranges else (np.nan, np.nan)
+            inside = bool(be is not None and p in ranges and lo <= be[1] <= hi)
+            rows.append({"parameter": p, "current": v, "break_even": be[1] if be else np.nan,
+                         "factor": be[0] if be else np.nan, "range_low": lo, "range_high": hi,
+                         "within_stated_range": inside,
+                         "note": f"{b!r} ties with {a!r}" if be else "no tie within the searched range"})
+        return pd.DataFrame(rows)
+
+    def value_of_information(self, factors=(0.5, 1.0, 2.0), weights=(0.25, 0.5, 0.25)) -> dict:
+        """Expected value of perfect information about the rate of falls (``factors`` x the estimate with
+        ``weights``), and about every sampled input at once (from the joint samples)."""
+        f = np.asarray(factors, dtype=float)
+        w = np.asarray(weights, dtype=float)
+        if f.shape != w.shape or np.any(f <= 0) or np.any(w < 0) or abs(w.sum() - 1) > 1e-9:
+            raise MitigationError(f"value_of_information: factors {f.tolist()} must be > 0 and weights {w.tolist()} "
+                                  "non-negative, as many, summing to 1")
+        r = self._central({"rate_factor": f})
+        t = r["total"]
+        names = r["names"]
+        expected = w @ t
+        now = int(np.argmin(expected))
+        informed = float(w @ t.min(axis=1))
+        return {"evpi": float(expected[now] - informed), "best_now": names[now],
+                "expected_cost_now": float(expected[now]), "expected_cost_informed": informed,
+                "best_by_rate": {f"x{x:g}": names[int(np.argmin(row))] for x, row in zip(f, t)},
+                "factors": f.tolist(), "weights": w.tolist(),
+                "evpi_all_sampled_inputs": self.uncertain["evpi"]}
+
+    # ---- decision tree -------------------------------------------------------------------------
+    def to_tree(self):
+        """The decision tree of this study at central values (costs in present value), from the same engine.
+
+        Under each option a chance node gives the outcome of one fall reaching the road;
+        branch costs are that outcome's mean cost (over the sizes reaching the road) times
+        the discounted expected number of such falls, so the rollback equals the central
+        cost of the ranking.
+        """
+        from .decision_tree import DecisionTree
+        r = self._central_result
+        ec, ex, co = self.economics, self.exposure, self.consequences
+        pvf = pv_factor(ec.discount_rate, ec.horizon_years)
+        k_occ, p_occ = occupancy_distribution(ex.occupants_per_vehicle, ex.occupants_distribution)
+        occ = float(np.dot(k_occ, p_occ))
+        p_st, p_strike = float(r["p_st"][0]), float(r["p_strike"][0])
+        per_fall = float(closure_cost_per_fall(co, ex.vehicles_per_day))
+        branches = []
+        for k, opt in enumerate(self.options):
+            x = r["road_bins"][0, k]
+            road = x.sum()
+            n_pv = pvf * road
+            vd = float(np.dot(x, r["v_d"][0]) / road) if road > 0 else 0.0
+            vs = float(np.dot(x, r["v_s"][0]) / road) if road > 0 else 0.0
+            outcomes = [
+                {"name": "vehicle hit", "probability": p_st,
+                 "cost": n_pv * (per_fall + co.vehicle_damage + occ * vd * co.value_of_statistical_life)},
+                {"name": "vehicle strikes rock on road", "probability": p_strike,
+                 "cost": n_pv * (per_fall + co.vehicle_damage + occ * vs * co.value_of_statistical_life)},
+                {"name": "closure and clean-up only", "probability": 1 - p_st - p_strike, "cost": n_pv * per_fall}]
+            branches.append({"name": opt.name, "cost": float(r["capital"][0, k] + r["pv_renewals"][0, k]
+                                                             + r["pv_maintenance"][0, k]),
+                             "child": {"type": "chance", "name": "each fall reaching the road",
+                                       "branches": outcomes}})
+        return DecisionTree.from_dict({"type": "decision", "name": "mitigation", "objective": "min",
+                                       "branches": branches}, source=self.source)
+
+    def options_table(self) -> pd.DataFrame:
+        """What each option is and assumes, and its effect as used."""
+        r = self._central_result
+        rows = []
+        for k, o in enumerate(self.options):
+            ret = r["retention"][0, k]
+            rows.append({"option": o.name, "kind": o.kind, "what it is and assumes": o.describe(),
+                         "retention": None if np.isnan(ret) else float(ret),
+                         "effectiveness": float(r["effectiveness"][0, k]), "effect_basis": self._basis(o)})
+        return pd.DataFrame(rows)
 
 
-def parse_option(spec: dict, i: int, source: str) -> Option:
-    where = f"options[{i}]"
-    if not isinstance(spec, dict):
-        raise MitigationError(f"{source}: {where} must be a table")
-    name = spec.get("name")
-    if not name:
-        raise MitigationError(f"{source}: {where} needs a name")
-    where = f"option {name!r}"
-    allowed = {f.name for f in fields(Option)}
-    unknown = set(spec) - allowed
-    if unknown:
-        key = sorted(unknown)[0]
-        close = difflib.get_close_matches(key, allowed, n=1)
-        raise MitigationError(f"{source}: {where}: unknown field {key!r}" + (f"; did you mean {close[0]!r}?"
-                                                                            if close else ""))
-    kind = spec.get("kind")
-    if kind not in OPTION_KINDS:
-        raise MitigationError(f"{source}: {where}: kind = {kind!r} is not one of {', '.join(OPTION_KINDS)}")
-    if "capital_cost" not in spec:
-        raise MitigationError(f"{source}: {where}: missing field 'capital_cost' (use 0 for none)")
-    for key in ("capital_cost", "annual_maintenance", "life_years", "repair_cost_per_impact", "rate_reduction",
-                "retention", "max_mass_kg", "capacity_kj", "height_m"):
-        v = spec.get(key)
-        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or v < 0):
-            raise MitigationError(f"{source}: {where}: {key} = {v!r} must be a number >= 0")
-    need = {"scaling": ("rate_reduction",), "fence": ("capacity_kj", "height_m"),
-            "attenuator": ("capacity_kj", "height_m"), "shed": ("capacity_kj",)}.get(kind, ())
-    for key in need:
-        if spec.get(key) is None:
-            raise MitigationError(f"{source}: {where}: a {kind} needs {key}")
-    for key in ("rate_reduction", "retention"):
-        if spec.get(key) is not None and spec[key] > 1:
-            raise MitigationError(f"{source}: {where}: {key} = {spec[key]!r} is a share and must lie in [0, 1]")
-    if kind == "ditch" and (spec.get("retention") is None) == (spec.get("max_mass_kg") is None):
-        raise MitigationError(f"{source}: {where}: a ditch needs exactly one of retention or max_mass_kg")
-    if spec.get("life_years") == 0:
-        raise MitigationError(f"{source}: {where}: life_years must be > 0")
-    return Option(**{k: (float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else v)
-                     for k, v in spec.items()})
+def study_inputs(data: dict, source: str) -> dict:
+    """Keyword arguments of :class:`MitigationStudy` from a parsed mitigation (or site) table."""
+    options, exposure, consequences, economics, used, uncertainty, criteria = parse_mitigation(data, source)
+    return {"options": options, "exposure": exposure, "consequences": consequences, "economics": economics,
+            "defaults_used": used, "uncertainty": uncertainty, "criteria": criteria}
 
 
-def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
-    """Validate a mitigation table: returns (options, exposure, consequences, economics, defaults_used)."""
-    allowed = {"options", "traffic", "consequences", "economics"}
-    for key in data:
-        if key not in allowed:
-            close = difflib.get_close_matches(key, allowed, n=1)
-            raise MitigationError(f"{source}: unknown table [{key}]" + (f"; did you mean [{close[0]}]?" if close
-                                                                       else f"; allowed: {sorted(allowed)}"))
-    used: list = []
-    exposure = _table(data.get("traffic", {}), Exposure, "traffic", source, used)
-    consequences = _table(data.get("consequences", {}), Consequences, "consequences", source, used)
-    economics = _table(data.get("economics", {}), Economics, "economics", source, used)
-    if economics.discount_rate >= 1:
-        raise MitigationError(f"{source}: economics.discount_rate = {economics.discount_rate!r} must be a rate "
-                              "below 1 (e.g. 0.03)")
-    specs = data.get("options", [])
-    if not isinstance(specs, list) or len(specs) < 2:
-        raise MitigationError(f"{source}: [[options]] needs at least two options to compare")
-    options = tuple(parse_option(s, i, source) for i, s in enumerate(specs))
-    names = [o.name for o in options]
-    dup = {n for n in names if names.count(n) > 1}
-    if dup:
-        raise MitigationError(f"{source}: duplicate option name(s) {sorted(dup)}")
-    return options, exposure, consequences, economics, tuple(used)
+def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0, **kw) -> MitigationStudy:
+    """Read a mitigation TOML file (a site file works too) and combine it with an energy hazard.
 
-
-def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0) -> MitigationStudy:
-    """Read a mitigation TOML file and combine it with an energy hazard."""
+    Keyword arguments (``context``, ``reference``, ``small_fall_masses_kg``, ``small_falls_per_year``)
+    pass to :class:`MitigationStudy`.
+    """
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"mitigation file not found: {path}")
@@ -462,6 +1046,5 @@ def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0) -> M
         except tomllib.TOMLDecodeError as exc:
             raise MitigationError(f"{path}: not valid TOML: {exc}") from exc
     data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard")}   # a site file works too
-    options, exposure, consequences, economics, used = parse_mitigation(data, str(path))
-    return MitigationStudy(hazard=hazard, options=options, exposure=exposure, consequences=consequences,
-                           economics=economics, road_share=road_share, source=str(path), defaults_used=used)
+    return MitigationStudy(hazard=hazard, road_share=road_share, source=str(path), **study_inputs(data, str(path)),
+                           **kw)

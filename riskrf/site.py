@@ -12,7 +12,7 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .mitigation import MitigationError, parse_mitigation
+from .mitigation import MitigationError, study_inputs
 
 
 class SiteError(ValueError):
@@ -25,9 +25,10 @@ SITE_FIELDS = {
                   "m_min_kg": None, "m_max_kg": None, "rate_scale": 1.0, "annual_maxima": None},
     "hazard": {"scenario": None, "velocities": None, "collector": None, "road_collector": "road",
                "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
-               "free_board_m": 0.5, "design_period_years": 100.0, "bootstrap": 300, "seed": 1},
+               "free_board_m": 0.5, "design_period_years": 100.0, "bootstrap": 300, "seed": 1,
+               "option_blocks": 20_000},
 }
-MITIGATION_TABLES = ("traffic", "consequences", "economics", "options")
+MITIGATION_TABLES = ("traffic", "consequences", "economics", "options", "uncertainty", "criteria")
 
 
 @dataclass(frozen=True)
@@ -88,13 +89,21 @@ def load_site(path) -> Site:
     if (hz["scenario"] is None) == (hz["velocities"] is None):
         raise SiteError(f"{path}: give exactly one of hazard.scenario (a slope scenario to simulate) or "
                         "hazard.velocities (a velocity file)")
-    for key in ("n_blocks", "bootstrap"):
+    for key in ("n_blocks", "bootstrap", "option_blocks"):
         if not isinstance(hz[key], int) or hz[key] < 1:
             raise SiteError(f"{path}: hazard.{key} = {hz[key]!r} must be a whole number >= 1")
     if not isinstance(hz["fences_kj"], list) or not all(isinstance(v, (int, float)) and v > 0
                                                         for v in hz["fences_kj"]):
         raise SiteError(f"{path}: hazard.fences_kj = {hz['fences_kj']!r} must be a list of capacities > 0")
-    for key in ("fence_height_m", "free_board_m", "design_period_years"):
+    fh = hz["fence_height_m"]
+    if isinstance(fh, list):
+        if len(fh) != len(hz["fences_kj"]) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                      and v > 0 for v in fh):
+            raise SiteError(f"{path}: hazard.fence_height_m = {fh!r} must be one height > 0 or one per fence in "
+                            f"hazard.fences_kj ({len(hz['fences_kj'])})")
+    elif isinstance(fh, bool) or not isinstance(fh, (int, float)) or fh <= 0:
+        raise SiteError(f"{path}: hazard.fence_height_m = {fh!r} must be a number > 0 (or a list, one per fence)")
+    for key in ("free_board_m", "design_period_years"):
         if not isinstance(hz[key], (int, float)) or hz[key] < 0:
             raise SiteError(f"{path}: hazard.{key} = {hz[key]!r} must be a number >= 0")
     inv = tables["inventory"]
@@ -120,11 +129,48 @@ def load_site(path) -> Site:
                             f"has no such collector; its collectors are {names}")
     mit = {k: data[k] for k in MITIGATION_TABLES if k in data}
     try:
-        options, exposure, consequences, economics, mdefaults = parse_mitigation(mit, str(path))
+        mitigation = study_inputs(mit, str(path))
     except MitigationError as exc:
         raise SiteError(str(exc)) from exc
-    used += list(mdefaults)
+    used += list(mitigation.pop("defaults_used"))
+    if hz["scenario"] is not None:
+        _check_option_geometry(mitigation["options"], scenario, hz, path, mitigation["uncertainty"])
     return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
                 description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
-                mitigation={"options": options, "exposure": exposure, "consequences": consequences,
-                            "economics": economics}, defaults_used=tuple(used))
+                mitigation=mitigation, defaults_used=tuple(used))
+
+
+def _check_option_geometry(options, scenario, hz, path, uncertainty=None):
+    """Option geometry against the scenario, before anything is computed: positions inside the profile,
+    ditches that fit, scaling zones inside the release zone, uncertain material parameters that exist."""
+    from .measures import Ditch, MeasureError, ditch_profile, material_value, seeder_share
+    prof = scenario.profile
+    paths = list(uncertainty.materials) if uncertainty is not None else []
+    if uncertainty is not None and uncertainty.calibration is not None:
+        paths += [c.removeprefix("materials.") for c in uncertainty.calibration.columns]
+    for p in paths:
+        try:
+            material_value(scenario, p, f"{path}: uncertainty.materials")
+        except MeasureError as exc:
+            raise SiteError(str(exc)) from exc
+    for o in options:
+        where = f"{path}: option {o.name!r}"
+        for fld in ("x_m", "road_x_m"):
+            v = getattr(o, fld)
+            if v is not None and not prof.x[0] < v < prof.x[-1]:
+                raise SiteError(f"{where}: {fld} = {v:g} m is outside the profile ({prof.x[0]:g}, {prof.x[-1]:g}) m")
+        try:
+            if o.kind == "ditch" and o.retention is None:
+                d = Ditch(o.x_m, o.width_m, o.depth_m, option=o.name)
+                ditch_profile(prof, d.x_m, d.width_m, d.depth_m, where=where)
+                if o.material is not None and o.material not in prof.material_names:
+                    raise SiteError(f"{where}: material = {o.material!r} is not a material of the scenario "
+                                    f"({', '.join(prof.material_names)})")
+                road = next((c for c in scenario.collectors if c.name == hz["road_collector"]), None)
+                if road is not None and d.span[0] <= road.x <= d.span[1]:
+                    raise SiteError(f"{where}: the ditch ({d.span[0]:g}-{d.span[1]:g} m) would cut through the road "
+                                    f"line (collector {road.name!r} at x = {road.x:g} m)")
+            if o.kind == "scaling" and o.zone_x_m is not None:
+                seeder_share(scenario, o.zone_x_m, where)
+        except MeasureError as exc:
+            raise SiteError(str(exc)) from exc

@@ -124,7 +124,7 @@ def test_report_in_headless_chromium(assessed):
 
 
 @pytest.mark.parametrize("replace,match", [
-    ({"fence_height_m = 5.0": "fence_hieght_m = 5.0"}, "unknown field hazard.'fence_hieght_m'; did you mean "
+    ({"fence_height_m = [5.0, 7.0]": "fence_hieght_m = [5.0, 7.0]"}, "unknown field hazard.'fence_hieght_m'; did you mean "
                                                          "'fence_height_m'"),
     ({'lauterbrunnen_tls_2018.csv"': 'no_such_inventory.csv"'}, "inventory.path = .*no_such_inventory.csv.*file not "
                                                                  "found"),

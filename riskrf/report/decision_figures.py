@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..road_risk import HK_GEO_FN_LINES
+from ..road_risk import HK_GEO_FN_LINES, HK_GEO_N_CUTOFF, HK_GEO_N_LIMIT, HK_GEO_SCRUTINY_F_MIN
 from .fit_figures import _axes
 
 
@@ -14,6 +14,12 @@ def _fmt(v):
     if a >= 1e3:
         return f"{v / 1e3:.3g}k"
     return f"{v:.3g}"
+
+
+def _nodes(node):
+    yield node
+    for b in node.branches:
+        yield from _nodes(b.child)
 
 
 def plot_tree(tree, ax=None, *, max_label: int = 28):
@@ -38,22 +44,7 @@ def plot_tree(tree, ax=None, *, max_label: int = 28):
     n_leaves = max(len(leaves), 1)
     depth = max(d for d, _ in pos.values()) + 1
     ax = _axes(ax, figsize=(3.2 * depth + 2, 0.45 * n_leaves + 1.5))
-    values = {}
-    better = min if tree.objective == "min" else max
-
-    def value(node):
-        from ..decision_tree import _evaluate
-        if node.type == "terminal":
-            v = _evaluate(node.value, tree.parameters, node.path)
-        else:
-            vals = [tree._net(b) + value(b.child) for b in node.branches]
-            if node.type == "decision":
-                v = better(vals)
-            else:
-                v = sum(_evaluate(b.probability, tree.parameters, b.name) * x for b, x in zip(node.branches, vals))
-        values[id(node)] = v
-        return v
-    value(tree.root)
+    values = {id(node): rb.node_values[node.path] for node in _nodes(tree.root)}   # one rollback: decision_tree
 
     def draw(node, on_path):
         x, y = pos[id(node)]
@@ -123,19 +114,28 @@ def plot_risk_profiles(profile, ax=None):
 
 
 def plot_fn(curves: dict, ax=None, *, criteria: dict | None = None):
-    """F-N curves ``{label: DataFrame(N, F)}`` on log-log axes with criterion lines F = C / N^k."""
+    """F-N curves ``{label: DataFrame(N, F)}`` on the Hong Kong GEO diagram (GEO Report 75, ERM-Hong Kong 1998):
+    lines F = C / N^k up to N = 1,000, the "intense scrutiny" band for N = 1,000-5,000 and the
+    unacceptable region beyond."""
     ax = _axes(ax)
     criteria = HK_GEO_FN_LINES if criteria is None else criteria
-    nmax = 10.0
     for i, (label, df) in enumerate(curves.items()):
-        if len(df):
-            ax.step(df["N"], df["F"], where="post", color=f"C{i % 10}", lw=2, label=label, marker="o", ms=3)
-            nmax = max(nmax, float(df["N"].max()) * 10)
-    N = np.geomspace(1, nmax, 50)
+        if len(df) and np.any(df["F"] > 0):
+            d = df[df["F"] > 0]
+            ax.step(d["N"], d["F"], where="post", color=f"C{i % 10}", lw=2, label=label, marker="o", ms=3)
+    N = np.geomspace(1, HK_GEO_N_CUTOFF, 50)
     for j, (name, (C, k)) in enumerate(criteria.items()):
-        ax.loglog(N, C / N ** k, color="k", ls=["--", ":"][j % 2], lw=1, label=f"criterion: {name}")
+        ax.plot(N, C / N ** k, color="k", ls=["--", ":"][j % 2], lw=1, label=f"GEO 1998: {name}")
+    c_hi, k_hi = criteria["unacceptable above"]
+    top = c_hi / HK_GEO_N_CUTOFF ** k_hi
+    ax.plot([HK_GEO_N_CUTOFF, HK_GEO_N_CUTOFF], [HK_GEO_SCRUTINY_F_MIN, top], color="k", lw=1)
+    ax.fill_between([HK_GEO_N_CUTOFF, HK_GEO_N_LIMIT], HK_GEO_SCRUTINY_F_MIN, top, color="0.85",
+                    label="intense scrutiny (N 1,000-5,000)")
+    ax.axvline(HK_GEO_N_LIMIT, color="k", lw=1)
     ax.set_xscale("log")
     ax.set_yscale("log")
+    ax.set_xlim(0.8, 1e4)
+    ax.set_ylim(HK_GEO_SCRUTINY_F_MIN / 10, 1.0)
     ax.set_xlabel("number of fatalities N")
     ax.set_ylabel("annual frequency of N or more fatalities F [1/yr]")
     ax.grid(True, which="both", alpha=0.3)

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
-from ..road_risk import AGS2007_INDIVIDUAL_RISK, fn_zone
+from ..road_risk import fn_zone
 
 CSS = """
 body{font-family:Georgia,'Times New Roman',serif;max-width:1100px;margin:2em auto;padding:0 1.5em;color:#222;
@@ -169,35 +169,81 @@ def render_report(a, figs: Path) -> str:
         parts += [f"<h3>{_e(name)}</h3>", _table(table)]
 
     # 7. Risk
-    ir_limit = AGS2007_INDIVIDUAL_RISK["existing slope"]
+    ir_limit = a.study.criteria.individual_risk_per_year
     risk = ranking[["option", "road_falls_per_year", "deaths_per_year", "individual_risk"]].copy()
-    risk["meets AGS 2007 1e-4/yr (existing slope)"] = risk["individual_risk"] <= ir_limit
-    fns = {o.name: a.study.fn_curve(o.name) for o in a.study.options}
-    risk["F(N>=1) [1/yr]"] = [float(fns[o]["F"].iloc[0]) if len(fns[o]) else 0.0 for o in risk["option"]]
-    risk["Hong Kong GEO F-N zone"] = [fn_zone(fns[o]) for o in risk["option"]]
+    risk[f"meets {ir_limit:.0e}/yr"] = risk["individual_risk"] <= ir_limit
+    risk["F(N>=1) [1/yr]"] = ranking["F_N1_per_year"]
+    risk["Hong Kong GEO F-N zone"] = ranking["fn_zone"]
     parts += ["<h2>7. Risk to road users</h2>",
               f"<p>Bunce et al. (1997): P(S:T) = N<sub>v</sub> L<sub>v</sub> / (24 &times; 1000 &times; "
               f"V<sub>v</sub>) for {a.study.exposure.vehicles_per_day:,.0f} vehicles a day of "
               f"{a.study.exposure.vehicle_length_m:g} m at {a.study.exposure.speed_kmh:g} km/h; a vehicle striking "
-              "a rock on the road; individual risk of a commuter (AGS 2007).</p>",
+              "a rock on the road; individual risk of a commuter (AGS 2007). Both individual and societal risk count "
+              "direct hits and strikes on fallen rocks, falls of every size reaching the road (the power law above "
+              "m<sub>min</sub> and the inventory's smaller falls below it), a probability of death that grows with "
+              "block mass (an assumption anchored to AGS 2000 / Finlay et al. 1999, see the defaults) and occupants "
+              "per vehicle as a distribution. F-N zones on the Hong Kong diagram (ERM-Hong Kong, GEO Report 75, "
+              "1998): lines F = 10<sup>-3</sup>/N and 10<sup>-5</sup>/N to N = 1,000, intense scrutiny for "
+              "N = 1,000-5,000, unacceptable beyond.</p>",
               _table(risk, fmt="{:.3g}"), _figure(figs / "fn_curve.png", "F-N curves with Hong Kong GEO criteria")]
 
     # 8. Decision
     be = a.decision["break_even"]
+    rec = a.decision["recommendation"]
+    unc = a.decision["uncertainty"]
+
+    from .format import money
+
+    def _money(v):
+        return "" if v is None or pd.isna(v) else money(v, cur)
+    costs = pd.DataFrame({
+        "rank": ranking["rank"], "option": ranking["option"],
+        "expected total cost": ranking["expected_total_cost"].map(_money),
+        "5 % - 95 %": [f"{_money(x)} - {_money(y)}" for x, y in zip(ranking["cost_p05"], ranking["cost_p95"])],
+        "probability cheapest": ranking["probability_best"].map(lambda v: f"{v:.0%}"),
+        "expected regret": ranking["expected_regret"].map(_money),
+        "capital": ranking["capital"].map(_money), "renewals (PV)": ranking["pv_renewals"].map(_money),
+        "maintenance, repairs, replacements (PV)": ranking["pv_maintenance"].map(_money),
+        "expected losses (PV)": ranking["pv_expected_loss"].map(_money),
+        "meets criteria": ranking["meets_criteria"].map(lambda v: "yes" if v else "no"),
+        "meets them in (share of samples)": ranking["probability_meets_criteria"].map(lambda v: f"{v:.0%}")})
+    opts = a.decision["options_table"].copy()
+    opts["retention"] = opts["retention"].map(lambda v: "" if v is None or pd.isna(v) else f"{v:.0%}")
+    opts["effectiveness"] = opts["effectiveness"].map(lambda v: f"{v:.0%}")
+    opts = opts.rename(columns={"effectiveness": "falls kept off the road", "effect_basis": "effect from"})
     parts += ["<h2>8. Mitigation decision (Wyllie 2014, 8.5.5)</h2>",
-              f"<p>Expected total cost = capital + present value of maintenance and repairs + present value of "
-              f"expected losses, over {a.study.economics.horizon_years:g} years at "
-              f"{a.study.economics.discount_rate:.1%} ({_e(cur)}).</p>",
-              _table(ranking.drop(columns=["kind"]), fmt="{:,.4g}"),
-              _figure(figs / "tree.png", "Decision tree; the optimal path in red"),
-              f"<h3>What would make {_e(second)} as good as {_e(best)}</h3>",
-              _table(be), _figure(figs / "tornado.png", "Tornado: the best option's expected total cost with each "
-                                                         "input halved and doubled")]
+              f"<div class='box'><b>Recommendation: {_e(rec['option'])}</b> ({_e(rec['basis'])}).<br>"
+              f"{_e(rec['reason'])}</div>",
+              "<h3>The options</h3><p>Each option is a change of the site; its effect is derived (re-simulated "
+              "profile, simulated heights and energies at the barrier line, the mass model) unless marked as a typed "
+              "assumption. Retention: share of the falls that would reach the road which the structure stops.</p>",
+              _table(opts),
+              "<h3>Costs</h3>",
+              f"<p>Expected total cost = capital + present value of renewals + present value of maintenance, repairs "
+              f"(impacts between SEL and MEL) and replacements (impacts above capacity) + present value of expected "
+              f"losses, over {a.study.economics.horizon_years:g} years at {a.study.economics.discount_rate:.1%}. "
+              f"Mean and 5-95 % over {unc['samples']:,} joint samples of the uncertain inputs (seed {unc['seed']}); "
+              "probability cheapest: share of the samples in which the option costs least (they sum to 100 %).</p>",
+              _table(costs),
+              "<h3>Uncertain inputs</h3>",
+              _table(pd.DataFrame([{"input": k, "low": v["low"], "high": v["high"], "law": v["law"]}
+                                   for k, v in unc["inputs"].items()]), fmt="{:,.4g}"),
+              f"<p>Not sampled: {_e('; '.join(unc['not_sampled']))}.</p>",
+              _figure(figs / "tree.png", "Decision tree at central values; the optimal path in red"),
+              "<h3>What would make the runner-up as good (break-even)</h3>",
+              _table(be[np.isfinite(be["break_even"])], fmt="{:,.4g}"),
+              _figure(figs / "tornado.png", "Tornado: the lowest expected total cost as each input moves over its "
+                                            "stated range (x0.5 / x2 where none is stated); the 15 inputs that change "
+                                            "the best option or the order first, then by swing"),
+              "<h3>Inputs that change the best option or the order</h3>",
+              _table(a.decision["tornado"].loc[a.decision["tornado"]["changes_order"],
+                                               ["parameter", "low", "high", "range", "best_at_low", "best_at_high",
+                                                "changes_best"]], fmt="{:,.4g}")]
     voi = a.decision["value_of_information"]
     parts.append(f"<p>Value of perfect information about the rate of falls (true rate half, as estimated or "
-                 f"double the estimate, with probabilities 1/4, 1/2, 1/4): <b>{voi['evpi']:,.0f} {_e(cur)}</b> &mdash; "
-                 f"the most that monitoring which settles the rate is worth. Best option by rate: "
-                 + ", ".join(f"{_e(k)}: {_e(v)}" for k, v in voi["best_by_rate"].items()) + ".</p>")
+                 f"double the estimate, with probabilities 1/4, 1/2, 1/4): <b>{_money(voi['evpi'])}</b>; about all "
+                 f"sampled inputs at once: <b>{_money(voi['evpi_all_sampled_inputs'])}</b> &mdash; the most that "
+                 "investigations settling them are worth.</p>")
 
     # 9. Assumptions
     parts += ["<h2>9. Assumptions, defaults and warnings</h2><div class='warn'><ul>",

@@ -1,45 +1,105 @@
-"""Printable and written results of a mitigation study: ranking, break-even, tornado, figures."""
+"""Printable and written results of a mitigation study: ranking, recommendation, break-even, tornado, figures."""
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
 
+from .format import money  # noqa: F401  (money for a manager: "1,250,000 CHF")
+
+
+def option_entries(study, ranking: pd.DataFrame) -> list:
+    """The ``options`` entries of summary.json: one dict per option, ranked."""
+    out = []
+    table = study.options_table().set_index("option")
+    for _, r in ranking.iterrows():
+        e = {"name": r["option"], "kind": r["kind"], "rank": int(r["rank"]),
+             "description": table.loc[r["option"], "what it is and assumes"],
+             "expected_total_cost": float(r["expected_total_cost"]), "cost_p05": float(r["cost_p05"]),
+             "cost_p95": float(r["cost_p95"]), "cost_at_central_values": float(r["cost_at_central_values"]),
+             "probability_best": float(r["probability_best"]), "expected_regret": float(r["expected_regret"]),
+             "capital_cost": float(r["capital"]), "pv_renewals": float(r["pv_renewals"]),
+             "pv_maintenance_repairs_replacements": float(r["pv_maintenance"]),
+             "pv_expected_loss": float(r["pv_expected_loss"]),
+             "road_falls_per_year": float(r["road_falls_per_year"]),
+             "individual_risk_per_year": float(r["individual_risk"]),
+             "deaths_per_year": float(r["deaths_per_year"]), "fn_zone": r["fn_zone"],
+             "meets_criteria": bool(r["meets_criteria"]),
+             "probability_meets_criteria": float(r["probability_meets_criteria"]),
+             "effectiveness": float(r["effectiveness"]),
+             "effect_basis": r["effect_basis"],
+             "repairs_per_year": float(r["repairs_per_year"]),
+             "replacements_per_year": float(r["replacements_per_year"])}
+        if r["retention"] is not None and not pd.isna(r["retention"]):
+            e["retention"] = float(r["retention"])
+        out.append(e)
+    return out
+
 
 def study_report(study) -> dict:
-    """Ranking, tornado, break-even and a printable text of a mitigation study."""
+    """Ranking, recommendation, tornado, break-even, value of information and a printable text."""
     ranking = study.ranking()
     tornado = study.tornado()
     be = study.break_even_table()
+    rec = study.recommendation(ranking)
+    voi = study.value_of_information()
     cur = study.currency
-    show = ranking.copy()
-    for c in ("capital", "pv_maintenance", "pv_expected_loss", "expected_total_cost"):
-        show[c] = show[c].map(lambda v: f"{v:,.0f}")
-    show["individual_risk"] = show["individual_risk"].map(lambda v: f"{v:.2e}")
-    show["road_falls_per_year"] = show["road_falls_per_year"].map(lambda v: f"{v:.3g}")
-    show["deaths_per_year"] = show["deaths_per_year"].map(lambda v: f"{v:.2e}")
-    show["benefit_cost_ratio"] = show["benefit_cost_ratio"].map(lambda v: "" if pd.isna(v) else f"{v:.2f}")
-    a, b = ranking["option"].iloc[0], ranking["option"].iloc[1]
+    u = study.uncertainty
+    ranges = study.parameter_ranges()
+    show = pd.DataFrame({
+        "rank": ranking["rank"], "option": ranking["option"],
+        f"expected total cost [{cur}]": ranking["expected_total_cost"].map(lambda v: f"{v:,.0f}"),
+        "5-95 %": [f"{a:,.0f}-{b:,.0f}" for a, b in zip(ranking["cost_p05"], ranking["cost_p95"])],
+        "P(cheapest)": ranking["probability_best"].map(lambda v: f"{v:.1%}"),
+        "capital": ranking["capital"].map(lambda v: f"{v:,.0f}"),
+        "PV renewals": ranking["pv_renewals"].map(lambda v: f"{v:,.0f}"),
+        "road falls/yr": ranking["road_falls_per_year"].map(lambda v: f"{v:.3g}"),
+        "retention": ranking["retention"].map(lambda v: "" if v is None or pd.isna(v) else f"{v:.1%}"),
+        "deaths/yr": ranking["deaths_per_year"].map(lambda v: f"{v:.2e}"),
+        "indiv. risk/yr": ranking["individual_risk"].map(lambda v: f"{v:.2e}"),
+        "F-N zone": ranking["fn_zone"]})
     lines = [f"Mitigation ranking by expected total cost ({cur}, present values over "
-             f"{study.economics.horizon_years:g} years at {study.economics.discount_rate:.1%}):",
-             show.drop(columns=["kind"]).to_string(index=False), "",
-             f"Best: {a}.  What would make {b!r} as good (break-even, other inputs unchanged):"]
+             f"{study.economics.horizon_years:g} years at {study.economics.discount_rate:.1%}; mean and 5-95 % over "
+             f"{u.samples:,} joint samples of the uncertain inputs, seed {u.seed}):",
+             show.to_string(index=False), "",
+             "What each option is and assumes:"]
+    for _, r in study.options_table().iterrows():
+        lines.append(f"  {r['option']}: {r['what it is and assumes']} [{r['effect_basis']}]")
+    lines += ["", f"RECOMMENDATION: {rec['option']} ({rec['basis']}).", "  " + rec["reason"], "",
+              "Uncertain inputs sampled jointly: " + "; ".join(f"{k} {lo:.4g}-{hi:.4g} ({how})"
+                                                                for k, (lo, hi, how) in ranges.items())]
+    r0 = study._central_result
+    order = np.argsort(r0["total"][0], kind="stable")
+    ca, cb = r0["names"][order[0]], r0["names"][order[1]]
+    lines += ["", f"Break-even (at central values {ca!r} is cheapest, then {cb!r}; value at which they tie, "
+                  "other inputs unchanged):"]
     for r in be.itertuples():
         if np.isfinite(r.break_even):
-            lines.append(f"  {r.parameter}: {r.current:,.4g} -> {r.break_even:,.4g} (x{r.factor:.3g})")
-        else:
-            lines.append(f"  {r.parameter}: {r.note}")
-    voi = study.value_of_information()
-    lines += ["", f"Value of perfect information about the fall rate (x0.5 / x1 / x2 with probabilities "
-                  f"1/4, 1/2, 1/4): {voi['evpi']:,.0f} {cur}; best option by rate: "
-                  + ", ".join(f"{k}: {v}" for k, v in voi["best_by_rate"].items())]
-    lines += ["", "Tornado (best option's expected total cost with each input halved / doubled):"]
+            flag = "  <- INSIDE the stated range" if r.within_stated_range else ""
+            lines.append(f"  {r.parameter}: {r.current:,.4g} -> {r.break_even:,.4g}{flag}")
+    n_none = int((~np.isfinite(be["break_even"])).sum())
+    if n_none:
+        lines.append(f"  ({n_none} inputs cannot make them tie within the searched range)")
+    lines += ["", f"Value of perfect information: about the fall rate (x0.5 / x1 / x2 with probabilities 1/4, 1/2, "
+                  f"1/4) {voi['evpi']:,.0f} {cur}; about all sampled inputs {voi['evpi_all_sampled_inputs']:,.0f} "
+                  f"{cur}."]
+    lines += ["", "Tornado (lowest expected total cost at central values as each input moves over its range; "
+                  "inputs that change the best option first):"]
     for r in tornado.itertuples():
-        lines.append(f"  {r.parameter:<40} {r.cost_at_low:>14,.0f} .. {r.cost_at_high:>14,.0f}   "
-                     f"best: {r.best_at_low} / {r.best_at_high}")
+        lines.append(f"  {r.parameter:<38} {r.low:>12,.4g} .. {r.high:<12,.4g} cost {r.cost_at_low:>14,.0f} .. "
+                     f"{r.cost_at_high:>14,.0f}   best: {r.best_at_low} / {r.best_at_high}"
+                     + ("  CHANGES THE BEST" if r.changes_best else "  changes the order" if r.changes_order
+                        else ""))
     if study.defaults_used:
         lines += ["", "Defaults used: " + "; ".join(study.defaults_used)]
+    not_sampled = ["fragmentation (no fragmentation model)"]
+    if not any(k.startswith("material:") for k in ranges):
+        not_sampled.insert(0, "slope material parameters (no [uncertainty.materials] ranges given)")
+    uncertainty = {"samples": u.samples, "seed": u.seed,
+                   "inputs": {k: {"low": lo, "high": hi, "law": how} for k, (lo, hi, how) in ranges.items()},
+                   "not_sampled": not_sampled}
     return {"ranking": ranking, "tornado": tornado, "break_even": be, "value_of_information": voi,
-            "text": "\n".join(lines)}
+            "recommendation": rec, "options": option_entries(study, ranking), "uncertainty": uncertainty,
+            "options_table": study.options_table(), "text": "\n".join(lines)}
 
 
 def write_mitigation_outputs(study, report, tmp) -> None:
@@ -50,14 +110,15 @@ def write_mitigation_outputs(study, report, tmp) -> None:
     report["tornado"].to_csv(tmp / "tornado.csv", index=False)
     report["break_even"].to_csv(tmp / "break_even.csv", index=False)
     tree = study.to_tree()
-    write_json({"currency": study.currency, "ranking": report["ranking"], "break_even": report["break_even"],
+    write_json({"currency": study.currency, "recommendation": report["recommendation"],
+                "options": report["options"], "ranking": report["ranking"], "break_even": report["break_even"],
                 "tornado": report["tornado"], "tree_value": tree.rollback().value,
-                "value_of_information": report["value_of_information"],
+                "value_of_information": report["value_of_information"], "uncertainty": report["uncertainty"],
                 "defaults_used": list(study.defaults_used)}, tmp / "decision.json")
     ax = plot_tree(tree)
     save_figure(ax.figure, tmp / "tree.png")
-    ax = plot_tornado(report["tornado"], currency=study.currency)
+    ax = plot_tornado(report["tornado"].head(15), currency=study.currency)   # the 15 inputs that matter most
     save_figure(ax.figure, tmp / "tornado.png")
-    curves = {o.name: study.fn_curve(o.name) for o in study.options if o.kind != "realignment"}
+    curves = {o.name: study.fn_curve(o.name) for o in study.options}
     ax = plot_fn(curves)
     save_figure(ax.figure, tmp / "fn_curve.png")
