@@ -111,6 +111,7 @@ class SimulationResult:
 
     @property
     def n_impacts(self) -> int:
+        """Total number of ground impacts over all blocks."""
         return int(self.per_block["impacts"].sum())
 
     # ---- envelopes and paths -----------------------------------------------------
