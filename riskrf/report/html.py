@@ -27,8 +27,9 @@ def _name(path) -> str:
     return Path(str(path)).name
 
 
-#: Directory part of an absolute path in text (not inside a data URI, where "/" follows a letter).
-_ABSOLUTE_DIRS = re.compile(r"(?<![\w.:/&;-])/(?:[\w.-]+/)+(?=[\w.-])")
+#: Directory part of an absolute path in text.  Not inside a base64 data URI, where "/" always follows one
+#: of [A-Za-z0-9+/=,], nor in "km/h", "1/4" or closing tags.
+_ABSOLUTE_DIRS = re.compile(r"(?<![\w.:/&;+=,<-])/(?:[\w.-]+/)+(?=[\w.-])")
 
 
 def _item_table(df: pd.DataFrame) -> pd.DataFrame:
