@@ -32,6 +32,25 @@ def _name(path) -> str:
 _ABSOLUTE_DIRS = re.compile(r"(?<![\w.:/&;+=,<-])/(?:[\w.-]+/)+(?=[\w.-])")
 
 
+def _assumptions(a, hz, rate_scale) -> pd.DataFrame:
+    """Defaults and judgement inputs of an assessment: input, value, basis."""
+    rows = []
+    if getattr(hz.mass, "m_max", None):
+        rows.append(("maximum credible block m_max [kg]", sig(hz.mass.m_max), "judgement (site file)"))
+    rows.append(("rate share of the inventory at this slope", sig(rate_scale),
+                 "judgement (site file)" if rate_scale != 1 else "whole inventory (no scaling)"))
+    for entry in a.site.defaults_used:
+        name, _, value = str(entry).partition(" = ")
+        if ": ASSUMPTION" in name or "ASSUMPTION" in value:
+            name, _, value = str(entry).partition(": ASSUMPTION ")
+            rows.append((name, value, "typed assumption"))
+        elif value.endswith("(default)"):
+            rows.append((name, value[: -len("(default)")].strip(), "riskrf default"))
+        else:
+            rows.append((name, value, "riskrf default"))
+    return pd.DataFrame(rows, columns=["input", "value", "basis"])
+
+
 def _item_table(df: pd.DataFrame) -> pd.DataFrame:
     """A summary() frame indexed by item names, as two readable columns."""
     out = df.reset_index()
@@ -257,7 +276,10 @@ def render_report(a, figs: Path) -> str:
               "Velocities are taken as independent of block mass."),
              ("The rate and mass distribution come from the fitted power law, applied at the barrier line"
               + (f" with the rate scaled by {sig(rate_scale)} (typed assumption)" if rate_scale != 1 else "") + ".")]
-    items += [f"Default used: {d}" for d in site.defaults_used]
-    items += [f"Warning: {w}" for w in a.warnings]
     doc.add("<div class='warn'><ul>" + "".join(f"<li>{_e(t)}</li>" for t in items) + "</ul></div>")
+    doc.add("<p>Every input the site file did not give, and every judgement input, with where its value "
+            "comes from:</p>", doc.table(_assumptions(a, hz, rate_scale), "Defaults and judgement inputs"))
+    if a.warnings:
+        doc.add("<h3>Warnings</h3><div class='warn'><ul>"
+                + "".join(f"<li>{_e(w)}</li>" for w in a.warnings) + "</ul></div>")
     return _ABSOLUTE_DIRS.sub("", doc.render(header=header))
