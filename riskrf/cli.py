@@ -447,7 +447,50 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--bootstrap", type=int, default=200, help="bootstrap replicates (default 200; 0 to skip)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <scenario>-calibration)")
     p.set_defaults(func=cmd_calibrate)
+
+    p = sub.add_parser("rates", help="rock fall rates against rainfall, season and trend (Poisson / negative binomial)",
+                       description="Count the events of a dated inventory per day, month or year and fit Poisson and "
+                       "negative-binomial regressions on antecedent rainfall, season and a year trend (see the README "
+                       "section 'Rate models').  Prints the model comparison (AIC, deviance, overdispersion tests), "
+                       "rate ratios with intervals, the trend test and expected rates by month; writes CSV tables and "
+                       "the figures seasonality.png and rainfall_response.png.", epilog=EPILOG)
+    p.add_argument("inventory", help="dated inventory file with its record period (sidecar .toml or --start/--end)")
+    p.add_argument("--rainfall", required=True, metavar="FILE",
+                   help="daily rainfall: the Hong Kong Observatory file, or a CSV with date,rainfall_mm")
+    _add_inventory_arguments(p)
+    p.add_argument("--period", choices=("day", "month", "year"), default="day", help="counting period (default day)")
+    p.add_argument("--windows", default="1,3,15", metavar="D1,D2,...",
+                   help="antecedent rainfall bands for daily counts as window lengths in days (default 1,3,15: "
+                        "the day, the 2 days before, days 3-14 before)")
+    p.add_argument("--rain-transform", choices=("linear", "sqrt", "log1p"), default="linear",
+                   help="rainfall in the model: linear (rate ratio per 100 mm; default), sqrt or log1p "
+                        "(rate ratio of 100 mm against none)")
+    p.add_argument("--season", choices=("harmonic", "wet", "month", "none"), default="harmonic",
+                   help="season terms (default harmonic: annual sine and cosine)")
+    p.add_argument("--no-trend", action="store_true", help="leave out the year trend")
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-rates)")
+    p.set_defaults(func=cmd_rates)
     return parser
+
+
+def cmd_rates(args) -> int:
+    from .outputs import atomic_output_dir
+    from .rate_model import rate_model
+
+    try:
+        windows = tuple(int(w) for w in args.windows.split(","))
+    except ValueError:
+        raise ValueError(f"--windows {args.windows!r}: give whole numbers of days separated by commas") from None
+    inv = _read(args, args.inventory)
+    model = rate_model(inv, args.rainfall, period=args.period, windows_days=windows,
+                       season=None if args.season == "none" else args.season, trend=not args.no_trend,
+                       rain_transform=args.rain_transform)
+    print(model.summary_text())
+    out = Path(args.out) if args.out else Path(f"{Path(args.inventory).stem}-rates")
+    with atomic_output_dir(out) as tmp:
+        model.write(tmp)
+    print(f"\nWrote rate_ratios.csv, model_comparison.csv, design.csv, season.csv and figures to {out}/")
+    return 0
 
 
 def main(argv=None) -> int:
