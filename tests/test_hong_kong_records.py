@@ -160,3 +160,37 @@ def test_nvdb_e6_record_road_reference_and_chainage():
     raw = pd.read_csv(E6, dtype=str, keep_default_na=False)
     assert raw["road_reference"].str.match(r"EV6 hp\d+$").all()
     assert raw["chainage_from_m"].astype(int).between(0, 100_000).all()
+
+
+def test_fit_on_the_hong_kong_record_prefers_the_power_law_over_an_infinite_mean_gev():
+    from riskrf.frequency_study import analyse_inventory
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        inv = read_inventory(HK)
+        analysis = analyse_inventory(inv, n_bootstrap=0)
+    assert analysis.maxima.notna().sum() == 37 and analysis.gumbel.p_zero == 0   # no empty year
+    # measured (README, Hong Kong worked example): xi = 1.71, b = 0.691 above m_min 2.5 m3
+    assert analysis.gev.shape == pytest.approx(1.712, abs=0.01)
+    assert analysis.power_law.b == pytest.approx(0.691, abs=0.005)
+    assert not analysis.deviance["gumbel_adequate"]
+    pref = analysis.preferred_model()
+    assert pref["model"] == "power law" and pref["gev_shape_plausible"] is False
+    assert "implausible" in pref["reason"] and "infinite" in pref["reason"] and "1/b = 1.45" in pref["reason"]
+
+
+@pytest.mark.parametrize("kind,expected", [("exp-gumbel", "GEV"), ("gumbel", "Gumbel")])
+def test_preferred_model_wording_for_a_plausible_gev_and_an_adequate_gumbel(tmp_path, kind, expected):
+    from riskrf.frequency_study import analyse_inventory
+    rng = np.random.default_rng(5)
+    years = np.arange(1961, 2021)
+    z = rng.gumbel(0, 1, years.size)
+    masses = 1000 * np.exp(0.3 * z) if kind == "exp-gumbel" else 5000 + 800 * z   # GEV xi > 0, or Gumbel
+    f = tmp_path / "maxima.csv"
+    f.write_text("date,mass_kg\n" + "".join(f"{y}-07-01,{m:.1f}\n" for y, m in zip(years, masses)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        inv = read_inventory(f, start="1961-01-01", end="2020-12-31", density_kg_m3=2650)
+        analysis = analyse_inventory(inv, n_bootstrap=0, m_min=float(masses.min()))
+    pref = analysis.preferred_model()
+    assert pref["model"] == expected and pref["gev_shape_plausible"] is True
+    assert ("does not reject the Gumbel" in pref["reason"]) is (expected == "Gumbel")
