@@ -417,8 +417,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("demo", help="run the whole chain on the bundled example site",
                        description="Run riskrf assess on the bundled example site: the real Lauterbrunnen "
-                       "laser-scanning inventory (power law), the clearly labelled SYNTHETIC 40-year record (annual "
-                       "maxima), the shipped road-cut barrier scenario and illustrative traffic, costs and options. "
+                       "laser-scanning inventory (power law), the real Hong Kong rock-cut incident register 1984-2020 "
+                       "(annual maxima), the shipped road-cut barrier scenario and illustrative traffic, costs and options. "
                        "Works from any directory; takes well under a minute.", epilog=EPILOG)
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default ./riskrf-demo)")
     p.add_argument("--seed", type=int, default=None, help="random seed (default 1)")
