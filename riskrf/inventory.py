@@ -379,8 +379,12 @@ def _parse_dates(raw: pd.Series, path, col: str, rows: np.ndarray):
     return dates, years
 
 
-def _parse_sizes(raw: pd.Series, path, col: str, rows: np.ndarray) -> tuple[pd.Series, pd.Series]:
-    """Return (values, censoring): censoring is "" (exact), "below", "above", "approximate" or "unknown"."""
+def _split_censored(raw: pd.Series) -> tuple[pd.Series, pd.Series]:
+    """Strip a censoring prefix (``<1``, ``>20``, ``~15``) from size cells.
+
+    Returns (text without the prefix, censoring): censoring is ``""`` (exact),
+    ``"below"``, ``"above"``, ``"approximate"`` or ``"unknown"`` (empty cell).
+    """
     text = raw.astype(str).str.strip()
     censoring = pd.Series("", index=raw.index, dtype=object)
     censoring[text == ""] = "unknown"
@@ -389,13 +393,16 @@ def _parse_sizes(raw: pd.Series, path, col: str, rows: np.ndarray) -> tuple[pd.S
     if has_prefix.any():
         censoring[has_prefix] = match.loc[has_prefix, 0].str.lower().map(CENSORING)
         text = text.where(~has_prefix, match[1])
-    text = text.str.replace(",", ".", regex=False)
+    return text.astype(object), censoring
+
+
+def _parse_sizes(raw: pd.Series, path, col: str, rows: np.ndarray) -> pd.Series:
+    text = raw.str.strip().str.replace(",", ".", regex=False) if raw.dtype == object else raw
     values = pd.to_numeric(text.replace("", np.nan), errors="coerce")
     bad = values.isna() & (text != "")
     if bad.any():
         i = bad.idxmax()
-        raise ValueError(f"{path}: row {rows[i]}, column {col!r}: {raw[i]!r} is not a number (a censored size is "
-                         "written '<1', '>20' or '~15'; leave the cell empty when no size was recorded)")
+        raise ValueError(f"{path}: row {rows[i]}, column {col!r}: {raw[i]!r} is not a number")
     nonpos = values.notna() & ~(values > 0)
     if nonpos.any():
         i = nonpos.idxmax()
@@ -404,7 +411,7 @@ def _parse_sizes(raw: pd.Series, path, col: str, rows: np.ndarray) -> tuple[pd.S
     if inf.any():
         i = inf.idxmax()
         raise ValueError(f"{path}: row {rows[i]}, column {col!r}: size {raw[i]!r} is not finite")
-    return values, censoring
+    return values
 
 
 def read_inventory(path, *, start=None, end=None, duration_years=None, density_kg_m3=None,
@@ -488,14 +495,14 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         unit = volume_unit or vunit or "m3"
         if unit not in _VOLUME_UNITS:
             raise ValueError(f"volume_unit = {volume_unit!r} is not one of {sorted(_VOLUME_UNITS)}")
-        volume, vcens = _parse_sizes(table[vcol], path, vcol, rows)
-        volume = volume * _VOLUME_UNITS[unit]
+        vtext, vcens = _split_censored(table[vcol])
+        volume = _parse_sizes(vtext, path, vcol, rows) * _VOLUME_UNITS[unit]
     if mcol is not None:
         unit = mass_unit or munit or "kg"
         if unit not in _MASS_UNITS:
             raise ValueError(f"mass_unit = {mass_unit!r} is not one of {sorted(_MASS_UNITS)}")
-        mass, mcens = _parse_sizes(table[mcol], path, mcol, rows)
-        mass = mass * _MASS_UNITS[unit]
+        mtext, mcens = _split_censored(table[mcol])
+        mass = _parse_sizes(mtext, path, mcol, rows) * _MASS_UNITS[unit]
     if vcol is None:
         volume = mass / density
         size_column, censoring, size_raw = "mass", mcens, table[mcol]
