@@ -17,6 +17,7 @@ from .extremes import MIN_MAXIMA, GEVFit, GumbelFit, fit_gev, fit_gumbel
 from .inventory import Inventory
 from .outputs import write_json
 from .power_law import GutenbergRichterFit, fit_gutenberg_richter
+from .report.format import sig
 from .validation import RiskrfWarning
 
 #: Return periods of the design-mass table [yr].
@@ -109,22 +110,24 @@ class FrequencyAnalysis:
         implied = 1.0 / gr.b if gr.b > 0 else np.inf
         if d["gumbel_adequate"]:
             return {"model": "Gumbel", "gev_shape_plausible": bool(xi < 0.5),
-                    "reason": f"the deviance test does not reject the Gumbel (D = {d['deviance']:.2f}, "
-                              f"p = {d['p_value']:.3f}); the simpler model is preferred"}
+                    "reason": f"the deviance test does not reject the Gumbel (D = {sig(d['deviance'], 4)}, "
+                              f"p = {sig(d['p_value'], 2)}); the simpler model is preferred"}
         if xi < 0.5:
             return {"model": "GEV", "gev_shape_plausible": True,
-                    "reason": f"the deviance test rejects the Gumbel (D = {d['deviance']:.2f}, p = {d['p_value']:.3g}) "
+                    "reason": f"the deviance test rejects the Gumbel (D = {sig(d['deviance'], 4)}, "
+                              f"p = {sig(d['p_value'], 2)}) "
                               f"and the GEV shape xi = {xi:.3f} is plausible (finite mean and variance)"}
         what = "mean and variance are" if xi >= 1 else "variance is"
         return {"model": "power law", "gev_shape_plausible": False,
-                "reason": f"the deviance test rejects the Gumbel (D = {d['deviance']:.2f}, p = {d['p_value']:.3g}), but "
+                "reason": f"the deviance test rejects the Gumbel (D = {sig(d['deviance'], 4)}, "
+                          f"p = {sig(d['p_value'], 2)}), but "
                           f"the GEV shape xi = {xi:.2f} ± {gev.stderr[2]:.2f} is implausible: its {what} infinite, "
                           f"which no rock slope can produce.  It says the sizes have a heavy, power-law tail: "
                           f"power-law sizes give Fréchet maxima with xi = 1/b = {implied:.2f} (b = {gr.b:.3f}).  "
                           f"Use the power law for design masses (with m_max if a largest credible block can be "
                           f"justified) and read GEV return levels only within the "
                           f"{self.inventory.duration_years:.0f}-year record; the Gumbel understates the tail"
-                          + (f".  Caution: the bootstrap rejects an exact power law (p = {self.bootstrap_p:.3f}), so "
+                          + (f".  Caution: the bootstrap rejects an exact power law (p = {sig(self.bootstrap_p, 2)}), so "
                              "the tail beyond the record is uncertain; compare the lognormal alternative"
                              if self.bootstrap_p is not None and self.bootstrap_p <= 0.1 else "")}
 
@@ -134,6 +137,7 @@ class FrequencyAnalysis:
         return d.pivot(index="T_years", columns="model", values="mass_kg")
 
     def to_dict(self) -> dict:
+        """The fits as plain JSON-ready values (for summary.json)."""
         gr = self.power_law
         out = {
             "inventory": self.inventory.summary()["value"].to_dict(),
