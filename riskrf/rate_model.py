@@ -115,6 +115,7 @@ class RateModel:
     windows_days: tuple
     notes: tuple = field(default_factory=tuple)
     _glm_preferred: object = field(default=None, repr=False, compare=False)
+    rainfall: Rainfall | None = field(default=None, repr=False, compare=False)
 
     # --- small accessors -------------------------------------------------
     @property
@@ -239,14 +240,44 @@ class RateModel:
         out["events_per_year_equivalent"] = out["events_per_day"] * 365.25
         return out
 
-    def expected_annual_rate(self) -> float:
-        """Expected events per year over the record's rainfall climate, trend at the end of the record [1/yr]."""
+    def expected_annual_rate(self, *, rain_factor: float = 1.0, heavy_day_mm: float | None = None,
+                             heavy_day_change: float = 0.0) -> float:
+        """Expected events per year over the record's rainfall climate, trend at the end of the record [1/yr].
+
+        A stated change of climate can be applied (an assumption, reported as such by the caller):
+
+        * ``rain_factor``: every rainfall total multiplied by this factor (e.g. 1.1 for +10 %);
+        * ``heavy_day_change`` with ``heavy_day_mm`` (daily models): days whose own rainfall reaches
+          ``heavy_day_mm`` become ``1 + heavy_day_change`` times as frequent (e.g. 0.1 for +10 % heavy-rain
+          days), each with its recorded rainfall pattern, and the other days correspondingly rarer so the
+          year keeps its length.  The rate is the reweighted mean of the fitted daily rates.
+        """
+        if not (np.isfinite(rain_factor) and rain_factor >= 0):
+            raise ValueError(f"rain_factor = {rain_factor!r} must be a number >= 0")
         d = self.design.copy()
         if "year_c" in d:
             d["year_c"] = d["year_c"].max()
+        for t in self.terms.itertuples():
+            if t.term.startswith("rain_"):
+                d[t.term] = d[t.term] * rain_factor
         X = self._exog(d)
-        mu = self._glm_preferred.predict(X, offset=np.log(d["exposure_days"].to_numpy(float)))
-        return float(np.sum(mu) / (d["exposure_days"].sum() / 365.25))
+        mu = np.asarray(self._glm_preferred.predict(X, offset=np.log(d["exposure_days"].to_numpy(float))))
+        weights = np.ones(len(d))
+        if heavy_day_change:
+            if self.period != "day" or "rain_d0_mm" not in d:
+                raise ValueError("heavy_day_change needs a daily model whose first rainfall band is the day itself "
+                                 "(windows_days starting with 1)")
+            if heavy_day_mm is None or not (np.isfinite(heavy_day_mm) and heavy_day_mm > 0):
+                raise ValueError(f"heavy_day_mm = {heavy_day_mm!r}: give the daily rainfall [mm] of a heavy-rain day")
+            heavy = self.design["rain_d0_mm"].to_numpy() >= heavy_day_mm
+            n_h, n = int(heavy.sum()), len(d)
+            if n_h == 0:
+                raise ValueError(f"heavy_day_mm = {heavy_day_mm!r}: no day of the record reaches it")
+            w_h = 1.0 + heavy_day_change
+            if w_h < 0 or w_h * n_h > n:
+                raise ValueError(f"heavy_day_change = {heavy_day_change!r} gives an impossible share of heavy days")
+            weights = np.where(heavy, w_h, (n - w_h * n_h) / (n - n_h))
+        return float(np.sum(weights * mu) / (np.sum(weights * d["exposure_days"].to_numpy(float)) / 365.25))
 
     # --- text and files ---------------------------------------------------
     def summary_text(self) -> str:
@@ -699,7 +730,7 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
                      trend=trend_info, level=level, year_ref=year_ref, inventory_source=src,
                      rainfall_source=rain.source if rain is not None else "", start=start, end=end,
                      season=season_used, windows_days=windows if period == "day" else (),
-                     notes=tuple(list(inventory.notes) + notes), _glm_preferred=glm_pref)
+                     notes=tuple(list(inventory.notes) + notes), _glm_preferred=glm_pref, rainfall=rain)
 
 
 __all__ = ["RateModel", "rate_model", "MIN_PERIODS", "DEFAULT_WINDOWS_DAYS", "RiskrfWarning"]
