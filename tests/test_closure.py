@@ -126,3 +126,27 @@ def test_rainstorm_warning_file_and_closure_bad_rows(fitted, tmp_path):
         read_rainstorm_warnings(f)
     with pytest.raises(ValueError, match=r"level\(s\) \['Purple'\] do not occur"):
         warning_closure(fitted, w, levels=("Purple",))
+
+
+def test_cli_rates_with_closure_rules_and_a_change_of_climate(tmp_path, capsys):
+    from riskrf.cli import main
+    rng = np.random.default_rng(9)
+    days = pd.date_range("2000-12-01", "2008-12-31", freq="D")
+    rain = np.where(rng.random(len(days)) < 0.35, rng.gamma(0.7, 40.0, len(days)), 0.0)
+    (tmp_path / "rain.csv").write_text("date,rainfall_mm\n" + "".join(f"{d.date()},{r:.1f}\n"
+                                                                      for d, r in zip(days, rain)))
+    record = days[days >= "2001-01-01"]
+    counts = rng.poisson(0.05 * 4.0 ** (rain[-len(record):] / 100))
+    (tmp_path / "falls.csv").write_text("date,volume_m3\n" + "".join(f"{d.date()},2\n"
+                                                                     for d in np.repeat(record, counts)))
+    out = tmp_path / "out"
+    args = ["rates", str(tmp_path / "falls.csv"), "--rainfall", str(tmp_path / "rain.csv"), "--start", "2001-01-01",
+            "--end", "2008-12-31", "--windows", "1,3", "--closure-mm", "80", "--cost-per-hour", "500",
+            "--heavy-day-mm", "100", "--heavy-day-change", "0.1", "--out", str(out)]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "close while the 1-day rainfall reaches 80 mm" in text and "Stated change of climate (ASSUMPTION)" in text
+    assert (out / "closure_rules.csv").exists()
+    assert main(args[:-2] + ["--period", "month", "--out", str(tmp_path / "m")]) == 2
+    assert "--period month: closure rules (--closure-mm, --warnings) and --heavy-day-change need a daily model" \
+        in capsys.readouterr().err
