@@ -127,7 +127,8 @@ class FrequencyAnalysis:
                           f"Use the power law for design masses (with m_max if a largest credible block can be "
                           f"justified) and read GEV return levels only within the "
                           f"{self.inventory.duration_years:.0f}-year record; the Gumbel understates the tail"
-                          + (f".  Caution: the bootstrap rejects an exact power law (p = {sig(self.bootstrap_p, 2)}), so "
+                          + (f".  Caution: the bootstrap rejects an exact power law "
+                             f"(p = {sig(self.bootstrap_p, 2)}), so "
                              "the tail beyond the record is uncertain; compare the lognormal alternative"
                              if self.bootstrap_p is not None and self.bootstrap_p <= 0.1 else "")}
 

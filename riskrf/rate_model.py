@@ -153,7 +153,8 @@ class RateModel:
                 f"{r.rate_ratio:.4g} ({self.level:.0%} CI {r.ci_low:.4g}-{r.ci_high:.4g}, p = {r.p_value:.3g})")
         if self.trend:
             t = self.trend
-            rows["trend"] = (f"{'detected' if t['detected'] else 'not detected'}: rate x {t['rate_ratio_per_year']:.4f} "
+            word = "detected" if t["detected"] else "not detected"
+            rows["trend"] = (f"{word}: rate x {t['rate_ratio_per_year']:.4f} "
                              f"per year ({t['ci_low']:.4f}-{t['ci_high']:.4f}), LR = {t['lr_statistic']:.3f}, "
                              f"p = {t['p_value']:.3g}")
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
@@ -289,7 +290,8 @@ class RateModel:
                  self.comparison.to_string(float_format=lambda v: f"{v:.4g}"), ""]
         od = self.overdispersion
         if od:
-            lines.append(f"Overdispersion: alpha = {od['alpha']:.4g}; LR test of alpha = 0: LR = {od['lr_statistic']:.3f}, "
+            lines.append(f"Overdispersion: alpha = {od['alpha']:.4g}; LR test of alpha = 0: "
+                         f"LR = {od['lr_statistic']:.3f}, "
                          f"p = {od['lr_p_value']:.3g}; Cameron-Trivedi: t = {od['ct_statistic']:.3f}, "
                          f"p = {od['ct_p_value']:.3g}")
         lines += [f"Preferred: {self.preferred} ({self.reason})", "",
@@ -299,9 +301,11 @@ class RateModel:
                          f"p = {r.p_value:.3g}")
         if self.trend:
             t = self.trend
-            lines += ["", f"Trend: {'detected' if t['detected'] else 'not detected'} (likelihood ratio {t['lr_statistic']:.3f}, "
+            word = "detected" if t["detected"] else "not detected"
+            lines += ["", f"Trend: {word} (likelihood ratio {t['lr_statistic']:.3f}, "
                           f"p = {t['p_value']:.3g}); rate x {t['rate_ratio_per_year']:.4f} per year "
-                          f"({t['ci_low']:.4f} - {t['ci_high']:.4f}), x {t['rate_ratio_per_year'] ** 10:.3f} per decade"]
+                          f"({t['ci_low']:.4f} - {t['ci_high']:.4f}), "
+                          f"x {t['rate_ratio_per_year'] ** 10:.3f} per decade"]
         lines += ["", f"Expected rate over the record's rainfall climate (trend at {self.end.year}): "
                       f"{self.expected_annual_rate():.4g} events per year"]
         if self.period != "year":
