@@ -293,6 +293,7 @@ class Inventory:
             "volume min / median / max [m3]": " / ".join(sig(x) for x in (v.min(), np.median(v), v.max())),
             "mass min / median / max [kg]": " / ".join(sig(x) for x in (m.min(), np.median(m), m.max())),
             "dated": self.is_dated,
+            "censored or no size (not in the size fits)": self.n_censored,
         }
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 

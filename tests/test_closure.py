@@ -150,3 +150,27 @@ def test_cli_rates_with_closure_rules_and_a_change_of_climate(tmp_path, capsys):
     assert main(args[:-2] + ["--period", "month", "--out", str(tmp_path / "m")]) == 2
     assert "--period month: closure rules (--closure-mm, --warnings) and --heavy-day-change need a daily model" \
         in capsys.readouterr().err
+
+
+def test_real_observatory_warning_list_and_closure_on_the_hong_kong_record():
+    import os
+    from pathlib import Path
+    from .conftest import INVENTORIES, ROOT
+    path = Path(os.environ.get("RISKRF_SHARED_DIR", ROOT / ".." / "shared")) / "inventories-raw" / \
+        "hong-kong-cedd" / "hko_rainstorm_warnings_1998_2022.csv"
+    if not path.exists():
+        pytest.skip(f"{path} not present (shared raw records)")
+    w = read_rainstorm_warnings(path)
+    assert len(w) == 721 and w["level"].value_counts().to_dict() == {"Amber": 579, "Red": 117, "Black": 25}
+    assert (w["end"] > w["start"]).all()                        # "24:00:00" rows read as the end of the day
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        inv = read_inventory(INVENTORIES / "hong-kong" / "hong_kong_rock_cuts_1984_2020.csv")
+        model = rate_model(inv, INVENTORIES / "hong-kong" / "hko_daily_rainfall_1983_2020.csv", rain_transform="sqrt")
+    red = warning_closure(model, w, levels=("Red", "Black"))
+    assert red.start == pd.Timestamp("1998-01-01") and red.end == pd.Timestamp("2020-12-31")
+    # measured (README, "Closing the road on rain"): 3.9 % of falls, 13.5 h per year
+    assert red.effectiveness == pytest.approx(0.0393, abs=0.001)
+    assert red.closure_hours_per_year == pytest.approx(13.5, abs=0.1)
+    day = closure_rule(model, 100.0)
+    assert day.effectiveness == pytest.approx(0.250, abs=0.002) and day.observed_share == pytest.approx(0.2225, abs=1e-3)
