@@ -173,4 +173,5 @@ def test_real_observatory_warning_list_and_closure_on_the_hong_kong_record():
     assert red.effectiveness == pytest.approx(0.0393, abs=0.001)
     assert red.closure_hours_per_year == pytest.approx(13.5, abs=0.1)
     day = closure_rule(model, 100.0)
-    assert day.effectiveness == pytest.approx(0.250, abs=0.002) and day.observed_share == pytest.approx(0.2225, abs=1e-3)
+    assert day.effectiveness == pytest.approx(0.250, abs=0.002)
+    assert day.observed_share == pytest.approx(0.2225, abs=1e-3)
