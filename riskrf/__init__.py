@@ -27,6 +27,8 @@ from .frequency_study import FrequencyAnalysis, analyse_inventory
 from .impact_energy import exceedance_probability, fit_velocity
 from .inventory import DEFAULT_DENSITY_KG_M3, Inventory, read_inventory
 from .power_law import GutenbergRichterFit, find_m_min, fit_gutenberg_richter
+from .rainfall import Rainfall, read_rainfall
+from .rate_model import RateModel, rate_model
 from .validation import RiskrfWarning
 
 __all__ = [
@@ -34,4 +36,5 @@ __all__ = [
     "GutenbergRichterFit", "Inventory", "RiskrfWarning", "analyse_inventory", "encounter_probability",
     "exceedance_probability", "find_m_min", "fit_gev", "fit_gumbel", "fit_gutenberg_richter", "fit_velocity",
     "gumbel_frequency_factor", "gumbel_reduced_variate", "plotting_positions", "read_inventory",
+    "Rainfall", "RateModel", "rate_model", "read_rainfall",
 ]

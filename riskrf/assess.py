@@ -182,7 +182,7 @@ class Assessment:
             out["annual_maxima"] = {"source": src.inventory.source, "gumbel": dict(zip(src.gumbel.param_names,
                                                                                       src.gumbel.params)),
                                     "gev": dict(zip(src.gev.param_names, src.gev.params)) if src.gev else None,
-                                    "deviance_test": src.deviance}
+                                    "deviance_test": src.deviance, "preferred_model": src.preferred_model()}
         return out
 
 

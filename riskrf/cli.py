@@ -425,8 +425,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("demo", help="run the whole chain on the bundled example site",
                        description="Run riskrf assess on the bundled example site: the real Lauterbrunnen "
-                       "laser-scanning inventory (power law), the clearly labelled SYNTHETIC 40-year record (annual "
-                       "maxima), the shipped road-cut barrier scenario and illustrative traffic, costs and options. "
+                       "laser-scanning inventory (power law), the real Hong Kong rock-cut incident register 1984-2020 "
+                       "(annual maxima), the shipped road-cut barrier scenario and illustrative traffic, costs and options. "
                        "Works from any directory; takes well under a minute.", epilog=EPILOG)
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default ./riskrf-demo)")
     p.add_argument("--seed", type=int, default=None, help="random seed (default 1)")
@@ -455,7 +455,88 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--bootstrap", type=int, default=200, help="bootstrap replicates (default 200; 0 to skip)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <scenario>-calibration)")
     p.set_defaults(func=cmd_calibrate)
+
+    p = sub.add_parser("rates", help="rock fall rates against rainfall, season and trend (Poisson / negative binomial)",
+                       description="Count the events of a dated inventory per day, month or year and fit Poisson and "
+                       "negative-binomial regressions on antecedent rainfall, season and a year trend (see the README "
+                       "section 'Rate models').  Prints the model comparison (AIC, deviance, overdispersion tests), "
+                       "rate ratios with intervals, the trend test and expected rates by month; writes CSV tables and "
+                       "the figures seasonality.png and rainfall_response.png.", epilog=EPILOG)
+    p.add_argument("inventory", help="dated inventory file with its record period (sidecar .toml or --start/--end)")
+    p.add_argument("--rainfall", required=True, metavar="FILE",
+                   help="daily rainfall: the Hong Kong Observatory file, or a CSV with date,rainfall_mm")
+    _add_inventory_arguments(p)
+    p.add_argument("--period", choices=("day", "month", "year"), default="day", help="counting period (default day)")
+    p.add_argument("--windows", default="1,3,15", metavar="D1,D2,...",
+                   help="antecedent rainfall bands for daily counts as window lengths in days (default 1,3,15: "
+                        "the day, the 2 days before, days 3-14 before)")
+    p.add_argument("--rain-transform", choices=("linear", "sqrt", "log1p"), default="linear",
+                   help="rainfall in the model: linear (rate ratio per 100 mm; default), sqrt or log1p "
+                        "(rate ratio of 100 mm against none)")
+    p.add_argument("--season", choices=("harmonic", "wet", "month", "none"), default="harmonic",
+                   help="season terms (default harmonic: annual sine and cosine)")
+    p.add_argument("--no-trend", action="store_true", help="leave out the year trend")
+    p.add_argument("--closure-mm", type=float, action="append", metavar="MM",
+                   help="evaluate a closure rule: close the road on days whose rainfall over --closure-window days "
+                        "reaches MM (daily models; repeat for several thresholds)")
+    p.add_argument("--closure-window", type=int, default=1, metavar="DAYS", help="closure rule window (default 1)")
+    p.add_argument("--warnings", default=None, metavar="FILE",
+                   help="Hong Kong Observatory rainstorm warning list: evaluate closing under Red or Black warnings")
+    p.add_argument("--cost-per-hour", type=float, default=0.0, metavar="MONEY",
+                   help="cost of one hour of closure, for the closure rules (default 0)")
+    p.add_argument("--heavy-day-mm", type=float, default=None, metavar="MM",
+                   help="with --heavy-day-change: daily rainfall of a heavy-rain day")
+    p.add_argument("--heavy-day-change", type=float, default=None, metavar="SHARE",
+                   help="expected rate if heavy-rain days became this much more frequent (0.1 = +10%%; an assumption)")
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-rates)")
+    p.set_defaults(func=cmd_rates)
     return parser
+
+
+def cmd_rates(args) -> int:
+    from .outputs import atomic_output_dir
+    from .rate_model import rate_model
+
+    try:
+        windows = tuple(int(w) for w in args.windows.split(","))
+    except ValueError:
+        raise ValueError(f"--windows {args.windows!r}: give whole numbers of days separated by commas") from None
+    if args.period != "day" and (args.closure_mm or args.warnings or args.heavy_day_change is not None):
+        raise ValueError(f"--period {args.period}: closure rules (--closure-mm, --warnings) and --heavy-day-change "
+                         "need a daily model (--period day)")
+    if (args.heavy_day_change is None) != (args.heavy_day_mm is None):
+        raise ValueError("give --heavy-day-mm and --heavy-day-change together")
+    inv = _read(args, args.inventory)
+    model = rate_model(inv, args.rainfall, period=args.period, windows_days=windows,
+                       season=None if args.season == "none" else args.season, trend=not args.no_trend,
+                       rain_transform=args.rain_transform)
+    print(model.summary_text())
+    if args.heavy_day_change is not None:
+        base = model.expected_annual_rate()
+        changed = model.expected_annual_rate(heavy_day_mm=args.heavy_day_mm, heavy_day_change=args.heavy_day_change)
+        print(f"\nStated change of climate (ASSUMPTION): days with >= {args.heavy_day_mm:g} mm "
+              f"{args.heavy_day_change:+.0%} as frequent: {changed:.4g} events per year against {base:.4g} "
+              f"({changed / base - 1:+.1%})")
+    rules = []
+    if args.closure_mm or args.warnings:
+        from .closure import closure_rule, warning_closure
+        rules = [closure_rule(model, mm, window_days=args.closure_window, cost_per_hour=args.cost_per_hour)
+                 for mm in (args.closure_mm or [])]
+        if args.warnings:
+            rules.append(warning_closure(model, args.warnings, levels=("Red", "Black"),
+                                         cost_per_hour=args.cost_per_hour))
+        import pandas as pd
+        table = pd.concat([r.summary()["value"].rename(f"rule {i + 1}") for i, r in enumerate(rules)], axis=1)
+        print("\nClosure rules (effectiveness = share of falls while closed, from the rate model):")
+        print(table.to_string())
+    out = Path(args.out) if args.out else Path(f"{Path(args.inventory).stem}-rates")
+    with atomic_output_dir(out) as tmp:
+        model.write(tmp)
+        if rules:
+            pd.concat([r.summary()["value"].rename(f"rule {i + 1}") for i, r in enumerate(rules)], axis=1).to_csv(
+                tmp / "closure_rules.csv")
+    print(f"\nWrote rate_ratios.csv, model_comparison.csv, design.csv, season.csv and figures to {out}/")
+    return 0
 
 
 def main(argv=None) -> int:

@@ -23,7 +23,7 @@ def _site_copy(tmp_path, replace=None, drop=None):
     """The demo site with absolute paths, optionally edited, in tmp_path."""
     text = SITE.read_text()
     data_dir = SITE.parent
-    for rel in ("lauterbrunnen_tls_2018.csv", "synthetic_corridor_1985_2024.csv",
+    for rel in ("lauterbrunnen_tls_2018.csv", "synthetic_corridor_1985_2024.csv", "hong_kong_rock_cuts_1984_2020.csv",
                 "../../simulation/scenarios/road_cut_barrier.toml"):
         text = text.replace(f'"{rel}"', f'"{(data_dir / rel).resolve()}"')
     text = text.replace("n_blocks = 50000", "n_blocks = 6000").replace("bootstrap = 200", "bootstrap = 40")
@@ -76,6 +76,8 @@ def test_summary_matches_the_modules(assessed):
     assert s["units"]["energy"] == "kJ" and s["units"]["money"] == "CHF"
     assert s["best_option"] == s["ranking"][0]["option"]
     assert "annual_maxima" in s and s["annual_maxima"]["deviance_test"]["p_value"] < 0.05
+    assert "hong_kong_rock_cuts" in s["annual_maxima"]["source"]          # the real record, not the synthetic one
+    assert s["annual_maxima"]["preferred_model"]["model"] == "power law"  # GEV xi = 1.71: implausible
 
 
 def test_copied_inputs_rerun_to_the_same_numbers(assessed, tmp_path):

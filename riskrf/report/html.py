@@ -142,8 +142,8 @@ def render_report(a, figs: Path) -> str:
     else:
         sub = figs if mf is fr else figs / "annual_maxima"
         d = mf.deviance or {}
-        preferred = ("Gumbel (the deviance test does not reject it)" if d.get("gumbel_adequate")
-                     else "GEV (the deviance test rejects the Gumbel)")
+        pref = mf.preferred_model()
+        preferred = f"{pref['model']}</b>: {_e(pref['reason'])}<b>"
         doc.add(f"<p>Record used: <code>{_e(_name(mf.inventory.source))}</code> &mdash; {_e(mf.inventory.site)}. "
                 f"{mf.gumbel.data.size:,} annual maxima in {mf.gumbel.n_years:,} years; years without a fall "
                 f"(p0 = {sig(mf.gumbel.p_zero, 2)}) enter through the mixed model.</p>",
