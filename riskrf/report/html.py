@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
+from ..energy_study import INTERVAL_COVERS, sensitivity_grid
 from ..road_risk import fn_zone
 
 CSS = """
@@ -76,7 +77,19 @@ def render_report(a, figs: Path) -> str:
     for T, row in ((100, e100), (300, e300)):
         if row is not None:
             summary.append(f"<li>{T}-year impact energy: {row['energy_kj']:,.4g} kJ (95 % interval "
-                           f"{row['ci_low_kj']:,.4g} - {row['ci_high_kj']:,.4g} kJ).</li>")
+                           f"{row['ci_low_kj']:,.4g} - {row['ci_high_kj']:,.4g} kJ, covering b, the rate and the "
+                           "finite simulation only).</li>")
+    if en.sensitivity is not None and len(en.sensitivity):
+        sv = en.sensitivity
+        summary.append(f"<li>Over the judgement inputs (m<sub>max</sub> {sv['m_max_kg'].min():,.3g} - "
+                       f"{sv['m_max_kg'].max():,.3g} kg, rate share {sv['rate_share'].min():g} - "
+                       f"{sv['rate_share'].max():g}) the {en.design_T:g}-year energy spans "
+                       f"{sv['energy_kj'].min():,.4g} - {sv['energy_kj'].max():,.4g} kJ (table in section 5).</li>")
+    if en.design_block is not None:
+        b = en.design_block
+        summary.append(f"<li>Design block: <b>{b.mass_kg:,.4g} kg ({b.volume_m3:,.3g} m&sup3;, diameter "
+                       f"{b.diameter_m:.3g} m)</b> by the {_e(b.rule)} rule"
+                       + "".join(f"; {_e(x)}" for x in b.assumptions[:1]) + ".</li>")
     for _, r in verdicts.iterrows():
         cls = "ok" if r["adequate"] else "fail"
         summary.append(f"<li>Fence {_e(r['fence'])}: <span class='{cls}'>"
@@ -108,7 +121,18 @@ def render_report(a, figs: Path) -> str:
               f"{'plausible' if (fr.bootstrap_p or 0) > 0.1 else 'questionable'} (p &gt; 0.1 needed).</p>",
               _table(comp), _figure(figs / "magnitude_frequency.png", "Magnitude - cumulative frequency with the "
                                                                       "fitted law and the interval of b"),
-              "<h3>Design masses</h3>", _table(fr.design_masses())]
+              "<h3>Design masses of the site</h3>",
+              "<p>The site's law, the one the hazard uses: truncated at the maximum credible block m<sub>max</sub> "
+              "and with the rate of the share of the source above the line. T-year fall at the source "
+              "(rate &times; P(M &gt; m) = 1/T) and reaching the line (with the reach probability of each mass). "
+              "Nothing exceeds m<sub>max</sub>; blank where fewer than one such fall is expected in T years. "
+              "These are event sizes; the design block (section 5) separates the block from the event.</p>",
+              _table(en.site_masses.drop(columns="law")) if en.site_masses is not None else "",
+              f"<p><small>Law: {_e(en.site_masses['law'].iloc[0]) if en.site_masses is not None else ''}.</small></p>",
+              "<h3>For reference: the whole monitored wall (regional fit, untruncated, rate not scaled)</h3>",
+              "<p>Not the site's design values: this fit describes every fall of the inventoried wall, with no upper "
+              "bound, so its long-return-period masses can exceed any credible block.</p>",
+              _table(fr.design_masses())]
 
     # 3. Annual maxima
     mf = fr if fr.gumbel is not None else a.maxima_frequency
@@ -156,11 +180,35 @@ def render_report(a, figs: Path) -> str:
               "<ul>" + "".join(f"<li>{_e(n)}</li>" for n in hz.notes) + "</ul>",
               _figure(figs / "energy_exceedance.png", "Annual frequency of impacts above each energy"),
               _figure(figs / "mass_velocity.png", "Masses and velocities with iso-energy lines"),
-              "<h3>Design energies</h3>", _table(en.design)]
+              "<h3>Design energies</h3>",
+              f"<p>The interval covers the {_e(INTERVAL_COVERS)}.</p>", _table(en.design)]
+    if hz.mass_coupled:
+        parts += ["<h3>Reach, speed and bounce height by block mass</h3>",
+                  "<p>Blocks simulated with masses spread log-uniformly over the mass law's range (stratified), "
+                  "so that heavier blocks move as the simulator says; the hazard integrates the mass law over these "
+                  "classes. Speeds include rotation; heights are of the block centre.</p>",
+                  _table(hz.velocity.class_table(), fmt="{:,.4g}")]
+    if en.sensitivity is not None and len(en.sensitivity):
+        parts += [f"<h3>Sensitivity of the {en.design_T:g}-year energy to the judgement inputs</h3>",
+                  "<p>The maximum credible block m<sub>max</sub> (rows; the power law refitted with each) and the "
+                  "share of the inventoried source above the line (columns), at the same simulated slope. These are "
+                  "judgement, not sampling: the bootstrap interval above does not include them. Energies in kJ.</p>",
+                  _table(sensitivity_grid(en.sensitivity).reset_index().rename(columns={"index": ""}))]
+    if en.design_block is not None:
+        b = en.design_block
+        parts += ["<h3>Design block</h3>",
+                  f"<div class='box'>Design block <b>{b.mass_kg:,.4g} kg</b> ({b.volume_m3:,.4g} m&sup3;, "
+                  f"equivalent sphere diameter {b.diameter_m:.3g} m): {_e(b.basis)}.</div>",
+                  "<p>An inventory of event volumes is not a list of blocks: a large detachment breaks up on the way "
+                  "down. The alternatives side by side, each with the 95th-percentile speed of simulated blocks of "
+                  "its own mass and the energy &frac12; m v<sub>95</sub><sup>2</sup> it carries:</p>",
+                  _table(b.alternatives, fmt="{:,.4g}"),
+                  "<ul>" + "".join(f"<li>{_e(x)}</li>" for x in b.assumptions) + "</ul>"]
     if en.uni is not None:
         u = en.uni
-        parts.append(f"<p>UNI 11211-4 design energy of the {en.design_T:g}-year block at the 95th-percentile "
-                     f"velocity: E<sub>k</sub> = {u.characteristic_energy_kj:,.4g} kJ, E<sub>d</sub> = "
+        what = "design block" if en.design_block is not None else f"{en.design_T:g}-year block"
+        parts.append(f"<p>UNI 11211-4 design energy of the {what} at the 95th-percentile "
+                     f"velocity{' of blocks of its mass' if hz.mass_coupled else ''}: E<sub>k</sub> = {u.characteristic_energy_kj:,.4g} kJ, E<sub>d</sub> = "
                      f"{u.design_energy_kj:,.4g} kJ with factors {_e(u.factors)}.</p>")
 
     # 6. Fences
@@ -249,10 +297,19 @@ def render_report(a, figs: Path) -> str:
     parts += ["<h2>9. Assumptions, defaults and warnings</h2><div class='warn'><ul>",
               "<li>Lumped-mass trajectories of spheres; restitution and friction parameters are starting values "
               "to be calibrated on site (Wyllie 2014, ch. 7).</li>",
-              "<li>Velocities are taken as independent of block mass; the rate and mass distribution come from the "
-              "fitted power law, applied at the barrier line"
+              ("<li>Reach probability, speed and bounce height depend on block mass as simulated (blocks released "
+               "across the mass law's range); "
+               if hz.mass_coupled else
+               "<li>Velocities and the reach probability are taken as independent of block mass "
+               "(hazard.mass_coupling = 'independent'); ")
+              + "the rate and mass distribution come from the fitted power law, applied at the barrier line"
               + (f" with the rate scaled by {site.inventory['rate_scale']:g}" if site.inventory["rate_scale"] != 1
                  else "") + ".</li>"]
+    if en.design_block is not None:
+        parts += [f"<li>Design block ({_e(en.design_block.rule)} rule): {_e(x)}</li>"
+                  for x in en.design_block.assumptions]
+    parts.append("<li>Judgement inputs not in any interval: m<sub>max</sub> and the rate share (see the sensitivity "
+                 "table in section 5).</li>")
     parts += [f"<li>Default used: {_e(d)}</li>" for d in site.defaults_used]
     parts += [f"<li>Warning: {_e(w)}</li>" for w in a.warnings]
     parts.append("</ul></div></body></html>")
