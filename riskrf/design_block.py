@@ -68,7 +68,7 @@ def percentile_block(volumes_m3, percentile: float = 97.0) -> float:
     bad = ~np.isfinite(v) | (v <= 0)
     if bad.any():
         i = int(np.argmax(bad))
-        raise ValueError(f"block volume [{i}] = {v[i]!r}: block sizes must be finite and > 0 m3")
+        raise ValueError(f"block volume [{i}] = {float(v[i])!r}: block sizes must be finite and > 0 m3")
     return float(np.percentile(v, p))
 
 
@@ -102,7 +102,7 @@ def read_block_survey(path, density_kg_m3: float) -> np.ndarray:
     bad = ~np.isfinite(values) | (values <= 0)
     if bad.any():
         i = int(np.argmax(bad))
-        raise ValueError(f"{path}: row {i + 2}, column {col!r}: {df[col].iloc[i]!r} is not a block size > 0")
+        raise ValueError(f"{path}: row {i + 2}, column {col!r}: value {df[col].iloc[i]} is not a block size > 0")
     return values * factor
 
 
@@ -150,13 +150,21 @@ def line_return_period_mass(hazard, T) -> np.ndarray:
     if not hazard.mass_coupled:
         p = 1.0 / (T * hazard.rate_per_year * hazard.reach_probability)
         return np.where(p < 1, mm.isf(np.minimum(p, 1.0)), np.nan)
+    from scipy import optimize
     vel = hazard.velocity
-    m, w, cls = vel._nodes(mm)
-    order = np.argsort(m)[::-1]
-    tail = np.cumsum((w * vel.reach_by_class[cls])[order]) * hazard.rate_per_year    # arrivals/yr above m
-    target = 1.0 / T
-    out = np.interp(np.log(target), np.log(np.maximum(tail, 1e-300)), np.log(m[order]), left=np.nan, right=np.nan)
-    return np.exp(out)
+    lo, hi = (float(v) for v in mm.support)
+    lo = lo if np.isfinite(lo) and lo > 0 else float(mm.isf(1.0 - 1e-12))
+    hi = hi if np.isfinite(hi) else float(mm.isf(1e-15))
+    rate = hazard.rate_per_year
+
+    def g(lm, target):
+        return np.log(max(rate * vel.arrival_sf(np.exp(lm), mm), 1e-300)) - np.log(target)
+    out = np.full(T.size, np.nan)
+    for i, t in enumerate(T):
+        a, b = np.log(lo) - 1e-9, np.log(hi) * (1 - 1e-12)
+        if g(a, 1.0 / t) > 0 > g(b, 1.0 / t):
+            out[i] = np.exp(optimize.brentq(g, a, b, args=(1.0 / t,), xtol=1e-12))
+    return out
 
 
 def site_design_masses(hazard, T=(10, 50, 100, 300, 1000), density_kg_m3: float = 2650.0) -> pd.DataFrame:

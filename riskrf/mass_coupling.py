@@ -69,7 +69,7 @@ class MassCoupledSamples:
                              f"{s.shape}, {h.shape}")
         if np.any(~np.isfinite(m) | (m <= 0)):
             i = int(np.argmax(~np.isfinite(m) | (m <= 0)))
-            raise ValueError(f"mass_kg[{i}] = {m[i]!r}: masses must be finite and > 0 kg")
+            raise ValueError(f"mass_kg[{i}] = {float(m[i])!r}: masses must be finite and > 0 kg")
         e = np.asarray(self.edges_kg, dtype=float)
         if e.ndim != 1 or e.size < 2 or np.any(np.diff(e) <= 0) or e[0] <= 0:
             raise ValueError(f"edges_kg must be at least two increasing masses > 0 kg; got {e!r}")
@@ -176,6 +176,17 @@ class MassCoupledSamples:
         """P(a fall reaches the line) under mass model ``mm``: sum over classes of P(M in class) P(reach | class)."""
         m, w, cls = self._nodes(mm)
         return float(np.clip(np.sum(w * self.reach_by_class[cls]), 0.0, 1.0))
+
+    def arrival_sf(self, mass_kg, mm) -> float:
+        """P(a fall is heavier than m and reaches the line) [-] under ``mm`` (reach constant within a class)."""
+        m = float(mass_kg)
+        lo = self.edges_kg[:-1].copy()
+        lo[0] = 0.0                                   # the end classes take the mass outside the range
+        hi = self.edges_kg[1:]
+        sf_lo = np.asarray(mm.sf(np.maximum(m, lo)), dtype=float)
+        sf_hi = np.asarray(mm.sf(hi), dtype=float)
+        sf_hi[-1] = 0.0
+        return float(np.sum(self.reach_by_class * np.clip(sf_lo - sf_hi, 0.0, None)))
 
     def class_weights(self, mm) -> np.ndarray:
         """P(M in class) under ``mm`` (the classes at the ends take the mass outside the simulated range)."""
