@@ -146,9 +146,15 @@ def plot_mass_velocity(hazard, ax=None, *, energies=(100, 500, 1000, 2000, 5000,
     rng = np.random.default_rng(seed)
     m = mass_model(hazard.mass).rvs(n_points, rng)
     v = hazard.velocity
-    if hasattr(v, "velocity_ms"):
+    vs = None
+    if getattr(hazard, "mass_coupled", False):     # simulated (mass, speed) pairs: speed depends on mass
+        pick = rng.integers(0, v.velocity_ms.size, n_points)
+        m, vs = v.arriving_mass_kg[pick], v.velocity_ms[pick]
+    elif hasattr(v, "velocity_ms"):
         v = v.velocity_ms
-    if hasattr(v, "rvs"):
+    if vs is not None:
+        pass
+    elif hasattr(v, "rvs"):
         vs = np.abs(v.rvs(size=n_points, random_state=rng))
     elif hasattr(v, "dist"):
         vs = np.abs(v.dist.rvs(size=n_points, random_state=rng))
