@@ -249,6 +249,12 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
     row = alt.loc[alt["chosen"]].iloc[0]
     if not np.isfinite(row["mass_kg"]):
         raise ValueError(f"the {T:g}-year block is undefined: fewer than one fall a {T:g} years at this rate")
+    if m_max:
+        above = alt["mass_kg"] > m_max * (1 + 1e-12)
+        alt.loc[above, "note"] = alt.loc[above, "note"] + "; ABOVE the stated maximum credible block m_max"
+        if row["mass_kg"] > m_max * (1 + 1e-12):
+            raise ValueError(f"design block {row['mass_kg']:.6g} kg ({row['rule']}) exceeds the stated maximum credible "
+                             f"block m_max = {m_max:.6g} kg: revise m_max or the design-block rule")
     if rule == "percentile":
         basis = (f"{pct:g}th percentile of the block sizes ({source}), after ONR 24810 (design block: 95th-98th "
                  "percentile of the surveyed blocks)")

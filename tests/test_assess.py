@@ -104,6 +104,7 @@ def test_design_block_site_masses_and_sensitivity_in_outputs(assessed):
                  "whole monitored wall", "EVENT volumes", "Reach, speed and bounce height by block mass"):
         assert text in html, text
     assert (out / "design_energy_sensitivity.csv").exists() and (out / "design_block.csv").exists()
+    assert (out / "figures" / "design_energy_sensitivity.png").exists()
 
 
 @pytest.mark.parametrize("edit, match", [

@@ -247,3 +247,8 @@ def test_bad_design_block_inputs(tmp_path, demo_hazard, lauterbrunnen):
         read_block_survey(bad_row, 2650.0)
     with pytest.raises(ValueError, match="block volume \\[1\\] = 0.0"):
         percentile_block([1.0, 0.0], 97)
+    # a design block above the stated maximum credible block is a contradiction, refused
+    from dataclasses import replace
+    small = demo_hazard.with_mass(replace(demo_hazard.mass, m_max=1.0e5))
+    with pytest.raises(ValueError, match="design block 149063 kg \\(percentile p98\\) exceeds .* m_max = 100000 kg"):
+        design_block(small, rule="percentile", percentile=98, inventory=inv)

@@ -193,7 +193,9 @@ def render_report(a, figs: Path) -> str:
                   "<p>The maximum credible block m<sub>max</sub> (rows; the power law refitted with each) and the "
                   "share of the inventoried source above the line (columns), at the same simulated slope. These are "
                   "judgement, not sampling: the bootstrap interval above does not include them. Energies in kJ.</p>",
-                  _table(sensitivity_grid(en.sensitivity).reset_index().rename(columns={"index": ""}))]
+                  _table(sensitivity_grid(en.sensitivity).reset_index().rename(columns={"index": ""})),
+                  _figure(figs / "design_energy_sensitivity.png", f"The {en.design_T:g}-year energy against the rate "
+                          "share, one line per maximum credible block")]
     if en.design_block is not None:
         b = en.design_block
         parts += ["<h3>Design block</h3>",
