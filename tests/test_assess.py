@@ -8,7 +8,6 @@ import pytest
 import riskrf
 import simulation
 from riskrf.cli import main
-from riskrf.annual_hazard import EnergyHazard
 from riskrf.site import load_site
 
 from .conftest import ROOT
