@@ -26,6 +26,7 @@ from .impact_energy import (
 )
 from .mass_coupling import MassCoupledSamples
 from .power_law import GutenbergRichterFit
+from .report.format import sig
 from .units import SPHERE_INERTIA
 from .validation import check_positive, check_probability_level, check_return_periods
 
@@ -288,7 +289,7 @@ class EnergyHazard:
                 "reach probability": self.reach_probability, "arrivals per year": self.arrival_rate,
                 "mass model": mass_model(self.mass).description,
                 "mass coupling": ("reach, speed and bounce height by block mass (simulated "
-                                  f"{self.velocity.edges_kg[0]:.4g}-{self.velocity.edges_kg[-1]:.4g} kg)")
+                                  f"{sig(self.velocity.edges_kg[0])}-{sig(self.velocity.edges_kg[-1])} kg)")
                 if self.mass_coupled else "none: one reach probability and velocity law for all masses"}
         for q, e in zip((95, 99), self.energy_percentile([95, 99])):
             rows[f"energy p{q} per arriving fall [kJ]"] = e

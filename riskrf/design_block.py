@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .report.format import sig
 from .units import J_PER_KJ
 
 #: The percentile band of ONR 24810:2021 for the design block [%].
@@ -167,6 +168,17 @@ def line_return_period_mass(hazard, T) -> np.ndarray:
     return out
 
 
+def _law_text(hazard) -> str:
+    """The site's mass law in words, numbers without exponent notation."""
+    m = hazard.mass
+    if hasattr(m, "b") and hasattr(m, "m_min"):
+        return (f"power law b = {sig(m.b)} above {sig(m.m_min)} kg"
+                + (f", truncated at m_max = {sig(m.m_max)} kg" if getattr(m, "m_max", None) else ", not truncated")
+                + f", {sig(hazard.rate_per_year)} falls/yr")
+    from .impact_energy import mass_model
+    return f"{mass_model(m).description}, {sig(hazard.rate_per_year)} falls/yr"
+
+
 def site_design_masses(hazard, T=(10, 50, 100, 300, 1000), density_kg_m3: float = 2650.0) -> pd.DataFrame:
     """Design masses [kg] of the site's law (the hazard's: truncated at m_max, rate scaled to the source above the
     line): the T-year fall at the source and the T-year fall reaching the line; NaN where fewer than one such fall
@@ -179,7 +191,7 @@ def site_design_masses(hazard, T=(10, 50, 100, 300, 1000), density_kg_m3: float 
     line = line_return_period_mass(hazard, T)
     return pd.DataFrame({"T_years": T, "source_mass_kg": source, "source_volume_m3": source / density_kg_m3,
                          "line_mass_kg": line, "line_volume_m3": line / density_kg_m3,
-                         "law": mm.description + f", {hazard.rate_per_year:.4g} falls/yr"})
+                         "law": _law_text(hazard)})
 
 
 def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.0, survey_volumes_m3=None,

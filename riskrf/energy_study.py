@@ -12,6 +12,7 @@ from .barriers import UNI11211_FACTORS, check_fence, uni11211_design_energy
 from .frequency_study import DESIGN_RETURN_PERIODS
 from .outputs import write_json
 from .power_law import GutenbergRichterFit, fit_gutenberg_richter
+from .report.format import sig
 from .units import DEFAULT_DENSITY_KG_M3
 
 #: What the bootstrap interval of a design energy covers, and what it does not (stated with every interval).
@@ -191,8 +192,8 @@ def _block_top_check(hazard, block, height_m: float, free_board_m: float) -> pd.
     return pd.DataFrame([{"check": "design block top: p95 centre height + radius + free board vs height",
                           "demand": demand, "capacity": float(height_m), "unit": "m", "interval": "",
                           "adequate": bool(demand <= height_m),
-                          "note": f"design block {block.mass_kg:,.4g} kg, diameter {block.diameter_m:.3g} m; p95 "
-                                  f"centre height {h95:.3g} m of {how}"}])
+                          "note": f"design block {sig(block.mass_kg)} kg, diameter {sig(block.diameter_m)} m; p95 "
+                                  f"centre height {sig(h95)} m of {how}"}])
 
 
 def design_energy_sensitivity(hazard: EnergyHazard, masses_kg, duration_years: float, *, m_min: float,
@@ -222,7 +223,7 @@ def design_energy_sensitivity(hazard: EnergyHazard, masses_kg, duration_years: f
 def sensitivity_grid(table: pd.DataFrame) -> pd.DataFrame:
     """The sensitivity table as a grid: m_max [kg] rows, rate share columns, T-year energy [kJ] values."""
     g = table.pivot(index="m_max_kg", columns="rate_share", values="energy_kj")
-    g.index = [f"m_max {v:,.4g} kg" if np.isfinite(v) else "m_max none" for v in g.index]
+    g.index = [f"m_max {sig(v)} kg" if np.isfinite(v) else "m_max none" for v in g.index]
     g.columns = [f"share {c:g}" for c in g.columns]
     return g
 

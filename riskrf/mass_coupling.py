@@ -33,6 +33,7 @@ from functools import cached_property
 import numpy as np
 import pandas as pd
 
+from .report.format import sig
 from .units import J_PER_KJ
 
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
@@ -247,9 +248,9 @@ class MassCoupledSamples:
     def description(self) -> str:
         t = self.class_table()
         return (f"mass-coupled: {self.mass_kg.size:,} blocks released with masses log-uniform over "
-                f"{self.edges_kg[0]:.4g}-{self.edges_kg[-1]:.4g} kg in {self.n_bins} classes; P(reach) "
+                f"{sig(self.edges_kg[0])}-{sig(self.edges_kg[-1])} kg in {self.n_bins} classes; P(reach) "
                 f"{t['reach_probability'].iloc[0]:.3f} -> {t['reach_probability'].iloc[-1]:.3f} and median speed "
-                f"{t['velocity_p50_ms'].iloc[0]:.3g} -> {t['velocity_p50_ms'].iloc[-1]:.3g} m/s from the lightest "
+                f"{sig(t['velocity_p50_ms'].iloc[0])} -> {sig(t['velocity_p50_ms'].iloc[-1])} m/s from the lightest "
                 "to the heaviest class")
 
 
@@ -351,7 +352,7 @@ def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_p
         for what, values in (("design mass", design), ("T-year block", t_blocks)):
             for v in values:
                 if not lo <= v <= hi:
-                    raise ValueError(f"mass_range_kg = ({lo:.4g}, {hi:.4g}): the {what} {v:.4g} kg lies outside the "
+                    raise ValueError(f"mass_range_kg = ({sig(lo, 4)}, {sig(hi, 4)}): the {what} {sig(v, 4)} kg lies outside the "
                                      "simulated masses; widen the range so that no design value is extrapolated")
     if n_bins is None:
         n_bins = int(np.clip(n // 400, 4, 24))
@@ -385,8 +386,8 @@ def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_p
              f"reach probability {reach:.4f} averaged over the mass model (by mass class: "
              f"{samples.reach_by_class.min():.3f}-{samples.reach_by_class.max():.3f})"]
     if below > 1e-9 or above > 1e-9:
-        notes.append(f"mass model beyond the simulated masses: P(M < {edges[0]:.4g} kg) = {below:.2g}, "
-                     f"P(M > {edges[-1]:.4g} kg) = {above:.2g}; they take the behaviour of the nearest mass class "
+        notes.append(f"mass model beyond the simulated masses: P(M < {sig(edges[0])} kg) = {sig(below, 2)}, "
+                     f"P(M > {sig(edges[-1])} kg) = {sig(above, 2)}; they take the behaviour of the nearest mass class "
                      "(an extrapolation, stated)")
     hz = EnergyHazard(mass=mass, velocity=samples, rate_per_year=rate, reach_probability=max(reach, 1e-300),
                       n_released=result.n, heights_m=samples.heights_m, collector=collector, notes=tuple(notes))
