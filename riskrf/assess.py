@@ -278,7 +278,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
         block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
                              survey_source=db_cfg["survey"], inventory=inventory, sizes=inv_cfg["sizes"],
-                             design_T=hz_cfg["design_period_years"], density_kg_m3=inventory.density_kg_m3)
+                             design_T=hz_cfg["design_period_years"], density_kg_m3=inventory.density_kg_m3,
+                             fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"])
         sensitivity = design_energy_sensitivity(
             hazard, inventory.masses, inventory.duration_years, m_min=gr.m_min, m_max_values=m_max_values,
             rate_shares=shares, T=hz_cfg["design_period_years"]) \

@@ -146,12 +146,15 @@ def cmd_energy(args) -> int:
     inv = _read(args, args.inventory)
     gr, hazard, _ = build_energy_hazard(args, inv)
     block = sensitivity = None
-    if args.design_percentile is not None or args.block_survey:
+    fragmenting = args.fractal_dimension is not None or args.fragmentation_iterations is not None
+    if args.design_percentile is not None or args.block_survey or fragmenting:
         from .design_block import design_block, read_block_survey
         survey = read_block_survey(args.block_survey, inv.density_kg_m3) if args.block_survey else None
-        block = design_block(hazard, rule="percentile", percentile=args.design_percentile or 97.0,
+        rule = "percentile" if (args.design_percentile is not None or survey is not None) else "fragmentation"
+        block = design_block(hazard, rule=rule, percentile=args.design_percentile or 97.0,
                              survey_volumes_m3=survey, survey_source=args.block_survey, inventory=inv,
-                             sizes=args.inventory_sizes, design_T=args.design_period, density_kg_m3=inv.density_kg_m3)
+                             sizes=args.inventory_sizes, design_T=args.design_period, density_kg_m3=inv.density_kg_m3,
+                             fractal_dimension=args.fractal_dimension, iterations=args.fragmentation_iterations)
     if args.design_period * hazard.arrival_rate > 1:
         from .energy_study import design_energy_sensitivity
         m_values = [0.5 * gr.m_max, gr.m_max, 2.0 * gr.m_max] if gr.m_max else [None]
@@ -424,6 +427,11 @@ def build_parser() -> argparse.ArgumentParser:
                         "else of the inventory's sizes (stated as an assumption when they are event volumes)")
     p.add_argument("--block-survey", default=None, metavar="FILE",
                    help="block survey (.csv/.xlsx/.parquet with a volume_m3 or mass_kg column) for the design block")
+    p.add_argument("--fractal-dimension", type=float, default=None, metavar="D",
+                   help="fragmentation step (Perfect 1997): fractal dimension D in (0, 3) of the fragments of the "
+                        "design-period event; the design block is then a percentile of its fragments")
+    p.add_argument("--fragmentation-iterations", type=int, default=None, metavar="N",
+                   help="fragmentation generations (1-12) with --fractal-dimension")
     p.add_argument("--inventory-sizes", choices=("event_volumes", "blocks"), default="event_volumes",
                    help="what the inventory's sizes are (default event_volumes)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-energy)")

@@ -21,6 +21,18 @@ block by a rule, stated with the result:
     line): m_T with rate x P(M > m_T) = 1/T (Wyllie 2014, 8.4.1).  It treats a
     detached volume as one intact block: an upper bound.
 
+``fragmentation``
+    The T-year event volume broken up by a fractal fragmentation step (Perfect
+    1997, Eng. Geol. 48:185-198; the model behind the rock fall fractal
+    fragmentation model of Ruiz-Carulla, Corominas and Mavrouli 2017,
+    Landslides 14:875-889, here without their in-situ block-size initiators and
+    survival rate): the detached volume splits into b^3 = 8 equal blocks, each
+    of which splits again with probability p = b^(D - 3) for ``iterations``
+    generations, so that the number of fragments larger than a size L grows as
+    L^-D (D the fractal dimension).  The design block is the chosen percentile,
+    by count, of the fragment volumes.  D and the number of generations are
+    the user's stated ASSUMPTIONS (calibrate them on a deposit survey).
+
 :func:`design_block` computes the chosen block and the alternatives side by
 side (the ONR 24810 band, the T-year fall at the source and at the line), each
 with its volume, equivalent-sphere diameter and the energy it carries at the
@@ -41,7 +53,7 @@ from .units import J_PER_KJ
 
 #: The percentile band of ONR 24810:2021 for the design block [%].
 ONR24810_PERCENTILES = (95.0, 98.0)
-RULES = ("percentile", "return_period")
+RULES = ("percentile", "return_period", "fragmentation")
 SIZES = ("event_volumes", "blocks")
 
 
@@ -105,6 +117,44 @@ def read_block_survey(path, density_kg_m3: float) -> np.ndarray:
         i = int(np.argmax(bad))
         raise ValueError(f"{path}: row {i + 2}, column {col!r}: value {df[col].iloc[i]} is not a block size > 0")
     return values * factor
+
+
+def fractal_fragments(volume_m3: float, fractal_dimension: float, iterations: int, branching: int = 2
+                      ) -> pd.DataFrame:
+    """Expected fragments of a detached volume [m³] by fractal fragmentation (Perfect 1997).
+
+    Generation k (1..``iterations``) holds blocks of volume V / b^(3k) (b = ``branching``).  Each block of
+    generation k < ``iterations`` splits again with probability p = b^(D - 3); the others stay as fragments,
+    so the expected number of fragments of generation k is b^(3k) p^(k-1) (1 - p) (k < iterations) and
+    b^(3 iterations) p^(iterations - 1) for the last; successive counts grow by b^D and the volumes add to V.
+
+    Returns a DataFrame: ``volume_m3`` per fragment, ``count`` (expected), ``volume_share``.
+    """
+    v0 = float(volume_m3)
+    if not np.isfinite(v0) or v0 <= 0:
+        raise ValueError(f"volume_m3 = {volume_m3!r} must be finite and > 0 m3")
+    D = fractal_dimension
+    if isinstance(D, bool) or not isinstance(D, (int, float, np.integer, np.floating)) or not 0.0 < float(D) < 3.0:
+        raise ValueError(f"design_block.fractal_dimension = {D!r} must lie strictly between 0 and 3 "
+                         "(N(>L) ~ L^-D; rock fragmentation typically 2-3)")
+    n = iterations
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= 12:
+        raise ValueError(f"design_block.iterations = {n!r} must be a whole number of fragmentation generations "
+                         "between 1 and 12")
+    b = int(branching)
+    p = float(b) ** (float(D) - 3.0)
+    k = np.arange(1, n + 1)
+    count = float(b) ** (3.0 * k) * p ** (k - 1.0) * np.where(k < n, 1.0 - p, 1.0)
+    vol = v0 / float(b) ** (3.0 * k)
+    return pd.DataFrame({"generation": k, "volume_m3": vol, "count": count, "volume_share": count * vol / v0})
+
+
+def fragment_percentile(fragments: pd.DataFrame, percentile: float) -> float:
+    """The fragment volume [m³] at ``percentile`` (by count) of a :func:`fractal_fragments` table."""
+    q = check_percentile(percentile) / 100.0
+    f = fragments.sort_values("volume_m3")
+    cdf = np.cumsum(f["count"].to_numpy()) / f["count"].sum()
+    return float(f["volume_m3"].to_numpy()[min(np.searchsorted(cdf, q), len(f) - 1)])
 
 
 @dataclass(frozen=True)
@@ -196,13 +246,14 @@ def site_design_masses(hazard, T=(10, 50, 100, 300, 1000), density_kg_m3: float 
 
 def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.0, survey_volumes_m3=None,
                  survey_source: str | None = None, inventory=None, sizes: str = "event_volumes",
-                 design_T: float = 100.0, density_kg_m3: float = 2650.0) -> DesignBlock:
+                 design_T: float = 100.0, density_kg_m3: float = 2650.0, fractal_dimension: float | None = None,
+                 iterations: int | None = None) -> DesignBlock:
     """The design block by ``rule`` with its alternatives (see module notes).
 
     Parameters
     ----------
     hazard : EnergyHazard (its mass law and rate are the site's; mass-coupled speeds give each block's v95)
-    rule : "percentile" or "return_period"
+    rule : "percentile", "return_period" or "fragmentation"
     percentile : float in (0, 100) [%], the percentile of the block sizes (ONR 24810: 95-98)
     survey_volumes_m3 : array of block volumes [m³] from a block survey, optional
     survey_source : name of the survey (file) for the outputs
@@ -210,6 +261,8 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
     sizes : "event_volumes" or "blocks": what the inventory's sizes are
     design_T : return period [yr] of the return-period block
     density_kg_m3 : rock density [kg/m³]
+    fractal_dimension, iterations : parameters of the fragmentation step (:func:`fractal_fragments`); needed for
+        ``rule="fragmentation"``, shown as an alternative whenever given
     """
     from .validation import check_choice, check_positive
     check_choice(rule, "design_block.rule", RULES)
@@ -228,6 +281,14 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
         if sizes == "event_volumes" and rule == "percentile":
             assumptions.append("ASSUMPTION: no block survey; the percentile is taken of the inventory's EVENT "
                                "volumes, which overstate the blocks that reach a barrier (detachments break up)")
+    fragmenting = fractal_dimension is not None or iterations is not None
+    if rule == "fragmentation" and not fragmenting:
+        raise ValueError("design_block.rule = 'fragmentation' needs design_block.fractal_dimension and "
+                         "design_block.iterations (the user's stated fragmentation parameters)")
+    if fragmenting:
+        fractal_fragments(1.0, fractal_dimension, iterations)        # checks both parameters before any work
+        assumptions.append(f"ASSUMPTION: fragmentation parameters stated, not calibrated: fractal dimension "
+                           f"D = {sig(fractal_dimension)}, {iterations} generation(s) (Perfect 1997)")
     if rule == "percentile" and survey is None:
         raise ValueError("design_block.rule = 'percentile' needs a block survey (design_block.survey) or an "
                          "inventory whose sizes stand in for one")
@@ -252,11 +313,17 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
         "site law: " + str(table["law"].iloc[0]))
     add(f"return period {T:g} yr reaching the line", float(table["line_mass_kg"].iloc[0]),
         "site law x reach probability by mass" if hazard.mass_coupled else "site law x one reach probability")
+    if fragmenting and np.isfinite(table["source_mass_kg"].iloc[0]):
+        frags = fractal_fragments(float(table["source_volume_m3"].iloc[0]), fractal_dimension, iterations)
+        add(f"fragmentation of the {T:g}-yr event, p{pct:g}", fragment_percentile(frags, pct) * rho,
+            f"fractal fragmentation (Perfect 1997), D = {sig(fractal_dimension)}, {iterations} generation(s): "
+            f"{sig(frags['count'].sum())} fragments; percentile by count")
     m_max = getattr(hazard.mass, "m_max", None)
     if m_max:
         add("maximum credible block m_max", float(m_max), "stated by the user (judgement); the upper bound")
     alt = pd.DataFrame(rows)
-    chosen = f"percentile p{pct:g}" if rule == "percentile" else f"return period {T:g} yr at the source"
+    chosen = {"percentile": f"percentile p{pct:g}", "return_period": f"return period {T:g} yr at the source",
+              "fragmentation": f"fragmentation of the {T:g}-yr event, p{pct:g}"}[rule]
     alt["chosen"] = alt["rule"] == chosen
     row = alt.loc[alt["chosen"]].iloc[0]
     if not np.isfinite(row["mass_kg"]):
@@ -270,6 +337,9 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
     if rule == "percentile":
         basis = (f"{pct:g}th percentile of the block sizes ({source}), after ONR 24810 (design block: 95th-98th "
                  "percentile of the surveyed blocks)")
+    elif rule == "fragmentation":
+        basis = (f"{pct:g}th percentile (by count) of the fragments of the {T:g}-year event volume broken up by "
+                 f"fractal fragmentation (Perfect 1997; D = {sig(fractal_dimension)}, {iterations} generation(s))")
     else:
         basis = (f"{T:g}-year fall of the site's law (truncated at m_max, rate scaled to the source above the line), "
                  "taken as one intact block")
@@ -293,6 +363,7 @@ def design_block_candidates_kg(*, rule, percentile, survey_volumes_m3, inventory
     return out
 
 
-__all__ = ["DesignBlock", "ONR24810_PERCENTILES", "design_block", "design_block_candidates_kg",
+__all__ = ["DesignBlock", "ONR24810_PERCENTILES", "design_block", "design_block_candidates_kg", "fractal_fragments",
+           "fragment_percentile",
            "line_return_period_mass", "percentile_block", "read_block_survey", "site_design_masses",
            "sphere_diameter_m"]

@@ -28,7 +28,8 @@ SITE_FIELDS = {
                "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
                "free_board_m": 0.5, "design_period_years": 100.0, "bootstrap": 300, "seed": 1,
                "option_blocks": 20_000, "mass_coupling": "simulated"},
-    "design_block": {"rule": "return_period", "percentile": 97.0, "survey": None},
+    "design_block": {"rule": "return_period", "percentile": 97.0, "survey": None, "fractal_dimension": None,
+                     "iterations": None},
 }
 MITIGATION_TABLES = ("traffic", "consequences", "economics", "options", "uncertainty", "criteria")
 
@@ -160,6 +161,16 @@ def _check_design_block(tables, path):
         db["percentile"] = check_percentile(db["percentile"], "design_block.percentile")
     except (TypeError, ValueError) as exc:
         raise SiteError(f"{path}: {exc}") from exc
+    fragmenting = db["fractal_dimension"] is not None or db["iterations"] is not None
+    if db["rule"] == "fragmentation" and not fragmenting:
+        raise SiteError(f"{path}: design_block.rule = 'fragmentation' needs design_block.fractal_dimension and "
+                        "design_block.iterations (the fragmentation parameters you assume)")
+    if fragmenting:
+        from .design_block import fractal_fragments
+        try:
+            fractal_fragments(1.0, db["fractal_dimension"], db["iterations"])
+        except (TypeError, ValueError) as exc:
+            raise SiteError(f"{path}: {exc}") from exc
     if db["survey"] is not None and not isinstance(db["survey"], str):
         raise SiteError(f"{path}: design_block.survey = {db['survey']!r} must be a file name")
 

@@ -89,8 +89,8 @@ def test_design_block_site_masses_and_sensitivity_in_outputs(assessed):
     assert block["rule"] == "percentile" and any("EVENT volumes" in a for a in block["assumptions"])
     inv = riskrf.read_inventory(SITE.parent / "lauterbrunnen_tls_2018.csv")
     assert block["volume_m3"] == pytest.approx(np.percentile(inv.masses / inv.density_kg_m3, 97))
-    assert {"percentile p95", "percentile p98", "return period 100 yr at the source"} <= \
-        {r["rule"] for r in block["alternatives"]}
+    assert {"percentile p95", "percentile p98", "return period 100 yr at the source",
+            "fragmentation of the 100-yr event, p97"} <= {r["rule"] for r in block["alternatives"]}
     assert all(r["mass_kg"] <= m_max for r in block["alternatives"])
     sens = s["design_energy_sensitivity"]
     assert {r["m_max_kg"] for r in sens} == {1e6, 2e6, 4e6} and {r["rate_share"] for r in sens} == {0.025, 0.05, 0.1}
@@ -109,10 +109,14 @@ def test_design_block_site_masses_and_sensitivity_in_outputs(assessed):
 @pytest.mark.parametrize("edit, match", [
     ({"percentile = 97\n": "percentile = 100\n"}, "design_block.percentile = 100"),
     ({"percentile = 97\n": "percentile = 0\n"}, "design_block.percentile = 0"),
-    ({'rule = "percentile"': 'rule = "fragmentation"'}, "design_block.rule = 'fragmentation'"),
+    ({'rule = "percentile"': 'rule = "fragments"'}, "design_block.rule = 'fragments'"),
     ({'sizes = "event_volumes"': 'sizes = "events"'}, "inventory.sizes = 'events'"),
     ({'mass_coupling = "simulated"': 'mass_coupling = "yes"'}, "hazard.mass_coupling = 'yes'"),
     ({"percentile = 97\n": 'percentile = 97\nsurvey = "nowhere.csv"\n'}, "design_block.survey = 'nowhere.csv'"),
+    ({"fractal_dimension = 2.5": "fractal_dimension = 3.2"}, "design_block.fractal_dimension = 3.2"),
+    ({"iterations = 3": "iterations = 0"}, "design_block.iterations = 0"),
+    ({'rule = "percentile"': 'rule = "fragmentation"', "fractal_dimension = 2.5\n": "", "iterations = 3\n": ""},
+     "needs design_block.fractal_dimension and design_block.iterations"),
 ])
 def test_design_block_site_fields_are_checked(tmp_path, edit, match):
     from riskrf.site import SiteError

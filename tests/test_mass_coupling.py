@@ -252,3 +252,38 @@ def test_bad_design_block_inputs(tmp_path, demo_hazard, lauterbrunnen):
     small = demo_hazard.with_mass(replace(demo_hazard.mass, m_max=1.0e5))
     with pytest.raises(ValueError, match="design block 149063 kg \\(percentile p98\\) exceeds .* m_max = 100000 kg"):
         design_block(small, rule="percentile", percentile=98, inventory=inv)
+
+
+def test_fractal_fragmentation_conserves_volume_and_is_fractal():
+    """Perfect (1997) fractal fragmentation: fragment volumes add up to the event volume, and the number of
+    fragments grows by b^D from one generation to the next (N(>L) ~ L^-D); analytic case D = 2.5, 3 generations."""
+    from riskrf.design_block import fractal_fragments, fragment_percentile
+    f = fractal_fragments(294.0, 2.5, 3)
+    assert (f["count"] * f["volume_m3"]).sum() == pytest.approx(294.0, rel=1e-12)
+    np.testing.assert_allclose(f["volume_m3"], 294.0 / 8.0 ** np.arange(1, 4))
+    p = 2.0 ** -0.5
+    np.testing.assert_allclose(f["count"], [8 * (1 - p), 64 * p * (1 - p), 512 * p * p])
+    # generations before the last: counts grow by b^D = 2^2.5 per halving of the fragment size
+    assert f["count"].iloc[1] / f["count"].iloc[0] == pytest.approx(2.0 ** 2.5)
+    # 256 of 271.6 fragments are of the finest generation (94.3 %): p50 there, p97 in the second generation
+    assert fragment_percentile(f, 50) == pytest.approx(294.0 / 512)
+    assert fragment_percentile(f, 97) == pytest.approx(294.0 / 64)
+    for D, n, match in ((3.0, 3, "fractal_dimension = 3.0"), (0.0, 3, "fractal_dimension = 0.0"),
+                        (-1, 2, "fractal_dimension = -1"), (2.5, 0, "iterations = 0"), (2.5, 2.5, "iterations = 2.5"),
+                        (2.5, 13, "iterations = 13")):
+        with pytest.raises(ValueError, match=match):
+            fractal_fragments(10.0, D, n)
+
+
+def test_fragmentation_design_block(demo_hazard, lauterbrunnen):
+    inv, gr = lauterbrunnen
+    b = design_block(demo_hazard, rule="fragmentation", percentile=97, inventory=inv, fractal_dimension=2.5,
+                     iterations=3, density_kg_m3=inv.density_kg_m3)
+    v100 = float(gr.isf(1.0 / (100 * demo_hazard.rate_per_year))) / inv.density_kg_m3
+    assert b.rule == "fragmentation" and b.volume_m3 == pytest.approx(v100 / 64)
+    assert any("fragmentation parameters stated" in a for a in b.assumptions)
+    assert demo_hazard.velocity.contains(b.mass_kg)
+    with pytest.raises(ValueError, match="needs design_block.fractal_dimension"):
+        design_block(demo_hazard, rule="fragmentation", inventory=inv)
+    with pytest.raises(ValueError, match="fractal_dimension = 3.5"):
+        design_block(demo_hazard, rule="fragmentation", inventory=inv, fractal_dimension=3.5, iterations=3)
