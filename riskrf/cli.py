@@ -120,7 +120,22 @@ def build_energy_hazard(args, inventory):
         inventory, m_min=args.m_min, m_max=args.m_max, rate_scale=args.rate_scale, scenario=args.scenario,
         velocities=args.velocities, collector=args.collector, n=args.n, seed=args.seed,
         reach_probability=args.reach_probability,
-        condition_on_mass=args.condition_on_mass)
+        condition_on_mass=args.condition_on_mass,
+        mass_coupling="independent" if args.mass_independent else "simulated",
+        design_masses_kg=_energy_design_masses(args, inventory))
+
+
+def _energy_design_masses(args, inventory):
+    """Masses [kg] the energy command reads design values at: the design-block band and the sensitivity's m_max."""
+    from .design_block import design_block_candidates_kg, read_block_survey
+    out = [2.0 * args.m_max] if args.m_max else []
+    survey_path, pct = getattr(args, "block_survey", None), getattr(args, "design_percentile", None)
+    survey = read_block_survey(survey_path, inventory.density_kg_m3) if survey_path else None
+    if pct is not None or survey is not None:
+        out += design_block_candidates_kg(rule="percentile", percentile=pct or 97.0,
+                                          survey_volumes_m3=survey, inventory=inventory,
+                                          density_kg_m3=inventory.density_kg_m3)
+    return out
 
 
 def cmd_energy(args) -> int:
@@ -130,9 +145,27 @@ def cmd_energy(args) -> int:
 
     inv = _read(args, args.inventory)
     gr, hazard, _ = build_energy_hazard(args, inv)
+    block = sensitivity = None
+    fragmenting = args.fractal_dimension is not None or args.fragmentation_iterations is not None
+    if args.design_percentile is not None or args.block_survey or fragmenting:
+        from .design_block import design_block, read_block_survey
+        survey = read_block_survey(args.block_survey, inv.density_kg_m3) if args.block_survey else None
+        rule = "percentile" if (args.design_percentile is not None or survey is not None) else "fragmentation"
+        block = design_block(hazard, rule=rule, percentile=args.design_percentile or 97.0,
+                             survey_volumes_m3=survey, survey_source=args.block_survey, inventory=inv,
+                             sizes=args.inventory_sizes, design_T=args.design_period, density_kg_m3=inv.density_kg_m3,
+                             fractal_dimension=args.fractal_dimension, iterations=args.fragmentation_iterations)
+    if args.design_period * hazard.arrival_rate > 1:
+        from .energy_study import design_energy_sensitivity
+        m_values = [0.5 * gr.m_max, gr.m_max, 2.0 * gr.m_max] if gr.m_max else [None]
+        sensitivity = design_energy_sensitivity(hazard, inv.masses, inv.duration_years, m_min=gr.m_min,
+                                                m_max_values=m_values,
+                                                rate_shares=[0.5 * args.rate_scale, args.rate_scale,
+                                                             2.0 * args.rate_scale], T=args.design_period)
     analysis = analyse_energy(hazard, fences=args.fence or (2000.0, 5000.0), fence_height_m=args.fence_height,
                               free_board_m=args.free_board, design_T=args.design_period,
-                              density_kg_m3=inv.density_kg_m3, n_bootstrap=args.bootstrap, seed=args.seed)
+                              density_kg_m3=inv.density_kg_m3, n_bootstrap=args.bootstrap, seed=args.seed,
+                              design_block=block, sensitivity=sensitivity)
     print(f"Inventory {inv.source}: power law b = {gr.b:.4f} ± {gr.b_stderr:.4f} above m_min = {gr.m_min:.5g} kg "
           f"({gr.n_tail} falls, {gr.rate_min:.4g} per year)" + (f", m_max = {gr.m_max:.5g} kg" if gr.m_max else ""))
     print(analysis.summary_text())
@@ -218,7 +251,10 @@ def _add_energy_arguments(p):
                    help="multiply the inventory's rate of falls by F, e.g. the share of the inventoried cliff "
                         "above this line (default 1)")
     p.add_argument("--condition-on-mass", action="store_true",
-                   help="condition simulated velocities on block mass (when velocity depends on size)")
+                   help="older form: class the seeder's own simulated masses (implies --mass-independent reach)")
+    p.add_argument("--mass-independent", action="store_true",
+                   help="one reach probability and velocity law for all masses, from the seeder's masses (default: "
+                        "blocks simulated across the power law's mass range, reach and speed by mass)")
     p.add_argument("--m-min", type=float, default=None, metavar="KG", help="power-law threshold (default: KS)")
     p.add_argument("--m-max", type=float, default=None, metavar="KG",
                    help="maximum credible block mass, kg (upper truncation; default none)")
@@ -386,6 +422,18 @@ def build_parser() -> argparse.ArgumentParser:
                    help="free board above the p95 bounce height, m (UNI 11211-4: at least 0.5; default 0.5)")
     p.add_argument("--design-period", type=float, default=100.0, metavar="YR",
                    help="return period of the fence checks and UNI design block, years (default 100)")
+    p.add_argument("--design-percentile", type=float, default=None, metavar="P",
+                   help="design block: the P-th percentile of the block sizes (ONR 24810: 95-98), of --block-survey or "
+                        "else of the inventory's sizes (stated as an assumption when they are event volumes)")
+    p.add_argument("--block-survey", default=None, metavar="FILE",
+                   help="block survey (.csv/.xlsx/.parquet with a volume_m3 or mass_kg column) for the design block")
+    p.add_argument("--fractal-dimension", type=float, default=None, metavar="D",
+                   help="fragmentation step (Perfect 1997): fractal dimension D in (0, 3) of the fragments of the "
+                        "design-period event; the design block is then a percentile of its fragments")
+    p.add_argument("--fragmentation-iterations", type=int, default=None, metavar="N",
+                   help="fragmentation generations (1-12) with --fractal-dimension")
+    p.add_argument("--inventory-sizes", choices=("event_volumes", "blocks"), default="event_volumes",
+                   help="what the inventory's sizes are (default event_volumes)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-energy)")
     p.set_defaults(func=cmd_energy)
 

@@ -1068,6 +1068,6 @@ def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0, **kw
             data = tomllib.load(fh)
         except tomllib.TOMLDecodeError as exc:
             raise MitigationError(f"{path}: not valid TOML: {exc}") from exc
-    data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard")}   # a site file works too
+    data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard", "design_block")}   # a site file works too
     return MitigationStudy(hazard=hazard, road_share=road_share, source=str(path), **study_inputs(data, str(path)),
                            **kw)

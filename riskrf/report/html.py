@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
+from ..energy_study import INTERVAL_COVERS, sensitivity_grid
 from ..impact_energy import PairedSamples
 from ..road_risk import fn_zone
 from .format import Document, cell, money, probability, sig
@@ -93,7 +94,19 @@ def render_report(a, figs: Path) -> str:
         if T in design.index:
             row = design.loc[T]
             summary.append(f"<li>{T:g}-year impact energy: {sig(row['energy_kj'], 2)} kJ (95 % interval "
-                           f"{sig(row['ci_low_kj'], 2)} - {sig(row['ci_high_kj'], 2)} kJ).</li>")
+                           f"{sig(row['ci_low_kj'], 2)} - {sig(row['ci_high_kj'], 2)} kJ, covering b, the rate and "
+                           "the finite simulation only).</li>")
+    if en.sensitivity is not None and len(en.sensitivity):
+        sv = en.sensitivity
+        summary.append(f"<li>Over the judgement inputs (m<sub>max</sub> {sig(sv['m_max_kg'].min())} - "
+                       f"{sig(sv['m_max_kg'].max())} kg, rate share {sig(sv['rate_share'].min())} - "
+                       f"{sig(sv['rate_share'].max())}) the {en.design_T:g}-year energy spans "
+                       f"{sig(sv['energy_kj'].min(), 2)} - {sig(sv['energy_kj'].max(), 2)} kJ (section 5).</li>")
+    if en.design_block is not None:
+        b = en.design_block
+        summary.append(f"<li>Design block: <b>{sig(b.mass_kg)} kg ({sig(b.volume_m3)} m&sup3;, diameter "
+                       f"{sig(b.diameter_m)} m)</b> by the {_e(b.rule)} rule"
+                       + "".join(f"; {_e(x)}" for x in b.assumptions[:1]) + ".</li>")
     for _, r in verdicts.iterrows():
         cls = "ok" if r["adequate"] else "fail"
         summary.append(f"<li>Fence {_e(r['fence'])}: <span class='{cls}'>"
@@ -130,8 +143,18 @@ def render_report(a, figs: Path) -> str:
             doc.table(fr.comparison.reset_index(), "Candidate laws compared"),
             doc.figure(figs / "magnitude_frequency.png",
                        "Magnitude - cumulative frequency with the fitted law and the interval of b"),
-            "<h3>Design masses</h3>",
-            doc.table(fr.design_masses(), "Design masses of the inventory's law"))
+            "<h3>Design masses of the site</h3>",
+            "<p>The site's law, the one the hazard uses: truncated at the maximum credible block m<sub>max</sub> "
+            "and with the rate of the share of the source above the line. T-year fall at the source "
+            "(rate &times; P(M &gt; m) = 1/T) and reaching the line (with the reach probability of each mass). "
+            "Nothing exceeds m<sub>max</sub>; blank where fewer than one such fall is expected in T years. "
+            "These are event sizes; the design block (section 5) separates the block from the event.</p>",
+            doc.table(en.site_masses.drop(columns="law"), "Design masses of the site's law: "
+                      + str(en.site_masses["law"].iloc[0])) if en.site_masses is not None else "",
+            "<h3>For reference: the whole monitored wall (regional fit, untruncated, rate not scaled)</h3>",
+            "<p>Not the site's design values: this fit describes every fall of the inventoried wall, with no upper "
+            "bound, so its long-return-period masses can exceed any credible block.</p>",
+            doc.table(fr.design_masses(), "Design masses of the whole wall's law (reference only)"))
 
     # 3. Annual maxima
     mf = fr if fr.gumbel is not None else a.maxima_frequency
@@ -179,11 +202,38 @@ def render_report(a, figs: Path) -> str:
             "<ul>" + "".join(f"<li>{_e(n)}</li>" for n in hz.notes) + "</ul>",
             doc.figure(figs / "energy_exceedance.png", "Annual frequency of impacts above each energy"),
             doc.figure(figs / "mass_velocity.png", "Masses and velocities with iso-energy lines"),
-            "<h3>Design energies</h3>", doc.table(en.design, "Design energies by return period", digits=2))
+            "<h3>Design energies</h3>", f"<p>The interval covers the {_e(INTERVAL_COVERS)}.</p>",
+            doc.table(en.design, "Design energies by return period", digits=2))
+    if hz.mass_coupled:
+        doc.add("<h3>Reach, speed and bounce height by block mass</h3>",
+                "<p>Blocks simulated with masses spread log-uniformly over the mass law's range (stratified), so "
+                "that heavier blocks move as the simulator says; the hazard integrates the mass law over these "
+                "classes. Speeds include rotation; heights are of the block centre.</p>",
+                doc.table(hz.velocity.class_table(), "Simulated blocks by mass class at the barrier line"))
+    if en.sensitivity is not None and len(en.sensitivity):
+        doc.add(f"<h3>Sensitivity of the {en.design_T:g}-year energy to the judgement inputs</h3>",
+                "<p>The maximum credible block m<sub>max</sub> (rows; the power law refitted with each) and the "
+                "share of the inventoried source above the line (columns), at the same simulated slope. These are "
+                "judgement, not sampling: the bootstrap interval above does not include them. Energies in kJ.</p>",
+                doc.table(sensitivity_grid(en.sensitivity).reset_index().rename(columns={"index": "m_max"}),
+                          f"{en.design_T:g}-year energy [kJ] by m_max and rate share", digits=2),
+                doc.figure(figs / "design_energy_sensitivity.png", f"The {en.design_T:g}-year energy against the "
+                           "rate share, one line per maximum credible block"))
+    if en.design_block is not None:
+        b = en.design_block
+        doc.add("<h3>Design block</h3>",
+                f"<div class='box'>Design block <b>{sig(b.mass_kg)} kg</b> ({sig(b.volume_m3)} m&sup3;, "
+                f"equivalent sphere diameter {sig(b.diameter_m)} m): {_e(b.basis)}.</div>",
+                "<p>An inventory of event volumes is not a list of blocks: a large detachment breaks up on the way "
+                "down. The alternatives side by side, each with the 95th-percentile speed of simulated blocks of "
+                "its own mass and the energy &frac12; m v<sub>95</sub><sup>2</sup> it carries:</p>",
+                doc.table(b.alternatives, "Design block and its alternatives"),
+                "<ul>" + "".join(f"<li>{_e(x)}</li>" for x in b.assumptions) + "</ul>")
     if en.uni is not None:
         u = en.uni
-        doc.add(f"<p>UNI 11211-4 design energy of the {en.design_T:g}-year block at the 95th-percentile "
-                f"velocity: E<sub>k</sub> = {sig(u.characteristic_energy_kj, 2)} kJ, E<sub>d</sub> = "
+        what = "design block" if en.design_block is not None else f"{en.design_T:g}-year block"
+        doc.add(f"<p>UNI 11211-4 design energy of the {what} at the 95th-percentile "
+                f"velocity{' of blocks of its mass' if hz.mass_coupled else ''}: E<sub>k</sub> = {sig(u.characteristic_energy_kj, 2)} kJ, E<sub>d</sub> = "
                 f"{sig(u.design_energy_kj, 2)} kJ with factors {_e(cell(u.factors))}.</p>")
 
     # 6. Fences
@@ -269,13 +319,21 @@ def render_report(a, figs: Path) -> str:
 
     # 9. Assumptions
     doc.section("Assumptions, defaults and warnings")
-    coupled = isinstance(hz.velocity, PairedSamples)
+    classed = isinstance(hz.velocity, PairedSamples)
     items = [("Lumped-mass trajectories of round blocks; restitution and friction parameters are starting values "
               "to be calibrated on site (Wyllie 2014, ch. 7)."),
-             ("Velocities are taken with the simulated block mass they belong to." if coupled else
-              "Velocities are taken as independent of block mass."),
+             ("Reach probability, speed and bounce height depend on block mass as simulated (blocks released "
+              "across the mass law's range)." if hz.mass_coupled else
+              "Velocities are taken with the simulated block mass they belong to (the seeder's masses); one reach "
+              "probability for all masses." if classed else
+              "Velocities and the reach probability are taken as independent of block mass "
+              "(hazard.mass_coupling = 'independent')."),
              ("The rate and mass distribution come from the fitted power law, applied at the barrier line"
-              + (f" with the rate scaled by {sig(rate_scale)} (typed assumption)" if rate_scale != 1 else "") + ".")]
+              + (f" with the rate scaled by {sig(rate_scale)} (typed assumption)" if rate_scale != 1 else "") + "."),
+             "Judgement inputs not in any interval: m_max and the rate share (see the sensitivity table in "
+             "section 5)."]
+    if en.design_block is not None:
+        items += [f"Design block ({en.design_block.rule} rule): {x}" for x in en.design_block.assumptions]
     doc.add("<div class='warn'><ul>" + "".join(f"<li>{_e(t)}</li>" for t in items) + "</ul></div>")
     doc.add("<p>Every input the site file did not give, and every judgement input, with where its value "
             "comes from:</p>", doc.table(_assumptions(a, hz, rate_scale), "Defaults and judgement inputs"))
