@@ -36,6 +36,7 @@ from scipy import optimize, stats
 from .extremes import _AnnualMaximumFit
 from .mass_coupling import MassCoupledSamples
 from .power_law import GutenbergRichterFit
+from .report.format import sig
 from .units import DEFAULT_DENSITY_KG_M3, J_PER_KJ, SPHERE_INERTIA
 from .validation import check_choice
 
@@ -140,8 +141,8 @@ def mass_model(mass) -> _MassModel:
         if mass.units != "kg":
             raise ValueError(f"the power-law fit is in {mass.units!r}; convert it with .to_mass(density) first")
         return _MassModel(mass.sf, mass.isf, lambda n, rng: mass.rvs(n, rng),
-                          f"power law b = {mass.b:.3f} above {mass.m_min:.4g} kg"
-                          + (f", truncated at {mass.m_max:.4g} kg" if mass.m_max else ""), mass.support)
+                          f"power law b = {sig(mass.b)} above {sig(mass.m_min)} kg"
+                          + (f", truncated at {sig(mass.m_max)} kg" if mass.m_max else ""), mass.support)
     if isinstance(mass, _AnnualMaximumFit):
         d = mass.dist
         lo = float(d.ppf(1e-12))
@@ -172,7 +173,7 @@ def mass_model(mass) -> _MassModel:
 
     def isf(p):
         return np.quantile(m, 1.0 - np.asarray(p), method="inverted_cdf")
-    return _MassModel(sf, isf, lambda n, rng: rng.choice(m, size=n), f"empirical ({m.size} masses)",
+    return _MassModel(sf, isf, lambda n, rng: rng.choice(m, size=n), f"empirical ({m.size:,} masses)",
                       (float(m[0]), float(m[-1])))
 
 

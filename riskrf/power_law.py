@@ -431,7 +431,6 @@ class GutenbergRichterFit:
         completed.  Replicates use ``SeedSequence(seed).spawn`` so results do
         not depend on chunking.
         """
-        from ._power_law_kernels import ks_scan
 
         if self.method != "mle":
             raise ValueError(f"this fit has method = {self.method!r}: the bootstrap test needs a maximum-likelihood "

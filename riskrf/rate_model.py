@@ -504,7 +504,6 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
     # Rainfall: every event date and every day of the period with its antecedent window must be covered.
     design = pd.DataFrame({"period_start": starts, "exposure_days": exposure})
     rain_cols: list[tuple[str, str]] = []
-    windows_used = windows if period == "day" else ()
     if rain is not None:
         lead = max(windows) - 1 if period == "day" else 0
         first_needed = start - pd.Timedelta(days=lead)
