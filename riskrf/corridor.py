@@ -25,6 +25,7 @@ import math
 import os
 import time
 import tomllib
+import uuid
 import zlib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -318,7 +319,7 @@ def load_corridor(path, *, keep_going: bool = False) -> Corridor:
     if df.empty:
         raise CorridorError(f"{tsrc}: the sections table has no rows")
     scale = 1000.0 if unit == "km" else 1.0
-    errors, sections = [], []
+    errors, sections, bad_rows = [], [], set()
     seen = {}
     for i, raw in df.iterrows():
         row = i + 2              # spreadsheet row (header is row 1)
@@ -450,16 +451,17 @@ def load_corridor(path, *, keep_going: bool = False) -> Corridor:
                                     notes=str(vals["notes"] or "")))
         except CorridorError as exc:
             errors.append(str(exc))
+            bad_rows.add(row)
     ordered = sorted(sections, key=lambda s: s.chainage_from_m)
     for a, b in zip(ordered[:-1], ordered[1:]):
         if b.chainage_from_m < a.chainage_to_m:
             errors.append(f"{tsrc}: row {b.row} (section {b.id!r}): chainage {b.chainage_from_m:g}-{b.chainage_to_m:g} "
                           f"m overlaps row {a.row} (section {a.id!r}, {a.chainage_from_m:g}-{a.chainage_to_m:g} m)")
+            bad_rows.add(b.row)
     if errors and not keep_going:
         raise CorridorError(f"{len(errors)} bad section row(s) (use --keep-going to run the others):\n  "
                             + "\n  ".join(errors))
-    bad_ids = {e.split("(section ")[1].split(")")[0].strip("'") for e in errors if "(section " in e}
-    ordered = [s for s in ordered if s.id not in bad_ids or not keep_going]
+    ordered = [s for s in ordered if s.row not in bad_rows]
     if not ordered:
         raise CorridorError(f"{tsrc}: no valid section to assess:\n  " + "\n  ".join(errors))
     return Corridor(name=str(cor.get("name", path.stem)), path=path, sections=tuple(ordered), mass=gr,
@@ -717,9 +719,9 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
             done_rows = [have[s.id] for s in todo if s not in keep]
             todo = keep
         c_future = client.scatter(corridor, broadcast=True) if todo else None
-        futures = {client.submit(_task, s, c_future, n_blocks, key=f"riskrf-section-{s.id}-{corridor.seed}-"
-                                 f"{n_blocks or corridor.n_blocks}-{id(corridor)}", retries=retries): s.id
-                   for s in todo}
+        run = uuid.uuid4().hex[:8]           # fresh keys: a rerun never picks up an earlier run's (failed) result
+        futures = {client.submit(_task, s, c_future, n_blocks, key=f"riskrf-section-{s.id}-{run}", retries=retries):
+                   s.id for s in todo}
         failures = []
         total = len(corridor.sections)
         count = len(done_rows)
