@@ -137,10 +137,17 @@ def test_corridor_file_errors(tmp_path):
 def test_unreachable_scheduler_fails_fast_and_writes_nothing(tmp_path, capsys):
     t0 = time.perf_counter()
     with pytest.raises(ConnectionError, match="cannot reach the dask scheduler"):
-        cr.connect("tcp://127.0.0.1:9", timeout_s=2)
+        cr.connect("tcp://127.0.0.1:9", timeout_s=1)
     assert time.perf_counter() - t0 < 10
     out = tmp_path / "out"
-    rc = main(["corridor", str(DATA / "small.toml"), "--scheduler", "tcp://127.0.0.1:9", "--out", str(out)])
+    real = cr.connect
+    import functools
+    import riskrf.corridor
+    riskrf.corridor.connect = functools.partial(real, timeout_s=1)
+    try:
+        rc = main(["corridor", str(DATA / "small.toml"), "--scheduler", "tcp://127.0.0.1:9", "--out", str(out)])
+    finally:
+        riskrf.corridor.connect = real
     assert rc == 2 and "cannot reach the dask scheduler" in capsys.readouterr().err
     assert not out.exists() and not any(tmp_path.iterdir())
 
