@@ -236,7 +236,11 @@ def load_corridor(path, *, keep_going: bool = False) -> Corridor:
                     "uncertainty", "options"}, "", src)
     cor = data.get("corridor", {})
     _unknown(cor, {"name", "description", "sections", "seed", "n_blocks", "option_blocks", "chainage_unit",
-                   "rate_basis"}, "corridor.", src)
+                   "rate_basis", "rhrs_cap_points"}, "corridor.", src)
+    rhrs_cap = cor.get("rhrs_cap_points")
+    if rhrs_cap is not None and (isinstance(rhrs_cap, bool) or not isinstance(rhrs_cap, (int, float))
+                                 or rhrs_cap < 81):
+        raise CorridorError(f"{src}: corridor.rhrs_cap_points = {rhrs_cap!r} must be a number >= 81")
     if "sections" not in cor:
         raise CorridorError(f"{src}: [corridor] needs sections = \"table.csv\" (CSV, Excel or Parquet)")
     for k in ("seed", "n_blocks", "option_blocks"):
@@ -442,7 +446,7 @@ def load_corridor(path, *, keep_going: bool = False) -> Corridor:
                          or k in ("slope_height_m", "roadway_width_m") and v is not None}
                 attrs.update(given)
                 try:
-                    rating = rhrs.rate(**attrs)
+                    rating = rhrs.rate(cap_points=rhrs_cap, **attrs)
                 except (ValueError, TypeError) as exc:
                     raise CorridorError(f"{where}: RHRS: {exc}") from exc
             sections.append(Section(id=sid, row=row, chainage_from_m=c0, chainage_to_m=c1, scenario=sc,

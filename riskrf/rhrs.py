@@ -163,10 +163,13 @@ class RHRSRating:
 
     x: dict
     inputs: dict = field(default_factory=dict)
+    cap_points: float | None = None
 
     @property
     def scores(self) -> dict:
-        return {k: 3.0 ** v for k, v in self.x.items()}
+        """Score of each category, 3**x, limited to ``cap_points`` when a cap was chosen."""
+        cap = math.inf if self.cap_points is None else self.cap_points
+        return {k: min(3.0 ** v, cap) for k, v in self.x.items()}
 
     @property
     def total(self) -> float:
@@ -189,7 +192,7 @@ RATE_FIELDS = ("slope_height_m", "ditch_effectiveness", "adt_vehicles_per_day", 
                "difference_in_erosion_rates", "block_size_m", "volume_m3", "climate_and_water", "rockfall_history")
 
 
-def rate(**attrs) -> RHRSRating:
+def rate(*, cap_points: float | None = None, **attrs) -> RHRSRating:
     """Rate one slope from its attributes (names in :data:`RATE_FIELDS`, SI units).
 
     Needed: slope_height_m; ditch_effectiveness; the AVR (``avr_percent``, or ``adt_vehicles_per_day``,
@@ -197,7 +200,12 @@ def rate(**attrs) -> RHRSRating:
     ``decision_sight_distance_m``); roadway_width_m; the geologic character (case 1 or case 2 pair);
     block_size_m or volume_m3 (the larger score counts when both are given, as the manual rates the
     greater of the two); climate_and_water; rockfall_history.
+
+    ``cap_points``: optional upper limit of each category score (a user's choice, e.g. 100, so that one
+    continuous category far beyond the 81-point class cannot dominate the total); default uncapped.
     """
+    if cap_points is not None:
+        cap_points = _finite(cap_points, "cap_points", lo=81)
     unknown = sorted(set(attrs) - set(RATE_FIELDS))
     if unknown:
         raise ValueError(f"unknown RHRS attribute(s) {unknown}; allowed: {list(RATE_FIELDS)}")
@@ -249,4 +257,4 @@ def rate(**attrs) -> RHRSRating:
     need("climate_and_water", "rockfall_history")
     x["climate_and_water"] = class_x("climate_and_water", a["climate_and_water"])
     x["rockfall_history"] = class_x("rockfall_history", a["rockfall_history"])
-    return RHRSRating(x=x, inputs=inputs)
+    return RHRSRating(x=x, inputs=inputs, cap_points=cap_points)

@@ -130,3 +130,12 @@ def test_scores_monotone_in_height(h1, h2):
     lo, hi = sorted((h1, h2))
     assert rhrs.score(rhrs.slope_height_x(lo)) <= rhrs.score(rhrs.slope_height_x(hi))
     assert math.isclose(rhrs.score(rhrs.slope_height_x(hi)), 3 ** (hi / FT / 25), rel_tol=1e-12)
+
+
+def test_cap_points_limits_each_category():
+    a = {**_worst_case(), "slope_height_m": 200 * FT}          # x = 8: 6561 points uncapped
+    assert rhrs.rate(**a).scores["slope_height"] == pytest.approx(6561.0)
+    capped = rhrs.rate(cap_points=100, **a)
+    assert capped.scores["slope_height"] == 100 and capped.total == pytest.approx(9 * 81 + 100)
+    with pytest.raises(ValueError, match="cap_points"):
+        rhrs.rate(cap_points=10, **a)
