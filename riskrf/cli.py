@@ -359,7 +359,8 @@ def cmd_corridor(args) -> int:
     for _, r in top.iterrows():
         print(f"  {r['id']}: RHRS {r['rhrs_score']:.0f} (rank {r['rank_rhrs']:.0f}), {r['deaths_per_year']:.2e} deaths/yr, "
               f"best: {r['best_option']} ({r['best_option_capital']:,.0f} {corridor.currency})")
-    print(f"Outputs: {out.resolve()} (corridor.csv, sections.csv, budget_curve.csv, chainage.png, summary.json)")
+    print(f"Report: {(out / 'report.html').resolve()} (also corridor.csv, sections.csv, budget_curve.csv, "
+          "chainage.png, summary.json)")
     return 0
 
 
@@ -493,8 +494,8 @@ def build_parser() -> argparse.ArgumentParser:
                        "naming a sections table) and check every row first; then run each section's chain "
                        "(simulation, energy hazard, road-user risk, option ranking) as a task on dask.distributed: "
                        "a local cluster sized to the machine by default, or an existing scheduler unchanged.  "
-                       "Writes corridor.csv (ranked by risk beside the RHRS rank), sections.csv, budget_curve.csv, "
-                       "chainage.png and summary.json (see the README section 'Corridor').", epilog=EPILOG)
+                       "Writes report.html, corridor.csv (ranked by risk beside the RHRS rank), sections.csv, "
+                       "budget_curve.csv, chainage.png and summary.json (see the README section 'Corridor').", epilog=EPILOG)
     p.add_argument("corridor", help="corridor file (.toml); paths in it are relative to it")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <corridor>-corridor)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",

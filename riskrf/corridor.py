@@ -43,7 +43,8 @@ BUNDLED_MATERIALS = Path(__file__).resolve().parents[1] / "simulation" / "scenar
 GEOMETRY_COLUMNS = ("cut_height_m", "face_angle_deg", "ditch_width_m", "ditch_depth_m", "runout_to_road_m",
                     "road_width_m")
 NUMBER_COLUMNS = GEOMETRY_COLUMNS + ("chainage_from", "chainage_to", "falls_per_year", "falls_per_km_year",
-                                     "vehicles_per_day", "speed_kmh", "release_zone_share")
+                                     "falls_per_m2_year", "vehicles_per_day", "speed_kmh", "release_zone_share")
+RATE_COLUMNS = ("falls_per_year", "falls_per_km_year", "falls_per_m2_year")
 TEXT_COLUMNS = ("id", "scenario", "face_material", "ditch_material", "road_material", "options", "notes")
 RHRS_COLUMNS = tuple("rhrs_" + f for f in rhrs.RATE_FIELDS)
 ALL_COLUMNS = TEXT_COLUMNS + NUMBER_COLUMNS + RHRS_COLUMNS
@@ -365,14 +366,25 @@ def load_corridor(path, *, keep_going: bool = False) -> Corridor:
             if c1 <= c0:
                 raise CorridorError(f"{where}: chainage_to = {num['chainage_to']:g} must exceed chainage_from = "
                                     f"{num['chainage_from']:g} ({unit})")
-            for c in ("falls_per_year", "falls_per_km_year", "vehicles_per_day", "speed_kmh"):
+            for c in RATE_COLUMNS + ("vehicles_per_day", "speed_kmh"):
                 if c in num and num[c] < 0 or (c == "speed_kmh" and c in num and num[c] == 0):
                     raise CorridorError(f"{where}: column {c!r} = {num[c]:g} must be > 0" if c == "speed_kmh" else
                                         f"{where}: column {c!r} = {num[c]:g} must be >= 0")
-            if ("falls_per_year" in num) == ("falls_per_km_year" in num):
-                raise CorridorError(f"{where}: give exactly one of falls_per_year or falls_per_km_year (own rate, or a "
-                                    "corridor rate per km times the section length)")
-            rate = num["falls_per_year"] if "falls_per_year" in num else num["falls_per_km_year"] * (c1 - c0) / 1000
+            given_rates = [c for c in RATE_COLUMNS if c in num]
+            if len(given_rates) != 1:
+                raise CorridorError(f"{where}: give exactly one of falls_per_year, falls_per_km_year or "
+                                    f"falls_per_m2_year (own rate, or a corridor rate per km of road or per m2 of rock "
+                                    f"face); got {given_rates or 'none'}")
+            if "falls_per_year" in num:
+                rate = num["falls_per_year"]
+            elif "falls_per_km_year" in num:
+                rate = num["falls_per_km_year"] * (c1 - c0) / 1000
+            else:
+                if "cut_height_m" not in num or "face_angle_deg" not in num:
+                    raise CorridorError(f"{where}: falls_per_m2_year needs cut_height_m and face_angle_deg (the face "
+                                        "area is the section length x the face's slope length)")
+                face_m2 = (c1 - c0) * num["cut_height_m"] / math.sin(math.radians(num["face_angle_deg"]))
+                rate = num["falls_per_m2_year"] * face_m2
             if not rate > 0:
                 raise CorridorError(f"{where}: the section's rate of falls is {rate:g} per year; a section without "
                                     "falls needs no assessment (remove it or give a rate > 0)")
@@ -760,9 +772,64 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
                           seconds=time.perf_counter() - t0, n_blocks=int(n_blocks or corridor.n_blocks))
 
 
+def render_html(res: CorridorResult, figure_png: Path) -> str:
+    """Self-contained HTML corridor report: key figures, chainage figure, ranked table, budget curve, where the
+    RHRS and the quantitative ranking disagree, rejected rows, failures and assumptions."""
+    import base64
+
+    from . import __version__
+    from .report.format import cell, escape, human_header
+    from .report.html import CSS
+    c = res.corridor
+    cur = c.currency
+    s = res.summary()
+    b = res.budget_curve()
+    t = res.table
+
+    def table(df, money_cols=()):
+        head = "".join(f"<th>{escape(human_header(col))}</th>" for col in df.columns)
+        body = "".join("<tr>" + "".join(f"<td>{escape(cell(v, money_columns=col in money_cols, currency=cur))}</td>"
+                                        for col, v in zip(df.columns, row)) + "</tr>"
+                       for row in df.itertuples(index=False))
+        return f"<table><tr>{head}</tr>{body}</table>"
+
+    img = base64.b64encode(Path(figure_png).read_bytes()).decode("ascii")
+    money_cols = ("best_option_capital", "best_option_total_cost", "expected_annual_cost_per_km", "spend",
+                  "cumulative_spend")
+    disagree = s[s["rank_difference"].abs() >= max(3, len(s) // 5)] if s["rank_rhrs"].notna().any() else s.iloc[0:0]
+    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{escape(c.name)}</title><style>{CSS}</style>"
+             f"</head><body><h1>{escape(c.name)}</h1>",
+             f"<p>{len(t)} sections assessed on {res.workers} dask worker(s) in {res.seconds:.1f} s, "
+             f"{res.n_blocks:,} simulated blocks per section, corridor seed {c.seed} (riskrf {__version__}).</p>",
+             "<div class='box'><ul>"
+             f"<li>Deaths per year, doing nothing: {cell(float(t['deaths_per_year'].sum()))}; with each section's best "
+             f"option: {cell(float(t['best_deaths_per_year'].sum()))}</li>"
+             f"<li>Capital of the best options: {cell(float(t['best_option_capital'].sum()), money_columns=True, currency=cur)}"
+             "</li><li>Rates: " + ("falls reaching the road (as recorded), release rate derived per section from the "
+                                   "simulated share reaching the road" if c.rate_basis == "road" else
+                                   "falls released (>= m_min)") + f"</li><li>{escape(c.mass_note)}</li></ul></div>",
+             "<h2>Along the chainage</h2>",
+             f"<figure><img alt='chainage' src='data:image/png;base64,{img}'><figcaption>RHRS score, individual risk "
+             "and deaths per year per km of each section, doing nothing and with its best option.</figcaption></figure>",
+             "<h2>Sections ranked by quantitative risk (RHRS rank beside)</h2>", table(s, money_cols),
+             "<h2>Budget curve</h2><p>Sections in order of deaths avoided per unit spent with their best option: what "
+             "a budget buys when sections are done in this order.</p>", table(b, money_cols)]
+    if len(disagree):
+        parts += ["<h2>Where the RHRS and the risk ranking disagree</h2>",
+                  "<p>Sections whose RHRS rank and risk rank differ by at least "
+                  f"{max(3, len(s) // 5)} places.</p>",
+                  table(disagree[["id", "rank_risk", "rank_rhrs", "rhrs_score", "deaths_per_year", "individual_risk"]])]
+    if c.errors or res.failures:
+        parts.append("<h2>Rejected rows and failed sections</h2><div class='warn'><ul>"
+                     + "".join(f"<li>{escape(e)}</li>" for e in list(c.errors) + list(res.failures)) + "</ul></div>")
+    parts.append("<h2>Inputs left at their defaults</h2><ul>"
+                 + "".join(f"<li>{escape(d)}</li>" for d in c.defaults_used) + "</ul></body></html>")
+    return "\n".join(parts)
+
+
 def write_corridor(res: CorridorResult, out: Path) -> None:
-    """Write corridor.csv (ranked), sections.csv (by chainage), budget_curve.csv, chainage.png, summary.json into
-    ``out`` (a directory that is filled all at once)."""
+    """Write report.html, corridor.csv (ranked), sections.csv (by chainage), budget_curve.csv, chainage.png and
+    summary.json into ``out`` (a directory that appears only when everything is written)."""
     import matplotlib.pyplot as plt
 
     from .outputs import atomic_output_dir, write_json
@@ -773,4 +840,5 @@ def write_corridor(res: CorridorResult, out: Path) -> None:
         fig = res.figure()
         fig.savefig(tmp / "chainage.png", dpi=120)
         plt.close(fig)
+        (tmp / "report.html").write_text(render_html(res, tmp / "chainage.png"), encoding="utf-8")
         write_json(res.to_json(), tmp / "summary.json")

@@ -128,7 +128,7 @@ def test_corridor_file_errors(tmp_path):
         p = _write(tmp_path, HEAD + "A,0,100,20,3,1,0.5,\n")
         p.write_text(p.read_text().replace("seed = 7", "sead = 7"))
         cr.load_corridor(p)
-    with pytest.raises(cr.CorridorError, match="exactly one of falls_per_year or falls_per_km_year"):
+    with pytest.raises(cr.CorridorError, match="exactly one of falls_per_year, falls_per_km_year or falls_per_m2_year"):
         cr.load_corridor(_write(tmp_path, HEAD.replace(",scenario", ",falls_per_km_year,scenario")
                                 .replace("falls_per_year,falls_per_km_year", "falls_per_year,falls_per_km_year")
                                 + "A,0,100,20,3,1,0.5,2,\n"))
@@ -187,9 +187,21 @@ def test_cli_writes_outputs(tmp_path, monkeypatch, runs):
     monkeypatch.setattr(cr, "connect", lambda scheduler=None, n_workers=None, **k: _client(1))
     out = tmp_path / "run"
     assert main(["corridor", str(DATA / "small.toml"), "-n", str(N), "--out", str(out)]) == 0
-    for f in ("corridor.csv", "sections.csv", "budget_curve.csv", "chainage.png", "summary.json"):
+    for f in ("report.html", "corridor.csv", "sections.csv", "budget_curve.csv", "chainage.png", "summary.json"):
         assert (out / f).exists()
     t = pd.read_csv(out / "sections.csv")
     np.testing.assert_allclose(t["deaths_per_year"], runs[2].table["deaths_per_year"], rtol=1e-12)
     assert not (tmp_path / ".run.sections").exists()
     shutil.rmtree(out)
+
+
+def test_rate_per_m2_of_face_and_parquet_table(tmp_path):
+    rows = ("id,chainage_from,chainage_to,cut_height_m,ditch_width_m,runout_to_road_m,falls_per_m2_year\n"
+            "A,0,100,20,3,1,0.0001\n")
+    path = _write(tmp_path, rows)
+    sec = cr.load_corridor(path).sections[0]
+    # face area = 100 m x 20 m / sin(60 deg) = 2309.4 m2 -> 0.23094 falls per year
+    assert sec.falls_per_year == pytest.approx(1e-4 * 100 * 20 / np.sin(np.radians(60)))
+    pd.read_csv(tmp_path / "s.csv").astype(str).to_parquet(tmp_path / "s.parquet")
+    path.write_text(path.read_text().replace('sections = "s.csv"', 'sections = "s.parquet"'))
+    assert cr.load_corridor(path).sections[0].falls_per_year == pytest.approx(sec.falls_per_year)
