@@ -672,7 +672,7 @@ class CorridorResult:
             ax[0].annotate(str(sid), (a + b / 2, 0), xytext=(0, 2), textcoords="offset points", ha="center",
                            fontsize=6, rotation=90)
         fig.suptitle(f"{self.corridor.name}: {len(t)} sections")
-        fig.tight_layout()
+        fig.subplots_adjust(left=0.09, right=0.98, bottom=0.07, top=0.93, hspace=0.12)   # tight_layout: seconds
         return fig
 
     def to_json(self) -> dict:

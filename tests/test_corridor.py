@@ -28,17 +28,21 @@ def _client(n):
 
 
 @pytest.fixture(scope="module")
-def runs(corridor):
-    """The same corridor serially, on 1 worker and on 2 workers (threaded local clusters)."""
-    serial = pd.DataFrame([cr.assess_section(s, corridor, N) for s in corridor.sections])
-    out = {"serial": serial}
+def clients():
+    """Threaded local clusters of 1 and 2 workers, shared by the tests of this module."""
+    made = {n: _client(n) for n in (1, 2)}
+    yield {n: c for n, (c, _) in made.items()}
+    for client, cluster in made.values():
+        client.close()
+        cluster.close()
+
+
+@pytest.fixture(scope="module")
+def runs(corridor, clients):
+    """The same corridor serially, on 1 worker and on 2 workers."""
+    out = {"serial": pd.DataFrame([cr.assess_section(s, corridor, N) for s in corridor.sections])}
     for n in (1, 2):
-        client, cluster = _client(n)
-        try:
-            out[n] = cr.run_corridor(corridor, client=client, n_blocks=N)
-        finally:
-            client.close()
-            cluster.close()
+        out[n] = cr.run_corridor(corridor, client=clients[n], n_blocks=N)
     return out
 
 
@@ -152,8 +156,8 @@ def test_unreachable_scheduler_fails_fast_and_writes_nothing(tmp_path, capsys):
     assert not out.exists() and not any(tmp_path.iterdir())
 
 
-def test_failure_reported_with_keep_going_and_resume(corridor, tmp_path, monkeypatch):
-    client, cluster = _client(2)
+def test_failure_reported_with_keep_going_and_resume(corridor, tmp_path, monkeypatch, clients):
+    client = clients[2]
     real = cr.assess_section
     calls = []
 
@@ -178,13 +182,25 @@ def test_failure_reported_with_keep_going_and_resume(corridor, tmp_path, monkeyp
                                progress=lambda d, t, s: seen.append(s))
         assert seen == ["B"] and list(res2.table["id"]) == ["A", "B", "C"]
     finally:
-        client.close()
-        cluster.close()
+        monkeypatch.setattr(cr, "assess_section", real)
 
 
-def test_cli_writes_outputs(tmp_path, monkeypatch, runs):
-    # a threaded 1-worker local cluster through the CLI path (LocalCluster(processes=True) is the default)
-    monkeypatch.setattr(cr, "connect", lambda scheduler=None, n_workers=None, **k: _client(1))
+class _Borrowed:
+    """A shared client that the CLI may 'close' without closing it."""
+
+    def __init__(self, client):
+        self._c = client
+
+    def __getattr__(self, name):
+        return getattr(self._c, name)
+
+    def close(self):
+        pass
+
+
+def test_cli_writes_outputs(tmp_path, monkeypatch, runs, clients):
+    # the CLI path on the shared threaded 1-worker cluster (a LocalCluster of processes is the default)
+    monkeypatch.setattr(cr, "connect", lambda scheduler=None, n_workers=None, **k: (_Borrowed(clients[1]), None))
     out = tmp_path / "run"
     assert main(["corridor", str(DATA / "small.toml"), "-n", str(N), "--out", str(out)]) == 0
     for f in ("report.html", "corridor.csv", "sections.csv", "budget_curve.csv", "chainage.png", "summary.json"):
@@ -192,6 +208,8 @@ def test_cli_writes_outputs(tmp_path, monkeypatch, runs):
     t = pd.read_csv(out / "sections.csv")
     np.testing.assert_allclose(t["deaths_per_year"], runs[2].table["deaths_per_year"], rtol=1e-12)
     assert not (tmp_path / ".run.sections").exists()
+    html = (out / "report.html").read_text()
+    assert all(sid in html for sid in ("A", "B", "C")) and "Budget curve" in html and "data:image/png;base64" in html
     shutil.rmtree(out)
 
 
