@@ -343,7 +343,7 @@ def cmd_corridor(args) -> int:
 
     try:
         res = run_corridor(corridor, scheduler=args.scheduler, n_workers=args.workers, n_blocks=n, partitions=parts,
-                           resume=args.resume, keep_going=args.keep_going, progress=progress)
+                           resume=args.resume, keep_going=args.keep_going, progress=progress, log=print)
     except (ConnectionError, RuntimeError) as exc:
         print(f"\nriskrf corridor: error: {exc}", file=sys.stderr)
         if parts.exists():

@@ -595,7 +595,7 @@ def connect(scheduler: str | None = None, n_workers: int | None = None, *, timeo
             raise ConnectionError(f"cannot reach the dask scheduler at {address!r} within {timeout_s:g} s: {exc}") \
                 from None
     n = int(n_workers or os.cpu_count() or 1)
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=processes, dashboard_address=None)
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=processes, dashboard_address=":0")
     return Client(cluster), cluster
 
 
@@ -705,7 +705,7 @@ def _write_partition(directory: Path, row: dict) -> None:
 
 def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = None, n_workers: int | None = None,
                  n_blocks: int | None = None, partitions: Path | None = None, resume: bool = False,
-                 keep_going: bool = False, progress=None, retries: int = 1) -> CorridorResult:
+                 keep_going: bool = False, progress=None, retries: int = 1, log=None) -> CorridorResult:
     """Assess every section of ``corridor`` as a task on a ``dask.distributed`` client.
 
     ``client``: an existing Client (used as is); else :func:`connect` (``scheduler`` / DASK_SCHEDULER_ADDRESS, or
@@ -713,7 +713,8 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
     (written atomically as sections finish, so memory stays flat and an interrupted run keeps its work);
     ``resume`` skips sections already there.  A task that fails (or whose worker dies) is retried ``retries``
     times; then the run stops, or with ``keep_going`` the failure is listed and the rest continue.
-    ``progress(done, total, section_id)`` is called as each section finishes.
+    ``progress(done, total, section_id)`` is called as each section finishes; ``log(text)`` once connected
+    (the cluster's dashboard address).
     """
     from distributed import as_completed
     t0 = time.perf_counter()
@@ -721,6 +722,8 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
     cluster = None
     if own:
         client, cluster = connect(scheduler, n_workers)
+    if log is not None:
+        log(f"dask dashboard (live progress per worker): {getattr(client, 'dashboard_link', None)}")
     try:
         todo = list(corridor.sections)
         done_rows = []

@@ -23,7 +23,7 @@ def corridor():
 
 
 def _client(n):
-    cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=False, dashboard_address=None)
+    cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=False, dashboard_address=":0")
     return distributed.Client(cluster), cluster
 
 

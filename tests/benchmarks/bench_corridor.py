@@ -68,7 +68,7 @@ def main() -> int:
         tables, rates = {}, {}
         for n in (1, 2):
             cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                               dashboard_address=None)
+                                               dashboard_address=":0")
             client = distributed.Client(cluster)
             try:
                 client.run(_warm)
@@ -94,7 +94,7 @@ def main() -> int:
         per_section_s = 1.0 / rates[1]
         print(f"measured cost: {per_section_s:.2f} s per section at {args.blocks:,} blocks on one worker")
         # a worker killed mid-run: its sections are rescheduled on the restarted/other worker; same table
-        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
         client = distributed.Client(cluster)
         killed = []
         try:
