@@ -46,6 +46,7 @@ def _read(args, path):
 
 
 def cmd_fit(args) -> int:
+    """``riskrf fit``: read an inventory, fit the power law (and Gumbel/GEV when dated), print and write the results."""
     from .frequency_study import analyse_inventory
     from .outputs import atomic_output_dir
 
@@ -82,6 +83,7 @@ def write_table(df, path: Path) -> None:
 
 
 def cmd_simulate(args) -> int:
+    """``riskrf simulate``: run a scenario, print its summary, write the crossings table and figures."""
     import pandas as pd
 
     import simulation
@@ -123,6 +125,7 @@ def build_energy_hazard(args, inventory):
 
 
 def cmd_energy(args) -> int:
+    """``riskrf energy``: impact-energy hazard at a barrier line, design energies and fence checks."""
     from .energy_study import analyse_energy
     from .outputs import atomic_output_dir
 
@@ -142,6 +145,7 @@ def cmd_energy(args) -> int:
 
 
 def cmd_decide(args) -> int:
+    """``riskrf decide``: rank mitigation options (site file) or roll back a decision tree file."""
     from .decision_tree import DecisionTree
     from .mitigation import load_mitigation
     from .outputs import atomic_output_dir, write_json
@@ -225,6 +229,7 @@ def _add_energy_arguments(p):
 
 
 def cmd_assess(args) -> int:
+    """``riskrf assess``: the whole chain for a site file, written atomically to ``--out``."""
     from .assess import run_assessment, write_assessment
     from .outputs import atomic_output_dir
     from .site import load_site
@@ -247,6 +252,7 @@ def cmd_assess(args) -> int:
 
 
 def cmd_demo(args) -> int:
+    """``riskrf demo``: ``assess`` on the bundled demo site."""
     from importlib import resources
 
     with resources.as_file(resources.files("riskrf") / "data" / "demo_site.toml") as site:
@@ -259,6 +265,7 @@ def cmd_demo(args) -> int:
 
 
 def cmd_calibrate(args) -> int:
+    """``riskrf calibrate``: fit scenario material parameters to observed stop points."""
     import simulation
     from simulation.calibration import read_observed
 
@@ -365,6 +372,7 @@ def cmd_corridor(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``riskrf`` argument parser with one sub-command per task."""
     parser = argparse.ArgumentParser(
         prog="riskrf", description="Rock fall hazard, risk and mitigation decisions (after Wyllie 2014, "
         "Rock Fall Engineering, chapters 3-8).  Start with 'riskrf demo' (the whole chain on a bundled site, "
@@ -509,6 +517,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    """Entry point of the ``riskrf`` command; returns the exit status (0 ok, 2 bad input)."""
     # Figures are written to files: a non-interactive backend, unless the user chose one.
     os.environ.setdefault("MPLBACKEND", "Agg")
     # Library code logs its stages (logger "riskrf"); the command line shows them as plain lines.

@@ -89,6 +89,7 @@ class FrequencyAnalysis:
         return d.pivot(index="T_years", columns="model", values="mass_kg")
 
     def to_dict(self) -> dict:
+        """The fits as plain JSON-ready values (for summary.json)."""
         gr = self.power_law
         out = {
             "inventory": self.inventory.summary()["value"].to_dict(),

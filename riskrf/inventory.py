@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .report.format import sig
 from .units import DEFAULT_DENSITY_KG_M3, KG_PER_TONNE
 from .validation import check_positive, warn
 
@@ -211,8 +212,8 @@ class Inventory:
             "record period from": self.period_source,
             "events per year": round(self.n_events / self.duration_years, 3),
             "density [kg/m3]": f"{self.density_kg_m3:g}" + (" (default)" if self.density_is_default else ""),
-            "volume min / median / max [m3]": f"{v.min():.4g} / {np.median(v):.4g} / {v.max():.4g}",
-            "mass min / median / max [kg]": f"{m.min():.4g} / {np.median(m):.4g} / {m.max():.4g}",
+            "volume min / median / max [m3]": " / ".join(sig(x) for x in (v.min(), np.median(v), v.max())),
+            "mass min / median / max [kg]": " / ".join(sig(x) for x in (m.min(), np.median(m), m.max())),
             "dated": self.is_dated,
         }
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})

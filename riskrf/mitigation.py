@@ -49,24 +49,21 @@ import numpy as np
 import pandas as pd
 
 from .annual_hazard import EnergyHazard
+from .barriers import damage_state_shares, out_of_service_share
 from .economics import pv_factor, renewal_factor
 from .impact_energy import mass_model
-from .measures import (Ditch, MeasureError, SimulationContext, effective_samples, material_value, road_crossings,
-                       runout_beyond, scenario_with_ditches, scenario_with_materials, seeder_share)
-from .power_law import GutenbergRichterFit
-from .road_risk import (
-    commuter_passage_probability,
-    commuter_strike_probability,
-    fn_zone,
-    occupancy_distribution,
-    occupant_fn,
-    spatial_temporal_probability,
-    stationary_rock_strike_probability,
-    vulnerability_by_mass,
+from .measures import (
+    Ditch,
+    MeasureError,
+    SimulationContext,
+    effective_samples,
+    material_value,
+    road_crossings,
+    runout_beyond,
+    scenario_with_ditches,
+    scenario_with_materials,
+    seeder_share,
 )
-from .barriers import damage_state_shares, out_of_service_share
-from .units import kinetic_energy_kj
-
 from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.mitigation)
     BARRIER_KINDS,
     DEFAULT_REPAIR_DAYS,
@@ -84,6 +81,19 @@ from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.mitigati
     parse_mitigation,
     parse_option,
 )
+from .power_law import GutenbergRichterFit
+from .report.format import probability
+from .road_risk import (
+    commuter_passage_probability,
+    commuter_strike_probability,
+    fn_zone,
+    occupancy_distribution,
+    occupant_fn,
+    spatial_temporal_probability,
+    stationary_rock_strike_probability,
+    vulnerability_by_mass,
+)
+from .units import kinetic_energy_kj
 
 
 @dataclass(frozen=True)
@@ -801,7 +811,7 @@ class MitigationStudy:
         if len(ok):
             rec = ok.iloc[0]
             why = (f"{rec['option']} is the cheapest option that meets the tolerability criteria (individual risk "
-                   f"{rec['individual_risk']:.2g}/yr against {lim:.0e}/yr; societal risk {rec['fn_zone']} on the "
+                   f"{probability(rec['individual_risk'])}/yr against {probability(lim)}/yr; societal risk {rec['fn_zone']} on the "
                    f"{self.criteria.fn_diagram} F-N diagram). Its expected total cost is "
                    f"{rec['expected_total_cost']:,.0f} {cur} (5-95 %: {rec['cost_p05']:,.0f} to "
                    f"{rec['cost_p95']:,.0f} {cur}); it meets them in {rec['probability_meets_criteria']:.0%} of the "
@@ -811,7 +821,7 @@ class MitigationStudy:
                 why += (f" Cheaper options leave the risk intolerable: {cheapest['option']} costs least "
                         f"({cheapest['expected_total_cost']:,.0f} {cur}, the cheapest in "
                         f"{cheapest['probability_best']:.0%} of the joint samples) but leaves individual risk "
-                        f"{cheapest['individual_risk']:.2g}/yr and societal risk {cheapest['fn_zone']}"
+                        f"{probability(cheapest['individual_risk'])}/yr and societal risk {cheapest['fn_zone']}"
                         + (f"; so do {', '.join(intolerable['option'].iloc[1:])}" if len(intolerable) > 1 else "")
                         + f". Meeting the criteria costs "
                         f"{rec['expected_total_cost'] - cheapest['expected_total_cost']:,.0f} {cur} more in "
@@ -828,11 +838,11 @@ class MitigationStudy:
             else:
                 rec = cand.sort_values("deaths_avoided_per_million", ascending=False).iloc[0]
                 basis = "largest risk reduction per unit cost (no option meets the criteria)"
-                why = (f"No option meets the tolerability criteria (individual risk {lim:.0e}/yr and the F-N "
+                why = (f"No option meets the tolerability criteria (individual risk {probability(lim)}/yr and the F-N "
                        f"diagram). {rec['option']} reduces the risk most per unit cost: "
                        f"{rec['deaths_avoided_per_million']:.3g} statistical lives saved over "
                        f"{self.economics.horizon_years:g} years per million {cur} spent; residual individual risk "
-                       f"{rec['individual_risk']:.2g}/yr.")
+                       f"{probability(rec['individual_risk'])}/yr.")
         if "ASSUMPTION" in str(rec["effect_basis"]):
             why += f" Note: its effectiveness is typed, not derived ({rec['effect_basis']})."
         return {"option": str(rec["option"]), "basis": basis, "reason": why,

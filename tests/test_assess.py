@@ -90,7 +90,14 @@ def test_copied_inputs_rerun_to_the_same_numbers(assessed, tmp_path):
 
 
 def test_report_in_headless_chromium(assessed):
-    """Open report.html in a real browser: no console errors, every figure has a size, save a screenshot."""
+    """Open report.html in a real browser at 1,400 and 400 px and print it to PDF.
+
+    No console errors, every figure has a size, no horizontal scroll on a phone, no absolute path of
+    the machine and no Python exponent notation in the text; screenshots and the PDF are kept in
+    tests/artifacts/ for a person to look at.
+    """
+    import base64
+    import re
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
     driver_path = shutil.which("chromedriver")
     if not chromium or not driver_path:
@@ -102,10 +109,11 @@ def test_report_in_headless_chromium(assessed):
     opts = webdriver.ChromeOptions()
     opts.binary_location = chromium
     for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-                "--disable-component-update", "--disable-sync", "--no-first-run", "--window-size=1280,2000"):
+                "--disable-component-update", "--disable-sync", "--no-first-run", "--window-size=1400,2000"):
         opts.add_argument(arg)
     opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     driver = webdriver.Chrome(service=Service(driver_path), options=opts)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
     try:
         driver.get((out / "report.html").resolve().as_uri())
         assert "rock fall hazard and mitigation" in driver.title
@@ -116,9 +124,20 @@ def test_report_in_headless_chromium(assessed):
         assert all(c and w > 0 and h > 0 and rw > 0 and rh > 0 for c, w, h, rw, rh in sizes), sizes
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
         assert errors == []
-        ARTIFACTS.mkdir(parents=True, exist_ok=True)
-        driver.save_screenshot(str(ARTIFACTS / "report.png"))
-        assert (ARTIFACTS / "report.png").stat().st_size > 10_000
+        text = driver.execute_script("return document.body.innerText;")
+        assert not re.search(r"\d\.\d+e[+-]\d\d", text), re.findall(r".{30}\d\.\d+e[+-]\d\d.{10}", text)
+        assert str(ROOT) not in text and "/home/" not in text and "/tmp/" not in text
+        assert "Table 1." in text and "Figure 1." in text and "Contents" in text
+        driver.save_screenshot(str(ARTIFACTS / "report_1400px.png"))
+        driver.set_window_size(400, 900)
+        overflow = driver.execute_script("return document.documentElement.scrollWidth - window.innerWidth;")
+        assert overflow <= 0, f"horizontal scroll of {overflow} px at 400 px"
+        driver.save_screenshot(str(ARTIFACTS / "report_400px.png"))
+        pdf = base64.b64decode(driver.print_page())
+        (ARTIFACTS / "report.pdf").write_bytes(pdf)
+        assert pdf[:5] == b"%PDF-" and len(pdf) > 50_000
+        for name in ("report_1400px.png", "report_400px.png"):
+            assert (ARTIFACTS / name).stat().st_size > 10_000
     finally:
         driver.quit()
 
