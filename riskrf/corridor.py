@@ -781,8 +781,7 @@ def render_html(res: CorridorResult, figure_png: Path) -> str:
     import base64
 
     from . import __version__
-    from .report.format import cell, escape, human_header
-    from .report.html import CSS
+    from .report.format import CSS, cell, escape, human_header
     c = res.corridor
     cur = c.currency
     s = res.summary()
