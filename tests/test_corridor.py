@@ -223,3 +223,31 @@ def test_rate_per_m2_of_face_and_parquet_table(tmp_path):
     pd.read_csv(tmp_path / "s.csv").astype(str).to_parquet(tmp_path / "s.parquet")
     path.write_text(path.read_text().replace('sections = "s.csv"', 'sections = "s.parquet"'))
     assert cr.load_corridor(path).sections[0].falls_per_year == pytest.approx(sec.falls_per_year)
+
+
+E6 = Path(__file__).resolve().parents[1] / "corridors" / "e6_drivdalen"
+
+
+def test_e6_example_corridor_loads_with_record_rates():
+    c = cr.load_corridor(E6 / "e6_drivdalen.toml")
+    assert len(c.sections) == 19 and c.rate_basis == "road"
+    # 20 NVDB rock falls on main section 1, metres 0-19,000, in 2000-2014; +0.5 per section (Jeffreys mean)
+    assert sum(s.falls_per_year for s in c.sections) == pytest.approx((20 + 19 * 0.5) / 15, abs=1e-5)
+    assert "fitted to e6_volumes.csv" in c.mass_note and c.mass.n_tail == 34
+    assert all(s.rating is not None and max(s.rating.scores.values()) <= 100 for s in c.sections)
+
+
+def test_e6_builder_reproduces_the_shipped_tables(tmp_path):
+    shared = Path(__file__).resolve().parents[1] / ".." / "shared"
+    gml = shared / "inventories-raw" / "nvdb-skred-norway" / "Skred_E6_Trondelag_2000_2014.gml"
+    if not gml.exists():
+        pytest.skip(f"shared NVDB record not present at {gml}")
+    import importlib.util
+    for f in ("build_e6_corridor.py", "e6_drivdalen.toml"):
+        shutil.copy(E6 / f, tmp_path / f)
+    spec = importlib.util.spec_from_file_location("build_e6", tmp_path / "build_e6_corridor.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.main([str(gml)]) == 0
+    for f in ("e6_sections.csv", "e6_rockfalls.csv", "e6_volumes.csv"):
+        assert (tmp_path / f).read_text() == (E6 / f).read_text()
