@@ -223,6 +223,19 @@ def test_rate_per_m2_of_face_and_parquet_table(tmp_path):
     pd.read_csv(tmp_path / "s.csv").astype(str).to_parquet(tmp_path / "s.parquet")
     path.write_text(path.read_text().replace('sections = "s.csv"', 'sections = "s.parquet"'))
     assert cr.load_corridor(path).sections[0].falls_per_year == pytest.approx(sec.falls_per_year)
+    pd.read_csv(tmp_path / "s.csv").to_excel(tmp_path / "s.xlsx", index=False)
+    path.write_text(path.read_text().replace('sections = "s.parquet"', 'sections = "s.xlsx"'))
+    assert cr.load_corridor(path).sections[0].falls_per_year == pytest.approx(sec.falls_per_year)
+
+
+def test_release_rate_basis(tmp_path):
+    path = _write(tmp_path, HEAD + "A,0,100,20,3,1,0.5,\n")
+    path.write_text(path.read_text().replace("[corridor]", '[corridor]\nrate_basis = "release"'))
+    c = cr.load_corridor(path)
+    row = cr.assess_section(c.sections[0], c, N)
+    # released falls as given; those reaching the road = given x simulated share reaching the road line
+    assert row["release_falls_per_year"] == 0.5
+    assert row["road_falls_per_year"] == pytest.approx(0.5 * row["reach_road"], rel=1e-9)
 
 
 E6 = Path(__file__).resolve().parents[1] / "corridors" / "e6_drivdalen"
