@@ -211,7 +211,8 @@ def _mass_law(table: dict, base: Path, source: str):
                              m_max=None if m_max is None else float(m_max), rate_min=1.0, n_tail=10 ** 9,
                              n_total=10 ** 9, duration_years=1.0, method="typed", m_min_method="given", ks_distance=0.0)
     note = (f"ASSUMPTION: typed mass law b = {b:g}, m_min = {m_min:g} kg"
-            + (f", m_max = {float(m_max):g} kg" if m_max is not None else "") + " (no inventory fitted)")
+            + (f", m_max = {float(m_max):g} kg" if m_max is not None else "")
+            + " (no inventory fitted; no sampling uncertainty of b)")
     return gr, note
 
 
@@ -452,10 +453,11 @@ def load_corridor(path, *, keep_going: bool = False) -> Corridor:
             rating = None
             given = {c.removeprefix("rhrs_"): num[c] for c in RHRS_COLUMNS if c in num}
             if given:
-                derived = {"slope_height_m": num.get("cut_height_m"), "slope_length_m": c1 - c0,
-                           "adt_vehicles_per_day": vpd, "speed_kmh": speed, "roadway_width_m": num.get("road_width_m")}
-                attrs = {k: v for k, v in derived.items() if v is not None and "avr_percent" not in given
-                         or k in ("slope_height_m", "roadway_width_m") and v is not None}
+                # what the section's own columns already say; rhrs_* columns override
+                derived = {"slope_height_m": num.get("cut_height_m"), "roadway_width_m": num.get("road_width_m")}
+                if "avr_percent" not in given:
+                    derived.update(slope_length_m=c1 - c0, adt_vehicles_per_day=vpd, speed_kmh=speed)
+                attrs = {k: v for k, v in derived.items() if v is not None}
                 attrs.update(given)
                 try:
                     rating = rhrs.rate(cap_points=rhrs_cap, **attrs)
@@ -737,7 +739,8 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
                                             and int(have[s.id]["seed"]) == _section_seed(corridor.seed, s.id))]
             done_rows = [have[s.id] for s in todo if s not in keep]
             todo = keep
-        c_future = client.scatter(corridor, broadcast=True) if todo else None
+        # every worker gets the corridor-wide inputs once, without the sections (each task carries its own)
+        c_future = client.scatter(replace(corridor, sections=()), broadcast=True) if todo else None
         run = uuid.uuid4().hex[:8]           # fresh keys: a rerun never picks up an earlier run's (failed) result
         futures = {client.submit(_task, s, c_future, n_blocks, key=f"riskrf-section-{s.id}-{run}", retries=retries):
                    s.id for s in todo}
