@@ -219,7 +219,8 @@ def _mass_law(table: dict, base: Path, source: str):
 def load_corridor(path, *, keep_going: bool = False) -> Corridor:
     """Read and check a corridor file and its sections table before any work.
 
-    Every bad row is reported (file, row, section id, column, value).  With ``keep_going`` the bad rows
+    Every bad row is reported (file, row, section id, column, value; rows are counted as in a spreadsheet,
+    header = row 1, comment lines of a CSV not counted).  With ``keep_going`` the bad rows
     are left out and listed in :attr:`Corridor.errors`; otherwise any bad row raises :class:`CorridorError`
     listing all of them.  Errors in the corridor file itself always raise.
     """
@@ -348,7 +349,9 @@ def load_corridor(path, *, keep_going: bool = False) -> Corridor:
                 v = vals[c]
                 if v == "" or v is None:
                     continue
-                if isinstance(v, (int, float)) and not isinstance(v, bool):
+                if isinstance(v, bool):
+                    raise CorridorError(f"{where}: column {c!r} = {v!r} must be a number, not true/false")
+                if isinstance(v, (int, float)):
                     num[c] = float(v)
                     continue
                 try:
