@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import shutil
 import sys
 import warnings
 from pathlib import Path
@@ -365,6 +366,47 @@ def cmd_calibrate(args) -> int:
     return 0
 
 
+def cmd_corridor(args) -> int:
+    from .corridor import load_corridor, run_corridor, write_corridor
+
+    corridor = load_corridor(args.corridor, keep_going=args.keep_going)   # every row checked before any work
+    for e in corridor.errors:
+        print(f"skipped (--keep-going): {e}")
+    out = Path(args.out) if args.out else Path(f"{Path(args.corridor).stem}-corridor")
+    parts = out.parent / f".{out.name}.sections"
+    n = args.n or corridor.n_blocks
+    where = args.scheduler or os.environ.get("DASK_SCHEDULER_ADDRESS") or \
+        f"a local cluster of {args.workers or os.cpu_count()} workers"
+    print(f"riskrf corridor: {len(corridor.sections)} sections x {n:,} blocks on {where}; "
+          f"finished sections go to {parts}")
+
+    def progress(done, total, sid):
+        bar = "#" * int(30 * done / total)
+        print(f"\r[{bar:<30}] {done}/{total} sections (last: {sid})", end="" if done < total else "\n", flush=True)
+
+    try:
+        res = run_corridor(corridor, scheduler=args.scheduler, n_workers=args.workers, n_blocks=n, partitions=parts,
+                           resume=args.resume, keep_going=args.keep_going, progress=progress, log=print)
+    except (ConnectionError, RuntimeError) as exc:
+        print(f"\nriskrf corridor: error: {exc}", file=sys.stderr)
+        if parts.exists():
+            print(f"finished sections are kept in {parts}; rerun with --resume to skip them", file=sys.stderr)
+        return 2
+    write_corridor(res, out)
+    shutil.rmtree(parts, ignore_errors=True)        # the run is complete: its partitions are in sections.csv
+    for f in res.failures:
+        print(f"failed: {f}")
+    top = res.summary().head(5)
+    print(f"{len(res.table)} sections in {res.seconds:.1f} s on {res.workers} workers "
+          f"({len(res.table) / max(res.seconds, 1e-9) * 60:.1f} sections per minute).  Highest risk first:")
+    for _, r in top.iterrows():
+        print(f"  {r['id']}: RHRS {r['rhrs_score']:.0f} (rank {r['rank_rhrs']:.0f}), {r['deaths_per_year']:.2e} deaths/yr, "
+              f"best: {r['best_option']} ({r['best_option_capital']:,.0f} {corridor.currency})")
+    print(f"Report: {(out / 'report.html').resolve()} (also corridor.csv, sections.csv, budget_curve.csv, "
+          "chainage.png, summary.json)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``riskrf`` argument parser with one sub-command per task."""
     parser = argparse.ArgumentParser(
@@ -538,6 +580,23 @@ def build_parser() -> argparse.ArgumentParser:
                    help="expected rate if heavy-rain days became this much more frequent (0.1 = +10%%; an assumption)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-rates)")
     p.set_defaults(func=cmd_rates)
+
+    p = sub.add_parser("corridor", help="screen and assess many sections along a road (RHRS + risk, on dask)",
+                       description="Read a corridor file (TOML with defaults, mass law, traffic, costs and options, "
+                       "naming a sections table) and check every row first; then run each section's chain "
+                       "(simulation, energy hazard, road-user risk, option ranking) as a task on dask.distributed: "
+                       "a local cluster sized to the machine by default, or an existing scheduler unchanged.  "
+                       "Writes report.html, corridor.csv (ranked by risk beside the RHRS rank), sections.csv, "
+                       "budget_curve.csv, chainage.png and summary.json (see the README section 'Corridor').", epilog=EPILOG)
+    p.add_argument("corridor", help="corridor file (.toml); paths in it are relative to it")
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <corridor>-corridor)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="address of an existing dask scheduler (default: DASK_SCHEDULER_ADDRESS, else a local cluster)")
+    p.add_argument("--workers", type=int, default=None, help="workers of the local cluster (default: one per core)")
+    p.add_argument("-n", type=int, default=None, help="simulated blocks per section (default: the corridor file's)")
+    p.add_argument("--keep-going", action="store_true", help="skip bad rows and failed sections, listing them")
+    p.add_argument("--resume", action="store_true", help="skip sections already finished by an earlier run")
+    p.set_defaults(func=cmd_corridor)
     return parser
 
 
