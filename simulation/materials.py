@@ -23,21 +23,21 @@ retrieved source; **[R]** recalled from the named source and not re-checked
 against its text here -- verify before relying on it; **[D]** a derived or chosen
 value, with its reasoning.
 
-========== ============================ ============== ======== ===========================
-preset     normal restitution e_N       impact          rough-   rolling-resistance angle
-                                        friction [deg]  ness [m] phi_g [deg] (ground motion)
-========== ============================ ============== ======== ===========================
-bedrock    Wyllie law 19.5 theta^-1.03  30 +- 3         0.10     22 (roll)
-talus      Wyllie law                   35 +- 4         0.30     38 (roll)
-scree      constant 0.33 +- 0.03        35 +- 4         0.15     36 (roll)
-colluvium  constant 0.29 +- 0.02        35 +- 4         0.20     33 (roll)
-soil       constant 0.28 +- 0.03        38 +- 4         0.10     33 (roll)
-meadow     constant 0.23 +- 0.02        40 +- 4         0.05     38 (roll)
-asphalt    Wyllie law                   30 +- 2         0.02     14 (roll)
-concrete   Wyllie law                   30 +- 2         0.02     12 (roll)
-========== ============================ ============== ======== ===========================
+========== ============================ ======================== ======== ====================
+preset     normal restitution e_N       tangential law            rough-   rolling-resistance
+                                                                  ness [m] angle phi_g [deg]
+========== ============================ ======================== ======== ====================
+bedrock    Wyllie law 19.5 theta^-1.03  Stronge, friction 30 +- 3 0.10     22
+talus      Wyllie law                   e_T 0.55 +- 0.12          0.30     38
+scree      constant 0.33 +- 0.03        e_T 0.55 +- 0.12          0.15     36
+colluvium  constant 0.29 +- 0.02        e_T 0.55 +- 0.12          0.20     33
+soil       constant 0.28 +- 0.03        e_T 0.55 +- 0.12          0.10     33
+meadow     constant 0.23 +- 0.02        e_T 0.55 +- 0.12          0.05     38
+asphalt    Wyllie law                   Stronge, friction 30 +- 2 0.02     14
+concrete   Wyllie law                   Stronge, friction 30 +- 2 0.02     12
+========== ============================ ======================== ======== ====================
 
-Aliases: ``rock`` = bedrock, ``road`` = asphalt, ``vegetated_soil`` and ``grass`` = meadow,
+All presets roll (``ground_motion = "roll"``).  Aliases: ``rock`` = bedrock, ``road`` = asphalt, ``vegetated_soil`` and ``grass`` = meadow,
 ``debris`` = colluvium.
 
 Sources of each column:
@@ -56,12 +56,21 @@ Sources of each column:
   table [V].  The spreads are the half-ranges / 2 (about two standard deviations span
   the published range).  These are RocFall/CRSP-style coefficients of the velocity
   components, the definition the ``constant`` law uses.
-* **Impact friction angle (Stronge tangential law).**  Wyllie (2014): e_T 0.3-0.8,
-  "related to the friction coefficient at the impact point" [V].  Rock: the basic
-  friction angle of rock surfaces, 25-35 deg (Barton & Choubey 1977; Wyllie & Mah
-  2004, table 4.1) [R]; granular ground (talus, scree, colluvium, soil): the friction
-  angle of coarse granular soils and rockfill, 35-45 deg [R]; pavements 30 deg [D]
-  (a rough dry road surface; it decides only whether an impact sticks or slips).
+* **Tangential law, natural ground (talus, scree, colluvium, soil, meadow): Wyllie's
+  e_T.**  Wyllie (2014) found "the tangential coefficient of restitution ranges between
+  0.3 and 0.8 ... independent of the velocity and normal force" at his five sites [V];
+  the presets use the constant law e_T = v_t'/v_t with mean 0.55 and standard
+  deviation 0.12 (the range read as +- 2 sd; the spin decays by the same factor).  A
+  rough rotating sphere (Stronge's law) that is already rolling loses nothing at a
+  shallow impact, while real blocks on talus and soil lose much of their tangential
+  speed at every impact (shape, ploughing, breakage); with the Stronge law on talus,
+  blocks falling 60 m stopped at a median shadow angle of 17 deg, far beyond what
+  Evans & Hungr (1993) observed, and with e_T they stop where talus slopes show
+  (README, "Shadow angles") [D].
+* **Tangential law, hard surfaces (bedrock, asphalt, concrete): Stronge's rough
+  sphere** with the friction angle of rock surfaces, 25-35 deg (basic friction angle,
+  Barton & Choubey 1977; Wyllie & Mah 2004, table 4.1) [R]; pavements 30 deg [D] (a
+  dry road surface; it decides only whether an impact sticks or slips).
 * **Roughness** [D]: the asperity amplitude seen by a 0.5-1 m block: coarse talus
   boulders 0.3 m (Rockyfor3D roughness classes MOH 0.1-0.5 m on talus, Dorren 2016
   [R]), bedrock 0.1 m, scree and colluvium 0.15-0.2 m, soil 0.1 m, meadow 0.05 m,
@@ -126,16 +135,16 @@ ALIASES = {"rock": "bedrock", "road": "asphalt", "vegetated_soil": "meadow", "gr
 SOURCES = {
     "bedrock": "e_N: Wyllie (2014) impact-angle law [V]; friction: basic friction angle of rock 25-35 deg "
                "(Barton & Choubey 1977) [R]; roughness, rolling resistance: chosen [D]",
-    "talus": "e_N: Wyllie (2014) law, fitted on impacts including talus [V]; friction 35-45 deg granular [R]; "
+    "talus": "e_N: Wyllie (2014) law, fitted on impacts including talus [V]; e_T 0.3-0.8 (Wyllie 2014) [V]; "
              "rolling resistance above the 30-38 deg angle of repose of talus (Kirkby & Statham 1975; Evans & "
              "Hungr 1993) so blocks can stop on it [R/D]; roughness: Rockyfor3D talus classes (Dorren 2016) [R]",
     "scree": "e_N 0.33 (0.30-0.36): Rockyfor3D soil type 'scree or medium compact soil with small boulders' "
-             "(Dorren 2016) [R]; rolling resistance: angle of repose [R/D]",
-    "colluvium": "e_N 0.29 (0.28-0.30): CRSP 3 colluvium lower foreslope, Colorado permit table [V]; rolling "
+             "(Dorren 2016) [R]; e_T 0.3-0.8 (Wyllie 2014) [V]; rolling resistance: angle of repose [R/D]",
+    "colluvium": "e_N 0.29 (0.28-0.30): CRSP 3 colluvium lower foreslope, Colorado permit table [V]; e_T 0.3-0.8 (Wyllie 2014) [V]; rolling "
                  "resistance: soft ground (Dorren 2003) [R]",
-    "soil": "e_N 0.28 (0.25-0.31): Rockyfor3D 'fine soil, depth < 100 cm' (Dorren 2016) [R]; rolling resistance: "
+    "soil": "e_N 0.28 (0.25-0.31): Rockyfor3D 'fine soil, depth < 100 cm' (Dorren 2016) [R]; e_T 0.3-0.8 (Wyllie 2014) [V]; rolling resistance: "
             "soft ground (Dorren 2003) [R]",
-    "meadow": "e_N 0.23 (0.21-0.25): Rockyfor3D 'fine soil, depth > 100 cm' (Dorren 2016) [R]; rolling "
+    "meadow": "e_N 0.23 (0.21-0.25): Rockyfor3D 'fine soil, depth > 100 cm' (Dorren 2016) [R]; e_T 0.3-0.8 (Wyllie 2014) [V]; rolling "
               "resistance: vegetated soft ground (Dorren 2003) [R]",
     "asphalt": "e_N: Wyllie (2014) law, fitted on impacts including asphalt [V]; rolling resistance: hard "
                "surface [D]",
@@ -224,7 +233,9 @@ def presets_table():
         rows.append({"preset": name,
                      "normal_restitution": "wyllie" if en["law"] == "wyllie" else
                      f"{en['mean']:.2f} +- {en.get('std', 0):.2f}",
-                     "impact_friction_angle_deg": et["friction_angle_deg"], "impact_friction_std_deg": et["std_deg"],
+                     "tangential": (f"Stronge, friction {et['friction_angle_deg']:g} +- {et.get('std_deg', 0):g} deg"
+                                    if et["law"] == "friction" else
+                                    f"e_T {et['mean']:.2f} +- {et.get('std', 0):.2f}"),
                      "roughness_m": p["roughness_m"], "ground_motion": p["ground_motion"],
                      "ground_friction_angle_deg": p["ground_friction_angle_deg"], "sources": SOURCES[name]})
     return pd.DataFrame(rows).set_index("preset")
