@@ -131,10 +131,15 @@ def damage_state_shares(energy_kj, over, mel_kj: float):
     over (``over``, per row), are held below SEL, held between SEL and MEL, or break through above MEL.
 
     Returns (passing, held_repair, destroyed), each a share per column; passing = over + destroyed.
+    With no simulated falls (no rows: none reached the barrier in that slope model) every share is 0, not
+    nan: the shares multiply an arrival rate of zero.
     """
     e = np.asarray(energy_kj, dtype=float)
     over = np.asarray(over, dtype=bool).reshape(-1, *([1] * (e.ndim - 1)))
     mel = check_positive(mel_kj, "mel_kj")
+    if e.shape[0] == 0:
+        zero = np.zeros(e.shape[1:])
+        return zero, zero.copy(), zero.copy()
     working = ~over
     through = working & (e > mel)
     held_repair = working & (e > service_energy_level(mel)) & (e <= mel)

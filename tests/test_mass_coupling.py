@@ -105,9 +105,13 @@ def test_energy_hazard_agrees_with_brute_force_monte_carlo(scenario):
     se = np.sqrt(bf * (1 - bf) / n_bf)
     tol = 4.0 * se * np.sqrt(1.0 + n_bf / n_c)       # both estimators' noise, the coupled one from n_c blocks
     assert np.all(np.abs(hz.annual_frequency(energies) - bf) <= tol)
-    # The mass-independent form from the seeder's masses does not meet the same tolerance.
+    # The mass-independent form from the seeder's masses is systematically further off: its worst error is several
+    # times the coupled one's, and it underestimates the rare energies (on the shipped slope with the material
+    # presets: -32 % at 3,160 kJ and -46 % at 10,000 kJ, against -8 % and -14 % for the coupled form).
     h0 = EnergyHazard.from_simulation(mass, simulation.run(scenario, n=n_c, seed=2), "barrier", rate_per_year=1.0)
-    assert np.any(np.abs(h0.annual_frequency(energies) - bf) > tol)
+    err0, err = np.abs(h0.annual_frequency(energies) - bf), np.abs(hz.annual_frequency(energies) - bf)
+    assert err0.max() > 3 * err.max()
+    assert h0.annual_frequency(energies)[-1] < 0.7 * bf[-1] < hz.annual_frequency(energies)[-1]
 
 
 def test_exceedance_is_monotone_and_reach_by_mass(demo_hazard):
@@ -117,8 +121,10 @@ def test_exceedance_is_monotone_and_reach_by_mass(demo_hazard):
     assert np.all(np.diff(lam) <= 1e-15) and lam[0] <= hz.arrival_rate * (1 + 1e-12)
     assert hz.mass_coupled and "mass-coupled" in hz.notes[0]
     t = hz.velocity.class_table()
-    # the simulator makes heavier blocks faster on this slope (median speed, lightest vs heaviest class)
-    assert t["velocity_p50_ms"].iloc[-1] > t["velocity_p50_ms"].iloc[0] + 2.0
+    # the simulator makes heavier blocks faster and more often arriving on this slope (lightest vs heaviest class;
+    # with the material presets: median 9.4 -> 11.3 m/s, reach 0.33 -> 0.47)
+    assert t["velocity_p50_ms"].iloc[-1] > t["velocity_p50_ms"].iloc[0] + 0.5
+    assert t["reach_probability"].iloc[-1] > t["reach_probability"].iloc[0] + 0.05
     # T-year energies increase with T, and the bootstrap interval brackets the estimate
     e_T = hz.energy_at_return_period([10, 100, 1000])
     assert np.all(np.diff(e_T) > 0)
@@ -159,8 +165,18 @@ def test_site_design_masses_follow_the_hazard_law_and_stay_below_m_max(demo_haza
     assert ok.all() and np.all(t["source_mass_kg"] <= gr.m_max) and np.all(t["line_mass_kg"] <= gr.m_max)
     # rate x P(M > m_T) = 1/T exactly, with the truncated law
     np.testing.assert_allclose(rate * gr.sf(t["source_mass_kg"].to_numpy()), 1 / t["T_years"], rtol=1e-9)
-    # every simulated block reaches this barrier, so the T-year fall at the line is the one at the source
-    np.testing.assert_allclose(t["line_mass_kg"], t["source_mass_kg"], rtol=0.02)
+    # The T-year fall reaching the line: rate x P(M > m, reaches) = 1/T.  On the shipped slope (material presets)
+    # 29-47 % of the blocks reach the barrier, by mass class, so the line's T-year mass lies below the source's and
+    # P(M > m_line) is bracketed by the smallest and largest reach probability of the classes.
+    from riskrf.impact_energy import mass_model
+    mm = mass_model(demo_hazard.mass)
+    line, src = t["line_mass_kg"].to_numpy(), t["source_mass_kg"].to_numpy()
+    assert np.all(line <= src * (1 + 1e-9))
+    arrivals = np.array([demo_hazard.velocity.arrival_sf(m, mm) for m in line])
+    np.testing.assert_allclose(rate * arrivals, 1 / t["T_years"], rtol=1e-6)
+    reach = demo_hazard.velocity.class_table()["reach_probability"]
+    exceed = mm.sf(line)
+    assert np.all(exceed * reach.min() <= arrivals * (1 + 1e-9)) and np.all(arrivals <= exceed * reach.max() * (1 + 1e-9))
     # a fall rarer than the rate allows: blank, never extrapolated
     assert np.isnan(site_design_masses(demo_hazard, [0.5])["source_mass_kg"].iloc[0])
 
