@@ -380,6 +380,8 @@ def cmd_corridor(args) -> int:
     print(f"riskrf corridor: {len(corridor.sections)} sections x {n:,} blocks on {where}; "
           f"finished sections go to {parts}")
 
+    from .report.format import probability
+
     def progress(done, total, sid):
         bar = "#" * int(30 * done / total)
         print(f"\r[{bar:<30}] {done}/{total} sections (last: {sid})", end="" if done < total else "\n", flush=True)
@@ -400,7 +402,7 @@ def cmd_corridor(args) -> int:
     print(f"{len(res.table)} sections in {res.seconds:.1f} s on {res.workers} workers "
           f"({len(res.table) / max(res.seconds, 1e-9) * 60:.1f} sections per minute).  Highest risk first:")
     for _, r in top.iterrows():
-        print(f"  {r['id']}: RHRS {r['rhrs_score']:.0f} (rank {r['rank_rhrs']:.0f}), {r['deaths_per_year']:.2e} deaths/yr, "
+        print(f"  {r['id']}: RHRS {r['rhrs_score']:.0f} (rank {r['rank_rhrs']:.0f}), {probability(r['deaths_per_year'])} deaths/yr, "
               f"best: {r['best_option']} ({r['best_option_capital']:,.0f} {corridor.currency})")
     print(f"Report: {(out / 'report.html').resolve()} (also corridor.csv, sections.csv, budget_curve.csv, "
           "chainage.png, summary.json)")
