@@ -225,25 +225,40 @@ class EnergyHazard:
         T = check_return_periods(T)
         level = check_probability_level(level)
         Tv = np.atleast_1d(T).astype(float)
-        rng = np.random.default_rng(seed)
         sims = np.empty((int(n_bootstrap), Tv.size))
+        for i, (curve, scale) in enumerate(self._bootstrap_curves(int(n_bootstrap), seed)):
+            sims[i] = _interp_log_inverse(curve, 1.0 / (Tv * scale))
+        q = (1 - level) / 2
+        lo, hi = np.nanquantile(sims, q, axis=0), np.nanquantile(sims, 1 - q, axis=0)
+        return lo.reshape(np.shape(T)), hi.reshape(np.shape(T))
+
+    def _bootstrap_curves(self, n_bootstrap: int, seed):
+        """Replicates (P(E > e) on the energy grid, arrivals per year) of the parametric bootstrap.
+
+        With an integer seed they are kept on the object, so the design table and the exceedance figure
+        draw on the same replicates instead of repeating them.
+        """
+        key = (n_bootstrap, seed) if isinstance(seed, (int, np.integer)) else None
+        cache = self.__dict__.setdefault("_bootstrap_cache", {})
+        if key is not None and key in cache:
+            return cache[key]
+        rng = np.random.default_rng(seed)
+        out = []
         v_nodes = self._velocity_nodes()
-        for i in range(int(n_bootstrap)):
+        for _ in range(n_bootstrap):
             mass, rate = self._perturbed_mass(rng)
             if self.mass_coupled:       # blocks resampled within each mass class: reach and speed together
-                curve = self.velocity.resample(rng).joint_exceedance(_E_GRID, mass_model(mass))
-                sims[i] = _interp_log_inverse(curve, 1.0 / (Tv * rate))
+                out.append((self.velocity.resample(rng).joint_exceedance(_E_GRID, mass_model(mass)), rate))
                 continue
             reach = self.reach_probability
             if self.n_released:
                 reach = max(rng.binomial(self.n_released, self.reach_probability), 1) / self.n_released
             vel = v_nodes[rng.integers(0, v_nodes.size, v_nodes.size)] if isinstance(v_nodes, np.ndarray) \
                 else v_nodes
-            curve = exceedance_probability(_E_GRID, mass, vel)
-            sims[i] = _interp_log_inverse(curve, 1.0 / (Tv * rate * reach))
-        q = (1 - level) / 2
-        lo, hi = np.nanquantile(sims, q, axis=0), np.nanquantile(sims, 1 - q, axis=0)
-        return lo.reshape(np.shape(T)), hi.reshape(np.shape(T))
+            out.append((exceedance_probability(_E_GRID, mass, vel), rate * reach))
+        if key is not None:
+            cache[key] = out
+        return out
 
     def _velocity_nodes(self):
         """Velocity samples compressed to at most 2048 equal-probability quantiles (for the bootstrap)."""

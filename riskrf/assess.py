@@ -247,6 +247,11 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RiskrfWarning)
         inv_cfg = site.inventory
+        hz_cfg = site.hazard
+        # On a fresh installation the simulator is compiled once (numba, cached on disk): do it on the other
+        # core while the fits run.
+        from simulation.engine import Precompile
+        compiling = Precompile(site.resolve(hz_cfg["scenario"])) if hz_cfg["scenario"] else None
         t = stage(1, "reading the inventory and fitting magnitude-frequency models")
         inventory = read_inventory(site.resolve(inv_cfg["path"]), start=inv_cfg["start"], end=inv_cfg["end"],
                                    duration_years=inv_cfg["duration_years"], density_kg_m3=inv_cfg["density_kg_m3"])
@@ -257,7 +262,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
         timings["fits"] = round(time.perf_counter() - t, 2)
 
-        hz_cfg, db_cfg = site.hazard, site.design_block
+        db_cfg = site.design_block
         survey = read_block_survey(site.resolve(db_cfg["survey"]), inventory.density_kg_m3) \
             if db_cfg["survey"] else None
         m_max_values, shares = sensitivity_inputs(site)
@@ -267,6 +272,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                                            density_kg_m3=inventory.density_kg_m3)
         extra += [m for m in m_max_values if m is not None]
         t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
+        if compiling is not None:
+            compiling.wait()
         gr, hazard, result = energy_hazard_from_inputs(
             inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=inv_cfg["rate_scale"],
             scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
@@ -329,6 +336,14 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     out = Path(out)
     figs = out / "figures"
     figs.mkdir()
+
+    def simulation_and_decision_outputs():
+        if a.result is not None:
+            _simulation_figures(a, figs)
+        write_mitigation_outputs(a.study, a.decision, figs)
+
+    # The two halves of the figures are drawn at once on two cores where that is safe (see _Beside).
+    beside = _Beside(simulation_and_decision_outputs)
     a.frequency.write(figs)
     for name in ("summary.json", "design_masses.csv", "completeness.csv"):
         shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
@@ -341,9 +356,7 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
                  "design_block.csv"):
         if (figs / name).exists():
             shutil.move(str(figs / name), str(out / name))
-    if a.result is not None:
-        _simulation_figures(a, figs)
-    write_mitigation_outputs(a.study, a.decision, figs)
+    beside.wait()
     for name in ("ranking.csv", "tornado.csv", "break_even.csv", "decision.json"):
         shutil.move(str(figs / name), str(out / name))
     a.timings["report"] = round(time.perf_counter() - t, 2)
@@ -352,6 +365,38 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
     _copy_inputs(a, out / "inputs")
     return summary
+
+
+class _Beside:
+    """Run ``work`` (which only writes files) in a forked child while the caller goes on; :meth:`wait` joins it.
+
+    Drawing figures is single-threaded Python, so the figures of the simulation and the decision are drawn in
+    a child process on the second core while the parent draws the others.  Forking is used only where it is
+    safe (POSIX, no other thread in the process, e.g. not inside a notebook kernel with threads); otherwise,
+    or if the child fails, the work runs in this process.  The outputs are the same either way.
+    """
+
+    def __init__(self, work):
+        import os
+        import threading
+        self.work, self.proc = work, None
+        if hasattr(os, "fork") and threading.active_count() == 1:
+            import multiprocessing
+            try:
+                self.proc = multiprocessing.get_context("fork").Process(target=work, daemon=True)
+                self.proc.start()
+            except (OSError, ValueError):
+                self.proc = None
+        if self.proc is None:
+            work()
+
+    def wait(self) -> None:
+        if self.proc is not None:
+            self.proc.join()
+            if self.proc.exitcode != 0:
+                logger.warning("drawing figures in a second process failed (exit %s); drawing them here",
+                               self.proc.exitcode)
+                self.work()
 
 
 def _simulation_figures(a, figs):

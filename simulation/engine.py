@@ -185,3 +185,44 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
     return SimulationResult(scenario=scenario, n=n, seed=seed, blocks=blocks, per_block=per_block,
                             crossings=merged, envelope_x=env_x, envelope_acc=env_acc,
                             paths={name: arr[:k] for name, arr in paths.items()}, elapsed_s=elapsed)
+
+
+def _warm_up(path: str) -> None:
+    """Compile the kernel by simulating a few blocks of the scenario at ``path`` (child-process target)."""
+    from .scenario import load_scenario
+    run(load_scenario(path), n=4, seed=0, record_paths=4)
+
+
+class Precompile:
+    """The simulator compiled in a background process while the caller does other work.
+
+    numba compiles the trajectory kernel on first use and caches the machine code on disk
+    (``cache=True``); on a fresh installation that first compilation takes 10-20 s.  Started
+    early (``Precompile(scenario_path)``), it runs on the second core during work that does not
+    need the simulator; :meth:`wait` returns when the cache is written, after which the kernel
+    loads in well under a second.  Where the cache is already warm the child finishes at once.
+    A failure in the child only means the kernel is compiled on first use instead.
+    """
+
+    def __init__(self, scenario_path):
+        import multiprocessing
+        self._proc = None
+        try:       # a warm on-disk cache: nothing to do
+            if kernel.simulate._cache._cache_file._index_path and \
+                    __import__("os").path.exists(kernel.simulate._cache._cache_file._index_path):
+                return
+        except AttributeError:
+            pass
+        self._proc = multiprocessing.get_context("spawn").Process(target=_warm_up, args=(str(scenario_path),),
+                                                                  daemon=True)
+        self._proc.start()
+
+    def wait(self, timeout: float | None = 300.0) -> bool:
+        """Block until the compilation is done; True when the child finished cleanly (or was not needed)."""
+        if self._proc is None:
+            return True
+        self._proc.join(timeout)
+        if self._proc.is_alive():
+            self._proc.terminate()
+            return False
+        return self._proc.exitcode == 0
