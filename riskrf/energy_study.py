@@ -98,7 +98,18 @@ def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_
                    T=DESIGN_RETURN_PERIODS, design_T: float = 100.0, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
                    n_bootstrap: int = 300, seed=1, uni_factors: dict | None = None) -> EnergyAnalysis:
     """Design table, fence checks (each capacity in ``fences`` at ``fence_height_m``: one height [m] for all, or
-    one per fence) and UNI 11211-4 energy."""
+    one per fence) and UNI 11211-4 energy.  ``design_T`` [yr] must exceed 1 (a T-year event has annual
+    probability 1/T); ``free_board_m`` >= 0 and heights > 0 [m]."""
+    from .validation import check_return_periods
+    try:
+        check_return_periods(design_T, "design_T")
+    except (TypeError, ValueError):
+        raise ValueError(f"design_T = {design_T!r}: the design return period must be a finite number > 1 year "
+                         "(a T-year event has annual probability 1/T)") from None
+    if not (np.isfinite(free_board_m) and free_board_m >= 0):
+        raise ValueError(f"free_board_m = {free_board_m!r} must be a finite number >= 0 m")
+    if any(not (np.isfinite(h) and h > 0) for h in np.atleast_1d(np.asarray(fence_height_m, dtype=float))):
+        raise ValueError(f"fence_height_m = {fence_height_m!r}: every height must be a finite number > 0 m")
     T_all = np.union1d(np.asarray(T, dtype=float), [design_T])
     table = hazard.design_table(T_all, n_bootstrap=n_bootstrap, seed=seed)
     row = table.loc[table["T_years"] == design_T].iloc[0]

@@ -220,13 +220,18 @@ def test_velocity_exports_are_read(inputs, text, kwargs, velocities, heights):
 
 
 def test_cli_fit_reads_a_european_export(inputs, tmp_path, capsys):
-    f = write(inputs / "kataster.csv", SEMICOLON_COMMA.replace("Datum", "Datum").replace(
-        "05.03.2019", "05/03/2019").replace("31.12.2019", "06/04/2019").replace("20.06.2020", "07/05/2020"))
+    rng = np.random.default_rng(3)
+    lines = [f"{1 + i % 12:02d}/{1 + (i * 5) % 12:02d}/{2019 + i // 12};{v:.3f}".replace(".", ",")
+             for i, v in enumerate(np.exp(rng.normal(0, 1.5, 40)))]
+    f = write(inputs / "kataster.csv", "Datum;Volumen [m³]\n" + "\n".join(lines) + "\n", "cp1252")
     before = snapshot(inputs)
     rc = main(["fit", str(f), "--date-format", "%d/%m/%Y", "--density", "2650", "--bootstrap", "0",
                "--out", str(tmp_path / "o")])
     assert rc == 0, capsys.readouterr().err
-    assert "2019-03-05" in json.dumps(json.loads((tmp_path / "o" / "summary.json").read_text()))
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert "2019-01-01" in json.dumps(summary)      # 01/01/2019 .. ; day first as declared
+    last = max(pd.Timestamp(int(x[6:10]), int(x[3:5]), int(x[0:2])) for x in lines)   # day first
+    assert last.strftime("%Y-%m-%d") in json.dumps(summary)
     assert snapshot(inputs) == before
 
 
@@ -470,10 +475,10 @@ def test_decision_trees_with_impossible_numbers(inputs, tmp_path, capsys, case, 
 
 
 def test_deep_tree_is_refused_without_a_traceback(inputs, tmp_path, capsys):
-    node = {"type": "terminal", "value": 1}
+    text = '{"type": "terminal", "value": 1}'
     for i in range(1500):
-        node = {"type": "decision", "branches": [{"name": f"d{i}", "child": node}, {"name": "stop"}]}
-    f = write(inputs / "deep.json", json.dumps(node))
+        text = '{"type": "decision", "branches": [{"name": "d%d", "child": %s}, {"name": "stop"}]}' % (i, text)
+    f = write(inputs / "deep.json", text)
     rc = main(["decide", str(f), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert rc == 2 and "deep.json" in err and "nested" in err and "Traceback" not in err
@@ -614,5 +619,6 @@ def test_ctrl_c_ends_with_one_line_and_nothing_written(tmp_path):
     proc.send_signal(signal.SIGINT)
     stdout, stderr = proc.communicate(timeout=120)
     assert proc.returncode == 130, stderr
-    assert stderr.strip().splitlines() == ["riskrf simulate: interrupted; nothing was written"]
+    assert stderr.strip().splitlines() == ["riskrf simulate: interrupted; nothing was written "
+                                          "(outputs appear only when complete)"]
     assert list(tmp_path.iterdir()) == []
