@@ -113,8 +113,6 @@ def cmd_simulate(args) -> int:
     import simulation
 
     from .outputs import atomic_outputs, check_output
-    from .preflight import check_number
-    check_number(args.n, "-n", low=1)
     out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-crossings.parquet")
     check_output(out, overwrite=args.overwrite, kind="file")
     if out.suffix.lower() not in (".parquet", ".csv"):
