@@ -102,7 +102,7 @@ def read_table(path, *, sheet=None, header_row: int | None = None, encoding: str
         try:
             import io
             table = pd.read_csv(io.StringIO(text), sep=sep, dtype=str, skip_blank_lines=False,
-                                keep_default_na=False, skiprows=(header_row or 1) - 1, engine="python")
+                                keep_default_na=False, skiprows=(header_row or 1) - 1)
         except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, csv_error()) as exc:
             raise ValueError(f"{path}: cannot read as a {sep!r}-separated table: {exc}") from None
         first = (header_row or 1) + 1

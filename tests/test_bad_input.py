@@ -622,3 +622,26 @@ def test_ctrl_c_ends_with_one_line_and_nothing_written(tmp_path):
     assert stderr.strip().splitlines() == ["riskrf simulate: interrupted; nothing was written "
                                           "(outputs appear only when complete)"]
     assert list(tmp_path.iterdir()) == []
+
+
+def test_real_day_first_export_hong_kong_cedd():
+    """A real government export: dd/mm/yyyy dates, three rows of non-UTF-8 bytes, '-' for unknown dates.
+
+    Data: CEDD/GEO, Hong Kong SAR Government, via DATA.GOV.HK ("Landslide incidents" 1984-2020), copied
+    unmodified in shared/inventories-raw/hong-kong-cedd (see its PROVENANCE.md: a regional record of
+    incidents on all man-made slopes, not one slope).
+    """
+    from riskrf.tables import parse_dates, read_table
+    path = ROOT / ".." / "shared" / "inventories-raw" / "hong-kong-cedd" / "cedd_incidents_1984_2020.csv"
+    if not path.exists():
+        pytest.skip("shared/inventories-raw/hong-kong-cedd not present")
+    table, first, notes = read_table(path)
+    assert len(table) == 9840 and any("cp1252" in n for n in notes)
+    rows = np.arange(len(table)) + first
+    with pytest.raises(ValueError, match=r"row 2096, column 'CALLDATE': cannot read date '-'"):
+        parse_dates(table["CALLDATE"], path, "CALLDATE", rows)
+    known = table["CALLDATE"].str.strip() != "-"
+    dates, years = parse_dates(table["CALLDATE"].where(known, ""), path, "CALLDATE", rows)
+    assert (dates.dt.day > 12).sum() > 1000                  # the day-first order is decided by the data
+    assert dates.iloc[0] == pd.Timestamp("2021-01-12")       # '12/01/2021', first row: 12 January, not 1 December
+    assert dates.min() >= pd.Timestamp("1984-01-01") and dates.isna().sum() == (~known).sum()
