@@ -147,7 +147,6 @@ def read_table(path, *, sheet=None, header_row: int | None = None, encoding: str
     else:
         raise ValueError(f"{path}: unsupported {what} format {suffix!r}; use .csv, .txt, .tsv, .xlsx or .parquet")
     table.columns = [str(c).strip() for c in table.columns]
-    table = table.astype(object).apply(lambda c: c.map(lambda v: "" if v is None else str(v)))
     return table.reset_index(drop=True), first, notes
 
 
@@ -165,7 +164,7 @@ def _excel_cell(v):
 
 def is_blank(table: pd.DataFrame) -> pd.Series:
     """Rows whose every cell is empty text."""
-    return table.apply(lambda c: c.map(lambda v: isinstance(v, str) and v.strip() == "")).all(axis=1)
+    return (table.astype(str).apply(lambda c: c.str.strip()) == "").all(axis=1)
 
 
 def csv_error():
@@ -173,7 +172,7 @@ def csv_error():
     return csv.Error
 
 
-_THOUSANDS_JUNK = re.compile(r"[\s\u00a0\u202f'’]")
+_THOUSANDS_JUNK = r"[\s\u00a0\u202f'’]"     # a pattern string: pyarrow runs it vectorised
 _BOTH_COMMA_LAST = re.compile(r"^[+-]?\d{1,3}(\.\d{3})+,\d*([eE][+-]?\d+)?$")
 _BOTH_DOT_LAST = re.compile(r"^[+-]?\d{1,3}(,\d{3})+\.\d*([eE][+-]?\d+)?$")
 
@@ -192,7 +191,10 @@ def parse_numbers(raw: pd.Series, path, col: str, rows, *, decimal: str | None =
         raise ValueError(f"decimal = {decimal!r} is not '.' or ','")
     if pd.api.types.is_numeric_dtype(raw) and not pd.api.types.is_bool_dtype(raw):
         return pd.to_numeric(raw).astype(float)
-    is_num = raw.map(lambda v: isinstance(v, (float, int, np.floating, np.integer)) and not isinstance(v, bool))
+    if pd.api.types.infer_dtype(raw, skipna=True) in ("string", "empty"):
+        is_num = pd.Series(False, index=raw.index)
+    else:     # Excel: number cells are numbers, not text to interpret
+        is_num = raw.map(lambda v: isinstance(v, (float, int, np.floating, np.integer)) and not isinstance(v, bool))
     text = raw.where(~is_num, "").astype(str).str.strip()
     text = text.str.replace(_THOUSANDS_JUNK, "", regex=True)
     has_comma = text.str.contains(",", regex=False)
@@ -254,6 +256,17 @@ def parse_dates(raw: pd.Series, path, col: str, rows, *, date_format: str | None
     years.  Raises ``ValueError`` naming the file, row, column and value for an unreadable or
     ambiguous date, or a date in the future.
     """
+    # Dates repeat: parse each distinct value once (in order of first appearance, so that messages
+    # name the first row holding a value) and spread the results over the rows.
+    codes, uniques = pd.factorize(raw.astype(str), use_na_sentinel=False)
+    if len(uniques) < len(raw):
+        first = np.unique(codes, return_index=True)[1]
+        sub = raw.iloc[first]
+        d_u, y_u = parse_dates(sub.reset_index(drop=True), path, col, np.asarray(rows)[first],
+                               date_format=date_format)
+        dates = pd.Series(d_u.to_numpy()[codes], index=raw.index, dtype="datetime64[ns]")
+        years = pd.Series(pd.array(y_u.to_numpy()[codes], dtype="Int64"), index=raw.index)
+        return dates, years
     text = raw.astype(str).str.strip()
     years = pd.Series(pd.NA, index=text.index, dtype="Int64")
     dates = pd.Series(pd.NaT, index=text.index, dtype="datetime64[ns]")
