@@ -211,10 +211,10 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         inventory = read_inventory(site.resolve(inv_cfg["path"]), start=inv_cfg["start"], end=inv_cfg["end"],
                                    duration_years=inv_cfg["duration_years"], density_kg_m3=inv_cfg["density_kg_m3"],
                                    **reader)
+        dated = read_inventory(site.resolve(inv_cfg["annual_maxima"])) if inv_cfg["annual_maxima"] else None
         frequency = analyse_inventory(inventory, m_min=inv_cfg["m_min_kg"], n_bootstrap=500, seed=seed)
         maxima_frequency = None
-        if inv_cfg["annual_maxima"]:
-            dated = read_inventory(site.resolve(inv_cfg["annual_maxima"]))
+        if dated is not None:
             maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
         timings["fits"] = round(time.perf_counter() - t, 2)
 

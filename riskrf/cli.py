@@ -157,6 +157,8 @@ def cmd_energy(args) -> int:
     check_energy_args(args)
     out = check_out(args, f"{Path(args.inventory).stem}-energy")
     inv = _read(args, args.inventory)
+    for note in inv.notes:
+        print(f"note: {note}")
     gr, hazard, _ = build_energy_hazard(args, inv)
     analysis = analyse_energy(hazard, fences=args.fence or (2000.0, 5000.0), fence_height_m=args.fence_height,
                               free_board_m=args.free_board, design_T=args.design_period,

@@ -149,6 +149,13 @@ def load_site(path) -> Site:
         if hz["road_collector"] not in names and "road_collector" in data.get("hazard", {}):
             raise SiteError(f"{path}: hazard.road_collector = {hz['road_collector']!r}: scenario {hz['scenario']!r} "
                             f"has no such collector; its collectors are {names}")
+    if hz["velocities"] is not None:         # read now: a bad velocity file is found before the fits run
+        from .velocities import read_velocities
+        try:
+            read_velocities(path.parent / hz["velocities"], collector=hz["collector"],
+                            velocity_unit=hz["velocity_unit"])
+        except ValueError as exc:
+            raise SiteError(f"{path}: hazard.velocities = {hz['velocities']!r}: {exc}") from exc
     mit = {k: data[k] for k in MITIGATION_TABLES if k in data}
     try:
         mitigation = study_inputs(mit, str(path))

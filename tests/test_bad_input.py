@@ -105,6 +105,8 @@ def _toml(data: dict) -> str:
             continue
         lines.append(f"[{table}]")
         for k, v in body.items():
+            if v is None:
+                continue
             if isinstance(v, dict) and all(not isinstance(x, dict) for x in v.values()) and table == "uncertainty":
                 continue
             lines.append(f"{json.dumps(k)} = {val(v)}")
@@ -645,3 +647,13 @@ def test_real_day_first_export_hong_kong_cedd():
     assert (dates.dt.day > 12).sum() > 1000                  # the day-first order is decided by the data
     assert dates.iloc[0] == pd.Timestamp("2021-01-12")       # '12/01/2021', first row: 12 January, not 1 December
     assert dates.min() >= pd.Timestamp("1984-01-01") and dates.isna().sum() == (~known).sum()
+
+
+def test_site_with_a_bad_velocity_file_is_refused_before_the_fits(inputs, tmp_path, capsys, no_work):
+    vel = write(inputs / "v.csv", "velocity_ms;height_m\n12,5;1\n14;-2\n")
+    site = site_file(inputs, hazard={"scenario": None, "velocities": str(vel), "collector": None})
+    before = snapshot(inputs)
+    rc = main(["assess", str(site), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "hazard.velocities" in err and "row 3, column 'height_m'" in err and "'-2'" in err, err
+    assert snapshot(inputs) == before and not (tmp_path / "o").exists()
