@@ -657,3 +657,33 @@ def test_site_with_a_bad_velocity_file_is_refused_before_the_fits(inputs, tmp_pa
     err = capsys.readouterr().err
     assert rc == 2 and "hazard.velocities" in err and "row 3, column 'height_m'" in err and "'-2'" in err, err
     assert snapshot(inputs) == before and not (tmp_path / "o").exists()
+
+
+HOSTILE = [
+    # (case, file name, bytes, command builder, what the one-line message must contain)
+    ("empty file", "inv.csv", b"", lambda f, o: ["fit", str(f), "--out", o], "inv.csv"),
+    ("BOM only", "inv.csv", b"\xef\xbb\xbf", lambda f, o: ["fit", str(f), "--out", o], "inv.csv"),
+    ("header only", "inv.csv", b"date;volume_m3\n", lambda f, o: ["fit", str(f), "--out", o], "has no rows"),
+    ("old .xls", "inv.xls", b"\xd0\xcf\x11\xe0", lambda f, o: ["fit", str(f), "--out", o], "unsupported"),
+    ("inventory is a directory", "dir", None, lambda f, o: ["fit", str(f), "--out", o], "is a directory"),
+    ("missing inventory", "nope.csv", False, lambda f, o: ["fit", str(f), "--out", o], "nope.csv"),
+    ("tree is a directory", "dir", None, lambda f, o: ["decide", str(f), "--out", o], "dir"),
+    ("tree not JSON", "t.json", b"{not json", lambda f, o: ["decide", str(f), "--out", o], "cannot parse"),
+    ("corrupt parquet", "inv.parquet", b"PAR1garbage", lambda f, o: ["fit", str(f), "--out", o], "cannot read"),
+    ("out below a file", "inv.csv", b"volume_m3\n1\n",
+     lambda f, o: ["fit", str(f), "--duration-years", "1", "--out", str(f) + "/sub"], "is a file"),
+]
+
+
+@pytest.mark.parametrize("case,name,data,build,needle", HOSTILE, ids=[c[0] for c in HOSTILE])
+def test_hostile_files_give_one_line_errors(inputs, tmp_path, capsys, case, name, data, build, needle):
+    f = inputs / name
+    if data is None:
+        f.mkdir()
+    elif data is not False:
+        f.write_bytes(data)
+    before = snapshot(inputs)
+    rc = main(build(f, str(tmp_path / "o")))
+    err = capsys.readouterr().err
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and needle in err and "Traceback" not in err, err
+    assert snapshot(inputs) == before and not (tmp_path / "o").exists()
