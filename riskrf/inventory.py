@@ -15,7 +15,6 @@ fits then use the mixed model that gives such years their own probability
 """
 from __future__ import annotations
 
-import csv
 import datetime as _dt
 import re
 import tomllib
@@ -25,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .tables import is_blank, parse_dates, parse_numbers, read_table, sniff_delimiter  # noqa: F401 (re-exported)
 from .units import DEFAULT_DENSITY_KG_M3, KG_PER_TONNE
 from .validation import check_positive, warn
 
@@ -216,9 +216,6 @@ class Inventory:
             "dated": self.is_dated,
         }
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
-
-
-from .tables import is_blank, parse_dates, parse_numbers, read_table, sniff_delimiter  # noqa: E402,F401  (sniff_delimiter: public before)
 
 
 #: Reader options a sidecar ``[record]`` table (or a site file's ``[inventory]``) may give.

@@ -347,4 +347,4 @@ def parse_dates(raw: pd.Series, path, col: str, rows, *, date_format: str | None
     return dates, years
 
 
-__all__ = ["read_table", "parse_numbers", "parse_dates", "sniff_delimiter"]
+__all__ = ["is_blank", "parse_dates", "parse_numbers", "read_table", "sniff_delimiter"]

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .inventory import sniff_delimiter
+from .tables import sniff_delimiter  # noqa: F401 (re-exported: public before)
 
 #: Accepted column names after normalisation (lower case, units and punctuation stripped).
 COLUMN_NAMES = {

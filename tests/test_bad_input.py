@@ -619,7 +619,7 @@ def test_ctrl_c_ends_with_one_line_and_nothing_written(tmp_path):
     assert proc.stdout.readline().strip() == "ready"
     time.sleep(1.5)
     proc.send_signal(signal.SIGINT)
-    stdout, stderr = proc.communicate(timeout=120)
+    _, stderr = proc.communicate(timeout=120)
     assert proc.returncode == 130, stderr
     assert stderr.strip().splitlines() == ["riskrf simulate: interrupted; nothing was written "
                                           "(outputs appear only when complete)"]
@@ -643,7 +643,7 @@ def test_real_day_first_export_hong_kong_cedd():
     with pytest.raises(ValueError, match=r"row 2096, column 'CALLDATE': cannot read date '-'"):
         parse_dates(table["CALLDATE"], path, "CALLDATE", rows)
     known = table["CALLDATE"].str.strip() != "-"
-    dates, years = parse_dates(table["CALLDATE"].where(known, ""), path, "CALLDATE", rows)
+    dates, _ = parse_dates(table["CALLDATE"].where(known, ""), path, "CALLDATE", rows)
     assert (dates.dt.day > 12).sum() > 1000                  # the day-first order is decided by the data
     assert dates.iloc[0] == pd.Timestamp("2021-01-12")       # '12/01/2021', first row: 12 January, not 1 December
     assert dates.min() >= pd.Timestamp("1984-01-01") and dates.isna().sum() == (~known).sum()
