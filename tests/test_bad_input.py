@@ -687,3 +687,14 @@ def test_hostile_files_give_one_line_errors(inputs, tmp_path, capsys, case, name
     err = capsys.readouterr().err
     assert rc == 2 and len(err.strip().splitlines()) == 1 and needle in err and "Traceback" not in err, err
     assert snapshot(inputs) == before and not (tmp_path / "o").exists()
+
+
+def test_nan_probability_and_tonnes_given_as_kg(inputs):
+    from riskrf.decision_tree import DecisionTree
+    spec = {"type": "chance", "branches": [{"name": "a", "probability": float("nan")},
+                                           {"name": "b", "probability": 1.0}]}
+    with pytest.raises(ValueError, match=r"> a: probability.*nan"):
+        DecisionTree.from_dict(spec, source="t.json")
+    f = write(inputs / "inv.csv", "date,mass_kg\n2019-03-05,0.5\n2019-04-06,0.2\n2019-05-07,0.8\n")
+    with pytest.warns(RiskrfWarning, match=r"inv.csv: column 'mass_kg': median mass 0.5 kg.*tonnes.*mass_unit"):
+        read_inventory(f, start="2019-01-01", end="2019-12-31", density_kg_m3=2650)
