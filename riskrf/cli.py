@@ -328,7 +328,11 @@ def cmd_calibrate(args) -> int:
         select[key] = value
     from .preflight import check_out
     check_out(args, f"{Path(args.scenario).stem}-calibration")
-    observed = read_observed(args.observed, column=args.column, select=select)
+    table = None
+    if Path(args.observed).suffix.lower() in (".csv", ".txt", ".tsv") and Path(args.observed).is_file():
+        from .tables import read_numeric_table       # separators, decimal commas, encodings as for inventories
+        table = read_numeric_table(args.observed, what="observed stops")
+    observed = read_observed(args.observed, column=args.column, select=select, table=table)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         cal = simulation.calibrate(args.scenario, observed, parameters, n=args.n, seed=args.seed,

@@ -238,6 +238,20 @@ def parse_numbers(raw: pd.Series, path, col: str, rows, *, decimal: str | None =
     return values.astype(float)
 
 
+def read_numeric_table(path, **kwargs) -> pd.DataFrame:
+    """:func:`read_table`, with every column whose filled cells are all numbers (by the decimal-mark rule)
+    converted to float; other columns stay text.  Row ``i`` is file line ``i + first data line``."""
+    table, first, _ = read_table(path, **kwargs)
+    rows = np.arange(len(table)) + first
+    out = {}
+    for col in table.columns:
+        try:
+            out[col] = parse_numbers(table[col], path, col, rows)
+        except ValueError:
+            out[col] = table[col]
+    return pd.DataFrame(out, index=table.index)
+
+
 _YEAR = re.compile(r"^(\d{4})(?:\.0)?$")
 _YMD = re.compile(r"^(\d{4})[-/.](\d{1,2})[-/.](\d{1,2})(?:[ T].*)?$")
 _DMY_DOT = re.compile(r"^(\d{1,2})\.(\d{1,2})\.(\d{4})(?:[ T].*)?$")

@@ -698,3 +698,19 @@ def test_nan_probability_and_tonnes_given_as_kg(inputs):
     f = write(inputs / "inv.csv", "date,mass_kg\n2019-03-05,0.5\n2019-04-06,0.2\n2019-05-07,0.8\n")
     with pytest.warns(RiskrfWarning, match=r"inv.csv: column 'mass_kg': median mass 0.5 kg.*tonnes.*mass_unit"):
         read_inventory(f, start="2019-01-01", end="2019-12-31", density_kg_m3=2650)
+
+
+def test_observed_stops_with_semicolons_and_decimal_commas(inputs, monkeypatch, capsys, tmp_path):
+    """`riskrf calibrate` reads observed stops by the same rules (the calibration itself is stubbed)."""
+    import simulation
+    f = write(inputs / "stops.csv", "profile;x_stop_m\nP1;101,5\nP1;98,25\nP2;120\n")
+    seen = {}
+
+    def fake(scenario, observed, parameters, **kw):
+        seen["x"] = observed["x_stop_m"].tolist()
+        raise ValueError("stop here")
+    monkeypatch.setattr(simulation, "calibrate", fake)
+    rc = main(["calibrate", str(SCENARIO), str(f), "--parameter", "materials.talus.ground_friction_angle_deg=15:40",
+               "--select", "profile=P1", "--out", str(tmp_path / "o")])
+    assert rc == 2 and "stop here" in capsys.readouterr().err
+    assert seen["x"] == [101.5, 98.25]
