@@ -183,7 +183,9 @@ def cmd_decide(args) -> int:
     if (args.tree is None) == (args.options is None):
         raise ValueError("give a decision tree file (riskrf decide TREE.json) or --options OPTIONS.toml with "
                          "--inventory and --scenario, not both")
-    from .preflight import check_energy_args, check_out
+    from .preflight import check_energy_args, check_number, check_out
+    check_number(args.risk_tolerance, "--risk-tolerance", low=0, low_open=True,
+                 what=" (in money; leave it out for expected values)")
     out = check_out(args, "decision")
     if args.tree is None:
         if args.inventory is None:

@@ -476,6 +476,14 @@ def test_decision_trees_with_impossible_numbers(inputs, tmp_path, capsys, case, 
     assert not (tmp_path / "o").exists() and snapshot(inputs) == before
 
 
+@pytest.mark.parametrize("value", ["0", "-5", "nan", "inf"])
+def test_risk_tolerance_must_be_positive_and_finite(inputs, tmp_path, capsys, value):
+    f = write(inputs / "t.json", '{"type": "decision", "branches": [{"name": "a", "cost": 5}, {"name": "b"}]}')
+    rc = main(["decide", str(f), "--risk-tolerance", value, "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2 and f"--risk-tolerance = {value}" in err and not (tmp_path / "o").exists(), err
+
+
 def test_deep_tree_is_refused_without_a_traceback(inputs, tmp_path, capsys):
     text = '{"type": "terminal", "value": 1}'
     for i in range(1500):
