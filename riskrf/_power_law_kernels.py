@@ -10,6 +10,27 @@ from numba import njit
 
 
 @njit(cache=True)
+def tail_ks(logx, first, last, k, b):
+    """KS distance of the tail from index k to the power law F(x) = 1 - (x / x_k)^-b, over every point.
+
+    The empirical CDF is compared on both sides of each jump: ``last``/``first`` index arrays give the
+    step heights (see :func:`riskrf.power_law._tail_arrays`).
+    """
+    N = logx.shape[0]
+    n = N - k
+    d = 0.0
+    for j in range(k, N):
+        F = 1.0 - np.exp(-b * (logx[j] - logx[k]))
+        hi = abs(F - (last[j] - k + 1) / n)
+        lo = abs(F - (first[j] - k) / n)
+        if hi > d:
+            d = hi
+        if lo > d:
+            d = lo
+    return d
+
+
+@njit(cache=True)
 def ks_scan(logx, suffix_log, first, last, candidates):
     """KS distance and MLE exponent for each candidate threshold index.
 
@@ -36,16 +57,7 @@ def ks_scan(logx, suffix_log, first, last, candidates):
         if s <= 0.0:
             continue
         b = n / s
-        d = 0.0
-        for j in range(k, N):
-            F = 1.0 - np.exp(-b * (logx[j] - logx[k]))
-            hi = abs(F - (last[j] - k + 1) / n)
-            lo = abs(F - (first[j] - k) / n)
-            if hi > d:
-                d = hi
-            if lo > d:
-                d = lo
-        D[c] = d
+        D[c] = tail_ks(logx, first, last, k, b)
         B[c] = b
     return D, B
 
@@ -64,14 +76,7 @@ def _ks_bounds(logx, first, last, k, b, m):
     n = N - k
     d = 0.0
     if m >= n:
-        for j in range(k, N):
-            F = 1.0 - np.exp(-b * (logx[j] - logx[k]))
-            hi = abs(F - (last[j] - k + 1) / n)
-            lo = abs(F - (first[j] - k) / n)
-            if hi > d:
-                d = hi
-            if lo > d:
-                d = lo
+        d = tail_ks(logx, first, last, k, b)
         return d, d
     ub = 0.0
     prev_F = 0.0

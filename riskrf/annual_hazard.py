@@ -24,7 +24,9 @@ from .impact_energy import (
     exceedance_probability,
     mass_model,
 )
+from .mass_coupling import MassCoupledSamples
 from .power_law import GutenbergRichterFit
+from .report.format import sig
 from .units import SPHERE_INERTIA
 from .validation import check_positive, check_probability_level, check_return_periods
 
@@ -44,13 +46,15 @@ class EnergyHazard:
     Attributes
     ----------
     mass : mass model (usually a :class:`~riskrf.GutenbergRichterFit`)
-    velocity : velocity model: samples [m/s], scipy distribution, VelocityFit or PairedSamples.
+    velocity : velocity model: samples [m/s], scipy distribution, VelocityFit, PairedSamples or
+        MassCoupledSamples (reach, speed and bounce height by block mass: :func:`riskrf.energy_hazard`).
         With samples from a simulation the effective speed includes rotation:
         v_eff^2 = v^2 + k (w r)^2 (k = I / m r^2: 0.4 sphere, 0.5 cylinder), so that
         1/2 m v_eff^2 is the total kinetic energy (exact for a rolling body, whose
         surface speed w r does not depend on its mass).
     rate_per_year : falls per year described by the mass model (power law: falls >= m_min).
-    reach_probability : P(a fall reaches the barrier line) (simulation).
+    reach_probability : P(a fall reaches the barrier line) (simulation; averaged over the mass model when the
+        velocity model is mass-coupled).
     n_released : number of simulated blocks behind ``reach_probability`` (for its uncertainty).
     heights_m : bounce heights [m] at the line (of the block centre above the ground), if known.
     """
@@ -73,10 +77,13 @@ class EnergyHazard:
     @classmethod
     def from_simulation(cls, mass, result, collector: str, *, rate_per_year=None, rotational: bool = True,
                         condition_on_mass: bool = False) -> "EnergyHazard":
-        """Build the hazard from a mass fit and a :class:`simulation.SimulationResult`.
+        """Build the hazard from a mass fit and a :class:`simulation.SimulationResult` (the mass-INDEPENDENT form).
 
         Uses each block's first crossing of ``collector``; the reach probability is
-        the fraction of released blocks that crossed it.
+        the fraction of released blocks that crossed it, one value for every mass, and the
+        velocities are pooled over the seeder's masses (``condition_on_mass`` classes them by the
+        seeder's masses, without simulating beyond them).  The mass-coupled hazard, which simulates
+        the whole range of the mass model, is :func:`riskrf.energy_hazard`.
         """
         if rate_per_year is None:
             if not isinstance(mass, GutenbergRichterFit):
@@ -91,11 +98,28 @@ class EnergyHazard:
             spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
             v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
         velocity = PairedSamples(v, df["mass_kg"].to_numpy()) if condition_on_mass else v
-        notes = (f"velocities: first crossings of {collector!r} by {len(df):,} of {result.n:,} simulated blocks"
+        notes = ("mass-independent form: one reach probability and one velocity law for all masses"
+                 + (" (velocities classed by the seeder's masses)" if condition_on_mass else ""),
+                 f"velocities: first crossings of {collector!r} by {len(df):,} of {result.n:,} simulated blocks"
                  + ("; rotational energy included (v_eff^2 = v^2 + k (w r)^2)" if rotational else ""),)
         return cls(mass=mass, velocity=velocity, rate_per_year=float(rate_per_year),
                    reach_probability=len(df) / result.n, n_released=result.n,
                    heights_m=df["height_m"].to_numpy(), collector=collector, notes=notes)
+
+    @property
+    def mass_coupled(self) -> bool:
+        """Whether reach, speed and bounce height depend on block mass (:func:`riskrf.energy_hazard`)."""
+        return isinstance(self.velocity, MassCoupledSamples)
+
+    def with_mass(self, mass, rate_per_year: float | None = None) -> "EnergyHazard":
+        """The same slope with another mass model (and rate): a mass-coupled reach probability is recomputed."""
+        rate = self.rate_per_year if rate_per_year is None else check_positive(rate_per_year, "rate_per_year")
+        if self.mass_coupled:
+            mm = mass_model(mass)
+            vel = self.velocity.with_representative(mm)
+            return replace(self, mass=mass, rate_per_year=float(rate), velocity=vel,
+                           reach_probability=max(vel.reach_probability(mm), 1e-300), heights_m=vel.heights_m)
+        return replace(self, mass=mass, rate_per_year=float(rate))
 
     # ---- per fall -------------------------------------------------------------------
     def exceedance_probability(self, energy_kj):
@@ -109,9 +133,13 @@ class EnergyHazard:
             raise ValueError(f"percentiles must lie strictly between 0 and 100; got {q.tolist()}")
         return self._invert(1.0 - q / 100.0, scale=1.0)
 
-    def velocity_percentile(self, q) -> float:
-        """Velocity [m/s] not exceeded by q % of the falls reaching the line, whatever the velocity model."""
+    def velocity_percentile(self, q, mass_kg=None) -> float:
+        """Velocity [m/s] not exceeded by q % of the falls reaching the line, whatever the velocity model.
+
+        With a mass-coupled model and ``mass_kg``: of the simulated blocks of that mass (its mass class)."""
         v = self.velocity
+        if isinstance(v, MassCoupledSamples) and mass_kg is not None:
+            return v.velocity_percentile(q, mass_kg)
         if isinstance(v, VelocityFit):
             v = v.dist
         if hasattr(v, "ppf"):
@@ -187,8 +215,11 @@ class EnergyHazard:
         b x Gamma(n, 1)/n, the exact sampling law of the MLE; rate* = Gamma(n)/T),
         or the parameters of a Gumbel/GEV fit (normal with the fit's covariance);
         the finite number of simulated trajectories (velocities resampled with
-        replacement, reach probability binomial).  Not included: the choice of
-        model, the simulation's physical parameters, the record's completeness.
+        replacement, reach probability binomial; mass-coupled: the blocks of each
+        mass class resampled).  Not included: the choice of model, the maximum
+        credible block m_max and the rate share of the source (judgement inputs:
+        see ``riskrf.energy_study.design_energy_sensitivity``), the simulation's
+        physical parameters, the record's completeness.
         Returns (lower, upper) arrays.
         """
         T = check_return_periods(T)
@@ -199,6 +230,10 @@ class EnergyHazard:
         v_nodes = self._velocity_nodes()
         for i in range(int(n_bootstrap)):
             mass, rate = self._perturbed_mass(rng)
+            if self.mass_coupled:       # blocks resampled within each mass class: reach and speed together
+                curve = self.velocity.resample(rng).joint_exceedance(_E_GRID, mass_model(mass))
+                sims[i] = _interp_log_inverse(curve, 1.0 / (Tv * rate))
+                continue
             reach = self.reach_probability
             if self.n_released:
                 reach = max(rng.binomial(self.n_released, self.reach_probability), 1) / self.n_released
@@ -213,7 +248,7 @@ class EnergyHazard:
     def _velocity_nodes(self):
         """Velocity samples compressed to at most 2048 equal-probability quantiles (for the bootstrap)."""
         v = self.velocity
-        if isinstance(v, (VelocityFit, PairedSamples)) or hasattr(v, "pdf"):
+        if isinstance(v, (VelocityFit, PairedSamples, MassCoupledSamples)) or hasattr(v, "pdf"):
             return v
         v = np.sort(np.asarray(v, dtype=float))
         if v.size <= 2048:
@@ -252,7 +287,10 @@ class EnergyHazard:
     def summary(self) -> pd.DataFrame:
         rows = {"collector": self.collector, "falls per year (mass model)": self.rate_per_year,
                 "reach probability": self.reach_probability, "arrivals per year": self.arrival_rate,
-                "mass model": mass_model(self.mass).description}
+                "mass model": mass_model(self.mass).description,
+                "mass coupling": ("reach, speed and bounce height by block mass (simulated "
+                                  f"{sig(self.velocity.edges_kg[0])}-{sig(self.velocity.edges_kg[-1])} kg)")
+                if self.mass_coupled else "none: one reach probability and velocity law for all masses"}
         for q, e in zip((95, 99), self.energy_percentile([95, 99])):
             rows[f"energy p{q} per arriving fall [kJ]"] = e
         if self.heights_m is not None:

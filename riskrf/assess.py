@@ -21,9 +21,11 @@ import numpy as np
 
 from . import __version__
 from .annual_hazard import EnergyHazard, inertia_factors
-from .energy_study import EnergyAnalysis, analyse_energy
+from .design_block import design_block, design_block_candidates_kg, read_block_survey
+from .energy_study import INTERVAL_COVERS, EnergyAnalysis, analyse_energy, design_energy_sensitivity
 from .frequency_study import FrequencyAnalysis, analyse_inventory
 from .inventory import Inventory, read_inventory
+from .mass_coupling import energy_hazard
 from .mitigation import MitigationStudy
 from .outputs import write_json
 from .power_law import fit_gutenberg_richter
@@ -36,11 +38,18 @@ logger = logging.getLogger("riskrf")
 def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, rate_scale: float = 1.0,
                               scenario=None, velocities=None, collector: str | None = None, n: int = 50_000,
                               seed=1, reach_probability: float = 1.0, condition_on_mass: bool = False,
+                              mass_coupling: str = "simulated", design_masses_kg=(),
                               velocity_unit: str | None = None):
     """Power-law fit of the inventory combined with simulated or given velocities.
 
     ``collector`` names the barrier line: in a scenario it defaults to "barrier"; a
     velocity file is filtered to that collector only when one is named.
+
+    With a scenario and ``mass_coupling="simulated"`` (the default) the hazard is
+    :func:`riskrf.energy_hazard`: ``n`` blocks simulated across the power law's mass range
+    (widened to ``design_masses_kg``), reach and speed by mass.  ``"independent"`` (or
+    ``condition_on_mass``) is the older form from the seeder's own masses.  The returned
+    simulation is always the scenario's own seeder run (figures, road share, mitigation).
 
     Returns (power-law fit, EnergyHazard, SimulationResult or None).
     """
@@ -58,8 +67,14 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
         collector = collector or "barrier"
         sc.collector_index(collector)
         result = simulation.run(sc, n=n, seed=seed)
-        hazard = EnergyHazard.from_simulation(gr, result, collector, rate_per_year=rate,
-                                              condition_on_mass=condition_on_mass)
+        if mass_coupling not in ("simulated", "independent"):
+            raise ValueError(f"mass_coupling = {mass_coupling!r} must be 'simulated' or 'independent'")
+        if mass_coupling == "simulated" and not condition_on_mass:
+            hazard = energy_hazard(gr, sc, collector, rate_per_year=rate, n=n, seed=seed,
+                                   design_masses_kg=design_masses_kg)
+        else:
+            hazard = EnergyHazard.from_simulation(gr, result, collector, rate_per_year=rate,
+                                                  condition_on_mass=condition_on_mass)
     else:
         df = read_velocities(velocities, collector=collector, velocity_unit=velocity_unit)
         v = df["velocity_ms"].to_numpy(dtype=float)
@@ -121,6 +136,25 @@ def fence_checks_from_site(site) -> tuple:
     return caps, tuple(fh) if isinstance(fh, list) else tuple([fh] * len(caps))
 
 
+def sensitivity_inputs(site) -> tuple:
+    """(m_max values [kg], rate shares [-]) for the design-energy sensitivity: low, stated and high values.
+
+    m_max: the site's uncertainty.m_max_kg range, else x0.5 and x2 of inventory.m_max_kg (only the stated value,
+    None, when the law is not truncated); rate share: inventory.rate_scale x uncertainty.rate_factor, else x0.5
+    and x2."""
+    m_max = site.inventory["m_max_kg"]
+    unc = site.mitigation.get("uncertainty")
+    if m_max is None:
+        m_values = [None]
+    elif unc is not None and unc.m_max_kg is not None:
+        m_values = sorted({float(unc.m_max_kg[0]), float(m_max), float(unc.m_max_kg[1])})
+    else:
+        m_values = [0.5 * m_max, float(m_max), 2.0 * m_max]
+    share = float(site.inventory["rate_scale"])
+    lo, hi = (unc.rate_factor if unc is not None and unc.rate_factor[0] != unc.rate_factor[1] else (0.5, 2.0))
+    return m_values, sorted({share * lo, share, share * hi})
+
+
 @dataclass
 class Assessment:
     site: Site
@@ -154,8 +188,17 @@ class Assessment:
                           "m_min_method": gr.m_min_method, "rate_min_per_year": gr.rate_min,
                           "bootstrap_p_value": fr.bootstrap_p},
             "design_masses": fr.design_masses().to_dict(orient="records"),
+            "design_masses_basis": "whole monitored wall (regional fit): untruncated, rate not scaled; the site's "
+                                   "own design masses are site_design_masses",
+            "site_design_masses": self.energy.site_masses.to_dict(orient="records")
+            if self.energy.site_masses is not None else None,
+            "design_block": self.energy.design_block.to_dict() if self.energy.design_block is not None else None,
+            "design_energy_sensitivity": self.energy.sensitivity.to_dict(orient="records")
+            if self.energy.sensitivity is not None else None,
+            "design_energy_interval_covers": INTERVAL_COVERS,
             "hazard": {"power_law_for_hazard": {"b": float(hz.mass.b), "m_max_kg": hz.mass.m_max,
                                                 "m_min_kg": float(hz.mass.m_min)},
+                       "mass_coupled": hz.mass_coupled,
                        "falls_per_year": hz.rate_per_year, "reach_probability": hz.reach_probability,
                        "arrivals_per_year": hz.arrival_rate,
                        "road_share": self.study.road_share,
@@ -183,7 +226,7 @@ class Assessment:
             out["annual_maxima"] = {"source": src.inventory.source, "gumbel": dict(zip(src.gumbel.param_names,
                                                                                       src.gumbel.params)),
                                     "gev": dict(zip(src.gev.param_names, src.gev.params)) if src.gev else None,
-                                    "deviance_test": src.deviance}
+                                    "deviance_test": src.deviance, "preferred_model": src.preferred_model()}
         return out
 
 
@@ -218,21 +261,39 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
         timings["fits"] = round(time.perf_counter() - t, 2)
 
-        hz_cfg = site.hazard
+        hz_cfg, db_cfg = site.hazard, site.design_block
+        survey = read_block_survey(site.resolve(db_cfg["survey"]), inventory.density_kg_m3) \
+            if db_cfg["survey"] else None
+        m_max_values, shares = sensitivity_inputs(site)
+        # masses design values are read at: the percentile band of the design block, the largest m_max studied
+        extra = design_block_candidates_kg(rule=db_cfg["rule"], percentile=db_cfg["percentile"],
+                                           survey_volumes_m3=survey, inventory=inventory,
+                                           density_kg_m3=inventory.density_kg_m3)
+        extra += [m for m in m_max_values if m is not None]
         t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
         gr, hazard, result = energy_hazard_from_inputs(
             inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=inv_cfg["rate_scale"],
             scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
             velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
             collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
+            mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=extra,
             velocity_unit=hz_cfg["velocity_unit"])
         timings["simulation"] = round(time.perf_counter() - t, 2)
 
-        t = stage(3, "computing the impact-energy hazard, design energies and fence checks")
+        t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
+        block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
+                             survey_source=db_cfg["survey"], inventory=inventory, sizes=inv_cfg["sizes"],
+                             design_T=hz_cfg["design_period_years"], density_kg_m3=inventory.density_kg_m3,
+                             fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"])
+        sensitivity = design_energy_sensitivity(
+            hazard, inventory.masses, inventory.duration_years, m_min=gr.m_min, m_max_values=m_max_values,
+            rate_shares=shares, T=hz_cfg["design_period_years"]) \
+            if hz_cfg["design_period_years"] * hazard.arrival_rate > 1 else None
         fences, heights = fence_checks_from_site(site)
         energy = analyse_energy(hazard, fences=fences, fence_height_m=heights,
                                 free_board_m=hz_cfg["free_board_m"], design_T=hz_cfg["design_period_years"],
-                                density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed)
+                                density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed,
+                                design_block=block, sensitivity=sensitivity)
         timings["energy"] = round(time.perf_counter() - t, 2)
 
         t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
@@ -281,7 +342,8 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
         sub.mkdir()
         a.maxima_frequency.write(sub)
     a.energy.write(figs)
-    for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv"):
+    for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv", "design_energy_sensitivity.csv",
+                 "design_block.csv"):
         if (figs / name).exists():
             shutil.move(str(figs / name), str(out / name))
     if a.result is not None:
@@ -308,8 +370,8 @@ def _copy_inputs(a: Assessment, dest: Path) -> None:
     site = a.site
     text = site.path.read_text(encoding="utf-8")
     for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
-                       ("hazard", "velocities")):
-        rel = (site.inventory if table == "inventory" else site.hazard)[key]
+                       ("hazard", "velocities"), ("design_block", "survey")):
+        rel = {"inventory": site.inventory, "hazard": site.hazard, "design_block": site.design_block}[table][key]
         if rel:
             src = site.resolve(rel)
             shutil.copy2(src, dest / src.name)

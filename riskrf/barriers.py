@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from .report.format import sig
 from .units import DAYS_PER_YEAR, J_PER_KJ, SEL_PER_MEL
 from .validation import check_positive
 
@@ -106,7 +107,7 @@ def check_fence(hazard, mel_kj: float, height_m: float, *, T: float = 100.0, fre
     for name, cap in (("MEL", mel), ("SEL", sel)):
         lam = float(hazard.annual_frequency(cap))
         rows.append({"check": f"{T:g}-year energy vs {name}", "demand": e_T, "capacity": cap, "unit": "kJ",
-                     "interval": f"{float(lo):.4g}-{float(hi):.4g}", "adequate": e_T <= cap,
+                     "interval": f"{sig(lo, 2)} - {sig(hi, 2)}", "adequate": e_T <= cap,
                      "note": f"impacts above {name}: {lam:.3g}/yr (1 in {1 / lam if lam > 0 else np.inf:.3g} yr), "
                              f"P(in {design_life_years:g} yr) = {-np.expm1(-lam * design_life_years):.3f}"})
     if hazard.heights_m is not None:
@@ -130,10 +131,15 @@ def damage_state_shares(energy_kj, over, mel_kj: float):
     over (``over``, per row), are held below SEL, held between SEL and MEL, or break through above MEL.
 
     Returns (passing, held_repair, destroyed), each a share per column; passing = over + destroyed.
+    With no simulated falls (no rows: none reached the barrier in that slope model) every share is 0, not
+    nan: the shares multiply an arrival rate of zero.
     """
     e = np.asarray(energy_kj, dtype=float)
     over = np.asarray(over, dtype=bool).reshape(-1, *([1] * (e.ndim - 1)))
     mel = check_positive(mel_kj, "mel_kj")
+    if e.shape[0] == 0:
+        zero = np.zeros(e.shape[1:])
+        return zero, zero.copy(), zero.copy()
     working = ~over
     through = working & (e > mel)
     held_repair = working & (e > service_energy_level(mel)) & (e <= mel)

@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import shutil
 import sys
 import traceback
 import warnings
@@ -70,6 +71,7 @@ def _read(args, path):
 
 
 def cmd_fit(args) -> int:
+    """``riskrf fit``: read an inventory, fit the power law (and Gumbel/GEV when dated), print and write the results."""
     from .frequency_study import analyse_inventory
     from .outputs import atomic_output_dir
 
@@ -108,6 +110,7 @@ def write_table(df, path: Path, suffix: str | None = None) -> None:
 
 
 def cmd_simulate(args) -> int:
+    """``riskrf simulate``: run a scenario, print its summary, write the crossings table and figures."""
     import pandas as pd
 
     import simulation
@@ -146,10 +149,26 @@ def build_energy_hazard(args, inventory):
         inventory, m_min=args.m_min, m_max=args.m_max, rate_scale=args.rate_scale, scenario=args.scenario,
         velocities=args.velocities, collector=args.collector, n=args.n, seed=args.seed,
         reach_probability=args.reach_probability,
-        condition_on_mass=args.condition_on_mass, velocity_unit=args.velocity_unit)
+        condition_on_mass=args.condition_on_mass, velocity_unit=args.velocity_unit,
+        mass_coupling="independent" if args.mass_independent else "simulated",
+        design_masses_kg=_energy_design_masses(args, inventory))
+
+
+def _energy_design_masses(args, inventory):
+    """Masses [kg] the energy command reads design values at: the design-block band and the sensitivity's m_max."""
+    from .design_block import design_block_candidates_kg, read_block_survey
+    out = [2.0 * args.m_max] if args.m_max else []
+    survey_path, pct = getattr(args, "block_survey", None), getattr(args, "design_percentile", None)
+    survey = read_block_survey(survey_path, inventory.density_kg_m3) if survey_path else None
+    if pct is not None or survey is not None:
+        out += design_block_candidates_kg(rule="percentile", percentile=pct or 97.0,
+                                          survey_volumes_m3=survey, inventory=inventory,
+                                          density_kg_m3=inventory.density_kg_m3)
+    return out
 
 
 def cmd_energy(args) -> int:
+    """``riskrf energy``: impact-energy hazard at a barrier line, design energies and fence checks."""
     from .energy_study import analyse_energy
     from .outputs import atomic_output_dir
 
@@ -160,9 +179,27 @@ def cmd_energy(args) -> int:
     for note in inv.notes:
         print(f"note: {note}")
     gr, hazard, _ = build_energy_hazard(args, inv)
+    block = sensitivity = None
+    fragmenting = args.fractal_dimension is not None or args.fragmentation_iterations is not None
+    if args.design_percentile is not None or args.block_survey or fragmenting:
+        from .design_block import design_block, read_block_survey
+        survey = read_block_survey(args.block_survey, inv.density_kg_m3) if args.block_survey else None
+        rule = "percentile" if (args.design_percentile is not None or survey is not None) else "fragmentation"
+        block = design_block(hazard, rule=rule, percentile=args.design_percentile or 97.0,
+                             survey_volumes_m3=survey, survey_source=args.block_survey, inventory=inv,
+                             sizes=args.inventory_sizes, design_T=args.design_period, density_kg_m3=inv.density_kg_m3,
+                             fractal_dimension=args.fractal_dimension, iterations=args.fragmentation_iterations)
+    if args.design_period * hazard.arrival_rate > 1:
+        from .energy_study import design_energy_sensitivity
+        m_values = [0.5 * gr.m_max, gr.m_max, 2.0 * gr.m_max] if gr.m_max else [None]
+        sensitivity = design_energy_sensitivity(hazard, inv.masses, inv.duration_years, m_min=gr.m_min,
+                                                m_max_values=m_values,
+                                                rate_shares=[0.5 * args.rate_scale, args.rate_scale,
+                                                             2.0 * args.rate_scale], T=args.design_period)
     analysis = analyse_energy(hazard, fences=args.fence or (2000.0, 5000.0), fence_height_m=args.fence_height,
                               free_board_m=args.free_board, design_T=args.design_period,
-                              density_kg_m3=inv.density_kg_m3, n_bootstrap=args.bootstrap, seed=args.seed)
+                              density_kg_m3=inv.density_kg_m3, n_bootstrap=args.bootstrap, seed=args.seed,
+                              design_block=block, sensitivity=sensitivity)
     print(f"Inventory {inv.source}: power law b = {gr.b:.4f} ± {gr.b_stderr:.4f} above m_min = {gr.m_min:.5g} kg "
           f"({gr.n_tail} falls, {gr.rate_min:.4g} per year)" + (f", m_max = {gr.m_max:.5g} kg" if gr.m_max else ""))
     print(analysis.summary_text())
@@ -173,6 +210,7 @@ def cmd_energy(args) -> int:
 
 
 def cmd_decide(args) -> int:
+    """``riskrf decide``: rank mitigation options (site file) or roll back a decision tree file."""
     from .decision_tree import DecisionTree
     from .mitigation import load_mitigation
     from .outputs import atomic_output_dir, write_json
@@ -255,7 +293,10 @@ def _add_energy_arguments(p):
                    help="multiply the inventory's rate of falls by F, e.g. the share of the inventoried cliff "
                         "above this line (default 1)")
     p.add_argument("--condition-on-mass", action="store_true",
-                   help="condition simulated velocities on block mass (when velocity depends on size)")
+                   help="older form: class the seeder's own simulated masses (implies --mass-independent reach)")
+    p.add_argument("--mass-independent", action="store_true",
+                   help="one reach probability and velocity law for all masses, from the seeder's masses (default: "
+                        "blocks simulated across the power law's mass range, reach and speed by mass)")
     p.add_argument("--m-min", type=float, default=None, metavar="KG", help="power-law threshold (default: KS)")
     p.add_argument("--m-max", type=float, default=None, metavar="KG",
                    help="maximum credible block mass, kg (upper truncation; default none)")
@@ -268,6 +309,7 @@ def _add_energy_arguments(p):
 
 
 def cmd_assess(args) -> int:
+    """``riskrf assess``: the whole chain for a site file, written atomically to ``--out``."""
     from .assess import run_assessment, write_assessment
     from .outputs import atomic_output_dir
     from .site import load_site
@@ -292,6 +334,7 @@ def cmd_assess(args) -> int:
 
 
 def cmd_demo(args) -> int:
+    """``riskrf demo``: ``assess`` on the bundled demo site."""
     from importlib import resources
 
     with resources.as_file(resources.files("riskrf") / "data" / "demo_site.toml") as site:
@@ -304,6 +347,7 @@ def cmd_demo(args) -> int:
 
 
 def cmd_calibrate(args) -> int:
+    """``riskrf calibrate``: fit scenario material parameters to observed stop points."""
     import simulation
     from simulation.calibration import read_observed
 
@@ -374,7 +418,52 @@ def cmd_calibrate(args) -> int:
     return 0
 
 
+def cmd_corridor(args) -> int:
+    from .corridor import load_corridor, run_corridor, write_corridor
+
+    corridor = load_corridor(args.corridor, keep_going=args.keep_going)   # every row checked before any work
+    for e in corridor.errors:
+        print(f"skipped (--keep-going): {e}")
+    from .preflight import check_out
+    out = check_out(args, f"{Path(args.corridor).stem}-corridor")
+    parts = out.parent / f".{out.name}.sections"
+    n = args.n or corridor.n_blocks
+    where = args.scheduler or os.environ.get("DASK_SCHEDULER_ADDRESS") or \
+        f"a local cluster of {args.workers or os.cpu_count()} workers"
+    print(f"riskrf corridor: {len(corridor.sections)} sections x {n:,} blocks on {where}; "
+          f"finished sections go to {parts}")
+
+    from .report.format import probability
+
+    def progress(done, total, sid):
+        bar = "#" * int(30 * done / total)
+        print(f"\r[{bar:<30}] {done}/{total} sections (last: {sid})", end="" if done < total else "\n", flush=True)
+
+    try:
+        res = run_corridor(corridor, scheduler=args.scheduler, n_workers=args.workers, n_blocks=n, partitions=parts,
+                           resume=args.resume, keep_going=args.keep_going, progress=progress, log=print)
+    except (ConnectionError, RuntimeError) as exc:
+        print(f"\nriskrf corridor: error: {exc}", file=sys.stderr)
+        if parts.exists():
+            print(f"finished sections are kept in {parts}; rerun with --resume to skip them", file=sys.stderr)
+        return 2
+    write_corridor(res, out, overwrite=args.overwrite)
+    shutil.rmtree(parts, ignore_errors=True)        # the run is complete: its partitions are in sections.csv
+    for f in res.failures:
+        print(f"failed: {f}")
+    top = res.summary().head(5)
+    print(f"{len(res.table)} sections in {res.seconds:.1f} s on {res.workers} workers "
+          f"({len(res.table) / max(res.seconds, 1e-9) * 60:.1f} sections per minute).  Highest risk first:")
+    for _, r in top.iterrows():
+        print(f"  {r['id']}: RHRS {r['rhrs_score']:.0f} (rank {r['rank_rhrs']:.0f}), {probability(r['deaths_per_year'])} deaths/yr, "
+              f"best: {r['best_option']} ({r['best_option_capital']:,.0f} {corridor.currency})")
+    print(f"Report: {(out / 'report.html').resolve()} (also corridor.csv, sections.csv, budget_curve.csv, "
+          "chainage.png, summary.json)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
+    """The ``riskrf`` argument parser with one sub-command per task."""
     parser = argparse.ArgumentParser(
         prog="riskrf", description="Rock fall hazard, risk and mitigation decisions (after Wyllie 2014, "
         "Rock Fall Engineering, chapters 3-8).  Start with 'riskrf demo' (the whole chain on a bundled site, "
@@ -431,6 +520,18 @@ def build_parser() -> argparse.ArgumentParser:
                    help="free board above the p95 bounce height, m (UNI 11211-4: at least 0.5; default 0.5)")
     p.add_argument("--design-period", type=float, default=100.0, metavar="YR",
                    help="return period of the fence checks and UNI design block, years (default 100)")
+    p.add_argument("--design-percentile", type=float, default=None, metavar="P",
+                   help="design block: the P-th percentile of the block sizes (ONR 24810: 95-98), of --block-survey or "
+                        "else of the inventory's sizes (stated as an assumption when they are event volumes)")
+    p.add_argument("--block-survey", default=None, metavar="FILE",
+                   help="block survey (.csv/.xlsx/.parquet with a volume_m3 or mass_kg column) for the design block")
+    p.add_argument("--fractal-dimension", type=float, default=None, metavar="D",
+                   help="fragmentation step (Perfect 1997): fractal dimension D in (0, 3) of the fragments of the "
+                        "design-period event; the design block is then a percentile of its fragments")
+    p.add_argument("--fragmentation-iterations", type=int, default=None, metavar="N",
+                   help="fragmentation generations (1-12) with --fractal-dimension")
+    p.add_argument("--inventory-sizes", choices=("event_volumes", "blocks"), default="event_volumes",
+                   help="what the inventory's sizes are (default event_volumes)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-energy)")
     p.set_defaults(func=cmd_energy)
 
@@ -470,8 +571,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("demo", help="run the whole chain on the bundled example site",
                        description="Run riskrf assess on the bundled example site: the real Lauterbrunnen "
-                       "laser-scanning inventory (power law), the clearly labelled SYNTHETIC 40-year record (annual "
-                       "maxima), the shipped road-cut barrier scenario and illustrative traffic, costs and options. "
+                       "laser-scanning inventory (power law), the real Hong Kong rock-cut incident register 1984-2020 "
+                       "(annual maxima), the shipped road-cut barrier scenario and illustrative traffic, costs and options. "
                        "Works from any directory; takes well under a minute.", epilog=EPILOG)
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default ./riskrf-demo)")
     p.add_argument("--seed", type=int, default=None, help="random seed (default 1)")
@@ -500,6 +601,58 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--bootstrap", type=int, default=200, help="bootstrap replicates (default 200; 0 to skip)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <scenario>-calibration)")
     p.set_defaults(func=cmd_calibrate)
+
+    p = sub.add_parser("rates", help="rock fall rates against rainfall, season and trend (Poisson / negative binomial)",
+                       description="Count the events of a dated inventory per day, month or year and fit Poisson and "
+                       "negative-binomial regressions on antecedent rainfall, season and a year trend (see the README "
+                       "section 'Rate models').  Prints the model comparison (AIC, deviance, overdispersion tests), "
+                       "rate ratios with intervals, the trend test and expected rates by month; writes CSV tables and "
+                       "the figures seasonality.png and rainfall_response.png.", epilog=EPILOG)
+    p.add_argument("inventory", help="dated inventory file with its record period (sidecar .toml or --start/--end)")
+    p.add_argument("--rainfall", required=True, metavar="FILE",
+                   help="daily rainfall: the Hong Kong Observatory file, or a CSV with date,rainfall_mm")
+    _add_inventory_arguments(p)
+    p.add_argument("--period", choices=("day", "month", "year"), default="day", help="counting period (default day)")
+    p.add_argument("--windows", default="1,3,15", metavar="D1,D2,...",
+                   help="antecedent rainfall bands for daily counts as window lengths in days (default 1,3,15: "
+                        "the day, the 2 days before, days 3-14 before)")
+    p.add_argument("--rain-transform", choices=("linear", "sqrt", "log1p"), default="linear",
+                   help="rainfall in the model: linear (rate ratio per 100 mm; default), sqrt or log1p "
+                        "(rate ratio of 100 mm against none)")
+    p.add_argument("--season", choices=("harmonic", "wet", "month", "none"), default="harmonic",
+                   help="season terms (default harmonic: annual sine and cosine)")
+    p.add_argument("--no-trend", action="store_true", help="leave out the year trend")
+    p.add_argument("--closure-mm", type=float, action="append", metavar="MM",
+                   help="evaluate a closure rule: close the road on days whose rainfall over --closure-window days "
+                        "reaches MM (daily models; repeat for several thresholds)")
+    p.add_argument("--closure-window", type=int, default=1, metavar="DAYS", help="closure rule window (default 1)")
+    p.add_argument("--warnings", default=None, metavar="FILE",
+                   help="Hong Kong Observatory rainstorm warning list: evaluate closing under Red or Black warnings")
+    p.add_argument("--cost-per-hour", type=float, default=0.0, metavar="MONEY",
+                   help="cost of one hour of closure, for the closure rules (default 0)")
+    p.add_argument("--heavy-day-mm", type=float, default=None, metavar="MM",
+                   help="with --heavy-day-change: daily rainfall of a heavy-rain day")
+    p.add_argument("--heavy-day-change", type=float, default=None, metavar="SHARE",
+                   help="expected rate if heavy-rain days became this much more frequent (0.1 = +10%%; an assumption)")
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-rates)")
+    p.set_defaults(func=cmd_rates)
+
+    p = sub.add_parser("corridor", help="screen and assess many sections along a road (RHRS + risk, on dask)",
+                       description="Read a corridor file (TOML with defaults, mass law, traffic, costs and options, "
+                       "naming a sections table) and check every row first; then run each section's chain "
+                       "(simulation, energy hazard, road-user risk, option ranking) as a task on dask.distributed: "
+                       "a local cluster sized to the machine by default, or an existing scheduler unchanged.  "
+                       "Writes report.html, corridor.csv (ranked by risk beside the RHRS rank), sections.csv, "
+                       "budget_curve.csv, chainage.png and summary.json (see the README section 'Corridor').", epilog=EPILOG)
+    p.add_argument("corridor", help="corridor file (.toml); paths in it are relative to it")
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <corridor>-corridor)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="address of an existing dask scheduler (default: DASK_SCHEDULER_ADDRESS, else a local cluster)")
+    p.add_argument("--workers", type=int, default=None, help="workers of the local cluster (default: one per core)")
+    p.add_argument("-n", type=int, default=None, help="simulated blocks per section (default: the corridor file's)")
+    p.add_argument("--keep-going", action="store_true", help="skip bad rows and failed sections, listing them")
+    p.add_argument("--resume", action="store_true", help="skip sections already finished by an earlier run")
+    p.set_defaults(func=cmd_corridor)
     for p in sub.choices.values():       # every command with outputs: never clobber without --overwrite
         if any("--out" in a.option_strings for a in p._actions):
             p.add_argument("--overwrite", action="store_true",
@@ -508,7 +661,56 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def cmd_rates(args) -> int:
+    from .outputs import atomic_output_dir
+    from .rate_model import rate_model
+
+    try:
+        windows = tuple(int(w) for w in args.windows.split(","))
+    except ValueError:
+        raise ValueError(f"--windows {args.windows!r}: give whole numbers of days separated by commas") from None
+    if args.period != "day" and (args.closure_mm or args.warnings or args.heavy_day_change is not None):
+        raise ValueError(f"--period {args.period}: closure rules (--closure-mm, --warnings) and --heavy-day-change "
+                         "need a daily model (--period day)")
+    if (args.heavy_day_change is None) != (args.heavy_day_mm is None):
+        raise ValueError("give --heavy-day-mm and --heavy-day-change together")
+    from .preflight import check_inventory_args, check_out
+    check_inventory_args(args)
+    out = check_out(args, f"{Path(args.inventory).stem}-rates")
+    inv = _read(args, args.inventory)
+    model = rate_model(inv, args.rainfall, period=args.period, windows_days=windows,
+                       season=None if args.season == "none" else args.season, trend=not args.no_trend,
+                       rain_transform=args.rain_transform)
+    print(model.summary_text())
+    if args.heavy_day_change is not None:
+        base = model.expected_annual_rate()
+        changed = model.expected_annual_rate(heavy_day_mm=args.heavy_day_mm, heavy_day_change=args.heavy_day_change)
+        print(f"\nStated change of climate (ASSUMPTION): days with >= {args.heavy_day_mm:g} mm "
+              f"{args.heavy_day_change:+.0%} as frequent: {changed:.4g} events per year against {base:.4g} "
+              f"({changed / base - 1:+.1%})")
+    rules = []
+    if args.closure_mm or args.warnings:
+        from .closure import closure_rule, warning_closure
+        rules = [closure_rule(model, mm, window_days=args.closure_window, cost_per_hour=args.cost_per_hour)
+                 for mm in (args.closure_mm or [])]
+        if args.warnings:
+            rules.append(warning_closure(model, args.warnings, levels=("Red", "Black"),
+                                         cost_per_hour=args.cost_per_hour))
+        import pandas as pd
+        table = pd.concat([r.summary()["value"].rename(f"rule {i + 1}") for i, r in enumerate(rules)], axis=1)
+        print("\nClosure rules (effectiveness = share of falls while closed, from the rate model):")
+        print(table.to_string())
+    with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
+        model.write(tmp)
+        if rules:
+            pd.concat([r.summary()["value"].rename(f"rule {i + 1}") for i, r in enumerate(rules)], axis=1).to_csv(
+                tmp / "closure_rules.csv")
+    print(f"\nWrote rate_ratios.csv, model_comparison.csv, design.csv, season.csv and figures to {out}/")
+    return 0
+
+
 def main(argv=None) -> int:
+    """Entry point of the ``riskrf`` command; returns the exit status (0 ok, 2 bad input)."""
     # Figures are written to files: a non-interactive backend, unless the user chose one.
     os.environ.setdefault("MPLBACKEND", "Agg")
     # Library code logs its stages (logger "riskrf"); the command line shows them as plain lines.

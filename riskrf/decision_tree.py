@@ -95,6 +95,7 @@ def _evaluate_raw(expr, params: dict, where: str):
 
 @dataclass
 class Branch:
+    """One branch of a node: its name, the node it leads to and its cost (a number or a parameter name)."""
     name: str
     child: "Node"
     cost: object = 0.0
@@ -104,6 +105,7 @@ class Branch:
 
 @dataclass
 class Node:
+    """A decision, chance or terminal node of a decision tree."""
     type: str                       # "decision", "chance" or "terminal"
     name: str = ""
     branches: list = field(default_factory=list)
@@ -138,6 +140,7 @@ class DecisionTree:
     # ---- construction ---------------------------------------------------------------
     @classmethod
     def from_dict(cls, spec: dict, source: str = "<dict>") -> "DecisionTree":
+        """Tree from a dict as read from TOML/JSON; ``source`` names it in error messages."""
         if not isinstance(spec, dict):
             raise TreeError(f"{source}: a tree must be a table/object; got {type(spec).__name__}")
         params = spec.get("parameters", {})
@@ -156,6 +159,7 @@ class DecisionTree:
 
     @classmethod
     def from_file(cls, path) -> "DecisionTree":
+        """Tree from a TOML or JSON file; every field is checked before use."""
         path = Path(path)
         if not path.exists():
             raise FileNotFoundError(f"decision tree file not found: {path}")
@@ -172,6 +176,7 @@ class DecisionTree:
         return cls.from_dict(data, source=str(path))
 
     def with_parameters(self, **values) -> "DecisionTree":
+        """A copy of the tree with some parameters set to new values (unknown names are refused)."""
         unknown = set(values) - set(self.parameters)
         if unknown:
             raise TreeError(f"{self.source}: unknown parameter(s) {sorted(unknown)}; parameters are "
@@ -180,6 +185,7 @@ class DecisionTree:
 
     # ---- validation -----------------------------------------------------------------
     def validate(self):
+        """Check probabilities (each chance node sums to 1), node types and parameter references."""
         def walk(node):
             if node.type == "chance":
                 total = 0.0

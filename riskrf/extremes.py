@@ -177,14 +177,17 @@ class _AnnualMaximumFit:
 
     @property
     def loglik(self) -> float:
+        """Maximised log-likelihood of the annual maxima."""
         return float(-self._nll(self.params))
 
     @property
     def aic(self) -> float:
+        """Akaike information criterion 2k - 2 ln L (lower is better)."""
         return 2 * len(self.params) - 2 * self.loglik
 
     @property
     def stderr(self) -> np.ndarray:
+        """Standard errors of the parameters from the observed information (NaN where unavailable)."""
         return np.sqrt(np.diag(self.cov)) if self.cov is not None else np.full(len(self.params), np.nan)
 
     def return_level_ci(self, T, level: float = 0.95, method: str | None = None, *, n_bootstrap: int = 1000,
@@ -223,6 +226,7 @@ class _AnnualMaximumFit:
 
     @property
     def default_ci_method(self) -> str:
+        """Interval method used when none is asked: profile likelihood for MLE, delta for moments, bootstrap for L-moments."""
         return {"mle": "profile", "moments": "delta", "lmoments": "bootstrap"}[self.method]
 
     def _delta_ci(self, T, level):
@@ -350,6 +354,7 @@ class GumbelFit(_AnnualMaximumFit):
 
     @property
     def params(self):
+        """(loc, scale) in the unit of the maxima."""
         return (self.loc, self.scale)
 
     @staticmethod
@@ -398,6 +403,7 @@ class GumbelFit(_AnnualMaximumFit):
         return super()._return_level_variance(T)
 
     def summary(self) -> pd.DataFrame:
+        """Parameters with standard errors and the fitting method, one row each."""
         se = self.stderr
         label = {"mle": "maximum likelihood", "moments": "method of moments (Wyllie: S with ddof=1)",
                  "lmoments": "L-moments (Hosking 1990)"}[self.method]
@@ -420,6 +426,7 @@ class GEVFit(_AnnualMaximumFit):
 
     @property
     def params(self):
+        """(loc, scale, shape xi) with scipy's sign convention reversed: xi > 0 is a heavy (Frechet) tail."""
         return (self.loc, self.scale, self.shape)
 
     @staticmethod
@@ -486,6 +493,7 @@ class GEVFit(_AnnualMaximumFit):
                 "loglik_gev": self.loglik, "loglik_gumbel": gum.loglik}
 
     def summary(self) -> pd.DataFrame:
+        """Parameters with standard errors, the shape's meaning and the fitting method, one row each."""
         se = self.stderr
         rows = [("loc (mu)", self.loc, se[0], "maximum likelihood"),
                 ("scale (sigma)", self.scale, se[1], "maximum likelihood"),

@@ -17,6 +17,7 @@ from .extremes import MIN_MAXIMA, GEVFit, GumbelFit, fit_gev, fit_gumbel
 from .inventory import Inventory
 from .outputs import write_json
 from .power_law import GutenbergRichterFit, fit_gutenberg_richter
+from .report.format import sig
 from .validation import RiskrfWarning
 
 #: Return periods of the design-mass table [yr].
@@ -83,12 +84,61 @@ class FrequencyAnalysis:
             add(f"{name} ({fit.method})", fit.return_level(T), lo, hi, fit.default_ci_method)
         return pd.DataFrame(rows)
 
+    def preferred_model(self) -> dict:
+        """Which annual-maximum model to use for design masses, and why, in words.
+
+        Rules: when the deviance test does not reject the Gumbel (p >= 0.05) the
+        simpler Gumbel is preferred.  When it does, the GEV is preferred only if
+        its shape is plausible (xi < 0.5: finite mean and variance).  With
+        0.5 <= xi < 1 the variance is infinite and with xi >= 1 even the mean
+        is: no rock slope produces unboundedly large falls, so the GEV is then
+        read as evidence of a heavy (power-law) size tail (maxima of
+        power-law sizes are Fréchet with xi = 1/b: Embrechts, Klüppelberg &
+        Mikosch 1997, section 3.3.1), and
+        the power law, with an upper truncation m_max where one can be
+        justified, is preferred for design masses; the GEV's return levels are
+        not used beyond the record.  Returns ``{"model", "reason", "gev_shape_plausible"}``.
+        """
+        gr, gev, d = self.power_law, self.gev, self.deviance
+        if gev is None or d is None:
+            if self.gumbel is not None:
+                return {"model": "Gumbel", "gev_shape_plausible": None,
+                        "reason": "too few annual maxima for the GEV; the Gumbel is the only annual-maximum model"}
+            return {"model": "power law", "gev_shape_plausible": None,
+                    "reason": "no annual maxima (undated record); the power law is the only model"}
+        xi = gev.shape
+        implied = 1.0 / gr.b if gr.b > 0 else np.inf
+        if d["gumbel_adequate"]:
+            return {"model": "Gumbel", "gev_shape_plausible": bool(xi < 0.5),
+                    "reason": f"the deviance test does not reject the Gumbel (D = {sig(d['deviance'], 4)}, "
+                              f"p = {sig(d['p_value'], 2)}); the simpler model is preferred"}
+        if xi < 0.5:
+            return {"model": "GEV", "gev_shape_plausible": True,
+                    "reason": f"the deviance test rejects the Gumbel (D = {sig(d['deviance'], 4)}, "
+                              f"p = {sig(d['p_value'], 2)}) "
+                              f"and the GEV shape xi = {xi:.3f} is plausible (finite mean and variance)"}
+        what = "mean and variance are" if xi >= 1 else "variance is"
+        return {"model": "power law", "gev_shape_plausible": False,
+                "reason": f"the deviance test rejects the Gumbel (D = {sig(d['deviance'], 4)}, "
+                          f"p = {sig(d['p_value'], 2)}), but "
+                          f"the GEV shape xi = {xi:.2f} ± {gev.stderr[2]:.2f} is implausible: its {what} infinite, "
+                          f"which no rock slope can produce.  It says the sizes have a heavy, power-law tail: "
+                          f"power-law sizes give Fréchet maxima with xi = 1/b = {implied:.2f} (b = {gr.b:.3f}).  "
+                          f"Use the power law for design masses (with m_max if a largest credible block can be "
+                          f"justified) and read GEV return levels only within the "
+                          f"{self.inventory.duration_years:.0f}-year record; the Gumbel understates the tail"
+                          + (f".  Caution: the bootstrap rejects an exact power law "
+                             f"(p = {sig(self.bootstrap_p, 2)}), so "
+                             "the tail beyond the record is uncertain; compare the lognormal alternative"
+                             if self.bootstrap_p is not None and self.bootstrap_p <= 0.1 else "")}
+
     def design_table(self, T=DESIGN_RETURN_PERIODS) -> pd.DataFrame:
         """Wide table of design masses [kg]: one row per return period, one column per model."""
         d = self.design_masses(T)
         return d.pivot(index="T_years", columns="model", values="mass_kg")
 
     def to_dict(self) -> dict:
+        """The fits as plain JSON-ready values (for summary.json)."""
         gr = self.power_law
         out = {
             "inventory": self.inventory.summary()["value"].to_dict(),
@@ -103,6 +153,7 @@ class FrequencyAnalysis:
             },
             "design_masses": self.design_masses().to_dict(orient="records"),
             "skipped": self.skipped,
+            "preferred_model": self.preferred_model(),
             "warnings": list(self.warnings),
         }
         if self.power_law_lsq is not None:
@@ -160,6 +211,14 @@ class FrequencyAnalysis:
                          f"{'Gumbel adequate' if d['gumbel_adequate'] else 'GEV needed'}")
         for name, why in self.skipped.items():
             lines += ["", f"{name}: not fitted ({why})"]
+        if inv.is_dated:
+            every = inv.all_events()
+            per_year = every.groupby(every["year"].astype("Int64")).size().reindex(inv.record_years(), fill_value=0)
+            lines += ["", f"Completeness: events per year {per_year.index[0]}-{per_year.index[-1]} "
+                          f"(all sizes, {inv.n_censored} censored or without size included; see completeness.csv):",
+                      "  " + " ".join(str(int(n)) for n in per_year.to_numpy())]
+        pref = self.preferred_model()
+        lines += ["", f"Preferred model: {pref['model']}: {pref['reason']}."]
         table = self.design_table()
         lines += ["", "Design masses [kg] by return period (intervals in design_masses.csv):",
                   table.to_string(float_format=lambda v: f"{v:,.4g}")]

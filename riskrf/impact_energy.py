@@ -10,8 +10,10 @@ law between m_min and m_max), a Gumbel/GEV fit of annual maxima (then E is the
 energy of the year's largest block), any scipy frozen distribution, or an array of
 masses (empirical).  Velocity models: a scipy frozen distribution, an array of
 samples (a simulator collector, or a RocFall/RAMMS export), a :class:`VelocityFit`
-(parametric model chosen by AIC), or :class:`PairedSamples` (velocity samples with
-the mass of each block, to condition on mass).
+(parametric model chosen by AIC), :class:`PairedSamples` (velocity samples with
+the mass of each block, to condition on mass), or
+:class:`~riskrf.mass_coupling.MassCoupledSamples` (blocks simulated across the
+mass range: reach and speed both depend on mass; P(E > e) is then per arriving fall).
 
 The default ``method="quad"`` integrates in log space: Gauss-Legendre panels on
 ln v for a parametric velocity, an exact average over velocity samples, or
@@ -32,7 +34,9 @@ import pandas as pd
 from scipy import optimize, stats
 
 from .extremes import _AnnualMaximumFit
+from .mass_coupling import MassCoupledSamples
 from .power_law import GutenbergRichterFit
+from .report.format import sig
 from .units import DEFAULT_DENSITY_KG_M3, J_PER_KJ, SPHERE_INERTIA
 from .validation import check_choice
 
@@ -137,8 +141,8 @@ def mass_model(mass) -> _MassModel:
         if mass.units != "kg":
             raise ValueError(f"the power-law fit is in {mass.units!r}; convert it with .to_mass(density) first")
         return _MassModel(mass.sf, mass.isf, lambda n, rng: mass.rvs(n, rng),
-                          f"power law b = {mass.b:.3f} above {mass.m_min:.4g} kg"
-                          + (f", truncated at {mass.m_max:.4g} kg" if mass.m_max else ""), mass.support)
+                          f"power law b = {sig(mass.b)} above {sig(mass.m_min)} kg"
+                          + (f", truncated at {sig(mass.m_max)} kg" if mass.m_max else ""), mass.support)
     if isinstance(mass, _AnnualMaximumFit):
         d = mass.dist
         lo = float(d.ppf(1e-12))
@@ -169,7 +173,7 @@ def mass_model(mass) -> _MassModel:
 
     def isf(p):
         return np.quantile(m, 1.0 - np.asarray(p), method="inverted_cdf")
-    return _MassModel(sf, isf, lambda n, rng: rng.choice(m, size=n), f"empirical ({m.size} masses)",
+    return _MassModel(sf, isf, lambda n, rng: rng.choice(m, size=n), f"empirical ({m.size:,} masses)",
                       (float(m[0]), float(m[-1])))
 
 
@@ -227,6 +231,9 @@ def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, 
         velocity = velocity.dist
     if isinstance(velocity, PairedSamples):
         return _conditional_on_mass(e, mm, velocity)
+    if isinstance(velocity, MassCoupledSamples):
+        # per arriving fall: P(E > e, reach) / P(reach), both integrated over the mass model
+        return velocity.joint_exceedance(e, mm) / velocity.reach_probability(mm)
     if hasattr(velocity, "pdf") and hasattr(velocity, "isf"):
         if angular_velocity is not None:
             raise ValueError("angular_velocity needs velocity samples paired with it, not a distribution")
@@ -319,6 +326,21 @@ def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=Non
     w = None
     if isinstance(velocity, VelocityFit):
         velocity = velocity.dist
+    if isinstance(velocity, MassCoupledSamples):
+        cls = velocity.class_of(m)
+        members = [np.flatnonzero(velocity.class_of(velocity.mass_kg) == c) for c in range(velocity.n_bins)]
+        pick = np.empty(m.size, dtype=np.int64)
+        for c in range(velocity.n_bins):
+            sel = cls == c
+            pick[sel] = members[c][rng.integers(0, members[c].size, int(sel.sum()))]
+        v = velocity.speed_ms[pick]
+        arrived = np.isfinite(v)
+        energy = np.where(arrived, 0.5 * m * np.where(arrived, v, 0.0) ** 2 / J_PER_KJ, -np.inf)
+        n_arr = int(arrived.sum())
+        energy.sort()
+        k = n_samples - np.searchsorted(energy, e.ravel(), side="right")
+        lo, hi = wilson_interval(k, max(n_arr, 1), level)
+        return (k / max(n_arr, 1)).reshape(e.shape), lo.reshape(e.shape), hi.reshape(e.shape)
     if isinstance(velocity, PairedSamples):
         edges_m, vel = velocity.classes()
         cls = np.searchsorted(edges_m, m)

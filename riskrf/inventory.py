@@ -12,6 +12,17 @@ Years with no recorded fall are kept in :meth:`Inventory.annual_maxima` as
 missing values (NaN), never dropped and never set to zero: the extreme-value
 fits then use the mixed model that gives such years their own probability
 (see :func:`riskrf.fit_gumbel`).
+
+Censored sizes.  Agency registers often give a size only as a bound or an
+estimate.  In a size column a value may be written ``<1`` (the size is below
+1: an upper bound), ``>20`` (above 20: a lower bound) or ``~15`` (about 15: an
+approximate estimate); an empty size means "not recorded".  Such events are
+never dropped and never given a made-up size: they are kept in
+:attr:`Inventory.censored` (column ``censoring`` = ``below``, ``above``,
+``approximate`` or ``unknown``, with the bound or estimate in ``volume_m3`` /
+``mass_kg``), left out of the size fits (power law, annual maxima) with a
+warning that counts them, and counted by rate models through
+:meth:`Inventory.all_events`.
 """
 from __future__ import annotations
 
@@ -25,6 +36,7 @@ import numpy as np
 import pandas as pd
 
 from .tables import is_blank, parse_dates, parse_numbers, read_table, sniff_delimiter  # noqa: F401 (re-exported)
+from .report.format import sig
 from .units import DEFAULT_DENSITY_KG_M3, KG_PER_TONNE
 from .validation import check_positive, warn
 
@@ -38,6 +50,21 @@ _LOCATION_NAMES = {"location", "chainage", "chainage_m", "station", "place", "si
 _NOTES_NAMES = {"notes", "note", "comment", "comments", "remarks", "bemerkung"}
 _MASS_UNITS = {"kg": 1.0, "t": KG_PER_TONNE, "tonne": KG_PER_TONNE, "tonnes": KG_PER_TONNE, "tons": KG_PER_TONNE}
 _VOLUME_UNITS = {"m3": 1.0, "dm3": 1e-3, "l": 1e-3, "litre": 1e-3, "cm3": 1e-6}
+
+
+#: Prefix of a censored size -> the value of the ``censoring`` column.
+CENSORING = {"<": "below", "<=": "below", "≤": "below", ">": "above", ">=": "above", "≥": "above",
+             "~": "approximate", "≈": "approximate", "ca.": "approximate", "ca": "approximate"}
+_CENSORED_RE = re.compile(r"^\s*(<=|>=|<|>|≤|≥|~|≈|ca\.?)\s*([0-9.,eE+-]+)\s*$")
+_EVENT_COLUMNS = ["date", "year", "volume_m3", "mass_kg", "location", "notes", "source_row"]
+
+
+def _empty_censored() -> pd.DataFrame:
+    return pd.DataFrame({"date": pd.Series(dtype="datetime64[ns]"), "year": pd.Series(dtype="Int64"),
+                         "volume_m3": pd.Series(dtype=float), "mass_kg": pd.Series(dtype=float),
+                         "location": pd.Series(dtype=object), "notes": pd.Series(dtype=object),
+                         "source_row": pd.Series(dtype=int), "censoring": pd.Series(dtype=object),
+                         "size_text": pd.Series(dtype=object)})
 
 
 def _normalise(name: str) -> str:
@@ -93,6 +120,13 @@ class Inventory:
         ``"volume"`` or ``"mass"``: which size was recorded (the other is derived).
     notes : tuple of str
         Every warning raised while reading, kept for reports.
+    censored : pandas.DataFrame
+        Events of the record period whose size is censored or missing: the
+        columns of ``events`` plus ``censoring`` (``below``: the true size is
+        below ``volume_m3``/``mass_kg``; ``above``: above it; ``approximate``:
+        about it; ``unknown``: no size, NaN) and ``size_text`` (as written).
+        They are not in ``events`` (the size fits use exact sizes only) but are
+        counted by :meth:`all_events` and the rate models.
     """
 
     events: pd.DataFrame
@@ -106,6 +140,25 @@ class Inventory:
     size_column: str = "volume"
     site: str = ""
     notes: tuple = field(default_factory=tuple)
+    censored: pd.DataFrame = field(default_factory=_empty_censored)
+
+    def all_events(self) -> pd.DataFrame:
+        """Every event of the record period, exact and censored sizes alike, in date order.
+
+        The columns of :attr:`events` plus ``censoring`` (``""`` for an exact
+        size) and ``size_text``.  Use it to count events (rate models); use
+        :attr:`events` or :attr:`masses` for size statistics.
+        """
+        exact = self.events.assign(censoring="", size_text="")
+        if self.censored.empty:
+            return exact.reset_index(drop=True)
+        both = pd.concat([exact, self.censored[exact.columns]], ignore_index=True)
+        return both.sort_values(["date", "year", "source_row"], kind="stable").reset_index(drop=True)
+
+    @property
+    def n_censored(self) -> int:
+        """Number of events with a censored or missing size (in :attr:`censored`)."""
+        return len(self.censored)
 
     @property
     def masses(self) -> np.ndarray:
@@ -160,11 +213,37 @@ class Inventory:
             warn(f"{self.source}: {len(empty)} of {len(years)} years have no recorded fall "
                  f"({', '.join(map(str, empty[:10]))}{' ...' if len(empty) > 10 else ''}); they are kept "
                  "as NaN and the Gumbel/GEV fits treat them with the mixed (zero-year) model")
+        self._warn_censored_maxima(series, col)
         partial = [y for y in (years[:1] + years[-1:]) if self._coverage(y) < 0.999]
         if partial:
             warn(f"{self.source}: year(s) {sorted(set(partial))} are only partly covered by the record "
                  f"period {self.start} to {self.end}; their maxima may be low")
         return series
+
+    def _warn_censored_maxima(self, series: pd.Series, col: str) -> None:
+        """Warn about censored sizes that could set or change a year's maximum."""
+        cens = self.censored
+        if cens.empty:
+            return
+        cens = cens[cens["year"].notna()]
+        affected = []
+        for _, row in cens.iterrows():
+            year, value, kind = int(row["year"]), row[col], row["censoring"]
+            if year not in series.index:
+                continue
+            top = series.loc[year]
+            if np.isnan(top):
+                changes = True                      # the year has no exact size at all
+            elif kind == "unknown":
+                changes = False                     # no size recorded: nothing to compare
+            else:
+                changes = value > top or (kind == "above" and value >= top)
+            if changes:
+                affected.append(f"{year} ({row['size_text'] or 'no size'}, row {row['source_row']})")
+        if affected:
+            warn(f"{self.source}: {len(affected)} censored or missing size(s) could set or change their year's "
+                 f"maximum, which uses exact sizes only: {', '.join(affected[:8])}"
+                 f"{' ...' if len(affected) > 8 else ''}")
 
     def _coverage(self, year: int) -> float:
         if self.start is None or self.end is None:
@@ -211,9 +290,10 @@ class Inventory:
             "record period from": self.period_source,
             "events per year": round(self.n_events / self.duration_years, 3),
             "density [kg/m3]": f"{self.density_kg_m3:g}" + (" (default)" if self.density_is_default else ""),
-            "volume min / median / max [m3]": f"{v.min():.4g} / {np.median(v):.4g} / {v.max():.4g}",
-            "mass min / median / max [kg]": f"{m.min():.4g} / {np.median(m):.4g} / {m.max():.4g}",
+            "volume min / median / max [m3]": " / ".join(sig(x) for x in (v.min(), np.median(v), v.max())),
+            "mass min / median / max [kg]": " / ".join(sig(x) for x in (m.min(), np.median(m), m.max())),
             "dated": self.is_dated,
+            "censored or no size (not in the size fits)": self.n_censored,
         }
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
@@ -253,6 +333,32 @@ def _as_date(value, what: str) -> _dt.date:
         return _dt.date.fromisoformat(str(value))
     except ValueError as exc:
         raise ValueError(f"{what} = {value!r} is not a date (use YYYY-MM-DD)") from exc
+
+
+def _split_censored(raw: pd.Series) -> tuple[pd.Series, pd.Series]:
+    """Strip a censoring prefix (``<1``, ``>20``, ``~15``) from size cells.
+
+    Returns (text without the prefix, censoring): censoring is ``""`` (exact),
+    ``"below"``, ``"above"``, ``"approximate"`` or ``"unknown"`` (empty cell).
+    """
+    text = raw.astype(str).str.strip()
+    censoring = pd.Series("", index=raw.index, dtype=object)
+    censoring[text == ""] = "unknown"
+    # Only cells starting with a prefix character go through the (slow) extraction.
+    candidates = text.str.match(r"^(<|>|≤|≥|~|≈|ca)", case=False)
+    match = text[candidates].str.extract(_CENSORED_RE)
+    has_prefix = pd.Series(False, index=raw.index)
+    has_prefix[match.index] = match[0].notna()
+    if has_prefix.any():
+        hit = match[match[0].notna()]
+        censoring[hit.index] = hit[0].str.lower().map(CENSORING)
+        text = text.where(~has_prefix, match[1].reindex(text.index))
+    text = text.astype(object)
+    if raw.dtype == object and pd.api.types.infer_dtype(raw, skipna=True) not in ("string", "empty"):
+        # Excel number cells stay numbers: their decimal point is not text to interpret (riskrf.tables)
+        is_num = raw.map(lambda v: isinstance(v, (float, int, np.floating, np.integer)) and not isinstance(v, bool))
+        text[is_num] = raw[is_num]
+    return text, censoring
 
 
 def _parse_sizes(raw: pd.Series, path, col: str, rows: np.ndarray, decimal=None) -> pd.Series:
@@ -400,22 +506,27 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         unit = volume_unit or vunit or "m3"
         if unit not in _VOLUME_UNITS:
             raise ValueError(f"volume_unit = {volume_unit!r} is not one of {sorted(_VOLUME_UNITS)}")
-        volume = _parse_sizes(table[vcol], path, vcol, rows, decimal) * _VOLUME_UNITS[unit]
+        vtext, vcens = _split_censored(table[vcol])
+        volume = _parse_sizes(vtext, path, vcol, rows, decimal) * _VOLUME_UNITS[unit]
     if mcol is not None:
         unit = mass_unit or munit or "kg"
         if unit not in _MASS_UNITS:
             raise ValueError(f"mass_unit = {mass_unit!r} is not one of {sorted(_MASS_UNITS)}")
-        mass = _parse_sizes(table[mcol], path, mcol, rows, decimal) * _MASS_UNITS[unit]
+        mtext, mcens = _split_censored(table[mcol])
+        mass = _parse_sizes(mtext, path, mcol, rows, decimal) * _MASS_UNITS[unit]
     if vcol is None:
         volume = mass / density
-        size_column = "mass"
+        size_column, censoring, size_raw = "mass", mcens, table[mcol]
     elif mcol is None:
         mass = volume * density
-        size_column = "volume"
+        size_column, censoring, size_raw = "volume", vcens, table[vcol]
     else:
         size_column = "mass"
         volume = volume.fillna(mass / density)
         mass = mass.fillna(volume * density)
+        use_mass = mcens != "unknown"
+        censoring = mcens.where(use_mass, vcens)
+        size_raw = table[mcol].where(use_mass, table[vcol])
     if density_is_default:
         note(f"{path}: density not given; the default {DEFAULT_DENSITY_KG_M3:g} kg/m3 converts "
              f"{'volume to mass' if size_column == 'volume' else 'mass to volume'}")
@@ -430,13 +541,15 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         "location": table[lcol].astype(str) if lcol else "",
         "notes": table[ncol].astype(str) if ncol else "",
         "source_row": rows,
+        "censoring": censoring.to_numpy(dtype=object),
+        "size_text": size_raw.astype(str).str.strip().to_numpy(dtype=object),
     })
     missing = events["mass_kg"].isna()
     if missing.any():
         lines = events.loc[missing, "source_row"].tolist()
-        note(f"{path}: {len(lines)} row(s) have no size and are left out (rows "
-             f"{', '.join(map(str, lines[:12]))}{' ...' if len(lines) > 12 else ''})")
-        events = events.loc[~missing]
+        note(f"{path}: {len(lines)} row(s) have no size and are left out of the size fits (rows "
+             f"{', '.join(map(str, lines[:12]))}{' ...' if len(lines) > 12 else ''}); they are kept in "
+             "Inventory.censored and counted by rate models")
     events = _check_duplicates(events, table, path, duplicates, note)
 
     # Record period.
@@ -485,20 +598,30 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
                  f"out (rows {', '.join(map(str, lines[:12]))}{' ...' if len(lines) > 12 else ''})")
             events = events.loc[~outside]
     duration_years = check_positive(duration_years, "duration_years")
-    if not events.empty:
-        _check_plausible_sizes(events, path, vcol if vcol is not None else mcol, vcol is not None,
-                               # a unit in the column name counts as declared unless it is the default one:
-                               # litres typed into a 'volume_m3' column are exactly the mistake to catch
-                               (volume_unit or (vunit if vunit != "m3" else None)) if vcol is not None
-                               else (mass_unit or (munit if munit != "kg" else None)), duration_years,
-                               note)
+    is_cens = events["censoring"] != ""
+    censored = events.loc[is_cens].reset_index(drop=True)
+    bounded = censored[censored["censoring"] != "unknown"]
+    if not bounded.empty:
+        kinds = bounded["censoring"].value_counts()
+        lines = bounded["source_row"].tolist()
+        note(f"{path}: {len(bounded)} censored size(s) kept as censored, not used by the size fits (power law, "
+             f"annual maxima) but counted by rate models: "
+             + ", ".join(f"{int(kinds[k])} {k}" for k in ("below", "above", "approximate") if k in kinds)
+             + f" (rows {', '.join(map(str, lines[:12]))}{' ...' if len(lines) > 12 else ''})")
+    events = events.loc[~is_cens, _EVENT_COLUMNS]
     if events.empty:
-        raise ValueError(f"{path}: no usable events (every row lacked a size or lay outside the record period)")
+        raise ValueError(f"{path}: no usable events (every row lacked an exact size or lay outside the record "
+                         "period)")
     events = events.reset_index(drop=True)
+    _check_plausible_sizes(events, path, vcol if vcol is not None else mcol, vcol is not None,
+                           # a unit in the column name counts as declared unless it is the default one:
+                           # litres typed into a 'volume_m3' column are exactly the mistake to catch
+                           (volume_unit or (vunit if vunit != "m3" else None)) if vcol is not None
+                           else (mass_unit or (munit if munit != "kg" else None)), duration_years, note)
     return Inventory(events=events, duration_years=duration_years, start=start, end=end,
                      density_kg_m3=density, density_is_default=density_is_default, source=str(path),
                      period_source=period_source, size_column=size_column,
-                     site=str(sidecar.get("site", "")), notes=tuple(notes))
+                     site=str(sidecar.get("site", "")), notes=tuple(notes), censored=censored)
 
 
 def _line_list(lines, limit=12) -> str:

@@ -49,24 +49,21 @@ import numpy as np
 import pandas as pd
 
 from .annual_hazard import EnergyHazard
+from .barriers import damage_state_shares, out_of_service_share
 from .economics import pv_factor, renewal_factor
 from .impact_energy import mass_model
-from .measures import (Ditch, MeasureError, SimulationContext, effective_samples, material_value, road_crossings,
-                       runout_beyond, scenario_with_ditches, scenario_with_materials, seeder_share)
-from .power_law import GutenbergRichterFit
-from .road_risk import (
-    commuter_passage_probability,
-    commuter_strike_probability,
-    fn_zone,
-    occupancy_distribution,
-    occupant_fn,
-    spatial_temporal_probability,
-    stationary_rock_strike_probability,
-    vulnerability_by_mass,
+from .measures import (
+    Ditch,
+    MeasureError,
+    SimulationContext,
+    effective_samples,
+    material_value,
+    road_crossings,
+    runout_beyond,
+    scenario_with_ditches,
+    scenario_with_materials,
+    seeder_share,
 )
-from .barriers import damage_state_shares, out_of_service_share
-from .units import kinetic_energy_kj
-
 from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.mitigation)
     BARRIER_KINDS,
     DEFAULT_REPAIR_DAYS,
@@ -84,6 +81,19 @@ from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.mitigati
     parse_mitigation,
     parse_option,
 )
+from .power_law import GutenbergRichterFit
+from .report.format import probability
+from .road_risk import (
+    commuter_passage_probability,
+    commuter_strike_probability,
+    fn_zone,
+    occupancy_distribution,
+    occupant_fn,
+    spatial_temporal_probability,
+    stationary_rock_strike_probability,
+    vulnerability_by_mass,
+)
+from .units import kinetic_energy_kj
 
 
 @dataclass(frozen=True)
@@ -111,7 +121,7 @@ class OptionResult:
 class _Stage:
     """One element acting on the falls in series (see ``_chain``)."""
 
-    kind: str                  # "release", "ditch", "barrier", "exposure"
+    kind: str                  # "release", "ditch", "barrier", "exposure", "closure"
     option: str
     multiplier: np.ndarray | None = None      # release: per mass bin
     param: str | None = None                  # parameter holding a sampled retention / rate reduction
@@ -421,6 +431,9 @@ class MitigationStudy:
             if c.kind == "shed":
                 stages.append(self._barrier_stage(c))
         for c in comps:
+            if c.kind == "closure":
+                stages.append(_Stage("closure", c.name, param=f"closure_share:{c.name}"))
+        for c in comps:
             if c.kind == "realignment":
                 if c.road_x_m is None:
                     factor = np.zeros(len(self._models))
@@ -462,6 +475,8 @@ class MitigationStudy:
                 p[f"rate_reduction:{o.name}"] = o.rate_reduction
             if o.retention is not None:
                 p[f"retention:{o.name}"] = o.retention
+            if o.kind == "closure":
+                p[f"closure_share:{o.name}"] = o.share_while_closed
             if o.kind in BARRIER_KINDS:
                 p[f"repair_days:{o.name}"] = self._repair_days(o)
         for key, (ret, _, _, _) in self._derived.items():
@@ -574,7 +589,8 @@ class MitigationStudy:
         K = len(names)
         res = {k: np.zeros((S, K)) for k in ("capital", "pv_renewals", "pv_maintenance", "pv_expected_loss",
                                               "total", "road", "hits", "strikes", "deaths", "eal", "ir",
-                                              "repairs", "replacements", "retention", "effectiveness")}
+                                              "repairs", "replacements", "retention", "effectiveness",
+                                              "user_share")}
         road_bins = np.zeros((S, K, mid.size)) if per_bin else None
         base_road = arrivals.sum(axis=1) * road_share
         for k, opt in enumerate(self.options):
@@ -595,10 +611,14 @@ class MitigationStudy:
                 if c.life_years:
                     renew += kc * renewal_factor(c.life_years, ec.horizon_years, r)
             on_road = False
+            users = np.ones(S)          # share of falls meeting open road (a closure protects users only)
             for st in stages:
                 if st.after_road and not on_road:
                     x = x * road_share[:, None]
                     on_road = True
+                if st.kind == "closure":
+                    users = users * (1.0 - P[st.param])
+                    continue
                 if st.kind == "release":
                     x = x * (st.multiplier[None, :] if st.multiplier is not None else (1.0 - P[st.param])[:, None])
                     continue
@@ -633,12 +653,12 @@ class MitigationStudy:
                         stopped_by_structures = np.full(S, np.nan)
             else:
                 stopped_by_structures = np.full(S, np.nan)
-            hits = x * p_st[:, None]
-            strikes = x * p_strike[:, None]
+            hits = x * (p_st * users)[:, None]
+            strikes = x * (p_strike * users)[:, None]
             deaths = occ * ((hits * v_d).sum(axis=1) + (strikes * v_s).sum(axis=1))
             eal = deaths * P["value_of_statistical_life"] + (hits.sum(axis=1) + strikes.sum(axis=1)) \
                 * co.vehicle_damage + road * per_fall_cost
-            ir = (x * (p_ts * v_d + p_cs * v_s)).sum(axis=1)
+            ir = (x * (p_ts * v_d + p_cs * v_s)).sum(axis=1) * users
             pv_m = pvf * (maint + repair_money)
             pv_l = pvf * eal
             for key, val in (("capital", capital), ("pv_renewals", renew), ("pv_maintenance", pv_m),
@@ -649,6 +669,7 @@ class MitigationStudy:
                 res[key][:, k] = val
             with np.errstate(invalid="ignore", divide="ignore"):
                 res["effectiveness"][:, k] = np.where(base_road > 0, 1.0 - road / base_road, 0.0)
+            res["user_share"][:, k] = users
             if per_bin:
                 road_bins[:, k, :] = x
         res["names"] = names
@@ -712,7 +733,7 @@ class MitigationStudy:
         Ns = np.arange(1, int(kk.max()) + 1)
         c_hi, k_hi = HK_GEO_FN_LINES["unacceptable above"]
         a_d, a_s = share_with_at_least(r["v_d"], kk, pk), share_with_at_least(r["v_s"], kk, pk)   # (S, J, N)
-        x = r["road_bins"]                                             # (S, K, J)
+        x = r["road_bins"] * r["user_share"][:, :, None]               # (S, K, J) falls meeting open road
         F = np.einsum("skj,sjn->skn", x * r["p_st"][:, None, None], a_d) \
             + np.einsum("skj,sjn->skn", x * r["p_strike"][:, None, None], a_s)
         return ~np.any(F > c_hi / Ns[None, None, :] ** k_hi, axis=2)
@@ -724,7 +745,7 @@ class MitigationStudy:
         opt = self.option(option)
         r = self._central_result
         k = r["names"].index(opt.name)
-        x = r["road_bins"][0, k]
+        x = r["road_bins"][0, k] * r["user_share"][0, k]             # falls meeting open road
         freq = np.concatenate([x * r["p_st"][0], x * r["p_strike"][0]])
         vul = np.concatenate([r["v_d"][0], r["v_s"][0]])
         kk, pk = occupancy_distribution(self.exposure.occupants_per_vehicle, self.exposure.occupants_distribution)
@@ -801,7 +822,7 @@ class MitigationStudy:
         if len(ok):
             rec = ok.iloc[0]
             why = (f"{rec['option']} is the cheapest option that meets the tolerability criteria (individual risk "
-                   f"{rec['individual_risk']:.2g}/yr against {lim:.0e}/yr; societal risk {rec['fn_zone']} on the "
+                   f"{probability(rec['individual_risk'])}/yr against {probability(lim)}/yr; societal risk {rec['fn_zone']} on the "
                    f"{self.criteria.fn_diagram} F-N diagram). Its expected total cost is "
                    f"{rec['expected_total_cost']:,.0f} {cur} (5-95 %: {rec['cost_p05']:,.0f} to "
                    f"{rec['cost_p95']:,.0f} {cur}); it meets them in {rec['probability_meets_criteria']:.0%} of the "
@@ -811,7 +832,7 @@ class MitigationStudy:
                 why += (f" Cheaper options leave the risk intolerable: {cheapest['option']} costs least "
                         f"({cheapest['expected_total_cost']:,.0f} {cur}, the cheapest in "
                         f"{cheapest['probability_best']:.0%} of the joint samples) but leaves individual risk "
-                        f"{cheapest['individual_risk']:.2g}/yr and societal risk {cheapest['fn_zone']}"
+                        f"{probability(cheapest['individual_risk'])}/yr and societal risk {cheapest['fn_zone']}"
                         + (f"; so do {', '.join(intolerable['option'].iloc[1:])}" if len(intolerable) > 1 else "")
                         + f". Meeting the criteria costs "
                         f"{rec['expected_total_cost'] - cheapest['expected_total_cost']:,.0f} {cur} more in "
@@ -828,11 +849,11 @@ class MitigationStudy:
             else:
                 rec = cand.sort_values("deaths_avoided_per_million", ascending=False).iloc[0]
                 basis = "largest risk reduction per unit cost (no option meets the criteria)"
-                why = (f"No option meets the tolerability criteria (individual risk {lim:.0e}/yr and the F-N "
+                why = (f"No option meets the tolerability criteria (individual risk {probability(lim)}/yr and the F-N "
                        f"diagram). {rec['option']} reduces the risk most per unit cost: "
                        f"{rec['deaths_avoided_per_million']:.3g} statistical lives saved over "
                        f"{self.economics.horizon_years:g} years per million {cur} spent; residual individual risk "
-                       f"{rec['individual_risk']:.2g}/yr.")
+                       f"{probability(rec['individual_risk'])}/yr.")
         if "ASSUMPTION" in str(rec["effect_basis"]):
             why += f" Note: its effectiveness is typed, not derived ({rec['effect_basis']})."
         return {"option": str(rec["option"]), "basis": basis, "reason": why,
@@ -999,12 +1020,14 @@ class MitigationStudy:
             n_pv = pvf * road
             vd = float(np.dot(x, r["v_d"][0]) / road) if road > 0 else 0.0
             vs = float(np.dot(x, r["v_s"][0]) / road) if road > 0 else 0.0
+            u = float(r["user_share"][0, k])          # a closure: share of falls meeting open road
             outcomes = [
-                {"name": "vehicle hit", "probability": p_st,
+                {"name": "vehicle hit", "probability": p_st * u,
                  "cost": n_pv * (per_fall + co.vehicle_damage + occ * vd * co.value_of_statistical_life)},
-                {"name": "vehicle strikes rock on road", "probability": p_strike,
+                {"name": "vehicle strikes rock on road", "probability": p_strike * u,
                  "cost": n_pv * (per_fall + co.vehicle_damage + occ * vs * co.value_of_statistical_life)},
-                {"name": "closure and clean-up only", "probability": 1 - p_st - p_strike, "cost": n_pv * per_fall}]
+                {"name": "closure and clean-up only", "probability": 1 - (p_st + p_strike) * u,
+                 "cost": n_pv * per_fall}]
             branches.append({"name": opt.name, "cost": float(r["capital"][0, k] + r["pv_renewals"][0, k]
                                                              + r["pv_maintenance"][0, k]),
                              "child": {"type": "chance", "name": "each fall reaching the road",
@@ -1045,6 +1068,6 @@ def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0, **kw
             data = tomllib.load(fh)
         except tomllib.TOMLDecodeError as exc:
             raise MitigationError(f"{path}: not valid TOML: {exc}") from exc
-    data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard")}   # a site file works too
+    data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard", "design_block")}   # a site file works too
     return MitigationStudy(hazard=hazard, road_share=road_share, source=str(path), **study_inputs(data, str(path)),
                            **kw)

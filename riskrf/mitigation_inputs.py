@@ -19,7 +19,7 @@ from .road_risk import (
     occupancy_distribution,
 )
 
-OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "combined")
+OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "closure", "combined")
 BARRIER_KINDS = ("fence", "attenuator", "shed")
 #: Days a destroyed structure stays out of service (ASSUMPTION; override with ``repair_days``).
 DEFAULT_REPAIR_DAYS = {"fence": 30.0, "attenuator": 30.0, "shed": 180.0}
@@ -150,6 +150,9 @@ class Option:
     annual_maintenance_range: tuple | None = None
     retention_range: tuple | None = None
     rate_reduction_range: tuple | None = None
+    share_while_closed: float | None = None       # closure: share of falls while the road is closed
+    closure_hours_per_year: float | None = None   # closure: hours closed per year
+    cost_per_closure_hour: float = 0.0            # closure: cost of one hour of closure
     description: str = ""
 
     @property
@@ -189,6 +192,11 @@ class Option:
         elif k == "realignment":
             text = (f"road moved to x = {self.road_x_m:g} m" if self.road_x_m is not None
                     else "road moved away from the slope (no exposure)")
+        elif k == "closure":
+            text = (f"road closed {self.closure_hours_per_year:,.1f} h per year at {self.cost_per_closure_hour:,.0f} "
+                    f"per hour ({self.closure_hours_per_year * self.cost_per_closure_hour:,.0f} per year, in the "
+                    f"annual maintenance); {self.share_while_closed:.1%} of falls occur while closed (rate model); "
+                    "protects road users, falls still reach the road")
         else:
             text = "combination of " + " + ".join(self.options)
         return (self.description + ": " if self.description else "") + text
@@ -198,7 +206,7 @@ class Option:
 NUMBER_FIELDS = ("capital_cost", "annual_maintenance", "life_years", "repair_cost_per_impact", "replacement_cost",
                  "repair_days", "rate_reduction", "retention", "x_m", "width_m", "depth_m", "inner_slope_hv",
                  "outer_slope_hv", "capacity_kj", "height_m", "min_mass_kg", "max_mass_kg", "covered_length_m",
-                 "road_x_m")
+                 "road_x_m", "share_while_closed", "closure_hours_per_year", "cost_per_closure_hour")
 RANGE_FIELDS = ("capital_cost_range", "annual_maintenance_range", "retention_range", "rate_reduction_range",
                 "zone_x_m")
 
@@ -284,7 +292,21 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
         if key in spec:
             vals[key] = _range(spec[key], f"{source}: {where}: {key}",
                                share=key in ("retention_range", "rate_reduction_range"))
-    for key in ("rate_reduction", "retention"):
+    if kind == "closure":
+        for key in ("share_while_closed", "closure_hours_per_year"):
+            if spec.get(key) is None:
+                raise MitigationError(f"{source}: {where}: a closure needs {key} (riskrf.closure.closure_rule "
+                                      "gives both from a rate model: ClosureRule.option_spec)")
+        if spec["closure_hours_per_year"] > 8766:
+            raise MitigationError(f"{source}: {where}: closure_hours_per_year = {spec['closure_hours_per_year']!r} "
+                                  "exceeds the hours of a year (8766)")
+        vals["annual_maintenance"] = float(spec.get("annual_maintenance", 0.0)) + \
+            float(spec["closure_hours_per_year"]) * float(spec.get("cost_per_closure_hour", 0.0))
+    elif any(spec.get(k) is not None for k in ("share_while_closed", "closure_hours_per_year",
+                                                "cost_per_closure_hour")):
+        raise MitigationError(f"{source}: {where}: share_while_closed, closure_hours_per_year and "
+                              "cost_per_closure_hour are only for kind = 'closure'")
+    for key in ("rate_reduction", "retention", "share_while_closed"):
         if spec.get(key) is not None and spec[key] > 1:
             raise MitigationError(f"{source}: {where}: {key} = {spec[key]!r} is a share and must lie in [0, 1]")
     need = {"fence": ("capacity_kj", "height_m"), "attenuator": ("capacity_kj", "height_m"),

@@ -215,9 +215,11 @@ class PowerLawBootstrap:
 
     @property
     def p_stderr(self) -> float:
+        """Monte Carlo standard error of the bootstrap p-value, sqrt(p (1 - p) / completed replicates)."""
         return float(np.sqrt(self.p_value * (1 - self.p_value) / self.n_completed))
 
     def summary(self) -> pd.DataFrame:
+        """p-value, its Monte Carlo error, the KS statistic used and the replicates completed."""
         label = {"clauset": "Clauset et al. (2009) code: max |F(x_i) - (i-1)/n|",
                  "sup": "supremum distance of the empirical CDF (ties exact)"}[self.ks_statistic]
         rows = [("p_value", self.p_value, f"Monte Carlo SE {self.p_stderr:.3f}; > 0.1: power law plausible"),
@@ -294,6 +296,7 @@ class GutenbergRichterFit:
         return _truncated_sf(m, self.b, self.m_min, self.m_max)
 
     def cdf(self, m):
+        """P(M <= m) of the fitted law above m_min (truncated at m_max where given)."""
         return 1.0 - self.sf(m)
 
     def isf(self, p):
@@ -304,6 +307,7 @@ class GutenbergRichterFit:
         return _truncated_isf(p, self.b, self.m_min, self.m_max)
 
     def pdf(self, m):
+        """Probability density [1/kg] of the fitted law, zero outside its support."""
         m = np.asarray(m, dtype=float)
         inside = (m >= self.m_min) & (m <= (self.m_max if self.m_max is not None else np.inf))
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -317,6 +321,7 @@ class GutenbergRichterFit:
 
     @property
     def support(self) -> tuple:
+        """(m_min, m_max) in kg; m_max is infinite for the untruncated law."""
         return (self.m_min, self.m_max if self.m_max is not None else np.inf)
 
     # -- frequencies ---------------------------------------------------------------
@@ -426,7 +431,6 @@ class GutenbergRichterFit:
         completed.  Replicates use ``SeedSequence(seed).spawn`` so results do
         not depend on chunking.
         """
-        from ._power_law_kernels import ks_scan
 
         if self.method != "mle":
             raise ValueError(f"this fit has method = {self.method!r}: the bootstrap test needs a maximum-likelihood "

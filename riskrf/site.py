@@ -24,6 +24,7 @@ SITE_FIELDS = {
     "site": {"name": None, "description": ""},
     "inventory": {"path": None, "start": None, "end": None, "duration_years": None, "density_kg_m3": None,
                   "m_min_kg": None, "m_max_kg": None, "rate_scale": 1.0, "annual_maxima": None,
+                  "sizes": "event_volumes",
                   # reader options (README "Input formats"); None = the reader's rule or the sidecar's value
                   "sheet": None, "header_row": None, "encoding": None, "decimal": None, "date_format": None,
                   "volume_unit": None, "mass_unit": None, "duplicates": None, "volume_column": None,
@@ -31,7 +32,9 @@ SITE_FIELDS = {
     "hazard": {"scenario": None, "velocities": None, "collector": None, "road_collector": "road",
                "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
                "free_board_m": 0.5, "design_period_years": 100.0, "bootstrap": 300, "seed": 1,
-               "option_blocks": 20_000, "velocity_unit": None},
+               "option_blocks": 20_000, "mass_coupling": "simulated", "velocity_unit": None},
+    "design_block": {"rule": "return_period", "percentile": 97.0, "survey": None, "fractal_dimension": None,
+                     "iterations": None},
 }
 MITIGATION_TABLES = ("traffic", "consequences", "economics", "options", "uncertainty", "criteria")
 
@@ -45,6 +48,7 @@ class Site:
     hazard: dict
     mitigation: dict
     defaults_used: tuple = field(default_factory=tuple)
+    design_block: dict = field(default_factory=lambda: dict(SITE_FIELDS["design_block"]))
 
     def resolve(self, relative) -> Path:
         return (self.path.parent / relative).resolve()
@@ -131,8 +135,9 @@ def load_site(path) -> Site:
                         f"{inv['m_max_kg']!r}")
     if not isinstance(inv["rate_scale"], (int, float)) or not 0 < inv["rate_scale"] <= 1e6:
         raise SiteError(f"{path}: inventory.rate_scale = {inv['rate_scale']!r} must be a number > 0")
+    _check_design_block(tables, path)
     for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
-                       ("hazard", "velocities")):
+                       ("hazard", "velocities"), ("design_block", "survey")):
         rel = tables[table][key]
         if rel is not None and not (path.parent / rel).exists():
             raise SiteError(f"{path}: {table}.{key} = {rel!r}: file not found ({(path.parent / rel).resolve()})")
@@ -166,7 +171,37 @@ def load_site(path) -> Site:
         _check_option_geometry(mitigation["options"], scenario, hz, path, mitigation["uncertainty"])
     return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
                 description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
-                mitigation=mitigation, defaults_used=tuple(used))
+                mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"])
+
+
+def _check_design_block(tables, path):
+    """inventory.sizes, hazard.mass_coupling and the [design_block] table (rule, percentile, survey)."""
+    from .design_block import RULES, SIZES, check_percentile
+    inv, hz, db = tables["inventory"], tables["hazard"], tables["design_block"]
+    if inv["sizes"] not in SIZES:
+        raise SiteError(f"{path}: inventory.sizes = {inv['sizes']!r} must be one of {list(SIZES)} (what the "
+                        "inventory's volumes are: detached event volumes, or individual block sizes)")
+    if hz["mass_coupling"] not in ("simulated", "independent"):
+        raise SiteError(f"{path}: hazard.mass_coupling = {hz['mass_coupling']!r} must be 'simulated' (reach and "
+                        "speed by block mass, the default) or 'independent'")
+    if db["rule"] not in RULES:
+        raise SiteError(f"{path}: design_block.rule = {db['rule']!r} must be one of {list(RULES)}")
+    try:
+        db["percentile"] = check_percentile(db["percentile"], "design_block.percentile")
+    except (TypeError, ValueError) as exc:
+        raise SiteError(f"{path}: {exc}") from exc
+    fragmenting = db["fractal_dimension"] is not None or db["iterations"] is not None
+    if db["rule"] == "fragmentation" and not fragmenting:
+        raise SiteError(f"{path}: design_block.rule = 'fragmentation' needs design_block.fractal_dimension and "
+                        "design_block.iterations (the fragmentation parameters you assume)")
+    if fragmenting:
+        from .design_block import fractal_fragments
+        try:
+            fractal_fragments(1.0, db["fractal_dimension"], db["iterations"])
+        except (TypeError, ValueError) as exc:
+            raise SiteError(f"{path}: {exc}") from exc
+    if db["survey"] is not None and not isinstance(db["survey"], str):
+        raise SiteError(f"{path}: design_block.survey = {db['survey']!r} must be a file name")
 
 
 def _check_option_geometry(options, scenario, hz, path, uncertainty=None):

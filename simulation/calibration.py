@@ -454,7 +454,12 @@ def dump_toml(data: dict) -> str:
 
 
 def _current_value(data: dict, name: str):
-    node = data
+    """The value at dotted path ``name`` (material presets expanded), or nan when the scenario gives none."""
+    from .materials import PresetError, resolve_materials
+    try:
+        node = resolve_materials(data)
+    except PresetError:
+        node = data
     for key in name.split("."):
         if isinstance(node, list):
             node = {str(i.get("name")): i for i in node if isinstance(i, dict)}

@@ -34,14 +34,31 @@ def _material_arrays(scenario: Scenario):
         m_gain=np.array([m.allow_energy_gain for m in mats]))
 
 
-def seed_blocks(scenario: Scenario, n: int, seed) -> dict:
-    """Initial state of n blocks: position [m], velocity [m/s], spin [rad/s], mass [kg], radius [m], I/(m r^2)."""
+def check_masses(masses_kg, n=None) -> np.ndarray:
+    """Block masses [kg] given to :func:`run`: a 1-d array of finite values > 0 (n of them when n is given)."""
+    m = np.asarray(masses_kg, dtype=float)
+    if m.ndim != 1 or m.size == 0:
+        raise ValueError(f"masses_kg must be a non-empty 1-d array of masses [kg]; got shape {m.shape}")
+    bad = ~np.isfinite(m) | (m <= 0)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(f"masses_kg[{i}] = {float(m[i])!r}: block masses must be finite and > 0 kg")
+    if n is not None and m.size != n:
+        raise ValueError(f"masses_kg has {m.size} masses but n = {n}: give one mass per block (or n=None)")
+    return m
+
+
+def seed_blocks(scenario: Scenario, n: int, seed, masses_kg=None) -> dict:
+    """Initial state of n blocks: position [m], velocity [m/s], spin [rad/s], mass [kg], radius [m], I/(m r^2).
+
+    With ``masses_kg`` the blocks get those masses and the seeder's mass distribution is not used (the other
+    quantities are drawn exactly as without it, from the same streams)."""
     sd = scenario.seeder
     ss = np.random.SeedSequence(seed)
     g_x, g_h, g_m, g_vx, g_vz, g_w = (np.random.default_rng(c) for c in ss.spawn(6))
     x = g_x.uniform(sd.x_low, sd.x_high, n) if sd.x_high > sd.x_low else np.full(n, sd.x_low)
     h = sd.height_m.sample(g_h, n)
-    mass = sd.mass_kg.sample(g_m, n)
+    mass = sd.mass_kg.sample(g_m, n) if masses_kg is None else check_masses(masses_kg, n).copy()
     return {"x": x, "z": scenario.profile.ground(x) + h, "vx": sd.vx_ms.sample(g_vx, n),
             "vz": sd.vz_ms.sample(g_vz, n), "w": sd.angular_velocity_rads.sample(g_w, n),
             "mass": mass, "radius": sd.radius(mass), "inertia_factor": np.full(n, sd.inertia_factor)}
@@ -65,7 +82,7 @@ def _progress_bar(done: int, total: int, started: float, stream) -> None:
         stream.write("\n")
 
 
-def run(scenario: Scenario, n: int = 10_000, seed=None, *, chunk_size: int = DEFAULT_CHUNK,
+def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, chunk_size: int = DEFAULT_CHUNK,
         record_paths: int = 20, progress: bool | None = None) -> SimulationResult:
     """Simulate ``n`` blocks released by the scenario's seeder.
 
@@ -74,9 +91,13 @@ def run(scenario: Scenario, n: int = 10_000, seed=None, *, chunk_size: int = DEF
     scenario : Scenario
         From :func:`simulation.load_scenario`.
     n : int
-        Number of blocks (> 0).
+        Number of blocks (> 0; 10,000 when neither it nor ``masses_kg`` is given); with ``masses_kg`` it may be
+        left out (one block per mass) or must equal their number.
     seed : int, optional
         Random seed; the same seed gives identical results for any ``chunk_size``.
+    masses_kg : array, optional
+        The mass [kg] of each block (finite, > 0); the seeder's mass distribution is then ignored
+        (used to simulate across a mass model's whole range, e.g. ``riskrf.energy_hazard``).
     chunk_size : int
         Blocks per kernel call (memory bound; results do not depend on it).
     record_paths : int
@@ -84,6 +105,11 @@ def run(scenario: Scenario, n: int = 10_000, seed=None, *, chunk_size: int = DEF
     progress : bool, optional
         Show a progress bar on standard error (default: when n >= 200,000 and stderr is a terminal).
     """
+    if masses_kg is not None:
+        masses_kg = check_masses(masses_kg, None if n is None else n)
+        n = masses_kg.size
+    elif n is None:
+        n = 10_000
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
         raise ValueError(f"n must be a positive whole number of blocks; got {n!r}")
     if chunk_size <= 0:
@@ -92,7 +118,7 @@ def run(scenario: Scenario, n: int = 10_000, seed=None, *, chunk_size: int = DEF
     if progress is None:
         progress = n >= 200_000 and sys.stderr.isatty()
     key = np.random.SeedSequence(seed).generate_state(1, dtype=np.uint64)[0]
-    blocks = seed_blocks(scenario, n, seed)
+    blocks = seed_blocks(scenario, n, seed, masses_kg)
     prof = scenario.profile
     st = scenario.settings
     mats = _material_arrays(scenario)

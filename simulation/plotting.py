@@ -69,11 +69,18 @@ def plot_collector_distributions(result, name: str, axes=None):
             top.set_xscale("log")
         top.set_xlabel(label)
         top.set_ylabel("blocks")
-        p = 1.0 - np.arange(x.size) / x.size
-        bottom.step(x, p, where="post", color="C0")
+        # The exceedance curve at every block up to 2,000, else at 2,000 points spaced evenly in rank and
+        # in log-probability (the tail keeps its resolution; drawing 50,000 steps took 15 s for nothing).
+        idx = np.arange(x.size)
+        if x.size > 2000:
+            idx = np.unique(np.concatenate([np.linspace(0, x.size - 1, 1000),
+                                            x.size - np.geomspace(1, x.size, 1000)]).astype(int))
+        p = 1.0 - idx / x.size
+        xs = x[idx]
+        bottom.step(xs, p, where="post", color="C0")
         lo = np.clip(p - 1.96 * np.sqrt(p * (1 - p) / x.size), 1 / x.size / 10, 1)
         hi = np.clip(p + 1.96 * np.sqrt(p * (1 - p) / x.size), 0, 1)
-        bottom.fill_between(x, lo, hi, step="post", color="C0", alpha=0.2, label="95% Monte Carlo band")
+        bottom.fill_between(xs, lo, hi, step="post", color="C0", alpha=0.2, label="95% Monte Carlo band")
         bottom.set_yscale("log")
         if log:
             bottom.set_xscale("log")

@@ -22,6 +22,11 @@ def wilson_interval(k, n, level: float = 0.95):
     return np.clip(centre - half, 0, 1), np.clip(centre + half, 0, 1)
 
 
+
+def _three_figures(v: float) -> str:
+    """Three significant figures without exponent notation: 1,070 not 1.07e+03."""
+    return f"{v:,.0f}" if abs(v) >= 100 else f"{v:.3g}"
+
 @dataclass(frozen=True)
 class SimulationResult:
     """Everything a run produced.  Units: m, m/s, rad/s, kg, kJ, s."""
@@ -106,6 +111,7 @@ class SimulationResult:
 
     @property
     def n_impacts(self) -> int:
+        """Total number of ground impacts over all blocks."""
         return int(self.per_block["impacts"].sum())
 
     # ---- envelopes and paths -----------------------------------------------------
@@ -195,7 +201,7 @@ class SimulationResult:
             if len(df):
                 for col, unit in (("velocity_ms", "m/s"), ("height_m", "m"), ("energy_kj", "kJ")):
                     q = np.percentile(df[col], [50, 95, 99])
-                    rows[f"{c.name}: {col} p50/p95/p99 [{unit}]"] = " / ".join(f"{v:.3g}" for v in q)
+                    rows[f"{c.name}: {col} p50/p95/p99 [{unit}]"] = " / ".join(_three_figures(v) for v in q)
                 if c.is_barrier:
                     rows[f"{c.name}: outcomes"] = ", ".join(f"{k} {v}" for k, v in
                                                            df["outcome"].value_counts().items() if v)

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
+from .materials import PresetError, resolve_material
 from .impact import EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_FRICTION
 from .slope import Profile
 from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2
@@ -149,8 +150,15 @@ class Material:
     @classmethod
     def parse(cls, name: str, spec: dict, source: str) -> "Material":
         where = f"materials.{name}."
-        _check_keys(spec, {"normal_restitution", "tangential", "roughness_m", "ground_motion",
+        if not isinstance(spec, dict):
+            raise ScenarioError(f"{source}: materials.{name} must be a table of material fields; got {spec!r}")
+        _check_keys(spec, {"preset", "normal_restitution", "tangential", "roughness_m", "ground_motion",
                            "ground_friction_angle_deg", "allow_energy_gain"}, where, source)
+        if "preset" in spec:            # a named material from published ranges (simulation.materials)
+            try:
+                spec = resolve_material(spec, f"materials.{name}", source)
+            except PresetError as exc:
+                raise ScenarioError(str(exc)) from None
         gain = bool(spec.get("allow_energy_gain", False))
         en_max = 10.0 if gain else 1.0
         en = spec.get("normal_restitution", {"law": "wyllie"})
@@ -166,6 +174,10 @@ class Material:
             raise ScenarioError(f"{source}: {where}normal_restitution.law = {en.get('law')!r} is not one of "
                                 f"{sorted(laws)}")
         en_law = laws[en.get("law", "constant")]
+        if en_law == EN_WYLLIE and "mean" in en:
+            raise ScenarioError(f"{source}: {where}normal_restitution.mean = {en['mean']!r} is not used by "
+                                "law 'wyllie' (the law gives e_N from the impact angle; 'std' sets its spread); "
+                                "set law = 'constant' to give a mean")
         en_mean = 0.0 if en_law == EN_WYLLIE else _number(en.get("mean"), f"{where}normal_restitution.mean",
                                                            source, lo=0.0, hi=en_max)
         en_std = _number(en.get("std", 0.0), f"{where}normal_restitution.std", source, lo=0.0, hi=1.0)

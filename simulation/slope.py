@@ -31,6 +31,7 @@ class Profile:
 
     @classmethod
     def build(cls, x, z, material_index, material_names, source: str = "profile") -> "Profile":
+        """Profile from vertex coordinates [m] and per-segment material indices, checked (x strictly increasing)."""
         x = np.asarray(x, dtype=float)
         z = np.asarray(z, dtype=float)
         mi = np.asarray(material_index, dtype=np.int64)
@@ -81,6 +82,7 @@ class Profile:
 
     @property
     def n_segments(self) -> int:
+        """Number of straight segments."""
         return self.x.size - 1
 
     def ground(self, x) -> np.ndarray:
@@ -92,4 +94,5 @@ class Profile:
         return np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, self.n_segments - 1)
 
     def contains(self, x) -> bool:
+        """Whether abscissa ``x`` [m] lies within the profile."""
         return bool(self.x[0] <= x <= self.x[-1])

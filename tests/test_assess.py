@@ -8,7 +8,6 @@ import pytest
 import riskrf
 import simulation
 from riskrf.cli import main
-from riskrf.annual_hazard import EnergyHazard
 from riskrf.site import load_site
 
 from .conftest import ROOT
@@ -23,7 +22,7 @@ def _site_copy(tmp_path, replace=None, drop=None):
     """The demo site with absolute paths, optionally edited, in tmp_path."""
     text = SITE.read_text()
     data_dir = SITE.parent
-    for rel in ("lauterbrunnen_tls_2018.csv", "synthetic_corridor_1985_2024.csv",
+    for rel in ("lauterbrunnen_tls_2018.csv", "synthetic_corridor_1985_2024.csv", "hong_kong_rock_cuts_1984_2020.csv",
                 "../../simulation/scenarios/road_cut_barrier.toml"):
         text = text.replace(f'"{rel}"', f'"{(data_dir / rel).resolve()}"')
     text = text.replace("n_blocks = 50000", "n_blocks = 6000").replace("bootstrap = 200", "bootstrap = 40")
@@ -67,15 +66,64 @@ def test_summary_matches_the_modules(assessed):
     # The hazard from the same seeded simulation, built directly with the modules:
     grt = riskrf.fit_gutenberg_richter(inv, m_max=2.0e6)
     sc = simulation.load_scenario(ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml")
-    res = simulation.run(sc, n=6000, seed=1)
-    hz = EnergyHazard.from_simulation(grt, res, "barrier", rate_per_year=0.05 * grt.rate_min)
-    assert s["hazard"]["arrivals_per_year"] == pytest.approx(hz.arrival_rate)
+    # mass-coupled (the default): simulated over m_min to the largest m_max of the sensitivity study (4,000 t)
+    hz = riskrf.energy_hazard(grt, sc, "barrier", rate_per_year=0.05 * grt.rate_min, n=6000, seed=1,
+                              design_masses_kg=[4.0e6])
+    assert s["hazard"]["mass_coupled"] and s["hazard"]["arrivals_per_year"] == pytest.approx(hz.arrival_rate)
     e = {row["T_years"]: row["energy_kj"] for row in s["design_energies"]}
     np.testing.assert_allclose([e[100.0], e[300.0]], hz.energy_at_return_period([100, 300]), rtol=1e-9)
     assert s["hazard"]["energy_p95_kj"] == pytest.approx(hz.energy_percentile(95)[0], rel=1e-9)
     assert s["units"]["energy"] == "kJ" and s["units"]["money"] == "CHF"
     assert s["best_option"] == s["ranking"][0]["option"]
     assert "annual_maxima" in s and s["annual_maxima"]["deviance_test"]["p_value"] < 0.05
+    assert "hong_kong_rock_cuts" in s["annual_maxima"]["source"]          # the real record, not the synthetic one
+    assert s["annual_maxima"]["preferred_model"]["model"] == "power law"  # GEV xi = 1.71: implausible
+
+
+def test_design_block_site_masses_and_sensitivity_in_outputs(assessed):
+    """Issue 10: the site's own design masses (never above m_max), the design block with its alternatives and the
+    assumption behind it, the sensitivity to m_max and rate share, and what the interval covers."""
+    site, out = assessed
+    s = json.loads((out / "summary.json").read_text())
+    m_max = s["hazard"]["power_law_for_hazard"]["m_max_kg"]
+    assert all(r["source_mass_kg"] <= m_max and r["line_mass_kg"] <= m_max for r in s["site_design_masses"])
+    block = s["design_block"]
+    assert block["rule"] == "percentile" and any("EVENT volumes" in a for a in block["assumptions"])
+    inv = riskrf.read_inventory(SITE.parent / "lauterbrunnen_tls_2018.csv")
+    assert block["volume_m3"] == pytest.approx(np.percentile(inv.masses / inv.density_kg_m3, 97))
+    assert {"percentile p95", "percentile p98", "return period 100 yr at the source",
+            "fragmentation of the 100-yr event, p97"} <= {r["rule"] for r in block["alternatives"]}
+    assert all(r["mass_kg"] <= m_max for r in block["alternatives"])
+    sens = s["design_energy_sensitivity"]
+    assert {r["m_max_kg"] for r in sens} == {1e6, 2e6, 4e6} and {r["rate_share"] for r in sens} == {0.025, 0.05, 0.1}
+    central = [r["energy_kj"] for r in sens if r["m_max_kg"] == 2e6 and r["rate_share"] == 0.05][0]
+    e100 = [r["energy_kj"] for r in s["design_energies"] if r["T_years"] == 100.0][0]
+    assert central == pytest.approx(e100, rel=1e-6)
+    assert "NOT the maximum credible block" in s["design_energy_interval_covers"]
+    html = (out / "report.html").read_text()
+    for text in ("Design block", "Sensitivity of the 100-year energy", "Design masses of the site",
+                 "whole monitored wall", "EVENT volumes", "Reach, speed and bounce height by block mass"):
+        assert text in html, text
+    assert (out / "design_energy_sensitivity.csv").exists() and (out / "design_block.csv").exists()
+    assert (out / "figures" / "design_energy_sensitivity.png").exists()
+
+
+@pytest.mark.parametrize("edit, match", [
+    ({"percentile = 97\n": "percentile = 100\n"}, "design_block.percentile = 100"),
+    ({"percentile = 97\n": "percentile = 0\n"}, "design_block.percentile = 0"),
+    ({'rule = "percentile"': 'rule = "fragments"'}, "design_block.rule = 'fragments'"),
+    ({'sizes = "event_volumes"': 'sizes = "events"'}, "inventory.sizes = 'events'"),
+    ({'mass_coupling = "simulated"': 'mass_coupling = "yes"'}, "hazard.mass_coupling = 'yes'"),
+    ({"percentile = 97\n": 'percentile = 97\nsurvey = "nowhere.csv"\n'}, "design_block.survey = 'nowhere.csv'"),
+    ({"fractal_dimension = 2.5": "fractal_dimension = 3.2"}, "design_block.fractal_dimension = 3.2"),
+    ({"iterations = 3": "iterations = 0"}, "design_block.iterations = 0"),
+    ({'rule = "percentile"': 'rule = "fragmentation"', "fractal_dimension = 2.5\n": "", "iterations = 3\n": ""},
+     "needs design_block.fractal_dimension and design_block.iterations"),
+])
+def test_design_block_site_fields_are_checked(tmp_path, edit, match):
+    from riskrf.site import SiteError
+    with pytest.raises(SiteError, match=match):
+        load_site(_site_copy(tmp_path, replace=edit))
 
 
 def test_copied_inputs_rerun_to_the_same_numbers(assessed, tmp_path):
@@ -90,7 +138,14 @@ def test_copied_inputs_rerun_to_the_same_numbers(assessed, tmp_path):
 
 
 def test_report_in_headless_chromium(assessed):
-    """Open report.html in a real browser: no console errors, every figure has a size, save a screenshot."""
+    """Open report.html in a real browser at 1,400 and 400 px and print it to PDF.
+
+    No console errors, every figure has a size, no horizontal scroll on a phone, no absolute path of
+    the machine and no Python exponent notation in the text; screenshots and the PDF are kept in
+    tests/artifacts/ for a person to look at.
+    """
+    import base64
+    import re
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
     driver_path = shutil.which("chromedriver")
     if not chromium or not driver_path:
@@ -102,10 +157,11 @@ def test_report_in_headless_chromium(assessed):
     opts = webdriver.ChromeOptions()
     opts.binary_location = chromium
     for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-                "--disable-component-update", "--disable-sync", "--no-first-run", "--window-size=1280,2000"):
+                "--disable-component-update", "--disable-sync", "--no-first-run", "--window-size=1400,2000"):
         opts.add_argument(arg)
     opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     driver = webdriver.Chrome(service=Service(driver_path), options=opts)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
     try:
         driver.get((out / "report.html").resolve().as_uri())
         assert "rock fall hazard and mitigation" in driver.title
@@ -116,9 +172,20 @@ def test_report_in_headless_chromium(assessed):
         assert all(c and w > 0 and h > 0 and rw > 0 and rh > 0 for c, w, h, rw, rh in sizes), sizes
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
         assert errors == []
-        ARTIFACTS.mkdir(parents=True, exist_ok=True)
-        driver.save_screenshot(str(ARTIFACTS / "report.png"))
-        assert (ARTIFACTS / "report.png").stat().st_size > 10_000
+        text = driver.execute_script("return document.body.innerText;")
+        assert not re.search(r"\d\.\d+e[+-]\d\d", text), re.findall(r".{30}\d\.\d+e[+-]\d\d.{10}", text)
+        assert str(ROOT) not in text and "/home/" not in text and "/tmp/" not in text
+        assert "Table 1." in text and "Figure 1." in text and "Contents" in text
+        driver.save_screenshot(str(ARTIFACTS / "report_1400px.png"))
+        driver.set_window_size(400, 900)
+        overflow = driver.execute_script("return document.documentElement.scrollWidth - window.innerWidth;")
+        assert overflow <= 0, f"horizontal scroll of {overflow} px at 400 px"
+        driver.save_screenshot(str(ARTIFACTS / "report_400px.png"))
+        pdf = base64.b64decode(driver.print_page())
+        (ARTIFACTS / "report.pdf").write_bytes(pdf)
+        assert pdf[:5] == b"%PDF-" and len(pdf) > 50_000
+        for name in ("report_1400px.png", "report_400px.png"):
+            assert (ARTIFACTS / name).stat().st_size > 10_000
     finally:
         driver.quit()
 

@@ -189,3 +189,25 @@ def test_energy_never_increases_between_events(z, en, et, phi, law, tangential, 
         e = res.events(b)["total_energy_kj"].to_numpy()
         scale = max(np.abs(e).max(), 1.0)
         assert np.all(np.diff(e) <= 1e-9 * scale), res.events(b).to_string()
+
+
+def test_take_off_flight_is_drawn_as_a_parabola():
+    """A block rolling over a convex edge takes off; path() between take-off and the next impact is the
+    exact parabola from the take-off state (it was drawn as a straight line)."""
+    sc = scenario([0, 10, 30], [10, 9, 0], material={"ground_motion": "roll", "ground_friction_angle_deg": 1.0},
+                  seeder={"x": 0.5, "height_m": 0.0, "vx_ms": 15.0})
+    res = simulation.run(sc, n=1, seed=1, record_paths=1)
+    ev = res.events(0)
+    takeoffs = ev.index[ev["event"] == "take-off"]
+    assert len(takeoffs) >= 1
+    i = takeoffs[0]
+    t0, x0, z0, vx, vz = ev.loc[i, ["t_s", "x_m", "z_m", "vx_ms", "vz_ms"]]
+    x1 = ev.loc[i + 1, "x_m"]
+    path = res.path(0, dt=0.005)
+    inside = path[(path["x_m"] > x0 + 1e-6) & (path["x_m"] < x1 - 1e-6)]
+    assert len(inside) >= 5
+    tt = (inside["x_m"] - x0) / vx
+    np.testing.assert_allclose(inside["z_m"], z0 + vz * tt - 0.5 * G * tt ** 2, atol=1e-9)
+    # and it is not the chord between the two events
+    chord = z0 + (ev.loc[i + 1, "z_m"] - z0) * (inside["x_m"] - x0) / (x1 - x0)
+    assert np.max(np.abs(inside["z_m"] - chord)) > 0.05

@@ -60,7 +60,7 @@ def test_synthetic_corridor_keeps_empty_years_as_nan_and_warns():
 
 
 def test_bundled_demo_data_are_the_documented_inventories():
-    for name in ("lauterbrunnen_tls_2018", "synthetic_corridor_1985_2024"):
+    for name in ("lauterbrunnen_tls_2018", "synthetic_corridor_1985_2024", "hong_kong_rock_cuts_1984_2020"):
         for ext in ("csv", "toml"):
             shipped = ROOT / "riskrf" / "data" / f"{name}.{ext}"
             source = next(INVENTORIES.rglob(f"{name}.{ext}"))

@@ -280,6 +280,7 @@ def test_site_file_geometry_errors_before_computing(tmp_path):
     site = tmp_path / "site.toml"
     site.write_text(bad.replace('"lauterbrunnen', f'"{ROOT}/riskrf/data/lauterbrunnen').replace(
         '"synthetic_corridor', f'"{ROOT}/riskrf/data/synthetic_corridor').replace(
+        '"hong_kong_rock_cuts', f'"{ROOT}/riskrf/data/hong_kong_rock_cuts').replace(
         '"../../simulation', f'"{ROOT}/simulation'))
     with pytest.raises(SiteError, match="option 'catch ditch': x_m = 128 m with width_m = 8 m spans 128-136 m, "
                                         "outside the profile"):
@@ -438,3 +439,13 @@ def test_property_structures_only_remove_falls_and_combinations_compose(cap, hei
     # scaling acts on the release only, so the fence in series sees (1 - rr) of the falls
     assert scale == pytest.approx(none * (1 - rr), rel=1e-9, abs=1e-15)
     assert s.uncertain["probability_best"].sum() == pytest.approx(1.0)
+
+
+def test_damage_state_shares_with_no_arrivals_are_zero_not_nan():
+    """A slope model (material draw) in which no simulated block reaches the road gave a nan expected cost for the
+    rock shed (np.mean over no falls); the shares of no falls multiply a zero arrival rate and are 0."""
+    from riskrf.barriers import damage_state_shares
+    passing, held, destroyed = damage_state_shares(np.zeros((0, 4)), np.zeros(0, dtype=bool), 1000.0)
+    assert passing.shape == (4,) and not np.isnan(passing).any() and not held.any() and not destroyed.any()
+    p, h, d = damage_state_shares(np.array([[500.0], [2000.0]]), np.array([False, False]), 1000.0)
+    assert (p[0], h[0], d[0]) == (0.5, 0.5, 0.5)          # SEL = 333 kJ: 500 held for repair, 2000 through

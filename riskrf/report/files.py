@@ -50,6 +50,11 @@ def write_energy_figures(analysis, out: Path, fence_capacities_kj) -> list[Path]
     ax = plot_mass_velocity(analysis.hazard, seed=analysis.seed)
     ax.set_title("Mass and velocity of arriving falls")
     written.append(save_figure(ax.figure, out / "mass_velocity.png"))
+    if getattr(analysis, "sensitivity", None) is not None and len(analysis.sensitivity):
+        from .fit_figures import plot_design_energy_sensitivity
+        ax = plot_design_energy_sensitivity(analysis.sensitivity)
+        ax.set_title("Design energy over the judgement inputs")
+        written.append(save_figure(ax.figure, out / "design_energy_sensitivity.png"))
     return written
 
 

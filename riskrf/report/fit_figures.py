@@ -146,9 +146,15 @@ def plot_mass_velocity(hazard, ax=None, *, energies=(100, 500, 1000, 2000, 5000,
     rng = np.random.default_rng(seed)
     m = mass_model(hazard.mass).rvs(n_points, rng)
     v = hazard.velocity
-    if hasattr(v, "velocity_ms"):
+    vs = None
+    if getattr(hazard, "mass_coupled", False):     # simulated (mass, speed) pairs: speed depends on mass
+        pick = rng.integers(0, v.velocity_ms.size, n_points)
+        m, vs = v.arriving_mass_kg[pick], v.velocity_ms[pick]
+    elif hasattr(v, "velocity_ms"):
         v = v.velocity_ms
-    if hasattr(v, "rvs"):
+    if vs is not None:
+        pass
+    elif hasattr(v, "rvs"):
         vs = np.abs(v.rvs(size=n_points, random_state=rng))
     elif hasattr(v, "dist"):
         vs = np.abs(v.dist.rvs(size=n_points, random_state=rng))
@@ -164,4 +170,22 @@ def plot_mass_velocity(hazard, ax=None, *, energies=(100, 500, 1000, 2000, 5000,
     ax.set_ylabel("block mass [kg]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize="x-small", title="E = ½ m v²", ncol=2)
+    return ax
+
+
+def plot_design_energy_sensitivity(table, ax=None):
+    """The T-year energy [kJ] against the rate share, one line per maximum credible block m_max
+    (a table from :func:`riskrf.energy_study.design_energy_sensitivity`)."""
+    ax = _axes(ax)
+    for i, (m_max, g) in enumerate(table.groupby("m_max_kg")):
+        g = g.sort_values("rate_share")
+        label = f"m_max {m_max / 1000:,.4g} t" if np.isfinite(m_max) else "no m_max"
+        ax.plot(g["rate_share"], g["energy_kj"], "o-", color=f"C{i}", label=label)
+    T = float(table["T_years"].iloc[0])
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("rate share of the source above the line [-]")
+    ax.set_ylabel(f"{T:g}-year impact energy [kJ]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="small", title="judgement inputs")
     return ax

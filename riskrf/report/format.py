@@ -137,16 +137,20 @@ class Document:
 
     @property
     def next_table(self) -> str:
+        """Label of the next table to be added, for references in the text."""
         return f"Table {self.n_tables + 1}"
 
     @property
     def next_figure(self) -> str:
+        """Label of the next figure to be added, for references in the text."""
         return f"Figure {self.n_figures + 1}"
 
     def add(self, *fragments: str) -> None:
+        """Append HTML fragments (empty ones are skipped)."""
         self.parts.extend(f for f in fragments if f)
 
     def section(self, title: str) -> None:
+        """Start numbered section ``title`` (listed in the table of contents)."""
         number = len(self.sections) + 1
         anchor = f"s{number}"
         self.sections.append((anchor, f"{number}. {title}"))

@@ -40,20 +40,16 @@ from simulation.profile_extraction import profile_from_points, read_stl  # noqa:
 #: Substrate zones of the source (SOURCE_README "Digital Terrain Model") -> scenario material names.
 ZONES = {"Blue": "vegetated_slope", "Gray": "hard_ground", "Red": "rocky_slope"}
 
-#: A-priori materials before calibration (ranges of Wyllie 2014 ch. 2 and Table 5.x / RocFall
-#: default coefficient tables; a vegetated soil slope is soft and absorbing, the gray zone is hard
-#: rock walls and compacted benches, the red zone a rocky slope).  ASSUMPTIONS, labelled as such in
-#: the scenario description; ``riskrf calibrate`` fits them to the observed stops.
+#: A-priori materials before calibration: the presets of simulation/materials.py (published ranges; see the
+#: README "Material presets").  The blue zone is a vegetated soil slope ("soil"), the red zone a rocky slope
+#: ("talus").  The gray zone is "vertical rock walls and horizontal sturdy soil": the "bedrock" preset, with
+#: Wyllie's tangential coefficient of natural ground (e_T 0.3-0.8, as the other natural-ground presets) because
+#: its benches are compacted soil.  ASSUMPTIONS, labelled as such in the scenario description;
+#: ``riskrf calibrate`` fits them to the observed stops.
 MATERIALS = {
-    "vegetated_slope": {"normal_restitution": {"law": "constant", "mean": 0.30, "std": 0.05},
-                        "tangential": {"law": "friction", "friction_angle_deg": 35.0, "std_deg": 3.0},
-                        "roughness_m": 0.2, "ground_motion": "roll", "ground_friction_angle_deg": 30.0},
-    "hard_ground": {"normal_restitution": {"law": "constant", "mean": 0.45, "std": 0.05},
-                    "tangential": {"law": "friction", "friction_angle_deg": 30.0, "std_deg": 3.0},
-                    "roughness_m": 0.1, "ground_motion": "roll", "ground_friction_angle_deg": 20.0},
-    "rocky_slope": {"normal_restitution": {"law": "constant", "mean": 0.35, "std": 0.05},
-                    "tangential": {"law": "friction", "friction_angle_deg": 32.0, "std_deg": 3.0},
-                    "roughness_m": 0.3, "ground_motion": "roll", "ground_friction_angle_deg": 30.0},
+    "vegetated_slope": {"preset": "soil"},
+    "hard_ground": {"preset": "bedrock", "tangential": {"law": "constant", "mean": 0.55, "std": 0.12}},
+    "rocky_slope": {"preset": "talus"},
 }
 CITATION = ("Garcia, Villard, Richefeu, Daudon (2022) Engineering Geology 310:106855; data: "
             "richefeu/AuthumeQuarryRockfalls_Data-in-Brief f695c933 (no licence file; derived profile and "
@@ -127,7 +123,7 @@ def build(raw: Path, out_dir: Path = HERE, data_dir: Path = REPO / "tests" / "da
         lines += [f"x = {_toml_value(d['x'])}", f"z = {_toml_value(d['z'])}",
                   f"materials = {_toml_value(d['materials'])}", ""]
         for m in used:
-            lines.append(f"[materials.{m}]   # zone {[k for k, v in ZONES.items() if v == m][0]}; a-priori values")
+            lines.append(f"[materials.{m}]   # zone {[k for k, v in ZONES.items() if v == m][0]}; a-priori: preset")
             lines += [f"{k} = {_toml_value(v)}" for k, v in MATERIALS[m].items()]
             lines.append("")
         lines += ["[seeder]", 'type = "point"', "x = 0.0", f"height_m = {drop_h:.3f}",

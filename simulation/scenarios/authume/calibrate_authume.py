@@ -33,12 +33,13 @@ sys.path.insert(0, str(REPO))
 import simulation  # noqa: E402
 from simulation.calibration import apply_parameters, scenario_dict  # noqa: E402
 
-#: Fitted on both profiles (substrates present on both).  Bounds: published ranges, widened
-#: (restitution 0.05-0.7, rolling-friction angles 5-50 deg).
+#: Fitted on both profiles (substrates present on both).  A-priori values: the presets (soil for the vegetated
+#: slope, bedrock with Wyllie's e_T for the hard ground).  Bounds: published ranges, widened (rolling-resistance
+#: angles 3-50 deg; e_T 0.2-1.0 around Wyllie's 0.3-0.8).
 PARAMETERS = {
-    "materials.hard_ground.normal_restitution.mean": (0.05, 0.7),
+    "materials.vegetated_slope.ground_friction_angle_deg": (3.0, 45.0),
+    "materials.vegetated_slope.tangential.mean": (0.2, 1.0),
     "materials.hard_ground.ground_friction_angle_deg": (5.0, 50.0),
-    "materials.vegetated_slope.ground_friction_angle_deg": (5.0, 50.0),
 }
 OBSERVED = REPO / "tests" / "data" / "authume" / "observed_runout.csv"
 

@@ -1,0 +1,266 @@
+"""Corridor: validation before work, generated cuts, identical results on 1 and 2 dask workers and serially,
+resume, failures, unreachable scheduler.  Small: 3 sections x 300 blocks."""
+import shutil
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+distributed = pytest.importorskip("distributed")
+
+from riskrf import corridor as cr  # noqa: E402
+from riskrf.cli import main  # noqa: E402
+
+DATA = Path(__file__).resolve().parent / "data" / "corridor"
+N = 300
+
+
+@pytest.fixture(scope="module")
+def corridor():
+    return cr.load_corridor(DATA / "small.toml")
+
+
+def _client(n):
+    cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=False, dashboard_address=":0")
+    return distributed.Client(cluster), cluster
+
+
+@pytest.fixture(scope="module")
+def clients():
+    """Threaded local clusters of 1 and 2 workers, shared by the tests of this module."""
+    made = {n: _client(n) for n in (1, 2)}
+    yield {n: c for n, (c, _) in made.items()}
+    for client, cluster in made.values():
+        client.close()
+        cluster.close()
+
+
+@pytest.fixture(scope="module")
+def runs(corridor, clients):
+    """The same corridor serially, on 1 worker and on 2 workers."""
+    out = {"serial": pd.DataFrame([cr.assess_section(s, corridor, N) for s in corridor.sections])}
+    for n in (1, 2):
+        out[n] = cr.run_corridor(corridor, client=clients[n], n_blocks=N)
+    return out
+
+
+def _comparable(df):
+    return df.drop(columns=["seconds"]).sort_values("id").reset_index(drop=True)
+
+
+def test_one_and_two_workers_equal_serial(runs):
+    ref = _comparable(runs["serial"])
+    for n in (1, 2):
+        pd.testing.assert_frame_equal(_comparable(runs[n].table), ref, check_exact=True)
+    assert runs[2].workers == 2 and runs[1].workers == 1
+
+
+def test_rates_and_ranking(runs, corridor):
+    t = runs[2].table
+    # rate_basis "road": the recorded rate is falls reaching the road, so the do-nothing road falls equal it
+    np.testing.assert_allclose(t["road_falls_per_year"], t["rate_given_per_year"], rtol=1e-9)
+    np.testing.assert_allclose(t["release_falls_per_year"] * t["reach_road"], t["rate_given_per_year"], rtol=1e-12)
+    s = runs[2].summary()
+    assert list(s["rank_risk"]) == sorted(s["rank_risk"])
+    assert s["deaths_per_year"].is_monotonic_decreasing
+    assert (s["rank_difference"] == s["rank_rhrs"] - s["rank_risk"]).all()
+    # RHRS total of each section equals the sum of its category scores (per-row derivation from the table)
+    for sec in corridor.sections:
+        assert t.set_index("id").loc[sec.id, "rhrs_score"] == pytest.approx(sum(sec.rating.scores.values()))
+    b = runs[2].budget_curve()
+    assert b["cumulative_spend"].is_monotonic_increasing
+    ratio = b["deaths_avoided_per_year"] / b["spend"]
+    assert ratio.is_monotonic_decreasing
+
+
+def test_seed_depends_on_id_not_order(corridor):
+    a = cr._section_seed(7, "A")
+    assert a == cr._section_seed(7, "A") and a != cr._section_seed(7, "B") and a != cr._section_seed(8, "A")
+    # the child SeedSequence(seed).spawn would give at key crc32(id)
+    import zlib
+    child = np.random.SeedSequence(7, spawn_key=(zlib.crc32(b"A"),))
+    assert a == int(child.generate_state(1, dtype=np.uint64)[0]) >> 1
+
+
+def test_generated_cut_geometry(corridor):
+    sec = corridor.section("A")                    # 25 m at 60 deg, ditch 3 x 1 m, 1 m shoulder, 7 m road
+    p = sec.scenario.profile
+    toe = cr.CREST_M + 25 / np.tan(np.radians(60))
+    assert p.z[0] == 25 and p.z.min() == pytest.approx(-1.0)
+    assert p.x[-1] == pytest.approx(toe + 3 + 1 + 7 + cr.VERGE_M)
+    road = {c.name: c.x for c in sec.scenario.collectors}
+    assert road["road"] == pytest.approx(toe + 3 + 1 + 0.01) and road["barrier"] == pytest.approx(toe + 3 + 0.5)
+
+
+def _write(tmp_path, rows, extra_toml=""):
+    toml = (DATA / "small.toml").read_text().replace('sections = "small_sections.csv"', 'sections = "s.csv"')
+    (tmp_path / "c.toml").write_text(toml + extra_toml)
+    (tmp_path / "s.csv").write_text(rows)
+    return tmp_path / "c.toml"
+
+
+HEAD = "id,chainage_from,chainage_to,cut_height_m,ditch_width_m,runout_to_road_m,falls_per_year,scenario\n"
+
+
+def test_bad_rows_named_and_keep_going(tmp_path):
+    rows = HEAD + ("A,0,100,20,3,1,0.5,\n"
+                   "A,100,200,20,3,1,0.5,\n"             # duplicate id
+                   "B,150,300,20,3,1,0.5,\n"             # overlaps A (0-100)? no; overlaps nothing -> C overlaps B
+                   "C,250,400,20,3,1,0.5,\n"             # overlaps B
+                   "D,400,500,20,3,1,lots,\n"            # not a number
+                   "E,500,600,20,3,1,0.5,missing.toml\n"  # scenario file missing
+                   "F,600,700,20,0.5,1,0.5,\n")          # ditch too narrow for its depth (1 m)
+    path = _write(tmp_path, rows)
+    with pytest.raises(cr.CorridorError) as e:
+        cr.load_corridor(path)
+    msg = str(e.value)
+    assert "row 3 (section 'A'): column 'id' = 'A' duplicates row 2" in msg
+    assert "row 5 (section 'C'): chainage 250-400 m overlaps row 4 (section 'B'" in msg
+    assert "row 6 (section 'D'): column 'falls_per_year' = 'lots' is not a number" in msg
+    assert "row 7 (section 'E'): column 'scenario' = 'missing.toml': file not found" in msg
+    assert "row 8 (section 'F'): column 'ditch_width_m' = 0.5 is too narrow" in msg
+    c = cr.load_corridor(path, keep_going=True)
+    assert [s.id for s in c.sections] == ["A", "B"] and len(c.errors) == 5
+
+
+def test_corridor_file_errors(tmp_path):
+    with pytest.raises(cr.CorridorError, match="unknown column 'chainage_form'; did you mean 'chainage_from'"):
+        cr.load_corridor(_write(tmp_path, "id,chainage_form,chainage_to\nA,0,1\n"))
+    with pytest.raises(cr.CorridorError, match="unknown field corridor.'sead'; did you mean 'seed'"):
+        p = _write(tmp_path, HEAD + "A,0,100,20,3,1,0.5,\n")
+        p.write_text(p.read_text().replace("seed = 7", "sead = 7"))
+        cr.load_corridor(p)
+    with pytest.raises(cr.CorridorError, match="exactly one of falls_per_year, falls_per_km_year or falls_per_m2_year"):
+        cr.load_corridor(_write(tmp_path, HEAD.replace(",scenario", ",falls_per_km_year,scenario")
+                                .replace("falls_per_year,falls_per_km_year", "falls_per_year,falls_per_km_year")
+                                + "A,0,100,20,3,1,0.5,2,\n"))
+
+
+def test_unreachable_scheduler_fails_fast_and_writes_nothing(tmp_path, capsys):
+    t0 = time.perf_counter()
+    with pytest.raises(ConnectionError, match="cannot reach the dask scheduler"):
+        cr.connect("tcp://127.0.0.1:9", timeout_s=1)
+    assert time.perf_counter() - t0 < 10
+    out = tmp_path / "out"
+    real = cr.connect
+    import functools
+    import riskrf.corridor
+    riskrf.corridor.connect = functools.partial(real, timeout_s=1)
+    try:
+        rc = main(["corridor", str(DATA / "small.toml"), "--scheduler", "tcp://127.0.0.1:9", "--out", str(out)])
+    finally:
+        riskrf.corridor.connect = real
+    assert rc == 2 and "cannot reach the dask scheduler" in capsys.readouterr().err
+    assert not out.exists() and not any(tmp_path.iterdir())
+
+
+def test_failure_reported_with_keep_going_and_resume(corridor, tmp_path, monkeypatch, clients):
+    client = clients[2]
+    real = cr.assess_section
+    calls = []
+
+    def flaky(section, cor, n_blocks=None, seed=None):
+        calls.append(section.id)
+        if section.id == "B":
+            raise RuntimeError("simulated worker failure")
+        return real(section, cor, n_blocks, seed)
+
+    try:
+        monkeypatch.setattr(cr, "assess_section", flaky)
+        parts = tmp_path / "parts"
+        with pytest.raises(RuntimeError, match="section 'B' failed"):
+            cr.run_corridor(corridor, client=client, n_blocks=N, partitions=parts, retries=0)
+        res = cr.run_corridor(corridor, client=client, n_blocks=N, partitions=parts, keep_going=True, retries=0)
+        assert list(res.table["id"]) == ["A", "C"] and "section 'B'" in res.failures[0]
+        assert len(list(parts.glob("*.parquet"))) == 2 and not list(parts.glob("*.partial"))
+        monkeypatch.setattr(cr, "assess_section", real)
+        calls.clear()
+        seen = []
+        res2 = cr.run_corridor(corridor, client=client, n_blocks=N, partitions=parts, resume=True,
+                               progress=lambda d, t, s: seen.append(s))
+        assert seen == ["B"] and list(res2.table["id"]) == ["A", "B", "C"]
+    finally:
+        monkeypatch.setattr(cr, "assess_section", real)
+
+
+class _Borrowed:
+    """A shared client that the CLI may 'close' without closing it."""
+
+    def __init__(self, client):
+        self._c = client
+
+    def __getattr__(self, name):
+        return getattr(self._c, name)
+
+    def close(self):
+        pass
+
+
+def test_cli_writes_outputs(tmp_path, monkeypatch, runs, clients):
+    # the CLI path on the shared threaded 1-worker cluster (a LocalCluster of processes is the default)
+    monkeypatch.setattr(cr, "connect", lambda scheduler=None, n_workers=None, **k: (_Borrowed(clients[1]), None))
+    out = tmp_path / "run"
+    assert main(["corridor", str(DATA / "small.toml"), "-n", str(N), "--out", str(out)]) == 0
+    for f in ("report.html", "corridor.csv", "sections.csv", "budget_curve.csv", "chainage.png", "summary.json"):
+        assert (out / f).exists()
+    t = pd.read_csv(out / "sections.csv")
+    np.testing.assert_allclose(t["deaths_per_year"], runs[2].table["deaths_per_year"], rtol=1e-12)
+    assert not (tmp_path / ".run.sections").exists()
+    html = (out / "report.html").read_text()
+    assert all(sid in html for sid in ("A", "B", "C")) and "Budget curve" in html and "data:image/png;base64" in html
+    shutil.rmtree(out)
+
+
+def test_rate_per_m2_of_face_and_parquet_table(tmp_path):
+    rows = ("id,chainage_from,chainage_to,cut_height_m,ditch_width_m,runout_to_road_m,falls_per_m2_year\n"
+            "A,0,100,20,3,1,0.0001\n")
+    path = _write(tmp_path, rows)
+    sec = cr.load_corridor(path).sections[0]
+    # face area = 100 m x 20 m / sin(60 deg) = 2309.4 m2 -> 0.23094 falls per year
+    assert sec.falls_per_year == pytest.approx(1e-4 * 100 * 20 / np.sin(np.radians(60)))
+    pd.read_csv(tmp_path / "s.csv").astype(str).to_parquet(tmp_path / "s.parquet")
+    path.write_text(path.read_text().replace('sections = "s.csv"', 'sections = "s.parquet"'))
+    assert cr.load_corridor(path).sections[0].falls_per_year == pytest.approx(sec.falls_per_year)
+    pd.read_csv(tmp_path / "s.csv").to_excel(tmp_path / "s.xlsx", index=False)
+    path.write_text(path.read_text().replace('sections = "s.parquet"', 'sections = "s.xlsx"'))
+    assert cr.load_corridor(path).sections[0].falls_per_year == pytest.approx(sec.falls_per_year)
+
+
+def test_release_rate_basis(tmp_path):
+    path = _write(tmp_path, HEAD + "A,0,100,20,3,1,0.5,\n")
+    path.write_text(path.read_text().replace("[corridor]", '[corridor]\nrate_basis = "release"'))
+    c = cr.load_corridor(path)
+    row = cr.assess_section(c.sections[0], c, N)
+    # released falls as given; those reaching the road = given x simulated share reaching the road line
+    assert row["release_falls_per_year"] == 0.5
+    assert row["road_falls_per_year"] == pytest.approx(0.5 * row["reach_road"], rel=1e-9)
+
+
+E6 = Path(__file__).resolve().parents[1] / "corridors" / "e6_drivdalen"
+
+
+def test_e6_example_corridor_loads_with_record_rates():
+    c = cr.load_corridor(E6 / "e6_drivdalen.toml")
+    assert len(c.sections) == 19 and c.rate_basis == "road"
+    # 20 NVDB rock falls on main section 1, metres 0-19,000, in 2000-2014; +0.5 per section (Jeffreys mean)
+    assert sum(s.falls_per_year for s in c.sections) == pytest.approx((20 + 19 * 0.5) / 15, abs=1e-5)
+    assert "fitted to e6_volumes.csv" in c.mass_note and c.mass.n_tail == 34
+    assert all(s.rating is not None and max(s.rating.scores.values()) <= 100 for s in c.sections)
+
+
+def test_e6_builder_reproduces_the_shipped_tables(tmp_path):
+    shared = Path(__file__).resolve().parents[1] / ".." / "shared"
+    gml = shared / "inventories-raw" / "nvdb-skred-norway" / "Skred_E6_Trondelag_2000_2014.gml"
+    if not gml.exists():
+        pytest.skip(f"shared NVDB record not present at {gml}")
+    import importlib.util
+    for f in ("build_e6_corridor.py", "e6_drivdalen.toml"):
+        shutil.copy(E6 / f, tmp_path / f)
+    spec = importlib.util.spec_from_file_location("build_e6", tmp_path / "build_e6_corridor.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.main([str(gml)]) == 0
+    for f in ("e6_sections.csv", "e6_rockfalls.csv", "e6_volumes.csv"):
+        assert (tmp_path / f).read_text() == (E6 / f).read_text()
