@@ -55,8 +55,8 @@ def _add_inventory_arguments(p):
     g.add_argument("--mass-column", default=None, metavar="NAME", help="mass column when not recognised")
     g.add_argument("--date-column", default=None, metavar="NAME", help="date column when not recognised")
     g.add_argument("--duplicates", choices=("warn", "drop", "keep", "error"), default=None,
-                   help="dated rows repeating an earlier row exactly: warn and keep (default; refused when half "
-                        "or more repeat), drop, keep, or error")
+                   help="dated rows repeating an earlier row exactly: warn and keep (default; refused when every "
+                        "dated row has a copy), drop, keep, or error")
 
 
 def _read(args, path):

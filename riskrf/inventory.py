@@ -412,8 +412,8 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         the dates are ambiguous (:mod:`riskrf.tables`).
     duplicates : {"warn", "drop", "keep", "error"}, optional
         What to do with dated rows that repeat an earlier row exactly.  Default
-        ``"warn"``: kept with a warning, but refused when half or more of the dated
-        rows are repeats (a file appended twice doubles the rate).
+        ``"warn"``: kept with a warning, but refused when every dated row has an
+        exact copy (a file appended twice doubles the rate).
 
     Returns
     -------
@@ -643,7 +643,8 @@ def _check_duplicates(events, table, path, policy, note):
     if policy == "drop":
         note(f"{what}; the {k} duplicate rows are dropped as asked (duplicates='drop')")
         return events.loc[~dup]
-    if policy == "error" or 2 * k >= int(dated.sum()):
+    copied = table.loc[events.index].duplicated(keep=False)
+    if policy == "error" or bool(copied[dated].all()):
         raise ValueError(f"{what}: a file appended twice doubles the rate of falls.  Pass duplicates='drop' "
                          "(CLI --duplicates drop) to remove them, or duplicates='keep' if they are distinct falls")
     note(f"{what}; they are kept as distinct falls (pass duplicates='drop' to remove them)")
