@@ -38,7 +38,8 @@ logger = logging.getLogger("riskrf")
 def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, rate_scale: float = 1.0,
                               scenario=None, velocities=None, collector: str | None = None, n: int = 50_000,
                               seed=1, reach_probability: float = 1.0, condition_on_mass: bool = False,
-                              mass_coupling: str = "simulated", design_masses_kg=()):
+                              mass_coupling: str = "simulated", design_masses_kg=(),
+                              velocity_unit: str | None = None):
     """Power-law fit of the inventory combined with simulated or given velocities.
 
     ``collector`` names the barrier line: in a scenario it defaults to "barrier"; a
@@ -75,7 +76,7 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
             hazard = EnergyHazard.from_simulation(gr, result, collector, rate_per_year=rate,
                                                   condition_on_mass=condition_on_mass)
     else:
-        df = read_velocities(velocities, collector=collector)
+        df = read_velocities(velocities, collector=collector, velocity_unit=velocity_unit)
         v = df["velocity_ms"].to_numpy(dtype=float)
         note = f"velocities: {len(df):,} samples from {velocities}"
         if "angular_velocity_rads" in df and "radius_m" in df:
@@ -253,12 +254,15 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         from simulation.engine import Precompile
         compiling = Precompile(site.resolve(hz_cfg["scenario"])) if hz_cfg["scenario"] else None
         t = stage(1, "reading the inventory and fitting magnitude-frequency models")
+        from .inventory import READER_OPTIONS
+        reader = {k: inv_cfg[k] for k in READER_OPTIONS if inv_cfg.get(k) is not None}
         inventory = read_inventory(site.resolve(inv_cfg["path"]), start=inv_cfg["start"], end=inv_cfg["end"],
-                                   duration_years=inv_cfg["duration_years"], density_kg_m3=inv_cfg["density_kg_m3"])
+                                   duration_years=inv_cfg["duration_years"], density_kg_m3=inv_cfg["density_kg_m3"],
+                                   **reader)
+        dated = read_inventory(site.resolve(inv_cfg["annual_maxima"])) if inv_cfg["annual_maxima"] else None
         frequency = analyse_inventory(inventory, m_min=inv_cfg["m_min_kg"], n_bootstrap=500, seed=seed)
         maxima_frequency = None
-        if inv_cfg["annual_maxima"]:
-            dated = read_inventory(site.resolve(inv_cfg["annual_maxima"]))
+        if dated is not None:
             maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
         timings["fits"] = round(time.perf_counter() - t, 2)
 
@@ -279,7 +283,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
             velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
             collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
-            mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=extra)
+            mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=extra,
+            velocity_unit=hz_cfg["velocity_unit"])
         timings["simulation"] = round(time.perf_counter() - t, 2)
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")

@@ -6,6 +6,7 @@ import logging
 import os
 import shutil
 import sys
+import traceback
 import warnings
 from pathlib import Path
 
@@ -37,12 +38,36 @@ def _add_inventory_arguments(p):
     p.add_argument("--end", default=None, help="end of the record period, YYYY-MM-DD")
     p.add_argument("--duration-years", type=float, default=None, metavar="YR",
                    help="length of the record in years, for undated inventories")
+    g = p.add_argument_group("reading the inventory (README 'Input formats'; each may also be in the sidecar)")
+    g.add_argument("--sheet", default=None, help="Excel sheet: name, or number counting from 1")
+    g.add_argument("--header-row", type=int, default=None, metavar="ROW",
+                   help="1-based row holding the column names (default 1), e.g. 4 below three title rows")
+    g.add_argument("--date-format", default=None, metavar="FMT",
+                   help="strftime pattern of every date, e.g. %%d/%%m/%%Y; needed only for ambiguous dates")
+    g.add_argument("--decimal", choices=(".", ","), default=None,
+                   help="decimal mark (default: decided per column; a column mixing 1,5 and 1.5 needs it)")
+    g.add_argument("--encoding", default=None, help="text encoding (default UTF-8, else cp1252 with a note)")
+    g.add_argument("--volume-unit", default=None, choices=("m3", "dm3", "l", "litre", "cm3"),
+                   help="unit of the volume column; also confirms volumes that look too large for m3")
+    g.add_argument("--mass-unit", default=None, choices=("kg", "t", "tonne", "tonnes", "tons"),
+                   help="unit of the mass column")
+    g.add_argument("--volume-column", default=None, metavar="NAME", help="volume column when not recognised")
+    g.add_argument("--mass-column", default=None, metavar="NAME", help="mass column when not recognised")
+    g.add_argument("--date-column", default=None, metavar="NAME", help="date column when not recognised")
+    g.add_argument("--duplicates", choices=("warn", "drop", "keep", "error"), default=None,
+                   help="dated rows repeating an earlier row exactly: warn and keep (default; refused when every "
+                        "dated row has a copy), drop, keep, or error")
 
 
 def _read(args, path):
     from .inventory import read_inventory
+    if path is None:
+        raise ValueError(f"riskrf {args.command} needs --inventory INVENTORY (the rock fall inventory file)")
+    reader = {k: getattr(args, k) for k in ("sheet", "header_row", "date_format", "decimal", "encoding",
+                                            "volume_unit", "mass_unit", "volume_column", "mass_column",
+                                            "date_column", "duplicates")}
     return read_inventory(path, start=args.start, end=args.end, duration_years=args.duration_years,
-                          density_kg_m3=args.density)
+                          density_kg_m3=args.density, **reader)
 
 
 def cmd_fit(args) -> int:
@@ -50,22 +75,24 @@ def cmd_fit(args) -> int:
     from .frequency_study import analyse_inventory
     from .outputs import atomic_output_dir
 
+    from .preflight import check_inventory_args, check_out
+    check_inventory_args(args)
+    out = check_out(args, f"{Path(args.inventory).stem}-fit")
     inv = _read(args, args.inventory)
     analysis = analyse_inventory(inv, m_min=args.m_min, method=args.method, m_max=args.m_max,
                                  gumbel_method=args.gumbel_method, n_bootstrap=args.bootstrap, seed=args.seed)
     print(analysis.summary_text())
-    out = Path(args.out) if args.out else Path(f"{Path(args.inventory).stem}-fit")
-    with atomic_output_dir(out) as tmp:
+    with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         analysis.write(tmp)
     print(f"\nWrote summary.json, design_masses.csv, completeness.csv and figures to {out}/")
     return 0
 
 
-def write_table(df, path: Path) -> None:
+def write_table(df, path: Path, suffix: str | None = None) -> None:
     """Write a DataFrame as Parquet or CSV by the file suffix, atomically (temporary name, then rename)."""
     import os
     import tempfile
-    suffix = path.suffix.lower()
+    suffix = (suffix or path.suffix).lower()
     if suffix not in (".parquet", ".csv"):
         raise ValueError(f"--out {path}: use a .parquet or .csv file name")
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -88,13 +115,14 @@ def cmd_simulate(args) -> int:
 
     import simulation
 
-    from .outputs import atomic_output_dir
-
-    scenario = simulation.load_scenario(args.scenario)
+    from .outputs import atomic_outputs, check_output
     out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-crossings.parquet")
+    check_output(out, overwrite=args.overwrite, kind="file")
     if out.suffix.lower() not in (".parquet", ".csv"):
         raise ValueError(f"--out {out}: use a .parquet or .csv file name")
     figures = Path(args.figures) if args.figures else out.with_name(f"{out.stem}-figures")
+    check_output(figures, overwrite=args.overwrite, kind="dir", option="--figures")
+    scenario = simulation.load_scenario(args.scenario)
     progress = None if args.progress is None else args.progress
     result = simulation.run(scenario, n=args.n, seed=args.seed, progress=progress)
     print(f"Scenario {scenario.name} ({scenario.source}): {args.n:,} blocks, seed {args.seed}")
@@ -103,10 +131,10 @@ def cmd_simulate(args) -> int:
     crossings = pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
     if "outcome" in crossings:
         crossings["outcome"] = crossings["outcome"].astype(str)
-    write_table(crossings, out)
-    from .report.files import write_simulation_figures
-    with atomic_output_dir(figures) as tmp:
-        write_simulation_figures(result, tmp, [c.name for c in scenario.collectors])
+    from .report import files as report_files
+    with atomic_outputs([(out, "file"), (figures, "dir")], overwrite=args.overwrite) as (tmp_out, tmp):
+        write_table(crossings, tmp_out, suffix=out.suffix)       # table and figures appear together or not at all
+        report_files.write_simulation_figures(result, tmp, [c.name for c in scenario.collectors])
         result.runout.to_csv(tmp / "runout.csv", index=False)
         result.envelopes.to_csv(tmp / "envelopes.csv", index=False)
     print(f"\nWrote {len(crossings):,} collector crossings to {out} and figures, runout.csv and "
@@ -121,7 +149,7 @@ def build_energy_hazard(args, inventory):
         inventory, m_min=args.m_min, m_max=args.m_max, rate_scale=args.rate_scale, scenario=args.scenario,
         velocities=args.velocities, collector=args.collector, n=args.n, seed=args.seed,
         reach_probability=args.reach_probability,
-        condition_on_mass=args.condition_on_mass,
+        condition_on_mass=args.condition_on_mass, velocity_unit=args.velocity_unit,
         mass_coupling="independent" if args.mass_independent else "simulated",
         design_masses_kg=_energy_design_masses(args, inventory))
 
@@ -144,7 +172,12 @@ def cmd_energy(args) -> int:
     from .energy_study import analyse_energy
     from .outputs import atomic_output_dir
 
+    from .preflight import check_energy_args, check_out
+    check_energy_args(args)
+    out = check_out(args, f"{Path(args.inventory).stem}-energy")
     inv = _read(args, args.inventory)
+    for note in inv.notes:
+        print(f"note: {note}")
     gr, hazard, _ = build_energy_hazard(args, inv)
     block = sensitivity = None
     fragmenting = args.fractal_dimension is not None or args.fragmentation_iterations is not None
@@ -170,8 +203,7 @@ def cmd_energy(args) -> int:
     print(f"Inventory {inv.source}: power law b = {gr.b:.4f} ± {gr.b_stderr:.4f} above m_min = {gr.m_min:.5g} kg "
           f"({gr.n_tail} falls, {gr.rate_min:.4g} per year)" + (f", m_max = {gr.m_max:.5g} kg" if gr.m_max else ""))
     print(analysis.summary_text())
-    out = Path(args.out) if args.out else Path(f"{Path(args.inventory).stem}-energy")
-    with atomic_output_dir(out) as tmp:
+    with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         analysis.write(tmp)
     print(f"\nWrote energy_summary.json, design_energies.csv, fence_checks.csv and figures to {out}/")
     return 0
@@ -189,7 +221,15 @@ def cmd_decide(args) -> int:
     if (args.tree is None) == (args.options is None):
         raise ValueError("give a decision tree file (riskrf decide TREE.json) or --options OPTIONS.toml with "
                          "--inventory and --scenario, not both")
-    out = Path(args.out) if args.out else Path("decision")
+    from .preflight import check_energy_args, check_number, check_out
+    check_number(args.risk_tolerance, "--risk-tolerance", low=0, low_open=True,
+                 what=" (in money; leave it out for expected values)")
+    out = check_out(args, "decision")
+    if args.tree is None:
+        if args.inventory is None:
+            raise ValueError("riskrf decide --options needs --inventory INVENTORY and --scenario SCENARIO "
+                             "(or --velocities FILE)")
+        check_energy_args(args, road_collector=args.road_collector)
     if args.tree is not None:
         tree = DecisionTree.from_file(args.tree)
         rb = tree.rollback(risk_tolerance=args.risk_tolerance)
@@ -205,7 +245,7 @@ def cmd_decide(args) -> int:
         for var, value in evpi.items():
             print(f"  EVPI of {var!r}: {value:.6g}")
         tornado = tree.tornado() if tree.parameters else None
-        with atomic_output_dir(out) as tmp:
+        with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
             ranking.to_csv(tmp / "ranking.csv", index=False)
             tree.risk_profile().to_csv(tmp / "risk_profiles.csv", index=False)
             write_json({"objective": tree.objective, "value": rb.value, "options": rb.option_values,
@@ -225,12 +265,13 @@ def cmd_decide(args) -> int:
     inv = _read(args, args.inventory)
     gr, hazard, result = build_energy_hazard(args, inv)
     from .assess import road_share, study_context
-    study = load_mitigation(args.options, hazard, road_share=road_share(result, hazard.collector, args.road_collector),
-                            **study_context(result, hazard.collector, args.road_collector, args.option_blocks,
+    road = args.road_collector or "road"
+    study = load_mitigation(args.options, hazard, road_share=road_share(result, hazard.collector, road),
+                            **study_context(result, hazard.collector, road, args.option_blocks,
                                             args.seed, inv, hazard, args.rate_scale))
     report = study_report(study)
     print(report["text"])
-    with atomic_output_dir(out) as tmp:
+    with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         write_mitigation_outputs(study, report, tmp)
     print(f"\nWrote ranking.csv, tornado.csv, break_even.csv, decision.json and figures to {out}/")
     return 0
@@ -262,6 +303,9 @@ def _add_energy_arguments(p):
     p.add_argument("--seed", type=int, default=1, help="random seed (simulation and bootstrap; default 1)")
     p.add_argument("--bootstrap", type=int, default=300, metavar="N",
                    help="bootstrap replicates for the intervals (default 300)")
+    p.add_argument("--velocity-unit", choices=("m/s", "km/h"), default=None,
+                   help="unit of the velocity file's velocity column (default m/s; a median above 50 m/s is refused "
+                        "as probable km/h unless the unit is given)")
 
 
 def cmd_assess(args) -> int:
@@ -270,10 +314,12 @@ def cmd_assess(args) -> int:
     from .outputs import atomic_output_dir
     from .site import load_site
 
+    from .preflight import check_number, check_out
+    check_number(args.n, "-n", low=1)
+    out = check_out(args, f"{Path(args.site).stem}-assessment")
     site = load_site(args.site)          # every input is checked before anything is computed
-    out = Path(args.out) if args.out else Path(f"{Path(args.site).stem}-assessment")
     assessment = run_assessment(site, seed=args.seed, n_blocks=args.n)
-    with atomic_output_dir(out) as tmp:
+    with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         s = write_assessment(assessment, tmp)
     stages = ", ".join(f"{k} {v:.1f} s" for k, v in assessment.timings.items())
     print(f"\nStage times: {stages}.")
@@ -326,7 +372,13 @@ def cmd_calibrate(args) -> int:
         if not sep:
             raise ValueError(f"--select {item!r}: use COLUMN=VALUE, e.g. profile=P1")
         select[key] = value
-    observed = read_observed(args.observed, column=args.column, select=select)
+    from .preflight import check_out
+    check_out(args, f"{Path(args.scenario).stem}-calibration")
+    table = None
+    if Path(args.observed).suffix.lower() in (".csv", ".txt", ".tsv") and Path(args.observed).is_file():
+        from .tables import read_numeric_table       # separators, decimal commas, encodings as for inventories
+        table = read_numeric_table(args.observed, what="observed stops")
+    observed = read_observed(args.observed, column=args.column, select=select, table=table)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         cal = simulation.calibrate(args.scenario, observed, parameters, n=args.n, seed=args.seed,
@@ -347,7 +399,7 @@ def cmd_calibrate(args) -> int:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    with atomic_output_dir(out) as tmp:
+    with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         (tmp / f"{Path(args.scenario).stem}_calibrated.toml").write_text(cal.to_toml())
         cal.summary().to_csv(tmp / "parameters.csv")
         cal.comparison().to_csv(tmp / "comparison.csv")
@@ -372,7 +424,8 @@ def cmd_corridor(args) -> int:
     corridor = load_corridor(args.corridor, keep_going=args.keep_going)   # every row checked before any work
     for e in corridor.errors:
         print(f"skipped (--keep-going): {e}")
-    out = Path(args.out) if args.out else Path(f"{Path(args.corridor).stem}-corridor")
+    from .preflight import check_out
+    out = check_out(args, f"{Path(args.corridor).stem}-corridor")
     parts = out.parent / f".{out.name}.sections"
     n = args.n or corridor.n_blocks
     where = args.scheduler or os.environ.get("DASK_SCHEDULER_ADDRESS") or \
@@ -394,7 +447,7 @@ def cmd_corridor(args) -> int:
         if parts.exists():
             print(f"finished sections are kept in {parts}; rerun with --resume to skip them", file=sys.stderr)
         return 2
-    write_corridor(res, out)
+    write_corridor(res, out, overwrite=args.overwrite)
     shutil.rmtree(parts, ignore_errors=True)        # the run is complete: its partitions are in sections.csv
     for f in res.failures:
         print(f"failed: {f}")
@@ -418,6 +471,7 @@ def build_parser() -> argparse.ArgumentParser:
         "and slope, and run 'riskrf assess your_site.toml'.  Each step also runs alone: fit -> simulate -> "
         "energy -> decide.", epilog=EPILOG)
     parser.add_argument("--version", action="version", version=f"riskrf {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show the full traceback of an error")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("fit", help="fit power-law, Gumbel and GEV models to a rock fall inventory",
@@ -493,7 +547,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--inventory", default=None, help="inventory file (with --options)")
     p.add_argument("--option-blocks", type=int, default=20_000, metavar="N",
                    help="blocks per re-simulation deriving an option's effect (ditch profiles; default 20,000)")
-    p.add_argument("--road-collector", default="road",
+    p.add_argument("--road-collector", default=None,
                    help="collector at the road: P(road | barrier) from the simulation (default 'road')")
     p.add_argument("--risk-tolerance", type=float, default=None,
                    help="exponential-utility risk tolerance for tree rollback (default: expected values)")
@@ -599,6 +653,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--keep-going", action="store_true", help="skip bad rows and failed sections, listing them")
     p.add_argument("--resume", action="store_true", help="skip sections already finished by an earlier run")
     p.set_defaults(func=cmd_corridor)
+    for p in sub.choices.values():       # every command with outputs: never clobber without --overwrite
+        if any("--out" in a.option_strings for a in p._actions):
+            p.add_argument("--overwrite", action="store_true",
+                           help="replace an existing --out (whole, atomically); without it an existing output is "
+                                "refused before any work")
     return parser
 
 
@@ -615,6 +674,9 @@ def cmd_rates(args) -> int:
                          "need a daily model (--period day)")
     if (args.heavy_day_change is None) != (args.heavy_day_mm is None):
         raise ValueError("give --heavy-day-mm and --heavy-day-change together")
+    from .preflight import check_inventory_args, check_out
+    check_inventory_args(args)
+    out = check_out(args, f"{Path(args.inventory).stem}-rates")
     inv = _read(args, args.inventory)
     model = rate_model(inv, args.rainfall, period=args.period, windows_days=windows,
                        season=None if args.season == "none" else args.season, trend=not args.no_trend,
@@ -638,8 +700,7 @@ def cmd_rates(args) -> int:
         table = pd.concat([r.summary()["value"].rename(f"rule {i + 1}") for i, r in enumerate(rules)], axis=1)
         print("\nClosure rules (effectiveness = share of falls while closed, from the rate model):")
         print(table.to_string())
-    out = Path(args.out) if args.out else Path(f"{Path(args.inventory).stem}-rates")
-    with atomic_output_dir(out) as tmp:
+    with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         model.write(tmp)
         if rules:
             pd.concat([r.summary()["value"].rename(f"rule {i + 1}") for i, r in enumerate(rules)], axis=1).to_csv(
@@ -665,9 +726,37 @@ def main(argv=None) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # every warning is reported in the printed summary instead
             return args.func(args)
+    except KeyboardInterrupt:
+        return _interrupted(args)
     except (ValueError, TypeError, FileNotFoundError, KeyError) as exc:   # includes SiteError, ScenarioError
+        if args.debug:
+            traceback.print_exc()
         print(f"riskrf {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except Exception as exc:     # OSError, RecursionError, ...: one line, the traceback only with --debug
+        if _caused_by_interrupt(exc):       # Ctrl-C inside compiled code surfaces as SystemError
+            return _interrupted(args)
+        if args.debug:
+            traceback.print_exc()
+        print(f"riskrf {args.command}: error: {type(exc).__name__}: {exc} (run with --debug for the traceback)",
+              file=sys.stderr)
+        return 2
+
+
+def _caused_by_interrupt(exc) -> bool:
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
+def _interrupted(args) -> int:
+    print(f"riskrf {args.command}: interrupted; nothing was written (outputs appear only when complete)",
+          file=sys.stderr)
+    return 130
 
 
 if __name__ == "__main__":

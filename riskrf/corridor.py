@@ -835,13 +835,14 @@ def render_html(res: CorridorResult, figure_png: Path) -> str:
     return "\n".join(parts)
 
 
-def write_corridor(res: CorridorResult, out: Path) -> None:
+def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False) -> None:
     """Write report.html, corridor.csv (ranked), sections.csv (by chainage), budget_curve.csv, chainage.png and
-    summary.json into ``out`` (a directory that appears only when everything is written)."""
+    summary.json into ``out`` (a directory that appears only when everything is written; an existing non-empty
+    ``out`` is replaced whole only with ``overwrite``)."""
     import matplotlib.pyplot as plt
 
     from .outputs import atomic_output_dir, write_json
-    with atomic_output_dir(out) as tmp:
+    with atomic_output_dir(out, overwrite=overwrite) as tmp:
         res.summary().to_csv(tmp / "corridor.csv", index=False)
         res.table.to_csv(tmp / "sections.csv", index=False)
         res.budget_curve().to_csv(tmp / "budget_curve.csv", index=False)

@@ -28,6 +28,7 @@ from __future__ import annotations
 import ast
 import json
 import math
+import sys
 import operator
 import tomllib
 from dataclasses import dataclass, field
@@ -47,11 +48,26 @@ class TreeError(ValueError):
 
 
 def _evaluate(expr, params: dict, where: str):
-    """Value of a number or an arithmetic expression of named parameters."""
+    """Value of a number or an arithmetic expression of named parameters; always finite."""
+    try:
+        value = _evaluate_raw(expr, params, where)
+    except OverflowError:
+        raise TreeError(f"{where}: {expr!r} overflows: the result is not a finite number") from None
+    except ZeroDivisionError:
+        raise TreeError(f"{where}: {expr!r}: division by zero") from None
+    if not math.isfinite(value):
+        raise TreeError(f"{where}: {expr!r} is not a finite number")
+    return value
+
+
+def _evaluate_raw(expr, params: dict, where: str):
     if isinstance(expr, bool):
         raise TreeError(f"{where}: {expr!r} is not a number")
     if isinstance(expr, (int, float)):
-        return float(expr)
+        try:
+            return float(expr)
+        except OverflowError:
+            raise TreeError(f"{where}: {expr:.6g} is not a finite number (too large)") from None
     if not isinstance(expr, str):
         raise TreeError(f"{where}: {expr!r} is not a number or an expression")
     try:
@@ -134,8 +150,12 @@ class DecisionTree:
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
                 raise TreeError(f"{source}: parameter {k!r} = {v!r} is not a finite number")
         defs = spec.get("nodes", {})
-        root = _build(spec, defs, source, (), source)
-        return cls(root, spec.get("objective", "min"), params, source)
+        try:
+            root = _build(spec, defs, source, (), source)
+            return cls(root, spec.get("objective", "min"), params, source)
+        except RecursionError:
+            raise TreeError(f"{source}: the tree is nested too deeply to evaluate (more than about "
+                            f"{sys.getrecursionlimit() // 4} levels)") from None
 
     @classmethod
     def from_file(cls, path) -> "DecisionTree":
@@ -151,6 +171,8 @@ class DecisionTree:
                 data = json.loads(path.read_text(encoding="utf-8"))
         except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
             raise TreeError(f"{path}: cannot parse: {exc}") from exc
+        except RecursionError:
+            raise TreeError(f"{path}: the tree is nested too deeply to read") from None
         return cls.from_dict(data, source=str(path))
 
     def with_parameters(self, **values) -> "DecisionTree":
@@ -174,6 +196,8 @@ class DecisionTree:
                     total += p
                 if abs(total - 1.0) > PROBABILITY_TOLERANCE:
                     raise TreeError(f"{node.path}: probabilities sum to {total:.10g}, not 1")
+            if node.type == "terminal":
+                _evaluate(node.value, self.parameters, f"{node.path}: value")
             for b in node.branches:
                 _evaluate(b.cost, self.parameters, f"{b.child.path}: cost")
                 _evaluate(b.payoff, self.parameters, f"{b.child.path}: payoff")

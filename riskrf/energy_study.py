@@ -146,6 +146,16 @@ def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_
     speed of simulated blocks of its mass when the hazard is mass-coupled) instead of the T-year block, and each
     fence gets an over-topping check by the block's top.  ``sensitivity``: a table from
     :func:`design_energy_sensitivity`, carried into the outputs."""
+    from .validation import check_return_periods
+    try:
+        check_return_periods(design_T, "design_T")
+    except (TypeError, ValueError):
+        raise ValueError(f"design_T = {design_T!r}: the design return period must be a finite number > 1 year "
+                         "(a T-year event has annual probability 1/T)") from None
+    if not (np.isfinite(free_board_m) and free_board_m >= 0):
+        raise ValueError(f"free_board_m = {free_board_m!r} must be a finite number >= 0 m")
+    if any(not (np.isfinite(h) and h > 0) for h in np.atleast_1d(np.asarray(fence_height_m, dtype=float))):
+        raise ValueError(f"fence_height_m = {fence_height_m!r}: every height must be a finite number > 0 m")
     T_all = np.union1d(np.asarray(T, dtype=float), [design_T])
     table = hazard.design_table(T_all, n_bootstrap=n_bootstrap, seed=seed)
     row = table.loc[table["T_years"] == design_T].iloc[0]

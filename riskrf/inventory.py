@@ -26,7 +26,6 @@ warning that counts them, and counted by rate models through
 """
 from __future__ import annotations
 
-import csv
 import datetime as _dt
 import re
 import tomllib
@@ -36,6 +35,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .tables import is_blank, parse_dates, parse_numbers, read_table, sniff_delimiter  # noqa: F401 (re-exported)
 from .report.format import sig
 from .units import DEFAULT_DENSITY_KG_M3, KG_PER_TONNE
 from .validation import check_positive, warn
@@ -298,47 +298,30 @@ class Inventory:
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
 
-def sniff_delimiter(path) -> str:
-    """The delimiter of a text table among , ; tab and |, defaulting to a comma."""
-    with open(path, encoding="utf-8-sig", errors="replace") as fh:
-        sample = fh.read(8192)
-    try:
-        return csv.Sniffer().sniff(sample, delimiters=",;\t|").delimiter
-    except csv.Error:
-        return ","
+#: Reader options a sidecar ``[record]`` table (or a site file's ``[inventory]``) may give.
+READER_OPTIONS = ("sheet", "header_row", "encoding", "decimal", "date_format", "volume_unit", "mass_unit",
+                  "duplicates", "volume_column", "mass_column", "date_column", "location_column")
 
 
-def _read_table(path: Path) -> pd.DataFrame:
-    suffix = path.suffix.lower()
-    if suffix in (".csv", ".txt", ".tsv"):
-        sep = sniff_delimiter(path)
-        try:
-            return pd.read_csv(path, sep=sep, dtype=str, skip_blank_lines=False, keep_default_na=False,
-                               encoding="utf-8-sig")
-        except (pd.errors.ParserError, UnicodeDecodeError) as exc:
-            raise ValueError(f"{path}: cannot read as a {sep!r}-separated table: {exc}") from exc
-    if suffix in (".xlsx", ".xlsm"):
-        return pd.read_excel(path, dtype=str, keep_default_na=False)
-    if suffix == ".parquet":
-        return pd.read_parquet(path).astype(object).where(lambda d: d.notna(), "").astype(str)
-    raise ValueError(f"{path}: unsupported inventory format {suffix!r}; use .csv, .xlsx or .parquet")
-
-
-def _sidecar(path: Path) -> tuple[dict, Path | None]:
+def _sidecar(path: Path) -> tuple[dict, Path | None, str | None]:
+    """The ``[record]`` table of ``<stem>.toml`` beside the inventory: (fields, path, note)."""
     side = path.with_suffix(".toml")
     if not side.exists():
-        return {}, None
+        return {}, None, None
     try:
         with open(side, "rb") as fh:
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"{side}: not valid TOML: {exc}") from exc
+    if "record" not in data and any(k in data for k in ("inventory", "hazard", "site", "options")):
+        return {}, None, (f"{side} is a site file, not a [record] sidecar of {path.name}; it is not read as "
+                          "the inventory's sidecar (the site file's [inventory] fields apply)")
     record = data.get("record", data)
-    known = {"start", "end", "duration_years", "density_kg_m3", "site"}
+    known = {"start", "end", "duration_years", "density_kg_m3", "site", *READER_OPTIONS}
     unknown = set(record) - known
     if unknown:
         raise ValueError(f"{side}: unknown field(s) {sorted(unknown)} in [record]; expected {sorted(known)}")
-    return record, side
+    return record, side, None
 
 
 def _as_date(value, what: str) -> _dt.date:
@@ -352,35 +335,6 @@ def _as_date(value, what: str) -> _dt.date:
         raise ValueError(f"{what} = {value!r} is not a date (use YYYY-MM-DD)") from exc
 
 
-def _parse_dates(raw: pd.Series, path, col: str, rows: np.ndarray):
-    """Return (dates as datetime64, years as Int64); raise naming the row for bad or future values."""
-    text = raw.str.strip()
-    years = pd.Series(pd.NA, index=raw.index, dtype="Int64")
-    dates = pd.Series(pd.NaT, index=raw.index, dtype="datetime64[ns]")
-    today = pd.Timestamp(_dt.date.today())
-    for i, s in text.items():
-        if s == "":
-            continue
-        if re.fullmatch(r"\d{4}(\.0)?", s):
-            years[i] = int(float(s))
-            stamp = None
-        else:
-            try:
-                stamp = pd.Timestamp(s)
-            except (ValueError, TypeError):
-                stamp = pd.NaT
-            if stamp is pd.NaT or pd.isna(stamp):
-                raise ValueError(f"{path}: row {rows[i]}, column {col!r}: cannot read date {s!r} "
-                                 "(use YYYY-MM-DD or a four-digit year)")
-            if stamp > today:
-                raise ValueError(f"{path}: row {rows[i]}, column {col!r}: date {s!r} is in the future")
-            dates[i] = stamp
-            years[i] = stamp.year
-        if years[i] > today.year:
-            raise ValueError(f"{path}: row {rows[i]}, column {col!r}: date {s!r} is in the future")
-    return dates, years
-
-
 def _split_censored(raw: pd.Series) -> tuple[pd.Series, pd.Series]:
     """Strip a censoring prefix (``<1``, ``>20``, ``~15``) from size cells.
 
@@ -390,21 +344,25 @@ def _split_censored(raw: pd.Series) -> tuple[pd.Series, pd.Series]:
     text = raw.astype(str).str.strip()
     censoring = pd.Series("", index=raw.index, dtype=object)
     censoring[text == ""] = "unknown"
-    match = text.str.extract(_CENSORED_RE)
-    has_prefix = match[0].notna()
+    # Only cells starting with a prefix character go through the (slow) extraction.
+    candidates = text.str.match(r"^(<|>|≤|≥|~|≈|ca)", case=False)
+    match = text[candidates].str.extract(_CENSORED_RE)
+    has_prefix = pd.Series(False, index=raw.index)
+    has_prefix[match.index] = match[0].notna()
     if has_prefix.any():
-        censoring[has_prefix] = match.loc[has_prefix, 0].str.lower().map(CENSORING)
-        text = text.where(~has_prefix, match[1])
-    return text.astype(object), censoring
+        hit = match[match[0].notna()]
+        censoring[hit.index] = hit[0].str.lower().map(CENSORING)
+        text = text.where(~has_prefix, match[1].reindex(text.index))
+    text = text.astype(object)
+    if raw.dtype == object and pd.api.types.infer_dtype(raw, skipna=True) not in ("string", "empty"):
+        # Excel number cells stay numbers: their decimal point is not text to interpret (riskrf.tables)
+        is_num = raw.map(lambda v: isinstance(v, (float, int, np.floating, np.integer)) and not isinstance(v, bool))
+        text[is_num] = raw[is_num]
+    return text, censoring
 
 
-def _parse_sizes(raw: pd.Series, path, col: str, rows: np.ndarray) -> pd.Series:
-    text = raw.str.strip().str.replace(",", ".", regex=False) if raw.dtype == object else raw
-    values = pd.to_numeric(text.replace("", np.nan), errors="coerce")
-    bad = values.isna() & (text != "")
-    if bad.any():
-        i = bad.idxmax()
-        raise ValueError(f"{path}: row {rows[i]}, column {col!r}: {raw[i]!r} is not a number")
+def _parse_sizes(raw: pd.Series, path, col: str, rows: np.ndarray, decimal=None) -> pd.Series:
+    values = parse_numbers(raw, path, col, rows, decimal=decimal)
     nonpos = values.notna() & ~(values > 0)
     if nonpos.any():
         i = nonpos.idxmax()
@@ -418,7 +376,8 @@ def _parse_sizes(raw: pd.Series, path, col: str, rows: np.ndarray) -> pd.Series:
 
 def read_inventory(path, *, start=None, end=None, duration_years=None, density_kg_m3=None,
                    volume_column=None, mass_column=None, date_column=None, location_column=None,
-                   mass_unit=None, volume_unit=None) -> Inventory:
+                   mass_unit=None, volume_unit=None, sheet=None, header_row=None, encoding=None, decimal=None,
+                   date_format=None, duplicates=None) -> Inventory:
     """Read a rock fall inventory from CSV, Excel (.xlsx) or Parquet.
 
     Parameters
@@ -438,8 +397,23 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         ``mass``/``masse``/``mass_kg``/``Mass [t]``, ``date``/``datum``/``year``, ...
     mass_unit : {"kg", "t"}, optional
         Unit of the mass column when its name does not say (default kg).
-    volume_unit : {"m3", "dm3", "cm3"}, optional
-        Unit of the volume column when its name does not say (default m³).
+    volume_unit : {"m3", "dm3", "l", "litre", "cm3"}, optional
+        Unit of the volume column when its name does not say (default m³).  Giving it
+        also confirms volumes that look implausibly large for m³ (see Notes).
+    sheet, header_row : optional
+        Excel sheet (name, or number counting from 1) and the 1-based row holding
+        the column names (also for text files with title lines above the header).
+    encoding : str, optional
+        Text encoding; default UTF-8 (with or without BOM), else cp1252 with a note.
+    decimal : {".", ","}, optional
+        Decimal mark; default decided per column (:mod:`riskrf.tables`).
+    date_format : str, optional
+        ``strftime`` pattern of every date, e.g. ``"%d/%m/%Y"``; needed only when
+        the dates are ambiguous (:mod:`riskrf.tables`).
+    duplicates : {"warn", "drop", "keep", "error"}, optional
+        What to do with dated rows that repeat an earlier row exactly.  Default
+        ``"warn"``: kept with a warning, but refused when every dated row has an
+        exact copy (a file appended twice doubles the rate).
 
     Returns
     -------
@@ -455,22 +429,56 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
     and after the last fall).  Rows with an empty size are dropped with a
     warning that lists them; events dated outside the record period are
     excluded with a warning.
+
+    Every reader option (``sheet`` ... ``duplicates``, the column names and units)
+    may also be given in the sidecar's ``[record]`` table; arguments win.  Numbers
+    with decimal commas, dates and encodings follow the rules of
+    :mod:`riskrf.tables` (README, "Input formats").
+
+    Plausibility: when the volume unit was not declared (``volume_unit`` or a unit
+    in the column name such as ``Volume [l]``), volumes whose median exceeds
+    100 m³, or with more than one fall of 10⁵ m³ or more per decade of record,
+    are refused as probable litres or cm³ entered as m³ (declare
+    ``volume_unit="m3"`` to confirm them).
     """
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"inventory file not found: {path}")
-    table = _read_table(path)
-    blank = (table.apply(lambda c: c.str.strip()) == "").all(axis=1)
-    rows = np.arange(len(table)) + (1 if path.suffix.lower() == ".parquet" else 2)
-    table = table.loc[~blank]
-    rows = rows[~blank.to_numpy()]
-    table.index = range(len(table))
-    columns = [c for c in table.columns if not str(c).startswith("Unnamed")]
+    if path.is_dir():
+        raise ValueError(f"{path} is a directory, not an inventory file")
     notes: list[str] = []
 
     def note(msg):
         notes.append(msg)
         warn(msg)
+
+    sidecar, side_path, side_note = _sidecar(path)
+    if side_note:
+        note(side_note)
+    given = dict(volume_column=volume_column, mass_column=mass_column, date_column=date_column,
+                 location_column=location_column, mass_unit=mass_unit, volume_unit=volume_unit, sheet=sheet,
+                 header_row=header_row, encoding=encoding, decimal=decimal, date_format=date_format,
+                 duplicates=duplicates)
+    for key in READER_OPTIONS:
+        if given[key] is None and key in sidecar:
+            given[key] = sidecar[key]
+    (volume_column, mass_column, date_column, location_column, mass_unit, volume_unit, sheet, header_row,
+     encoding, decimal, date_format, duplicates) = given.values()
+    duplicates = duplicates or "warn"
+    if duplicates not in ("warn", "drop", "keep", "error"):
+        raise ValueError(f"duplicates = {duplicates!r} is not one of 'warn', 'drop', 'keep', 'error'")
+    if decimal not in (None, ".", ","):
+        raise ValueError(f"decimal = {decimal!r} is not '.' or ','")
+    table, first_row, read_notes = read_table(path, sheet=sheet, header_row=header_row, encoding=encoding,
+                                              what="inventory")
+    for msg in read_notes:
+        note(msg)
+    blank = is_blank(table)
+    rows = np.arange(len(table)) + first_row
+    table = table.loc[~blank]
+    rows = rows[~blank.to_numpy()]
+    table.index = range(len(table))
+    columns = [c for c in table.columns if not str(c).startswith("Unnamed")]
 
     vcol, vunit = (volume_column, None) if volume_column else _find_column(columns, _VOLUME_NAMES, _VOLUME_UNITS)
     mcol, munit = (mass_column, None) if mass_column else _find_column(columns, _MASS_NAMES, _MASS_UNITS)
@@ -479,15 +487,16 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         if given is not None and given not in table.columns:
             raise ValueError(f"{path}: {what} = {given!r} is not a column; columns are {columns}")
     if vcol is None and mcol is None:
+        hint = (" (is the header on another row or sheet? pass header_row=/sheet=, CLI --header-row/--sheet)"
+                if path.suffix.lower() in (".xlsx", ".xlsm", ".csv", ".txt", ".tsv") else "")
         raise ValueError(f"{path}: no volume or mass column found among {columns}; name one 'volume_m3' or "
-                         "'mass_kg', or pass volume_column=/mass_column=")
+                         f"'mass_kg', or pass volume_column=/mass_column={hint}")
     if table.empty:
         raise ValueError(f"{path}: the inventory has no rows")
     dcol = date_column or _find_column(columns, _DATE_NAMES)[0]
     lcol = location_column or _find_column(columns, _LOCATION_NAMES)[0]
     ncol = _find_column(columns, _NOTES_NAMES)[0]
 
-    sidecar, side_path = _sidecar(path)
     if density_kg_m3 is None and "density_kg_m3" in sidecar:
         density_kg_m3 = sidecar["density_kg_m3"]
     density_is_default = density_kg_m3 is None
@@ -498,13 +507,13 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         if unit not in _VOLUME_UNITS:
             raise ValueError(f"volume_unit = {volume_unit!r} is not one of {sorted(_VOLUME_UNITS)}")
         vtext, vcens = _split_censored(table[vcol])
-        volume = _parse_sizes(vtext, path, vcol, rows) * _VOLUME_UNITS[unit]
+        volume = _parse_sizes(vtext, path, vcol, rows, decimal) * _VOLUME_UNITS[unit]
     if mcol is not None:
         unit = mass_unit or munit or "kg"
         if unit not in _MASS_UNITS:
             raise ValueError(f"mass_unit = {mass_unit!r} is not one of {sorted(_MASS_UNITS)}")
         mtext, mcens = _split_censored(table[mcol])
-        mass = _parse_sizes(mtext, path, mcol, rows) * _MASS_UNITS[unit]
+        mass = _parse_sizes(mtext, path, mcol, rows, decimal) * _MASS_UNITS[unit]
     if vcol is None:
         volume = mass / density
         size_column, censoring, size_raw = "mass", mcens, table[mcol]
@@ -523,7 +532,7 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
              f"{'volume to mass' if size_column == 'volume' else 'mass to volume'}")
 
     if dcol is not None:
-        dates, years = _parse_dates(table[dcol].astype(str), path, dcol, rows)
+        dates, years = parse_dates(table[dcol].astype(str), path, dcol, rows, date_format=date_format)
     else:
         dates = pd.Series(pd.NaT, index=table.index, dtype="datetime64[ns]")
         years = pd.Series(pd.NA, index=table.index, dtype="Int64")
@@ -541,6 +550,7 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         note(f"{path}: {len(lines)} row(s) have no size and are left out of the size fits (rows "
              f"{', '.join(map(str, lines[:12]))}{' ...' if len(lines) > 12 else ''}); they are kept in "
              "Inventory.censored and counted by rate models")
+    events = _check_duplicates(events, table, path, duplicates, note)
 
     # Record period.
     if start is not None or end is not None:
@@ -603,7 +613,72 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         raise ValueError(f"{path}: no usable events (every row lacked an exact size or lay outside the record "
                          "period)")
     events = events.reset_index(drop=True)
+    _check_plausible_sizes(events, path, vcol if vcol is not None else mcol, vcol is not None,
+                           # a unit in the column name counts as declared unless it is the default one:
+                           # litres typed into a 'volume_m3' column are exactly the mistake to catch
+                           (volume_unit or (vunit if vunit != "m3" else None)) if vcol is not None
+                           else (mass_unit or (munit if munit != "kg" else None)), duration_years, note)
     return Inventory(events=events, duration_years=duration_years, start=start, end=end,
                      density_kg_m3=density, density_is_default=density_is_default, source=str(path),
                      period_source=period_source, size_column=size_column,
                      site=str(sidecar.get("site", "")), notes=tuple(notes), censored=censored)
+
+
+def _line_list(lines, limit=12) -> str:
+    return ", ".join(map(str, lines[:limit])) + (" ..." if len(lines) > limit else "")
+
+
+def _check_duplicates(events, table, path, policy, note):
+    """Dated rows repeating an earlier row exactly: counted; kept, dropped or refused by ``policy``."""
+    dated = events["date"].notna()
+    if policy == "keep" or not dated.any():
+        return events
+    dup = table.loc[events.index].duplicated(keep="first") & dated
+    k = int(dup.sum())
+    if k == 0:
+        return events
+    lines = events.loc[dup, "source_row"].tolist()
+    what = (f"{path}: {k} of {int(dated.sum())} rows repeat an earlier row exactly (duplicate "
+            f"{'row' if k == 1 else 'rows'} {_line_list(lines)})")
+    if policy == "drop":
+        note(f"{what}; the {k} duplicate rows are dropped as asked (duplicates='drop')")
+        return events.loc[~dup]
+    copied = table.loc[events.index].duplicated(keep=False)
+    if policy == "error" or bool(copied[dated].all()):
+        raise ValueError(f"{what}: a file appended twice doubles the rate of falls.  Pass duplicates='drop' "
+                         "(CLI --duplicates drop) to remove them, or duplicates='keep' if they are distinct falls")
+    note(f"{what}; they are kept as distinct falls (pass duplicates='drop' to remove them)")
+    return events
+
+
+#: Above these, sizes given "in m3" are probably litres or cm3 (or grams given as kg).
+PLAUSIBLE_MEDIAN_M3 = 100.0
+PLAUSIBLE_LARGE_M3 = 1e5
+PLAUSIBLE_LARGE_PER_YEAR = 0.1
+
+
+def _check_plausible_sizes(events, path, col, is_volume, declared_unit, duration_years, note):
+    """Refuse sizes that look like a unit mistake unless the unit was declared (see :func:`read_inventory`)."""
+    v = events["volume_m3"].to_numpy(dtype=float)
+    med = float(np.median(v))
+    large = int((v >= PLAUSIBLE_LARGE_M3).sum())
+    rate = large / duration_years
+    if is_volume:
+        if declared_unit is not None:
+            return
+        if med > PLAUSIBLE_MEDIAN_M3 or rate > PLAUSIBLE_LARGE_PER_YEAR:
+            raise ValueError(
+                f"{path}: column {col!r}: median {med:.3g} m3 and {large} fall(s) of 10^5 m3 or more "
+                f"({rate:.2g} a year) look like litres or cm3 entered as m3 (a rock fall inventory's median is "
+                "usually below 10 m3, and a 10^5 m3 fall is a rock avalanche).  Declare the unit: "
+                "volume_unit='l', 'cm3' or, if the volumes are right, 'm3' (CLI --volume-unit, sidecar "
+                "volume_unit)")
+        return
+    m = events["mass_kg"].to_numpy(dtype=float)
+    if declared_unit is None and (med > PLAUSIBLE_MEDIAN_M3 or rate > PLAUSIBLE_LARGE_PER_YEAR):
+        raise ValueError(
+            f"{path}: column {col!r}: median mass {np.median(m):.3g} kg ({med:.3g} m3) looks like grams entered "
+            "as kg.  Declare the unit: mass_unit='kg' if the masses are right (CLI --mass-unit, sidecar mass_unit)")
+    if declared_unit is None and np.median(m) < 1.0:
+        note(f"{path}: column {col!r}: median mass {np.median(m):.3g} kg is below 1 kg; if the masses are in "
+             "tonnes, declare mass_unit='t' (CLI --mass-unit)")

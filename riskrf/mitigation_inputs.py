@@ -486,6 +486,9 @@ def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
             used.append(f"consequences.{key}: ASSUMPTION size-dependent curve {getattr(consequences, key)} "
                         "(mass_kg, probability of death)")
     economics = Economics(**_table(data.get("economics", {}), Economics, "economics", source, used))
+    if not economics.horizon_years > 0:
+        raise MitigationError(f"{source}: economics.horizon_years = {economics.horizon_years!r} must be > 0 years "
+                              "(the period over which costs and losses are counted)")
     if economics.discount_rate >= 1:
         raise MitigationError(f"{source}: economics.discount_rate = {economics.discount_rate!r} must be a rate "
                               "below 1 (e.g. 0.03)")

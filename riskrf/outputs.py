@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import contextlib
+import csv
 import json
 import math
 import os
@@ -13,33 +14,147 @@ import numpy as np
 import pandas as pd
 
 
-@contextlib.contextmanager
-def atomic_output_dir(path):
-    """Yield a temporary directory whose files are moved into ``path`` only on success.
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
-    On any exception the temporary directory is removed and ``path`` is left as
-    it was (a new ``path`` is not created).  Each file is moved with
-    :func:`os.replace`, so a reader never sees a half-written file.
+
+def check_output(path, *, overwrite: bool = False, kind: str = "dir", option: str = "--out") -> Path:
+    """Refuse an output that would clobber something, before any work starts.
+
+    ``kind="dir"``: an existing file is always refused; an existing non-empty
+    directory is refused unless ``overwrite`` (it is then replaced whole, see
+    :func:`atomic_outputs`); an empty one is used.  ``kind="file"``: an existing
+    directory is always refused, an existing file unless ``overwrite``.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.partial-", dir=path.parent))
-    try:
-        yield tmp
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    if not path.exists():
-        os.replace(tmp, path)
-        return
-    for item in sorted(tmp.rglob("*")):
-        target = path / item.relative_to(tmp)
+    for parent in path.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(f"{option} {path}: {parent} is a file, not a directory")
+            break
+    if kind == "dir":
+        if path.exists() and not path.is_dir():
+            raise ValueError(f"{option} {path} is a file; name a new directory for the outputs (an existing file "
+                             "is never replaced by a directory, even with --overwrite)")
+        if path.is_dir() and any(path.iterdir()) and not overwrite:
+            raise ValueError(f"{option} {path} already exists and is not empty; choose a new name, or pass "
+                             "--overwrite to replace it whole (its current files are removed)")
+    else:
+        if path.is_dir():
+            raise ValueError(f"{option} {path} is a directory; name a .parquet or .csv file")
+        if path.exists() and not overwrite:
+            raise ValueError(f"{option} {path} already exists; choose a new name, or pass --overwrite to replace it")
+    return path
+
+
+_FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
+
+
+def _neutralise_cell(cell: str) -> str:
+    if cell and cell.startswith(_FORMULA_START):
+        try:
+            float(cell)
+            return cell
+        except ValueError:
+            return "'" + cell
+    return cell
+
+
+def neutralise_csv(path) -> None:
+    """Prefix with ``'`` every text cell that a spreadsheet would execute as a formula (=, +, -, @)."""
+    path = Path(path)
+    with open(path, newline="", encoding="utf-8", errors="surrogateescape") as fh:
+        rows = list(csv.reader(fh))
+    changed = False
+    for row in rows:
+        for j, cell in enumerate(row):
+            new = _neutralise_cell(cell)
+            if new is not cell:
+                row[j] = new
+                changed = True
+    if changed:
+        with open(path, "w", newline="", encoding="utf-8", errors="surrogateescape") as fh:
+            csv.writer(fh, lineterminator="\n").writerows(rows)
+
+
+def _finish(tmp: Path) -> None:
+    """Permissions by the user's umask (temporary names are created private) and safe CSV cells."""
+    mode_dir, mode_file = 0o777 & ~_umask(), 0o666 & ~_umask()
+    items = [tmp] + (sorted(tmp.rglob("*")) if tmp.is_dir() else [])
+    for item in items:
         if item.is_dir():
-            target.mkdir(parents=True, exist_ok=True)
-        else:
-            target.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(item, target)
-    shutil.rmtree(tmp, ignore_errors=True)
+            os.chmod(item, mode_dir)
+        elif item.is_file():
+            os.chmod(item, mode_file)
+            if item.suffix.lower() == ".csv":
+                neutralise_csv(item)
+
+
+@contextlib.contextmanager
+def atomic_outputs(targets, *, overwrite: bool = False, option: str = "--out"):
+    """Write several outputs (directories and files) that appear together or not at all.
+
+    ``targets`` is a list of ``(path, kind)`` with kind ``"dir"`` or ``"file"``.  Yields the
+    list of temporary siblings to write into (a directory, or a file name for a file).  On
+    success each is renamed into place; an existing target is replaced only with ``overwrite``
+    (it is renamed aside first and restored if a later rename fails).  On any exception,
+    including Ctrl-C, the temporary siblings are removed and the targets are left as they were.
+    """
+    targets = [(Path(p), k) for p, k in targets]
+    for p, k in targets:
+        check_output(p, overwrite=overwrite, kind=k, option=option)
+    tmps = []
+    try:
+        for p, k in targets:
+            p.parent.mkdir(parents=True, exist_ok=True)
+            if k == "dir":
+                tmps.append(Path(tempfile.mkdtemp(prefix=f".{p.name}.partial-", dir=p.parent)))
+            else:
+                fd, name = tempfile.mkstemp(prefix=f".{p.stem}.partial-", suffix=p.suffix, dir=p.parent)
+                os.close(fd)
+                tmps.append(Path(name))
+        yield tmps if len(tmps) > 1 else tmps[0]
+        for (p, k), tmp in zip(targets, tmps):
+            check_output(p, overwrite=overwrite, kind=k, option=option)    # nothing appeared meanwhile
+            _finish(tmp)
+        moved, aside = [], []
+        try:
+            for (p, k), tmp in zip(targets, tmps):
+                if p.exists() and (k == "file" or any(p.iterdir())):
+                    old = p.with_name(f".{p.name}.replaced-{os.getpid()}")
+                    os.replace(p, old)
+                    aside.append((p, old))
+                elif p.is_dir():
+                    p.rmdir()
+                os.replace(tmp, p)
+                moved.append(p)
+        except BaseException:
+            for p in moved:
+                shutil.rmtree(p, ignore_errors=True) if p.is_dir() else p.unlink(missing_ok=True)
+            for p, old in aside:
+                os.replace(old, p)
+            raise
+        for _, old in aside:
+            shutil.rmtree(old, ignore_errors=True) if old.is_dir() else old.unlink(missing_ok=True)
+    finally:
+        for tmp in tmps:
+            if tmp.is_dir():
+                shutil.rmtree(tmp, ignore_errors=True)
+            else:
+                tmp.unlink(missing_ok=True)
+
+
+@contextlib.contextmanager
+def atomic_output_dir(path, *, overwrite: bool = False):
+    """Yield a temporary directory that replaces ``path`` only on success (see :func:`atomic_outputs`).
+
+    An existing non-empty ``path`` is refused unless ``overwrite``, and then replaced whole
+    (never merged); an existing file is always refused.
+    """
+    with atomic_outputs([(path, "dir")], overwrite=overwrite) as tmp:
+        yield tmp
 
 
 def _clean(value):

@@ -8,6 +8,7 @@ the report can state them.  Everything is checked before any computing starts.
 from __future__ import annotations
 
 import difflib
+import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,11 +24,15 @@ SITE_FIELDS = {
     "site": {"name": None, "description": ""},
     "inventory": {"path": None, "start": None, "end": None, "duration_years": None, "density_kg_m3": None,
                   "m_min_kg": None, "m_max_kg": None, "rate_scale": 1.0, "annual_maxima": None,
-                  "sizes": "event_volumes"},
+                  "sizes": "event_volumes",
+                  # reader options (README "Input formats"); None = the reader's rule or the sidecar's value
+                  "sheet": None, "header_row": None, "encoding": None, "decimal": None, "date_format": None,
+                  "volume_unit": None, "mass_unit": None, "duplicates": None, "volume_column": None,
+                  "mass_column": None, "date_column": None, "location_column": None},
     "hazard": {"scenario": None, "velocities": None, "collector": None, "road_collector": "road",
                "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
                "free_board_m": 0.5, "design_period_years": 100.0, "bootstrap": 300, "seed": 1,
-               "option_blocks": 20_000, "mass_coupling": "simulated"},
+               "option_blocks": 20_000, "mass_coupling": "simulated", "velocity_unit": None},
     "design_block": {"rule": "return_period", "percentile": 97.0, "survey": None, "fractal_dimension": None,
                      "iterations": None},
 }
@@ -60,6 +65,8 @@ def load_site(path) -> Site:
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"site file not found: {path}")
+    if path.is_dir():
+        raise SiteError(f"{path} is a directory; give the site file (.toml) inside it")
     try:
         with open(path, "rb") as fh:
             data = tomllib.load(fh)
@@ -107,10 +114,25 @@ def load_site(path) -> Site:
                             f"hazard.fences_kj ({len(hz['fences_kj'])})")
     elif isinstance(fh, bool) or not isinstance(fh, (int, float)) or fh <= 0:
         raise SiteError(f"{path}: hazard.fence_height_m = {fh!r} must be a number > 0 (or a list, one per fence)")
-    for key in ("free_board_m", "design_period_years"):
-        if not isinstance(hz[key], (int, float)) or hz[key] < 0:
-            raise SiteError(f"{path}: hazard.{key} = {hz[key]!r} must be a number >= 0")
+    def number(v):
+        return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    if not number(hz["free_board_m"]) or hz["free_board_m"] < 0:
+        raise SiteError(f"{path}: hazard.free_board_m = {hz['free_board_m']!r} must be a number >= 0 m")
+    if not number(hz["design_period_years"]) or hz["design_period_years"] <= 1:
+        raise SiteError(f"{path}: hazard.design_period_years = {hz['design_period_years']!r} must be a number > 1 "
+                        "year (a T-year event has annual probability 1/T)")
+    if not number(hz["reach_probability"]) or not 0 < hz["reach_probability"] <= 1:
+        raise SiteError(f"{path}: hazard.reach_probability = {hz['reach_probability']!r} must be a probability in "
+                        "(0, 1]")
+    if hz["velocity_unit"] not in (None, "m/s", "km/h"):
+        raise SiteError(f"{path}: hazard.velocity_unit = {hz['velocity_unit']!r} is not 'm/s' or 'km/h'")
     inv = tables["inventory"]
+    for key in ("m_min_kg", "m_max_kg", "density_kg_m3", "duration_years"):
+        if inv[key] is not None and (not number(inv[key]) or inv[key] <= 0):
+            raise SiteError(f"{path}: inventory.{key} = {inv[key]!r} must be a number > 0")
+    if inv["m_min_kg"] is not None and inv["m_max_kg"] is not None and inv["m_min_kg"] >= inv["m_max_kg"]:
+        raise SiteError(f"{path}: inventory.m_min_kg = {inv['m_min_kg']!r} must be below inventory.m_max_kg = "
+                        f"{inv['m_max_kg']!r}")
     if not isinstance(inv["rate_scale"], (int, float)) or not 0 < inv["rate_scale"] <= 1e6:
         raise SiteError(f"{path}: inventory.rate_scale = {inv['rate_scale']!r} must be a number > 0")
     _check_design_block(tables, path)
@@ -132,6 +154,13 @@ def load_site(path) -> Site:
         if hz["road_collector"] not in names and "road_collector" in data.get("hazard", {}):
             raise SiteError(f"{path}: hazard.road_collector = {hz['road_collector']!r}: scenario {hz['scenario']!r} "
                             f"has no such collector; its collectors are {names}")
+    if hz["velocities"] is not None:         # read now: a bad velocity file is found before the fits run
+        from .velocities import read_velocities
+        try:
+            read_velocities(path.parent / hz["velocities"], collector=hz["collector"],
+                            velocity_unit=hz["velocity_unit"])
+        except ValueError as exc:
+            raise SiteError(f"{path}: hazard.velocities = {hz['velocities']!r}: {exc}") from exc
     mit = {k: data[k] for k in MITIGATION_TABLES if k in data}
     try:
         mitigation = study_inputs(mit, str(path))

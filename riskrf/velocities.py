@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .inventory import sniff_delimiter
+from .tables import sniff_delimiter  # noqa: F401 (re-exported: public before)
 
 #: Accepted column names after normalisation (lower case, units and punctuation stripped).
 COLUMN_NAMES = {
@@ -30,48 +30,92 @@ def _norm(name: str) -> str:
     return s
 
 
-def read_velocities(path, *, collector: str | None = None) -> pd.DataFrame:
+#: Velocity units accepted by ``velocity_unit`` and recognised at the end of a column name.
+VELOCITY_UNITS = {"m/s": 1.0, "ms": 1.0, "km/h": 1 / 3.6, "kmh": 1 / 3.6}
+_KMH_NAMES = ("velocity_kmh", "velocity_km_h", "speed_kmh", "speed_km_h", "v_kmh", "v_km_h",
+              "translational_velocity_km_h", "translational_velocity_kmh")
+#: Above this median, velocities "in m/s" are probably km/h: a free fall of 130 m gives 50 m/s, and rock fall
+#: velocities at barriers are mostly 5-35 m/s (Wyllie 2014, chapter 5).
+PLAUSIBLE_MEDIAN_MS = 50.0
+
+
+def read_velocities(path, *, collector: str | None = None, velocity_unit: str | None = None, decimal=None,
+                    sheet=None, header_row=None, encoding=None) -> pd.DataFrame:
     """Velocity samples [m/s] (and heights [m], angular velocities [rad/s], masses [kg] when present).
 
-    Reads CSV or Parquet.  Columns are matched case-insensitively after removing
+    Reads CSV/TXT, Excel or Parquet with the rules of :mod:`riskrf.tables` (separators,
+    decimal commas, encodings).  Columns are matched case-insensitively after removing
     units and punctuation: ``velocity_ms`` (or ``velocity``, ``Translational
-    Velocity (m/s)``, ``speed``), ``height_m`` (``Bounce Height (m)``, ``jump
-    height``), ``angular_velocity_rads`` (``Rotational Velocity (rad/s)``),
-    ``mass_kg``, ``radius_m`` and ``collector``.  With ``collector`` only that
-    collector's rows are kept.  Raises naming the file and the columns found.
+    Velocity (m/s)``, ``speed``; ``Velocity (km/h)`` is converted), ``height_m``
+    (``Bounce Height (m)``, ``jump height``), ``angular_velocity_rads`` (``Rotational
+    Velocity (rad/s)``), ``mass_kg``, ``radius_m`` and ``collector``.  With
+    ``collector`` only that collector's rows are kept.
+
+    ``velocity_unit`` ("m/s" or "km/h") declares the unit of the velocity column.
+    Without it, a median velocity above 50 m/s is refused as probable km/h.
+    Velocities must be finite and >= 0, heights finite and >= 0, every cell filled.
+    Raises naming the file, row, column and value.
     """
+    from .tables import parse_numbers, read_table
     path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"velocity file not found: {path}")
-    if path.suffix.lower() == ".parquet":
-        raw = pd.read_parquet(path)
-    elif path.suffix.lower() in (".csv", ".txt"):
-        raw = pd.read_csv(path, sep=sniff_delimiter(path))
-    else:
-        raise ValueError(f"{path}: unsupported velocity file type {path.suffix!r}; use .csv or .parquet")
+    if velocity_unit is not None and velocity_unit not in VELOCITY_UNITS:
+        raise ValueError(f"velocity_unit = {velocity_unit!r} is not one of 'm/s', 'km/h'")
+    raw, first_row, _ = read_table(path, sheet=sheet, header_row=header_row, encoding=encoding,
+                                   what="velocity")
     found = {}
+    factor = VELOCITY_UNITS[velocity_unit] if velocity_unit else 1.0
     for col in raw.columns:
         n = _norm(col)
+        if n in _KMH_NAMES and "velocity_ms" not in found:
+            found["velocity_ms"] = col
+            if velocity_unit is None:
+                factor, velocity_unit = 1 / 3.6, "km/h"
+            continue
         for target, names in COLUMN_NAMES.items():
             if n in names and target not in found:
                 found[target] = col
     if "velocity_ms" not in found:
         raise ValueError(f"{path}: no velocity column among {list(raw.columns)}; expected one named "
-                         "'velocity_ms' (or 'velocity', 'Translational Velocity (m/s)', 'speed')")
+                         "'velocity_ms' (or 'velocity', 'Translational Velocity (m/s)', 'speed', 'velocity_kmh')")
     df = raw[list(found.values())].rename(columns={v: k for k, v in found.items()})
+    rows = np.arange(len(df)) + first_row
     if collector is not None:
         if "collector" not in df:
             raise ValueError(f"{path}: --collector {collector!r} given but the file has no 'collector' column")
         names = sorted(df["collector"].astype(str).unique())
-        df = df[df["collector"].astype(str) == collector]
+        keep = (df["collector"].astype(str) == collector).to_numpy()
+        df, rows = df[keep], rows[keep]
         if df.empty:
             raise ValueError(f"{path}: no rows for collector {collector!r}; collectors in the file: {names}")
-    v = pd.to_numeric(df["velocity_ms"], errors="coerce")
-    bad = v.isna() | (v < 0) | ~np.isfinite(v.fillna(0))
-    if bad.any():
-        i = int(np.argmax(bad.to_numpy()))
-        raise ValueError(f"{path}: row {df.index[i] + 2}, column {found['velocity_ms']!r}: "
-                         f"{df['velocity_ms'].iloc[i]!r} is not a velocity >= 0")
     if df.empty:
         raise ValueError(f"{path}: the file has no velocity samples")
-    return df.reset_index(drop=True)
+    df = df.reset_index(drop=True)
+    out = pd.DataFrame(index=df.index)
+    for target in ("velocity_ms", "height_m", "angular_velocity_rads", "mass_kg", "radius_m"):
+        if target not in df:
+            continue
+        col = found[target]
+        values = parse_numbers(df[target], path, col, rows, decimal=decimal)
+        lower = None if target == "angular_velocity_rads" else 0.0
+        bad = ~np.isfinite(values.to_numpy(dtype=float))
+        if lower is not None:
+            bad |= values.to_numpy(dtype=float) < lower
+        if target in ("mass_kg", "radius_m"):
+            bad |= values.to_numpy(dtype=float) <= 0
+        if bad.any():
+            i = int(np.argmax(bad))
+            need = {"velocity_ms": "a velocity >= 0", "height_m": "a height >= 0 (m above the slope)",
+                    "angular_velocity_rads": "a finite angular velocity", "mass_kg": "a mass > 0",
+                    "radius_m": "a radius > 0"}[target]
+            raise ValueError(f"{path}: row {rows[i]}, column {col!r}: {df[target].iloc[i]!r} is not {need}")
+        out[target] = values.to_numpy(dtype=float)
+    if "collector" in df:
+        out["collector"] = df["collector"].astype(str).to_numpy()
+    out["velocity_ms"] = out["velocity_ms"] * factor
+    med = float(np.median(out["velocity_ms"]))
+    if velocity_unit is None and med > PLAUSIBLE_MEDIAN_MS:
+        raise ValueError(f"{path}: column {found['velocity_ms']!r}: median {med:.3g} m/s is more than a free fall of "
+                         f"{med ** 2 / (2 * 9.81):.0f} m gives and looks like km/h entered as m/s (rock fall "
+                         "velocities are mostly 5-35 m/s).  Declare the unit: velocity_unit='km/h' or, if the values "
+                         "are right, 'm/s' (CLI --velocity-unit)")
+    return out

@@ -176,19 +176,23 @@ def _check_parameters(data: dict, parameters, source: str) -> dict:
 
 
 # ---- observations -----------------------------------------------------------------------------------------
-def read_observed(path, *, column: str = "x_stop_m", select: dict | None = None) -> pd.DataFrame:
+def read_observed(path, *, column: str = "x_stop_m", select: dict | None = None,
+                  table: pd.DataFrame | None = None) -> pd.DataFrame:
     """Observed stops from a CSV (or Parquet/XLSX) file: column ``x_stop_m`` [m], optionally collector columns.
 
     ``select`` keeps rows whose columns equal the given values (e.g.
     ``{"profile": "P1"}``).  Without an ``x_stop_m`` column, a file with
-    exactly one numeric column uses that column.
+    exactly one numeric column uses that column.  ``table``: the file already read (by a reader
+    with other rules, e.g. ``riskrf``'s for decimal commas); ``path`` then only names it.
     """
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"observed file not found: {path}")
     suffix = path.suffix.lower()
     try:
-        if suffix == ".parquet":
+        if table is not None:
+            df = table
+        elif suffix == ".parquet":
             df = pd.read_parquet(path)
         elif suffix in (".xlsx", ".xls"):
             df = pd.read_excel(path)

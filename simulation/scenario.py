@@ -75,6 +75,8 @@ class Distribution:
                 raise ScenarioError(f"{source}: {where} ({kind}) needs {k!r}")
         if kind in ("uniform", "triangular") and not p["low"] <= p.get("mode", p["low"]) <= p["high"]:
             raise ScenarioError(f"{source}: {where} needs low <= mode <= high; got {spec}")
+        if "min" in p and "max" in p and not p["min"] < p["max"]:
+            raise ScenarioError(f"{source}: {where} needs min < max; got min = {p['min']:g}, max = {p['max']:g}")
         if p.get("std", 0) < 0 or p.get("sigma", 0) < 0:
             raise ScenarioError(f"{source}: {where} spread must be >= 0; got {spec}")
         dist = cls(kind, p)

@@ -1,0 +1,80 @@
+"""Command-line arguments checked before any work starts: each error names the option and its value."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from .outputs import check_output
+
+
+def _num(args, attr):
+    return getattr(args, attr, None)
+
+
+def _fail(option, value, need):
+    shown = f"{value:g}" if isinstance(value, float) else repr(value) if isinstance(value, str) else f"{value}"
+    raise ValueError(f"{option} = {shown}: {need}")
+
+
+def check_number(value, option, *, low=None, high=None, low_open=False, high_open=False, what="") -> None:
+    """Raise unless ``value`` is finite and within the bounds; None passes (not given)."""
+    if value is None:
+        return
+    ok = isinstance(value, (int, float)) and math.isfinite(value)
+    if ok and low is not None:
+        ok = value > low if low_open else value >= low
+    if ok and high is not None:
+        ok = value < high if high_open else value <= high
+    if not ok:
+        lo = "" if low is None else (f"> {low:g}" if low_open else f">= {low:g}")
+        hi = "" if high is None else (f"< {high:g}" if high_open else f"<= {high:g}")
+        _fail(option, value, f"must be a finite number {' and '.join(x for x in (lo, hi) if x)}" + what)
+
+
+def check_inventory_args(args) -> None:
+    """Options shared by fit, energy and decide."""
+    check_number(_num(args, "density"), "--density", low=0, low_open=True, what=" kg/m3")
+    check_number(_num(args, "duration_years"), "--duration-years", low=0, low_open=True, what=" years")
+    check_number(_num(args, "m_min"), "--m-min", low=0, low_open=True, what=" kg")
+    check_number(_num(args, "m_max"), "--m-max", low=0, low_open=True, what=" kg")
+    if _num(args, "m_min") is not None and _num(args, "m_max") is not None and args.m_min >= args.m_max:
+        raise ValueError(f"--m-min = {args.m_min:g} kg must be below --m-max = {args.m_max:g} kg")
+    check_number(_num(args, "bootstrap"), "--bootstrap", low=0)
+    for attr, opt in (("header_row", "--header-row"),):
+        check_number(_num(args, attr), opt, low=1)
+
+
+def check_energy_args(args, *, road_collector=None) -> None:
+    """Every option `riskrf energy` and `riskrf decide --options` will use, with the scenario's collectors."""
+    check_inventory_args(args)
+    check_number(args.n, "-n", low=1)
+    check_number(args.reach_probability, "--reach-probability", low=0, high=1, low_open=True)
+    check_number(args.rate_scale, "--rate-scale", low=0, low_open=True)
+    if hasattr(args, "design_period"):
+        check_number(args.design_period, "--design-period", low=1, low_open=True,
+                     what=" years (a T-year event has annual probability 1/T)")
+        check_number(args.fence_height, "--fence-height", low=0, low_open=True, what=" m")
+        check_number(args.free_board, "--free-board", low=0, what=" m")
+        for cap in args.fence or ():
+            check_number(cap, "--fence", low=0, low_open=True, what=" kJ")
+    if (args.scenario is None) == (args.velocities is None):
+        raise ValueError("give exactly one of --scenario (simulate the velocities) or --velocities (a file)")
+    if args.velocities is not None and not Path(args.velocities).is_file():
+        raise FileNotFoundError(f"--velocities {args.velocities}: file not found")
+    if args.scenario is not None:
+        import simulation
+        sc = simulation.load_scenario(args.scenario)
+        names = [c.name for c in sc.collectors]
+        collector = args.collector or "barrier"
+        if collector not in names:
+            raise ValueError(f"--collector = {collector!r}: scenario {Path(args.scenario).name} has no such collector; "
+                             f"its collectors are {names}")
+        if road_collector is not None and road_collector not in names:
+            raise ValueError(f"--road-collector = {road_collector!r}: scenario {Path(args.scenario).name} has no such "
+                             f"collector; its collectors are {names}")
+
+
+def check_out(args, default, *, kind="dir") -> Path:
+    """The output path of a command, refused up front when it would clobber something."""
+    out = Path(args.out) if getattr(args, "out", None) else Path(default)
+    return check_output(out, overwrite=getattr(args, "overwrite", False), kind=kind)
