@@ -259,14 +259,17 @@ def roll_on_speed(v_along, w, r, k):
 
 
 @njit(cache=True)
-def barrier_outcome(energy_kj, centre_height_m, radius_m, capacity_kj, height_m):
+def barrier_outcome(energy_kj, underside_height_m, capacity_kj, height_m):
     """Outcome of a block meeting a flexible barrier, and the share of its kinetic energy kept.
 
-    The block passes over when its lowest point (centre height minus radius) is above the barrier
-    height; otherwise the barrier holds it when the energy is within the capacity (MEL) and lets it
-    through with the excess energy (E - capacity) when not.  Returns (outcome, energy share kept).
+    The simulated point is the block's underside (the point that touches the ground: impacts occur when
+    it reaches the profile and a rolling block has height 0), so the block passes over when that point
+    is above the barrier height; a block whose centre (height + radius) is above the barrier but whose
+    underside is not is stopped by it.  Otherwise the barrier holds the block when the energy is within
+    the capacity (MEL) and lets it through with the excess energy (E - capacity) when not.
+    Returns (outcome, energy share kept).
     """
-    if centre_height_m - radius_m > height_m:
+    if underside_height_m > height_m:
         return BARRIER_OVER, 1.0
     if energy_kj <= capacity_kj:
         return BARRIER_CAUGHT, 0.0
@@ -391,7 +394,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     keep = 1.0
                     if not math.isnan(c_cap[j]):
                         e = (0.5 * mass * (vx * vx + vzc * vzc) + 0.5 * inertia * w * w) / J_PER_KJ
-                        outcome, keep = barrier_outcome(e, h, r, c_cap[j], c_h[j])
+                        outcome, keep = barrier_outcome(e, h, c_cap[j], c_h[j])
                     _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
                                      bid, j, t_abs + tc, vx, vzc, w, h, outcome)
                     if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
@@ -428,6 +431,9 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                                      MODE_STOP, EV_LEFT)
                     break
                 seg = k
+                # The hit is accepted within a rounding tolerance of the segment's ends: bring it onto the
+                # segment itself, so the block is never placed on the line's extension below a neighbour.
+                x = min(max(x, px[k]), px[k + 1])
                 z = pz[k] + (pz[k + 1] - pz[k]) * (x - px[k]) / (px[k + 1] - px[k])
                 # Impact on segment k.
                 impacts += 1
@@ -549,7 +555,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 keep = 1.0
                 if not math.isnan(c_cap[j]):
                     e = (0.5 * mass * uc * uc + 0.5 * inertia * wc * wc) / J_PER_KJ
-                    outcome, keep = barrier_outcome(e, 0.0, r, c_cap[j], c_h[j])
+                    outcome, keep = barrier_outcome(e, 0.0, c_cap[j], c_h[j])
                 _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
                                  bid, j, t_abs + tc, vxc, vzc, wc, 0.0, outcome)
                 if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
@@ -601,7 +607,10 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             c2x, c2z = px[k2 + 1] - px[k2], pz[k2 + 1] - pz[k2]
             l2 = math.sqrt(c2x * c2x + c2z * c2z)
             cos2, sin2 = c2x / l2, c2z / l2
-            if -vxe * sin2 + vze * cos2 > 1e-9:
+            # A convex edge launches the block when its speed away from the next segment reaches the
+            # contact velocity; below it the block stays in contact (as a landing below it would), so a
+            # finely kinked terrain profile is not turned into thousands of micro-flights and impacts.
+            if -vxe * sin2 + vze * cos2 >= v_contact:
                 contact = False            # convex edge: the block takes off
                 vx, vz = vxe, vze
                 seg = k2
@@ -609,8 +618,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
                                  MODE_FLIGHT, EV_TAKEOFF)
             else:
-                # Concave edge: the velocity normal to the next segment is lost; a rolling block re-rolls
-                # conserving angular momentum about the new contact point.
+                # Concave edge, or a convex one crossed in contact: the velocity normal to the next segment
+                # is lost; a rolling block re-rolls conserving angular momentum about the new contact point.
                 seg = k2
                 v_along = vxe * cos2 + vze * sin2
                 if m_roll[seg_mat[k2]]:

@@ -32,17 +32,17 @@ def observed(profile):
 def test_p1_calibrated_reproduces_the_observed_runout():
     sim, obs = runout("authume_p1_calibrated"), observed("P1")
     assert obs.size == 41
-    assert stats.wasserstein_distance(sim, obs) < 2.0                     # README: 1.4 m
-    assert stats.ks_2samp(sim, obs).pvalue > 0.05                         # README: 0.70
+    assert stats.wasserstein_distance(sim, obs) < 2.0                     # README: 1.5 m
+    assert stats.ks_2samp(sim, obs).pvalue > 0.05                         # README: 0.65
     assert np.percentile(sim, [10, 50, 90]) == pytest.approx(np.percentile(obs, [10, 50, 90]), abs=2.0)
 
 
 def test_p2_calibrated_is_only_partly_reproduced():
-    """Stated in the README: the median is found, the far tail is not (KS rejects)."""
+    """Stated in the README: the quantiles are found, yet KS still rejects at 5 %."""
     sim, obs = runout("authume_p2_calibrated"), observed("P2")
-    assert abs(np.median(sim) - np.median(obs)) < 5.0                     # 52.6 vs 56.4 m
-    assert stats.wasserstein_distance(sim, obs) < 7.0                     # 5.7 m
-    assert stats.ks_2samp(sim, obs).pvalue < 0.01                         # 1e-5: not reproduced in full
+    assert np.percentile(sim, [10, 50, 90]) == pytest.approx(np.percentile(obs, [10, 50, 90]), abs=2.0)
+    assert stats.wasserstein_distance(sim, obs) < 4.0                     # 2.9 m
+    assert 0.005 < stats.ks_2samp(sim, obs).pvalue < 0.05                 # 0.04: not reproduced in full
 
 
 @pytest.mark.parametrize("name, profile", [("authume_p1", "P1"), ("authume_p2", "P2")])
