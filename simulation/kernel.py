@@ -259,17 +259,15 @@ def roll_on_speed(v_along, w, r, k):
 
 
 @njit(cache=True)
-def barrier_outcome(energy_kj, underside_height_m, capacity_kj, height_m):
+def barrier_outcome(energy_kj, centre_height_m, radius_m, capacity_kj, height_m):
     """Outcome of a block meeting a flexible barrier, and the share of its kinetic energy kept.
 
-    The simulated point is the block's underside (the point that touches the ground: impacts occur when
-    it reaches the profile and a rolling block has height 0), so the block passes over when that point
-    is above the barrier height; a block whose centre (height + radius) is above the barrier but whose
-    underside is not is stopped by it.  Otherwise the barrier holds the block when the energy is within
-    the capacity (MEL) and lets it through with the excess energy (E - capacity) when not.
-    Returns (outcome, energy share kept).
+    The simulated point is the lumped mass's centre (which, as in every lumped-mass model, meets the
+    ground as a point), so the block passes over when its underside (centre height minus radius) is
+    above the barrier height; otherwise the barrier holds it when the energy is within the capacity (MEL) and lets it
+    through with the excess energy (E - capacity) when not.  Returns (outcome, energy share kept).
     """
-    if underside_height_m > height_m:
+    if centre_height_m - radius_m > height_m:
         return BARRIER_OVER, 1.0
     if energy_kj <= capacity_kj:
         return BARRIER_CAUGHT, 0.0
@@ -394,7 +392,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     keep = 1.0
                     if not math.isnan(c_cap[j]):
                         e = (0.5 * mass * (vx * vx + vzc * vzc) + 0.5 * inertia * w * w) / J_PER_KJ
-                        outcome, keep = barrier_outcome(e, h, c_cap[j], c_h[j])
+                        outcome, keep = barrier_outcome(e, h, r, c_cap[j], c_h[j])
                     _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
                                      bid, j, t_abs + tc, vx, vzc, w, h, outcome)
                     if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
@@ -555,7 +553,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 keep = 1.0
                 if not math.isnan(c_cap[j]):
                     e = (0.5 * mass * uc * uc + 0.5 * inertia * wc * wc) / J_PER_KJ
-                    outcome, keep = barrier_outcome(e, 0.0, c_cap[j], c_h[j])
+                    outcome, keep = barrier_outcome(e, 0.0, r, c_cap[j], c_h[j])
                 _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
                                  bid, j, t_abs + tc, vxc, vzc, wc, 0.0, outcome)
                 if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:

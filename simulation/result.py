@@ -47,7 +47,7 @@ class SimulationResult:
         """One row per crossing of collector ``name``.
 
         Columns: ``block``, ``time_s``, ``velocity_ms``, ``vx_ms``, ``vz_ms``,
-        ``angular_velocity_rads``, ``height_m`` (of the block's underside, the simulated point, above the
+        ``angular_velocity_rads``, ``height_m`` (of the block centre above the
         ground), ``mass_kg``, ``radius_m``, ``inertia_factor`` (I / m r^2), ``energy_translational_kj``,
         ``energy_rotational_kj``, ``energy_kj`` (total), ``crossing_angle_deg``
         (below horizontal), ``outcome`` (crossed / caught / through / over).
