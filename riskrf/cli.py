@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import os
 import shutil
@@ -200,8 +201,9 @@ def cmd_energy(args) -> int:
                               free_board_m=args.free_board, design_T=args.design_period,
                               density_kg_m3=inv.density_kg_m3, n_bootstrap=args.bootstrap, seed=args.seed,
                               design_block=block, sensitivity=sensitivity)
-    print(f"Inventory {inv.source}: power law b = {gr.b:.4f} ± {gr.b_stderr:.4f} above m_min = {gr.m_min:.5g} kg "
-          f"({gr.n_tail} falls, {gr.rate_min:.4g} per year)" + (f", m_max = {gr.m_max:.5g} kg" if gr.m_max else ""))
+    from .report.format import sig
+    print(f"Inventory {inv.source}: power law b = {gr.b:.4f} ± {gr.b_stderr:.4f} above m_min = {sig(gr.m_min, 5)} kg "
+          f"({gr.n_tail} falls, {sig(gr.rate_min, 4)} per year)" + (f", m_max = {sig(gr.m_max, 5)} kg" if gr.m_max else ""))
     print(analysis.summary_text())
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         analysis.write(tmp)
@@ -709,6 +711,16 @@ def cmd_rates(args) -> int:
     return 0
 
 
+@contextlib.contextmanager
+def _readable_numbers():
+    """Printed tables show 4 significant figures with thousands separators, never ``2.308e+04``."""
+    import pandas as pd
+
+    from .report.format import sig
+    with pd.option_context("display.float_format", lambda v: sig(v, 4), "display.width", 200):
+        yield
+
+
 def main(argv=None) -> int:
     """Entry point of the ``riskrf`` command; returns the exit status (0 ok, 2 bad input)."""
     # Figures are written to files: a non-interactive backend, unless the user chose one.
@@ -723,7 +735,7 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), _readable_numbers():
             warnings.simplefilter("ignore")  # every warning is reported in the printed summary instead
             return args.func(args)
     except KeyboardInterrupt:

@@ -48,51 +48,51 @@ class EnergyAnalysis:
     def summary_text(self) -> str:
         hz = self.hazard
         lines = ["Impact energy hazard at the barrier line (Wyllie 2014, 8.1-8.3)",
-                 f"  falls per year (mass model)   {hz.rate_per_year:.4g}   [{hz.summary().loc['mass model', 'value']}]",
+                 f"  falls per year (mass model)   {sig(hz.rate_per_year, 4)}   [{hz.summary().loc['mass model', 'value']}]",
                  f"  reach probability             {hz.reach_probability:.4f}"
                  + (f"  ({hz.n_released:,} simulated blocks)" if hz.n_released else ""),
-                 f"  arrivals per year             {hz.arrival_rate:.4g}"]
+                 f"  arrivals per year             {sig(hz.arrival_rate, 4)}"]
         for note in hz.notes:
             lines.append(f"  {note}")
         e95, e99 = hz.energy_percentile([95, 99])
-        lines.append(f"  energy per arriving fall      p95 {e95:,.4g} kJ, p99 {e99:,.4g} kJ")
+        lines.append(f"  energy per arriving fall      p95 {sig(e95, 4)} kJ, p99 {sig(e99, 4)} kJ")
         if hz.heights_m is not None:
             lines.append(f"  bounce height                 p95 {hz.height_percentile(95):.3g} m, "
                          f"p99 {hz.height_percentile(99):.3g} m (block centre above the slope)")
         if hz.mass_coupled:
             lines += ["", "Reach, speed and bounce height by block mass (simulated across the mass range):",
-                      hz.velocity.class_table().to_string(index=False, float_format=lambda v: f"{v:,.4g}")]
+                      hz.velocity.class_table().to_string(index=False, float_format=lambda v: sig(v, 4))]
         lines += ["", f"Design energies (interval: {self.n_bootstrap} bootstrap replicates, seed {self.seed}; "
                       f"it covers the {INTERVAL_COVERS}):"]
         d = self.design.copy()
-        lines.append(d.to_string(index=False, float_format=lambda v: f"{v:,.4g}"))
+        lines.append(d.to_string(index=False, float_format=lambda v: sig(v, 4)))
         if self.site_masses is not None:
             lines += ["", "Design masses of the site's law (the hazard's; nothing above m_max) [kg]:",
-                      self.site_masses.drop(columns="law").to_string(index=False, float_format=lambda v: f"{v:,.4g}")]
+                      self.site_masses.drop(columns="law").to_string(index=False, float_format=lambda v: sig(v, 4))]
         if self.design_block is not None:
             b = self.design_block
-            lines += ["", f"Design block: {b.mass_kg:,.4g} kg ({b.volume_m3:,.4g} m3, sphere diameter "
+            lines += ["", f"Design block: {sig(b.mass_kg, 4)} kg ({sig(b.volume_m3, 4)} m3, sphere diameter "
                           f"{b.diameter_m:.3g} m) by rule {b.rule!r}: {b.basis}"]
             lines += [f"  {a}" for a in b.assumptions]
-            lines.append(b.alternatives.to_string(index=False, float_format=lambda v: f"{v:,.4g}"))
+            lines.append(b.alternatives.to_string(index=False, float_format=lambda v: sig(v, 4)))
         if self.sensitivity is not None:
             lines += ["", f"Sensitivity of the {self.design_T:g}-year energy [kJ] to the judgement inputs "
                           "(m_max: rows; rate share: columns):",
-                      sensitivity_grid(self.sensitivity).to_string(float_format=lambda v: f"{v:,.4g}")]
+                      sensitivity_grid(self.sensitivity).to_string(float_format=lambda v: sig(v, 4))]
         if self.uni is not None:
             u = self.uni
             block = u.design_mass_kg / (u.factors["gamma_VolF"] * u.factors["gamma_gamma"])
             what = "design block" if self.design_block is not None else f"{self.design_T:g}-year block"
             lines += ["", f"UNI 11211-4 design energy for the {what} "
-                          f"({block:,.4g} kg) at the p95 velocity: "
-                          f"E_k = {u.characteristic_energy_kj:,.4g} kJ, E_d = {u.design_energy_kj:,.4g} kJ "
+                          f"({sig(block, 4)} kg) at the p95 velocity: "
+                          f"E_k = {sig(u.characteristic_energy_kj, 4)} kJ, E_d = {sig(u.design_energy_kj, 4)} kJ "
                           f"(gamma_Tr {u.factors['gamma_Tr']}, gamma_Dp {u.factors['gamma_Dp']}, "
                           f"gamma_VolF {u.factors['gamma_VolF']}, gamma_gamma {u.factors['gamma_gamma']})"]
         for name, table in self.fences.items():
             lines += ["", f"Fence {name}:"]
             for _, r in table.iterrows():
                 mark = "OK  " if r["adequate"] else "FAIL"
-                lines.append(f"  [{mark}] {r['check']}: {r['demand']:,.4g} {r['unit']} vs {r['capacity']:,.4g} "
+                lines.append(f"  [{mark}] {r['check']}: {sig(r['demand'], 4)} {r['unit']} vs {sig(r['capacity'], 4)} "
                              f"{r['unit']}" + (f" (interval {r['interval']})" if r["interval"] else "")
                              + f"; {r['note']}")
         return "\n".join(lines)

@@ -183,9 +183,9 @@ class FrequencyAnalysis:
                  f"  b        {gr.b:.4f} ± {gr.b_stderr:.4f}  ({gr.level:.0%} interval {gr.b_ci[0]:.4f} - "
                  f"{gr.b_ci[1]:.4f}, {gr.b_ci_method.split(' (')[0]})",
                  f"  a        {gr.a:.4f}",
-                 f"  m_min    {gr.m_min:.5g} kg ({gr.m_min / inv.density_kg_m3:.4g} m3), "
+                 f"  m_min    {gr.m_min:.5g} kg ({sig(gr.m_min / inv.density_kg_m3, 4)} m3), "
                  f"{'Kolmogorov-Smirnov search' if gr.m_min_method == 'ks' else 'given'}; "
-                 f"{gr.n_tail} of {gr.n_total} falls above it, {gr.rate_min:.4g} per year"]
+                 f"{gr.n_tail} of {gr.n_total} falls above it, {sig(gr.rate_min, 4)} per year"]
         if gr.m_max is not None:
             lines.append(f"  m_max    {gr.m_max:.5g} kg (upper truncation)")
         if self.bootstrap_p is not None:
@@ -221,7 +221,7 @@ class FrequencyAnalysis:
         lines += ["", f"Preferred model: {pref['model']}: {pref['reason']}."]
         table = self.design_table()
         lines += ["", "Design masses [kg] by return period (intervals in design_masses.csv):",
-                  table.to_string(float_format=lambda v: f"{v:,.4g}")]
+                  table.to_string(float_format=lambda v: sig(v, 4))]
         if self.warnings:
             lines += ["", "Warnings:"] + [f"  - {w}" for w in self.warnings]
         return "\n".join(lines)
