@@ -10,6 +10,7 @@ the same numbers whatever the chunk size.
 """
 from __future__ import annotations
 
+import os
 import sys
 import time
 
@@ -207,11 +208,10 @@ class Precompile:
     def __init__(self, scenario_path):
         import multiprocessing
         self._proc = None
-        try:       # a warm on-disk cache: nothing to do
-            if kernel.simulate._cache._cache_file._index_path and \
-                    __import__("os").path.exists(kernel.simulate._cache._cache_file._index_path):
+        try:       # a warm on-disk cache: nothing to do (numba internals; if they move, compile anyway)
+            if os.path.exists(kernel.simulate._cache._cache_file._index_path):
                 return
-        except AttributeError:
+        except (AttributeError, TypeError):
             pass
         self._proc = multiprocessing.get_context("spawn").Process(target=_warm_up, args=(str(scenario_path),),
                                                                   daemon=True)
