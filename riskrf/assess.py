@@ -22,7 +22,12 @@ import numpy as np
 from . import __version__
 from .annual_hazard import EnergyHazard, inertia_factors
 from .design_block import design_block, design_block_candidates_kg, read_block_survey
-from .energy_study import INTERVAL_COVERS, EnergyAnalysis, analyse_energy, design_energy_sensitivity
+from .energy_study import (
+    INTERVAL_COVERS,
+    EnergyAnalysis,
+    analyse_energy,
+    design_energy_sensitivity,
+)
 from .frequency_study import FrequencyAnalysis, analyse_inventory
 from .inventory import Inventory, read_inventory
 from .mass_coupling import energy_hazard
