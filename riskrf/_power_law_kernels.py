@@ -16,10 +16,14 @@ def tail_ks(logx, first, last, k, b):
     The empirical CDF is compared on both sides of each jump: ``last``/``first`` index arrays give the
     step heights (see :func:`riskrf.power_law._tail_arrays`).
     """
-    N = logx.shape[0]
-    n = N - k
-    d = 0.0
-    for j in range(k, N):
+    return _ks_over(logx, first, last, k, b, k, logx.shape[0], 0.0)
+
+
+@njit(cache=True)
+def _ks_over(logx, first, last, k, b, j0, j1, d):
+    """max(d, KS deviations at positions j0 .. j1 - 1) of the tail from index k (both sides of each jump)."""
+    n = logx.shape[0] - k
+    for j in range(j0, j1):
         F = 1.0 - np.exp(-b * (logx[j] - logx[k]))
         hi = abs(F - (last[j] - k + 1) / n)
         lo = abs(F - (first[j] - k) / n)
@@ -134,14 +138,7 @@ def _ks_exact(logx, first, last, k, b, stop, F_buf, hi_buf, lo_buf):
             continue
         a = k + 64 * i
         e = min(a + 64, N - 1)
-        for jj in range(a + 1, e):
-            F = 1.0 - np.exp(-b * (logx[jj] - logx[k]))
-            hi = abs(F - (last[jj] - k + 1) / n)
-            lo = abs(F - (first[jj] - k) / n)
-            if hi > d:
-                d = hi
-            if lo > d:
-                d = lo
+        d = _ks_over(logx, first, last, k, b, a + 1, e, d)
         if d > stop:
             return d
     return d

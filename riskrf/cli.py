@@ -354,6 +354,7 @@ def cmd_calibrate(args) -> int:
     from simulation.calibration import read_observed
 
     from .outputs import atomic_output_dir, write_json
+    from .report.files import save_figure
 
     parameters = {}
     for item in args.parameter or []:
@@ -398,9 +399,6 @@ def cmd_calibrate(args) -> int:
     for note in cal.notes:
         print(f"note: {note}")
     out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-calibration")
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         (tmp / f"{Path(args.scenario).stem}_calibrated.toml").write_text(cal.to_toml())
         cal.summary().to_csv(tmp / "parameters.csv")
@@ -412,9 +410,7 @@ def cmd_calibrate(args) -> int:
                                               "objective": cal.distance, "objective_initial": cal.distance_initial,
                                               "observed": cal.observed_source, "select": select,
                     "notes": list(cal.notes)}, tmp / "calibration.json")
-        ax = cal.plot()
-        ax.figure.savefig(tmp / "runout_observed_vs_simulated.png", dpi=120, bbox_inches="tight")
-        plt.close(ax.figure)
+        save_figure(cal.plot().figure, tmp / "runout_observed_vs_simulated.png")
     print(f"\nWrote the calibrated scenario, parameters.csv, comparison.csv, bootstrap.csv, evaluations.csv, "
           f"calibration.json and runout_observed_vs_simulated.png to {out}/")
     return 0

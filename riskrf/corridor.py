@@ -647,38 +647,10 @@ class CorridorResult:
                              "cumulative_deaths_avoided_per_year": t["deaths_avoided_per_year"].cumsum().to_numpy()})
 
     def figure(self):
-        """Along chainage: RHRS score, individual risk (criterion line), deaths per year per km now and with the
-        best option."""
-        import matplotlib.pyplot as plt
-        t = self.table.sort_values("chainage_from_m")
-        x0, w = t["chainage_from_m"].to_numpy() / 1000, t["length_m"].to_numpy() / 1000
-        fig, ax = plt.subplots(3, 1, figsize=(10, 7.5), sharex=True)
-        ax[0].bar(x0, t["rhrs_score"], width=w, align="edge", color="#8c6d31", edgecolor="k", lw=0.3)
-        ax[0].set_ylabel("RHRS score")
-        ax[1].bar(x0, t["individual_risk"], width=w, align="edge", color="#d62728", alpha=0.7, edgecolor="k", lw=0.3,
-                  label="do nothing")
-        ax[1].bar(x0, t["best_individual_risk"], width=w, align="edge", color="#2ca02c", alpha=0.8, edgecolor="k",
-                  lw=0.3, label="best option")
-        ax[1].axhline(self.corridor.study["criteria"].individual_risk_per_year, color="k", ls="--", lw=1,
-                      label="tolerable")
-        ax[1].set_yscale("log")
-        ax[1].set_ylabel("individual risk [1/yr]")
-        ax[1].legend(fontsize=8, loc="upper right")
-        km = t["length_m"].to_numpy() / 1000
-        ax[2].bar(x0, t["deaths_per_year"] / km, width=w, align="edge", color="#d62728", alpha=0.7, edgecolor="k",
-                  lw=0.3, label="do nothing")
-        ax[2].bar(x0, t["best_deaths_per_year"] / km, width=w, align="edge", color="#2ca02c", alpha=0.8,
-                  edgecolor="k", lw=0.3, label="best option")
-        ax[2].set_yscale("log")
-        ax[2].set_ylabel("deaths per year per km")
-        ax[2].set_xlabel("chainage [km]")
-        ax[2].legend(fontsize=8, loc="upper right")
-        for i, (a, b, sid) in enumerate(zip(x0, w, t["id"])):
-            ax[0].annotate(str(sid), (a + b / 2, 0), xytext=(0, 2), textcoords="offset points", ha="center",
-                           fontsize=6, rotation=90)
-        fig.suptitle(f"{self.corridor.name}: {len(t)} sections")
-        fig.subplots_adjust(left=0.09, right=0.98, bottom=0.07, top=0.93, hspace=0.12)   # tight_layout: seconds
-        return fig
+        """Along chainage: RHRS score, individual risk and deaths per year per km (see
+        :func:`riskrf.report.corridor_report.plot_corridor`)."""
+        from .report.corridor_report import plot_corridor
+        return plot_corridor(self)
 
     def to_json(self) -> dict:
         s = self.summary()
@@ -781,73 +753,17 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
                           seconds=time.perf_counter() - t0, n_blocks=int(n_blocks or corridor.n_blocks))
 
 
-def render_html(res: CorridorResult, figure_png: Path) -> str:
-    """Self-contained HTML corridor report: key figures, chainage figure, ranked table, budget curve, where the
-    RHRS and the quantitative ranking disagree, rejected rows, failures and assumptions."""
-    import base64
-
-    from . import __version__
-    from .report.format import CSS, cell, escape, human_header
-    c = res.corridor
-    cur = c.currency
-    s = res.summary()
-    b = res.budget_curve()
-    t = res.table
-
-    def table(df, money_cols=()):
-        head = "".join(f"<th>{escape(human_header(col))}</th>" for col in df.columns)
-        body = "".join("<tr>" + "".join(f"<td>{escape(cell(v, money_columns=col in money_cols, currency=cur))}</td>"
-                                        for col, v in zip(df.columns, row)) + "</tr>"
-                       for row in df.itertuples(index=False))
-        return f"<table><tr>{head}</tr>{body}</table>"
-
-    img = base64.b64encode(Path(figure_png).read_bytes()).decode("ascii")
-    money_cols = ("best_option_capital", "best_option_total_cost", "expected_annual_cost_per_km", "spend",
-                  "cumulative_spend")
-    disagree = s[s["rank_difference"].abs() >= max(3, len(s) // 5)] if s["rank_rhrs"].notna().any() else s.iloc[0:0]
-    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{escape(c.name)}</title><style>{CSS}</style>"
-             f"</head><body><h1>{escape(c.name)}</h1>",
-             f"<p>{len(t)} sections assessed on {res.workers} dask worker(s) in {res.seconds:.1f} s, "
-             f"{res.n_blocks:,} simulated blocks per section, corridor seed {c.seed} (riskrf {__version__}).</p>",
-             "<div class='box'><ul>"
-             f"<li>Deaths per year, doing nothing: {cell(float(t['deaths_per_year'].sum()))}; with each section's best "
-             f"option: {cell(float(t['best_deaths_per_year'].sum()))}</li>"
-             f"<li>Capital of the best options: {cell(float(t['best_option_capital'].sum()), money_columns=True, currency=cur)}"
-             "</li><li>Rates: " + ("falls reaching the road (as recorded), release rate derived per section from the "
-                                   "simulated share reaching the road" if c.rate_basis == "road" else
-                                   "falls released (>= m_min)") + f"</li><li>{escape(c.mass_note)}</li></ul></div>",
-             "<h2>Along the chainage</h2>",
-             f"<figure><img alt='chainage' src='data:image/png;base64,{img}'><figcaption>RHRS score, individual risk "
-             "and deaths per year per km of each section, doing nothing and with its best option.</figcaption></figure>",
-             "<h2>Sections ranked by quantitative risk (RHRS rank beside)</h2>", table(s, money_cols),
-             "<h2>Budget curve</h2><p>Sections in order of deaths avoided per unit spent with their best option: what "
-             "a budget buys when sections are done in this order.</p>", table(b, money_cols)]
-    if len(disagree):
-        parts += ["<h2>Where the RHRS and the risk ranking disagree</h2>",
-                  "<p>Sections whose RHRS rank and risk rank differ by at least "
-                  f"{max(3, len(s) // 5)} places.</p>",
-                  table(disagree[["id", "rank_risk", "rank_rhrs", "rhrs_score", "deaths_per_year", "individual_risk"]])]
-    if c.errors or res.failures:
-        parts.append("<h2>Rejected rows and failed sections</h2><div class='warn'><ul>"
-                     + "".join(f"<li>{escape(e)}</li>" for e in list(c.errors) + list(res.failures)) + "</ul></div>")
-    parts.append("<h2>Inputs left at their defaults</h2><ul>"
-                 + "".join(f"<li>{escape(d)}</li>" for d in c.defaults_used) + "</ul></body></html>")
-    return "\n".join(parts)
-
-
 def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False) -> None:
     """Write report.html, corridor.csv (ranked), sections.csv (by chainage), budget_curve.csv, chainage.png and
     summary.json into ``out`` (a directory that appears only when everything is written; an existing non-empty
     ``out`` is replaced whole only with ``overwrite``)."""
-    import matplotlib.pyplot as plt
-
     from .outputs import atomic_output_dir, write_json
+    from .report.corridor_report import render_corridor_html
+    from .report.files import save_figure
     with atomic_output_dir(out, overwrite=overwrite) as tmp:
         res.summary().to_csv(tmp / "corridor.csv", index=False)
         res.table.to_csv(tmp / "sections.csv", index=False)
         res.budget_curve().to_csv(tmp / "budget_curve.csv", index=False)
-        fig = res.figure()
-        fig.savefig(tmp / "chainage.png", dpi=120)
-        plt.close(fig)
-        (tmp / "report.html").write_text(render_html(res, tmp / "chainage.png"), encoding="utf-8")
+        save_figure(res.figure(), tmp / "chainage.png")
+        (tmp / "report.html").write_text(render_corridor_html(res, tmp / "chainage.png"), encoding="utf-8")
         write_json(res.to_json(), tmp / "summary.json")

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .files import save_figure
+
 
 def write_rate_figures(model, out: Path, response) -> list[Path]:
     """Seasonality (observed and expected events per calendar month) and, for daily models, the expected
@@ -23,9 +25,7 @@ def write_rate_figures(model, out: Path, response) -> list[Path]:
     ax.set_ylabel("events per month per year")
     ax.set_title(f"Seasonality, {model.start.year}-{model.end.year}", fontsize=10)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out / "seasonality.png", dpi=120)
-    written.append(out / "seasonality.png")
+    written.append(save_figure(fig, out / "seasonality.png", tight_layout=True))
     if response is not None:
         band = response.columns[0]
         label = model.terms.set_index("term").loc[band, "label"].split(" (")[0]
@@ -39,7 +39,5 @@ def write_rate_figures(model, out: Path, response) -> list[Path]:
         ax.set_yscale("log")
         ax.set_title(f"Rate against rainfall ({model.preferred}; other bands at their means)", fontsize=10)
         ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / "rainfall_response.png", dpi=120)
-        written.append(out / "rainfall_response.png")
+        written.append(save_figure(fig, out / "rainfall_response.png", tight_layout=True))
     return written
