@@ -44,7 +44,7 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
                               scenario=None, velocities=None, collector: str | None = None, n: int = 50_000,
                               seed=1, reach_probability: float = 1.0, condition_on_mass: bool = False,
                               mass_coupling: str = "simulated", design_masses_kg=(),
-                              velocity_unit: str | None = None):
+                              velocity_unit: str | None = None, rate_note: str | None = None):
     """Power-law fit of the inventory combined with simulated or given velocities.
 
     ``collector`` names the barrier line: in a scenario it defaults to "barrier"; a
@@ -55,6 +55,7 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
     (widened to ``design_masses_kg``), reach and speed by mass.  ``"independent"`` (or
     ``condition_on_mass``) is the older form from the seeder's own masses.  The returned
     simulation is always the scenario's own seeder run (figures, road share, mitigation).
+    ``rate_note`` replaces the hazard's note on ``rate_scale`` (e.g. a rate from the site's rate model).
 
     Returns (power-law fit, EnergyHazard, SimulationResult or None).
     """
@@ -93,7 +94,9 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
         hazard = EnergyHazard(mass=gr, velocity=v, rate_per_year=rate, reach_probability=reach_probability,
                               heights_m=df["height_m"].to_numpy(dtype=float) if "height_m" in df else None,
                               collector=collector or "", notes=(note,))
-    if rate_scale != 1.0:
+    if rate_note is not None:
+        hazard = replace(hazard, notes=hazard.notes + (rate_note,))
+    elif rate_scale != 1.0:
         hazard = replace(hazard, notes=hazard.notes + (
             f"rate scaled by {rate_scale:g} (share of the inventoried source above this line)",))
     return gr, hazard, result
@@ -141,12 +144,12 @@ def fence_checks_from_site(site) -> tuple:
     return caps, tuple(fh) if isinstance(fh, list) else tuple([fh] * len(caps))
 
 
-def sensitivity_inputs(site) -> tuple:
+def sensitivity_inputs(site, rate_scale: float | None = None) -> tuple:
     """(m_max values [kg], rate shares [-]) for the design-energy sensitivity: low, stated and high values.
 
     m_max: the site's uncertainty.m_max_kg range, else x0.5 and x2 of inventory.m_max_kg (only the stated value,
     None, when the law is not truncated); rate share: inventory.rate_scale x uncertainty.rate_factor, else x0.5
-    and x2."""
+    and x2.  ``rate_scale`` replaces inventory.rate_scale (a rate from the site's rate model)."""
     m_max = site.inventory["m_max_kg"]
     unc = site.mitigation.get("uncertainty")
     if m_max is None:
@@ -155,7 +158,7 @@ def sensitivity_inputs(site) -> tuple:
         m_values = sorted({float(unc.m_max_kg[0]), float(m_max), float(unc.m_max_kg[1])})
     else:
         m_values = [0.5 * m_max, float(m_max), 2.0 * m_max]
-    share = float(site.inventory["rate_scale"])
+    share = float(site.inventory["rate_scale"] if rate_scale is None else rate_scale)
     lo, hi = (unc.rate_factor if unc is not None and unc.rate_factor[0] != unc.rate_factor[1] else (0.5, 2.0))
     return m_values, sorted({share * lo, share, share * hi})
 
@@ -174,6 +177,20 @@ class Assessment:
     n_blocks: int
     warnings: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
+    rates: object = None            # SiteRates of the site's [rates] model (riskrf.site_rates), or None
+
+    @property
+    def rate_source(self) -> str:
+        """Where the hazard's annual rate comes from, in words."""
+        inv = self.inventory
+        if self.site.inventory.get("rate_from") == "rate_model" and self.rates is not None:
+            text = "rate model: " + self.rates.rate_text()
+        else:
+            text = (f"inventory: {inv.n_events:,} recorded falls in {inv.duration_years:.3g} years "
+                    f"({self.frequency.power_law.rate_min:.4g} per year at or above m_min)")
+        scale = self.site.inventory["rate_scale"]
+        return text + (f"; times rate_scale {scale:g} (typed: share of the recorded source above this road)"
+                       if scale != 1 else "")
 
     def summary(self) -> dict:
         """Every headline number, machine-readable, with units."""
@@ -204,7 +221,8 @@ class Assessment:
             "hazard": {"power_law_for_hazard": {"b": float(hz.mass.b), "m_max_kg": hz.mass.m_max,
                                                 "m_min_kg": float(hz.mass.m_min)},
                        "mass_coupled": hz.mass_coupled,
-                       "falls_per_year": hz.rate_per_year, "reach_probability": hz.reach_probability,
+                       "falls_per_year": hz.rate_per_year, "rate_source": self.rate_source,
+                       "reach_probability": hz.reach_probability,
                        "arrivals_per_year": hz.arrival_rate,
                        "road_share": self.study.road_share,
                        "energy_p95_kj": float(hz.energy_percentile(95)[0]),
@@ -226,6 +244,8 @@ class Assessment:
             "warnings": self.warnings,
             "timings_s": self.timings,
         }
+        if self.rates is not None:
+            out["rate_model"] = self.rates.summary()
         if fr.gumbel is not None or (self.maxima_frequency and self.maxima_frequency.gumbel is not None):
             src = fr if fr.gumbel is not None else self.maxima_frequency
             out["annual_maxima"] = {"source": src.inventory.source, "gumbel": dict(zip(src.gumbel.param_names,
@@ -254,6 +274,12 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         warnings.simplefilter("always", RiskrfWarning)
         inv_cfg = site.inventory
         hz_cfg = site.hazard
+        # The site's rate model (hazard rate, closure rules) is fitted in a child on the other core meanwhile.
+        rates = None
+        if site.rates is not None:
+            from .site_rates import InBackground, evaluate_rates
+            rates = InBackground(lambda: evaluate_rates(site.rates, site.path.parent, inv_cfg,
+                                                        site.mitigation["options"]))
         # On a fresh installation the simulator is compiled once (numba, cached on disk): do it on the other
         # core while the fits run.
         from simulation.engine import Precompile
@@ -274,7 +300,13 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         db_cfg = site.design_block
         survey = read_block_survey(site.resolve(db_cfg["survey"]), inventory.density_kg_m3) \
             if db_cfg["survey"] else None
-        m_max_values, shares = sensitivity_inputs(site)
+        rate_scale, rate_note, site_rates = inv_cfg["rate_scale"], None, None
+        if inv_cfg.get("rate_from") == "rate_model":
+            site_rates = rates.result()
+            rate_scale = inv_cfg["rate_scale"] * site_rates.hazard_factor(inventory)
+            rate_note = "rate from the " + site_rates.rate_text() + (
+                f"; times rate_scale {inv_cfg['rate_scale']:g}" if inv_cfg["rate_scale"] != 1 else "")
+        m_max_values, shares = sensitivity_inputs(site, rate_scale)
         # masses design values are read at: the percentile band of the design block, the largest m_max studied
         extra = design_block_candidates_kg(rule=db_cfg["rule"], percentile=db_cfg["percentile"],
                                            survey_volumes_m3=survey, inventory=inventory,
@@ -284,12 +316,12 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         if compiling is not None:
             compiling.wait()
         gr, hazard, result = energy_hazard_from_inputs(
-            inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=inv_cfg["rate_scale"],
+            inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=rate_scale,
             scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
             velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
             collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
             mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=extra,
-            velocity_unit=hz_cfg["velocity_unit"])
+            velocity_unit=hz_cfg["velocity_unit"], rate_note=rate_note)
         timings["simulation"] = round(time.perf_counter() - t, 2)
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
@@ -310,16 +342,22 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
 
         t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
         share = road_share(result, hz_cfg["collector"], hz_cfg["road_collector"])
+        mitigation = site.mitigation
+        if rates is not None:
+            from .site_rates import resolve_closures
+            site_rates = rates.result()
+            mitigation = dict(mitigation, options=resolve_closures(mitigation["options"], site_rates))
         study = MitigationStudy(hazard=hazard, road_share=share, source=str(site.path),
                                 defaults_used=site.defaults_used,
                                 **study_context(result, hz_cfg["collector"], hz_cfg["road_collector"],
                                                 hz_cfg["option_blocks"], seed, inventory, hazard,
-                                                inv_cfg["rate_scale"]),
-                                **site.mitigation)
+                                                rate_scale),
+                                **mitigation)
         decision = study_report(study)
         timings["decision"] = round(time.perf_counter() - t, 2)
     notes = []
-    for w in list(frequency.warnings) + [str(c.message) for c in caught]:
+    for w in list(frequency.warnings) + [str(c.message) for c in caught] + list(site_rates.notes if site_rates
+                                                                                else ()):
         if w not in notes:
             notes.append(w)
     T_max = float(max(frequency.design_masses()["T_years"]))
@@ -332,7 +370,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         notes.append(f"only {frequency.power_law.n_tail} falls above m_min: the exponent b is uncertain")
     return Assessment(site=site, inventory=inventory, frequency=frequency, maxima_frequency=maxima_frequency,
                       result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
-                      warnings=notes, timings=timings)
+                      warnings=notes, timings=timings, rates=site_rates)
 
 
 def write_assessment(a: Assessment, out: Path, log=None) -> dict:
@@ -420,14 +458,16 @@ def _copy_inputs(a: Assessment, dest: Path) -> None:
     site = a.site
     text = site.path.read_text(encoding="utf-8")
     for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
-                       ("hazard", "velocities"), ("design_block", "survey")):
-        rel = {"inventory": site.inventory, "hazard": site.hazard, "design_block": site.design_block}[table][key]
+                       ("hazard", "velocities"), ("design_block", "survey"), ("rates", "record"),
+                       ("rates", "rainfall"), ("rates", "warnings")):
+        rel = {"inventory": site.inventory, "hazard": site.hazard, "design_block": site.design_block,
+               "rates": site.rates or {}}[table].get(key)
         if rel:
             src = site.resolve(rel)
             shutil.copy2(src, dest / src.name)
             text = text.replace(f'"{rel}"', f'"{src.name}"').replace(f"'{rel}'", f"'{src.name}'")
             side = src.with_suffix(".toml")
-            if table == "inventory" and side.exists():
+            if table in ("inventory", "rates") and side.exists():
                 shutil.copy2(side, dest / side.name)
     (dest / site.path.name).write_text(text, encoding="utf-8")   # paths now point at the copies beside it
     (dest / "run.json").write_text(json.dumps({

@@ -160,6 +160,12 @@ class MitigationStudy:
 
     def __post_init__(self):
         _check_combinations(self.options, self.source)
+        for o in self.options:
+            if o.kind == "closure" and o.share_while_closed is None:
+                raise MitigationError(
+                    f"{self.source}: option {o.name!r}: its closure rule ({o.rule_text()}) has not been evaluated: "
+                    "the share of falls while closed and the closure hours are computed from a daily rate model "
+                    "(a site file's [rates] table, riskrf assess; or riskrf.site_rates.resolve_closures)")
 
     @property
     def currency(self) -> str:
@@ -802,6 +808,8 @@ class MitigationStudy:
             return "-"
         if all(c.kind == "realignment" and c.road_x_m is None for c in comps):
             return "geometry: the road leaves the slope"
+        if all(c.kind == "closure" for c in comps):
+            return "computed: closure rule on the rate model and rainfall record"
         return "derived (simulation and site geometry)"
 
     def _meets(self, row) -> bool:
@@ -1068,6 +1076,15 @@ def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0, **kw
             data = tomllib.load(fh)
         except tomllib.TOMLDecodeError as exc:
             raise MitigationError(f"{path}: not valid TOML: {exc}") from exc
-    data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard", "design_block")}   # a site file works too
-    return MitigationStudy(hazard=hazard, road_share=road_share, source=str(path), **study_inputs(data, str(path)),
-                           **kw)
+    raw = data
+    data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard", "design_block", "rates")}
+    inputs = study_inputs(data, str(path))         # a site file works too
+    if any(o.kind == "closure" and o.has_closure_rule for o in inputs["options"]):
+        # closure rules: share and hours from the file's [rates] model (riskrf.site_rates)
+        from .site_rates import check_closure_options, check_rates, evaluate_rates, resolve_closures
+        inv = dict(raw.get("inventory", {})) if isinstance(raw.get("inventory"), dict) else {}
+        rates = check_rates(raw.get("rates"), inv, path, error=MitigationError)
+        check_closure_options(inputs["options"], rates, path, error=MitigationError)
+        inputs["options"] = resolve_closures(inputs["options"], evaluate_rates(rates, path.parent, inv,
+                                                                               inputs["options"]))
+    return MitigationStudy(hazard=hazard, road_share=road_share, source=str(path), **inputs, **kw)

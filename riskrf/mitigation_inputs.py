@@ -153,12 +153,22 @@ class Option:
     share_while_closed: float | None = None       # closure: share of falls while the road is closed
     closure_hours_per_year: float | None = None   # closure: hours closed per year
     cost_per_closure_hour: float = 0.0            # closure: cost of one hour of closure
+    threshold_mm: float | None = None             # closure rule: rainfall over window_days that closes the road
+    window_days: float | None = None              # closure rule: rainfall window [days] (default 1)
+    warning_levels: tuple | None = None           # closure rule: close under these rainstorm warning levels
+    closure_rule: str = ""                        # the rule in words and its source, once computed (site_rates)
     description: str = ""
+
+    @property
+    def has_closure_rule(self) -> bool:
+        """A closure given as a rule, whose share and hours are computed from the site's rate model."""
+        return self.threshold_mm is not None or self.warning_levels is not None
 
     @property
     def typed(self) -> bool:
         """Does a typed effectiveness (an assumption) replace the derived one?"""
-        return self.retention is not None or self.rate_reduction is not None
+        return self.retention is not None or self.rate_reduction is not None or (
+            self.kind == "closure" and not self.has_closure_rule)
 
     def describe(self) -> str:
         """What the option is and assumes, in words."""
@@ -192,21 +202,35 @@ class Option:
         elif k == "realignment":
             text = (f"road moved to x = {self.road_x_m:g} m" if self.road_x_m is not None
                     else "road moved away from the slope (no exposure)")
+        elif k == "closure" and self.share_while_closed is None:
+            text = f"{self.rule_text()}; share and hours not yet computed (needs the site's rate model, [rates])"
         elif k == "closure":
-            text = (f"road closed {self.closure_hours_per_year:,.1f} h per year at {self.cost_per_closure_hour:,.0f} "
-                    f"per hour ({self.closure_hours_per_year * self.cost_per_closure_hour:,.0f} per year, in the "
-                    f"annual maintenance); {self.share_while_closed:.1%} of falls occur while closed (rate model); "
-                    "protects road users, falls still reach the road")
+            how = "computed from the rate model" if self.has_closure_rule else "ASSUMED (typed)"
+            text = ((f"{self.closure_rule}: " if self.closure_rule else "")
+                    + f"road closed {self.closure_hours_per_year:,.1f} h per year ({how}) at "
+                    f"{self.cost_per_closure_hour:,.0f} per hour ({self.closure_hours_per_year * self.cost_per_closure_hour:,.0f}"
+                    f" per year, in the annual maintenance); {self.share_while_closed:.1%} of falls occur while closed "
+                    f"({how}); protects road users, falls still reach the road")
         else:
             text = "combination of " + " + ".join(self.options)
         return (self.description + ": " if self.description else "") + text
+
+    def rule_text(self) -> str:
+        """A closure rule in words (rainfall or warning rule)."""
+        if self.threshold_mm is not None:
+            w = int(self.window_days or 1)
+            return f"close while the {w}-day rainfall reaches {self.threshold_mm:g} mm (whole day)"
+        if self.warning_levels is not None:
+            return f"close while a {' or '.join(self.warning_levels)} rainstorm warning is in force"
+        return ""
 
 
 # ---- parsing -------------------------------------------------------------------------------------
 NUMBER_FIELDS = ("capital_cost", "annual_maintenance", "life_years", "repair_cost_per_impact", "replacement_cost",
                  "repair_days", "rate_reduction", "retention", "x_m", "width_m", "depth_m", "inner_slope_hv",
                  "outer_slope_hv", "capacity_kj", "height_m", "min_mass_kg", "max_mass_kg", "covered_length_m",
-                 "road_x_m", "share_while_closed", "closure_hours_per_year", "cost_per_closure_hour")
+                 "road_x_m", "share_while_closed", "closure_hours_per_year", "cost_per_closure_hour",
+                 "threshold_mm", "window_days")
 RANGE_FIELDS = ("capital_cost_range", "annual_maintenance_range", "retention_range", "rate_reduction_range",
                 "zone_x_m")
 
@@ -271,7 +295,7 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
     if not name:
         raise MitigationError(f"{source}: {where} needs a name")
     where = f"option {name!r}"
-    allowed = {f.name for f in fields(Option)}
+    allowed = {f.name for f in fields(Option)} - {"closure_rule"}     # closure_rule: filled when computed
     unknown = set(spec) - allowed
     if unknown:
         key = sorted(unknown)[0]
@@ -292,20 +316,52 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
         if key in spec:
             vals[key] = _range(spec[key], f"{source}: {where}: {key}",
                                share=key in ("retention_range", "rate_reduction_range"))
+    rule_keys = ("threshold_mm", "window_days", "warning_levels")
+    typed_keys = ("share_while_closed", "closure_hours_per_year")
     if kind == "closure":
-        for key in ("share_while_closed", "closure_hours_per_year"):
-            if spec.get(key) is None:
-                raise MitigationError(f"{source}: {where}: a closure needs {key} (riskrf.closure.closure_rule "
-                                      "gives both from a rate model: ClosureRule.option_spec)")
-        if spec["closure_hours_per_year"] > 8766:
-            raise MitigationError(f"{source}: {where}: closure_hours_per_year = {spec['closure_hours_per_year']!r} "
-                                  "exceeds the hours of a year (8766)")
-        vals["annual_maintenance"] = float(spec.get("annual_maintenance", 0.0)) + \
-            float(spec["closure_hours_per_year"]) * float(spec.get("cost_per_closure_hour", 0.0))
-    elif any(spec.get(k) is not None for k in ("share_while_closed", "closure_hours_per_year",
-                                                "cost_per_closure_hour")):
-        raise MitigationError(f"{source}: {where}: share_while_closed, closure_hours_per_year and "
-                              "cost_per_closure_hour are only for kind = 'closure'")
+        if spec.get("warning_levels") is not None:
+            lv = spec["warning_levels"]
+            if not (isinstance(lv, list) and lv and all(isinstance(x, str) and x.strip() for x in lv)):
+                raise MitigationError(f"{source}: {where}: warning_levels = {lv!r} must be a list of warning levels, "
+                                      "e.g. [\"Red\", \"Black\"]")
+            vals["warning_levels"] = tuple(x.strip().capitalize() for x in lv)
+        rule = [k for k in rule_keys if spec.get(k) is not None]
+        typed = [k for k in typed_keys if spec.get(k) is not None]
+        if rule and typed:
+            raise MitigationError(f"{source}: {where}: give a closure rule ({', '.join(rule)}; its share and hours are "
+                                  f"computed from the site's rate model) or typed {', '.join(typed)} (an assumption), "
+                                  "not both")
+        if rule:
+            if spec.get("threshold_mm") is not None and spec.get("warning_levels") is not None:
+                raise MitigationError(f"{source}: {where}: give threshold_mm (a rainfall rule) or warning_levels (a "
+                                      "warning rule), not both")
+            if spec.get("window_days") is not None and spec.get("threshold_mm") is None:
+                raise MitigationError(f"{source}: {where}: window_days = {spec['window_days']!r} belongs to a rainfall "
+                                      "rule: give threshold_mm too")
+            if spec.get("threshold_mm") is not None and not spec["threshold_mm"] > 0:
+                raise MitigationError(f"{source}: {where}: threshold_mm = {spec['threshold_mm']!r} must be a rainfall "
+                                      "> 0 mm")
+            wd = spec.get("window_days")
+            if wd is not None and (isinstance(wd, bool) or int(wd) != wd or wd < 1):
+                raise MitigationError(f"{source}: {where}: window_days = {wd!r} must be a whole number of days >= 1")
+            if spec.get("threshold_mm") is not None and wd is None:
+                vals["window_days"] = 1.0
+        else:
+            for key in typed_keys:
+                if spec.get(key) is None:
+                    raise MitigationError(
+                        f"{source}: {where}: a closure needs a rule (threshold_mm [+ window_days], or warning_levels; "
+                        f"computed from the site's [rates] model) or a typed {key} with "
+                        f"{' and '.join(typed_keys)} (an assumption; riskrf.closure.closure_rule gives both: "
+                        "ClosureRule.option_spec)")
+            if spec["closure_hours_per_year"] > 8766:
+                raise MitigationError(f"{source}: {where}: closure_hours_per_year = "
+                                      f"{spec['closure_hours_per_year']!r} exceeds the hours of a year (8766)")
+            vals["annual_maintenance"] = float(spec.get("annual_maintenance", 0.0)) + \
+                float(spec["closure_hours_per_year"]) * float(spec.get("cost_per_closure_hour", 0.0))
+    elif any(spec.get(k) is not None for k in typed_keys + rule_keys + ("cost_per_closure_hour",)):
+        raise MitigationError(f"{source}: {where}: share_while_closed, closure_hours_per_year, threshold_mm, "
+                              "window_days, warning_levels and cost_per_closure_hour are only for kind = 'closure'")
     for key in ("rate_reduction", "retention", "share_while_closed"):
         if spec.get(key) is not None and spec[key] > 1:
             raise MitigationError(f"{source}: {where}: {key} = {spec[key]!r} is a share and must lie in [0, 1]")

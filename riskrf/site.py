@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .mitigation import MitigationError, study_inputs
+from .site_rates import INVENTORY_RATE_FIELDS, check_closure_options, check_rates
 
 
 class SiteError(ValueError):
@@ -28,7 +29,9 @@ SITE_FIELDS = {
                   # reader options (README "Input formats"); None = the reader's rule or the sidecar's value
                   "sheet": None, "header_row": None, "encoding": None, "decimal": None, "date_format": None,
                   "volume_unit": None, "mass_unit": None, "duplicates": None, "volume_column": None,
-                  "mass_column": None, "date_column": None, "location_column": None},
+                  "mass_column": None, "date_column": None, "location_column": None,
+                  # where the hazard's rate comes from (README "Site files"; riskrf.site_rates)
+                  **INVENTORY_RATE_FIELDS},
     "hazard": {"scenario": None, "velocities": None, "collector": None, "road_collector": "road",
                "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
                "free_board_m": 0.5, "design_period_years": 100.0, "bootstrap": 300, "seed": 1,
@@ -37,6 +40,8 @@ SITE_FIELDS = {
                      "iterations": None},
 }
 MITIGATION_TABLES = ("traffic", "consequences", "economics", "options", "uncertainty", "criteria")
+#: Optional tables checked by their own modules: [rates] (riskrf.site_rates).
+OTHER_TABLES = ("rates",)
 
 
 @dataclass(frozen=True)
@@ -49,6 +54,7 @@ class Site:
     mitigation: dict
     defaults_used: tuple = field(default_factory=tuple)
     design_block: dict = field(default_factory=lambda: dict(SITE_FIELDS["design_block"]))
+    rates: dict | None = None
 
     def resolve(self, relative) -> Path:
         return (self.path.parent / relative).resolve()
@@ -72,7 +78,7 @@ def load_site(path) -> Site:
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise SiteError(f"{path}: not valid TOML: {exc}") from exc
-    allowed = set(SITE_FIELDS) | set(MITIGATION_TABLES)
+    allowed = set(SITE_FIELDS) | set(MITIGATION_TABLES) | set(OTHER_TABLES)
     for key in data:
         if key not in allowed:
             raise _unknown(key, allowed, "", path)
@@ -141,6 +147,9 @@ def load_site(path) -> Site:
         rel = tables[table][key]
         if rel is not None and not (path.parent / rel).exists():
             raise SiteError(f"{path}: {table}.{key} = {rel!r}: file not found ({(path.parent / rel).resolve()})")
+    rates = check_rates(data.get("rates"), inv, path, error=SiteError)
+    if rates is not None:
+        used += rates.pop("defaults_used")
     if hz["scenario"] is not None:
         import simulation
         if hz["collector"] is None:
@@ -167,11 +176,12 @@ def load_site(path) -> Site:
     except MitigationError as exc:
         raise SiteError(str(exc)) from exc
     used += list(mitigation.pop("defaults_used"))
+    check_closure_options(mitigation["options"], rates, path, error=SiteError)
     if hz["scenario"] is not None:
         _check_option_geometry(mitigation["options"], scenario, hz, path, mitigation["uncertainty"])
     return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
                 description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
-                mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"])
+                mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"], rates=rates)
 
 
 def _check_design_block(tables, path):
