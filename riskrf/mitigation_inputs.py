@@ -351,9 +351,9 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
                 if spec.get(key) is None:
                     raise MitigationError(
                         f"{source}: {where}: a closure needs a rule (threshold_mm [+ window_days], or warning_levels; "
-                        f"computed from the site's [rates] model) or a typed {key} with "
-                        f"{' and '.join(typed_keys)} (an assumption; riskrf.closure.closure_rule gives both: "
-                        "ClosureRule.option_spec)")
+                        "computed from the site's [rates] model) or typed share_while_closed and "
+                        "closure_hours_per_year (an assumption; riskrf.closure.closure_rule gives both: "
+                        f"ClosureRule.option_spec); {key} is missing")
             if spec["closure_hours_per_year"] > 8766:
                 raise MitigationError(f"{source}: {where}: closure_hours_per_year = "
                                       f"{spec['closure_hours_per_year']!r} exceeds the hours of a year (8766)")

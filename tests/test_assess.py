@@ -23,7 +23,7 @@ def _site_copy(tmp_path, replace=None, drop=None):
     text = SITE.read_text()
     data_dir = SITE.parent
     for rel in ("lauterbrunnen_tls_2018.csv", "synthetic_corridor_1985_2024.csv", "hong_kong_rock_cuts_1984_2020.csv",
-                "../../simulation/scenarios/road_cut_barrier.toml"):
+                "hko_daily_rainfall_1983_2020.csv", "../../simulation/scenarios/road_cut_barrier.toml"):
         text = text.replace(f'"{rel}"', f'"{(data_dir / rel).resolve()}"')
     text = text.replace("n_blocks = 50000", "n_blocks = 6000").replace("bootstrap = 200", "bootstrap = 40")
     for old, new in (replace or {}).items():

@@ -74,6 +74,10 @@ def site_file(directory: Path, *, name="site.toml", hazard=None, inventory=None,
     data["inventory"]["path"] = str(DEMO / "lauterbrunnen_tls_2018.csv")
     data["inventory"]["annual_maxima"] = str(DEMO / "synthetic_corridor_1985_2024.csv")
     data["hazard"]["scenario"] = str(SCENARIO)
+    if "rates" in data:
+        for key in ("record", "rainfall", "warnings"):
+            if key in data["rates"]:
+                data["rates"][key] = str(DEMO / data["rates"][key])
     for table, extra in (("hazard", hazard), ("inventory", inventory), ("economics", economics),
                          ("consequences", consequences)):
         if extra:

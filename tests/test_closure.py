@@ -83,7 +83,7 @@ def test_closure_option_in_the_decision_analysis():
 
 
 @pytest.mark.parametrize("spec,match", [
-    ({"kind": "closure", "capital_cost": 0, "closure_hours_per_year": 10}, "a closure needs share_while_closed"),
+    ({"kind": "closure", "capital_cost": 0, "closure_hours_per_year": 10}, "a closure needs a rule .* share_while_closed is missing"),
     ({"kind": "closure", "capital_cost": 0, "share_while_closed": 1.2, "closure_hours_per_year": 10},
      "share_while_closed = 1.2 is a share"),
     ({"kind": "closure", "capital_cost": 0, "share_while_closed": 0.2, "closure_hours_per_year": 9000},

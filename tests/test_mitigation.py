@@ -281,6 +281,7 @@ def test_site_file_geometry_errors_before_computing(tmp_path):
     site.write_text(bad.replace('"lauterbrunnen', f'"{ROOT}/riskrf/data/lauterbrunnen').replace(
         '"synthetic_corridor', f'"{ROOT}/riskrf/data/synthetic_corridor').replace(
         '"hong_kong_rock_cuts', f'"{ROOT}/riskrf/data/hong_kong_rock_cuts').replace(
+        '"hko_daily_rainfall', f'"{ROOT}/riskrf/data/hko_daily_rainfall').replace(
         '"../../simulation', f'"{ROOT}/simulation'))
     with pytest.raises(SiteError, match="option 'catch ditch': x_m = 128 m with width_m = 8 m spans 128-136 m, "
                                         "outside the profile"):

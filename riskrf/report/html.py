@@ -40,6 +40,11 @@ def _assumptions(a, hz, rate_scale) -> pd.DataFrame:
         rows.append(("maximum credible block m_max [kg]", sig(hz.mass.m_max), "judgement (site file)"))
     rows.append(("rate share of the inventory at this slope", sig(rate_scale),
                  "judgement (site file)" if rate_scale != 1 else "whole inventory (no scaling)"))
+    from_model = a.site.inventory.get("rate_from") == "rate_model"
+    rows.append(("hazard rate source", a.rate_source, "computed: rate model ([rates])" if from_model
+                 else "computed: the inventory's record"))
+    if a.rates is not None and a.rates.climate and from_model:
+        rows.append(("stated change of climate", a.rates.climate, "typed assumption"))
     for entry in a.site.defaults_used:
         name, _, value = str(entry).partition(" = ")
         if ": ASSUMPTION" in name or "ASSUMPTION" in value:
@@ -81,7 +86,7 @@ def render_report(a, figs: Path) -> str:
     summary = ["<div class='box'><b>Summary.</b><ul>",
                (f"<li>{inv.n_events:,} recorded falls in {sig(inv.duration_years)} years; power law b = "
                f"{sig(gr.b)} &plusmn; {sig(gr.b_stderr, 2)} above {sig(gr.m_min)} kg ({sig(gr.rate_min)} falls per "
-               "year in the inventory).</li>")]
+               "year in the inventory).</li>"), f"<li>Rate of falls for the hazard from the {_e(a.rate_source)}.</li>"]
     if getattr(hz.mass, "m_max", None):
         summary.append(f"<li>For the hazard the law is refitted with the maximum credible block m<sub>max</sub> = "
                        f"{sig(hz.mass.m_max)} kg (b = {sig(hz.mass.b)})"
@@ -128,6 +133,17 @@ def render_report(a, figs: Path) -> str:
             "<h3>Completeness</h3><p>Falls per year and the smallest recorded size show whether recording "
             "was consistent over the record.</p>",
             doc.table(inv.completeness().reset_index().head(60), "Completeness of the record by year"))
+    if a.rates is not None:
+        r = a.rates
+        closures = pd.DataFrame([{"option": k, **{c: v for c, v in d.items() if c not in ("evaluated_from",)}}
+                                 for k, d in r.summary()["closures"].items()])
+        doc.add(f"<h3>Rate model ({_e(_name(r.record))}, rainfall {_e(_name(r.rainfall))})</h3>"
+                "<p>Counts of the dated record against antecedent rainfall, season and trend (Poisson and negative "
+                "binomial regression; README 'Rate models'). Closure options given as rules take their share of "
+                "falls while closed and their closure hours from this model.</p>",
+                doc.table(_item_table(r.model_summary), "Rate model"))
+        if len(closures):
+            doc.add(doc.table(closures, "Closure rules computed from the rate model"))
 
     # 2. Magnitude-frequency
     doc.section("Magnitude-frequency relation (Wyllie 2014, 8.4.1)")
@@ -330,6 +346,7 @@ def render_report(a, figs: Path) -> str:
               "(hazard.mass_coupling = 'independent')."),
              ("The rate and mass distribution come from the fitted power law, applied at the barrier line"
               + (f" with the rate scaled by {sig(rate_scale)} (typed assumption)" if rate_scale != 1 else "") + "."),
+             f"Rate of falls from the {a.rate_source}.",
              "Judgement inputs not in any interval: m_max and the rate share (see the sensitivity table in "
              "section 5)."]
     if en.design_block is not None:
