@@ -141,7 +141,8 @@ def render_report(a, figs: Path) -> str:
                 "<p>Counts of the dated record against antecedent rainfall, season and trend (Poisson and negative "
                 "binomial regression; README 'Rate models'). Closure options given as rules take their share of "
                 "falls while closed and their closure hours from this model.</p>",
-                doc.table(_item_table(r.model_summary), "Rate model"))
+                doc.table(_item_table(r.model_summary.map(lambda v: re.sub(
+                    r"-?\d+(?:\.\d+)?e[+-]\d+", lambda m: sig(float(m.group())), str(v)))), "Rate model"))
         if len(closures):
             doc.add(doc.table(closures, "Closure rules computed from the rate model"))
 
