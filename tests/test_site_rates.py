@@ -194,3 +194,16 @@ def test_rainfall_file_errors_name_the_site_field_and_row(tmp_path):
     with pytest.raises(SiteError, match=r"site.toml: rates.rainfall = 'rain.csv': .*row 3, column 'rainfall_mm': "
                                         r"'wet'"):
         load_site(path)
+
+
+def test_options_file_with_rates_resolves_closure_rules_for_riskrf_decide(tmp_path):
+    from riskrf.mitigation import load_mitigation
+    path = write_site(tmp_path / "s")
+    study = load_mitigation(path, None)             # riskrf decide --options: a site file works too
+    opt = study.option("close on rain")
+    _, model = direct_model(tmp_path / "s")
+    assert opt.share_while_closed == pytest.approx(closure_rule(model, 60.0).effectiveness, rel=1e-12)
+    assert study._basis(opt).startswith("computed: closure rule")
+    path.write_text(path.read_text().replace(RATES, ""))
+    with pytest.raises(MitigationError, match=r"site.toml: option 'close on rain': a closure rule .* add a \[rates\]"):
+        load_mitigation(path, None)
