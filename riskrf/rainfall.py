@@ -224,6 +224,29 @@ def _read_hko(path: Path, lines: list[str]) -> Rainfall:
     return _build(dates, values, flags, rows, path, "HKO", notes)
 
 
+_MISSING = ("", "***", "-", "na", "nan")
+
+
+def _read_generic_plain(date_col: pd.Series, rain_col: pd.Series, path) -> Rainfall | None:
+    """The common case read at once: every date YYYY-MM-DD and every rainfall a number >= 0, 'trace' or a missing
+    mark (the same reading as the row-by-row loop).  None when any row needs the loop (and its error message)."""
+    d, r = date_col.str.strip(), rain_col.str.strip()
+    keep = ~((d == "") & (r == ""))
+    d, r = d[keep], r[keep]
+    if not len(d):
+        return None
+    days = pd.to_datetime(d, format="%Y-%m-%d", errors="coerce")
+    low = r.str.lower()
+    trace, missing = (low == "trace").to_numpy(), low.isin(_MISSING).to_numpy()
+    values = pd.to_numeric(r.where(~(trace | missing), "nan"), errors="coerce").to_numpy(dtype=float, copy=True)
+    numeric = ~(trace | missing)
+    if days.isna().any() or not (np.isfinite(values[numeric]).all() and (values[numeric] >= 0).all()):
+        return None
+    values[trace] = 0.0
+    flags = np.where(trace, "trace", np.where(missing, "missing", ""))
+    return _build(pd.DatetimeIndex(days), values, list(flags), (d.index.to_numpy() + 2).tolist(), path, "generic", [])
+
+
 def _read_generic(path: Path, text: str) -> Rainfall:
     sep = sniff_delimiter(path)
     table = pd.read_csv(io.StringIO(text), sep=sep, dtype=str, keep_default_na=False)
@@ -231,6 +254,9 @@ def _read_generic(path: Path, text: str) -> Rainfall:
     if "date" not in cols or "rainfall_mm" not in cols:
         raise ValueError(f"{path}: a rainfall file needs columns 'date' (YYYY-MM-DD) and 'rainfall_mm' (daily total, "
                          f"mm), or the Hong Kong Observatory layout; found {list(table.columns)}")
+    fast = _read_generic_plain(table[cols["date"]], table[cols["rainfall_mm"]], path)
+    if fast is not None:
+        return fast
     dates, values, flags, rows = [], [], [], []
     for i, (d, r) in enumerate(zip(table[cols["date"]], table[cols["rainfall_mm"]])):
         line = i + 2
