@@ -150,6 +150,28 @@ def check_rates(given, inventory: dict, path, error=ValueError) -> dict | None:
             r["_rainfall"] = read_rainfall(base / r["rainfall"])
     except ValueError as exc:
         raise error(f"{path}: rates.rainfall = {r['rainfall']!r}: {exc}") from exc
+    # the record and its period against the rainfall (gaps, coverage with the antecedent window), read now
+    from .inventory import READER_OPTIONS, read_inventory
+    reader = {k: inventory[k] for k in READER_OPTIONS if inventory.get(k) is not None} \
+        if r["record_is_inventory"] else {}
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")       # the reader's notes come again with the model's
+            record = read_inventory(base / r["record"], start=r["start"], end=r["end"], **reader)
+    except (ValueError, TypeError) as exc:
+        raise error(f"{path}: rates.record = {r['record']!r}: {exc}") from exc
+    if record.start is None or record.end is None:
+        raise error(f"{path}: rates.record = {r['record']!r}: its record period is unknown; give rates.start and "
+                    "rates.end (or a sidecar .toml with [record] start, end)")
+    lead = max(w) - 1 if r["period"] == "day" else 0
+    start = pd.Timestamp(record.start) - pd.Timedelta(days=lead)
+    try:
+        r["_rainfall"].check_covers(start, record.end, f"rates.record {r['record']!r} ({pd.Timestamp(record.start).date()} "
+                                    f"to {pd.Timestamp(record.end).date()}" + (f", with its {max(w)}-day antecedent "
+                                                                               "window)" if lead else ")"))
+    except ValueError as exc:
+        raise error(f"{path}: rates.rainfall = {r['rainfall']!r}: {exc}") from exc
+    r["_record"] = record
     r["_warnings"] = None
     if r["warnings"] is not None:
         try:
@@ -270,10 +292,12 @@ def evaluate_rates(rates: dict, base, inventory: dict, options=()) -> SiteRates:
     base = Path(base)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        reader = {}
-        if rates.get("record_is_inventory"):
-            reader = {k: inventory[k] for k in READER_OPTIONS if inventory.get(k) is not None}
-        record = read_inventory(base / rates["record"], start=rates["start"], end=rates["end"], **reader)
+        record = rates.get("_record")          # read by check_rates
+        if record is None:
+            reader = {}
+            if rates.get("record_is_inventory"):
+                reader = {k: inventory[k] for k in READER_OPTIONS if inventory.get(k) is not None}
+            record = read_inventory(base / rates["record"], start=rates["start"], end=rates["end"], **reader)
         model = rate_model(record, rates["_rainfall"], period=rates["period"],
                            windows_days=tuple(rates["windows_days"]), season=rates["season"], trend=rates["trend"],
                            rain_transform=rates["rain_transform"])
@@ -297,9 +321,9 @@ def evaluate_rates(rates: dict, base, inventory: dict, options=()) -> SiteRates:
                 closures[o.name] = warning_closure(model, rates["_warnings"], levels=o.warning_levels,
                                                    cost_per_hour=o.cost_per_closure_hour)
     notes = []
-    for w in caught:
-        if str(w.message) not in notes and issubclass(w.category, UserWarning):
-            notes.append(str(w.message))
+    for w in [str(c.message) for c in caught if issubclass(c.category, UserWarning)] + list(model.notes):
+        if w not in notes:
+            notes.append(w)
     years = model.design["exposure_days"].sum() / 365.25
     return SiteRates(record=str(base / rates["record"]), rainfall=str(base / rates["rainfall"]), period=model.period,
                      preferred=model.preferred, start=model.start, end=model.end,

@@ -228,3 +228,19 @@ def test_generic_rainfall_read_at_once_equals_the_row_by_row_reading(tmp_path, m
     monkeypatch.undo()
     with pytest.raises(ValueError, match=r"row 3, column 'rainfall_mm': rainfall '-3' must be"):
         R.read_rainfall(f)
+
+
+@pytest.mark.parametrize("edit,match", [
+    (lambda d: (d / "rain.csv").write_text("\n".join((d / "rain.csv").read_text().splitlines()[:300]) + "\n"),
+     r"rates.rainfall = 'rain.csv': rates.record 'falls.csv' \(2001-01-01 to 2006-12-31, with its 3-day antecedent "
+     r"window\): needs rainfall to 2006-12-31, after the rainfall record .* ends \(2001-09-25, row 300\)"),
+    (lambda d: (d / "rain.csv").write_text("\n".join(line for i, line in enumerate(
+        (d / "rain.csv").read_text().splitlines()) if not 400 <= i < 403) + "\n"),
+     r"rates.rainfall = 'rain.csv': .*no rainfall from 2002-01-04 to 2002-01-06 \(3 days missing, between rows 400 "
+     r"and 401\)"),
+])
+def test_rainfall_that_does_not_cover_the_record_fails_at_the_site_check(tmp_path, edit, match):
+    path = write_site(tmp_path / "s")
+    edit(tmp_path / "s")
+    with pytest.raises(SiteError, match=match):
+        load_site(path)
