@@ -135,7 +135,8 @@ def render_report(a, figs: Path) -> str:
             doc.table(inv.completeness().reset_index().head(60), "Completeness of the record by year"))
     if a.rates is not None:
         r = a.rates
-        closures = pd.DataFrame([{"option": k, **{c: v for c, v in d.items() if c not in ("evaluated_from",)}}
+        closures = pd.DataFrame([{"option": k, **{c: v for c, v in d.items() if not c.startswith("evaluated")},
+                                  "evaluated over": f"{d['evaluated_from']} to {d['evaluated_to']}"}
                                  for k, d in r.summary()["closures"].items()])
         doc.add(f"<h3>Rate model ({_e(_name(r.record))}, rainfall {_e(_name(r.rainfall))})</h3>"
                 "<p>Counts of the dated record against antecedent rainfall, season and trend (Poisson and negative "
