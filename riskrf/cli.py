@@ -329,6 +329,7 @@ def cmd_assess(args) -> int:
         print(f"{len(assessment.warnings)} warning(s), also listed in the report:")
         for w in assessment.warnings:
             print(f"  - {w}")
+    print(f"Rate of falls from the {s['hazard']['rate_source']}.")
     print(f"Lowest expected total cost: {s['best_option']} (then {s['second_option']}).")
     print(f"Recommendation: {s['recommendation']['option']} ({s['recommendation']['basis']}).")
     print(f"Report: {(out / 'report.html').resolve()}")

@@ -94,7 +94,10 @@ class ClosureRule:
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
     def option_spec(self, name: str, *, capital_cost: float = 0.0, life_years: float | None = None) -> dict:
-        """The closure as an option table for a mitigation file (``[[options]]``, kind ``closure``)."""
+        """The closure as an option table for a mitigation file (``[[options]]``, kind ``closure``) with the share and
+        hours TYPED from this evaluation: the outputs label such an option an assumption.  In a site file give the
+        rule instead (``threshold_mm`` + ``window_days`` or ``warning_levels``, with a ``[rates]`` table): the share
+        and hours are then computed in the run (:mod:`riskrf.site_rates`)."""
         spec = {"name": name, "kind": "closure", "capital_cost": float(capital_cost),
                 "share_while_closed": float(self.effectiveness),
                 "closure_hours_per_year": float(self.closure_hours_per_year),
