@@ -15,6 +15,7 @@ import sys
 import time
 import warnings
 from dataclasses import dataclass, field, replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -174,6 +175,9 @@ class Assessment:
     n_blocks: int
     warnings: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
+    #: figures already being drawn beside the computation: {"dir": Path, "pending": [_Beside, ...]} (see
+    #: ``run_assessment(figures_dir=...)``); empty when ``write_assessment`` draws them all.
+    drawing: dict = field(default_factory=dict, repr=False)
 
     def summary(self) -> dict:
         """Every headline number, machine-readable, with units."""
@@ -235,10 +239,20 @@ class Assessment:
         return out
 
 
-def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None = None, log=None) -> Assessment:
+def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None = None, log=None,
+                   figures_dir=None) -> Assessment:
     """Run the whole chain for a validated site; each stage is logged (``logging`` logger ``riskrf``, level INFO,
-    or the callable ``log``) and timed in :attr:`Assessment.timings`."""
+    or the callable ``log``) and timed in :attr:`Assessment.timings`.
+
+    ``figures_dir``: a directory (created here, must not exist) that ``write_assessment`` will use as
+    ``OUT/figures``; the figures and tables of each stage are then drawn there beside the later stages (on the
+    second core, where forking is safe) instead of all at the end.  The outputs are the same either way.
+    """
     log = log or logger.info
+    figures = None if figures_dir is None else Path(figures_dir)
+    pending = []
+    if figures is not None:
+        figures.mkdir()
     from .report.mitigation_text import study_report
 
     seed = site.hazard["seed"] if seed is None else seed
@@ -270,6 +284,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         if dated is not None:
             maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
         timings["fits"] = round(time.perf_counter() - t, 2)
+        if figures is not None:
+            pending.append(_Beside(partial(_frequency_outputs, frequency, maxima_frequency, figures)))
 
         db_cfg = site.design_block
         survey = read_block_survey(site.resolve(db_cfg["survey"]), inventory.density_kg_m3) \
@@ -307,6 +323,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                                 density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed,
                                 design_block=block, sensitivity=sensitivity)
         timings["energy"] = round(time.perf_counter() - t, 2)
+        if figures is not None:
+            pending.append(_Beside(partial(energy.write, figures)))
 
         t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
         share = road_share(result, hz_cfg["collector"], hz_cfg["road_collector"])
@@ -332,7 +350,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         notes.append(f"only {frequency.power_law.n_tail} falls above m_min: the exponent b is uncertain")
     return Assessment(site=site, inventory=inventory, frequency=frequency, maxima_frequency=maxima_frequency,
                       result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
-                      warnings=notes, timings=timings)
+                      warnings=notes, timings=timings,
+                      drawing={"dir": figures, "pending": pending} if figures is not None else {})
 
 
 def write_assessment(a: Assessment, out: Path, log=None) -> dict:
@@ -345,23 +364,26 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     t = time.perf_counter()
     out = Path(out)
     figs = out / "figures"
-    figs.mkdir()
+    drawn = a.drawing.get("dir") is not None and figs.resolve() == Path(a.drawing["dir"]).resolve()
+    if not drawn:
+        figs.mkdir()
 
     def simulation_and_decision_outputs():
         if a.result is not None:
             _simulation_figures(a, figs)
         write_mitigation_outputs(a.study, a.decision, figs)
 
-    # The two halves of the figures are drawn at once on two cores where that is safe (see _Beside).
+    # The figures are drawn in parts at once on two cores where that is safe (see _Beside); parts that
+    # run_assessment started beside its later stages are only waited for.
     beside = _Beside(simulation_and_decision_outputs)
-    a.frequency.write(figs)
+    if drawn:
+        for part in a.drawing["pending"]:
+            part.wait()
+    else:
+        _frequency_outputs(a.frequency, a.maxima_frequency, figs)
+        a.energy.write(figs)
     for name in ("summary.json", "design_masses.csv", "completeness.csv"):
         shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
-    if a.maxima_frequency is not None:
-        sub = figs / "annual_maxima"
-        sub.mkdir()
-        a.maxima_frequency.write(sub)
-    a.energy.write(figs)
     for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv", "design_energy_sensitivity.csv",
                  "design_block.csv"):
         if (figs / name).exists():
@@ -407,6 +429,15 @@ class _Beside:
                 logger.warning("drawing figures in a second process failed (exit %s); drawing them here",
                                self.proc.exitcode)
                 self.work()
+
+
+def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:
+    """Tables and figures of the inventory's fits (and of the annual-maximum record, in a subfolder)."""
+    frequency.write(figs)
+    if maxima_frequency is not None:
+        sub = figs / "annual_maxima"
+        sub.mkdir()
+        maxima_frequency.write(sub)
 
 
 def _simulation_figures(a, figs):

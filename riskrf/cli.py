@@ -320,8 +320,9 @@ def cmd_assess(args) -> int:
     check_number(args.n, "-n", low=1)
     out = check_out(args, f"{Path(args.site).stem}-assessment")
     site = load_site(args.site)          # every input is checked before anything is computed
-    assessment = run_assessment(site, seed=args.seed, n_blocks=args.n)
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
+        # figures of each stage are drawn into the temporary output beside the later stages
+        assessment = run_assessment(site, seed=args.seed, n_blocks=args.n, figures_dir=tmp / "figures")
         s = write_assessment(assessment, tmp)
     stages = ", ".join(f"{k} {v:.1f} s" for k, v in assessment.timings.items())
     print(f"\nStage times: {stages}.")
