@@ -304,6 +304,9 @@ class MitigationStudy:
                     raise MitigationError(f"{self.source}: option {opt.name!r}: fences and attenuators need simulated "
                                           "velocities paired with bounce heights (a scenario, or a velocity file with "
                                           "height_m)")
+                if opt.x_m is None and self._by_mass is not None:
+                    out.append(self._damage_by_mass(m, v, h, opt.height_m, cap))
+                    continue
                 over = h > opt.height_m
             # energies of every (block, mass bin) pair [kJ]: E = 1/2 m v^2; damage states from riskrf.barriers
             out.append(damage_state_shares(kinetic_energy_kj(mid[None, :], v[:, None]), over, cap))
@@ -313,6 +316,42 @@ class MitigationStudy:
         return _Stage("barrier", opt.name, passing=passing, held_sel=held_sel, destroy=destroy, coverage=coverage,
                       after_road=opt.kind == "shed",
                       param=f"retention:{opt.name}" if opt.retention is not None else None)
+
+    @cached_property
+    def _by_mass(self):
+        """For a mass-coupled hazard: per mass bin, its simulated mass class's arriving blocks (effective speeds
+        [m/s], bounce heights [m], paired) and P(reach | class) over the hazard's mean reach probability; else None.
+
+        The reference slope model's fence impacts and arrivals then follow block mass (heavier blocks arrive more
+        often and faster).  A material variant keeps this mass dependence, scaled by its own pooled samples:
+        speeds and heights by the ratio of its median to the reference's, reach by its own mean reach.
+        """
+        hz = self.hazard
+        if not hz.mass_coupled:
+            return None
+        vel = hz.velocity
+        mid = self._grid[1]
+        cls = vel.class_of(mid)
+        k = vel.class_of(vel.mass_kg)
+        arrived = vel.reached
+        samples = {c: (vel.speed_ms[arrived & (k == c)], vel.height_m[arrived & (k == c)]) for c in np.unique(cls)}
+        profile = vel.reach_by_class[cls] / max(float(hz.reach_probability), 1e-300)
+        return cls, samples, profile
+
+    def _damage_by_mass(self, model: dict, v, h, height_m: float, cap: float):
+        """damage_state_shares per mass bin with the speeds and heights of the bin's own mass class (see _by_mass)."""
+        cls, samples, _ = self._by_mass
+        mid = self._grid[1]
+        ref_v, ref_h = self._models[0]["barrier"]
+        sv = float(np.median(v) / np.median(ref_v)) if len(v) and len(ref_v) else 1.0
+        sh = float(np.median(h) / np.median(ref_h)) if len(h) and len(ref_h) and np.median(ref_h) > 0 else 1.0
+        shares = [np.zeros(mid.size) for _ in range(3)]
+        for c, (vc, hc) in samples.items():
+            j = cls == c
+            got = damage_state_shares(kinetic_energy_kj(mid[j][None, :], sv * vc[:, None]), sh * hc > height_m, cap)
+            for out, part in zip(shares, got):
+                out[j] = part
+        return tuple(shares)
 
     def _fence_samples_at(self, opt: Option) -> list:
         """Per slope model: (effective speeds [m/s], bounce heights [m]) at the option's own line x_m."""
@@ -578,6 +617,8 @@ class MitigationStudy:
         pmf = self._mass_pmf(P.get("b"), P.get("m_max_kg")) if "b" in P else self._mass_pmf()
         lam = rate[:, None] * pmf + (self.small_falls_per_year * P["rate_factor"])[:, None] * small_pmf[None, :]
         arrivals = lam * reach_m[d][:, None]                                       # (S, J) at the barrier line
+        if self._by_mass is not None:                   # mass-coupled: heavier blocks reach the line more often
+            arrivals = arrivals * self._by_mass[2][None, :]
         p_st = np.broadcast_to(spatial_temporal_probability(P["vehicles_per_day"], ex.vehicle_length_m,
                                                             ex.speed_kmh), (S,))
         p_strike = ex.share_stopping_on_road * np.broadcast_to(stationary_rock_strike_probability(
