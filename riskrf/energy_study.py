@@ -37,6 +37,7 @@ class EnergyAnalysis:
     design_block: object = None          # riskrf.design_block.DesignBlock or None
     sensitivity: pd.DataFrame | None = None
     site_masses: pd.DataFrame | None = None
+    tornado: object = None               # DesignEnergyTornado or None
 
     def fence_verdicts(self) -> pd.DataFrame:
         rows = []
@@ -79,6 +80,12 @@ class EnergyAnalysis:
             lines += ["", f"Sensitivity of the {self.design_T:g}-year energy [kJ] to the judgement inputs "
                           "(m_max: rows; rate share: columns):",
                       sensitivity_grid(self.sensitivity).to_string(float_format=lambda v: sig(v, 4))]
+        if self.tornado is not None:
+            lines += ["", "One-way sensitivity (tornado) of the design energies: each input at low and high, the "
+                          "others at base [kJ]:", self.tornado.text()]
+            for _, r in self.tornado.dominant().iterrows():
+                lines.append(f"  dominant for the {r['design_energy']}: {r['input']} "
+                             f"({sig(r['energy_low_kj'], 3)} - {sig(r['energy_high_kj'], 3)} kJ)")
         if self.uni is not None:
             u = self.uni
             block = u.design_mass_kg / (u.factors["gamma_VolF"] * u.factors["gamma_gamma"])
@@ -114,6 +121,8 @@ class EnergyAnalysis:
             out["design_block"] = self.design_block.to_dict()
         if self.sensitivity is not None:
             out["design_energy_sensitivity"] = self.sensitivity.to_dict(orient="records")
+        if self.tornado is not None:
+            out["design_energy_tornado"] = self.tornado.to_dict()
         if self.uni is not None:
             out["uni11211"] = {"design_return_period_years": self.design_T,
                                "characteristic_energy_kj": self.uni.characteristic_energy_kj,
@@ -128,6 +137,8 @@ class EnergyAnalysis:
         self.design.to_csv(out / "design_energies.csv", index=False)
         if self.sensitivity is not None:
             self.sensitivity.to_csv(out / "design_energy_sensitivity.csv", index=False)
+        if self.tornado is not None:
+            self.tornado.table.to_csv(out / "design_energy_tornado.csv", index=False)
         if self.design_block is not None:
             self.design_block.alternatives.to_csv(out / "design_block.csv", index=False)
         if self.fences:
@@ -138,14 +149,15 @@ class EnergyAnalysis:
 def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_board_m: float = 0.5,
                    T=DESIGN_RETURN_PERIODS, design_T: float = 100.0, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
                    n_bootstrap: int = 300, seed=1, uni_factors: dict | None = None, design_block=None,
-                   sensitivity: pd.DataFrame | None = None) -> EnergyAnalysis:
+                   sensitivity: pd.DataFrame | None = None, tornado=None) -> EnergyAnalysis:
     """Design table, fence checks (each capacity in ``fences`` at ``fence_height_m``: one height [m] for all, or
     one per fence) and UNI 11211-4 energy.
 
     ``design_block`` (a :class:`~riskrf.design_block.DesignBlock`): the UNI 11211-4 energy uses it (at the p95
     speed of simulated blocks of its mass when the hazard is mass-coupled) instead of the T-year block, and each
     fence gets an over-topping check by the block's top.  ``sensitivity``: a table from
-    :func:`design_energy_sensitivity`, carried into the outputs."""
+    :func:`design_energy_sensitivity`, carried into the outputs; ``tornado``: a :class:`DesignEnergyTornado`
+    (:func:`design_energy_tornado`), likewise."""
     from .validation import check_return_periods
     try:
         check_return_periods(design_T, "design_T")
@@ -184,7 +196,8 @@ def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_
     site_masses = site_design_masses(hazard, DESIGN_RETURN_PERIODS, density_kg_m3)
     return EnergyAnalysis(hazard=hazard, design=design, fences=checks, uni=uni, design_T=float(design_T),
                           density_kg_m3=density_kg_m3, seed=seed, n_bootstrap=int(n_bootstrap),
-                          design_block=design_block, sensitivity=sensitivity, site_masses=site_masses)
+                          design_block=design_block, sensitivity=sensitivity, site_masses=site_masses,
+                          tornado=tornado)
 
 
 def _block_top_check(hazard, block, height_m: float, free_board_m: float) -> pd.DataFrame:
@@ -292,7 +305,7 @@ class DesignEnergyTornado:
             sub = self.table[self.table["design_energy"] == name]
             lines.append(f"  {name} (base {sig(sub['energy_base_kj'].iloc[0], 4)} kJ):")
             for _, r in sub.iterrows():
-                lines.append(f"    {r['input']:<46s} {_value(r['low'], r['unit']):>12s} -> {sig(r['energy_low_kj'], 4):>9s} kJ"
+                lines.append(f"    {r['input']:<52s} {_value(r['low'], r['unit']):>12s} -> {sig(r['energy_low_kj'], 4):>9s} kJ"
                              f"   {_value(r['high'], r['unit']):>12s} -> {sig(r['energy_high_kj'], 4):>9s} kJ"
                              f"   swing {sig(r['swing_kj'], 3)} kJ   [{r['range_basis']}]")
         lines += [f"  note: {n}" for n in self.notes]
@@ -510,7 +523,7 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
                     block_energy(hz_hi, fr_hi, q))
     if block is not None:
         basis = "given" if velocity_percentile_range is not None else "typed: p90 and p99 (ASSUMPTION)"
-        label = "velocity percentile of the design-block energy [%]"
+        label = "velocity percentile of the block energy [%]"
         add(b_name, label, "%", q_lo, q, q_hi, basis, block_energy(hazard, base_chosen, q_lo), base_b,
             block_energy(hazard, base_chosen, q_hi))
         if f_name:
