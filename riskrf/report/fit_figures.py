@@ -202,16 +202,20 @@ def plot_design_energy_tornado(tornado, axes=None):
     subs = [tornado.table[tornado.table["design_energy"] == n] for n in names]
     if axes is None:
         import matplotlib.pyplot as plt
-        heights = [0.45 * len(s) + 1.2 for s in subs]
-        fig, axes = plt.subplots(len(names), 1, figsize=(8, sum(heights) + 0.4), squeeze=False,
+        heights = [0.6 * len(s) + 1.3 for s in subs]
+        fig, axes = plt.subplots(len(names), 1, figsize=(8, sum(heights) + 0.6), squeeze=False,
                                  gridspec_kw={"height_ratios": heights})
         axes = list(axes[:, 0])
+        fig.suptitle("Each input at its low (blue) and high (red) value, the others at base", fontsize="medium")
     for ax, name, sub in zip(axes, names, subs):
-        labels = [f"{r['input']}: {_short(r['low'])} / {_short(r['high'])}" for _, r in sub.iterrows()]
+        labels = [f"{r['input']}\n{_short(r['low'])} / {_short(r['high'])}" for _, r in sub.iterrows()]
         t = pd.DataFrame({"parameter": labels, "base": sub["energy_base_kj"].to_numpy(),
                           "value_at_low": sub["energy_low_kj"].to_numpy(),
                           "value_at_high": sub["energy_high_kj"].to_numpy()})
         plot_tornado(t, ax=ax, xlabel=f"{name} [kJ]", annotate=True)
+        ax.get_legend().remove()
+        ax.margins(x=0.12)
+        ax.tick_params(axis="y", labelsize="small")
         ax.set_title(f"{name}: base {_short(t['base'].iloc[0])} kJ", fontsize="small")
     return axes
 
