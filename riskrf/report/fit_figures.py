@@ -202,8 +202,8 @@ def plot_design_energy_tornado(tornado, axes=None):
     subs = [tornado.table[tornado.table["design_energy"] == n] for n in names]
     if axes is None:
         import matplotlib.pyplot as plt
-        heights = [0.6 * len(s) + 1.3 for s in subs]
-        fig, axes = plt.subplots(len(names), 1, figsize=(8, sum(heights) + 0.6), squeeze=False,
+        heights = [0.5 * len(s) + 1.1 for s in subs]
+        fig, axes = plt.subplots(len(names), 1, figsize=(7.5, sum(heights) + 0.5), squeeze=False,
                                  gridspec_kw={"height_ratios": heights})
         axes = list(axes[:, 0])
         fig.suptitle("Each input at its low (blue) and high (red) value, the others at base", fontsize="medium")
