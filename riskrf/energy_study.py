@@ -316,8 +316,12 @@ class DesignEnergyTornado:
                 "dominant": self.dominant().to_dict(orient="records"), "notes": list(self.notes)}
 
 
+#: Unit label of a dimensionless input in the tornado table.
+NO_UNIT = "dimensionless"
+
+
 def _value(v, unit) -> str:
-    return f"{sig(v, 4)} {unit}".strip() if unit not in ("-", "") else sig(v, 4)
+    return f"{sig(v, 4)} {unit}".strip() if unit not in (NO_UNIT, "") else sig(v, 4)
 
 
 def _pair(values, name, check):
@@ -479,7 +483,7 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
     elif gr is not None:
         notes.append("m_max: the law is not truncated (no maximum credible block stated); no m_max row")
     cases["rate share of the source above the line"] = (
-        "-", s_lo, share, s_hi, "given" if rate_share_range is not None else "typed: x0.5 and x2 (ASSUMPTION)",
+        NO_UNIT, s_lo, share, s_hi, "given" if rate_share_range is not None else "typed: x0.5 and x2 (ASSUMPTION)",
         hazard.with_mass(hazard.mass, hazard.rate_per_year * s_lo / share),
         hazard.with_mass(hazard.mass, hazard.rate_per_year * s_hi / share), (m_max, s_lo), (m_max, s_hi))
     if gr is not None:
@@ -488,7 +492,7 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
         def with_b(b):
             law = replace(gr, b=float(b), a=float(np.log10(gr.rate_min) + b * np.log10(gr.m_min)))
             return hazard.with_mass(law, hazard.rate_per_year)
-        cases["power-law exponent b"] = ("-", b_lo, gr.b, b_hi,
+        cases["power-law exponent b"] = (NO_UNIT, b_lo, gr.b, b_hi,
                                          f"{gr.level:.0%} interval of the fit ({gr.b_ci_method}); rate at m_min kept",
                                          with_b(b_lo), with_b(b_hi), None, None)
     else:
@@ -511,7 +515,7 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
 
     law_moves_block = rule in ("return_period", "fragmentation")
     for name, (unit, lo, base, hi, basis, hz_lo, hz_hi, key_lo, key_hi) in cases.items():
-        label = f"{name} [{unit}]" if unit != "-" else name
+        label = f"{name} [{unit}]" if unit != NO_UNIT else name
         add(t_name, label, unit, lo, base, hi, basis, t_energy(hz_lo, key_lo), base_t, t_energy(hz_hi, key_hi))
         if b_name and law_moves_block or f_name:
             (c_lo, fr_lo), (c_hi, fr_hi) = block_masses(hz_lo), block_masses(hz_hi)
@@ -535,8 +539,8 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
         basis_d = "given" if fractal_dimension_range is not None else "typed: stated D +- 0.25 (ASSUMPTION)"
         basis_g = "given" if iterations_range is not None else "typed: stated generations +- 1 (ASSUMPTION)"
         for name, unit, lo, base, hi, basis, key in (
-                ("fractal dimension D", "-", d_lo, D, d_hi, basis_d, "fractal_dimension"),
-                ("fragmentation generations", "-", g_lo, n_gen, g_hi, basis_g, "iterations")):
+                ("fractal dimension D", NO_UNIT, d_lo, D, d_hi, basis_d, "fractal_dimension"),
+                ("fragmentation generations", NO_UNIT, g_lo, n_gen, g_hi, basis_g, "iterations")):
             (c_lo, fr_lo), (c_hi, fr_hi) = block_masses(hazard, **{key: lo}), block_masses(hazard, **{key: hi})
             if rule == "fragmentation":
                 add(b_name, name, unit, lo, base, hi, basis, block_energy(hazard, c_lo, q), base_b,
