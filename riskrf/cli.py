@@ -212,7 +212,7 @@ def cmd_energy(args) -> int:
     print(analysis.summary_text())
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         analysis.write(tmp)
-    print(f"\nWrote energy_summary.json, design_energies.csv, fence_checks.csv"
+    print("\nWrote energy_summary.json, design_energies.csv, fence_checks.csv"
           + (", design_energy_tornado.csv" if tornado is not None else "") + f" and figures to {out}/")
     return 0
 

@@ -305,7 +305,8 @@ class DesignEnergyTornado:
             sub = self.table[self.table["design_energy"] == name]
             lines.append(f"  {name} (base {sig(sub['energy_base_kj'].iloc[0], 4)} kJ):")
             for _, r in sub.iterrows():
-                lines.append(f"    {r['input']:<52s} {_value(r['low'], r['unit']):>12s} -> {sig(r['energy_low_kj'], 4):>9s} kJ"
+                lines.append(f"    {r['input']:<52s} {_value(r['low'], r['unit']):>12s} -> "
+                             f"{sig(r['energy_low_kj'], 4):>9s} kJ"
                              f"   {_value(r['high'], r['unit']):>12s} -> {sig(r['energy_high_kj'], 4):>9s} kJ"
                              f"   swing {sig(r['swing_kj'], 3)} kJ   [{r['range_basis']}]")
         lines += [f"  note: {n}" for n in self.notes]
@@ -334,7 +335,8 @@ def _pair(values, name, check):
 
 
 def _positive(v, name) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not (np.isfinite(v) and v > 0):
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(v) and v > 0):
         raise ValueError(f"{name} = {v!r} must be a finite number > 0")
     return float(v)
 
@@ -432,7 +434,6 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
         fractal_fragments(1.0, d_hi, int(g_hi))
 
     notes = []
-    energies = {}
 
     def t_energy(hz, key=None):
         if key is not None and sensitivity is not None:
