@@ -28,6 +28,7 @@ from .energy_study import (
     EnergyAnalysis,
     analyse_energy,
     design_energy_sensitivity,
+    design_energy_tornado,
 )
 from .frequency_study import FrequencyAnalysis, analyse_inventory
 from .inventory import Inventory, read_inventory
@@ -161,6 +162,12 @@ def sensitivity_inputs(site) -> tuple:
     return m_values, sorted({share * lo, share, share * hi})
 
 
+def _ends(values):
+    """(lowest, highest) of a sensitivity list, None when it holds one value or None (nothing to vary)."""
+    v = [x for x in values if x is not None]
+    return (min(v), max(v)) if len(v) > 1 else None
+
+
 @dataclass
 class Assessment:
     site: Site
@@ -204,6 +211,7 @@ class Assessment:
             "design_block": self.energy.design_block.to_dict() if self.energy.design_block is not None else None,
             "design_energy_sensitivity": self.energy.sensitivity.to_dict(orient="records")
             if self.energy.sensitivity is not None else None,
+            "design_energy_tornado": self.energy.tornado.to_dict() if self.energy.tornado is not None else None,
             "design_energy_interval_covers": INTERVAL_COVERS,
             "hazard": {"power_law_for_hazard": {"b": float(hz.mass.b), "m_max_kg": hz.mass.m_max,
                                                 "m_min_kg": float(hz.mass.m_min)},
@@ -317,11 +325,16 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             hazard, inventory.masses, inventory.duration_years, m_min=gr.m_min, m_max_values=m_max_values,
             rate_shares=shares, T=hz_cfg["design_period_years"]) \
             if hz_cfg["design_period_years"] * hazard.arrival_rate > 1 else None
+        tornado = design_energy_tornado(
+            hazard, design_T=hz_cfg["design_period_years"], block=block, masses_kg=inventory.masses,
+            duration_years=inventory.duration_years, m_max_range=_ends(m_max_values),
+            rate_share=inv_cfg["rate_scale"], rate_share_range=_ends(shares), sensitivity=sensitivity) \
+            if sensitivity is not None else None
         fences, heights = fence_checks_from_site(site)
         energy = analyse_energy(hazard, fences=fences, fence_height_m=heights,
                                 free_board_m=hz_cfg["free_board_m"], design_T=hz_cfg["design_period_years"],
                                 density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed,
-                                design_block=block, sensitivity=sensitivity)
+                                design_block=block, sensitivity=sensitivity, tornado=tornado)
         timings["energy"] = round(time.perf_counter() - t, 2)
         if figures is not None:
             pending.append(_Beside(partial(energy.write, figures)))
@@ -385,7 +398,7 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     for name in ("summary.json", "design_masses.csv", "completeness.csv"):
         shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
     for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv", "design_energy_sensitivity.csv",
-                 "design_block.csv"):
+                 "design_energy_tornado.csv", "design_block.csv"):
         if (figs / name).exists():
             shutil.move(str(figs / name), str(out / name))
     beside.wait()

@@ -108,6 +108,37 @@ def test_design_block_site_masses_and_sensitivity_in_outputs(assessed):
     assert (out / "figures" / "design_energy_sensitivity.png").exists()
 
 
+def test_design_energy_tornado_in_outputs(assessed):
+    """Issue 10 item 4: the one-way sensitivity of the design energies, in the CSV, the summary and the report."""
+    import pandas as pd
+    site, out = assessed
+    s = json.loads((out / "summary.json").read_text())
+    t = pd.read_csv(out / "design_energy_tornado.csv")
+    assert {"design_energy", "input", "low", "base", "high", "energy_low_kj", "energy_base_kj", "energy_high_kj",
+            "swing_kj", "range_basis"} <= set(t.columns)
+    e100 = [r["energy_kj"] for r in s["design_energies"] if r["T_years"] == 100.0][0]
+    t100 = t[t["design_energy"] == "100-year energy at the barrier line"].set_index("input")
+    assert np.allclose(t100["energy_base_kj"], e100, rtol=1e-9)
+    # the site's uncertainty ranges (m_max 1,000-4,000 t, rate factor 0.5-2) and the grid's corners agree
+    sens = pd.DataFrame(s["design_energy_sensitivity"]).set_index(["m_max_kg", "rate_share"])["energy_kj"]
+    row = t100.loc["maximum credible block m_max [kg]"]
+    assert (row["low"], row["high"]) == (1e6, 4e6)
+    assert row["energy_low_kj"] == pytest.approx(sens[(1e6, 0.05)]) and row["energy_high_kj"] == pytest.approx(
+        sens[(4e6, 0.05)])
+    b = t100.loc["power-law exponent b"]
+    assert b["energy_low_kj"] > b["energy_base_kj"] > b["energy_high_kj"]        # lower b: heavier tail
+    block = t[t["design_energy"].str.startswith("design-block energy")]
+    assert list(block["input"]) == ["velocity percentile of the block energy [%]"]   # percentile rule
+    chosen = [r for r in s["design_block"]["alternatives"] if r["chosen"]][0]
+    assert block["energy_base_kj"].item() == pytest.approx(chosen["energy_at_v95_kj"], rel=1e-12)
+    frag = t[t["design_energy"].str.startswith("fragmentation alternative")]
+    assert {"fractal dimension D", "fragmentation generations"} <= set(frag["input"])
+    assert s["design_energy_tornado"]["dominant"][0]["design_energy"] == "100-year energy at the barrier line"
+    assert (out / "figures" / "design_energy_tornado.png").exists()
+    html = (out / "report.html").read_text()
+    assert "One-way sensitivity of the design energies (tornado)" in html and "dominates" in html
+
+
 @pytest.mark.parametrize("edit, match", [
     ({"percentile = 97\n": "percentile = 100\n"}, "design_block.percentile = 100"),
     ({"percentile = 97\n": "percentile = 0\n"}, "design_block.percentile = 0"),

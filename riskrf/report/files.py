@@ -90,6 +90,10 @@ def write_energy_figures(analysis, out: Path, fence_capacities_kj) -> list[Path]
         ax = plot_design_energy_sensitivity(analysis.sensitivity)
         ax.set_title("Design energy over the judgement inputs")
         written.append(save_figure(ax.figure, out / "design_energy_sensitivity.png"))
+    if getattr(analysis, "tornado", None) is not None and len(analysis.tornado.table):
+        from .fit_figures import plot_design_energy_tornado
+        axes = plot_design_energy_tornado(analysis.tornado)
+        written.append(save_figure(axes[0].figure, out / "design_energy_tornado.png", tight_layout=True))
     return written
 
 
