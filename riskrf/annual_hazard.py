@@ -21,6 +21,7 @@ from .frequency_study import DESIGN_RETURN_PERIODS
 from .impact_energy import (
     PairedSamples,
     VelocityFit,
+    exceedance_function,
     exceedance_probability,
     mass_model,
 )
@@ -191,14 +192,14 @@ class EnergyHazard:
     def _invert(self, p, scale):
         """Energy where scale x P(E > e) = p: grid interpolation, then refined by root finding."""
         p = np.atleast_1d(p)
-        curve = exceedance_probability(_E_GRID, self.mass, self.velocity) * scale
+        fn = exceedance_function(self.mass, self.velocity)
+        curve = fn(_E_GRID) * scale
         guess = _interp_log_inverse(curve, p)
         out = guess.copy()
         for i, (pi, g) in enumerate(zip(p, guess)):
             if not np.isfinite(g):
                 continue
-            f = lambda le: np.log(max(scale * exceedance_probability(np.exp(le), self.mass,  # noqa: E731
-                                                                     self.velocity).item(), 1e-300)) - np.log(pi)
+            f = lambda le: np.log(max(scale * fn(np.exp(le)).item(), 1e-300)) - np.log(pi)  # noqa: E731
             lo, hi = np.log(g) - 0.05, np.log(g) + 0.05
             for _ in range(40):
                 if f(lo) > 0 >= f(hi):
@@ -248,7 +249,7 @@ class EnergyHazard:
         for _ in range(n_bootstrap):
             mass, rate = self._perturbed_mass(rng)
             if self.mass_coupled:       # blocks resampled within each mass class: reach and speed together
-                out.append((self.velocity.resample(rng).joint_exceedance(_E_GRID, mass_model(mass)), rate))
+                out.append((self.velocity.resampled_joint_exceedance(rng, _E_GRID, mass_model(mass)), rate))
                 continue
             reach = self.reach_probability
             if self.n_released:

@@ -15,6 +15,7 @@ import sys
 import time
 import warnings
 from dataclasses import dataclass, field, replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +28,7 @@ from .energy_study import (
     EnergyAnalysis,
     analyse_energy,
     design_energy_sensitivity,
+    design_energy_tornado,
 )
 from .frequency_study import FrequencyAnalysis, analyse_inventory
 from .inventory import Inventory, read_inventory
@@ -163,6 +165,12 @@ def sensitivity_inputs(site, rate_scale: float | None = None) -> tuple:
     return m_values, sorted({share * lo, share, share * hi})
 
 
+def _ends(values):
+    """(lowest, highest) of a sensitivity list, None when it holds one value or None (nothing to vary)."""
+    v = [x for x in values if x is not None]
+    return (min(v), max(v)) if len(v) > 1 else None
+
+
 @dataclass
 class Assessment:
     site: Site
@@ -178,6 +186,9 @@ class Assessment:
     warnings: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
     rates: object = None            # SiteRates of the site's [rates] model (riskrf.site_rates), or None
+    #: figures already being drawn beside the computation: {"dir": Path, "pending": [_Beside, ...]} (see
+    #: ``run_assessment(figures_dir=...)``); empty when ``write_assessment`` draws them all.
+    drawing: dict = field(default_factory=dict, repr=False)
 
     @property
     def rate_source(self) -> str:
@@ -217,6 +228,7 @@ class Assessment:
             "design_block": self.energy.design_block.to_dict() if self.energy.design_block is not None else None,
             "design_energy_sensitivity": self.energy.sensitivity.to_dict(orient="records")
             if self.energy.sensitivity is not None else None,
+            "design_energy_tornado": self.energy.tornado.to_dict() if self.energy.tornado is not None else None,
             "design_energy_interval_covers": INTERVAL_COVERS,
             "hazard": {"power_law_for_hazard": {"b": float(hz.mass.b), "m_max_kg": hz.mass.m_max,
                                                 "m_min_kg": float(hz.mass.m_min)},
@@ -255,10 +267,20 @@ class Assessment:
         return out
 
 
-def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None = None, log=None) -> Assessment:
+def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None = None, log=None,
+                   figures_dir=None) -> Assessment:
     """Run the whole chain for a validated site; each stage is logged (``logging`` logger ``riskrf``, level INFO,
-    or the callable ``log``) and timed in :attr:`Assessment.timings`."""
+    or the callable ``log``) and timed in :attr:`Assessment.timings`.
+
+    ``figures_dir``: a directory (created here, must not exist) that ``write_assessment`` will use as
+    ``OUT/figures``; the figures and tables of each stage are then drawn there beside the later stages (on the
+    second core, where forking is safe) instead of all at the end.  The outputs are the same either way.
+    """
     log = log or logger.info
+    figures = None if figures_dir is None else Path(figures_dir)
+    pending = []
+    if figures is not None:
+        figures.mkdir()
     from .report.mitigation_text import study_report
 
     seed = site.hazard["seed"] if seed is None else seed
@@ -296,6 +318,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         if dated is not None:
             maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
         timings["fits"] = round(time.perf_counter() - t, 2)
+        if figures is not None:
+            pending.append(_Beside(partial(_frequency_outputs, frequency, maxima_frequency, figures)))
 
         db_cfg = site.design_block
         survey = read_block_survey(site.resolve(db_cfg["survey"]), inventory.density_kg_m3) \
@@ -333,12 +357,19 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             hazard, inventory.masses, inventory.duration_years, m_min=gr.m_min, m_max_values=m_max_values,
             rate_shares=shares, T=hz_cfg["design_period_years"]) \
             if hz_cfg["design_period_years"] * hazard.arrival_rate > 1 else None
+        tornado = design_energy_tornado(
+            hazard, design_T=hz_cfg["design_period_years"], block=block, masses_kg=inventory.masses,
+            duration_years=inventory.duration_years, m_max_range=_ends(m_max_values),
+            rate_share=rate_scale, rate_share_range=_ends(shares), sensitivity=sensitivity) \
+            if sensitivity is not None else None
         fences, heights = fence_checks_from_site(site)
         energy = analyse_energy(hazard, fences=fences, fence_height_m=heights,
                                 free_board_m=hz_cfg["free_board_m"], design_T=hz_cfg["design_period_years"],
                                 density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed,
-                                design_block=block, sensitivity=sensitivity)
+                                design_block=block, sensitivity=sensitivity, tornado=tornado)
         timings["energy"] = round(time.perf_counter() - t, 2)
+        if figures is not None:
+            pending.append(_Beside(partial(energy.write, figures)))
 
         t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
         share = road_share(result, hz_cfg["collector"], hz_cfg["road_collector"])
@@ -370,7 +401,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         notes.append(f"only {frequency.power_law.n_tail} falls above m_min: the exponent b is uncertain")
     return Assessment(site=site, inventory=inventory, frequency=frequency, maxima_frequency=maxima_frequency,
                       result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
-                      warnings=notes, timings=timings, rates=site_rates)
+                      warnings=notes, timings=timings, rates=site_rates,
+                      drawing={"dir": figures, "pending": pending} if figures is not None else {})
 
 
 def write_assessment(a: Assessment, out: Path, log=None) -> dict:
@@ -383,25 +415,28 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     t = time.perf_counter()
     out = Path(out)
     figs = out / "figures"
-    figs.mkdir()
+    drawn = a.drawing.get("dir") is not None and figs.resolve() == Path(a.drawing["dir"]).resolve()
+    if not drawn:
+        figs.mkdir()
 
     def simulation_and_decision_outputs():
         if a.result is not None:
             _simulation_figures(a, figs)
         write_mitigation_outputs(a.study, a.decision, figs)
 
-    # The two halves of the figures are drawn at once on two cores where that is safe (see _Beside).
+    # The figures are drawn in parts at once on two cores where that is safe (see _Beside); parts that
+    # run_assessment started beside its later stages are only waited for.
     beside = _Beside(simulation_and_decision_outputs)
-    a.frequency.write(figs)
+    if drawn:
+        for part in a.drawing["pending"]:
+            part.wait()
+    else:
+        _frequency_outputs(a.frequency, a.maxima_frequency, figs)
+        a.energy.write(figs)
     for name in ("summary.json", "design_masses.csv", "completeness.csv"):
         shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
-    if a.maxima_frequency is not None:
-        sub = figs / "annual_maxima"
-        sub.mkdir()
-        a.maxima_frequency.write(sub)
-    a.energy.write(figs)
     for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv", "design_energy_sensitivity.csv",
-                 "design_block.csv"):
+                 "design_energy_tornado.csv", "design_block.csv"):
         if (figs / name).exists():
             shutil.move(str(figs / name), str(out / name))
     beside.wait()
@@ -445,6 +480,15 @@ class _Beside:
                 logger.warning("drawing figures in a second process failed (exit %s); drawing them here",
                                self.proc.exitcode)
                 self.work()
+
+
+def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:
+    """Tables and figures of the inventory's fits (and of the annual-maximum record, in a subfolder)."""
+    frequency.write(figs)
+    if maxima_frequency is not None:
+        sub = figs / "annual_maxima"
+        sub.mkdir()
+        maxima_frequency.write(sub)
 
 
 def _simulation_figures(a, figs):

@@ -197,17 +197,23 @@ def cmd_energy(args) -> int:
                                                 m_max_values=m_values,
                                                 rate_shares=[0.5 * args.rate_scale, args.rate_scale,
                                                              2.0 * args.rate_scale], T=args.design_period)
+    from .energy_study import design_energy_tornado
+    tornado = design_energy_tornado(hazard, design_T=args.design_period, block=block, masses_kg=inv.masses,
+                                    duration_years=inv.duration_years, rate_share=args.rate_scale,
+                                    sensitivity=sensitivity) \
+        if args.design_period * hazard.arrival_rate > 1 else None
     analysis = analyse_energy(hazard, fences=args.fence or (2000.0, 5000.0), fence_height_m=args.fence_height,
                               free_board_m=args.free_board, design_T=args.design_period,
                               density_kg_m3=inv.density_kg_m3, n_bootstrap=args.bootstrap, seed=args.seed,
-                              design_block=block, sensitivity=sensitivity)
+                              design_block=block, sensitivity=sensitivity, tornado=tornado)
     from .report.format import sig
     print(f"Inventory {inv.source}: power law b = {gr.b:.4f} ± {gr.b_stderr:.4f} above m_min = {sig(gr.m_min, 5)} kg "
           f"({gr.n_tail} falls, {sig(gr.rate_min, 4)} per year)" + (f", m_max = {sig(gr.m_max, 5)} kg" if gr.m_max else ""))
     print(analysis.summary_text())
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         analysis.write(tmp)
-    print(f"\nWrote energy_summary.json, design_energies.csv, fence_checks.csv and figures to {out}/")
+    print("\nWrote energy_summary.json, design_energies.csv, fence_checks.csv"
+          + (", design_energy_tornado.csv" if tornado is not None else "") + f" and figures to {out}/")
     return 0
 
 
@@ -320,8 +326,9 @@ def cmd_assess(args) -> int:
     check_number(args.n, "-n", low=1)
     out = check_out(args, f"{Path(args.site).stem}-assessment")
     site = load_site(args.site)          # every input is checked before anything is computed
-    assessment = run_assessment(site, seed=args.seed, n_blocks=args.n)
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
+        # figures of each stage are drawn into the temporary output beside the later stages
+        assessment = run_assessment(site, seed=args.seed, n_blocks=args.n, figures_dir=tmp / "figures")
         s = write_assessment(assessment, tmp)
     stages = ", ".join(f"{k} {v:.1f} s" for k, v in assessment.timings.items())
     print(f"\nStage times: {stages}.")

@@ -552,7 +552,8 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
                             consequences=corridor.study["consequences"], economics=corridor.study["economics"],
                             road_share=road_share(result, "barrier", "road"), source=str(corridor.path),
                             context=SimulationContext(section.scenario, "barrier", "road",
-                                                      n_blocks=corridor.option_blocks, seed=s_seed % (2 ** 32)),
+                                                      n_blocks=corridor.option_blocks, seed=s_seed % (2 ** 32),
+                                                      threads=1),     # parallel across sections, not within
                             reference=result, uncertainty=unc, criteria=corridor.study["criteria"])
     rk = study.ranking()
     none = rk[rk["kind"] == "none"]

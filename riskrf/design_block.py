@@ -42,7 +42,7 @@ hazard's), never above its stated m_max.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -169,6 +169,8 @@ class DesignBlock:
     assumptions : statements that are judgement, to be repeated in every output
     alternatives : one row per candidate rule (``chosen`` marks the design block): mass, volume, diameter,
         the p95 speed [m/s] of simulated blocks of that mass at the line and the energy 1/2 m v95^2 [kJ]
+    inputs : the keyword arguments of :func:`design_block` that produced it (without the hazard), so that the
+        same rule can be re-applied to another hazard (the design-energy tornado)
     """
 
     rule: str
@@ -178,6 +180,7 @@ class DesignBlock:
     basis: str
     assumptions: tuple
     alternatives: pd.DataFrame
+    inputs: dict = field(default_factory=dict, repr=False, compare=False)
 
     def summary(self) -> pd.DataFrame:
         rows = {"rule": self.rule, "design block mass [kg]": self.mass_kg, "volume [m3]": self.volume_m3,
@@ -265,6 +268,9 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
         ``rule="fragmentation"``, shown as an alternative whenever given
     """
     from .validation import check_choice, check_positive
+    inputs = dict(rule=rule, percentile=percentile, survey_volumes_m3=survey_volumes_m3, survey_source=survey_source,
+                  inventory=inventory, sizes=sizes, design_T=design_T, density_kg_m3=density_kg_m3,
+                  fractal_dimension=fractal_dimension, iterations=iterations)
     check_choice(rule, "design_block.rule", RULES)
     check_choice(sizes, "inventory sizes", SIZES)
     pct = check_percentile(percentile, "design_block.percentile")
@@ -345,7 +351,7 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
                  "taken as one intact block")
     return DesignBlock(rule=rule, mass_kg=float(row["mass_kg"]), volume_m3=float(row["volume_m3"]),
                        diameter_m=float(row["diameter_m"]), basis=basis, assumptions=tuple(assumptions),
-                       alternatives=alt)
+                       alternatives=alt, inputs=inputs)
 
 
 def design_block_candidates_kg(*, rule, percentile, survey_volumes_m3, inventory, density_kg_m3) -> list:

@@ -1,7 +1,7 @@
 """The impact-energy analysis behind ``riskrf energy``: hazard, design energies, fence checks."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -37,6 +37,7 @@ class EnergyAnalysis:
     design_block: object = None          # riskrf.design_block.DesignBlock or None
     sensitivity: pd.DataFrame | None = None
     site_masses: pd.DataFrame | None = None
+    tornado: object = None               # DesignEnergyTornado or None
 
     def fence_verdicts(self) -> pd.DataFrame:
         rows = []
@@ -79,6 +80,12 @@ class EnergyAnalysis:
             lines += ["", f"Sensitivity of the {self.design_T:g}-year energy [kJ] to the judgement inputs "
                           "(m_max: rows; rate share: columns):",
                       sensitivity_grid(self.sensitivity).to_string(float_format=lambda v: sig(v, 4))]
+        if self.tornado is not None:
+            lines += ["", "One-way sensitivity (tornado) of the design energies: each input at low and high, the "
+                          "others at base [kJ]:", self.tornado.text()]
+            for _, r in self.tornado.dominant().iterrows():
+                lines.append(f"  dominant for the {r['design_energy']}: {r['input']} "
+                             f"({sig(r['energy_low_kj'], 3)} - {sig(r['energy_high_kj'], 3)} kJ)")
         if self.uni is not None:
             u = self.uni
             block = u.design_mass_kg / (u.factors["gamma_VolF"] * u.factors["gamma_gamma"])
@@ -114,6 +121,8 @@ class EnergyAnalysis:
             out["design_block"] = self.design_block.to_dict()
         if self.sensitivity is not None:
             out["design_energy_sensitivity"] = self.sensitivity.to_dict(orient="records")
+        if self.tornado is not None:
+            out["design_energy_tornado"] = self.tornado.to_dict()
         if self.uni is not None:
             out["uni11211"] = {"design_return_period_years": self.design_T,
                                "characteristic_energy_kj": self.uni.characteristic_energy_kj,
@@ -128,6 +137,8 @@ class EnergyAnalysis:
         self.design.to_csv(out / "design_energies.csv", index=False)
         if self.sensitivity is not None:
             self.sensitivity.to_csv(out / "design_energy_sensitivity.csv", index=False)
+        if self.tornado is not None:
+            self.tornado.table.to_csv(out / "design_energy_tornado.csv", index=False)
         if self.design_block is not None:
             self.design_block.alternatives.to_csv(out / "design_block.csv", index=False)
         if self.fences:
@@ -138,14 +149,15 @@ class EnergyAnalysis:
 def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_board_m: float = 0.5,
                    T=DESIGN_RETURN_PERIODS, design_T: float = 100.0, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
                    n_bootstrap: int = 300, seed=1, uni_factors: dict | None = None, design_block=None,
-                   sensitivity: pd.DataFrame | None = None) -> EnergyAnalysis:
+                   sensitivity: pd.DataFrame | None = None, tornado=None) -> EnergyAnalysis:
     """Design table, fence checks (each capacity in ``fences`` at ``fence_height_m``: one height [m] for all, or
     one per fence) and UNI 11211-4 energy.
 
     ``design_block`` (a :class:`~riskrf.design_block.DesignBlock`): the UNI 11211-4 energy uses it (at the p95
     speed of simulated blocks of its mass when the hazard is mass-coupled) instead of the T-year block, and each
     fence gets an over-topping check by the block's top.  ``sensitivity``: a table from
-    :func:`design_energy_sensitivity`, carried into the outputs."""
+    :func:`design_energy_sensitivity`, carried into the outputs; ``tornado``: a :class:`DesignEnergyTornado`
+    (:func:`design_energy_tornado`), likewise."""
     from .validation import check_return_periods
     try:
         check_return_periods(design_T, "design_T")
@@ -184,7 +196,8 @@ def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_
     site_masses = site_design_masses(hazard, DESIGN_RETURN_PERIODS, density_kg_m3)
     return EnergyAnalysis(hazard=hazard, design=design, fences=checks, uni=uni, design_T=float(design_T),
                           density_kg_m3=density_kg_m3, seed=seed, n_bootstrap=int(n_bootstrap),
-                          design_block=design_block, sensitivity=sensitivity, site_masses=site_masses)
+                          design_block=design_block, sensitivity=sensitivity, site_masses=site_masses,
+                          tornado=tornado)
 
 
 def _block_top_check(hazard, block, height_m: float, free_board_m: float) -> pd.DataFrame:
@@ -238,4 +251,315 @@ def sensitivity_grid(table: pd.DataFrame) -> pd.DataFrame:
     return g
 
 
-__all__ = ["EnergyAnalysis", "INTERVAL_COVERS", "analyse_energy", "design_energy_sensitivity", "sensitivity_grid"]
+#: Default ranges of the one-way sensitivity where the user states none (typed, labelled in every output).
+TORNADO_DEFAULTS = {"m_max_factors": (0.5, 2.0), "rate_share_factors": (0.5, 2.0),
+                    "velocity_percentile_range": (90.0, 99.0), "fractal_dimension_step": 0.25,
+                    "iterations_step": 1}
+
+
+@dataclass(frozen=True)
+class DesignEnergyTornado:
+    """One-way sensitivity of the design energies: each input at its low and high value, the others at base.
+
+    Attributes
+    ----------
+    table : DataFrame, one row per (design energy, input): ``design_energy`` (which energy the row moves),
+        ``input``, ``unit`` (of low/base/high), ``low``, ``base``, ``high``, ``range_basis`` (where low and high
+        come from), ``energy_low_kj``, ``energy_base_kj``, ``energy_high_kj`` (the design energy with the input at
+        low, base and high) and ``swing_kj`` (|high - low|); rows of one design energy sorted by swing.
+    design_T : return period [yr] of the T-year energy
+    notes : what was left out and why
+    """
+
+    table: pd.DataFrame
+    design_T: float
+    notes: tuple = ()
+
+    def summary(self) -> pd.DataFrame:
+        return self.table
+
+    @property
+    def design_energies(self) -> list:
+        """The design energies studied, in order (the T-year energy at the line first)."""
+        return list(dict.fromkeys(self.table["design_energy"]))
+
+    def dominant(self) -> pd.DataFrame:
+        """Per design energy: the input with the largest swing [kJ], its low-high energies and its share of the
+        sum of swings."""
+        rows = []
+        for name in self.design_energies:
+            sub = self.table[self.table["design_energy"] == name]
+            if not np.isfinite(sub["swing_kj"]).any():
+                continue
+            r = sub.loc[sub["swing_kj"].idxmax()]
+            total = float(np.nansum(sub["swing_kj"]))
+            rows.append({"design_energy": name, "input": r["input"], "energy_base_kj": r["energy_base_kj"],
+                         "energy_low_kj": r["energy_low_kj"], "energy_high_kj": r["energy_high_kj"],
+                         "swing_kj": r["swing_kj"], "share_of_swings": r["swing_kj"] / total if total > 0 else np.nan})
+        return pd.DataFrame(rows)
+
+    def text(self) -> str:
+        """The table for a terminal, numbers by :func:`sig`."""
+        lines = []
+        for name in self.design_energies:
+            sub = self.table[self.table["design_energy"] == name]
+            lines.append(f"  {name} (base {sig(sub['energy_base_kj'].iloc[0], 4)} kJ):")
+            for _, r in sub.iterrows():
+                lines.append(f"    {r['input']:<52s} {_value(r['low'], r['unit']):>12s} -> "
+                             f"{sig(r['energy_low_kj'], 4):>9s} kJ"
+                             f"   {_value(r['high'], r['unit']):>12s} -> {sig(r['energy_high_kj'], 4):>9s} kJ"
+                             f"   swing {sig(r['swing_kj'], 3)} kJ   [{r['range_basis']}]")
+        lines += [f"  note: {n}" for n in self.notes]
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        return {"design_T_years": self.design_T, "rows": self.table.to_dict(orient="records"),
+                "dominant": self.dominant().to_dict(orient="records"), "notes": list(self.notes)}
+
+
+#: Unit label of a dimensionless input in the tornado table.
+NO_UNIT = "dimensionless"
+
+
+def _value(v, unit) -> str:
+    return f"{sig(v, 4)} {unit}".strip() if unit not in (NO_UNIT, "") else sig(v, 4)
+
+
+def _pair(values, name, check):
+    """(low, high) of a range argument, each checked by ``check(value, f"{name}[i]")``."""
+    try:
+        lo, hi = values
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} = {values!r} must be a pair (low, high)") from None
+    return check(lo, f"{name}[0]"), check(hi, f"{name}[1]")
+
+
+def _positive(v, name) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(v) and v > 0):
+        raise ValueError(f"{name} = {v!r} must be a finite number > 0")
+    return float(v)
+
+
+def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, block=None, masses_kg=None,
+                          duration_years: float | None = None, m_max_range=None, rate_share: float = 1.0,
+                          rate_share_range=None, velocity_percentile: float | None = None,
+                          velocity_percentile_range=None, fractal_dimension_range=None, iterations_range=None,
+                          sensitivity: pd.DataFrame | None = None) -> DesignEnergyTornado:
+    """One-way sensitivity (tornado) of the design energies [kJ] to the judgement and uncertain inputs.
+
+    Design energies (each row says which one it moves):
+
+    * the T-year energy at the barrier line, ``hazard.energy_at_return_period(design_T)``;
+    * the design-block energy 1/2 m v_p^2 of ``block`` (:class:`~riskrf.design_block.DesignBlock`), v_p the
+      ``velocity_percentile`` speed (default the UNI 11211-4 95th) of blocks of its mass at the line;
+    * when fragmentation parameters are stated but another rule chose the block: the fragmentation
+      alternative's energy 1/2 m v_p^2, its own output.
+
+    Inputs, each at low and high with the others at base; every row is a re-evaluation of the same simulated
+    slope (:meth:`EnergyHazard.with_mass`), nothing is re-simulated:
+
+    * maximum credible block m_max [kg] (``m_max_range``; default x0.5 and x2 of the law's): the power law refitted
+      to ``masses_kg`` over ``duration_years`` with that truncation (as :func:`design_energy_sensitivity`), or,
+      without the masses, re-truncated with b kept;
+    * rate share [-] (``rate_share_range`` around ``rate_share``; default x0.5 and x2): the rate scaled;
+    * power-law exponent b [-] at the ends of the fit's interval ``hazard.mass.b_ci``: the law re-scaled with b
+      fixed, the rate of falls above m_min kept;
+    * fractal dimension D [-] and fragmentation generations (``fractal_dimension_range``, ``iterations_range``;
+      default D +- 0.25, generations +- 1, typed): only when the block's fragmentation parameters are stated;
+    * the velocity percentile [%] of the design-block energy (``velocity_percentile_range``, default 90 and 99).
+
+    An input enters a row only where it enters that design energy: the velocity percentile does not enter the
+    T-year energy (which integrates over every speed), and the law's inputs do not move a percentile block taken
+    from a survey.  ``sensitivity``: a :func:`design_energy_sensitivity` table whose T-year energies at
+    (m_max, rate share) are reused instead of recomputed.
+    """
+    from .barriers import UNI11211_FACTORS
+    from .design_block import check_percentile, design_block as _design_block, fractal_fragments
+    from .units import J_PER_KJ
+    from .validation import check_return_periods
+    try:
+        T = float(check_return_periods(design_T, "design_T"))
+    except (TypeError, ValueError):
+        raise ValueError(f"design_T = {design_T!r}: the design return period must be a finite number > 1 year") \
+            from None
+    share = _positive(rate_share, "rate_share")
+    s_lo, s_hi = (_pair(rate_share_range, "rate_share_range", _positive) if rate_share_range is not None
+                  else tuple(share * f for f in TORNADO_DEFAULTS["rate_share_factors"]))
+    q = check_percentile(UNI11211_FACTORS["velocity_percentile"] if velocity_percentile is None
+                         else velocity_percentile, "velocity_percentile")
+    q_range = velocity_percentile_range if velocity_percentile_range is not None \
+        else TORNADO_DEFAULTS["velocity_percentile_range"]
+    q_lo, q_hi = _pair(q_range, "velocity_percentile_range", check_percentile)
+    gr = hazard.mass if isinstance(hazard.mass, GutenbergRichterFit) else None
+    m_max = getattr(gr, "m_max", None)
+    masses = None
+    if masses_kg is not None:
+        masses = np.asarray(masses_kg, dtype=float)
+        duration_years = _positive(duration_years, "duration_years")
+    mm_lo = mm_hi = None
+    if m_max_range is not None:
+        mm_lo, mm_hi = _pair(m_max_range, "m_max_range", _positive)
+        if masses is not None:
+            for i, v in enumerate((mm_lo, mm_hi)):
+                if v < masses.max():
+                    raise ValueError(f"m_max_range[{i}] = {v:g} kg is below the largest recorded mass "
+                                     f"{masses.max():g} kg: a maximum credible block cannot be smaller")
+    elif m_max:
+        mm_lo, mm_hi = (m_max * f for f in TORNADO_DEFAULTS["m_max_factors"])
+        if masses is not None:
+            mm_lo = max(mm_lo, float(masses.max()))
+    inputs = dict(block.inputs) if block is not None else {}
+    D, n_gen = inputs.get("fractal_dimension"), inputs.get("iterations")
+    fragmenting = D is not None and n_gen is not None
+    d_lo = d_hi = g_lo = g_hi = None
+    if fragmenting:
+        if fractal_dimension_range is not None:
+            d_lo, d_hi = _pair(fractal_dimension_range, "fractal_dimension_range", _positive)
+        else:
+            step = TORNADO_DEFAULTS["fractal_dimension_step"]
+            d_lo, d_hi = (D - step if D - step > 0 else D / 2), (D + step if D + step < 3 else (D + 3) / 2)
+        for i, v in enumerate((d_lo, d_hi)):
+            if not 0 < v < 3:
+                raise ValueError(f"fractal_dimension_range[{i}] = {v!r} must lie strictly between 0 and 3")
+        if iterations_range is not None:
+            g_lo, g_hi = iterations_range
+        else:
+            g_lo, g_hi = max(1, n_gen - TORNADO_DEFAULTS["iterations_step"]), \
+                min(12, n_gen + TORNADO_DEFAULTS["iterations_step"])
+        for i, v in enumerate((g_lo, g_hi)):
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 1 <= v <= 12:
+                raise ValueError(f"iterations_range[{i}] = {v!r} must be a whole number of generations from 1 to 12")
+        fractal_fragments(1.0, d_lo, int(g_lo))
+        fractal_fragments(1.0, d_hi, int(g_hi))
+
+    notes = []
+
+    def t_energy(hz, key=None):
+        if key is not None and sensitivity is not None:
+            hit = sensitivity[np.isclose(sensitivity["m_max_kg"], key[0] if key[0] is not None else np.inf,
+                                         rtol=1e-9) & np.isclose(sensitivity["rate_share"], key[1], rtol=1e-9)
+                              & np.isclose(sensitivity["T_years"], T)]
+            if len(hit) == 1:
+                return float(hit["energy_kj"].iloc[0])
+        return float(hz.energy_at_return_period(T)) if T * hz.arrival_rate > 1 else 0.0
+
+    def block_masses(hz, **change):
+        """(chosen block, fragmentation alternative) masses [kg] under hazard ``hz`` with changed rule inputs."""
+        if block is None:
+            return np.nan, np.nan
+        if not change and hz is hazard:
+            alt = block.alternatives
+        else:
+            try:
+                alt = _design_block(hz, **{**inputs, **change}).alternatives
+            except ValueError as exc:
+                notes.append(f"design block undefined with {change or 'the changed law'}: {exc}")
+                return np.nan, np.nan
+        frag = alt.loc[alt["rule"].str.startswith("fragmentation"), "mass_kg"]
+        return float(alt.loc[alt["chosen"], "mass_kg"].iloc[0]), float(frag.iloc[0]) if len(frag) else np.nan
+
+    def block_energy(hz, m, pct):
+        if not np.isfinite(m):
+            return np.nan
+        return 0.5 * m * hz.velocity_percentile(pct, mass_kg=m) ** 2 / J_PER_KJ
+
+    # ---- the perturbed hazards (cheap: the same simulated slope, another mass law or rate) -----------------
+    cases = {}                      # input -> (unit, low, base, high, basis, hz_low, hz_high, change_low, change_high)
+    if mm_lo is not None:
+        if masses is not None:
+            def law(v):
+                return fit_gutenberg_richter(masses, duration_years, m_min=gr.m_min, m_max=v)
+            how = "law refitted to the inventory with each m_max"
+        else:
+            def law(v):
+                return replace(gr, m_max=float(v))
+            how = "law re-truncated, b kept"
+        basis = ("given" if m_max_range is not None else "typed: x0.5 and x2 of the stated m_max (ASSUMPTION)") \
+            + f"; {how}"
+        cases["maximum credible block m_max"] = ("kg", mm_lo, m_max, mm_hi, basis,
+                                                 hazard.with_mass(law(mm_lo), hazard.rate_per_year),
+                                                 hazard.with_mass(law(mm_hi), hazard.rate_per_year),
+                                                 (mm_lo, share), (mm_hi, share))
+    elif gr is not None:
+        notes.append("m_max: the law is not truncated (no maximum credible block stated); no m_max row")
+    cases["rate share of the source above the line"] = (
+        NO_UNIT, s_lo, share, s_hi, "given" if rate_share_range is not None else "typed: x0.5 and x2 (ASSUMPTION)",
+        hazard.with_mass(hazard.mass, hazard.rate_per_year * s_lo / share),
+        hazard.with_mass(hazard.mass, hazard.rate_per_year * s_hi / share), (m_max, s_lo), (m_max, s_hi))
+    if gr is not None:
+        b_lo, b_hi = gr.b_ci
+
+        def with_b(b):
+            law = replace(gr, b=float(b), a=float(np.log10(gr.rate_min) + b * np.log10(gr.m_min)))
+            return hazard.with_mass(law, hazard.rate_per_year)
+        cases["power-law exponent b"] = (NO_UNIT, b_lo, gr.b, b_hi,
+                                         f"{gr.level:.0%} interval of the fit ({gr.b_ci_method}); rate at m_min kept",
+                                         with_b(b_lo), with_b(b_hi), None, None)
+    else:
+        notes.append("b: the mass model is not a power-law fit; no b row")
+
+    t_name = f"{T:g}-year energy at the barrier line"
+    rule = inputs.get("rule")
+    b_name = f"design-block energy 1/2 m v_p{q:g}^2 ({rule} rule)" if block is not None else None
+    f_name = (f"fragmentation alternative 1/2 m v_p{q:g}^2 (not the chosen block)"
+              if fragmenting and rule != "fragmentation" else None)
+    base_t = t_energy(hazard, (m_max, share))
+    base_chosen, base_frag = block_masses(hazard)
+    base_b, base_f = block_energy(hazard, base_chosen, q), block_energy(hazard, base_frag, q)
+    rows = []
+
+    def add(output, name, unit, lo, base, hi, basis, e_lo, e_base, e_hi):
+        rows.append({"design_energy": output, "input": name, "unit": unit, "low": lo, "base": base, "high": hi,
+                     "range_basis": basis, "energy_low_kj": e_lo, "energy_base_kj": e_base, "energy_high_kj": e_hi,
+                     "swing_kj": abs(e_hi - e_lo)})
+
+    law_moves_block = rule in ("return_period", "fragmentation")
+    for name, (unit, lo, base, hi, basis, hz_lo, hz_hi, key_lo, key_hi) in cases.items():
+        label = f"{name} [{unit}]" if unit != NO_UNIT else name
+        add(t_name, label, unit, lo, base, hi, basis, t_energy(hz_lo, key_lo), base_t, t_energy(hz_hi, key_hi))
+        if b_name and law_moves_block or f_name:
+            (c_lo, fr_lo), (c_hi, fr_hi) = block_masses(hz_lo), block_masses(hz_hi)
+            if b_name and law_moves_block:
+                add(b_name, label, unit, lo, base, hi, basis, block_energy(hz_lo, c_lo, q), base_b,
+                    block_energy(hz_hi, c_hi, q))
+            if f_name:
+                add(f_name, label, unit, lo, base, hi, basis, block_energy(hz_lo, fr_lo, q), base_f,
+                    block_energy(hz_hi, fr_hi, q))
+    if block is not None:
+        basis = "given" if velocity_percentile_range is not None else "typed: p90 and p99 (ASSUMPTION)"
+        label = "velocity percentile of the block energy [%]"
+        add(b_name, label, "%", q_lo, q, q_hi, basis, block_energy(hazard, base_chosen, q_lo), base_b,
+            block_energy(hazard, base_chosen, q_hi))
+        if f_name:
+            add(f_name, label, "%", q_lo, q, q_hi, basis, block_energy(hazard, base_frag, q_lo), base_f,
+                block_energy(hazard, base_frag, q_hi))
+    else:
+        notes.append("no design block given: only the T-year energy is studied")
+    if fragmenting:
+        basis_d = "given" if fractal_dimension_range is not None else "typed: stated D +- 0.25 (ASSUMPTION)"
+        basis_g = "given" if iterations_range is not None else "typed: stated generations +- 1 (ASSUMPTION)"
+        for name, unit, lo, base, hi, basis, key in (
+                ("fractal dimension D", NO_UNIT, d_lo, D, d_hi, basis_d, "fractal_dimension"),
+                ("fragmentation generations", NO_UNIT, g_lo, n_gen, g_hi, basis_g, "iterations")):
+            (c_lo, fr_lo), (c_hi, fr_hi) = block_masses(hazard, **{key: lo}), block_masses(hazard, **{key: hi})
+            if rule == "fragmentation":
+                add(b_name, name, unit, lo, base, hi, basis, block_energy(hazard, c_lo, q), base_b,
+                    block_energy(hazard, c_hi, q))
+            else:
+                add(f_name, name, unit, lo, base, hi, basis, block_energy(hazard, fr_lo, q), base_f,
+                    block_energy(hazard, fr_hi, q))
+    elif block is not None:
+        notes.append("fragmentation not configured: no fractal-dimension or generations rows")
+    if block is not None and not law_moves_block:
+        notes.append(f"the {rule} design block is taken from the block sizes, not the law: m_max, the rate share "
+                     "and b do not move it")
+    table = pd.DataFrame(rows)
+    order = {name: i for i, name in enumerate(n for n in (t_name, b_name, f_name) if n)}
+    table = (table.assign(_o=table["design_energy"].map(order), _s=-table["swing_kj"].fillna(-1))
+             .sort_values(["_o", "_s"], kind="stable").drop(columns=["_o", "_s"]).reset_index(drop=True))
+    return DesignEnergyTornado(table=table, design_T=T, notes=tuple(dict.fromkeys(notes)))
+
+
+__all__ = ["DesignEnergyTornado", "EnergyAnalysis", "INTERVAL_COVERS", "TORNADO_DEFAULTS", "analyse_energy",
+           "design_energy_sensitivity", "design_energy_tornado", "sensitivity_grid"]

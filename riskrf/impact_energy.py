@@ -233,7 +233,7 @@ def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, 
         return _conditional_on_mass(e, mm, velocity)
     if isinstance(velocity, MassCoupledSamples):
         # per arriving fall: P(E > e, reach) / P(reach), both integrated over the mass model
-        return velocity.joint_exceedance(e, mm) / velocity.reach_probability(mm)
+        return velocity.exceedance_function(mm)(e)
     if hasattr(velocity, "pdf") and hasattr(velocity, "isf"):
         if angular_velocity is not None:
             raise ValueError("angular_velocity needs velocity samples paired with it, not a distribution")
@@ -248,6 +248,17 @@ def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, 
     for i, ei in enumerate(e.ravel()):
         out[i] = np.mean(mm.sf(_threshold_mass(ei, v, w, density_kg_m3)))
     return out.reshape(e.shape)
+
+
+def exceedance_function(mass, velocity):
+    """e [kJ] -> P(E > e) for one fall, with whatever does not depend on e prepared once.
+
+    The same values as :func:`exceedance_probability` (default quadrature); use it where one
+    curve is evaluated many times (root finding for design energies).
+    """
+    if isinstance(velocity, MassCoupledSamples):
+        return velocity.exceedance_function(mass_model(mass))
+    return lambda energy_kj: exceedance_probability(energy_kj, mass, velocity)
 
 
 def _integrate_velocity_dist(e, mm, vdist):

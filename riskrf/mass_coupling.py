@@ -159,24 +159,51 @@ class MassCoupledSamples:
             c_all.append(np.full(p.size, self.n_bins - 1))
         return np.concatenate(m_all), np.concatenate(w_all), np.concatenate(c_all)
 
+    def _groups(self, mm, arrivals=None):
+        """Per mass class with arriving blocks: quadrature masses [kg], their weights, blocks released, sorted
+        arriving speeds [m/s] and the cumulative count of arrivals up to each speed; and P(reach) under ``mm``
+        (the quadrature prepared once for many energies).  ``arrivals``: per class, how many times each sorted
+        arriving speed counts (a bootstrap replicate; default once each)."""
+        m, w, cls = self._nodes(mm)
+        groups, reach_by_class = [], np.zeros(self.n_bins)
+        for c, (n_c, speeds, _) in enumerate(self._classes):
+            cum = np.arange(speeds.size + 1.0) if arrivals is None else np.concatenate([[0.0], np.cumsum(arrivals[c])])
+            reach_by_class[c] = cum[-1] / n_c
+            sel = cls == c
+            if sel.any() and cum[-1] > 0:
+                groups.append((np.maximum(m[sel], 1e-300), w[sel], n_c, speeds, cum))
+        reach = float(np.clip(np.sum(w * reach_by_class[cls]), 0.0, 1.0))
+        return groups, reach
+
+    @staticmethod
+    def _joint(e, groups) -> np.ndarray:
+        out = np.zeros(e.size)
+        for m, w, n_c, speeds, cum in groups:
+            vstar = np.sqrt(2.0 * J_PER_KJ * e.ravel()[:, None] / m[None, :])
+            above = cum[-1] - cum[np.searchsorted(speeds, vstar.ravel(), side="right")].reshape(vstar.shape)
+            out += (above / n_c) @ w
+        return np.clip(out, 0.0, 1.0).reshape(e.shape)
+
     def joint_exceedance(self, energy_kj, mm) -> np.ndarray:
         """P(a fall reaches the line with energy above e) [-] under mass model ``mm`` (a ``mass_model``)."""
-        e = np.atleast_1d(np.asarray(energy_kj, dtype=float))
-        m, w, cls = self._nodes(mm)
-        out = np.zeros(e.size)
-        for c, (n_c, speeds, _) in enumerate(self._classes):
-            sel = cls == c
-            if not sel.any() or speeds.size == 0:
-                continue
-            vstar = np.sqrt(2.0 * J_PER_KJ * e.ravel()[:, None] / np.maximum(m[sel], 1e-300)[None, :])
-            above = speeds.size - np.searchsorted(speeds, vstar.ravel(), side="right").reshape(vstar.shape)
-            out += (above / n_c) @ w[sel]
-        return np.clip(out, 0.0, 1.0).reshape(np.shape(energy_kj))
+        e = np.asarray(energy_kj, dtype=float)
+        return self._joint(np.atleast_1d(e), self._groups(mm)[0]).reshape(e.shape)
+
+    def exceedance_function(self, mm):
+        """e [kJ] -> P(E > e) [-] for a fall reaching the line under ``mm``: the joint exceedance over P(reach),
+        with the mass-model quadrature prepared once (for root finding and repeated evaluation)."""
+        groups, reach = self._groups(mm)
+        if reach <= 0:
+            raise ValueError("no simulated block of the mass model's range reached the line")
+
+        def fn(energy_kj):
+            e = np.asarray(energy_kj, dtype=float)
+            return (self._joint(np.atleast_1d(e), groups) / reach).reshape(e.shape)
+        return fn
 
     def reach_probability(self, mm) -> float:
         """P(a fall reaches the line) under mass model ``mm``: sum over classes of P(M in class) P(reach | class)."""
-        m, w, cls = self._nodes(mm)
-        return float(np.clip(np.sum(w * self.reach_by_class[cls]), 0.0, 1.0))
+        return self._groups(mm)[1]
 
     def arrival_sf(self, mass_kg, mm) -> float:
         """P(a fall is heavier than m and reaches the line) [-] under ``mm`` (reach constant within a class)."""
@@ -210,13 +237,30 @@ class MassCoupledSamples:
         idx = np.minimum(np.searchsorted(cdf, (np.arange(k) + 0.5) / k), k - 1)
         return replace(self, representative=idx)
 
-    def resample(self, rng) -> "MassCoupledSamples":
-        """Bootstrap replicate: the blocks of each class drawn with replacement (reach and speeds together)."""
+    @cached_property
+    def _bootstrap_layout(self):
+        """Per class: the number of blocks released, and for each released block (in the class's order) its
+        position among the class's sorted arriving speeds (-1: it did not arrive)."""
         k = self.class_of(self.mass_kg)
-        idx = np.concatenate([rng.choice(np.flatnonzero(k == c), size=int(np.sum(k == c)))
-                              for c in range(self.n_bins)])
-        return MassCoupledSamples(self.mass_kg[idx], self.speed_ms[idx], self.height_m[idx], self.edges_kg,
-                                  self.collector)
+        out = []
+        for c in range(self.n_bins):
+            members = np.flatnonzero(k == c)
+            s = self.speed_ms[members]
+            position = np.full(members.size, -1)
+            arrived = np.flatnonzero(np.isfinite(s))
+            position[arrived[np.argsort(s[arrived], kind="stable")]] = np.arange(arrived.size)
+            out.append((members.size, position, arrived.size))
+        return out
+
+    def resampled_joint_exceedance(self, rng, energy_kj, mm) -> np.ndarray:
+        """:meth:`joint_exceedance` of one bootstrap replicate: the blocks of each mass class drawn with
+        replacement (reach and speed together), counted as multiplicities of the simulated blocks."""
+        arrivals = []
+        for n_c, position, n_arrived in self._bootstrap_layout:
+            drawn = position[rng.integers(0, n_c, n_c)]
+            arrivals.append(np.bincount(drawn[drawn >= 0], minlength=n_arrived))
+        e = np.asarray(energy_kj, dtype=float)
+        return self._joint(np.atleast_1d(e), self._groups(mm, arrivals)[0]).reshape(e.shape)
 
     # ---- conditional percentiles and tables -----------------------------------------------------
     def velocity_percentile(self, q, mass_kg) -> float:

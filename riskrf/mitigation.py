@@ -237,12 +237,14 @@ class MitigationStudy:
                 draws = [{n: float(rows.iloc[i][f"materials.{n}"]) for n in names} for i in pick]
             else:
                 draws = [{n: float(rng.uniform(*ranges[n][:2])) for n in names} for _ in range(u.material_draws)]
-            for vals in draws:
-                models.append(self._simulated_model(vals))
             central = {n: material_value(ctx.scenario, n) for n in names}
-            for n in names:
-                for end, v in (("low", ranges[n][0]), ("high", ranges[n][1])):
-                    models.append(self._simulated_model({**central, n: v}, label=f"{n} {end}"))
+            variants = [(vals, "draw") for vals in draws] + \
+                [({**central, n: v}, f"{n} {end}") for n in names for end, v in (("low", ranges[n][0]),
+                                                                                 ("high", ranges[n][1]))]
+            scenarios = [scenario_with_materials(ctx.scenario, vals, where=f"{self.source}: uncertainty.materials")
+                         for vals, _ in variants]
+            for (vals, label), sc, res in zip(variants, scenarios, ctx.run_many(scenarios)):
+                models.append(self._simulated_model(vals, label, sc, res))
         return models
 
     def _material_ranges(self) -> dict:
@@ -272,10 +274,8 @@ class MitigationStudy:
             m["road"] = effective_samples(self.reference, ctx.road_collector)
         return m
 
-    def _simulated_model(self, values: dict, label: str = "draw") -> dict:
+    def _simulated_model(self, values: dict, label: str, sc, res) -> dict:
         ctx = self.context
-        sc = scenario_with_materials(ctx.scenario, values, where=f"{self.source}: uncertainty.materials")
-        res = ctx.run(sc)
         v, h = effective_samples(res, ctx.barrier_collector)
         reach = max(v.size, 1) / res.n
         road = effective_samples(res, ctx.road_collector)
@@ -298,17 +298,21 @@ class MitigationStudy:
     def _barrier_stage(self, opt: Option) -> _Stage:
         mid = self._grid[1]
         cap = opt.capacity_kj
+        fence_lines = self._fence_samples_at(opt) if opt.x_m is not None and opt.kind != "shed" else None
         out = []
         for m in self._models:
             if opt.kind == "shed":
                 v, h = m.get("road", m["barrier"])
                 over = np.zeros(v.size, dtype=bool)
             else:
-                v, h = self._fence_samples_at(opt, m) if opt.x_m is not None else m["barrier"]
+                v, h = fence_lines[len(out)] if opt.x_m is not None else m["barrier"]
                 if h is None or len(h) != len(v):
                     raise MitigationError(f"{self.source}: option {opt.name!r}: fences and attenuators need simulated "
                                           "velocities paired with bounce heights (a scenario, or a velocity file with "
                                           "height_m)")
+                if opt.x_m is None and self._by_mass is not None:
+                    out.append(self._damage_by_mass(m, v, h, opt.height_m, cap))
+                    continue
                 over = h > opt.height_m
             # energies of every (block, mass bin) pair [kJ]: E = 1/2 m v^2; damage states from riskrf.barriers
             out.append(damage_state_shares(kinetic_energy_kj(mid[None, :], v[:, None]), over, cap))
@@ -319,7 +323,44 @@ class MitigationStudy:
                       after_road=opt.kind == "shed",
                       param=f"retention:{opt.name}" if opt.retention is not None else None)
 
-    def _fence_samples_at(self, opt: Option, model: dict):
+    @cached_property
+    def _by_mass(self):
+        """For a mass-coupled hazard: per mass bin, its simulated mass class's arriving blocks (effective speeds
+        [m/s], bounce heights [m], paired) and P(reach | class) over the hazard's mean reach probability; else None.
+
+        The reference slope model's fence impacts and arrivals then follow block mass (heavier blocks arrive more
+        often and faster).  A material variant keeps this mass dependence, scaled by its own pooled samples:
+        speeds and heights by the ratio of its median to the reference's, reach by its own mean reach.
+        """
+        hz = self.hazard
+        if not hz.mass_coupled:
+            return None
+        vel = hz.velocity
+        mid = self._grid[1]
+        cls = vel.class_of(mid)
+        k = vel.class_of(vel.mass_kg)
+        arrived = vel.reached
+        samples = {c: (vel.speed_ms[arrived & (k == c)], vel.height_m[arrived & (k == c)]) for c in np.unique(cls)}
+        profile = vel.reach_by_class[cls] / max(float(hz.reach_probability), 1e-300)
+        return cls, samples, profile
+
+    def _damage_by_mass(self, model: dict, v, h, height_m: float, cap: float):
+        """damage_state_shares per mass bin with the speeds and heights of the bin's own mass class (see _by_mass)."""
+        cls, samples, _ = self._by_mass
+        mid = self._grid[1]
+        ref_v, ref_h = self._models[0]["barrier"]
+        sv = float(np.median(v) / np.median(ref_v)) if len(v) and len(ref_v) else 1.0
+        sh = float(np.median(h) / np.median(ref_h)) if len(h) and len(ref_h) and np.median(ref_h) > 0 else 1.0
+        shares = [np.zeros(mid.size) for _ in range(3)]
+        for c, (vc, hc) in samples.items():
+            j = cls == c
+            got = damage_state_shares(kinetic_energy_kj(mid[j][None, :], sv * vc[:, None]), sh * hc > height_m, cap)
+            for out, part in zip(shares, got):
+                out[j] = part
+        return tuple(shares)
+
+    def _fence_samples_at(self, opt: Option) -> list:
+        """Per slope model: (effective speeds [m/s], bounce heights [m]) at the option's own line x_m."""
         import simulation.scenario as sc_mod
         ctx = self._need_context(opt, "x_m")
         prof = ctx.scenario.profile
@@ -327,9 +368,8 @@ class MitigationStudy:
             raise MitigationError(f"{self.source}: option {opt.name!r}: x_m = {opt.x_m:g} m is outside the profile "
                                   f"({prof.x[0]:g}, {prof.x[-1]:g}) m")
         col = sc_mod.Collector(f"{opt.name} line", float(opt.x_m))
-        sc = model["scenario"]
-        res = ctx.run(replace(sc, collectors=sc.collectors + (col,)))
-        return effective_samples(res, col.name)
+        runs = ctx.run_many(replace(m["scenario"], collectors=m["scenario"].collectors + (col,)) for m in self._models)
+        return [effective_samples(res, col.name) for res in runs]
 
     def _need_context(self, opt, fld):
         if self.context is None:
@@ -346,18 +386,25 @@ class MitigationStudy:
     def _reference_road_blocks(self):
         return road_crossings(self._reference_run, self.context.road_collector)
 
-    def _ditch_retention(self, ditches, model: dict, index: int):
+    def _ditch_retentions(self, ditches) -> list:
+        """:meth:`_ditch_retention` for every slope model (the ditched profiles simulated at once)."""
+        ctx = self.context
+        try:
+            scenarios = [scenario_with_ditches(m["scenario"], ditches, where=self.source,
+                                               road_collector=ctx.road_collector) for m in self._models]
+        except (MeasureError, ValueError) as exc:
+            raise MitigationError(str(exc)) from exc
+        return [self._ditch_retention(m, i, res) for i, (m, res) in
+                enumerate(zip(self._models, ctx.run_many(scenarios)))]
+
+    def _ditch_retention(self, model: dict, index: int, ditched):
         """Share of the falls that would reach the road that the ditches stop (common random numbers): overall,
         its Monte Carlo Beta law, and by block mass (5 strata of the simulated masses, interpolated in log mass
         onto the mass grid and held constant beyond the simulated range)."""
         ctx = self.context
         base_res = self._reference_run if index == 0 else model["result"]
         base = self._reference_road_blocks if index == 0 else road_crossings(base_res, ctx.road_collector)
-        try:
-            sc = scenario_with_ditches(model["scenario"], ditches, where=self.source, road_collector=ctx.road_collector)
-        except (MeasureError, ValueError) as exc:
-            raise MitigationError(str(exc)) from exc
-        kept = road_crossings(ctx.run(sc), ctx.road_collector)
+        kept = road_crossings(ditched, ctx.road_collector)
         mid = self._grid[1]
         k_b = base.size
         if k_b == 0:
@@ -424,7 +471,7 @@ class MitigationStudy:
                         1.0 if c.outer_slope_hv is None else c.outer_slope_hv, c.material, c.name) for c in geo]
             key = "+".join(c.name for c in geo)
             if key not in self._derived:
-                per_model = [self._ditch_retention(ds, m, i) for i, m in enumerate(self._models)]
+                per_model = self._ditch_retentions(ds)
                 self._derived[key] = (per_model[0][0], per_model[0][1], np.array([r for r, _, _ in per_model]),
                                       np.array([b for _, _, b in per_model]))
             # retention by mass bin and slope model, as a shift from the overall reference retention (the parameter)
@@ -576,6 +623,8 @@ class MitigationStudy:
         pmf = self._mass_pmf(P.get("b"), P.get("m_max_kg")) if "b" in P else self._mass_pmf()
         lam = rate[:, None] * pmf + (self.small_falls_per_year * P["rate_factor"])[:, None] * small_pmf[None, :]
         arrivals = lam * reach_m[d][:, None]                                       # (S, J) at the barrier line
+        if self._by_mass is not None:                   # mass-coupled: heavier blocks reach the line more often
+            arrivals = arrivals * self._by_mass[2][None, :]
         p_st = np.broadcast_to(spatial_temporal_probability(P["vehicles_per_day"], ex.vehicle_length_m,
                                                             ex.speed_kmh), (S,))
         p_strike = ex.share_stopping_on_road * np.broadcast_to(stationary_rock_strike_probability(

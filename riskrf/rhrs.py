@@ -31,6 +31,11 @@ presence of water, rockfall history) score 3, 9, 27 or 81 for the four published
 Scores are not capped (a 130-ft slope scores 3**5.2 = 302); :func:`rate` reports each category
 score and the total.  The formulas and class points are those listed in
 shared/research/domain-methods.md section 4.3 [R] (Pierson & Van Vickle 1993 summary sheet).
+
+Checked against a published rated slope: Taherynia, Mohammadi & Ajalloeian (2014), J. Geol. Res.
+2014:763598, Table 10. With ``cap_points=100`` and scores rounded to integers, as that paper prints
+them, all ten category ratings are reproduced (tests/test_rhrs_published.py;
+tests/data/taherynia2014/README.md).
 """
 from __future__ import annotations
 

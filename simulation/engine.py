@@ -11,6 +11,7 @@ the same numbers whatever the chunk size.
 from __future__ import annotations
 
 import os
+import subprocess
 import sys
 import time
 
@@ -206,23 +207,29 @@ class Precompile:
     """
 
     def __init__(self, scenario_path):
-        import multiprocessing
         self._proc = None
         try:       # a warm on-disk cache: nothing to do (numba internals; if they move, compile anyway)
             if os.path.exists(kernel.simulate._cache._cache_file._index_path):
                 return
         except (AttributeError, TypeError):
             pass
-        self._proc = multiprocessing.get_context("spawn").Process(target=_warm_up, args=(str(scenario_path),),
-                                                                  daemon=True)
-        self._proc.start()
+        # A fresh interpreter (not multiprocessing): it never re-imports the caller's main script, so a user's
+        # script without an ``if __name__ == "__main__"`` guard works unchanged.
+        try:
+            self._proc = subprocess.Popen([sys.executable, "-c", "import sys, simulation.engine as e; "
+                                           "e._warm_up(sys.argv[1])", str(scenario_path)],
+                                          stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                          stderr=subprocess.DEVNULL)
+        except OSError:
+            self._proc = None
 
     def wait(self, timeout: float | None = 300.0) -> bool:
         """Block until the compilation is done; True when the child finished cleanly (or was not needed)."""
         if self._proc is None:
             return True
-        self._proc.join(timeout)
-        if self._proc.is_alive():
-            self._proc.terminate()
+        try:
+            self._proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            self._proc.kill()
             return False
-        return self._proc.exitcode == 0
+        return self._proc.returncode == 0

@@ -307,7 +307,7 @@ def _envelope(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass, inerti
         env_acc[i, 6] += e
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
              px, pz, tree, n_leaves, seg_mat, run_first, run_last,
              m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,

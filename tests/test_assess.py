@@ -108,6 +108,37 @@ def test_design_block_site_masses_and_sensitivity_in_outputs(assessed):
     assert (out / "figures" / "design_energy_sensitivity.png").exists()
 
 
+def test_design_energy_tornado_in_outputs(assessed):
+    """Issue 10 item 4: the one-way sensitivity of the design energies, in the CSV, the summary and the report."""
+    import pandas as pd
+    site, out = assessed
+    s = json.loads((out / "summary.json").read_text())
+    t = pd.read_csv(out / "design_energy_tornado.csv")
+    assert {"design_energy", "input", "low", "base", "high", "energy_low_kj", "energy_base_kj", "energy_high_kj",
+            "swing_kj", "range_basis"} <= set(t.columns)
+    e100 = [r["energy_kj"] for r in s["design_energies"] if r["T_years"] == 100.0][0]
+    t100 = t[t["design_energy"] == "100-year energy at the barrier line"].set_index("input")
+    assert np.allclose(t100["energy_base_kj"], e100, rtol=1e-9)
+    # the site's uncertainty ranges (m_max 1,000-4,000 t, rate factor 0.5-2) and the grid's corners agree
+    sens = pd.DataFrame(s["design_energy_sensitivity"]).set_index(["m_max_kg", "rate_share"])["energy_kj"]
+    row = t100.loc["maximum credible block m_max [kg]"]
+    assert (row["low"], row["high"]) == (1e6, 4e6)
+    assert row["energy_low_kj"] == pytest.approx(sens[(1e6, 0.05)]) and row["energy_high_kj"] == pytest.approx(
+        sens[(4e6, 0.05)])
+    b = t100.loc["power-law exponent b"]
+    assert b["energy_low_kj"] > b["energy_base_kj"] > b["energy_high_kj"]        # lower b: heavier tail
+    block = t[t["design_energy"].str.startswith("design-block energy")]
+    assert list(block["input"]) == ["velocity percentile of the block energy [%]"]   # percentile rule
+    chosen = [r for r in s["design_block"]["alternatives"] if r["chosen"]][0]
+    assert block["energy_base_kj"].item() == pytest.approx(chosen["energy_at_v95_kj"], rel=1e-12)
+    frag = t[t["design_energy"].str.startswith("fragmentation alternative")]
+    assert {"fractal dimension D", "fragmentation generations"} <= set(frag["input"])
+    assert s["design_energy_tornado"]["dominant"][0]["design_energy"] == "100-year energy at the barrier line"
+    assert (out / "figures" / "design_energy_tornado.png").exists()
+    html = (out / "report.html").read_text()
+    assert "One-way sensitivity of the design energies (tornado)" in html and "dominates" in html
+
+
 @pytest.mark.parametrize("edit, match", [
     ({"percentile = 97\n": "percentile = 100\n"}, "design_block.percentile = 100"),
     ({"percentile = 97\n": "percentile = 0\n"}, "design_block.percentile = 0"),
@@ -131,10 +162,16 @@ def test_copied_inputs_rerun_to_the_same_numbers(assessed, tmp_path):
     inputs = tmp_path / "inputs"
     shutil.copytree(out / "inputs", inputs)
     rerun = tmp_path / "rerun"
-    assert main(["assess", str(inputs / "site.toml"), "--out", str(rerun)]) == 0
+    rerun.mkdir()
+    # From Python this time: the figures are all drawn by write_assessment (the command line draws them beside
+    # the computation); the same files and numbers either way.
+    from riskrf.assess import run_assessment, write_assessment
+    write_assessment(run_assessment(load_site(inputs / "site.toml")), rerun)
     a = json.loads((out / "summary.json").read_text())
     b = json.loads((rerun / "summary.json").read_text())
     assert a["design_energies"] == b["design_energies"] and a["ranking"] == b["ranking"]
+    files = lambda d: sorted(str(p.relative_to(d)) for p in d.rglob("*") if p.is_file())  # noqa: E731
+    assert files(out) == files(rerun)
 
 
 def test_report_in_headless_chromium(assessed):

@@ -24,8 +24,17 @@ def test_energy_from_scenario_on_real_inventory(tmp_path, capsys):
     table = pd.read_csv(out / "design_energies.csv")
     assert list(table["T_years"]) == [10, 50, 100, 300, 1000]
     assert (table["ci_low_kj"] <= table["energy_kj"]).all() and (table["energy_kj"] <= table["ci_high_kj"]).all()
-    for name in ("energy_exceedance.png", "mass_velocity.png", "fence_checks.csv"):
+    for name in ("energy_exceedance.png", "mass_velocity.png", "fence_checks.csv", "design_energy_tornado.png"):
         assert (out / name).stat().st_size > 0
+    # issue 10 item 4: the tornado of the design energy, printed and written, its base the 100-year energy
+    assert "One-way sensitivity (tornado)" in text and "dominant for the 100-year energy" in text
+    tornado = pd.read_csv(out / "design_energy_tornado.csv")
+    t100 = tornado[tornado["design_energy"] == "100-year energy at the barrier line"]
+    assert set(t100["input"]) == {"maximum credible block m_max [kg]", "rate share of the source above the line",
+                                  "power-law exponent b"}
+    e100 = table.loc[table["T_years"] == 100, "energy_kj"].item()
+    assert np.allclose(t100["energy_base_kj"], e100, rtol=1e-9)
+    assert (t100["energy_low_kj"] <= e100).sum() >= 2           # m_max and share low lower the energy, b low raises it
 
 
 def test_energy_from_velocity_file(tmp_path, capsys):

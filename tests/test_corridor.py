@@ -185,6 +185,47 @@ def test_failure_reported_with_keep_going_and_resume(corridor, tmp_path, monkeyp
         monkeypatch.setattr(cr, "assess_section", real)
 
 
+def test_duplicate_chainage_is_an_overlap(tmp_path):
+    # two ids on the same chainage: the second is reported as overlapping the first, by row and section
+    path = _write(tmp_path, HEAD + "A,0,100,20,3,1,0.5,\nB,0,100,20,3,1,0.5,\nC,100,200,20,3,1,0.5,\n")
+    with pytest.raises(cr.CorridorError, match=r"row 3 \(section 'B'\): chainage 0-100 m overlaps row 2 \(section 'A'"):
+        cr.load_corridor(path)
+    assert [s.id for s in cr.load_corridor(path, keep_going=True).sections] == ["A", "C"]
+
+
+def test_worker_dying_mid_run_is_rescheduled_and_nothing_half_written(corridor, runs, tmp_path, monkeypatch):
+    """A worker leaves the cluster while it runs section B (closed without waiting for its task, as when its
+    process dies): the scheduler reruns B on the other worker, the results equal the serial run, and the
+    partition directory holds one whole file per section and no partial file."""
+    from distributed.core import Status
+    client, cluster = _client(2)
+    real = cr.assess_section
+    died = []
+
+    def dying(section, cor, n_blocks=None, seed=None):
+        if section.id == "B" and not died:
+            w = distributed.get_worker()
+            died.append(w.address)
+            w.loop.add_callback(w.close, executor_wait=False, reason="test: worker dies mid-task")
+            t0 = time.perf_counter()
+            while w.status not in (Status.closing, Status.closed) and time.perf_counter() - t0 < 20:
+                time.sleep(0.02)
+            raise RuntimeError("this result must never be seen: its worker is gone")
+        return real(section, cor, n_blocks, seed)
+
+    try:
+        monkeypatch.setattr(cr, "assess_section", dying)
+        parts = tmp_path / "parts"
+        res = cr.run_corridor(corridor, client=client, n_blocks=N, partitions=parts, retries=0)
+    finally:
+        monkeypatch.setattr(cr, "assess_section", real)
+        client.close()
+        cluster.close()
+    assert len(died) == 1 and res.failures == ()
+    pd.testing.assert_frame_equal(_comparable(res.table), _comparable(runs["serial"]), check_exact=True)
+    assert len(list(parts.glob("*.parquet"))) == 3 and not list(parts.glob("*.partial"))
+
+
 class _Borrowed:
     """A shared client that the CLI may 'close' without closing it."""
 

@@ -450,3 +450,31 @@ def test_damage_state_shares_with_no_arrivals_are_zero_not_nan():
     assert passing.shape == (4,) and not np.isnan(passing).any() and not held.any() and not destroyed.any()
     p, h, d = damage_state_shares(np.array([[500.0], [2000.0]]), np.array([False, False]), 1000.0)
     assert (p[0], h[0], d[0]) == (0.5, 0.5, 0.5)          # SEL = 333 kJ: 500 held for repair, 2000 through
+
+
+def test_mass_coupled_hazard_gives_each_mass_its_own_reach_and_speed_at_the_fence():
+    """Two mass classes: light blocks (1-10 t) reach the line half the time at 10 m/s, heavy ones (10-100 t)
+    always at 30 m/s.  A 4,000 kJ fence holds every light block (E <= 500 kJ, below SEL) and no heavy one
+    (E >= 4,500 kJ): the barrier is destroyed by exactly the heavy arrivals, rate x P(heavy) x 1.  Pooled
+    speeds (one law for all masses) would let light blocks break it and heavy ones be held."""
+    from riskrf.mass_coupling import MassCoupledSamples
+    from riskrf.impact_energy import mass_model
+    n = 2000
+    m = np.geomspace(1e3, 1e5, n + 2)[1:-1]
+    heavy = m > 1e4
+    speed = np.where(heavy, 30.0, np.where(np.arange(n) % 2 == 0, 10.0, np.nan))
+    height = np.where(np.isfinite(speed), 1.0, np.nan)
+    samples = MassCoupledSamples(m, speed, height, np.array([1e3, 1e4, 1e5]), "barrier")
+    mass = stats.loguniform(1e3, 1e5)
+    mm = mass_model(mass)
+    rep = samples.with_representative(mm)
+    hz = EnergyHazard(mass=mass, velocity=rep, rate_per_year=2.0, reach_probability=samples.reach_probability(mm),
+                      heights_m=rep.heights_m)
+    assert hz.mass_coupled and hz.reach_probability == pytest.approx(0.75, abs=1e-3)
+    fence = Option("fence", "fence", 5e5, capacity_kj=4000, height_m=5, repair_days=0)
+    s = MitigationStudy(hazard=hz, options=(Option("nothing", "none"), fence), consequences=CONSTANT_V,
+                        uncertainty=Uncertainty(samples=20))
+    assert s.evaluate("nothing").road_falls_per_year == pytest.approx(2.0 * 0.75, rel=0.01)
+    r = s.evaluate("fence")
+    assert r.replacements_per_year == pytest.approx(2.0 * 0.5, rel=0.02)
+    assert r.repairs_per_year == 0.0

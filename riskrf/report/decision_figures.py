@@ -80,8 +80,12 @@ def plot_tree(tree, ax=None, *, max_label: int = 28):
     return ax
 
 
-def plot_tornado(table, ax=None, *, currency: str = ""):
-    """Tornado chart from :meth:`MitigationStudy.tornado` or :meth:`DecisionTree.tornado`."""
+def plot_tornado(table, ax=None, *, currency: str = "", xlabel: str | None = None, annotate: bool = False):
+    """Tornado chart from :meth:`MitigationStudy.tornado`, :meth:`DecisionTree.tornado` or any table with columns
+    ``parameter``, ``base`` and ``cost_at_low``/``cost_at_high`` or ``value_at_low``/``value_at_high``.
+
+    ``xlabel``: the quantity on the x axis (default: the expected total cost of the best option);
+    ``annotate``: write the value at the end of each bar."""
     ax = _axes(ax, figsize=(7, 0.5 * len(table) + 1.5))
     base = float(table["base"].iloc[0])
     lo_col = "cost_at_low" if "cost_at_low" in table else "value_at_low"
@@ -90,10 +94,15 @@ def plot_tornado(table, ax=None, *, currency: str = ""):
         lo, hi = getattr(r, lo_col), getattr(r, hi_col)
         ax.barh(i, lo - base, left=base, color="C0", alpha=0.8, label="input low" if i == 0 else None)
         ax.barh(i, hi - base, left=base, color="C3", alpha=0.8, label="input high" if i == 0 else None)
+        if annotate:
+            for v in (lo, hi):
+                if np.isfinite(v) and v != base:
+                    ax.annotate(_fmt(v), (v, i), xytext=(3 if v > base else -3, 0), textcoords="offset points",
+                                ha="left" if v > base else "right", va="center", fontsize="x-small")
     ax.axvline(base, color="k", lw=1)
     ax.set_yticks(range(len(table)), table["parameter"])
     ax.invert_yaxis()
-    ax.set_xlabel(f"expected total cost of the best option {currency}".strip())
+    ax.set_xlabel(xlabel or f"expected total cost of the best option {currency}".strip())
     ax.legend(fontsize="small")
     ax.grid(True, axis="x", alpha=0.3)
     return ax

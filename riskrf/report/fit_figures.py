@@ -4,6 +4,7 @@ only when a figure is drawn."""
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
 from ..extremes import gumbel_reduced_variate, plotting_positions
 from ..units import mass_for_energy_kg
@@ -189,3 +190,36 @@ def plot_design_energy_sensitivity(table, ax=None):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize="small", title="judgement inputs")
     return ax
+
+
+def plot_design_energy_tornado(tornado, axes=None):
+    """One tornado per design energy of a :class:`~riskrf.energy_study.DesignEnergyTornado` (stacked panels,
+    each with its own base line and x axis in kJ), drawn by :func:`riskrf.report.decision_figures.plot_tornado`.
+
+    Returns the list of axes, one per design energy."""
+    from .decision_figures import plot_tornado
+    names = tornado.design_energies
+    subs = [tornado.table[tornado.table["design_energy"] == n] for n in names]
+    if axes is None:
+        import matplotlib.pyplot as plt
+        heights = [0.5 * len(s) + 1.1 for s in subs]
+        fig, axes = plt.subplots(len(names), 1, figsize=(7.5, sum(heights) + 0.5), squeeze=False,
+                                 gridspec_kw={"height_ratios": heights})
+        axes = list(axes[:, 0])
+        fig.suptitle("Each input at its low (blue) and high (red) value, the others at base", fontsize="medium")
+    for ax, name, sub in zip(axes, names, subs):
+        labels = [f"{r['input']}\n{_short(r['low'])} / {_short(r['high'])}" for _, r in sub.iterrows()]
+        t = pd.DataFrame({"parameter": labels, "base": sub["energy_base_kj"].to_numpy(),
+                          "value_at_low": sub["energy_low_kj"].to_numpy(),
+                          "value_at_high": sub["energy_high_kj"].to_numpy()})
+        plot_tornado(t, ax=ax, xlabel=f"{name} [kJ]", annotate=True)
+        ax.get_legend().remove()
+        ax.margins(x=0.12)
+        ax.tick_params(axis="y", labelsize="small")
+        ax.set_title(f"{name}: base {_short(t['base'].iloc[0])} kJ", fontsize="small")
+    return axes
+
+
+def _short(v) -> str:
+    from .format import sig
+    return sig(v, 3)

@@ -64,6 +64,34 @@ def _item_table(df: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
+def _tornado_section(doc, tornado, figs: Path) -> None:
+    """One-way sensitivity (tornado) of the design energies: text naming the dominant input of each, figure, table."""
+    n_fig, n_tab = doc.next_figure, doc.next_table
+    dom = tornado.dominant()
+    said = "".join(
+        f"<li>{_e(r['design_energy'])}: <b>{_e(r['input'])}</b> dominates, moving it from "
+        f"{sig(r['energy_low_kj'], 2)} to {sig(r['energy_high_kj'], 2)} kJ (base {sig(r['energy_base_kj'], 2)} kJ; "
+        f"{r['share_of_swings']:.0%} of the summed swings).</li>" for _, r in dom.iterrows())
+    t = tornado.table
+    table = t[["design_energy", "input", "low", "base", "high", "energy_low_kj", "energy_base_kj", "energy_high_kj",
+               "swing_kj", "range_basis"]].rename(columns={
+        "design_energy": "design energy moved", "low": "input low", "base": "input base", "high": "input high",
+        "energy_low_kj": "energy at low [kJ]", "energy_base_kj": "energy at base [kJ]",
+        "energy_high_kj": "energy at high [kJ]", "swing_kj": "swing [kJ]", "range_basis": "range from"})
+    doc.add("<h3>One-way sensitivity of the design energies (tornado)</h3>",
+            f"<p>Each input moved alone to its low and high value, the others at base, on the same simulated slope "
+            f"(the mass law re-scaled or refitted, nothing re-simulated). Each panel of {n_fig} and each row of "
+            f"{n_tab} names the design energy it moves: the {tornado.design_T:g}-year energy at the barrier line "
+            "(hazard curve) and the design-block energy &frac12; m v<sub>p</sub><sup>2</sup> (one block at a "
+            "percentile speed of blocks of its mass) are separate numbers and are not mixed in one bar set. "
+            "Ranges marked ASSUMPTION are typed, not measured.</p>",
+            "<ul>" + said + "</ul>",
+            "<ul>" + "".join(f"<li>{_e(n)}</li>" for n in tornado.notes) + "</ul>",
+            doc.figure(figs / "design_energy_tornado.png", "Tornado of the design energies: each input at its low "
+                       "(blue) and high (red) value, one panel per design energy, bars sorted by swing"),
+            doc.table(table, "One-way sensitivity of the design energies", digits=3))
+
+
 def render_report(a, figs: Path) -> str:
     """HTML of the hazard and mitigation report for assessment ``a`` (figures read from ``figs``)."""
     site, inv, fr, gr = a.site, a.inventory, a.frequency, a.frequency.power_law
@@ -107,6 +135,13 @@ def render_report(a, figs: Path) -> str:
                        f"{sig(sv['m_max_kg'].max())} kg, rate share {sig(sv['rate_share'].min())} - "
                        f"{sig(sv['rate_share'].max())}) the {en.design_T:g}-year energy spans "
                        f"{sig(sv['energy_kj'].min(), 2)} - {sig(sv['energy_kj'].max(), 2)} kJ (section 5).</li>")
+    if en.tornado is not None and len(en.tornado.table):
+        d = en.tornado.dominant()
+        if len(d):
+            r = d.iloc[0]
+            summary.append(f"<li>The {_e(r['design_energy'])} is most sensitive to {_e(r['input'])} "
+                           f"({sig(r['energy_low_kj'], 2)} - {sig(r['energy_high_kj'], 2)} kJ; tornado in "
+                           "section 5).</li>")
     if en.design_block is not None:
         b = en.design_block
         summary.append(f"<li>Design block: <b>{sig(b.mass_kg)} kg ({sig(b.volume_m3)} m&sup3;, diameter "
@@ -237,6 +272,8 @@ def render_report(a, figs: Path) -> str:
                           f"{en.design_T:g}-year energy [kJ] by m_max and rate share", digits=2),
                 doc.figure(figs / "design_energy_sensitivity.png", f"The {en.design_T:g}-year energy against the "
                            "rate share, one line per maximum credible block"))
+    if en.tornado is not None and len(en.tornado.table):
+        _tornado_section(doc, en.tornado, figs)
     if en.design_block is not None:
         b = en.design_block
         doc.add("<h3>Design block</h3>",
@@ -349,8 +386,8 @@ def render_report(a, figs: Path) -> str:
              ("The rate and mass distribution come from the fitted power law, applied at the barrier line"
               + (f" with the rate scaled by {sig(rate_scale)} (typed assumption)" if rate_scale != 1 else "") + "."),
              f"Rate of falls from the {a.rate_source}.",
-             "Judgement inputs not in any interval: m_max and the rate share (see the sensitivity table in "
-             "section 5)."]
+             "Judgement inputs not in any interval: m_max and the rate share (see the sensitivity table and the "
+             "tornado of the design energies in section 5)."]
     if en.design_block is not None:
         items += [f"Design block ({en.design_block.rule} rule): {x}" for x in en.design_block.assumptions]
     doc.add("<div class='warn'><ul>" + "".join(f"<li>{_e(t)}</li>" for t in items) + "</ul></div>")
