@@ -356,8 +356,8 @@ class InBackground:
     """Run ``work()`` (returning a picklable value) in a forked child on the other core; :meth:`result` returns it.
 
     Used for the rate model, which a run needs only later (the hazard's rate, the closure options): fitted
-    while the inventory fits and the simulation run here, at a lower priority (``nice`` 10) so that it takes
-    the idle core rather than time from this process.  Forking only where it is safe (POSIX, no other
+    while the inventory fits and the simulation run here.  (Not at a lower priority: the figures drawn beside
+    the stages are needed only at the end, the rate model already before the ranking.)  Forking only where it is safe (POSIX, no other
     thread); otherwise, or if the child fails, ``work`` runs in this process at :meth:`result`.  An exception
     raised by ``work`` in the child is raised again by :meth:`result`.  The value is the same either way.
     """
@@ -399,11 +399,6 @@ class InBackground:
 
 
 def _send_result(work, conn):
-    import os
-    try:                   # yield to the parent (same numbers either way): it runs on the idle core, not against the fits
-        os.nice(10)
-    except (AttributeError, OSError):
-        pass
     try:
         value = work()
     except Exception as exc:          # noqa: BLE001  (sent back and raised in the parent)
