@@ -79,14 +79,50 @@ def cmd_fit(args) -> int:
     from .preflight import check_inventory_args, check_out
     check_inventory_args(args)
     out = check_out(args, f"{Path(args.inventory).stem}-fit")
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers = {args.workers}: must be a whole number >= 1")
+    if args.bootstrap_grid is not None and args.bootstrap_grid not in (0,) and args.bootstrap_grid < 2:
+        raise ValueError(f"--bootstrap-grid = {args.bootstrap_grid}: give 0 (scan every value) or >= 2 thresholds")
     inv = _read(args, args.inventory)
-    analysis = analyse_inventory(inv, m_min=args.m_min, method=args.method, m_max=args.m_max,
-                                 gumbel_method=args.gumbel_method, n_bootstrap=args.bootstrap, seed=args.seed)
+    show = sys.stderr.isatty() if args.progress is None else args.progress
+    bar = _BootstrapBar(sys.stderr) if show and args.bootstrap else None
+    grid = "auto" if args.bootstrap_grid is None else (None if args.bootstrap_grid == 0 else args.bootstrap_grid)
+    try:
+        analysis = analyse_inventory(inv, m_min=args.m_min, method=args.method, m_max=args.m_max,
+                                     gumbel_method=args.gumbel_method, n_bootstrap=args.bootstrap, seed=args.seed,
+                                     bootstrap_workers=args.workers, progress=bar, bootstrap_grid=grid)
+    except BaseException:
+        if bar is not None and bar.drawn:
+            sys.stderr.write("\n")          # end the bar's line: the error or "interrupted" gets its own
+        raise
     print(analysis.summary_text())
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         analysis.write(tmp)
     print(f"\nWrote summary.json, design_masses.csv, completeness.csv and figures to {out}/")
     return 0
+
+
+class _BootstrapBar:
+    """``progress(done, total)`` callback drawing the bootstrap's progress on a terminal stream."""
+
+    def __init__(self, stream):
+        import time
+        self.stream, self.started, self._clock = stream, time.perf_counter(), time.perf_counter
+
+    drawn = False
+
+    def __call__(self, done: int, total: int) -> None:
+        if done == 0:
+            self.started = self._clock()
+        self.drawn = done < total
+        bar = "#" * int(30 * done / total)
+        per = (self._clock() - self.started) / max(done, 1)
+        left = per * (total - done)
+        self.stream.write(f"\rbootstrap [{bar:<30}] {done:>6,}/{total:,} replicates  {per:.2f} s each, "
+                          f"{left:,.0f} s left ")
+        if done == total:
+            self.stream.write("\n")
+        self.stream.flush()
 
 
 def write_table(df, path: Path, suffix: str | None = None) -> None:
@@ -485,6 +521,18 @@ def build_parser() -> argparse.ArgumentParser:
     _add_fit_arguments(p)
     p.add_argument("--out", default=None, metavar="DIR",
                    help="output directory (default: <inventory name>-fit); written only when complete")
+    g = p.add_argument_group("bootstrap of large inventories (README 'Scale of the fits')")
+    g.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="show the bootstrap's progress bar (default: on when standard error is a terminal)")
+    g.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="threads running bootstrap replicates (default: one per core from 20,000 falls, else 1); "
+                        "results are identical for any number (replicate i always uses seed child i)")
+    g.add_argument("--bootstrap-grid", type=int, default=None, metavar="K",
+                   help="threshold candidates scanned in the data and in each bootstrap replicate.  Default: "
+                        "every distinct value (exact, Clauset et al. 2009) up to 100,000 falls; above that "
+                        "2,000 candidates at log-spaced tail sizes, which makes a replicate of 10^6 falls about "
+                        "0.05-0.1 s instead of 3-7 s and moves the threshold by < 0.6 %% of the tail size.  "
+                        "0 = every value")
     p.set_defaults(func=cmd_fit)
 
     p = sub.add_parser("simulate", help="Monte Carlo rock fall trajectories on a slope scenario",
