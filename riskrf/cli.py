@@ -179,6 +179,25 @@ def cmd_simulate(args) -> int:
     return 0
 
 
+def _drop_height(args):
+    """--drop-height: a height in m, or a scenario TOML whose profile gives it at --collector."""
+    value = getattr(args, "drop_height", None)
+    if value is None:
+        return None
+    if str(value).lower().endswith(".toml"):
+        from .velocities import free_fall_drop_m
+        from .units import STANDARD_GRAVITY_MS2
+        h, v0 = free_fall_drop_m(value, args.collector or "barrier")
+        return h + v0 ** 2 / (2 * STANDARD_GRAVITY_MS2)        # the release speed as an equivalent extra drop
+    try:
+        h = float(value)
+    except ValueError:
+        raise ValueError(f"--drop-height = {value!r}: give a height in m or a scenario .toml file") from None
+    if not h > 0 or h == float("inf"):
+        raise ValueError(f"--drop-height = {value!r}: must be a finite height > 0 m")
+    return h
+
+
 def build_energy_hazard(args, inventory):
     """Power-law fit of the inventory combined with a simulation or a velocity file (energy and decide)."""
     from .assess import energy_hazard_from_inputs
@@ -187,6 +206,7 @@ def build_energy_hazard(args, inventory):
         velocities=args.velocities, collector=args.collector, n=args.n, seed=args.seed,
         reach_probability=args.reach_probability,
         condition_on_mass=args.condition_on_mass, velocity_unit=args.velocity_unit,
+        drop_height_m=_drop_height(args),
         mass_coupling="independent" if args.mass_independent else "simulated",
         design_masses_kg=_energy_design_masses(args, inventory))
 
@@ -324,6 +344,10 @@ def _add_energy_arguments(p):
     p.add_argument("--collector", default=None,
                    help="collector (barrier line) name (default 'barrier' in a scenario; a velocity file is "
                         "filtered to it only when given)")
+    p.add_argument("--drop-height", default=None, metavar="M|SCENARIO",
+                   help="with --velocities: height drop [m] from release to the barrier line, or a scenario .toml "
+                        "whose profile gives it at --collector; velocities above 1.1 sqrt(2 g H) are warned about "
+                        "(default limit without it: 50 m/s, a 127 m free fall)")
     p.add_argument("-n", type=int, default=100_000, help="blocks to simulate with --scenario (default 100,000)")
     p.add_argument("--reach-probability", type=float, default=1.0, metavar="P",
                    help="with --velocities: probability that a fall reaches the line (default 1)")
