@@ -60,6 +60,25 @@ def _add_inventory_arguments(p):
                         "dated row has a copy), drop, keep, or error")
 
 
+def _add_reader_arguments(p, what: str, key: str, *, dates: bool = False, prefix: str = ""):
+    """--sheet, --header-row, --decimal, --encoding (and --date-format) for one table a command reads."""
+    g = p.add_argument_group(f"reading {what} (README 'Input formats'; also {key}sheet, ... in the file)"
+                             if key else f"reading {what} (README 'Input formats')")
+    opt = f"--{prefix}-" if prefix else "--"
+    dest = f"{prefix.replace('-', '_')}_" if prefix else ""
+    g.add_argument(f"{opt}sheet", dest=f"{dest}sheet", default=None, metavar="SHEET",
+                   help=f"Excel sheet of {what}: name, or number counting from 1")
+    g.add_argument(f"{opt}header-row", dest=f"{dest}header_row", type=int, default=None, metavar="ROW",
+                   help=f"1-based row holding the column names of {what} (default 1)")
+    g.add_argument(f"{opt}decimal", dest=f"{dest}decimal", choices=(".", ","), default=None,
+                   help="decimal mark (default: decided per column)")
+    g.add_argument(f"{opt}encoding", dest=f"{dest}encoding", default=None, metavar="ENCODING",
+                   help="text encoding (default UTF-8, else cp1252 with a note)")
+    if dates:
+        g.add_argument(f"{opt}date-format", dest=f"{dest}date_format", default=None, metavar="FMT",
+                       help="strftime pattern of every date, e.g. %%d/%%m/%%Y; needed only for ambiguous dates")
+
+
 def _read(args, path):
     from .inventory import read_inventory
     if path is None:
@@ -211,12 +230,16 @@ def build_energy_hazard(args, inventory):
         design_masses_kg=_energy_design_masses(args, inventory))
 
 
+def _survey_reader(args) -> dict:
+    return {k: getattr(args, f"survey_{k}", None) for k in ("sheet", "header_row", "decimal", "encoding")}
+
+
 def _energy_design_masses(args, inventory):
     """Masses [kg] the energy command reads design values at: the design-block band and the sensitivity's m_max."""
     from .design_block import design_block_candidates_kg, read_block_survey
     out = [2.0 * args.m_max] if args.m_max else []
     survey_path, pct = getattr(args, "block_survey", None), getattr(args, "design_percentile", None)
-    survey = read_block_survey(survey_path, inventory.density_kg_m3) if survey_path else None
+    survey = read_block_survey(survey_path, inventory.density_kg_m3, **_survey_reader(args)) if survey_path else None
     if pct is not None or survey is not None:
         out += design_block_candidates_kg(rule="percentile", percentile=pct or 97.0,
                                           survey_volumes_m3=survey, inventory=inventory,
@@ -240,7 +263,8 @@ def cmd_energy(args) -> int:
     fragmenting = args.fractal_dimension is not None or args.fragmentation_iterations is not None
     if args.design_percentile is not None or args.block_survey or fragmenting:
         from .design_block import design_block, read_block_survey
-        survey = read_block_survey(args.block_survey, inv.density_kg_m3) if args.block_survey else None
+        survey = read_block_survey(args.block_survey, inv.density_kg_m3, **_survey_reader(args)) \
+            if args.block_survey else None
         rule = "percentile" if (args.design_percentile is not None or survey is not None) else "fragmentation"
         block = design_block(hazard, rule=rule, percentile=args.design_percentile or 97.0,
                              survey_volumes_m3=survey, survey_source=args.block_survey, inventory=inv,
@@ -438,9 +462,10 @@ def cmd_calibrate(args) -> int:
     from .preflight import check_out
     check_out(args, f"{Path(args.scenario).stem}-calibration")
     table = None
-    if Path(args.observed).suffix.lower() in (".csv", ".txt", ".tsv") and Path(args.observed).is_file():
-        from .tables import read_numeric_table       # separators, decimal commas, encodings as for inventories
-        table = read_numeric_table(args.observed, what="observed stops")
+    if Path(args.observed).is_file():
+        from .tables import read_numeric_table       # separators, decimal commas, encodings, sheets as for inventories
+        table = read_numeric_table(args.observed, what="observed stops", decimal=args.decimal, sheet=args.sheet,
+                                   header_row=args.header_row, encoding=args.encoding)
     observed = read_observed(args.observed, column=args.column, select=select, table=table)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -479,7 +504,8 @@ def cmd_calibrate(args) -> int:
 def cmd_corridor(args) -> int:
     from .corridor import load_corridor, run_corridor, write_corridor
 
-    corridor = load_corridor(args.corridor, keep_going=args.keep_going)   # every row checked before any work
+    corridor = load_corridor(args.corridor, keep_going=args.keep_going, sheet=args.sheet,   # every row checked
+                             header_row=args.header_row, decimal=args.decimal, encoding=args.encoding)
     for e in corridor.errors:
         print(f"skipped (--keep-going): {e}")
     from .preflight import check_out
@@ -603,6 +629,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--inventory-sizes", choices=("event_volumes", "blocks"), default="event_volumes",
                    help="what the inventory's sizes are (default event_volumes)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-energy)")
+    _add_reader_arguments(p, "the --block-survey table", "", prefix="survey")
     p.set_defaults(func=cmd_energy)
 
     p = sub.add_parser("decide", help="rank mitigation options, or roll back any decision tree",
@@ -670,6 +697,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--maxiter", type=int, default=20, help="differential-evolution generations (default 20)")
     p.add_argument("--bootstrap", type=int, default=200, help="bootstrap replicates (default 200; 0 to skip)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <scenario>-calibration)")
+    _add_reader_arguments(p, "the observed stops", "")
     p.set_defaults(func=cmd_calibrate)
 
     p = sub.add_parser("rates", help="rock fall rates against rainfall, season and trend (Poisson / negative binomial)",
@@ -705,6 +733,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--heavy-day-change", type=float, default=None, metavar="SHARE",
                    help="expected rate if heavy-rain days became this much more frequent (0.1 = +10%%; an assumption)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-rates)")
+    _add_reader_arguments(p, "the --rainfall table (generic layout)", "", dates=True, prefix="rainfall")
     p.set_defaults(func=cmd_rates)
 
     p = sub.add_parser("corridor", help="screen and assess many sections along a road (RHRS + risk, on dask)",
@@ -722,6 +751,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-n", type=int, default=None, help="simulated blocks per section (default: the corridor file's)")
     p.add_argument("--keep-going", action="store_true", help="skip bad rows and failed sections, listing them")
     p.add_argument("--resume", action="store_true", help="skip sections already finished by an earlier run")
+    _add_reader_arguments(p, "the sections table", "corridor.sections_")
     p.set_defaults(func=cmd_corridor)
     for p in sub.choices.values():       # every command with outputs: never clobber without --overwrite
         if any("--out" in a.option_strings for a in p._actions):
@@ -747,8 +777,11 @@ def cmd_rates(args) -> int:
     from .preflight import check_inventory_args, check_out
     check_inventory_args(args)
     out = check_out(args, f"{Path(args.inventory).stem}-rates")
+    from .rainfall import read_rainfall
+    rainfall = read_rainfall(args.rainfall, **{k: getattr(args, f"rainfall_{k}") for k in
+                                               ("sheet", "header_row", "decimal", "encoding", "date_format")})
     inv = _read(args, args.inventory)
-    model = rate_model(inv, args.rainfall, period=args.period, windows_days=windows,
+    model = rate_model(inv, rainfall, period=args.period, windows_days=windows,
                        season=None if args.season == "none" else args.season, trend=not args.no_trend,
                        rain_transform=args.rain_transform)
     print(model.summary_text())
