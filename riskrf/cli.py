@@ -465,7 +465,7 @@ def cmd_calibrate(args) -> int:
     if Path(args.observed).is_file():
         from .tables import read_numeric_table       # separators, decimal commas, encodings, sheets as for inventories
         table = read_numeric_table(args.observed, what="observed stops", decimal=args.decimal, sheet=args.sheet,
-                                   header_row=args.header_row, encoding=args.encoding)
+                                   header_row=args.header_row, encoding=args.encoding, numeric=(args.column,))
     observed = read_observed(args.observed, column=args.column, select=select, table=table)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -107,7 +107,9 @@ def read_block_survey(path, density_kg_m3: float, *, sheet=None, header_row: int
     if col is not None:
         factor = _VOLUME_UNITS[unit or "m3"]
     else:
-        col, unit = _find_column(df.columns, _MASS_NAMES | {"block"}, _MASS_UNITS)
+        col, unit = _find_column(df.columns, _MASS_NAMES, _MASS_UNITS)
+        if col is None:          # a column named only "block" holds masses when nothing else does (not ids first)
+            col, unit = _find_column(df.columns, {"block"}, _MASS_UNITS)
         if col is not None:
             factor = _MASS_UNITS[unit or "kg"] / float(density_kg_m3)
     if col is None:

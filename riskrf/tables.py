@@ -263,10 +263,11 @@ def parse_numbers(raw: pd.Series, path, col: str, rows, *, decimal: str | None =
     return values.astype(float)
 
 
-def read_numeric_table(path, *, decimal: str | None = None, **kwargs) -> pd.DataFrame:
+def read_numeric_table(path, *, decimal: str | None = None, numeric=(), **kwargs) -> pd.DataFrame:
     """:func:`read_table`, with every column whose filled cells are all numbers (by the decimal-mark rule)
     converted to float; other columns stay text.  Rows wholly empty are dropped; the index holds each
-    row's file line (spreadsheet row; Parquet rows count from 1)."""
+    row's file line (spreadsheet row; Parquet rows count from 1).  Columns named in ``numeric`` must be
+    numbers: the first cell that is not raises ``ValueError`` naming the file, row, column and value."""
     table, first, _ = read_table(path, **kwargs)
     rows = np.arange(len(table)) + first
     keep = ~is_blank(table).to_numpy() if len(table) else np.ones(0, bool)
@@ -276,6 +277,8 @@ def read_numeric_table(path, *, decimal: str | None = None, **kwargs) -> pd.Data
         try:
             out[col] = parse_numbers(table[col], path, col, rows, decimal=decimal).to_numpy()
         except ValueError:
+            if col in numeric:
+                raise
             out[col] = table[col].to_numpy()
     return pd.DataFrame(out, index=pd.Index(rows, name="row"))
 
