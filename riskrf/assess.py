@@ -44,7 +44,7 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
                               scenario=None, velocities=None, collector: str | None = None, n: int = 50_000,
                               seed=1, reach_probability: float = 1.0, condition_on_mass: bool = False,
                               mass_coupling: str = "simulated", design_masses_kg=(),
-                              velocity_unit: str | None = None, drop_height_m=None):
+                              velocity_unit: str | None = None, drop_height_m=None, velocity_reader=None):
     """Power-law fit of the inventory combined with simulated or given velocities.
 
     ``collector`` names the barrier line: in a scenario it defaults to "barrier"; a
@@ -84,7 +84,7 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RiskrfWarning)      # kept in the hazard's notes below
             df = read_velocities(velocities, collector=collector, velocity_unit=velocity_unit,
-                                 drop_height_m=drop_height_m)
+                                 drop_height_m=drop_height_m, **(velocity_reader or {}))
         v = df["velocity_ms"].to_numpy(dtype=float)
         note = "; ".join([f"velocities: {len(df):,} samples from {velocities}", *df.attrs.get("warnings", [])])
         if "angular_velocity_rads" in df and "radius_m" in df:

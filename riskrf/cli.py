@@ -226,6 +226,8 @@ def build_energy_hazard(args, inventory):
         reach_probability=args.reach_probability,
         condition_on_mass=args.condition_on_mass, velocity_unit=args.velocity_unit,
         drop_height_m=_drop_height(args),
+        velocity_reader={k: getattr(args, f"velocities_{k}", None) for k in ("sheet", "header_row", "decimal",
+                                                                            "encoding")},
         mass_coupling="independent" if args.mass_independent else "simulated",
         design_masses_kg=_energy_design_masses(args, inventory))
 
@@ -368,6 +370,7 @@ def _add_energy_arguments(p):
     p.add_argument("--collector", default=None,
                    help="collector (barrier line) name (default 'barrier' in a scenario; a velocity file is "
                         "filtered to it only when given)")
+    _add_reader_arguments(p, "the --velocities table", "", prefix="velocities")
     p.add_argument("--drop-height", default=None, metavar="M|SCENARIO",
                    help="with --velocities: height drop [m] from release to the barrier line, or a scenario .toml "
                         "whose profile gives it at --collector; velocities above 1.1 sqrt(2 g H) are warned about "

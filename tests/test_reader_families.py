@@ -168,3 +168,28 @@ def test_observed_stops_from_a_european_export(tmp_path):
     obs = read_observed(tmp_path / "stops.xlsx", table=read_numeric_table(tmp_path / "stops.xlsx", sheet=2,
                                                                              header_row=4))
     assert list(obs["x_stop_m"]) == [52.5, 61.0] and list(obs.index) == [5, 6]
+
+
+# -- velocity files (riskrf energy --velocities) ---------------------------------------------------------
+def test_cli_energy_reads_velocities_on_sheet_2_below_title_rows(tmp_path, capsys):
+    from riskrf.cli import main
+
+    from .conftest import INVENTORIES
+    rng = np.random.default_rng(4)
+    body = pd.DataFrame({"Translational Velocity (m/s)": rng.normal(15, 2, 300).clip(1).round(2),
+                         "Bounce Height (m)": rng.exponential(1, 300).round(2)})
+    _excel_sheet2(tmp_path / "v.xlsx", body)
+    inv = str(INVENTORIES / "lauterbrunnen" / "lauterbrunnen_tls_2018.csv")
+    base = ["energy", "--inventory", inv, "--velocities", str(tmp_path / "v.xlsx"), "--bootstrap", "5",
+            "--fence", "1000"]
+    assert main(base + ["--out", str(tmp_path / "a")]) == 2                  # sheet 1 has no velocities
+    assert "no velocity column" in capsys.readouterr().err
+    assert main(base + ["--velocities-sheet", "Daten", "--velocities-header-row", "4",
+                        "--out", str(tmp_path / "b")]) == 0
+    assert "300 samples" in capsys.readouterr().out
+    eu = tmp_path / "v.csv"
+    eu.write_bytes(("\ufeffvelocity_ms;height_m\n" + "".join(f"{v:.2f};{h:.2f}\n".replace(".", ",") for v, h in
+                                                             body.to_numpy())).encode("utf-8"))
+    base[4] = str(eu)
+    assert main(base + ["--out", str(tmp_path / "c")]) == 0
+    assert "300 samples" in capsys.readouterr().out
