@@ -578,8 +578,9 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="show the bootstrap's progress bar (default: on when standard error is a terminal)")
     g.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="threads running bootstrap replicates (default: one per core from 20,000 falls, else 1); "
-                        "results are identical for any number (replicate i always uses seed child i)")
+                   help="threads running bootstrap replicates (default: one per core for 20,000-100,000 falls, "
+                        "where the compiled threshold scan dominates; else 1); results are identical for any number "
+                        "(replicate i always uses seed child i)")
     g.add_argument("--bootstrap-grid", type=int, default=None, metavar="K",
                    help="threshold candidates scanned in the data and in each bootstrap replicate.  Default: "
                         "every distinct value (exact, Clauset et al. 2009) up to 100,000 falls; above that "
