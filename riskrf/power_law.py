@@ -109,8 +109,9 @@ def find_m_min(masses, *, min_tail: int = 10, exhaustive: bool = False, statisti
         reproduces the published thresholds and p-values of Clauset et al. (2009).
     grid : int, optional
         Scan at most this many candidates, at tail sizes evenly spaced in log
-        between ``min_tail`` and the sample size (the "sample" option of
-        Clauset's plpva.m); the minimum is then over those candidates only.
+        between ``min_tail`` and the sample size (like the 'sample' option of
+        Clauset's plpva.m, which spaces candidates evenly over the distinct
+        values); the minimum is then over those candidates only.
         Used by the bootstrap test of large samples (:data:`LARGE_SAMPLE`).
 
     Returns
