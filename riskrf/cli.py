@@ -204,8 +204,8 @@ def _drop_height(args):
     if value is None:
         return None
     if str(value).lower().endswith(".toml"):
-        from .velocities import free_fall_drop_m
         from .units import STANDARD_GRAVITY_MS2
+        from .velocities import free_fall_drop_m
         h, v0 = free_fall_drop_m(value, args.collector or "barrier")
         return h + v0 ** 2 / (2 * STANDARD_GRAVITY_MS2)        # the release speed as an equivalent extra drop
     try:

@@ -16,7 +16,12 @@ import pandas as pd
 from .extremes import MIN_MAXIMA, GEVFit, GumbelFit, fit_gev, fit_gumbel
 from .inventory import Inventory
 from .outputs import write_json
-from .power_law import LARGE_SAMPLE, GutenbergRichterFit, PowerLawBootstrap, fit_gutenberg_richter
+from .power_law import (
+    LARGE_SAMPLE,
+    GutenbergRichterFit,
+    PowerLawBootstrap,
+    fit_gutenberg_richter,
+)
 from .report.format import sig
 from .validation import RiskrfWarning
 
