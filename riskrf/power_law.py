@@ -531,11 +531,15 @@ class GutenbergRichterFit:
         lower = self.m_min + 0.5 if self.discrete else self.m_min    # the data's own threshold
         stop = threading.Event()
 
-        def replicate(child):
-            """KS distance of one replicate, or NaN when it cannot be refitted."""
+        root = np.random.SeedSequence(seed)
+
+        def replicate(i):
+            """KS distance of replicate i, or NaN when it cannot be refitted."""
             if stop.is_set():
                 return np.nan
-            rng = np.random.default_rng(child)
+            # child i of root.spawn(n_bootstrap), made when needed (a million children would hold memory)
+            rng = np.random.default_rng(np.random.SeedSequence(root.entropy, spawn_key=root.spawn_key + (i,),
+                                                               pool_size=root.pool_size))
             k = rng.binomial(n, p_tail) if body.size else n
             tail = _truncated_isf(1.0 - rng.uniform(size=k), self.b, self.m_min, self.m_max)
             if self.discrete:
@@ -561,21 +565,22 @@ class GutenbergRichterFit:
                 b, _ = _mle_truncated_b(tail, self.m_min, self.m_max)
             return _ks_distance(tail, 1 - _truncated_sf(tail, b, self.m_min, self.m_max), self.ks_statistic)
 
-        children = np.random.SeedSequence(seed).spawn(n_bootstrap)
         D = np.full(n_bootstrap, np.nan)
         if progress is not None:
             progress(0, n_bootstrap)
         if workers == 1:
-            for i, child in enumerate(children):
-                D[i] = replicate(child)
+            for i in range(n_bootstrap):
+                D[i] = replicate(i)
                 if progress is not None:
                     progress(i + 1, n_bootstrap)
         else:
             pool = ThreadPoolExecutor(max_workers=int(workers), thread_name_prefix="riskrf-bootstrap")
             try:
-                pending = {pool.submit(replicate, child): i for i, child in enumerate(children)}
-                done = 0
-                while pending:
+                pending, queued, done = {}, 0, 0
+                while queued < n_bootstrap or pending:
+                    while queued < n_bootstrap and len(pending) < 4 * workers:     # a few in flight per thread
+                        pending[pool.submit(replicate, queued)] = queued
+                        queued += 1
                     finished, _ = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
                     for f in finished:
                         D[pending.pop(f)] = f.result()
