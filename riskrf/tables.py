@@ -45,11 +45,7 @@ def _header_line(text: str, header_row: int | None) -> str:
 
 def sniff_delimiter(path, *, encoding: str | None = None, header_row: int | None = None) -> str:
     """The most frequent of ``;``, tab, ``|`` and ``,`` on the header line (outside quotes); ``,`` when none."""
-    text = _decode(Path(path).read_bytes()[:65536], encoding)[0]
-    line = re.sub(r'"[^"]*"', "", _header_line(text, header_row))
-    counts = {d: line.count(d) for d in DELIMITERS}
-    best = max(DELIMITERS, key=lambda d: counts[d])
-    return best if counts[best] else ","
+    return _sniff_text(_decode(Path(path).read_bytes()[:65536], encoding)[0], header_row)
 
 
 def _sniff_text(text: str, header_row: int | None) -> str:
