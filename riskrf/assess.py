@@ -292,7 +292,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
             collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
             mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=extra,
-            velocity_unit=hz_cfg["velocity_unit"])
+            velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"))
         timings["simulation"] = round(time.perf_counter() - t, 2)
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
