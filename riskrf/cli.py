@@ -585,7 +585,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="threshold candidates scanned in the data and in each bootstrap replicate.  Default: "
                         "every distinct value (exact, Clauset et al. 2009) up to 100,000 falls; above that "
                         "2,000 candidates at log-spaced tail sizes, which makes a replicate of 10^6 falls about "
-                        "0.05-0.1 s instead of 3-7 s and moves the threshold by < 0.6 %% of the tail size.  "
+                        "0.05-0.1 s instead of 3-7 s (neighbouring candidates are < 0.6 %% apart in tail size).  "
                         "0 = every value")
     p.set_defaults(func=cmd_fit)
 

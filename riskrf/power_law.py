@@ -490,8 +490,8 @@ class GutenbergRichterFit:
             alike.  ``"auto"`` (default): every value up to
             :data:`LARGE_SAMPLE` (100,000) values, a grid of
             :data:`GRID_CANDIDATES` (2,000) above: a replicate of 10^6 values
-            then takes about 0.05 s instead of 3-7 s, and the threshold found
-            moves by under 0.6 % of the tail size.
+            then takes about 0.05 s instead of 3-7 s; neighbouring candidates
+            are under 0.6 % apart in tail size.
 
         A Ctrl-C (``KeyboardInterrupt``) stops the remaining replicates and propagates.
         """
