@@ -34,7 +34,7 @@ def _ks_over(logx, first, last, k, b, j0, j1, d):
     return d
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def ks_scan(logx, suffix_log, first, last, candidates):
     """KS distance and MLE exponent for each candidate threshold index.
 
@@ -144,7 +144,7 @@ def _ks_exact(logx, first, last, k, b, stop, F_buf, hi_buf, lo_buf):
     return d
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def ks_scan_best(logx, suffix_log, first, last, candidates):
     """The candidate of :func:`ks_scan` with the smallest KS distance, found exactly by bounding.
 

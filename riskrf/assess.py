@@ -46,7 +46,8 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
                               scenario=None, velocities=None, collector: str | None = None, n: int = 50_000,
                               seed=1, reach_probability: float = 1.0, condition_on_mass: bool = False,
                               mass_coupling: str = "simulated", design_masses_kg=(),
-                              velocity_unit: str | None = None, rate_note: str | None = None):
+                              velocity_unit: str | None = None, drop_height_m=None, velocity_reader=None,
+                              rate_note: str | None = None):
     """Power-law fit of the inventory combined with simulated or given velocities.
 
     ``collector`` names the barrier line: in a scenario it defaults to "barrier"; a
@@ -84,9 +85,12 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
             hazard = EnergyHazard.from_simulation(gr, result, collector, rate_per_year=rate,
                                                   condition_on_mass=condition_on_mass)
     else:
-        df = read_velocities(velocities, collector=collector, velocity_unit=velocity_unit)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RiskrfWarning)      # kept in the hazard's notes below
+            df = read_velocities(velocities, collector=collector, velocity_unit=velocity_unit,
+                                 drop_height_m=drop_height_m, **(velocity_reader or {}))
         v = df["velocity_ms"].to_numpy(dtype=float)
-        note = f"velocities: {len(df):,} samples from {velocities}"
+        note = "; ".join([f"velocities: {len(df):,} samples from {velocities}", *df.attrs.get("warnings", [])])
         if "angular_velocity_rads" in df and "radius_m" in df:
             spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
             v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
@@ -345,7 +349,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
             collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
             mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=extra,
-            velocity_unit=hz_cfg["velocity_unit"], rate_note=rate_note)
+            velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note)
         timings["simulation"] = round(time.perf_counter() - t, 2)
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")

@@ -108,17 +108,39 @@ class Corridor:
 # ---------------------------------------------------------------------------------------------------------
 # reading and validation
 # ---------------------------------------------------------------------------------------------------------
-def _read_table(path: Path) -> pd.DataFrame:
+def _read_table(path: Path, reader: dict | None = None) -> tuple[pd.DataFrame, np.ndarray]:
+    """The sections table as text cells, with the file line of each row (rules of :mod:`riskrf.tables`).
+
+    Number columns are converted by the decimal-mark rule of :func:`riskrf.tables.parse_numbers`
+    (decided per column: ``1,5`` and ``1.192,5`` read as in a European export); cells that are
+    not numbers stay text so that each row's error names its value.  Wholly empty rows and
+    ``#`` comment lines of a text file are skipped (their lines still count).
+    """
+    from .tables import is_blank, parse_numbers, read_table
     if not path.exists():
         raise CorridorError(f"sections table not found: {path}")
-    suffix = path.suffix.lower()
-    if suffix == ".csv":
-        return pd.read_csv(path, comment="#", dtype=str, keep_default_na=False)
-    if suffix in (".xlsx", ".xls"):
-        return pd.read_excel(path, dtype=str).fillna("")
-    if suffix == ".parquet":
-        return pd.read_parquet(path).astype(str).replace({"None": "", "nan": ""})
-    raise CorridorError(f"{path}: sections table must be .csv, .xlsx or .parquet; got {suffix!r}")
+    reader = dict(reader or {})
+    decimal = reader.pop("decimal", None)
+    try:
+        table, first, _ = read_table(path, what="sections table",
+                                     comment="#" if path.suffix.lower() in (".csv", ".txt", ".tsv") else None,
+                                     **reader)
+    except ValueError as exc:
+        raise CorridorError(str(exc)) from None
+    rows = np.arange(len(table)) + first
+    keep = ~is_blank(table).to_numpy() if len(table) else np.ones(0, bool)
+    table, rows = table[keep].reset_index(drop=True), rows[keep]
+    table = table.astype(object)
+    for c in [c for c in table.columns if c in NUMBER_COLUMNS + RHRS_COLUMNS]:
+        cells = table[c]
+        is_class = cells.astype(str).str.contains(r"[A-DF-Za-df-z]", regex=True)    # words (RHRS classes, typos)
+        try:
+            values = parse_numbers(cells.where(~is_class, ""), path, c, rows, decimal=decimal, errors="coerce")
+        except ValueError as exc:          # a column mixing decimal marks: a property of the file
+            raise CorridorError(str(exc)) from None
+        good = values.notna().to_numpy()
+        table[c] = [float(v) if g else cell for v, g, cell in zip(values, good, cells)]
+    return table, rows
 
 
 def _section_seed(seed: int, sid: str) -> int:
@@ -216,11 +238,16 @@ def _mass_law(table: dict, base: Path, source: str):
     return gr, note
 
 
-def load_corridor(path, *, keep_going: bool = False) -> Corridor:
+def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int | None = None,
+                  decimal: str | None = None, encoding: str | None = None) -> Corridor:
     """Read and check a corridor file and its sections table before any work.
 
-    Every bad row is reported (file, row, section id, column, value; rows are counted as in a spreadsheet,
-    header = row 1, comment lines of a CSV not counted).  With ``keep_going`` the bad rows
+    The sections table is read by the rules of :mod:`riskrf.tables` (separator, decimal comma,
+    UTF-8 or cp1252, Excel ``sheet`` and ``header_row``, Parquet); ``sheet``, ``header_row``,
+    ``decimal`` and ``encoding`` may also be given in the ``[corridor]`` table (``sections_sheet``,
+    ``sections_header_row``, ``sections_decimal``, ``sections_encoding``); arguments win.
+    Every bad row is reported (file, row, section id, column, value; rows are the file's lines
+    as an editor or spreadsheet numbers them, comment lines ``#`` of a CSV included).  With ``keep_going`` the bad rows
     are left out and listed in :attr:`Corridor.errors`; otherwise any bad row raises :class:`CorridorError`
     listing all of them.  Errors in the corridor file itself always raise.
     """
@@ -239,7 +266,14 @@ def load_corridor(path, *, keep_going: bool = False) -> Corridor:
                     "uncertainty", "options"}, "", src)
     cor = data.get("corridor", {})
     _unknown(cor, {"name", "description", "sections", "seed", "n_blocks", "option_blocks", "chainage_unit",
-                   "rate_basis", "rhrs_cap_points"}, "corridor.", src)
+                   "rate_basis", "rhrs_cap_points", "sections_sheet", "sections_header_row", "sections_decimal",
+                   "sections_encoding"}, "corridor.", src)
+    reader = {"sheet": sheet if sheet is not None else cor.get("sections_sheet"),
+              "header_row": header_row if header_row is not None else cor.get("sections_header_row"),
+              "decimal": decimal if decimal is not None else cor.get("sections_decimal"),
+              "encoding": encoding if encoding is not None else cor.get("sections_encoding")}
+    if reader["decimal"] not in (None, ".", ","):
+        raise CorridorError(f"{src}: corridor.sections_decimal = {reader['decimal']!r} must be '.' or ','")
     rhrs_cap = cor.get("rhrs_cap_points")
     if rhrs_cap is not None and (isinstance(rhrs_cap, bool) or not isinstance(rhrs_cap, (int, float))
                                  or rhrs_cap < 81):
@@ -312,7 +346,7 @@ def load_corridor(path, *, keep_going: bool = False) -> Corridor:
     option_names = [o.name for o, _ in options]
 
     table_path = (path.parent / cor["sections"]).resolve()
-    df = _read_table(table_path)
+    df, file_rows = _read_table(table_path, reader)
     tsrc = str(table_path)
     bad_cols = [c for c in df.columns if c not in ALL_COLUMNS]
     if bad_cols:
@@ -329,7 +363,7 @@ def load_corridor(path, *, keep_going: bool = False) -> Corridor:
     errors, sections, bad_rows = [], [], set()
     seen = {}
     for i, raw in df.iterrows():
-        row = i + 2              # spreadsheet row (header is row 1)
+        row = int(file_rows[i])  # file line / spreadsheet row (header row 1 unless header_row says otherwise)
         sid = str(raw["id"]).strip()
         where = f"{tsrc}: row {row} (section {sid!r})"
         try:

@@ -85,37 +85,46 @@ def percentile_block(volumes_m3, percentile: float = 97.0) -> float:
     return float(np.percentile(v, p))
 
 
-def read_block_survey(path, density_kg_m3: float) -> np.ndarray:
-    """Block volumes [m³] from a survey file (CSV, Excel or Parquet) with a volume (m³) or mass (kg, t) column.
+def read_block_survey(path, density_kg_m3: float, *, sheet=None, header_row: int | None = None,
+                      decimal: str | None = None, encoding: str | None = None) -> np.ndarray:
+    """Block volumes [m³] from a survey file with a volume (m³, dm³, l, cm³) or mass (kg, t) column.
 
-    Errors name the file and the column, or the row and the value."""
+    Read by the rules of :mod:`riskrf.tables` shared by every table riskrf reads: CSV/TXT with
+    any separator (``#`` comment lines skipped), Excel (``sheet``, ``header_row``) or Parquet;
+    decimal commas decided per column (``decimal`` overrides); UTF-8 with or without BOM, else
+    cp1252.  Empty rows are skipped.  Errors name the file and the column, or the row (file
+    line) and the value."""
     from .inventory import _MASS_NAMES, _MASS_UNITS, _VOLUME_NAMES, _VOLUME_UNITS, _find_column
+    from .tables import is_blank, parse_numbers, read_table
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"block survey not found: {path}")
-    suffix = path.suffix.lower()
-    if suffix in (".xlsx", ".xls"):
-        df = pd.read_excel(path)
-    elif suffix == ".parquet":
-        df = pd.read_parquet(path)
-    else:
-        df = pd.read_csv(path, comment="#")
+    text = path.suffix.lower() in (".csv", ".txt", ".tsv")
+    df, first, _ = read_table(path, sheet=sheet, header_row=header_row, encoding=encoding, what="block survey",
+                              comment="#" if text else None)
     col, unit = _find_column(df.columns, _VOLUME_NAMES, _VOLUME_UNITS)
     factor = None
     if col is not None:
         factor = _VOLUME_UNITS[unit or "m3"]
     else:
-        col, unit = _find_column(df.columns, _MASS_NAMES | {"block"}, _MASS_UNITS)
+        col, unit = _find_column(df.columns, _MASS_NAMES, _MASS_UNITS)
+        if col is None:          # a column named only "block" holds masses when nothing else does (not ids first)
+            col, unit = _find_column(df.columns, {"block"}, _MASS_UNITS)
         if col is not None:
             factor = _MASS_UNITS[unit or "kg"] / float(density_kg_m3)
     if col is None:
         raise ValueError(f"{path}: no block-size column; expected a volume (e.g. 'volume_m3') or mass (e.g. "
                          f"'mass_kg') column, found {list(map(str, df.columns))}")
-    values = pd.to_numeric(df[col], errors="coerce").to_numpy(dtype=float)
+    rows = np.arange(len(df)) + first
+    keep = ~is_blank(df).to_numpy() if len(df) else np.ones(0, bool)
+    df, rows = df[keep].reset_index(drop=True), rows[keep]
+    if df.empty:
+        raise ValueError(f"{path}: the block survey has no rows")
+    values = parse_numbers(df[col], path, col, rows, decimal=decimal).to_numpy(dtype=float)
     bad = ~np.isfinite(values) | (values <= 0)
     if bad.any():
         i = int(np.argmax(bad))
-        raise ValueError(f"{path}: row {i + 2}, column {col!r}: value {df[col].iloc[i]} is not a block size > 0")
+        raise ValueError(f"{path}: row {rows[i]}, column {col!r}: value {df[col].iloc[i]} is not a block size > 0")
     return values * factor
 
 

@@ -16,7 +16,12 @@ import pandas as pd
 from .extremes import MIN_MAXIMA, GEVFit, GumbelFit, fit_gev, fit_gumbel
 from .inventory import Inventory
 from .outputs import write_json
-from .power_law import GutenbergRichterFit, fit_gutenberg_richter
+from .power_law import (
+    LARGE_SAMPLE,
+    GutenbergRichterFit,
+    PowerLawBootstrap,
+    fit_gutenberg_richter,
+)
 from .report.format import sig
 from .validation import RiskrfWarning
 
@@ -41,6 +46,7 @@ class FrequencyAnalysis:
     deviance: dict | None = None
     skipped: dict = field(default_factory=dict)
     warnings: tuple = ()
+    bootstrap: PowerLawBootstrap | None = None
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def design_masses(self, T=DESIGN_RETURN_PERIODS, level: float = 0.95) -> pd.DataFrame:
@@ -149,6 +155,8 @@ class FrequencyAnalysis:
                 "m_max_kg": gr.m_max, "rate_min_per_year": gr.rate_min, "n_tail": gr.n_tail,
                 "ks_distance": gr.ks_distance, "bootstrap_p_value": self.bootstrap_p,
                 "n_bootstrap": self.n_bootstrap, "seed": self.seed,
+                "bootstrap_threshold_grid": None if self.bootstrap is None else self.bootstrap.grid,
+                "bootstrap_ks_distance": None if self.bootstrap is None else self.bootstrap.ks_distance,
                 "likelihood_ratio_tests": self.comparison.reset_index().to_dict(orient="records"),
             },
             "design_masses": self.design_masses().to_dict(orient="records"),
@@ -192,6 +200,10 @@ class FrequencyAnalysis:
             verdict = "plausible" if self.bootstrap_p > 0.1 else "rejected"
             lines.append(f"  fit      KS distance {gr.ks_distance:.4f}; bootstrap p = {self.bootstrap_p:.3f} "
                          f"({self.n_bootstrap} replicates, seed {self.seed}): power law {verdict} (plausible when p > 0.1)")
+            if self.bootstrap is not None and self.bootstrap.grid is not None:
+                lines.append(f"           (above {LARGE_SAMPLE:,} falls the data and each replicate scan "
+                             f"{self.bootstrap.grid:,} log-spaced thresholds, not every value: KS distance of the "
+                             f"data on that grid {self.bootstrap.ks_distance:.4f}; --bootstrap-grid 0 for the full scan)")
         for alt, row in self.comparison.iterrows():
             lines.append(f"  vs {alt:<12} log-likelihood ratio R = {row['loglik_ratio_R']:+.2f}, "
                          f"p = {row['p_value']:.3f} -> {row['favoured']}")
@@ -241,11 +253,14 @@ class FrequencyAnalysis:
 
 def analyse_inventory(inventory: Inventory, *, m_min=None, method: str = "mle", m_max=None,
                       gumbel_method: str = "mle", n_bootstrap: int = 1000, seed: int | None = 1,
-                      compare_lsq: bool = True) -> FrequencyAnalysis:
+                      compare_lsq: bool = True, bootstrap_workers: int | None = None, progress=None,
+                      bootstrap_grid="auto") -> FrequencyAnalysis:
     """Fit the power law to all masses and, when the inventory is dated, Gumbel and GEV to annual maxima.
 
     Every warning raised by the fits is collected in ``warnings``; models the
     data cannot support are listed in ``skipped`` with the reason.
+    ``bootstrap_workers``, ``progress`` and ``bootstrap_grid`` are passed to
+    :meth:`GutenbergRichterFit.bootstrap_test` (``workers``, ``progress``, ``grid``).
     """
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RiskrfWarning)
@@ -258,7 +273,9 @@ def analyse_inventory(inventory: Inventory, *, m_min=None, method: str = "mle", 
                                             method="lsq")
             except ValueError:
                 lsq = None
-        p = gr.bootstrap_pvalue(n_bootstrap, seed=seed) if (n_bootstrap and method == "mle") else None
+        boot = gr.bootstrap_test(n_bootstrap, seed=seed, workers=bootstrap_workers, progress=progress,
+                                 grid=bootstrap_grid) if (n_bootstrap and method == "mle") else None
+        p = None if boot is None else boot.p_value
         comparison = gr.compare()
         maxima = gumbel = gev = deviance = None
         skipped = {}
@@ -283,4 +300,5 @@ def analyse_inventory(inventory: Inventory, *, m_min=None, method: str = "mle", 
             notes.append(msg)
     return FrequencyAnalysis(inventory=inventory, power_law=gr, power_law_lsq=lsq, bootstrap_p=p,
                              n_bootstrap=int(n_bootstrap or 0), seed=seed, comparison=comparison, maxima=maxima,
-                             gumbel=gumbel, gev=gev, deviance=deviance, skipped=skipped, warnings=tuple(notes))
+                             gumbel=gumbel, gev=gev, deviance=deviance, skipped=skipped, warnings=tuple(notes),
+                             bootstrap=boot)

@@ -7,10 +7,12 @@ Two file formats are read by :func:`read_rainfall`:
   ``年/Year,月/Month,日/Day,數值/Value,數據完整性/data Completeness`` and one row
   per day; ``Trace`` (less than 0.05 mm) is read as 0 mm and flagged ``trace``,
   ``***`` (unavailable) and values marked ``#`` (incomplete) are missing.
-* **Generic CSV** for any other gauge: a ``date`` column (YYYY-MM-DD, one row
-  per day) and a ``rainfall_mm`` column (daily total in mm, >= 0; an empty cell
-  is a missing day; ``trace`` is read as 0 mm), optionally a ``note`` column.
-  Other columns are ignored.  Comma, semicolon or tab separated, UTF-8.
+* **Generic table** for any other gauge: a ``date`` column (one row per day) and a
+  ``rainfall_mm`` column (daily total in mm, >= 0; an empty cell, ``-``, ``***`` or
+  ``NA`` is a missing day; ``trace`` is read as 0 mm), optionally a ``note`` column.
+  Other columns are ignored.  Read by the rules of :mod:`riskrf.tables` shared by every
+  table riskrf reads: CSV with any separator, Excel, Parquet, decimal commas, UTF-8 or
+  cp1252, ``YYYY-MM-DD`` / ``DD.MM.YYYY`` dates (``NN/NN/YYYY`` by the whole-file rule).
 
 Missing days are never filled: they stay NaN and are listed in
 :attr:`Rainfall.gaps`; anything that needs rainfall on a missing day (a rate
@@ -19,14 +21,14 @@ error naming the file, the rows around the gap and its dates.
 """
 from __future__ import annotations
 
-import io
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from .inventory import sniff_delimiter
+from .tables import sniff_delimiter  # noqa: F401 (re-exported: public before)
 from .validation import warn
 
 
@@ -224,65 +226,70 @@ def _read_hko(path: Path, lines: list[str]) -> Rainfall:
     return _build(dates, values, flags, rows, path, "HKO", notes)
 
 
-_MISSING = ("", "***", "-", "na", "nan")
+_MISSING = ("", "***", "-", "NA", "NaN", "nan", "n/a", "N/A")
 
 
-def _read_generic_plain(date_col: pd.Series, rain_col: pd.Series, path) -> Rainfall | None:
-    """The common case read at once: every date YYYY-MM-DD and every rainfall a number >= 0, 'trace' or a missing
-    mark (the same reading as the row-by-row loop).  None when any row needs the loop (and its error message)."""
-    d, r = date_col.str.strip(), rain_col.str.strip()
-    keep = ~((d == "") & (r == ""))
-    d, r = d[keep], r[keep]
-    if not len(d):
-        return None
-    days = pd.to_datetime(d, format="%Y-%m-%d", errors="coerce")
-    low = r.str.lower()
-    trace, missing = (low == "trace").to_numpy(), low.isin(_MISSING).to_numpy()
-    values = pd.to_numeric(r.where(~(trace | missing), "nan"), errors="coerce").to_numpy(dtype=float, copy=True)
-    numeric = ~(trace | missing)
-    if days.isna().any() or not (np.isfinite(values[numeric]).all() and (values[numeric] >= 0).all()):
-        return None
-    values[trace] = 0.0
-    flags = np.where(trace, "trace", np.where(missing, "missing", ""))
-    return _build(pd.DatetimeIndex(days), values, list(flags), (d.index.to_numpy() + 2).tolist(), path, "generic", [])
-
-
-def _read_generic(path: Path, text: str) -> Rainfall:
-    sep = sniff_delimiter(path)
-    table = pd.read_csv(io.StringIO(text), sep=sep, dtype=str, keep_default_na=False)
+def _read_generic(path: Path, reader: dict) -> Rainfall:
+    """The generic layout through the shared table reader (:mod:`riskrf.tables`)."""
+    from .tables import is_blank, parse_dates, parse_numbers, read_table
+    reader = dict(reader)
+    decimal, date_format = reader.pop("decimal", None), reader.pop("date_format", None)
+    table, first, notes = read_table(path, what="rainfall", **reader)
     cols = {c.strip().lower(): c for c in table.columns}
     if "date" not in cols or "rainfall_mm" not in cols:
         raise ValueError(f"{path}: a rainfall file needs columns 'date' (YYYY-MM-DD) and 'rainfall_mm' (daily total, "
                          f"mm), or the Hong Kong Observatory layout; found {list(table.columns)}")
-    fast = _read_generic_plain(table[cols["date"]], table[cols["rainfall_mm"]], path)
-    if fast is not None:
-        return fast
-    dates, values, flags, rows = [], [], [], []
-    for i, (d, r) in enumerate(zip(table[cols["date"]], table[cols["rainfall_mm"]])):
-        line = i + 2
-        if not d.strip() and not r.strip():
-            continue
-        try:
-            day = pd.Timestamp(d.strip())
-        except ValueError:
-            day = pd.NaT
-        if pd.isna(day) or day != day.normalize():
-            raise ValueError(f"{path}: row {line}, column 'date': {d!r} is not a date YYYY-MM-DD")
-        v, flag = _value(r, path, line, "rainfall_mm")
-        dates.append(day), values.append(v), flags.append(flag), rows.append(line)
-    if not dates:
+    rows = np.arange(len(table)) + first
+    sub = table[[cols["date"], cols["rainfall_mm"]]]
+    keep = ~is_blank(sub).to_numpy() if len(sub) else np.ones(0, bool)
+    sub, rows = sub[keep].reset_index(drop=True), rows[keep]
+    if sub.empty:
         raise ValueError(f"{path}: no daily rows")
-    return _build(dates, values, flags, rows, path, "generic", [])
+    dcol, rcol = cols["date"], cols["rainfall_mm"]
+    empty_date = sub[dcol].astype(str).str.strip() == ""
+    if empty_date.any():
+        i = int(np.argmax(empty_date.to_numpy()))
+        raise ValueError(f"{path}: row {rows[i]}, column {dcol!r}: the date is empty (rainfall "
+                         f"{sub[rcol].iloc[i]!r})")
+    try:
+        dates, _ = parse_dates(sub[dcol], path, dcol, rows, date_format=date_format)
+    except ValueError as exc:      # the rainfall reader's wording: "'2001-13-02' is not a date (...)"
+        raise ValueError(re.sub(r"cannot read date ('.*?') ", r"\1 is not a date ", str(exc))) from None
+    year_only = dates.isna().to_numpy()
+    if year_only.any():
+        i = int(np.argmax(year_only))
+        raise ValueError(f"{path}: row {rows[i]}, column {dcol!r}: {sub[dcol].iloc[i]!r} is not a date: daily "
+                         "rainfall needs a day (YYYY-MM-DD, DD.MM.YYYY, ...)")
+    raw = sub[rcol]
+    text = raw.astype(str).str.strip()
+    trace = text.str.lower() == "trace"
+    missing = text.isin(_MISSING)
+    values = parse_numbers(raw.where(~(trace | missing), ""), path, rcol, rows, decimal=decimal)
+    bad = ~(trace | missing).to_numpy() & ~(np.isfinite(values.to_numpy()) & (values.to_numpy() >= 0))
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(f"{path}: row {rows[i]}, column {rcol!r}: rainfall {raw.iloc[i]!r} must be a finite "
+                         "number >= 0")
+    values = values.where(~trace, 0.0).where(~missing, np.nan)
+    flags = np.where(trace, "trace", np.where(missing, "missing", ""))
+    return _build(list(dates.dt.normalize()), list(values.to_numpy()), list(flags), list(rows), path, "generic",
+                  list(notes))
 
 
-def read_rainfall(path) -> Rainfall:
-    """Read a daily rainfall record (Hong Kong Observatory layout or the generic CSV).
+def read_rainfall(path, *, sheet=None, header_row: int | None = None, decimal: str | None = None,
+                  encoding: str | None = None, date_format: str | None = None) -> Rainfall:
+    """Read a daily rainfall record (Hong Kong Observatory layout or the generic table).
 
     Parameters
     ----------
     path : str or Path
         The file; the layout is recognised from its header (see the module
         docstring for both formats).
+    sheet, header_row, decimal, encoding, date_format
+        For the generic layout, the rules of :mod:`riskrf.tables` as for
+        inventories: CSV with any separator, Excel (``sheet``, ``header_row``)
+        or Parquet; decimal commas; UTF-8 or cp1252; ``DD.MM.YYYY`` dates and
+        ``NN/NN/YYYY`` by the whole-file rule (``date_format`` when ambiguous).
 
     Returns
     -------
@@ -299,12 +306,16 @@ def read_rainfall(path) -> Rainfall:
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"rainfall file not found: {path}")
+    reader = {"sheet": sheet, "header_row": header_row, "decimal": decimal, "encoding": encoding,
+              "date_format": date_format}
+    if path.suffix.lower() in (".xlsx", ".xlsm", ".parquet"):
+        return _read_generic(path, reader)
     text = path.read_bytes().decode("utf-8-sig", errors="replace")
     lines = text.splitlines()
     head = "\n".join(lines[:5])
     if "Hong Kong Observatory" in head or ("Year" in head and "Value" in head and "Completeness" in head):
         return _read_hko(path, lines)
-    return _read_generic(path, text)
+    return _read_generic(path, reader)
 
 
 def rainfall_from_series(daily: pd.Series, source: str = "<series>") -> Rainfall:

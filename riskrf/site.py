@@ -35,7 +35,8 @@ SITE_FIELDS = {
     "hazard": {"scenario": None, "velocities": None, "collector": None, "road_collector": "road",
                "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
                "free_board_m": 0.5, "design_period_years": 100.0, "bootstrap": 300, "seed": 1,
-               "option_blocks": 20_000, "mass_coupling": "simulated", "velocity_unit": None},
+               "option_blocks": 20_000, "mass_coupling": "simulated", "velocity_unit": None,
+               "drop_height_m": None},
     "design_block": {"rule": "return_period", "percentile": 97.0, "survey": None, "fractal_dimension": None,
                      "iterations": None},
 }
@@ -132,6 +133,9 @@ def load_site(path) -> Site:
                         "(0, 1]")
     if hz["velocity_unit"] not in (None, "m/s", "km/h"):
         raise SiteError(f"{path}: hazard.velocity_unit = {hz['velocity_unit']!r} is not 'm/s' or 'km/h'")
+    if hz["drop_height_m"] is not None and (not number(hz["drop_height_m"]) or hz["drop_height_m"] <= 0):
+        raise SiteError(f"{path}: hazard.drop_height_m = {hz['drop_height_m']!r} must be a height > 0 m (release "
+                        "to the barrier line, for the velocity plausibility check)")
     inv = tables["inventory"]
     for key in ("m_min_kg", "m_max_kg", "density_kg_m3", "duration_years"):
         if inv[key] is not None and (not number(inv[key]) or inv[key] <= 0):

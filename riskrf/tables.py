@@ -45,7 +45,10 @@ def _header_line(text: str, header_row: int | None) -> str:
 
 def sniff_delimiter(path, *, encoding: str | None = None, header_row: int | None = None) -> str:
     """The most frequent of ``;``, tab, ``|`` and ``,`` on the header line (outside quotes); ``,`` when none."""
-    text = _decode(Path(path).read_bytes()[:65536], encoding)[0]
+    return _sniff_text(_decode(Path(path).read_bytes()[:65536], encoding)[0], header_row)
+
+
+def _sniff_text(text: str, header_row: int | None) -> str:
     line = re.sub(r'"[^"]*"', "", _header_line(text, header_row))
     counts = {d: line.count(d) for d in DELIMITERS}
     best = max(DELIMITERS, key=lambda d: counts[d])
@@ -72,12 +75,15 @@ def _check_row(header_row, path):
 
 
 def read_table(path, *, sheet=None, header_row: int | None = None, encoding: str | None = None,
-               what: str = "table") -> tuple[pd.DataFrame, int, list]:
+               what: str = "table", comment: str | None = None) -> tuple[pd.DataFrame, int, list]:
     """Read a CSV, Excel or Parquet file with every cell as text (missing cells are ``""``).
 
     Returns ``(table, first_row, notes)``: ``first_row`` is the file line (spreadsheet row)
     of the first data row, so that row ``i`` of the table is line ``first_row + i``
     (Parquet rows count from 1).  Raises ``ValueError`` naming the file for anything unreadable.
+    ``comment`` (text files): lines starting with it (after blanks) are read as empty rows,
+    so line numbers stay the file's; without ``header_row`` the header is then the first
+    line that is neither empty nor a comment.
     """
     path = Path(path)
     if not path.exists():
@@ -92,13 +98,21 @@ def read_table(path, *, sheet=None, header_row: int | None = None, encoding: str
             raise ValueError(f"{path}: sheet = {sheet!r} applies to Excel workbooks only")
         raw = path.read_bytes()
         text, used = _decode(raw, encoding)
+        if comment:
+            lines = text.splitlines()
+            lines = ["" if ln.lstrip().startswith(comment) else ln for ln in lines]
+            if header_row is None:
+                header_row = next((i + 1 for i, ln in enumerate(lines) if ln.strip()), 1)
+            text = "\n".join(lines) + "\n"
+            sep = _sniff_text(text, header_row)
         if used == "cp1252" and not encoding:
             notes.append(f"{path}: not valid UTF-8; read as Windows-1252 (cp1252). Pass encoding= "
                          "(CLI --encoding) if that is wrong")
         n_lines = len(text.splitlines())
         if header_row is not None and header_row > n_lines:
             raise ValueError(f"{path}: header_row = {header_row} is beyond the file's {n_lines} line(s)")
-        sep = sniff_delimiter(path, encoding=used if used != "utf-8" else "utf-8-sig", header_row=header_row)
+        if not comment:
+            sep = sniff_delimiter(path, encoding=used if used != "utf-8" else "utf-8-sig", header_row=header_row)
         try:
             import io
             table = pd.read_csv(io.StringIO(text), sep=sep, dtype=str, skip_blank_lines=False,
@@ -181,12 +195,17 @@ def _where(path, row, col):
     return f"{path}: row {row}, column {col!r}"
 
 
-def parse_numbers(raw: pd.Series, path, col: str, rows, *, decimal: str | None = None) -> pd.Series:
+def parse_numbers(raw: pd.Series, path, col: str, rows, *, decimal: str | None = None,
+                  errors: str = "raise") -> pd.Series:
     """Numbers from text cells with the decimal-mark rule of this module; ``""`` gives NaN.
 
     ``rows`` holds the file line of each cell, for messages.  Raises ``ValueError`` naming the
-    file, row, column and value of the first cell that is not a number.
+    file, row, column and value of the first cell that is not a number; with
+    ``errors="coerce"`` such cells give NaN instead (a column mixing decimal marks is
+    still refused: that is a property of the file, not of one cell).
     """
+    if errors not in ("raise", "coerce"):
+        raise ValueError(f"errors = {errors!r} is not 'raise' or 'coerce'")
     if decimal not in (None, ".", ","):
         raise ValueError(f"decimal = {decimal!r} is not '.' or ','")
     if pd.api.types.is_numeric_dtype(raw) and not pd.api.types.is_bool_dtype(raw):
@@ -232,24 +251,32 @@ def parse_numbers(raw: pd.Series, path, col: str, rows, *, decimal: str | None =
     bad = values.isna() & (text != "") & ~is_num
     lowered = text.str.lower()
     bad |= lowered.isin(["nan", "+nan", "-nan"])
+    if errors == "coerce":
+        return values.astype(float).where(~bad, np.nan)
     if bad.any():
         i = bad.idxmax()
         raise ValueError(f"{_where(path, rows[i], col)}: {raw[i]!r} is not a number")
     return values.astype(float)
 
 
-def read_numeric_table(path, **kwargs) -> pd.DataFrame:
+def read_numeric_table(path, *, decimal: str | None = None, numeric=(), **kwargs) -> pd.DataFrame:
     """:func:`read_table`, with every column whose filled cells are all numbers (by the decimal-mark rule)
-    converted to float; other columns stay text.  Row ``i`` is file line ``i + first data line``."""
+    converted to float; other columns stay text.  Rows wholly empty are dropped; the index holds each
+    row's file line (spreadsheet row; Parquet rows count from 1).  Columns named in ``numeric`` must be
+    numbers: the first cell that is not raises ``ValueError`` naming the file, row, column and value."""
     table, first, _ = read_table(path, **kwargs)
     rows = np.arange(len(table)) + first
+    keep = ~is_blank(table).to_numpy() if len(table) else np.ones(0, bool)
+    table, rows = table[keep].reset_index(drop=True), rows[keep]
     out = {}
     for col in table.columns:
         try:
-            out[col] = parse_numbers(table[col], path, col, rows)
+            out[col] = parse_numbers(table[col], path, col, rows, decimal=decimal).to_numpy()
         except ValueError:
-            out[col] = table[col]
-    return pd.DataFrame(out, index=table.index)
+            if col in numeric:
+                raise
+            out[col] = table[col].to_numpy()
+    return pd.DataFrame(out, index=pd.Index(rows, name="row"))
 
 
 _YEAR = re.compile(r"^(\d{4})(?:\.0)?$")

@@ -37,10 +37,69 @@ _KMH_NAMES = ("velocity_kmh", "velocity_km_h", "speed_kmh", "speed_km_h", "v_kmh
 #: Above this median, velocities "in m/s" are probably km/h: a free fall of 130 m gives 50 m/s, and rock fall
 #: velocities at barriers are mostly 5-35 m/s (Wyllie 2014, chapter 5).
 PLAUSIBLE_MEDIAN_MS = 50.0
+#: Without a drop height, single velocities above this are flagged: 50 m/s is a free fall of
+#: 50^2 / (2 x 9.81) = 127 m, more than the slopes above most roads (ASSUMPTION, stated in the warning).
+PLAUSIBLE_MAX_MS = 50.0
+#: Margin on the free-fall speed sqrt(2 g H) before a velocity is called implausible: 10 %
+#: (release speed, rotation turned into translation and survey error; a rolling or bouncing block
+#: loses energy, so it cannot exceed the speed of a free fall from its release height).
+FREE_FALL_MARGIN = 0.10
+
+
+def _upper(dist) -> float:
+    """Largest value a scenario Distribution gives (or mean + 4 sd, median x e^4sigma when unbounded)."""
+    p = dist.params
+    if dist.kind == "constant":
+        return float(p["value"])
+    if dist.kind in ("uniform", "triangular"):
+        return float(p["high"])
+    if dist.kind == "normal":
+        return float(p.get("max", p["mean"] + 4 * p["std"]))
+    return float(p.get("max", p["median"] * np.exp(4 * p["sigma"])))
+
+
+def free_fall_drop_m(scenario, collector: str) -> tuple[float, float]:
+    """Height drop H [m] from the highest release point to the ground at ``collector``, and the release speed [m/s].
+
+    The release point is the highest profile vertex within the seeder's x range (ends
+    included) plus the seeder's largest release height; the release speed is the largest
+    of ``sqrt(vx^2 + vz^2)`` the seeder can draw.  A block cannot pass the collector faster
+    than ``sqrt(v0^2 + 2 g H)`` (energy conservation without losses).
+    """
+    import simulation
+    sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
+    col = sc.collectors[sc.collector_index(collector)]
+    prof, seed = sc.profile, sc.seeder
+    xs = np.concatenate([[seed.x_low, seed.x_high], prof.x[(prof.x >= seed.x_low) & (prof.x <= seed.x_high)]])
+    z_release = float(np.max(np.interp(xs, prof.x, prof.z))) + _upper(seed.height_m)
+    z_line = float(np.interp(col.x, prof.x, prof.z))
+    vx, vz = _upper(seed.vx_ms), _upper(seed.vz_ms)
+    return max(z_release - z_line, 0.0), float(np.hypot(vx, vz))
+
+
+def plausible_velocity_ms(drop_height_m=None, release_speed_ms: float = 0.0) -> tuple[float, str]:
+    """Largest plausible velocity at a barrier line [m/s] and how it was obtained (for the warning).
+
+    With a height drop H [m]: ``(1 + FREE_FALL_MARGIN) sqrt(v0^2 + 2 g H)``; without one:
+    :data:`PLAUSIBLE_MAX_MS` (50 m/s, a free fall of about 127 m), an assumption.
+    """
+    from .units import STANDARD_GRAVITY_MS2 as g
+    if drop_height_m is None:
+        return PLAUSIBLE_MAX_MS, (f"{PLAUSIBLE_MAX_MS:g} m/s, the speed of a free fall of "
+                                  f"{PLAUSIBLE_MAX_MS ** 2 / (2 * g):.0f} m (ASSUMPTION: no drop height given; "
+                                  "give drop_height_m, CLI --drop-height)")
+    h = float(drop_height_m)
+    if not np.isfinite(h) or h <= 0:
+        raise ValueError(f"drop_height_m = {drop_height_m!r} must be a finite height > 0 m")
+    v = (1 + FREE_FALL_MARGIN) * np.sqrt(release_speed_ms ** 2 + 2 * g * h)
+    start = f" from {release_speed_ms:.3g} m/s" if release_speed_ms else ""
+    return float(v), (f"{v:.3g} m/s, a free fall of {h:.4g} m{start} (sqrt(2 g H)) plus "
+                      f"{FREE_FALL_MARGIN:.0%}")
 
 
 def read_velocities(path, *, collector: str | None = None, velocity_unit: str | None = None, decimal=None,
-                    sheet=None, header_row=None, encoding=None) -> pd.DataFrame:
+                    sheet=None, header_row=None, encoding=None, drop_height_m=None,
+                    release_speed_ms: float = 0.0) -> pd.DataFrame:
     """Velocity samples [m/s] (and heights [m], angular velocities [rad/s], masses [kg] when present).
 
     Reads CSV/TXT, Excel or Parquet with the rules of :mod:`riskrf.tables` (separators,
@@ -55,6 +114,13 @@ def read_velocities(path, *, collector: str | None = None, velocity_unit: str | 
     Without it, a median velocity above 50 m/s is refused as probable km/h.
     Velocities must be finite and >= 0, heights finite and >= 0, every cell filled.
     Raises naming the file, row, column and value.
+
+    Plausibility: a velocity above what a free fall from the profile could give is
+    warned about (:class:`~riskrf.RiskrfWarning`, naming the row, the value and the
+    plausible limit; also listed in ``result.attrs["warnings"]``).  The limit is
+    ``1.1 sqrt(v0^2 + 2 g H)`` with ``drop_height_m`` H [m] (e.g. from
+    :func:`free_fall_drop_m` of the scenario) and ``release_speed_ms`` v0, else
+    50 m/s (a 127 m free fall; an assumption the warning states).
     """
     from .tables import parse_numbers, read_table
     path = Path(path)
@@ -118,4 +184,17 @@ def read_velocities(path, *, collector: str | None = None, velocity_unit: str | 
                          f"{med ** 2 / (2 * 9.81):.0f} m gives and looks like km/h entered as m/s (rock fall "
                          "velocities are mostly 5-35 m/s).  Declare the unit: velocity_unit='km/h' or, if the values "
                          "are right, 'm/s' (CLI --velocity-unit)")
+    limit, how = plausible_velocity_ms(drop_height_m, release_speed_ms)
+    v = out["velocity_ms"].to_numpy()
+    fast = v > limit
+    out.attrs["warnings"] = []
+    if fast.any():
+        i = int(np.argmax(v))
+        shown = f"{v[i]:.4g} m/s" + (f" (= {df['velocity_ms'].iloc[i]} km/h)" if factor != 1.0 else "")
+        msg = (f"{path}: {int(fast.sum()):,} of {v.size:,} velocities exceed what a free fall could give; the "
+               f"largest, row {rows[i]}, column {found['velocity_ms']!r}: {shown}; plausible at most {how}.  "
+               "Check the units, the collector and the drop height")
+        out.attrs["warnings"] = [msg]
+        from .validation import warn
+        warn(msg)
     return out

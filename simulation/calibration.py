@@ -183,7 +183,9 @@ def read_observed(path, *, column: str = "x_stop_m", select: dict | None = None,
     ``select`` keeps rows whose columns equal the given values (e.g.
     ``{"profile": "P1"}``).  Without an ``x_stop_m`` column, a file with
     exactly one numeric column uses that column.  ``table``: the file already read (by a reader
-    with other rules, e.g. ``riskrf``'s for decimal commas); ``path`` then only names it.
+    with other rules, e.g. ``riskrf.tables.read_numeric_table`` for separators, decimal commas,
+    encodings, Excel sheets and header rows); ``path`` then only names it and the table's index
+    is kept as the row labels of messages (that reader's index holds the file lines).
     """
     path = Path(path)
     if not path.exists():
@@ -221,7 +223,7 @@ def read_observed(path, *, column: str = "x_stop_m", select: dict | None = None,
         row = int(np.argmax(bad.to_numpy()))
         raise ValueError(f"{path}: column {column!r} is not numeric; row {row + 2} holds {df[column].iloc[row]!r}")
     out = df.rename(columns={column: "x_stop_m"})
-    if suffix not in (".parquet", ".xlsx", ".xls"):
+    if table is None and suffix not in (".parquet", ".xlsx", ".xls"):
         out.index = out.index + 2            # row labels are the CSV file's line numbers (line 1 is the header)
     out.attrs["source"] = f"{path} (column {column!r})"
     return out

@@ -397,6 +397,7 @@ SITE_REFUSALS = [
     ("reach probability 2", {"hazard": {"reach_probability": 2.0}}, r"hazard.reach_probability = 2.0"),
     ("NaN m_max", {"inventory": {"m_max_kg": float("nan")}}, r"inventory.m_max_kg = nan"),
     ("negative density", {"inventory": {"density_kg_m3": -2650}}, r"inventory.density_kg_m3 = -2650"),
+    ("negative drop height", {"hazard": {"drop_height_m": -5}}, r"hazard.drop_height_m = -5 must be a height > 0"),
 ]
 
 

@@ -209,27 +209,6 @@ def test_options_file_with_rates_resolves_closure_rules_for_riskrf_decide(tmp_pa
         load_mitigation(path, None)
 
 
-def test_generic_rainfall_read_at_once_equals_the_row_by_row_reading(tmp_path, monkeypatch):
-    # the site check reads the rainfall before any work; the common case is read vectorised
-    from riskrf import rainfall as R
-    f = tmp_path / "r.csv"
-    f.write_text("date,rainfall_mm\n2001-01-01,1.5\n2001-01-02,Trace\n,\n2001-01-03,***\n2001-01-05,\n"
-                 "2001-01-06,0\n2001-01-07,NaN\n2001-01-08,12\n")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        fast = R.read_rainfall(f)
-        monkeypatch.setattr(R, "_read_generic_plain", lambda *a: None)
-        loop = R.read_rainfall(f)
-    for name in ("daily", "flags", "rows"):
-        pd.testing.assert_series_equal(getattr(fast, name), getattr(loop, name))
-    pd.testing.assert_frame_equal(fast.gaps, loop.gaps)
-    assert fast.notes == loop.notes and fast.flags.tolist()[:3] == ["", "trace", "missing"]
-    f.write_text("date,rainfall_mm\n2001-01-01,1.5\n2001-01-02,-3\n")       # errors still come from the loop
-    monkeypatch.undo()
-    with pytest.raises(ValueError, match=r"row 3, column 'rainfall_mm': rainfall '-3' must be"):
-        R.read_rainfall(f)
-
-
 @pytest.mark.parametrize("edit,match", [
     (lambda d: (d / "rain.csv").write_text("\n".join((d / "rain.csv").read_text().splitlines()[:300]) + "\n"),
      r"rates.rainfall = 'rain.csv': rates.record 'falls.csv' \(2001-01-01 to 2006-12-31, with its 3-day antecedent "
