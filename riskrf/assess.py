@@ -285,6 +285,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
     pending = []
     if figures is not None:
         figures.mkdir()
+        import matplotlib.pyplot  # noqa: F401  (once here, not in each process drawing beside; backend unchanged)
     from .report.mitigation_text import study_report
 
     seed = site.hazard["seed"] if seed is None else seed
@@ -351,6 +352,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=extra,
             velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note)
         timings["simulation"] = round(time.perf_counter() - t, 2)
+        if figures is not None:
+            pending.append(_Beside(partial(_simulation_figures, result, hz_cfg["collector"], figures)))
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
         block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
@@ -413,7 +416,7 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     """Write every output of an assessment into ``out`` (an empty directory); returns the summary."""
     log = log or logger.info
     from .report.html import render_report
-    from .report.mitigation_text import write_mitigation_outputs
+    from .report.mitigation_text import write_mitigation_outputs, write_tree_figure
 
     log("[5/5] writing the report, tables and figures")
     t = time.perf_counter()
@@ -423,27 +426,28 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     if not drawn:
         figs.mkdir()
 
-    def simulation_and_decision_outputs():
-        if a.result is not None:
-            _simulation_figures(a, figs)
-        write_mitigation_outputs(a.study, a.decision, figs)
-
     # The figures are drawn in parts at once on two cores where that is safe (see _Beside); parts that
-    # run_assessment started beside its later stages are only waited for.
-    beside = _Beside(simulation_and_decision_outputs)
+    # run_assessment started beside its later stages are only waited for, while this process draws the decision's.
     if drawn:
-        for part in a.drawing["pending"]:
+        tree = _Beside(partial(write_tree_figure, a.study, figs))
+        write_mitigation_outputs(a.study, a.decision, figs, tree_figure=False)
+        for part in a.drawing["pending"] + [tree]:
             part.wait()
     else:
+        def simulation_and_decision_outputs():
+            _simulation_figures(a.result, a.site.hazard["collector"], figs)
+            write_mitigation_outputs(a.study, a.decision, figs)
+
+        beside = _Beside(simulation_and_decision_outputs)
         _frequency_outputs(a.frequency, a.maxima_frequency, figs)
         a.energy.write(figs)
+        beside.wait()
     for name in ("summary.json", "design_masses.csv", "completeness.csv"):
         shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
     for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv", "design_energy_sensitivity.csv",
                  "design_energy_tornado.csv", "design_block.csv"):
         if (figs / name).exists():
             shutil.move(str(figs / name), str(out / name))
-    beside.wait()
     for name in ("ranking.csv", "tornado.csv", "break_even.csv", "decision.json"):
         shutil.move(str(figs / name), str(out / name))
     a.timings["report"] = round(time.perf_counter() - t, 2)
@@ -495,10 +499,12 @@ def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:
         maxima_frequency.write(sub)
 
 
-def _simulation_figures(a, figs):
+def _simulation_figures(result, collector: str, figs: Path) -> None:
+    """Trajectories, the barrier line's distributions and the envelopes (nothing for a velocity file)."""
+    if result is None:
+        return
     from .report.files import write_simulation_figures
-    collector = a.site.hazard["collector"]
-    write_simulation_figures(a.result, figs, [collector], file_names={collector: "collector_distributions.png"})
+    write_simulation_figures(result, figs, [collector], file_names={collector: "collector_distributions.png"})
 
 def _copy_inputs(a: Assessment, dest: Path) -> None:
     """Copy the site file and everything it names, with the version, seed and command, for exact reruns."""

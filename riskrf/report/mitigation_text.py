@@ -102,9 +102,19 @@ def study_report(study) -> dict:
             "options_table": study.options_table(), "text": "\n".join(lines)}
 
 
-def write_mitigation_outputs(study, report, tmp) -> None:
+def write_tree_figure(study, tmp) -> None:
+    """The decision tree of the options (``tree.png``)."""
+    from .decision_figures import plot_tree
+    from .files import save_figure
+    ax = plot_tree(study.to_tree())
+    save_figure(ax.figure, tmp / "tree.png")
+
+
+def write_mitigation_outputs(study, report, tmp, *, tree_figure: bool = True) -> None:
+    """Ranking, tornado, break-even and decision tables, and the tree (unless ``tree_figure`` is False: drawn
+    apart by :func:`write_tree_figure`), tornado and F-N figures."""
     from ..outputs import write_json
-    from .decision_figures import plot_fn, plot_tornado, plot_tree
+    from .decision_figures import plot_fn, plot_tornado
     from .files import save_figure
     report["ranking"].to_csv(tmp / "ranking.csv", index=False)
     report["tornado"].to_csv(tmp / "tornado.csv", index=False)
@@ -115,8 +125,8 @@ def write_mitigation_outputs(study, report, tmp) -> None:
                 "tornado": report["tornado"], "tree_value": tree.rollback().value,
                 "value_of_information": report["value_of_information"], "uncertainty": report["uncertainty"],
                 "defaults_used": list(study.defaults_used)}, tmp / "decision.json")
-    ax = plot_tree(tree)
-    save_figure(ax.figure, tmp / "tree.png")
+    if tree_figure:
+        write_tree_figure(study, tmp)
     ax = plot_tornado(report["tornado"].head(15), currency=study.currency)   # the 15 inputs that matter most
     save_figure(ax.figure, tmp / "tornado.png")
     curves = {o.name: study.fn_curve(o.name) for o in study.options}
