@@ -114,7 +114,7 @@ def render_report(a, figs: Path) -> str:
     summary = ["<div class='box'><b>Summary.</b><ul>",
                (f"<li>{inv.n_events:,} recorded falls in {sig(inv.duration_years)} years; power law b = "
                f"{sig(gr.b)} &plusmn; {sig(gr.b_stderr, 2)} above {sig(gr.m_min)} kg ({sig(gr.rate_min)} falls per "
-               "year in the inventory).</li>"), f"<li>Rate of falls for the hazard from the {_e(a.rate_source)}.</li>"]
+               "year at or above it in the inventory).</li>"), f"<li>Rate of falls for the hazard from the {_e(a.rate_source)}.</li>"]
     if getattr(hz.mass, "m_max", None):
         summary.append(f"<li>For the hazard the law is refitted with the maximum credible block m<sub>max</sub> = "
                        f"{sig(hz.mass.m_max)} kg (b = {sig(hz.mass.b)})"
@@ -173,10 +173,19 @@ def render_report(a, figs: Path) -> str:
         closures = pd.DataFrame([{"option": k, **{c: v for c, v in d.items() if not c.startswith("evaluated")},
                                   "evaluated over": f"{d['evaluated_from']} to {d['evaluated_to']}"}
                                  for k, d in r.summary()["closures"].items()])
+        closures = closures.rename(columns={
+            "share_while_closed": "share of falls while closed (model)",
+            "recorded_share_while_closed": "share of recorded falls while closed",
+            "closure_hours_per_year": "closure hours [h/yr]", "closures_per_year": "closures [1/yr]",
+            "cost_per_hour": f"cost per closure hour [{cur}/h]"})
+        transferred = _name(r.record) != _name(inv.source)
         doc.add(f"<h3>Rate model ({_e(_name(r.record))}, rainfall {_e(_name(r.rainfall))})</h3>"
                 "<p>Counts of the dated record against antecedent rainfall, season and trend (Poisson and negative "
                 "binomial regression; README 'Rate models'). Closure options given as rules take their share of "
-                "falls while closed and their closure hours from this model.</p>",
+                "falls while closed and their closure hours from this model."
+                + (" The record is not this site's inventory: its rates, and the closure shares and hours computed "
+                   "from it, are transferred to this site (an assumption; see the site description)."
+                   if transferred else "") + "</p>",
                 doc.table(_item_table(r.model_summary.map(lambda v: re.sub(
                     r"-?\d+(?:\.\d+)?e[+-]\d+", lambda m: sig(float(m.group())), str(v)))), "Rate model"))
         if len(closures):
@@ -222,7 +231,11 @@ def render_report(a, figs: Path) -> str:
         preferred = f"{pref['model']}</b>: {_e(pref['reason'])}<b>"
         doc.add(f"<p>Record used: <code>{_e(_name(mf.inventory.source))}</code> &mdash; {_e(mf.inventory.site)}. "
                 f"{mf.gumbel.data.size:,} annual maxima in {mf.gumbel.n_years:,} years; years without a fall "
-                f"(p0 = {sig(mf.gumbel.p_zero, 2)}) enter through the mixed model.</p>",
+                f"(p0 = {sig(mf.gumbel.p_zero, 2)}) enter through the mixed model. Location and scale are "
+                "masses in kg."
+                + (" The fits, the power law and the bootstrap p-value quoted in the preferred-model text below "
+                   "are of this record, not of the site's inventory in section 2." if mf is not fr else "")
+                + "</p>",
                 doc.table(mf.gumbel.summary().reset_index(), "Gumbel fit of the annual maxima"))
         if mf.gev is not None:
             doc.add(doc.table(mf.gev.summary().reset_index(), "GEV fit of the annual maxima"),
@@ -328,9 +341,11 @@ def render_report(a, figs: Path) -> str:
         "5 % - 95 %": [f"{money_cur(x)} - {money_cur(y)}" for x, y in zip(ranking["cost_p05"], ranking["cost_p95"])],
         "probability cheapest": ranking["probability_best"].map(lambda v: f"{v:.0%}"),
         "expected regret": ranking["expected_regret"].map(money_cur),
-        "capital": ranking["capital"].map(money_cur), "renewals (PV)": ranking["pv_renewals"].map(money_cur),
-        "maintenance, repairs, replacements (PV)": ranking["pv_maintenance"].map(money_cur),
-        "expected losses (PV)": ranking["pv_expected_loss"].map(money_cur),
+        "cost at central values": ranking["cost_at_central_values"].map(money_cur),
+        "capital (central)": ranking["capital"].map(money_cur),
+        "renewals (PV, central)": ranking["pv_renewals"].map(money_cur),
+        "maintenance, repairs, replacements (PV, central)": ranking["pv_maintenance"].map(money_cur),
+        "expected losses (PV, central)": ranking["pv_expected_loss"].map(money_cur),
         "meets criteria": ranking["meets_criteria"].map(lambda v: "yes" if v else "no"),
         "meets them in (share of samples)": ranking["probability_meets_criteria"].map(lambda v: f"{v:.0%}")})
     opts = a.decision["options_table"].copy()
@@ -338,6 +353,7 @@ def render_report(a, figs: Path) -> str:
     opts["effectiveness"] = opts["effectiveness"].map(lambda v: f"{v:.0%}")
     opts = opts.rename(columns={"effectiveness": "falls kept off the road", "effect_basis": "effect from"})
     tornado = a.decision["tornado"]
+    central_best = ranking.loc[ranking["cost_at_central_values"].idxmin()]
     doc.section("Mitigation decision (Wyllie 2014, 8.5.5)")
     doc.add(f"<div class='box'><b>Recommendation: {_e(rec['option'])}</b> ({_e(rec['basis'])}).<br>"
             f"{_e(rec['reason'])}</div>",
@@ -350,16 +366,25 @@ def render_report(a, figs: Path) -> str:
             f"(impacts between SEL and MEL) and replacements (impacts above capacity) + present value of expected "
             f"losses, over {a.study.economics.horizon_years:g} years at {a.study.economics.discount_rate:.1%}. "
             f"Mean and 5-95 % over {unc['samples']:,} joint samples of the uncertain inputs (seed {unc['seed']}); "
-            "probability cheapest: share of the samples in which the option costs least (they sum to 100 %).</p>",
+            "probability cheapest: share of the samples in which the option costs least (they sum to 100 %). "
+            "The columns marked central are at the central values of the inputs and add up to the cost at central "
+            "values; the expected total cost is the mean over the samples and differs from it where the losses "
+            "have a long tail or a stated range is not centred on the central value.</p>",
             doc.table(costs, f"Expected total costs [{cur}]"),
             "<h3>Uncertain inputs</h3>",
             doc.table(pd.DataFrame([{"input": k, "low": v["low"], "high": v["high"], "law": v["law"]}
                                     for k, v in unc["inputs"].items()]), "Uncertain inputs sampled jointly"),
+            "<p>Low and high: the ends of a stated range, or the 5th and 95th percentiles of a sampling law.</p>",
             f"<p>Not sampled: {_e('; '.join(unc['not_sampled']))}.</p>",
             doc.figure(figs / "tree.png", "Decision tree at central values; the optimal path in red"),
-            "<h3>What would make the runner-up as good (break-even)</h3>",
+            "<h3>Break-even: input values at which the two cheapest options at central values tie</h3>",
+            f"<p>The break-even values, the tornado and the value of information below are computed at the central "
+            f"values of the inputs, where <b>{_e(central_best['option'])}</b> costs least "
+            f"({money_cur(central_best['cost_at_central_values'])})"
+            + ("" if central_best["meets_criteria"] else "; it does not meet the tolerability criteria, so it is "
+               "not the recommendation") + ". They compare costs only; the criteria are not applied.</p>",
             doc.table(be[np.isfinite(be["break_even"])], "Break-even values of single inputs"),
-            doc.figure(figs / "tornado.png", "Tornado: the lowest expected total cost as each input moves over its "
+            doc.figure(figs / "tornado.png", "Tornado: the lowest cost at central values as each input moves over its "
                                              "stated range (x0.5 / x2 where none is stated); the 15 inputs that "
                                              "change the best option or the order first, then by swing"),
             "<h3>Inputs that change the best option or the order</h3>",
@@ -368,7 +393,10 @@ def render_report(a, figs: Path) -> str:
                       "Inputs whose range changes the ranking"))
     voi = a.decision["value_of_information"]
     doc.add(f"<p>Value of perfect information about the rate of falls (true rate half, as estimated or "
-            f"double the estimate, with probabilities 1/4, 1/2, 1/4): <b>{money_cur(voi['evpi'])}</b>; about all "
+            f"double the estimate, with probabilities 1/4, 1/2, 1/4; at central values, costs only"
+            + (f": the cheapest option is {_e(', '.join(f'{v} at {k}' for k, v in voi['best_by_rate'].items()))}"
+               if voi.get("best_by_rate") else "") + "): "
+            f"<b>{money_cur(voi['evpi'])}</b>; about all "
             f"sampled inputs at once: <b>{money_cur(voi['evpi_all_sampled_inputs'])}</b> &mdash; the most that "
             "investigations settling them are worth.</p>")
 
