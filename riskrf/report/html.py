@@ -381,8 +381,12 @@ def render_report(a, figs: Path) -> str:
             f"<p>The break-even values, the tornado and the value of information below are computed at the central "
             f"values of the inputs, where <b>{_e(central_best['option'])}</b> costs least "
             f"({money_cur(central_best['cost_at_central_values'])})"
-            + ("" if central_best["meets_criteria"] else "; it does not meet the tolerability criteria, so it is "
-               "not the recommendation") + ". They compare costs only; the criteria are not applied.</p>",
+            + ("" if central_best["meets_criteria"] else
+               f"; it does not meet the tolerability criteria (F-N zone {_e(central_best['fn_zone'])}, "
+               f"F(N&ge;1) = {probability(central_best['F_N1_per_year'])}/yr; individual risk "
+               f"{probability(central_best['individual_risk'])}/yr; met in "
+               f"{central_best['probability_meets_criteria']:.0%} of the joint samples), so it is not the "
+               "recommendation") + ". They compare costs only; the criteria are not applied.</p>",
             doc.table(be[np.isfinite(be["break_even"])], "Break-even values of single inputs"),
             doc.figure(figs / "tornado.png", "Tornado: the lowest cost at central values as each input moves over its "
                                              "stated range (x0.5 / x2 where none is stated); the 15 inputs that "

@@ -127,7 +127,9 @@ def write_mitigation_outputs(study, report, tmp, *, tree_figure: bool = True) ->
                 "defaults_used": list(study.defaults_used)}, tmp / "decision.json")
     if tree_figure:
         write_tree_figure(study, tmp)
-    ax = plot_tornado(report["tornado"].head(15), currency=study.currency)   # the 15 inputs that matter most
+    ax = plot_tornado(report["tornado"].head(15), currency=study.currency,   # the 15 inputs that matter most
+                      xlabel=f"lowest cost of the options at central values [{study.currency}]")
+    ax.xaxis.set_major_formatter(lambda v, _pos: f"{v:,.0f}")
     save_figure(ax.figure, tmp / "tornado.png")
     curves = {o.name: study.fn_curve(o.name) for o in study.options}
     ax = plot_fn(curves)
