@@ -895,7 +895,11 @@ class MitigationStudy:
                         f"{rec['expected_total_cost'] - cheapest['expected_total_cost']:,.0f} {cur} more in "
                         "expectation.")
             else:
-                why += f" It is also the cheapest overall, in {rec['probability_best']:.0%} of the joint samples."
+                most = t.loc[t["probability_best"].idxmax()]
+                why += " It also has the lowest expected total cost of all options" + (
+                    f", though it is the cheapest in only {rec['probability_best']:.0%} of the joint samples "
+                    f"({most['option']}: {most['probability_best']:.0%})." if most["option"] != rec["option"]
+                    else f", and is the cheapest in {rec['probability_best']:.0%} of the joint samples.")
             basis = "cheapest tolerable option"
         else:
             cand = t[t["kind"] != "none"].dropna(subset=["deaths_avoided_per_million"])
@@ -1098,7 +1102,7 @@ class MitigationStudy:
         rows = []
         for k, o in enumerate(self.options):
             ret = r["retention"][0, k]
-            rows.append({"option": o.name, "kind": o.kind, "what it is and assumes": o.describe(),
+            rows.append({"option": o.name, "kind": o.kind, "what it is and assumes": o.describe(self.currency),
                          "retention": None if np.isnan(ret) else float(ret),
                          "effectiveness": float(r["effectiveness"][0, k]), "effect_basis": self._basis(o)})
         return pd.DataFrame(rows)

@@ -170,8 +170,8 @@ class Option:
         return self.retention is not None or self.rate_reduction is not None or (
             self.kind == "closure" and not self.has_closure_rule)
 
-    def describe(self) -> str:
-        """What the option is and assumes, in words."""
+    def describe(self, currency: str = "") -> str:
+        """What the option is and assumes, in words (money in ``currency``)."""
         k = self.kind
         if k == "none":
             text = "the site as it is"
@@ -206,10 +206,12 @@ class Option:
             text = f"{self.rule_text()}; share and hours not yet computed (needs the site's rate model, [rates])"
         elif k == "closure":
             how = "computed from the rate model" if self.has_closure_rule else "ASSUMED (typed)"
+            cur = f" {currency}" if currency else ""
             text = ((f"{self.closure_rule}: " if self.closure_rule else "")
                     + f"road closed {self.closure_hours_per_year:,.1f} h per year ({how}) at "
-                    f"{self.cost_per_closure_hour:,.0f} per hour ({self.closure_hours_per_year * self.cost_per_closure_hour:,.0f}"
-                    f" per year, in the annual maintenance); {self.share_while_closed:.1%} of falls occur while closed "
+                    f"{self.cost_per_closure_hour:,.0f}{cur} per hour "
+                    f"({self.closure_hours_per_year * self.cost_per_closure_hour:,.0f}{cur} per year, in the "
+                    f"annual maintenance); {self.share_while_closed:.1%} of falls occur while closed "
                     f"({how}); protects road users, falls still reach the road")
         else:
             text = "combination of " + " + ".join(self.options)

@@ -34,6 +34,10 @@ def main(samples: int = 1000):
         inv, m_max=inv_cfg["m_max_kg"], rate_scale=inv_cfg["rate_scale"], scenario=site.resolve(hz_cfg["scenario"]),
         n=hz_cfg["n_blocks"], seed=hz_cfg["seed"])
     mit = dict(site.mitigation)
+    if site.rates is not None:          # closure rules: share and hours from the site's daily rate model
+        from riskrf.site_rates import evaluate_rates, resolve_closures
+        rates = evaluate_rates(site.rates, site.path.parent, inv_cfg, mit["options"])
+        mit["options"] = resolve_closures(mit["options"], rates)
     mit["uncertainty"] = replace(mit["uncertainty"], samples=samples)
     study = MitigationStudy(hazard=hazard, road_share=road_share(result, "barrier", "road"),
                             **study_context(result, "barrier", "road", hz_cfg["option_blocks"], hz_cfg["seed"], inv,
