@@ -524,3 +524,15 @@ def test_quantile_mapping_of_bounce_heights_keeps_the_rolling_share():
     # 60 % of the reference rolls; in a variant where only 30 % roll, half of the reference's rolling blocks bounce
     var = np.r_[np.zeros(300), np.linspace(1.0, 9.0, 700)]
     assert np.mean(_quantile_map(np.zeros(100), ref, var) > 0) == pytest.approx(0.5, abs=0.02)
+
+
+def test_simulations_on_threads_equal_one_by_one_runs():
+    from riskrf.measures import scenario_with_materials
+    sc = simulation.load_scenario(ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml")
+    scs = [scenario_with_materials(sc, {"talus.ground_friction_angle_deg": v}) for v in (15.0, 20.0, 25.0)]
+    ctx = SimulationContext(sc, n_blocks=800, seed=3, threads=2)
+    for a, b in zip(ctx.run_many(scs), [ctx.run(x) for x in scs]):
+        for name in a.crossings:
+            np.testing.assert_array_equal(a.crossings[name], b.crossings[name])
+        for name in a.per_block:
+            np.testing.assert_array_equal(a.per_block[name], b.per_block[name])
