@@ -287,7 +287,14 @@ class MitigationStudy:
     def _model_arrays(self):
         """Reach probability at the barrier line and P(road | barrier) per slope model."""
         ms = self._models
-        return (np.array([m["reach"] for m in ms]), np.array([m["road_share"] for m in ms]))
+        reach = np.array([m["reach"] for m in ms])
+        if self._by_mass is not None and len(ms) > 1:
+            # mass-coupled: a variant's reach relative to the unmodified slope simulated alike (seeder masses),
+            # times the hazard's mass-averaged reach (see _by_mass)
+            res = self._reference_run
+            base = effective_samples(res, self.context.barrier_collector)[0].size / res.n
+            reach[1:] = reach[1:] * reach[0] / base if base > 0 else reach[1:]
+        return reach, np.array([m["road_share"] for m in ms])
 
     def material_models(self) -> pd.DataFrame:
         """The slope models used: material values, reach probability and road share of each."""
@@ -329,8 +336,11 @@ class MitigationStudy:
         [m/s], bounce heights [m], paired) and P(reach | class) over the hazard's mean reach probability; else None.
 
         The reference slope model's fence impacts and arrivals then follow block mass (heavier blocks arrive more
-        often and faster).  A material variant keeps this mass dependence, scaled by its own pooled samples:
-        speeds and heights by the ratio of its median to the reference's, reach by its own mean reach.
+        often and faster).  A material variant keeps this mass dependence, changed as its pooled samples changed
+        from those of the unmodified slope simulated alike (:attr:`_reference_run`: same blocks, seed and seeder
+        masses; the hazard's own samples are another mass mixture): speeds by the ratio of the medians, bounce
+        heights by quantile mapping (:func:`_quantile_map`; a ratio of medians is 0 or unbounded when most blocks
+        roll, h = 0), reach by the ratio of the mean reach probabilities (:attr:`_model_arrays`).
         """
         hz = self.hazard
         if not hz.mass_coupled:
@@ -348,13 +358,18 @@ class MitigationStudy:
         """damage_state_shares per mass bin with the speeds and heights of the bin's own mass class (see _by_mass)."""
         cls, samples, _ = self._by_mass
         mid = self._grid[1]
-        ref_v, ref_h = self._models[0]["barrier"]
-        sv = float(np.median(v) / np.median(ref_v)) if len(v) and len(ref_v) else 1.0
-        sh = float(np.median(h) / np.median(ref_h)) if len(h) and len(ref_h) and np.median(ref_h) > 0 else 1.0
+        sv, hmap = 1.0, None                                # the reference slope model: its own samples
+        if model is not self._models[0]:
+            ref_v, ref_h = effective_samples(self._reference_run, self.context.barrier_collector)
+            sv = float(np.median(v) / np.median(ref_v)) if len(v) and len(ref_v) else 1.0
+            if len(h) and len(ref_h):
+                def hmap(x):
+                    return _quantile_map(x, ref_h, h)
         shares = [np.zeros(mid.size) for _ in range(3)]
         for c, (vc, hc) in samples.items():
             j = cls == c
-            got = damage_state_shares(kinetic_energy_kj(mid[j][None, :], sv * vc[:, None]), sh * hc > height_m, cap)
+            hc = hc if hmap is None else hmap(hc)
+            got = damage_state_shares(kinetic_energy_kj(mid[j][None, :], sv * vc[:, None]), hc > height_m, cap)
             for out, part in zip(shares, got):
                 out[j] = part
         return tuple(shares)
@@ -1106,6 +1121,30 @@ class MitigationStudy:
                          "retention": None if np.isnan(ret) else float(ret),
                          "effectiveness": float(r["effectiveness"][0, k]), "effect_basis": self._basis(o)})
         return pd.DataFrame(rows)
+
+
+def _quantile_map(x, ref, var):
+    """Values ``x`` moved from the law of sample ``ref`` to that of sample ``var`` (quantile mapping):
+    F_var^-1(F_ref(x)), both empirical with plotting positions (i + 1/2) / n and linear between them; beyond
+    ``ref``'s extremes scaled by the ratio of the extremes.  Values of ``x`` equal to a value held several times
+    in ``ref`` (rolling blocks at h = 0) are spread evenly, in their order, over that value's probability range,
+    so that their share is kept.  Identity when ``var`` equals ``ref``; ``2 ref`` maps x to 2 x."""
+    x = np.asarray(x, dtype=float)
+    r, w = np.sort(np.asarray(ref, dtype=float)), np.sort(np.asarray(var, dtype=float))
+    u = np.interp(x, r, (np.arange(r.size) + 0.5) / r.size)
+    first, last = np.searchsorted(r, x, side="left"), np.searchsorted(r, x, side="right")
+    tied = np.flatnonzero(last - first > 1)
+    if tied.size:
+        order = tied[np.argsort(x[tied], kind="stable")]
+        _, start, count = np.unique(x[order], return_index=True, return_counts=True)
+        k = np.arange(order.size) - np.repeat(start, count)              # position among the equal values of x
+        m = np.repeat(count, count)
+        u[order] = (first[order] + (k + 0.5) / m * (last[order] - first[order])) / r.size
+    out = np.interp(u, (np.arange(w.size) + 0.5) / w.size, w)
+    hi, lo = x > r[-1], x < r[0]
+    out[hi] = x[hi] * (w[-1] / r[-1] if r[-1] > 0 else 1.0)
+    out[lo] = x[lo] * (w[0] / r[0] if r[0] > 0 else 1.0)
+    return out
 
 
 def study_inputs(data: dict, source: str) -> dict:

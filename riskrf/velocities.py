@@ -58,13 +58,27 @@ def _upper(dist) -> float:
     return float(p.get("max", p["median"] * np.exp(4 * p["sigma"])))
 
 
+def _largest_magnitude(dist) -> float:
+    """Largest |value| a scenario Distribution gives (its lower end mean - 4 sd when unbounded below): a release
+    velocity component may be negative (thrown downward, or towards -x)."""
+    p = dist.params
+    if dist.kind in ("uniform", "triangular"):
+        low = p["low"]
+    elif dist.kind == "normal":
+        low = p.get("min", p["mean"] - 4 * p["std"])
+    else:
+        low = 0.0 if dist.kind == "lognormal" else p["value"]
+    return max(abs(float(low)), abs(_upper(dist)))
+
+
 def free_fall_drop_m(scenario, collector: str) -> tuple[float, float]:
     """Height drop H [m] from the highest release point to the ground at ``collector``, and the release speed [m/s].
 
     The release point is the highest profile vertex within the seeder's x range (ends
     included) plus the seeder's largest release height; the release speed is the largest
-    of ``sqrt(vx^2 + vz^2)`` the seeder can draw.  A block cannot pass the collector faster
-    than ``sqrt(v0^2 + 2 g H)`` (energy conservation without losses).
+    of ``sqrt(vx^2 + vz^2)`` the seeder can draw (from the largest magnitudes: a component may be
+    negative).  A block cannot pass the collector faster than ``sqrt(v0^2 + 2 g H)`` (energy
+    conservation without losses).
     """
     import simulation
     sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
@@ -73,7 +87,7 @@ def free_fall_drop_m(scenario, collector: str) -> tuple[float, float]:
     xs = np.concatenate([[seed.x_low, seed.x_high], prof.x[(prof.x >= seed.x_low) & (prof.x <= seed.x_high)]])
     z_release = float(np.max(np.interp(xs, prof.x, prof.z))) + _upper(seed.height_m)
     z_line = float(np.interp(col.x, prof.x, prof.z))
-    vx, vz = _upper(seed.vx_ms), _upper(seed.vz_ms)
+    vx, vz = _largest_magnitude(seed.vx_ms), _largest_magnitude(seed.vz_ms)
     return max(z_release - z_line, 0.0), float(np.hypot(vx, vz))
 
 

@@ -303,3 +303,31 @@ def test_fragmentation_design_block(demo_hazard, lauterbrunnen):
         design_block(demo_hazard, rule="fragmentation", inventory=inv)
     with pytest.raises(ValueError, match="fractal_dimension = 3.5"):
         design_block(demo_hazard, rule="fragmentation", inventory=inv, fractal_dimension=3.5, iterations=3)
+
+
+def test_bootstrap_replicate_as_multiplicities_equals_the_resampled_blocks():
+    """resampled_joint_exceedance counts each class's blocks drawn with replacement as multiplicities of the
+    simulated blocks; it must give the joint exceedance of the explicitly resampled blocks (each class's members
+    drawn with rng.choice, the replicate before the change) for the same random stream, ties and a class with
+    no arrival included."""
+    g = np.random.default_rng(1)
+    n = 400
+    m = np.exp(g.uniform(np.log(10.0), np.log(1e5), n))
+    edges = np.geomspace(10.0, 1e5, 6)
+    s = g.gamma(5.0, 3.0, n)
+    s[g.uniform(size=n) < 0.3] = np.nan
+    s[5:40] = 10.0                                                    # ties
+    k = np.clip(np.searchsorted(edges, m, side="right") - 1, 0, 4)
+    s[k == 2] = np.nan                                                # a class where nothing arrives
+    h = np.where(np.isfinite(s), 1.0, np.nan)
+    samples = MassCoupledSamples(m, s, h, edges)
+    mm = mass_model(stats.lognorm(1.5, scale=200.0))
+    e = np.geomspace(0.01, 1e5, 200)
+    for seed in range(5):
+        a, b = np.random.default_rng(seed), np.random.default_rng(seed)
+        for _ in range(3):
+            got = samples.resampled_joint_exceedance(a, e, mm)
+            idx = np.concatenate([b.choice(np.flatnonzero(k == c), size=int(np.sum(k == c))) for c in range(5)])
+            expected = MassCoupledSamples(m[idx], s[idx], h[idx], edges).joint_exceedance(e, mm)
+            np.testing.assert_array_equal(got, expected)
+        assert a.random() == b.random()                               # the same draws consumed

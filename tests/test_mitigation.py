@@ -478,3 +478,61 @@ def test_mass_coupled_hazard_gives_each_mass_its_own_reach_and_speed_at_the_fenc
     r = s.evaluate("fence")
     assert r.replacements_per_year == pytest.approx(2.0 * 0.5, rel=0.02)
     assert r.repairs_per_year == 0.0
+
+
+def test_material_variant_with_the_central_materials_reproduces_a_mass_coupled_reference():
+    """A material variant is scaled relative to the unmodified slope simulated like it (same blocks, seed and
+    seeder masses), not to the mass-coupled hazard's own samples (another mass mixture): the tornado's 'low'
+    variant below has exactly the central materials, so its reach, fence impacts and overtopping must equal the
+    reference's.  (Before: its reach was the seeder run's, its speeds scaled by the seeder-run median over the
+    hazard's median, and its heights by a ratio of medians that is 0 when most arriving blocks roll, h = 0:
+    no block ever passed over a fence in that variant.)"""
+    import riskrf
+    from riskrf.measures import material_value
+    sc = simulation.load_scenario(ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml")
+    hz = riskrf.energy_hazard(stats.loguniform(50.0, 5e4), sc, "barrier", rate_per_year=1.0, n=2000, seed=1)
+    name = "talus.ground_friction_angle_deg"
+    central = material_value(sc, name)
+    fence = Option("fence", "fence", 5e5, capacity_kj=500, height_m=1.0, repair_days=0)
+    s = MitigationStudy(hazard=hz, options=(Option("nothing", "none"), fence), consequences=CONSTANT_V,
+                        uncertainty=Uncertainty(samples=20, material_draws=1,
+                                                materials={name: (central, central + 5.0)}),
+                        context=SimulationContext(sc, barrier_collector="barrier", road_collector="road",
+                                                  n_blocks=1000, seed=3))
+    labels = [m["label"] for m in s._models]
+    low = labels.index(f"{name} low")
+    assert s._models[low]["values"][name] == central
+    reach = s._model_arrays[0]
+    assert reach[low] == pytest.approx(reach[0], rel=1e-12)
+    st = s._barrier_stage(fence)
+    assert st.passing[0].max() > 0                          # some blocks pass over or break through the fence
+    for arr in (st.passing, st.held_sel, st.destroy):
+        np.testing.assert_allclose(arr[low], arr[0], atol=1e-12)
+
+
+def test_quantile_mapping_of_bounce_heights_keeps_the_rolling_share():
+    """The variant's height law is applied by quantile mapping: twice the heights map each height to twice
+    itself, rolling blocks (h = 0) stay on the ground, and a variant whose median is 0 still bounces above it."""
+    from riskrf.mitigation import _quantile_map
+    ref = np.r_[np.zeros(600), np.linspace(0.1, 4.0, 400)]
+    x = np.array([0.0, 0.5, 2.0, 3.9, 6.0])
+    np.testing.assert_allclose(_quantile_map(x, ref, 2 * ref), 2 * x, rtol=1e-12)
+    np.testing.assert_allclose(_quantile_map(x, ref, ref), x, rtol=1e-12)
+    var = np.r_[np.zeros(700), np.linspace(1.0, 9.0, 300)]          # median 0, yet 30 % bounce up to 9 m
+    mapped = _quantile_map(ref, ref, var)
+    assert np.mean(mapped > 5.0) == pytest.approx(np.mean(var > 5.0), abs=0.01)
+    # 60 % of the reference rolls; in a variant where only 30 % roll, half of the reference's rolling blocks bounce
+    var = np.r_[np.zeros(300), np.linspace(1.0, 9.0, 700)]
+    assert np.mean(_quantile_map(np.zeros(100), ref, var) > 0) == pytest.approx(0.5, abs=0.02)
+
+
+def test_simulations_on_threads_equal_one_by_one_runs():
+    from riskrf.measures import scenario_with_materials
+    sc = simulation.load_scenario(ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml")
+    scs = [scenario_with_materials(sc, {"talus.ground_friction_angle_deg": v}) for v in (15.0, 20.0, 25.0)]
+    ctx = SimulationContext(sc, n_blocks=800, seed=3, threads=2)
+    for a, b in zip(ctx.run_many(scs), [ctx.run(x) for x in scs]):
+        for name in a.crossings:
+            np.testing.assert_array_equal(a.crossings[name], b.crossings[name])
+        for name in a.per_block:
+            np.testing.assert_array_equal(a.per_block[name], b.per_block[name])

@@ -94,3 +94,17 @@ def test_cli_energy_reports_the_warning_in_its_summary(tmp_path, capsys):
     rc = main(["energy", "--inventory", str(INVENTORIES / "lauterbrunnen" / "lauterbrunnen_tls_2018.csv"),
                "--velocities", str(f), "--drop-height", "tall", "--out", str(tmp_path / "p")])
     assert rc == 2 and "--drop-height = 'tall'" in capsys.readouterr().err
+
+
+def test_release_speed_takes_the_largest_magnitude_a_seeder_can_draw():
+    """A block thrown downward (vz < 0) or towards -x: the release speed is the largest |v| of the seeder's
+    ranges, not the largest signed value (vz uniform in -6..-1 m/s gives up to 6 m/s, not 1 m/s)."""
+    from dataclasses import replace
+    from simulation.scenario import Distribution
+    sc = simulation.load_scenario(BARRIER)
+    sd = replace(sc.seeder, vx_ms=Distribution("uniform", {"low": -2.0, "high": 0.5}),
+                 vz_ms=Distribution("uniform", {"low": -6.0, "high": -1.0}))
+    _, v0 = free_fall_drop_m(replace(sc, seeder=sd), "barrier")
+    assert v0 == pytest.approx(np.hypot(2.0, 6.0))
+    sd = replace(sc.seeder, vz_ms=Distribution("normal", {"mean": -3.0, "std": 0.5}))
+    assert free_fall_drop_m(replace(sc, seeder=sd), "barrier")[1] == pytest.approx(np.hypot(1.5, 5.0))
