@@ -367,7 +367,9 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         tornado = design_energy_tornado(
             hazard, design_T=hz_cfg["design_period_years"], block=block, masses_kg=inventory.masses,
             duration_years=inventory.duration_years, m_max_range=_ends(m_max_values),
-            rate_share=rate_scale, rate_share_range=_ends(shares), sensitivity=sensitivity) \
+            rate_share=rate_scale, rate_share_range=_ends(shares), sensitivity=sensitivity,
+            **({"rate_label": "rate factor on the inventory's rate (rate model x rate_scale)"}
+               if site_rates is not None else {})) \
             if sensitivity is not None else None
         fences, heights = fence_checks_from_site(site)
         energy = analyse_energy(hazard, fences=fences, fence_height_m=heights,

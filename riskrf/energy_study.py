@@ -345,7 +345,8 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
                           duration_years: float | None = None, m_max_range=None, rate_share: float = 1.0,
                           rate_share_range=None, velocity_percentile: float | None = None,
                           velocity_percentile_range=None, fractal_dimension_range=None, iterations_range=None,
-                          sensitivity: pd.DataFrame | None = None) -> DesignEnergyTornado:
+                          sensitivity: pd.DataFrame | None = None,
+                          rate_label: str = "rate share of the source above the line") -> DesignEnergyTornado:
     """One-way sensitivity (tornado) of the design energies [kJ] to the judgement and uncertain inputs.
 
     Design energies (each row says which one it moves):
@@ -362,7 +363,8 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
     * maximum credible block m_max [kg] (``m_max_range``; default x0.5 and x2 of the law's): the power law refitted
       to ``masses_kg`` over ``duration_years`` with that truncation (as :func:`design_energy_sensitivity`), or,
       without the masses, re-truncated with b kept;
-    * rate share [-] (``rate_share_range`` around ``rate_share``; default x0.5 and x2): the rate scaled;
+    * rate share [-] (``rate_share_range`` around ``rate_share``; default x0.5 and x2): the rate scaled (its row is
+      named ``rate_label``: a rate from a rate model makes it a factor on the inventory's rate, not a share);
     * power-law exponent b [-] at the ends of the fit's interval ``hazard.mass.b_ci``: the law re-scaled with b
       fixed, the rate of falls above m_min kept;
     * fractal dimension D [-] and fragmentation generations (``fractal_dimension_range``, ``iterations_range``;
@@ -483,7 +485,7 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
                                                  (mm_lo, share), (mm_hi, share))
     elif gr is not None:
         notes.append("m_max: the law is not truncated (no maximum credible block stated); no m_max row")
-    cases["rate share of the source above the line"] = (
+    cases[rate_label] = (
         NO_UNIT, s_lo, share, s_hi, "given" if rate_share_range is not None else "typed: x0.5 and x2 (ASSUMPTION)",
         hazard.with_mass(hazard.mass, hazard.rate_per_year * s_lo / share),
         hazard.with_mass(hazard.mass, hazard.rate_per_year * s_hi / share), (m_max, s_lo), (m_max, s_hi))
