@@ -354,22 +354,33 @@ class MitigationStudy:
         profile = vel.reach_by_class[cls] / max(float(hz.reach_probability), 1e-300)
         return cls, samples, profile
 
-    def _damage_by_mass(self, model: dict, v, h, height_m: float, cap: float):
-        """damage_state_shares per mass bin with the speeds and heights of the bin's own mass class (see _by_mass)."""
-        cls, samples, _ = self._by_mass
-        mid = self._grid[1]
-        sv, hmap = 1.0, None                                # the reference slope model: its own samples
-        if model is not self._models[0]:
+    @cached_property
+    def _variant_classes(self) -> dict:
+        """id(slope model) -> per mass class (speeds [m/s], bounce heights [m]) at the barrier line as that model
+        changes them (see :attr:`_by_mass`); filled once per model, shared by every barrier option."""
+        return {}
+
+    def _class_samples(self, model: dict, v, h) -> dict:
+        cached = self._variant_classes.get(id(model))
+        if cached is not None:
+            return cached
+        samples = self._by_mass[1]
+        if model is not self._models[0]:                    # the reference slope model keeps its own samples
             ref_v, ref_h = effective_samples(self._reference_run, self.context.barrier_collector)
             sv = float(np.median(v) / np.median(ref_v)) if len(v) and len(ref_v) else 1.0
-            if len(h) and len(ref_h):
-                def hmap(x):
-                    return _quantile_map(x, ref_h, h)
+            mapped = len(h) and len(ref_h)
+            samples = {c: (sv * vc, _quantile_map(hc, ref_h, h) if mapped else hc) for c, (vc, hc) in samples.items()}
+        self._variant_classes[id(model)] = samples
+        return samples
+
+    def _damage_by_mass(self, model: dict, v, h, height_m: float, cap: float):
+        """damage_state_shares per mass bin with the speeds and heights of the bin's own mass class (see _by_mass)."""
+        cls = self._by_mass[0]
+        mid = self._grid[1]
         shares = [np.zeros(mid.size) for _ in range(3)]
-        for c, (vc, hc) in samples.items():
+        for c, (vc, hc) in self._class_samples(model, v, h).items():
             j = cls == c
-            hc = hc if hmap is None else hmap(hc)
-            got = damage_state_shares(kinetic_energy_kj(mid[j][None, :], sv * vc[:, None]), hc > height_m, cap)
+            got = damage_state_shares(kinetic_energy_kj(mid[j][None, :], vc[:, None]), hc > height_m, cap)
             for out, part in zip(shares, got):
                 out[j] = part
         return tuple(shares)
