@@ -22,6 +22,7 @@ import numpy as np
 
 from . import __version__
 from .annual_hazard import EnergyHazard, inertia_factors
+from .background import InBackground
 from .design_block import design_block, design_block_candidates_kg, read_block_survey
 from .energy_study import (
     INTERVAL_COVERS,
@@ -190,7 +191,7 @@ class Assessment:
     warnings: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
     rates: object = None            # SiteRates of the site's [rates] model (riskrf.site_rates), or None
-    #: figures already being drawn beside the computation: {"dir": Path, "pending": [_Beside, ...]} (see
+    #: figures already being drawn beside the computation: {"dir": Path, "pending": [InBackground, ...]} (see
     #: ``run_assessment(figures_dir=...)``); empty when ``write_assessment`` draws them all.
     drawing: dict = field(default_factory=dict, repr=False)
 
@@ -304,7 +305,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         # The site's rate model (hazard rate, closure rules) is fitted in a child on the other core meanwhile.
         rates = None
         if site.rates is not None:
-            from .site_rates import InBackground, evaluate_rates
+            from .site_rates import evaluate_rates
             rates = InBackground(lambda: evaluate_rates(site.rates, site.path.parent, inv_cfg,
                                                         site.mitigation["options"]))
         # On a fresh installation the simulator is compiled once (numba, cached on disk): do it on the other
@@ -324,7 +325,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
         timings["fits"] = round(time.perf_counter() - t, 2)
         if figures is not None:
-            pending.append(_Beside(partial(_frequency_outputs, frequency, maxima_frequency, figures)))
+            pending.append(InBackground(partial(_frequency_outputs, frequency, maxima_frequency, figures)))
 
         db_cfg = site.design_block
         survey = read_block_survey(site.resolve(db_cfg["survey"]), inventory.density_kg_m3) \
@@ -353,7 +354,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note)
         timings["simulation"] = round(time.perf_counter() - t, 2)
         if figures is not None:
-            pending.append(_Beside(partial(_simulation_figures, result, hz_cfg["collector"], figures)))
+            pending.append(InBackground(partial(_simulation_figures, result, hz_cfg["collector"], figures)))
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
         block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
@@ -378,7 +379,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                                 design_block=block, sensitivity=sensitivity, tornado=tornado)
         timings["energy"] = round(time.perf_counter() - t, 2)
         if figures is not None:
-            pending.append(_Beside(partial(energy.write, figures)))
+            pending.append(InBackground(partial(energy.write, figures)))
 
         t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
         share = road_share(result, hz_cfg["collector"], hz_cfg["road_collector"])
@@ -428,22 +429,22 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     if not drawn:
         figs.mkdir()
 
-    # The figures are drawn in parts at once on two cores where that is safe (see _Beside); parts that
+    # The figures are drawn in parts at once on two cores where that is safe (see riskrf.background); parts that
     # run_assessment started beside its later stages are only waited for, while this process draws the decision's.
     if drawn:
-        tree = _Beside(partial(write_tree_figure, a.study, figs))
+        tree = InBackground(partial(write_tree_figure, a.study, figs))
         write_mitigation_outputs(a.study, a.decision, figs, tree_figure=False)
         for part in a.drawing["pending"] + [tree]:
-            part.wait()
+            part.result()
     else:
         def simulation_and_decision_outputs():
             _simulation_figures(a.result, a.site.hazard["collector"], figs)
             write_mitigation_outputs(a.study, a.decision, figs)
 
-        beside = _Beside(simulation_and_decision_outputs)
+        beside = InBackground(simulation_and_decision_outputs)
         _frequency_outputs(a.frequency, a.maxima_frequency, figs)
         a.energy.write(figs)
-        beside.wait()
+        beside.result()
     for name in ("summary.json", "design_masses.csv", "completeness.csv"):
         shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
     for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv", "design_energy_sensitivity.csv",
@@ -458,38 +459,6 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
     _copy_inputs(a, out / "inputs")
     return summary
-
-
-class _Beside:
-    """Run ``work`` (which only writes files) in a forked child while the caller goes on; :meth:`wait` joins it.
-
-    Drawing figures is single-threaded Python, so the figures of the simulation and the decision are drawn in
-    a child process on the second core while the parent draws the others.  Forking is used only where it is
-    safe (POSIX, no other thread in the process, e.g. not inside a notebook kernel with threads); otherwise,
-    or if the child fails, the work runs in this process.  The outputs are the same either way.
-    """
-
-    def __init__(self, work):
-        import os
-        import threading
-        self.work, self.proc = work, None
-        if hasattr(os, "fork") and threading.active_count() == 1:
-            import multiprocessing
-            try:
-                self.proc = multiprocessing.get_context("fork").Process(target=work, daemon=True)
-                self.proc.start()
-            except (OSError, ValueError):
-                self.proc = None
-        if self.proc is None:
-            work()
-
-    def wait(self) -> None:
-        if self.proc is not None:
-            self.proc.join()
-            if self.proc.exitcode != 0:
-                logger.warning("drawing figures in a second process failed (exit %s); drawing them here",
-                               self.proc.exitcode)
-                self.work()
 
 
 def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:

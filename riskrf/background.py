@@ -1,0 +1,59 @@
+"""Work done beside the main computation, in a forked child process on the other core."""
+from __future__ import annotations
+
+
+class InBackground:
+    """Run ``work()`` (returning a picklable value) in a forked child on the other core; :meth:`result` returns it.
+
+    ``riskrf assess`` uses it for work a run needs only later: the site's rate model (the hazard's rate, the
+    closure options; fitted while the inventory fits and the simulation run) and each stage's figures and
+    tables (drawn while the next stages compute; their work only writes files and returns None).  Forking only
+    where it is safe (POSIX, no other thread, e.g. not inside a notebook kernel with threads); otherwise, or if
+    the child dies, ``work`` runs in this process at :meth:`result`.  An exception raised by ``work`` in the
+    child is raised again by :meth:`result`.  The value and the files are the same either way.
+    """
+
+    def __init__(self, work):
+        import os
+        import threading
+        self.work, self.proc, self.conn, self._done = work, None, None, None
+        if hasattr(os, "fork") and threading.active_count() == 1:
+            import multiprocessing
+            try:
+                ctx = multiprocessing.get_context("fork")
+                self.conn, child = ctx.Pipe(duplex=False)
+                self.proc = ctx.Process(target=_send_result, args=(work, child), daemon=True)
+                self.proc.start()
+                child.close()
+            except (OSError, ValueError):
+                self.proc = None
+
+    def result(self):
+        if self._done is not None:
+            return self._done[0]
+        value = None
+        if self.proc is not None:
+            try:
+                status, value = self.conn.recv()
+            except (EOFError, OSError):
+                status = "failed"
+            self.proc.join()
+            self.conn.close()
+            if status == "error":
+                raise value
+            if status != "ok":
+                value = self.work()
+        else:
+            value = self.work()
+        self._done = (value,)
+        return value
+
+
+def _send_result(work, conn):
+    try:
+        value = work()
+    except Exception as exc:          # noqa: BLE001  (sent back and raised in the parent)
+        conn.send(("error", exc))
+    else:
+        conn.send(("ok", value))
+    conn.close()
