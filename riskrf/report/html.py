@@ -396,8 +396,8 @@ def render_report(a, figs: Path) -> str:
                                                              "best_at_high", "changes_best"]],
                       "Inputs whose range changes the ranking"))
     voi = a.decision["value_of_information"]
-    doc.add(f"<p>Value of perfect information about the rate of falls (true rate half, as estimated or "
-            f"double the estimate, with probabilities 1/4, 1/2, 1/4; at central values, costs only"
+    doc.add("<p>Value of perfect information about the rate of falls (true rate half, as estimated or "
+            "double the estimate, with probabilities 1/4, 1/2, 1/4; at central values, costs only"
             + (f": the cheapest option is {_e(', '.join(f'{v} at {k}' for k, v in voi['best_by_rate'].items()))}"
                if voi.get("best_by_rate") else "") + "): "
             f"<b>{money_cur(voi['evpi'])}</b>; about all "
