@@ -366,7 +366,7 @@ class MitigationStudy:
             return cached
         samples = self._by_mass[1]
         if model is not self._models[0]:                    # the reference slope model keeps its own samples
-            ref_v, ref_h = effective_samples(self._reference_run, self.context.barrier_collector)
+            ref_v, ref_h = self._reference_barrier
             sv = float(np.median(v) / np.median(ref_v)) if len(v) and len(ref_v) else 1.0
             mapped = len(h) and len(ref_h)
             samples = {c: (sv * vc, _quantile_map(hc, ref_h, h) if mapped else hc) for c, (vc, hc) in samples.items()}
@@ -407,6 +407,11 @@ class MitigationStudy:
     def _reference_run(self):
         """The unmodified scenario with the re-simulation blocks and seed (the common random numbers)."""
         return self.context.run(self.context.scenario)
+
+    @cached_property
+    def _reference_barrier(self):
+        """(effective speeds [m/s], bounce heights [m]) at the barrier line of :attr:`_reference_run`."""
+        return effective_samples(self._reference_run, self.context.barrier_collector)
 
     @cached_property
     def _reference_road_blocks(self):

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from .tables import sniff_delimiter  # noqa: F401 (re-exported: public before)
+from .units import STANDARD_GRAVITY_MS2
 
 #: Accepted column names after normalisation (lower case, units and punctuation stripped).
 COLUMN_NAMES = {
@@ -46,29 +47,22 @@ PLAUSIBLE_MAX_MS = 50.0
 FREE_FALL_MARGIN = 0.10
 
 
-def _upper(dist) -> float:
-    """Largest value a scenario Distribution gives (or mean + 4 sd, median x e^4sigma when unbounded)."""
+def _practical_bounds(dist) -> tuple[float, float]:
+    """``Distribution.bounds()`` of a scenario distribution with an unbounded end replaced by 4 spreads from the
+    centre (mean +- 4 sd; median x e^(4 sigma) for a lognormal)."""
+    lo, hi = dist.bounds()
     p = dist.params
-    if dist.kind == "constant":
-        return float(p["value"])
-    if dist.kind in ("uniform", "triangular"):
-        return float(p["high"])
-    if dist.kind == "normal":
-        return float(p.get("max", p["mean"] + 4 * p["std"]))
-    return float(p.get("max", p["median"] * np.exp(4 * p["sigma"])))
+    if not np.isfinite(hi):
+        hi = p["mean"] + 4 * p["std"] if dist.kind == "normal" else p["median"] * np.exp(4 * p["sigma"])
+    if not np.isfinite(lo):
+        lo = p["mean"] - 4 * p["std"]
+    return float(lo), float(hi)
 
 
 def _largest_magnitude(dist) -> float:
-    """Largest |value| a scenario Distribution gives (its lower end mean - 4 sd when unbounded below): a release
-    velocity component may be negative (thrown downward, or towards -x)."""
-    p = dist.params
-    if dist.kind in ("uniform", "triangular"):
-        low = p["low"]
-    elif dist.kind == "normal":
-        low = p.get("min", p["mean"] - 4 * p["std"])
-    else:
-        low = 0.0 if dist.kind == "lognormal" else p["value"]
-    return max(abs(float(low)), abs(_upper(dist)))
+    """Largest |value| a scenario distribution gives: a release velocity component may be negative (thrown
+    downward, or towards -x)."""
+    return max(abs(v) for v in _practical_bounds(dist))
 
 
 def free_fall_drop_m(scenario, collector: str) -> tuple[float, float]:
@@ -85,7 +79,7 @@ def free_fall_drop_m(scenario, collector: str) -> tuple[float, float]:
     col = sc.collectors[sc.collector_index(collector)]
     prof, seed = sc.profile, sc.seeder
     xs = np.concatenate([[seed.x_low, seed.x_high], prof.x[(prof.x >= seed.x_low) & (prof.x <= seed.x_high)]])
-    z_release = float(np.max(np.interp(xs, prof.x, prof.z))) + _upper(seed.height_m)
+    z_release = float(np.max(np.interp(xs, prof.x, prof.z))) + _practical_bounds(seed.height_m)[1]
     z_line = float(np.interp(col.x, prof.x, prof.z))
     vx, vz = _largest_magnitude(seed.vx_ms), _largest_magnitude(seed.vz_ms)
     return max(z_release - z_line, 0.0), float(np.hypot(vx, vz))
@@ -97,7 +91,7 @@ def plausible_velocity_ms(drop_height_m=None, release_speed_ms: float = 0.0) -> 
     With a height drop H [m]: ``(1 + FREE_FALL_MARGIN) sqrt(v0^2 + 2 g H)``; without one:
     :data:`PLAUSIBLE_MAX_MS` (50 m/s, a free fall of about 127 m), an assumption.
     """
-    from .units import STANDARD_GRAVITY_MS2 as g
+    g = STANDARD_GRAVITY_MS2
     if drop_height_m is None:
         return PLAUSIBLE_MAX_MS, (f"{PLAUSIBLE_MAX_MS:g} m/s, the speed of a free fall of "
                                   f"{PLAUSIBLE_MAX_MS ** 2 / (2 * g):.0f} m (ASSUMPTION: no drop height given; "
@@ -195,8 +189,9 @@ def read_velocities(path, *, collector: str | None = None, velocity_unit: str | 
     med = float(np.median(out["velocity_ms"]))
     if velocity_unit is None and med > PLAUSIBLE_MEDIAN_MS:
         raise ValueError(f"{path}: column {found['velocity_ms']!r}: median {med:.3g} m/s is more than a free fall of "
-                         f"{med ** 2 / (2 * 9.81):.0f} m gives and looks like km/h entered as m/s (rock fall "
-                         "velocities are mostly 5-35 m/s).  Declare the unit: velocity_unit='km/h' or, if the values "
+                         f"{med ** 2 / (2 * STANDARD_GRAVITY_MS2):.0f} m gives and looks like km/h entered as m/s "
+                         "(rock fall velocities are mostly 5-35 m/s).  Declare the unit: velocity_unit='km/h' or, "
+                         "if the values "
                          "are right, 'm/s' (CLI --velocity-unit)")
     limit, how = plausible_velocity_ms(drop_height_m, release_speed_ms)
     v = out["velocity_ms"].to_numpy()
