@@ -177,11 +177,19 @@ class MassCoupledSamples:
 
     @staticmethod
     def _joint(e, groups) -> np.ndarray:
-        out = np.zeros(e.size)
+        flat = e.ravel()
+        out = np.zeros(flat.size)
         for m, w, n_c, speeds, cum in groups:
-            vstar = np.sqrt(2.0 * J_PER_KJ * e.ravel()[:, None] / m[None, :])
-            above = cum[-1] - cum[np.searchsorted(speeds, vstar.ravel(), side="right")].reshape(vstar.shape)
-            out += (above / n_c) @ w
+            # below the class's smallest kinetic energy every arrival exceeds e, above its largest none does: only
+            # the energies between need the speed search (the bounds are widened by 1e-9 against rounding)
+            e_low = 0.5 * float(m.min()) * speeds[0] ** 2 / J_PER_KJ * (1.0 - 1e-9)
+            e_high = 0.5 * float(m.max()) * speeds[-1] ** 2 / J_PER_KJ * (1.0 + 1e-9)
+            out[flat < e_low] += cum[-1] / n_c * w.sum()
+            mid = np.flatnonzero((flat >= e_low) & (flat <= e_high))
+            if mid.size:
+                vstar = np.sqrt(2.0 * J_PER_KJ * flat[mid, None] / m[None, :])
+                above = cum[-1] - cum[np.searchsorted(speeds, vstar.ravel(), side="right")].reshape(vstar.shape)
+                out[mid] += (above / n_c) @ w
         return np.clip(out, 0.0, 1.0).reshape(e.shape)
 
     def joint_exceedance(self, energy_kj, mm) -> np.ndarray:

@@ -160,20 +160,25 @@ def share_with_at_least(vulnerabilities, occupants_k, occupants_p, max_n: int | 
     """P(N >= n) for n = 1 ... max_n deaths in one vehicle: K occupants ~ ``occupants_p`` over ``occupants_k``,
     each dying independently with probability v, N | K ~ Binomial(K, v).  Shape: vulnerabilities.shape + (max_n,).
 
-    Exact binomial sums (pmf C(k, i) v^i (1 - v)^(k - i)), vectorised over any array of vulnerabilities.
+    Exact binomial sums, vectorised over any array of vulnerabilities: the pmf of Binomial(k, v) is built up one
+    occupant at a time (pmf_k(i) = pmf_(k-1)(i) (1 - v) + pmf_(k-1)(i - 1) v), so no power is evaluated.
     """
-    from math import comb
     v = np.asarray(vulnerabilities, dtype=float)[..., None]
     k_all = np.asarray(occupants_k, dtype=int)
     p_all = np.asarray(occupants_p, dtype=float)
     max_n = int(k_all.max()) if max_n is None else int(max_n)
+    weight = dict(zip(k_all.tolist(), p_all.tolist()))
     out = np.zeros(v.shape[:-1] + (max_n,))
-    for k, pk in zip(k_all, p_all):
-        i = np.arange(k + 1)
-        pmf = np.array([comb(int(k), int(j)) for j in i]) * v ** i * (1.0 - v) ** (k - i)
-        tail = np.cumsum(pmf[..., ::-1], axis=-1)[..., ::-1]          # tail[..., n] = P(N >= n)
-        m = min(max_n, int(k))
-        out[..., :m] += pk * tail[..., 1:m + 1]
+    pmf = np.ones(v.shape)                                            # Binomial(0, v): N = 0
+    for k in range(1, int(k_all.max()) + 1):
+        nxt = np.zeros(v.shape[:-1] + (k + 1,))
+        nxt[..., :k] = pmf * (1.0 - v)
+        nxt[..., 1:] += pmf * v
+        pmf = nxt
+        if weight.get(k, 0.0):
+            tail = np.cumsum(pmf[..., ::-1], axis=-1)[..., ::-1]      # tail[..., n] = P(N >= n)
+            m = min(max_n, k)
+            out[..., :m] += weight[k] * tail[..., 1:m + 1]
     return out
 
 

@@ -329,5 +329,28 @@ def test_bootstrap_replicate_as_multiplicities_equals_the_resampled_blocks():
             got = samples.resampled_joint_exceedance(a, e, mm)
             idx = np.concatenate([b.choice(np.flatnonzero(k == c), size=int(np.sum(k == c))) for c in range(5)])
             expected = MassCoupledSamples(m[idx], s[idx], h[idx], edges).joint_exceedance(e, mm)
-            np.testing.assert_array_equal(got, expected)
+            np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-15)   # summation order only
         assert a.random() == b.random()                               # the same draws consumed
+
+
+def test_joint_exceedance_equals_direct_count_including_class_energy_bounds():
+    """joint_exceedance skips the speed search outside each class's kinetic-energy range; it must equal the direct
+    count sum_j w_j #(speeds > sqrt(2 e / m_j)) / n_c at every energy, including energies exactly at a class's
+    smallest and largest kinetic energy (where the skipped ranges begin)."""
+    g = np.random.default_rng(7)
+    n = 600
+    m = np.exp(g.uniform(np.log(10.0), np.log(1e5), n))
+    edges = np.geomspace(10.0, 1e5, 5)
+    s = g.gamma(4.0, 3.0, n)
+    s[g.uniform(size=n) < 0.4] = np.nan
+    samples = MassCoupledSamples(m, s, np.where(np.isfinite(s), 1.0, np.nan), edges)
+    mm = mass_model(stats.lognorm(1.2, scale=500.0))
+    groups = samples._groups(mm)[0]
+    bounds = [0.5 * f(mq) * sp[i] ** 2 / 1000.0 for mq, _, _, sp, _ in groups for f, i in ((np.min, 0), (np.max, -1))]
+    e = np.sort(np.concatenate([np.geomspace(1e-4, 1e6, 400), bounds, np.nextafter(bounds, 0),
+                                np.nextafter(bounds, np.inf)]))
+    direct = np.zeros(e.size)
+    for mq, w, n_c, speeds, _ in groups:
+        vstar = np.sqrt(2000.0 * e[:, None] / mq[None, :])
+        direct += (np.sum(speeds[None, None, :] > vstar[:, :, None], axis=2) / n_c) @ w
+    np.testing.assert_allclose(samples.joint_exceedance(e, mm), np.clip(direct, 0, 1), rtol=1e-12, atol=1e-15)
