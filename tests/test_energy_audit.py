@@ -72,7 +72,8 @@ def test_shallow_wyllie_impacts_of_a_rolling_block_dissipate(angle_deg):
 
 
 def test_a_flat_floor_stops_every_block():
-    """With the package defaults a block thrown along a 2 km floor no longer crosses it."""
+    """A block thrown along a 2 km floor of hard ground (Wyllie's e_N, the Stronge law with friction 30 deg,
+    rolling resistance 20 deg, as the bedrock preset but 2 deg less) no longer crosses it."""
     sc = scenario([0, 2000], [0, 0], material={"normal_restitution": {"law": "wyllie"},
                                                "tangential": {"law": "friction", "friction_angle_deg": 30},
                                                "ground_motion": "roll", "ground_friction_angle_deg": 20},
