@@ -108,7 +108,7 @@ def test_observed_values_are_checked():
         simulation.calibrate(synthetic(), [40.0, 300.0] + [50.0] * 10, {FRICTION: (10, 40)}, n=20)
     with pytest.raises(ValueError, match=r"row 2 holds nan"):
         simulation.calibrate(synthetic(), [40.0, 41.0, np.nan] + [50.0] * 10, {FRICTION: (10, 40)}, n=20)
-    with pytest.raises(ValueError, match=r"observed DataFrame needs an 'x_stop_m' column"):
+    with pytest.raises(ValueError, match=r"observed DataFrame: needs an 'x_stop_m' column"):
         simulation.calibrate(synthetic(), pd.DataFrame({"x": [1.0]}), {FRICTION: (10, 40)}, n=20)
 
 
@@ -117,6 +117,30 @@ def test_fewer_than_ten_observed_stops_warn_that_calibration_is_weak():
                                                 r"than 10 the calibration is weak"):
         simulation.calibrate(synthetic(), [45.0, 47, 48, 50, 52, 55], {FRICTION: (10, 40)}, n=30, maxiter=1,
                              popsize=3, n_bootstrap=5)
+
+
+def test_cli_few_stops_warning_names_the_observed_file(tmp_path, capsys):
+    """The command line reads the file itself and passes a DataFrame: the warning still names the file."""
+    scen = tmp_path / "syn.toml"
+    scen.write_text(dump_toml(synthetic()))
+    obs = tmp_path / "five_stops.csv"
+    obs.write_text("x_stop_m\n45.0\n47.5\n48.0\n51.0\n55.0\n")
+    rc = main(["calibrate", str(scen), str(obs), "--parameter", f"{FRICTION}=10:40", "-n", "30", "--maxiter", "1",
+               "--bootstrap", "5", "--out", str(tmp_path / "cal")])
+    assert rc == 0
+    text = capsys.readouterr().out
+    warning = next(line for line in text.splitlines() if "only 5 observed stops" in line)
+    assert str(obs) in warning and "observed DataFrame" not in warning
+
+
+def test_unknown_table_path_names_the_scenario_file(tmp_path):
+    scen = tmp_path / "my_slope.toml"
+    scen.write_text(dump_toml(synthetic()))
+    with pytest.raises(ValueError, match=rf"{scen}: parameter 'materials.flor.roughness_m': no table "
+                                         r"'materials.flor' in the scenario; did you mean 'floor'"):
+        simulation.calibrate(scen, np.linspace(40, 60, 20), {"materials.flor.roughness_m": (0.1, 0.5)}, n=20)
+    with pytest.raises(ValueError, match=rf"{scen}: parameter 'material.floor.roughness_m': no table 'material'"):
+        set_parameter(synthetic(), "material.floor.roughness_m", 0.2, source=str(scen))
 
 
 # ---- the fit -----------------------------------------------------------------------------------------------
