@@ -33,8 +33,20 @@ def synthetic():
                        "mass_kg": {"dist": "lognormal", "median": 500, "sigma": 0.5, "max": 5000}}}
 
 
-def observed_from(values: dict, n: int, seed: int) -> np.ndarray:
-    sc = simulation.scenario_from_dict(apply_parameters(synthetic(), values))
+def synthetic_cliff():
+    """The same materials below a 65 degree face (21 m high over 10 m) instead of the 35 degree slope: blocks
+    reach the floor in flight and bounce on it, so the floor's normal restitution sets the upper tail of the
+    runout (p90 36 -> 51 m for e_N 0.2 -> 0.6 at friction 24 deg) while its friction angle sets the median
+    (p50 27 -> 22 m for 20 -> 28 deg at e_N 0.45; n = 2,000, seed 1): both are identified by the runout.  On the
+    35 degree slope blocks arrive rolling and e_N moves no quantile by more than 0.3 m."""
+    d = synthetic()
+    d["profile"] = {"x": [0.0, 10.0, 250.0], "z": [21.0, 0.0, 0.0], "materials": ["slope", "floor"]}
+    d["seeder"]["x"] = [0.5, 3.0]
+    return d
+
+
+def observed_from(values: dict, n: int, seed: int, base=synthetic) -> np.ndarray:
+    sc = simulation.scenario_from_dict(apply_parameters(base(), values))
     return simulation.run(sc, n=n, seed=seed, record_paths=0).per_block["x"]
 
 
@@ -147,27 +159,35 @@ def test_unknown_table_path_names_the_scenario_file(tmp_path):
 @pytest.fixture(scope="module")
 def recovered():
     truth = {FRICTION: 24.0, RESTITUTION: 0.45}
-    obs = observed_from(truth, n=60, seed=2024)            # "field" observations: another seed than the fit's
+    obs = observed_from(truth, n=200, seed=2024, base=synthetic_cliff)     # "field" observations: another seed
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CalibrationWarning)
-        cal = simulation.calibrate(synthetic(), obs, {FRICTION: (10, 40), RESTITUTION: (0.1, 0.7)}, n=400, seed=1,
-                                   maxiter=12, n_bootstrap=100)
+        cal = simulation.calibrate(synthetic_cliff(), obs, {FRICTION: (10, 40), RESTITUTION: (0.1, 0.7)}, n=500,
+                                   seed=1, maxiter=12, n_bootstrap=100)
     return truth, obs, cal
 
 
-def test_recovers_known_friction_from_synthetic_observations(recovered):
-    """Robustness (new physics, 10 sets of 60 synthetic observations, seeds 2024 and 1-9): fitted friction
-    23.2-25.4 deg (truth 24), Wasserstein after / before 0.08-0.29, KS p-value after 0.59-0.99, the truth inside
-    the 95 % bootstrap interval in 9 of 10 (as a 95 % interval should be).  An earlier version released every block
-    from one point: the runouts then had a standard deviation of 0.36 m, and a KS test against such a narrow
-    distribution rejected fits off by centimetres (p 0.03 once); the line release gives a field-like spread."""
+def test_recovers_both_known_parameters_from_synthetic_observations(recovered):
+    """Both fitted parameters are checked: the floor's friction angle within 2 deg and its normal restitution
+    within 0.05 of the truth (24 deg, 0.45), each truth inside its 95 % bootstrap interval.
+
+    Robustness (8 sets of 200 synthetic observations, seeds 2024 and 1-7, fit n = 500, seed 1): fitted friction
+    23.1-25.6 deg, e_N 0.407-0.458; the truth inside the 95 % interval in 7 of 8 sets for each parameter (the
+    bootstrap holds the Monte Carlo noise of the fit fixed, so the intervals are somewhat narrow); Wasserstein
+    after / before 0.27-0.56, KS p-value after 0.47-1.0.  With 60 observations e_N was only weakly identified
+    (fitted 0.19-0.52 over 9 sets): the sample size, not only the setup, decides what a runout identifies.
+    An earlier version of this test fitted e_N on the 35 degree slope where it hardly moves the runout (fitted
+    0.39, interval 0.19-0.45 excluding the truth) and asserted the friction only."""
     truth, obs, cal = recovered
-    assert obs.std() > 2.0                                   # a spread like a field record, not a point
+    assert obs.std() > 5.0                                   # a spread like a field record, not a point
     s = cal.summary()
     assert cal.parameters[FRICTION] == pytest.approx(truth[FRICTION], abs=2.0)
-    assert s.loc[FRICTION, "ci95_low"] <= truth[FRICTION] <= s.loc[FRICTION, "ci95_high"]
+    assert cal.parameters[RESTITUTION] == pytest.approx(truth[RESTITUTION], abs=0.05)
+    for k in (FRICTION, RESTITUTION):
+        assert s.loc[k, "ci95_low"] <= truth[k] <= s.loc[k, "ci95_high"], s
+        assert s.loc[k, "ci95_high"] - s.loc[k, "ci95_low"] < 0.4 * (s.loc[k, "bound_high"] - s.loc[k, "bound_low"])
     comp = cal.comparison()
-    assert comp.loc["wasserstein [m]", "after"] < 0.3 * comp.loc["wasserstein [m]", "before"]
+    assert comp.loc["wasserstein [m]", "after"] < 0.6 * comp.loc["wasserstein [m]", "before"]
     assert comp.loc["KS p-value", "after"] > 0.05
     assert cal.distance <= cal.distance_initial
     # the calibrated scenario carries the fitted values
@@ -180,7 +200,7 @@ def test_same_seed_same_calibration(recovered):
     truth, obs, cal = recovered
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CalibrationWarning)
-        again = simulation.calibrate(synthetic(), obs, {FRICTION: (10, 40), RESTITUTION: (0.1, 0.7)}, n=400,
+        again = simulation.calibrate(synthetic_cliff(), obs, {FRICTION: (10, 40), RESTITUTION: (0.1, 0.7)}, n=500,
                                      seed=1, maxiter=12, n_bootstrap=100)
     assert again.parameters == cal.parameters
     pd.testing.assert_frame_equal(again.bootstrap, cal.bootstrap)
