@@ -56,11 +56,11 @@ def main():
         df = pd.read_csv(ROOT / "tests" / "data" / "authume" / "observed_runout.csv")
         cases.append(("41 real P1 stops", df.loc[df.profile == "P1", "x_stop_m"].to_numpy()))
     for label, x in cases:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             cal = simulation.calibrate(P1, x, PARAMS, seed=1)
-        dt = time.perf_counter() - t0
+        dt, cpu = time.perf_counter() - t0, time.process_time() - c0
         print(f"{label}: {dt:.1f} s, {len(cal.evaluations)} evaluations of 1,000 blocks "
               f"({dt / len(cal.evaluations) * 1000:.0f} ms each); fitted "
               + ", ".join(f"{k.split('.')[-2]}.{k.split('.')[-1]} = {v:.3g}" for k, v in cal.parameters.items())
@@ -71,8 +71,8 @@ def main():
                                                        for k in PARAMS))
         ok = dt < TARGET_S
         failed |= not ok
-        print(f"  wall time {dt:.1f} s (must be < {TARGET_S:.0f} s): {'PASS' if ok else 'FAIL'}; "
-              f"load average now {os.getloadavg()[0]:.1f}")
+        print(f"  wall time {dt:.1f} s (must be < {TARGET_S:.0f} s): {'PASS' if ok else 'FAIL'}; CPU time {cpu:.1f} s "
+              f"(what a quiet machine would take, about); load average now {os.getloadavg()[0]:.1f}")
     return 1 if failed else 0
 
 
