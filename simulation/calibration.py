@@ -541,7 +541,8 @@ def calibrate(scenario, observed, parameters: dict, *, n: int = 1000, seed=1, di
     def evaluate(theta) -> float:
         key = tuple(np.round(theta, 12))
         if key not in cache:
-            sim = _simulate(apply_parameters(data, dict(zip(names, theta))), source, int(n), seed, collector)
+            trial = apply_parameters(data, dict(zip(names, theta)), source=source)
+            sim = _simulate(trial, source, int(n), seed, collector)
             cache[key] = (sim, _objective(sim, obs, scales, dist))
         return cache[key][1]
 
@@ -571,7 +572,7 @@ def calibrate(scenario, observed, parameters: dict, *, n: int = 1000, seed=1, di
     bootstrap = pd.DataFrame(np.array(boot_rows).reshape(-1, len(names)), columns=names)
 
     fitted = {k: float(v) for k, v in zip(names, best)}
-    fitted_data = apply_parameters(data, fitted)
+    fitted_data = apply_parameters(data, fitted, source=source)
     notes = []
     for k, v in fitted.items():
         b_lo, b_hi = bounds[k]
