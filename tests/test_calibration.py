@@ -197,13 +197,17 @@ def test_recovers_both_known_parameters_from_synthetic_observations(recovered):
 
 
 def test_same_seed_same_calibration(recovered):
-    truth, obs, cal = recovered
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", CalibrationWarning)
-        again = simulation.calibrate(synthetic_cliff(), obs, {FRICTION: (10, 40), RESTITUTION: (0.1, 0.7)}, n=500,
-                                     seed=1, maxiter=12, n_bootstrap=100)
-    assert again.parameters == cal.parameters
-    pd.testing.assert_frame_equal(again.bootstrap, cal.bootstrap)
+    """A small budget is enough to check determinism (the recovery fixture's full fit is not repeated)."""
+    obs = recovered[1]
+    runs = []
+    for _ in range(2):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", CalibrationWarning)
+            runs.append(simulation.calibrate(synthetic_cliff(), obs, {FRICTION: (10, 40), RESTITUTION: (0.1, 0.7)},
+                                             n=150, seed=3, maxiter=3, popsize=4, n_bootstrap=30))
+    assert runs[0].parameters == runs[1].parameters
+    pd.testing.assert_frame_equal(runs[0].bootstrap, runs[1].bootstrap)
+    pd.testing.assert_frame_equal(runs[0].evaluations, runs[1].evaluations)
 
 
 def test_calibrate_accepts_a_loaded_scenario_and_dataframe(tmp_path):
