@@ -98,29 +98,32 @@ def _did_you_mean(key, options) -> str:
     return f"; did you mean {close[0]!r}?" if close else f"; available: {', '.join(map(str, options))}"
 
 
-def set_parameter(data: dict, name: str, value: float) -> None:
+def set_parameter(data: dict, name: str, value: float, *, source: str | None = None) -> None:
     """Set the value at dotted path ``name`` in a scenario dictionary (in place).
 
     Tables along the path must exist up to the material (``materials.NAME``);
     a missing last field (a default) or a missing law table (e.g.
     ``normal_restitution.mean`` where the file gives ``normal_restitution =
     0.35``) is created.  ``collectors.NAME.FIELD`` addresses a collector by name.
+    ``source``: the scenario file (or other origin) named in error messages.
     """
+    where = f"{source}: " if source else ""
     parts = name.split(".")
     if len(parts) < 2 or any(not p for p in parts):
-        raise ValueError(f"parameter {name!r}: use a dotted path such as 'materials.talus.ground_friction_angle_deg'")
+        raise ValueError(f"{where}parameter {name!r}: use a dotted path such as "
+                         "'materials.talus.ground_friction_angle_deg'")
     node = data
     for depth, key in enumerate(parts[:-1]):
         if isinstance(node, list):          # [[collectors]]: address by name
             named = {str(item.get("name")): item for item in node if isinstance(item, dict)}
             if key not in named:
-                raise ValueError(f"parameter {name!r}: no entry named {key!r} in "
+                raise ValueError(f"{where}parameter {name!r}: no entry named {key!r} in "
                                  f"{'.'.join(parts[:depth])}{_did_you_mean(key, list(named))}")
             node = named[key]
             continue
         if key not in node:
             if depth < 2:
-                raise ValueError(f"parameter {name!r}: no table {'.'.join(parts[:depth + 1])!r} in the "
+                raise ValueError(f"{where}parameter {name!r}: no table {'.'.join(parts[:depth + 1])!r} in the "
                                  f"scenario{_did_you_mean(key, list(node))}")
             node[key] = {}
         elif not isinstance(node[key], (dict, list)):
@@ -130,18 +133,20 @@ def set_parameter(data: dict, name: str, value: float) -> None:
             elif isinstance(current, (int, float)) and not isinstance(current, bool):
                 node[key] = {"law": "constant", "mean": current}   # a constant coefficient
             else:
-                raise ValueError(f"parameter {name!r}: {'.'.join(parts[:depth + 1])} is {current!r}, not a table")
+                raise ValueError(f"{where}parameter {name!r}: {'.'.join(parts[:depth + 1])} is {current!r}, "
+                                 "not a table")
         node = node[key]
     if not isinstance(node, dict):
-        raise ValueError(f"parameter {name!r}: {'.'.join(parts[:-1])} is not a table")
+        raise ValueError(f"{where}parameter {name!r}: {'.'.join(parts[:-1])} is not a table")
     node[parts[-1]] = float(value)
 
 
-def apply_parameters(data: dict, values: dict) -> dict:
-    """A deep copy of the scenario dictionary with each dotted path set to its value."""
+def apply_parameters(data: dict, values: dict, *, source: str | None = None) -> dict:
+    """A deep copy of the scenario dictionary with each dotted path set to its value (``source`` names the
+    scenario in errors)."""
     out = copy.deepcopy(data)
     for k, v in values.items():
-        set_parameter(out, k, v)
+        set_parameter(out, k, v, source=source)
     return out
 
 
@@ -167,7 +172,7 @@ def _check_parameters(data: dict, parameters, source: str) -> dict:
     for name, (lo, hi) in bounds.items():
         for v in (lo, hi):
             trial = copy.deepcopy(data)
-            set_parameter(trial, name, v)
+            set_parameter(trial, name, v, source=source)
             try:
                 scenario_from_dict(trial, source=source)
             except ScenarioError as exc:
@@ -234,9 +239,11 @@ def _observed_frame(observed) -> tuple[pd.DataFrame, str]:
         df = read_observed(observed)
         return df, df.attrs["source"]
     if isinstance(observed, pd.DataFrame):
+        # a table from read_observed (as the command line passes it) names its file in attrs["source"]
+        source = observed.attrs.get("source") or "observed DataFrame"
         if "x_stop_m" not in observed.columns:
-            raise ValueError(f"observed DataFrame needs an 'x_stop_m' column [m]; columns are {list(observed.columns)}")
-        return observed, "observed DataFrame (column 'x_stop_m')"
+            raise ValueError(f"{source}: needs an 'x_stop_m' column [m]; columns are {list(observed.columns)}")
+        return observed, str(source)
     if isinstance(observed, pd.Series):
         return pd.DataFrame({"x_stop_m": observed.to_numpy()}), "observed Series"
     try:
@@ -534,7 +541,8 @@ def calibrate(scenario, observed, parameters: dict, *, n: int = 1000, seed=1, di
     def evaluate(theta) -> float:
         key = tuple(np.round(theta, 12))
         if key not in cache:
-            sim = _simulate(apply_parameters(data, dict(zip(names, theta))), source, int(n), seed, collector)
+            trial = apply_parameters(data, dict(zip(names, theta)), source=source)
+            sim = _simulate(trial, source, int(n), seed, collector)
             cache[key] = (sim, _objective(sim, obs, scales, dist))
         return cache[key][1]
 
@@ -564,7 +572,7 @@ def calibrate(scenario, observed, parameters: dict, *, n: int = 1000, seed=1, di
     bootstrap = pd.DataFrame(np.array(boot_rows).reshape(-1, len(names)), columns=names)
 
     fitted = {k: float(v) for k, v in zip(names, best)}
-    fitted_data = apply_parameters(data, fitted)
+    fitted_data = apply_parameters(data, fitted, source=source)
     notes = []
     for k, v in fitted.items():
         b_lo, b_hi = bounds[k]

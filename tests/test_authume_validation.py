@@ -38,11 +38,15 @@ def test_p1_calibrated_reproduces_the_observed_runout():
 
 
 def test_p2_calibrated_is_only_partly_reproduced():
-    """Stated in the README: the quantiles are found, yet KS still rejects at 5 %."""
+    """Stated in the README: calibration brings the quantiles to the observed ones (W1 34.4 m a priori, 2.9 m
+    calibrated), yet the two-sample KS test still rejects the calibrated runout at 5 % (p 0.04).  If a better fit
+    ever passes the KS test, the README's "only partly reproduced" is wrong and must be rewritten with this test."""
     sim, obs = runout("authume_p2_calibrated"), observed("P2")
+    w_calibrated = stats.wasserstein_distance(sim, obs)
+    w_prior = stats.wasserstein_distance(runout("authume_p2"), obs)
+    assert w_calibrated < 0.2 * w_prior                                   # 2.9 m against 34.4 m
     assert np.percentile(sim, [10, 50, 90]) == pytest.approx(np.percentile(obs, [10, 50, 90]), abs=2.0)
-    assert stats.wasserstein_distance(sim, obs) < 4.0                     # 2.9 m
-    assert 0.005 < stats.ks_2samp(sim, obs).pvalue < 0.05                 # 0.04: not reproduced in full
+    assert stats.ks_2samp(sim, obs).pvalue < 0.05                         # 0.04: not reproduced in full
 
 
 @pytest.mark.parametrize("name, profile", [("authume_p1", "P1"), ("authume_p2", "P2")])

@@ -33,8 +33,20 @@ def synthetic():
                        "mass_kg": {"dist": "lognormal", "median": 500, "sigma": 0.5, "max": 5000}}}
 
 
-def observed_from(values: dict, n: int, seed: int) -> np.ndarray:
-    sc = simulation.scenario_from_dict(apply_parameters(synthetic(), values))
+def synthetic_cliff():
+    """The same materials below a 65 degree face (21 m high over 10 m) instead of the 35 degree slope: blocks
+    reach the floor in flight and bounce on it, so the floor's normal restitution sets the upper tail of the
+    runout (p90 36 -> 51 m for e_N 0.2 -> 0.6 at friction 24 deg) while its friction angle sets the median
+    (p50 27 -> 22 m for 20 -> 28 deg at e_N 0.45; n = 2,000, seed 1): both are identified by the runout.  On the
+    35 degree slope blocks arrive rolling and e_N moves no quantile by more than 0.3 m."""
+    d = synthetic()
+    d["profile"] = {"x": [0.0, 10.0, 250.0], "z": [21.0, 0.0, 0.0], "materials": ["slope", "floor"]}
+    d["seeder"]["x"] = [0.5, 3.0]
+    return d
+
+
+def observed_from(values: dict, n: int, seed: int, base=synthetic) -> np.ndarray:
+    sc = simulation.scenario_from_dict(apply_parameters(base(), values))
     return simulation.run(sc, n=n, seed=seed, record_paths=0).per_block["x"]
 
 
@@ -108,7 +120,7 @@ def test_observed_values_are_checked():
         simulation.calibrate(synthetic(), [40.0, 300.0] + [50.0] * 10, {FRICTION: (10, 40)}, n=20)
     with pytest.raises(ValueError, match=r"row 2 holds nan"):
         simulation.calibrate(synthetic(), [40.0, 41.0, np.nan] + [50.0] * 10, {FRICTION: (10, 40)}, n=20)
-    with pytest.raises(ValueError, match=r"observed DataFrame needs an 'x_stop_m' column"):
+    with pytest.raises(ValueError, match=r"observed DataFrame: needs an 'x_stop_m' column"):
         simulation.calibrate(synthetic(), pd.DataFrame({"x": [1.0]}), {FRICTION: (10, 40)}, n=20)
 
 
@@ -119,31 +131,63 @@ def test_fewer_than_ten_observed_stops_warn_that_calibration_is_weak():
                              popsize=3, n_bootstrap=5)
 
 
+def test_cli_few_stops_warning_names_the_observed_file(tmp_path, capsys):
+    """The command line reads the file itself and passes a DataFrame: the warning still names the file."""
+    scen = tmp_path / "syn.toml"
+    scen.write_text(dump_toml(synthetic()))
+    obs = tmp_path / "five_stops.csv"
+    obs.write_text("x_stop_m\n45.0\n47.5\n48.0\n51.0\n55.0\n")
+    rc = main(["calibrate", str(scen), str(obs), "--parameter", f"{FRICTION}=10:40", "-n", "30", "--maxiter", "1",
+               "--bootstrap", "5", "--out", str(tmp_path / "cal")])
+    assert rc == 0
+    text = capsys.readouterr().out
+    warning = next(line for line in text.splitlines() if "only 5 observed stops" in line)
+    assert str(obs) in warning and "observed DataFrame" not in warning
+
+
+def test_unknown_table_path_names_the_scenario_file(tmp_path):
+    scen = tmp_path / "my_slope.toml"
+    scen.write_text(dump_toml(synthetic()))
+    with pytest.raises(ValueError, match=rf"{scen}: parameter 'materials.flor.roughness_m': no table "
+                                         r"'materials.flor' in the scenario; did you mean 'floor'"):
+        simulation.calibrate(scen, np.linspace(40, 60, 20), {"materials.flor.roughness_m": (0.1, 0.5)}, n=20)
+    with pytest.raises(ValueError, match=rf"{scen}: parameter 'material.floor.roughness_m': no table 'material'"):
+        set_parameter(synthetic(), "material.floor.roughness_m", 0.2, source=str(scen))
+
+
 # ---- the fit -----------------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def recovered():
     truth = {FRICTION: 24.0, RESTITUTION: 0.45}
-    obs = observed_from(truth, n=60, seed=2024)            # "field" observations: another seed than the fit's
+    obs = observed_from(truth, n=200, seed=2024, base=synthetic_cliff)     # "field" observations: another seed
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CalibrationWarning)
-        cal = simulation.calibrate(synthetic(), obs, {FRICTION: (10, 40), RESTITUTION: (0.1, 0.7)}, n=400, seed=1,
-                                   maxiter=12, n_bootstrap=100)
+        cal = simulation.calibrate(synthetic_cliff(), obs, {FRICTION: (10, 40), RESTITUTION: (0.1, 0.7)}, n=500,
+                                   seed=1, maxiter=12, n_bootstrap=100)
     return truth, obs, cal
 
 
-def test_recovers_known_friction_from_synthetic_observations(recovered):
-    """Robustness (new physics, 10 sets of 60 synthetic observations, seeds 2024 and 1-9): fitted friction
-    23.2-25.4 deg (truth 24), Wasserstein after / before 0.08-0.29, KS p-value after 0.59-0.99, the truth inside
-    the 95 % bootstrap interval in 9 of 10 (as a 95 % interval should be).  An earlier version released every block
-    from one point: the runouts then had a standard deviation of 0.36 m, and a KS test against such a narrow
-    distribution rejected fits off by centimetres (p 0.03 once); the line release gives a field-like spread."""
+def test_recovers_both_known_parameters_from_synthetic_observations(recovered):
+    """Both fitted parameters are checked: the floor's friction angle within 2 deg and its normal restitution
+    within 0.05 of the truth (24 deg, 0.45), each truth inside its 95 % bootstrap interval.
+
+    Robustness (8 sets of 200 synthetic observations, seeds 2024 and 1-7, fit n = 500, seed 1): fitted friction
+    23.1-25.6 deg, e_N 0.407-0.458; the truth inside the 95 % interval in 7 of 8 sets for each parameter (the
+    bootstrap holds the Monte Carlo noise of the fit fixed, so the intervals are somewhat narrow); Wasserstein
+    after / before 0.27-0.56, KS p-value after 0.47-1.0.  With 60 observations e_N was only weakly identified
+    (fitted 0.19-0.52 over 9 sets): the sample size, not only the setup, decides what a runout identifies.
+    An earlier version of this test fitted e_N on the 35 degree slope where it hardly moves the runout (fitted
+    0.39, interval 0.19-0.45 excluding the truth) and asserted the friction only."""
     truth, obs, cal = recovered
-    assert obs.std() > 2.0                                   # a spread like a field record, not a point
+    assert obs.std() > 5.0                                   # a spread like a field record, not a point
     s = cal.summary()
     assert cal.parameters[FRICTION] == pytest.approx(truth[FRICTION], abs=2.0)
-    assert s.loc[FRICTION, "ci95_low"] <= truth[FRICTION] <= s.loc[FRICTION, "ci95_high"]
+    assert cal.parameters[RESTITUTION] == pytest.approx(truth[RESTITUTION], abs=0.05)
+    for k in (FRICTION, RESTITUTION):
+        assert s.loc[k, "ci95_low"] <= truth[k] <= s.loc[k, "ci95_high"], s
+        assert s.loc[k, "ci95_high"] - s.loc[k, "ci95_low"] < 0.4 * (s.loc[k, "bound_high"] - s.loc[k, "bound_low"])
     comp = cal.comparison()
-    assert comp.loc["wasserstein [m]", "after"] < 0.3 * comp.loc["wasserstein [m]", "before"]
+    assert comp.loc["wasserstein [m]", "after"] < 0.6 * comp.loc["wasserstein [m]", "before"]
     assert comp.loc["KS p-value", "after"] > 0.05
     assert cal.distance <= cal.distance_initial
     # the calibrated scenario carries the fitted values
@@ -153,13 +197,17 @@ def test_recovers_known_friction_from_synthetic_observations(recovered):
 
 
 def test_same_seed_same_calibration(recovered):
-    truth, obs, cal = recovered
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", CalibrationWarning)
-        again = simulation.calibrate(synthetic(), obs, {FRICTION: (10, 40), RESTITUTION: (0.1, 0.7)}, n=400,
-                                     seed=1, maxiter=12, n_bootstrap=100)
-    assert again.parameters == cal.parameters
-    pd.testing.assert_frame_equal(again.bootstrap, cal.bootstrap)
+    """A small budget is enough to check determinism (the recovery fixture's full fit is not repeated)."""
+    obs = recovered[1]
+    runs = []
+    for _ in range(2):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", CalibrationWarning)
+            runs.append(simulation.calibrate(synthetic_cliff(), obs, {FRICTION: (10, 40), RESTITUTION: (0.1, 0.7)},
+                                             n=150, seed=3, maxiter=3, popsize=4, n_bootstrap=30))
+    assert runs[0].parameters == runs[1].parameters
+    pd.testing.assert_frame_equal(runs[0].bootstrap, runs[1].bootstrap)
+    pd.testing.assert_frame_equal(runs[0].evaluations, runs[1].evaluations)
 
 
 def test_calibrate_accepts_a_loaded_scenario_and_dataframe(tmp_path):

@@ -72,7 +72,8 @@ def test_shallow_wyllie_impacts_of_a_rolling_block_dissipate(angle_deg):
 
 
 def test_a_flat_floor_stops_every_block():
-    """With the package defaults a block thrown along a 2 km floor no longer crosses it."""
+    """A block thrown along a 2 km floor of hard ground (Wyllie's e_N, the Stronge law with friction 30 deg,
+    rolling resistance 20 deg, as the bedrock preset but 2 deg less) no longer crosses it."""
     sc = scenario([0, 2000], [0, 0], material={"normal_restitution": {"law": "wyllie"},
                                                "tangential": {"law": "friction", "friction_angle_deg": 30},
                                                "ground_motion": "roll", "ground_friction_angle_deg": 20},
@@ -193,8 +194,8 @@ profiles = st.lists(st.floats(-60.0, 15.0), min_size=1, max_size=8).map(
 @given(z=profiles, en=st.floats(0.05, 0.95), et=st.floats(0.3, 1.0), phi=st.floats(5.0, 45.0),
        law=st.sampled_from(["constant", "wyllie", "velocity"]), tangential=st.sampled_from(["constant", "friction"]),
        motion=st.sampled_from(["roll", "slide"]), rough=st.floats(0.0, 0.3), seed=st.integers(0, 1000),
-       barrier=st.booleans())
-def test_energy_never_increases_between_events(z, en, et, phi, law, tangential, motion, rough, seed, barrier):
+       barrier=st.booleans(), shape=st.sampled_from(["sphere", "cylinder"]))
+def test_energy_never_increases_between_events(z, en, et, phi, law, tangential, motion, rough, seed, barrier, shape):
     x = np.arange(z.size) * 10.0
     z = z - z.min() + 1.0
     nr = {"law": law} if law == "wyllie" else {"law": law, "mean": en, "std": 0.1}
@@ -205,13 +206,50 @@ def test_energy_never_increases_between_events(z, en, et, phi, law, tangential, 
                                               "ground_motion": motion, "ground_friction_angle_deg": phi},
                   seeder={"x": 0.5, "height_m": {"dist": "uniform", "low": 0.0, "high": 5.0},
                           "vx_ms": {"dist": "uniform", "low": -2.0, "high": 8.0}, "mass_kg": 500.0,
-                          "angular_velocity_rads": {"dist": "uniform", "low": -5.0, "high": 5.0}},
+                          "angular_velocity_rads": {"dist": "uniform", "low": -5.0, "high": 5.0},
+                          "shape": shape},
                   collectors=collectors)
     res = simulation.run(sc, n=6, seed=seed, record_paths=6)
+    assert (res.blocks["inertia_factor"] == (0.4 if shape == "sphere" else 0.5)).all()
     for b in range(6):
         e = res.events(b)["total_energy_kj"].to_numpy()
         scale = max(np.abs(e).max(), 1.0)
         assert np.all(np.diff(e) <= 1e-9 * scale), res.events(b).to_string()
+
+
+EVENT_COLUMNS = ["t_s", "x_m", "z_m", "vx_ms", "vz_ms", "angular_velocity_rads", "kinetic_energy_kj",
+                 "potential_energy_kj", "event"]
+
+
+def test_events_table_columns_order_and_collector_rows():
+    """Issue 9 "Build" 2: one recorded block's events in time order, from release to stop, with a collector
+    crossing row where the block passes the collector, and energies from the state (1/2 m v^2 + 1/2 I w^2, m g z)."""
+    sc = scenario([0, 20, 60], [12, 0, 0], material={"ground_motion": "roll", "ground_friction_angle_deg": 20.0},
+                  seeder={"x": 1.0, "height_m": 1.0, "vx_ms": 3.0}, collectors=[{"name": "toe", "x": 25.0}])
+    res = simulation.run(sc, n=3, seed=4, record_paths=3)
+    for b in range(3):
+        ev = res.events(b)
+        assert [c for c in ev.columns if c in EVENT_COLUMNS] == EVENT_COLUMNS       # all of them, in this order
+        assert ev["total_energy_kj"].to_numpy() == pytest.approx(
+            (ev["kinetic_energy_kj"] + ev["potential_energy_kj"]).to_numpy(), rel=1e-12)
+        assert ev["event"].iloc[0] == "release"
+        reason = res.runout["reason"].iloc[b]
+        assert reason == "stopped" and ev["event"].iloc[-1] == "stop"
+        assert ev["x_m"].iloc[-1] == pytest.approx(res.runout["x_stop_m"].iloc[b], abs=1e-9)
+        assert ev["t_s"].is_monotonic_increasing
+        crossing = ev.index[ev["event"] == "collector crossing: toe"]
+        assert len(crossing) >= 1
+        i = crossing[0]
+        assert ev.loc[i, "x_m"] == pytest.approx(25.0)
+        assert ev.loc[i - 1, "x_m"] < 25.0 < ev.loc[i + 1, "x_m"]      # between the events either side of x = 25 m
+        assert ev.loc[i - 1, "t_s"] <= ev.loc[i, "t_s"] <= ev.loc[i + 1, "t_s"]
+        mass, r = res.blocks["mass"][b], res.blocks["radius"][b]
+        row = ev.loc[i]
+        ke = 0.5 * mass * (row.vx_ms ** 2 + row.vz_ms ** 2) + 0.5 * 0.4 * mass * r ** 2 * row.angular_velocity_rads ** 2
+        assert row.kinetic_energy_kj == pytest.approx(ke / 1000.0, rel=1e-12)
+        assert row.potential_energy_kj == pytest.approx(mass * G * row.z_m / 1000.0, rel=1e-12)
+    with pytest.raises(KeyError, match="block 3 was not recorded"):
+        res.events(3)
 
 
 def test_take_off_flight_is_drawn_as_a_parabola():
