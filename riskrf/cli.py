@@ -243,7 +243,7 @@ def _energy_design_masses(args, inventory):
     survey_path, pct = getattr(args, "block_survey", None), getattr(args, "design_percentile", None)
     survey = read_block_survey(survey_path, inventory.density_kg_m3, **_survey_reader(args)) if survey_path else None
     if pct is not None or survey is not None:
-        out += design_block_candidates_kg(rule="percentile", percentile=pct or 97.0,
+        out += design_block_candidates_kg(rule="percentile", percentile=97.0 if pct is None else pct,
                                           survey_volumes_m3=survey, inventory=inventory,
                                           density_kg_m3=inventory.density_kg_m3)
     return out
@@ -268,7 +268,8 @@ def cmd_energy(args) -> int:
         survey = read_block_survey(args.block_survey, inv.density_kg_m3, **_survey_reader(args)) \
             if args.block_survey else None
         rule = "percentile" if (args.design_percentile is not None or survey is not None) else "fragmentation"
-        block = design_block(hazard, rule=rule, percentile=args.design_percentile or 97.0,
+        block = design_block(hazard, rule=rule,
+                             percentile=97.0 if args.design_percentile is None else args.design_percentile,
                              survey_volumes_m3=survey, survey_source=args.block_survey, inventory=inv,
                              sizes=args.inventory_sizes, design_T=args.design_period, density_kg_m3=inv.density_kg_m3,
                              fractal_dimension=args.fractal_dimension, iterations=args.fragmentation_iterations)
@@ -293,9 +294,10 @@ def cmd_energy(args) -> int:
           f"({gr.n_tail} falls, {sig(gr.rate_min, 4)} per year)" + (f", m_max = {sig(gr.m_max, 5)} kg" if gr.m_max else ""))
     print(analysis.summary_text())
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
-        analysis.write(tmp)
-    print("\nWrote energy_summary.json, design_energies.csv, fence_checks.csv"
-          + (", design_energy_tornado.csv" if tornado is not None else "") + f" and figures to {out}/")
+        written = analysis.write(tmp)
+    tables = [p.name for p in written if p.suffix != ".png"]
+    figures = [p.name for p in written if p.suffix == ".png"]
+    print(f"\nWrote {', '.join(tables)} and {len(figures)} figures ({', '.join(figures)}) to {out}/")
     return 0
 
 
