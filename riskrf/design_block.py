@@ -312,8 +312,12 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
                            "as one intact block (an upper bound)")
     rows = []
 
+    coupled = bool(getattr(hazard, "mass_coupled", False))
+
     def add(name, mass, note):
         v95 = hazard.velocity_percentile(95, mass_kg=mass) if np.isfinite(mass) else np.nan
+        if coupled and np.isfinite(mass) and not hazard.velocity.contains(mass):
+            note += "; outside the simulated masses (nearest class's speeds)"
         rows.append({"rule": name, "mass_kg": mass, "volume_m3": mass / rho, "diameter_m":
                      float(sphere_diameter_m(mass / rho)), "velocity_p95_ms": v95,
                      "energy_at_v95_kj": 0.5 * mass * v95 ** 2 / J_PER_KJ, "note": note})
@@ -343,6 +347,12 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
     row = alt.loc[alt["chosen"]].iloc[0]
     if not np.isfinite(row["mass_kg"]):
         raise ValueError(f"the {T:g}-year block is undefined: fewer than one fall a {T:g} years at this rate")
+    if coupled and not hazard.velocity.contains(row["mass_kg"]):
+        lo, hi = hazard.velocity.edges_kg[0], hazard.velocity.edges_kg[-1]
+        raise ValueError(f"design block {sig(row['mass_kg'], 4)} kg ({row['rule']}) lies outside the simulated masses "
+                         f"{sig(lo, 4)} - {sig(hi, 4)} kg: its speeds would be the nearest mass class's, not its own.  "
+                         "Choose a design-block rule or parameters whose block lies in that range, or simulate a "
+                         "range that includes it (energy_hazard(..., design_masses_kg=[mass]))")
     if m_max:
         above = alt["mass_kg"] > m_max * (1 + 1e-12)
         alt.loc[above, "note"] = alt.loc[above, "note"] + "; ABOVE the stated maximum credible block m_max"
