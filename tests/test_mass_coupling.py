@@ -140,6 +140,28 @@ def test_design_block_outside_the_simulated_masses_is_refused_or_labelled(demo_h
     assert demo_hazard.velocity.contains(ok.mass_kg)
 
 
+def test_block_top_check_adds_radius_and_free_board_to_the_p95_centre_height(demo_hazard, lauterbrunnen):
+    """Issue 10 audit c: the fence check by the design block's top = p95 centre height of blocks of its mass class +
+    its radius + free board, against the fence height; adequate exactly when that fits under the fence."""
+    from riskrf.energy_study import _block_top_check
+    inv, _ = lauterbrunnen
+    block = design_block(demo_hazard, rule="percentile", percentile=97, inventory=inv)
+    h95 = demo_hazard.velocity.height_percentile(95, block.mass_kg)
+    demand = h95 + block.diameter_m / 2 + 0.5
+    assert block.diameter_m == pytest.approx((6 * block.volume_m3 / np.pi) ** (1 / 3))
+    row = _block_top_check(demo_hazard, block, 5.0, 0.5).iloc[0]
+    assert row["demand"] == pytest.approx(demand, rel=1e-12) and row["capacity"] == 5.0 and row["unit"] == "m"
+    assert row["check"].startswith("design block top")
+    assert bool(_block_top_check(demo_hazard, block, demand * 1.001, 0.5)["adequate"].iloc[0])
+    assert not bool(_block_top_check(demo_hazard, block, demand * 0.999, 0.5)["adequate"].iloc[0])
+    # another block: the demand moves by its class's p95 height and its radius
+    other = design_block(demo_hazard, rule="percentile", percentile=95, inventory=inv)
+    d_other = _block_top_check(demo_hazard, other, 5.0, 0.5)["demand"].iloc[0]
+    assert d_other - row["demand"] == pytest.approx(
+        demo_hazard.velocity.height_percentile(95, other.mass_kg) - h95 + (other.diameter_m - block.diameter_m) / 2)
+    assert other.diameter_m < block.diameter_m
+
+
 def test_exceedance_is_monotone_and_reach_by_mass(demo_hazard):
     hz = demo_hazard
     e = np.geomspace(1.0, 3e6, 400)

@@ -80,7 +80,11 @@ def test_fence_residual_from_paired_heights_and_energies_with_damage_states():
     edges, mid, _ = s._grid
     pmf = s._mass_pmf()[0]
     e = 0.5 * mid[None, :] * V[:, None] ** 2 / 1000
-    over = (H > 4)[:, None]
+    # over-topping as in the simulator's barrier (simulation.kernel.barrier_outcome): the block's underside, centre
+    # height minus the radius of a sphere of that mass (2,650 kg/m3 without a scenario), clears the 4 m fence
+    radius = (3 * mid / (4 * np.pi * 2650.0)) ** (1 / 3)
+    over = H[:, None] - radius[None, :] > 4
+    assert (over != (H > 4)[:, None]).any()         # the block size matters on this grid
     passing = np.mean(over | (e > 2000), axis=0)
     destroy = np.mean(~over & (e > 2000), axis=0)
     lam_d = 1.0 * float(pmf @ destroy)
@@ -89,6 +93,14 @@ def test_fence_residual_from_paired_heights_and_energies_with_damage_states():
     assert r.road_falls_per_year == pytest.approx(expected, rel=1e-9)
     assert r.replacements_per_year == pytest.approx(lam_d * (1 - down), rel=1e-9)
     assert r.repairs_per_year > 0
+    # the engine's PV of maintenance: pv factor x (maintenance + repairs x repair cost + replacements x replacement
+    # cost; the replacement cost defaults to the capital cost), issue 13 audit k
+    row = s.ranking().set_index("option").loc["fence"]
+    opt = s.option("fence")
+    assert opt.replacement_cost is None
+    assert row["pv_maintenance"] == pytest.approx(pv_factor(0.03, 50) * (
+        opt.annual_maintenance + r.repairs_per_year * opt.repair_cost_per_impact
+        + r.replacements_per_year * opt.capital_cost), rel=1e-9)
 
 
 def test_fence_hit_above_capacity_costs_replacement_and_lets_later_falls_through_until_repaired():
