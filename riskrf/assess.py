@@ -225,9 +225,8 @@ class Assessment:
             "power_law": {"b": gr.b, "b_stderr": gr.b_stderr, "b_ci": list(gr.b_ci), "a": gr.a, "m_min_kg": gr.m_min,
                           "m_min_method": gr.m_min_method, "rate_min_per_year": gr.rate_min,
                           "bootstrap_p_value": fr.bootstrap_p},
-            "design_masses": fr.design_masses().to_dict(orient="records"),
-            "design_masses_basis": "whole monitored wall (regional fit): untruncated, rate not scaled; the site's "
-                                   "own design masses are site_design_masses",
+            "whole_wall_design_masses": fr.design_masses().assign(basis=WHOLE_WALL_BASIS).to_dict(orient="records"),
+            "whole_wall_design_masses_basis": WHOLE_WALL_BASIS,
             "site_design_masses": self.energy.site_masses.to_dict(orient="records")
             if self.energy.site_masses is not None else None,
             "design_block": self.energy.design_block.to_dict() if self.energy.design_block is not None else None,
@@ -445,10 +444,18 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
         _frequency_outputs(a.frequency, a.maxima_frequency, figs)
         a.energy.write(figs)
         beside.result()
-    for name in ("summary.json", "design_masses.csv", "completeness.csv"):
+    for name in ("summary.json", "completeness.csv"):
         shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
+    _label_reference_masses(figs / "design_masses.csv", out / "frequency_summary.json", WHOLE_WALL_BASIS,
+                            out / "whole_wall_design_masses.csv")
+    if a.maxima_frequency is not None:
+        sub = figs / "annual_maxima"
+        _label_reference_masses(sub / "design_masses.csv", sub / "summary.json",
+                                f"annual-maximum record {Path(str(a.maxima_frequency.inventory.source)).name}: "
+                                "another record's fit, untruncated: reference only, not this site's design masses",
+                                sub / "record_design_masses.csv")
     for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv", "design_energy_sensitivity.csv",
-                 "design_energy_tornado.csv", "design_block.csv"):
+                 "design_energy_tornado.csv", "design_block.csv", "site_design_masses.csv"):
         if (figs / name).exists():
             shutil.move(str(figs / name), str(out / name))
     for name in ("ranking.csv", "tornado.csv", "break_even.csv", "decision.json"):
@@ -459,6 +466,24 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
     _copy_inputs(a, out / "inputs")
     return summary
+
+
+#: What the inventory fit's design-mass table is, in the outputs of an assessment (issue 10).
+WHOLE_WALL_BASIS = ("whole monitored wall (inventory fit), untruncated power law, rate not scaled: reference only, "
+                    "not the site's design masses (site_design_masses.csv)")
+
+
+def _label_reference_masses(csv: Path, summary_json: Path, basis: str, dest: Path) -> None:
+    """Say what a fit's design-mass table is: a ``basis`` column in the CSV (moved to ``dest``), and in its summary
+    JSON the key ``design_masses`` renamed after ``dest`` (e.g. ``whole_wall_design_masses``) with its basis."""
+    import pandas as pd
+    pd.read_csv(csv).assign(basis=basis).to_csv(dest, index=False)
+    csv.unlink()
+    data = json.loads(summary_json.read_text(encoding="utf-8"))
+    key = dest.stem
+    data[key] = [dict(r, basis=basis) for r in data.pop("design_masses")]
+    data[key + "_basis"] = basis
+    write_json(data, summary_json)
 
 
 def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:
