@@ -23,7 +23,7 @@ import numpy as np
 from . import __version__
 from .annual_hazard import EnergyHazard, inertia_factors
 from .background import InBackground
-from .design_block import design_block, design_block_candidates_kg, read_block_survey
+from .design_block import design_block, design_block_candidates_kg, read_block_survey, resolve_sizes
 from .energy_study import (
     INTERVAL_COVERS,
     EnergyAnalysis,
@@ -357,7 +357,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
         block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
-                             survey_source=db_cfg["survey"], inventory=inventory, sizes=inv_cfg["sizes"],
+                             survey_source=db_cfg["survey"], inventory=inventory,
+                             sizes=resolve_sizes(inv_cfg["sizes"], inventory),
                              design_T=hz_cfg["design_period_years"], density_kg_m3=inventory.density_kg_m3,
                              fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"])
         sensitivity = design_energy_sensitivity(

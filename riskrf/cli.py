@@ -264,14 +264,15 @@ def cmd_energy(args) -> int:
     block = sensitivity = None
     fragmenting = args.fractal_dimension is not None or args.fragmentation_iterations is not None
     if args.design_percentile is not None or args.block_survey or fragmenting:
-        from .design_block import design_block, read_block_survey
+        from .design_block import design_block, read_block_survey, resolve_sizes
         survey = read_block_survey(args.block_survey, inv.density_kg_m3, **_survey_reader(args)) \
             if args.block_survey else None
         rule = "percentile" if (args.design_percentile is not None or survey is not None) else "fragmentation"
         block = design_block(hazard, rule=rule,
                              percentile=97.0 if args.design_percentile is None else args.design_percentile,
                              survey_volumes_m3=survey, survey_source=args.block_survey, inventory=inv,
-                             sizes=args.inventory_sizes, design_T=args.design_period, density_kg_m3=inv.density_kg_m3,
+                             sizes=resolve_sizes(args.inventory_sizes, inv), design_T=args.design_period,
+                             density_kg_m3=inv.density_kg_m3,
                              fractal_dimension=args.fractal_dimension, iterations=args.fragmentation_iterations)
     if args.design_period * hazard.arrival_rate > 1:
         from .energy_study import design_energy_sensitivity
@@ -640,8 +641,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "design-period event; the design block is then a percentile of its fragments")
     p.add_argument("--fragmentation-iterations", type=int, default=None, metavar="N",
                    help="fragmentation generations (1-12) with --fractal-dimension")
-    p.add_argument("--inventory-sizes", choices=("event_volumes", "blocks"), default="event_volumes",
-                   help="what the inventory's sizes are (default event_volumes)")
+    p.add_argument("--inventory-sizes", choices=("event_volumes", "blocks"), default=None,
+                   help="what the inventory's sizes are (default: the inventory sidecar's sizes, else event_volumes)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-energy)")
     _add_reader_arguments(p, "the --block-survey table", "", prefix="survey")
     p.set_defaults(func=cmd_energy)

@@ -48,13 +48,22 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .inventory import SIZES  # noqa: F401  (one home: what an inventory's sizes can be)
 from .report.format import sig
 from .units import J_PER_KJ
 
 #: The percentile band of ONR 24810:2021 for the design block [%].
 ONR24810_PERCENTILES = (95.0, 98.0)
 RULES = ("percentile", "return_period", "fragmentation")
-SIZES = ("event_volumes", "blocks")
+
+
+def resolve_sizes(stated, inventory=None) -> str:
+    """What the inventory's sizes are: ``stated`` (site file ``inventory.sizes`` or ``--inventory-sizes``) when
+    given, else the inventory sidecar's ``sizes``, else ``"event_volumes"`` (the default: a detached volume is taken
+    as one block, an upper bound)."""
+    if stated is not None:
+        return stated
+    return getattr(inventory, "sizes", None) or "event_volumes"
 
 
 def sphere_diameter_m(volume_m3):
@@ -390,5 +399,5 @@ def design_block_candidates_kg(*, rule, percentile, survey_volumes_m3, inventory
 
 __all__ = ["DesignBlock", "ONR24810_PERCENTILES", "design_block", "design_block_candidates_kg", "fractal_fragments",
            "fragment_percentile",
-           "line_return_period_mass", "percentile_block", "read_block_survey", "site_design_masses",
+           "line_return_period_mass", "percentile_block", "read_block_survey", "resolve_sizes", "site_design_masses",
            "sphere_diameter_m"]
