@@ -1073,7 +1073,7 @@ class MitigationStudy:
         rows = []
         for p, v in self.central_parameters().items():
             if p == "material_draw":
-                continue                 # material parameters: re-simulated at the ends of their ranges (tornado)
+                continue                 # material parameters: below, from their re-simulated low and high models
             be = self.break_even(p, option_a=a, option_b=b)
             lo, hi = (ranges[p][0], ranges[p][1]) if p in ranges else (np.nan, np.nan)
             inside = bool(be is not None and p in ranges and lo <= be[1] <= hi)
@@ -1081,7 +1081,42 @@ class MitigationStudy:
                          "factor": be[0] if be else np.nan, "range_low": lo, "range_high": hi,
                          "within_stated_range": inside,
                          "note": f"{b!r} ties with {a!r}" if be else "no tie within the searched range"})
+        rows += self._material_break_even(a, b, ranges)
         return pd.DataFrame(rows)
+
+    def _material_break_even(self, a: str, b: str, ranges: dict) -> list:
+        """Break-even rows of the uncertain material parameters.  Each is re-simulated only at the low and high
+        ends of its range (the slope models of the tornado), so the tie of options a and b is found by linear
+        interpolation of their cost difference between the low, base (reference) and high models; the tie
+        nearest the current value, or none within [low, high]."""
+        materials = [p for p in ranges if p.startswith("material:")]
+        if not materials or self.context is None:
+            return []
+        from .measures import material_value
+        names = self._central_result["names"]
+        ia, ib = names.index(a), names.index(b)
+        labels = [m["label"] for m in self._models]
+        rows = []
+        for p in materials:
+            path = p.split(":", 1)[1]
+            lo, hi, _ = ranges[p]
+            current = float(material_value(self.context.scenario, path))
+            draws = [labels.index(f"{path} low"), 0, labels.index(f"{path} high")]
+            t = self._central({"material_draw": draws})["total"]
+            x, d = np.array([lo, current, hi], dtype=float), t[:, ia] - t[:, ib]
+            keep = np.argsort(x, kind="stable")
+            x, d = x[keep], d[keep]
+            ties = [float(x[j]) for j in range(3) if d[j] == 0]
+            ties += [float(x[j] + (x[j + 1] - x[j]) * d[j] / (d[j] - d[j + 1])) for j in range(2)
+                     if d[j] * d[j + 1] < 0]
+            tie = min(ties, key=lambda v: abs(v - current)) if ties else None
+            how = "linear interpolation of the cost difference between the re-simulated low, base and high models"
+            rows.append({"parameter": p, "current": current, "break_even": np.nan if tie is None else tie,
+                         "factor": np.nan if tie is None or not current else tie / current,
+                         "range_low": lo, "range_high": hi, "within_stated_range": tie is not None,
+                         "note": (f"{b!r} ties with {a!r} ({how})" if tie is not None
+                                  else f"no tie within [{lo:g}, {hi:g}] ({how})")})
+        return rows
 
     def value_of_information(self, factors=(0.5, 1.0, 2.0), weights=(0.25, 0.5, 0.25)) -> dict:
         """Expected value of perfect information about the rate of falls (``factors`` x the estimate with
