@@ -165,6 +165,40 @@ def test_no_design_mass_above_m_max_unless_labelled_whole_wall(assessed):
     assert checked > 20
 
 
+def test_options_recommendation_and_fence_heights_in_outputs(assessed):
+    """Issue 13 audit k: every option in summary.json carries the required keys, P(best) sums to 1, a ditch's and each
+    fence's derived retention is there, the recommendation gives a reason, and each fence option is checked at its
+    own height_m.  Audit i, j: the report states what the loss engine does with fragmentation and queued vehicles."""
+    import pandas as pd
+    site, out = assessed
+    s = json.loads((out / "summary.json").read_text())
+    required = {"name", "kind", "expected_total_cost", "cost_p05", "cost_p95", "probability_best",
+                "road_falls_per_year", "individual_risk_per_year", "deaths_per_year"}
+    for o in s["options"]:
+        assert required <= set(o), (o["name"], required - set(o))
+        assert o["cost_p05"] <= o["expected_total_cost"] <= o["cost_p95"] or o["cost_p05"] == o["cost_p95"]
+    assert abs(sum(o["probability_best"] for o in s["options"]) - 1.0) <= 1e-9
+    kinds = {o["kind"] for o in s["options"]}
+    assert {"ditch", "fence"} <= kinds
+    for o in s["options"]:
+        if o["kind"] in ("ditch", "fence"):
+            assert o.get("retention") is not None and 0.0 <= o["retention"] <= 1.0, o["name"]
+    rec = s["recommendation"]
+    assert rec["option"] in {o["name"] for o in s["options"]} and rec["reason"].strip()
+    fences = [o for o in load_site(site).mitigation["options"] if o.kind == "fence" and o.x_m is None]
+    assert len({o.height_m for o in fences}) > 1                  # the demo's fences differ in height
+    checks = pd.read_csv(out / "fence_checks.csv")
+    for o in fences:
+        rows = checks[checks["fence"] == f"{o.capacity_kj:g} kJ / {o.height_m:g} m"]
+        heights = rows[rows["unit"] == "m"]
+        assert len(heights) >= 2 and (heights["capacity"] == o.height_m).all(), (o.name, heights)
+    html = (out / "report.html").read_text()
+    for text in ("queued or stopped vehicles behind a blockage", "each event volume one intact block",
+                 "fragmentation: the loss engine takes every event volume as one intact block"):
+        assert text in html, text
+    assert "no fragmentation model" not in html
+
+
 def test_design_energy_tornado_in_outputs(assessed):
     """Issue 10 item 4: the one-way sensitivity of the design energies, in the CSV, the summary and the report."""
     import pandas as pd
