@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .inventory import SIZES  # noqa: F401  (one home: what an inventory's sizes can be)
+from .inventory import SIZES  # one home: what an inventory's sizes can be
 from .report.format import sig
 from .units import J_PER_KJ
 
