@@ -23,7 +23,8 @@ import numpy as np
 from . import __version__
 from .annual_hazard import EnergyHazard, inertia_factors
 from .background import InBackground
-from .design_block import design_block, design_block_candidates_kg, read_block_survey, resolve_sizes
+from .design_block import (design_block, design_block_candidates_kg, fragment_block_kg, read_block_survey,
+                           resolve_sizes)
 from .energy_study import (
     INTERVAL_COVERS,
     EnergyAnalysis,
@@ -56,7 +57,8 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
 
     With a scenario and ``mass_coupling="simulated"`` (the default) the hazard is
     :func:`riskrf.energy_hazard`: ``n`` blocks simulated across the power law's mass range
-    (widened to ``design_masses_kg``), reach and speed by mass.  ``"independent"`` (or
+    (widened to ``design_masses_kg``: masses [kg], or a function of (power-law fit, rate per year) returning
+    them, for masses that follow from the site's law), reach and speed by mass.  ``"independent"`` (or
     ``condition_on_mass``) is the older form from the seeder's own masses.  The returned
     simulation is always the scenario's own seeder run (figures, road share, mitigation).
     ``rate_note`` replaces the hazard's note on ``rate_scale`` (e.g. a rate from the site's rate model).
@@ -69,6 +71,8 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
 
     gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=m_min, m_max=m_max)
     rate = gr.rate_min * rate_scale
+    if callable(design_masses_kg):
+        design_masses_kg = design_masses_kg(gr, rate)
     if (scenario is None) == (velocities is None):
         raise ValueError("give exactly one of --scenario (simulate the velocities) or --velocities (a file)")
     result = None
@@ -341,6 +345,13 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                                            survey_volumes_m3=survey, inventory=inventory,
                                            density_kg_m3=inventory.density_kg_m3)
         extra += [m for m in m_max_values if m is not None]
+
+        def design_masses(law, rate):
+            """The masses above and the fragmentation alternative of the site's law (simulated, not borrowed)."""
+            frag = fragment_block_kg(law, rate, design_T=hz_cfg["design_period_years"],
+                                     fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"],
+                                     percentile=db_cfg["percentile"], density_kg_m3=inventory.density_kg_m3)
+            return extra + ([frag] if frag is not None else [])
         t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
         if compiling is not None:
             compiling.wait()
@@ -349,7 +360,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
             velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
             collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
-            mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=extra,
+            mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=design_masses,
             velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note)
         timings["simulation"] = round(time.perf_counter() - t, 2)
         if figures is not None:

@@ -237,8 +237,9 @@ def _survey_reader(args) -> dict:
 
 
 def _energy_design_masses(args, inventory):
-    """Masses [kg] the energy command reads design values at: the design-block band and the sensitivity's m_max."""
-    from .design_block import design_block_candidates_kg, read_block_survey
+    """Masses [kg] the energy command reads design values at: the design-block band, the sensitivity's m_max and
+    the fragmentation alternative (a function of the site's law, evaluated once the law is fitted)."""
+    from .design_block import design_block_candidates_kg, fragment_block_kg, read_block_survey
     out = [2.0 * args.m_max] if args.m_max else []
     survey_path, pct = getattr(args, "block_survey", None), getattr(args, "design_percentile", None)
     survey = read_block_survey(survey_path, inventory.density_kg_m3, **_survey_reader(args)) if survey_path else None
@@ -246,7 +247,15 @@ def _energy_design_masses(args, inventory):
         out += design_block_candidates_kg(rule="percentile", percentile=97.0 if pct is None else pct,
                                           survey_volumes_m3=survey, inventory=inventory,
                                           density_kg_m3=inventory.density_kg_m3)
-    return out
+    D, gens = getattr(args, "fractal_dimension", None), getattr(args, "fragmentation_iterations", None)
+    if D is None or gens is None:
+        return out
+
+    def with_fragments(law, rate):
+        frag = fragment_block_kg(law, rate, design_T=args.design_period, fractal_dimension=D, iterations=gens,
+                                 percentile=97.0 if pct is None else pct, density_kg_m3=inventory.density_kg_m3)
+        return out + ([frag] if frag is not None else [])
+    return with_fragments
 
 
 def cmd_energy(args) -> int:

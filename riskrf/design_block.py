@@ -361,7 +361,8 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
         raise ValueError(f"design block {sig(row['mass_kg'], 4)} kg ({row['rule']}) lies outside the simulated masses "
                          f"{sig(lo, 4)} - {sig(hi, 4)} kg: its speeds would be the nearest mass class's, not its own.  "
                          "Choose a design-block rule or parameters whose block lies in that range, or simulate a "
-                         "range that includes it (energy_hazard(..., design_masses_kg=[mass]))")
+                         "range that includes it (energy_hazard(..., design_masses_kg=[mass]); riskrf energy and "
+                         "riskrf assess include the design-block candidates, fragmentation too, by themselves)")
     if m_max:
         above = alt["mass_kg"] > m_max * (1 + 1e-12)
         alt.loc[above, "note"] = alt.loc[above, "note"] + "; ABOVE the stated maximum credible block m_max"
@@ -397,7 +398,25 @@ def design_block_candidates_kg(*, rule, percentile, survey_volumes_m3, inventory
     return out
 
 
+def fragment_block_kg(law, rate_per_year: float, *, design_T: float, fractal_dimension, iterations,
+                      percentile: float, density_kg_m3: float) -> float | None:
+    """Mass [kg] of the fragmentation alternative of :func:`design_block` from the site's law alone (before the
+    hazard is simulated): the ``percentile`` fragment of the ``design_T``-year fall at the source.  None when no
+    fragmentation is stated or fewer than one such fall is expected; so that the simulated mass range can
+    include it."""
+    if fractal_dimension is None or iterations is None:
+        return None
+    from .impact_energy import mass_model
+    p = 1.0 / (float(design_T) * float(rate_per_year))
+    if not p < 1:
+        return None
+    source_kg = float(mass_model(law).isf(p))
+    frags = fractal_fragments(source_kg / density_kg_m3, fractal_dimension, iterations)
+    return fragment_percentile(frags, percentile) * density_kg_m3
+
+
 __all__ = ["DesignBlock", "ONR24810_PERCENTILES", "design_block", "design_block_candidates_kg", "fractal_fragments",
+           "fragment_block_kg",
            "fragment_percentile",
            "line_return_period_mass", "percentile_block", "read_block_survey", "resolve_sizes", "site_design_masses",
            "sphere_diameter_m"]

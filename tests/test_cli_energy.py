@@ -75,3 +75,19 @@ def test_energy_bad_velocity_file_writes_nothing(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
     rc = main(["energy", "--inventory", str(LAUTER), "--out", str(tmp_path / "o")])
     assert rc == 2 and "exactly one of --scenario" in capsys.readouterr().err
+
+
+def test_energy_simulates_the_fragment_design_block(tmp_path, capsys):
+    """Issue 10 audit b: fractal fragmentation D = 2.9, 5 generations gives a 100-year fragment block far below
+    m_min; riskrf energy widens the simulated masses to it, so its speeds are its own, not the lowest class's."""
+    out = tmp_path / "e"
+    rc = main(["energy", "--inventory", str(LAUTER), "--scenario", str(BARRIER), "-n", "3000", "--m-max", "2e6",
+               "--rate-scale", "0.05", "--bootstrap", "5", "--fractal-dimension", "2.9",
+               "--fragmentation-iterations", "5", "--out", str(out)])
+    assert rc == 0, capsys.readouterr().err
+    s = json.loads((out / "energy_summary.json").read_text())
+    block = s["design_block"]
+    assert block["rule"] == "fragmentation" and block["mass_kg"] < 100.0        # about 24 kg; m_min is 2,836 kg
+    assert s["mass_classes"][0]["mass_low_kg"] <= block["mass_kg"] * (1 + 1e-12)
+    alt = pd.read_csv(out / "design_block.csv")
+    assert not alt["note"].str.contains("outside the simulated masses").any()

@@ -7,6 +7,7 @@ import riskrf
 import simulation
 from riskrf.annual_hazard import EnergyHazard
 from riskrf.design_block import (
+    fragment_block_kg,
     design_block,
     percentile_block,
     read_block_survey,
@@ -138,6 +139,14 @@ def test_design_block_outside_the_simulated_masses_is_refused_or_labelled(demo_h
     # the same fragments inside the range (D = 2.5, 3 generations, the demo's) carry no such note
     ok = design_block(demo_hazard, rule="fragmentation", fractal_dimension=2.5, iterations=3)
     assert demo_hazard.velocity.contains(ok.mass_kg)
+    # the fragment block from the site's law alone (what riskrf energy / assess add to the simulated masses before
+    # simulating) is the design block's fragmentation alternative
+    for D, k in ((2.5, 3), (2.9, 5)):
+        alt = design_block(demo_hazard, rule="percentile", percentile=97, inventory=inv, fractal_dimension=D,
+                           iterations=k).alternatives.set_index("rule")
+        assert fragment_block_kg(demo_hazard.mass, demo_hazard.rate_per_year, design_T=100, fractal_dimension=D,
+                                 iterations=k, percentile=97, density_kg_m3=inv.density_kg_m3) == pytest.approx(
+            alt.loc["fragmentation of the 100-yr event, p97", "mass_kg"], rel=1e-12)
 
 
 def test_block_top_check_adds_radius_and_free_board_to_the_p95_centre_height(demo_hazard, lauterbrunnen):
