@@ -23,7 +23,8 @@ import numpy as np
 from . import __version__
 from .annual_hazard import EnergyHazard, inertia_factors
 from .background import InBackground
-from .design_block import design_block, design_block_candidates_kg, read_block_survey
+from .design_block import (design_block, design_block_candidates_kg, fragment_block_kg, read_block_survey,
+                           resolve_sizes)
 from .energy_study import (
     INTERVAL_COVERS,
     EnergyAnalysis,
@@ -56,7 +57,8 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
 
     With a scenario and ``mass_coupling="simulated"`` (the default) the hazard is
     :func:`riskrf.energy_hazard`: ``n`` blocks simulated across the power law's mass range
-    (widened to ``design_masses_kg``), reach and speed by mass.  ``"independent"`` (or
+    (widened to ``design_masses_kg``: masses [kg], or a function of (power-law fit, rate per year) returning
+    them, for masses that follow from the site's law), reach and speed by mass.  ``"independent"`` (or
     ``condition_on_mass``) is the older form from the seeder's own masses.  The returned
     simulation is always the scenario's own seeder run (figures, road share, mitigation).
     ``rate_note`` replaces the hazard's note on ``rate_scale`` (e.g. a rate from the site's rate model).
@@ -69,6 +71,8 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
 
     gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=m_min, m_max=m_max)
     rate = gr.rate_min * rate_scale
+    if callable(design_masses_kg):
+        design_masses_kg = design_masses_kg(gr, rate)
     if (scenario is None) == (velocities is None):
         raise ValueError("give exactly one of --scenario (simulate the velocities) or --velocities (a file)")
     result = None
@@ -225,9 +229,8 @@ class Assessment:
             "power_law": {"b": gr.b, "b_stderr": gr.b_stderr, "b_ci": list(gr.b_ci), "a": gr.a, "m_min_kg": gr.m_min,
                           "m_min_method": gr.m_min_method, "rate_min_per_year": gr.rate_min,
                           "bootstrap_p_value": fr.bootstrap_p},
-            "design_masses": fr.design_masses().to_dict(orient="records"),
-            "design_masses_basis": "whole monitored wall (regional fit): untruncated, rate not scaled; the site's "
-                                   "own design masses are site_design_masses",
+            "whole_wall_design_masses": fr.design_masses().assign(basis=WHOLE_WALL_BASIS).to_dict(orient="records"),
+            "whole_wall_design_masses_basis": WHOLE_WALL_BASIS,
             "site_design_masses": self.energy.site_masses.to_dict(orient="records")
             if self.energy.site_masses is not None else None,
             "design_block": self.energy.design_block.to_dict() if self.energy.design_block is not None else None,
@@ -342,6 +345,13 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                                            survey_volumes_m3=survey, inventory=inventory,
                                            density_kg_m3=inventory.density_kg_m3)
         extra += [m for m in m_max_values if m is not None]
+
+        def design_masses(law, rate):
+            """The masses above and the fragmentation alternative of the site's law (simulated, not borrowed)."""
+            frag = fragment_block_kg(law, rate, design_T=hz_cfg["design_period_years"],
+                                     fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"],
+                                     percentile=db_cfg["percentile"], density_kg_m3=inventory.density_kg_m3)
+            return extra + ([frag] if frag is not None else [])
         t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
         if compiling is not None:
             compiling.wait()
@@ -350,7 +360,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
             velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
             collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
-            mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=extra,
+            mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=design_masses,
             velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note)
         timings["simulation"] = round(time.perf_counter() - t, 2)
         if figures is not None:
@@ -358,7 +368,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
         block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
-                             survey_source=db_cfg["survey"], inventory=inventory, sizes=inv_cfg["sizes"],
+                             survey_source=db_cfg["survey"], inventory=inventory,
+                             sizes=resolve_sizes(inv_cfg["sizes"], inventory),
                              design_T=hz_cfg["design_period_years"], density_kg_m3=inventory.density_kg_m3,
                              fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"])
         sensitivity = design_energy_sensitivity(
@@ -445,10 +456,18 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
         _frequency_outputs(a.frequency, a.maxima_frequency, figs)
         a.energy.write(figs)
         beside.result()
-    for name in ("summary.json", "design_masses.csv", "completeness.csv"):
+    for name in ("summary.json", "completeness.csv"):
         shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
+    _label_reference_masses(figs / "design_masses.csv", out / "frequency_summary.json", WHOLE_WALL_BASIS,
+                            out / "whole_wall_design_masses.csv")
+    if a.maxima_frequency is not None:
+        sub = figs / "annual_maxima"
+        _label_reference_masses(sub / "design_masses.csv", sub / "summary.json",
+                                f"annual-maximum record {Path(str(a.maxima_frequency.inventory.source)).name}: "
+                                "another record's fit, untruncated: reference only, not this site's design masses",
+                                sub / "record_design_masses.csv")
     for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv", "design_energy_sensitivity.csv",
-                 "design_energy_tornado.csv", "design_block.csv"):
+                 "design_energy_tornado.csv", "design_block.csv", "site_design_masses.csv"):
         if (figs / name).exists():
             shutil.move(str(figs / name), str(out / name))
     for name in ("ranking.csv", "tornado.csv", "break_even.csv", "decision.json"):
@@ -459,6 +478,24 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
     _copy_inputs(a, out / "inputs")
     return summary
+
+
+#: What the inventory fit's design-mass table is, in the outputs of an assessment (issue 10).
+WHOLE_WALL_BASIS = ("whole monitored wall (inventory fit), untruncated power law, rate not scaled: reference only, "
+                    "not the site's design masses (site_design_masses.csv)")
+
+
+def _label_reference_masses(csv: Path, summary_json: Path, basis: str, dest: Path) -> None:
+    """Say what a fit's design-mass table is: a ``basis`` column in the CSV (moved to ``dest``), and in its summary
+    JSON the key ``design_masses`` renamed after ``dest`` (e.g. ``whole_wall_design_masses``) with its basis."""
+    import pandas as pd
+    pd.read_csv(csv).assign(basis=basis).to_csv(dest, index=False)
+    csv.unlink()
+    data = json.loads(summary_json.read_text(encoding="utf-8"))
+    key = dest.stem
+    data[key] = [dict(r, basis=basis) for r in data.pop("design_masses")]
+    data[key + "_basis"] = basis
+    write_json(data, summary_json)
 
 
 def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:

@@ -128,14 +128,16 @@ OUTCOMES = ("over", "held", "held, repair", "destroyed", "passed, out of service
 
 def damage_state_shares(energy_kj, over, mel_kj: float):
     """Shares of falls per column of ``energy_kj`` (rows: simulated blocks; columns e.g. mass classes) that pass
-    over (``over``, per row), are held below SEL, held between SEL and MEL, or break through above MEL.
+    over (``over``, per row, or per row and column), are held below SEL, held between SEL and MEL, or break through above MEL.
 
     Returns (passing, held_repair, destroyed), each a share per column; passing = over + destroyed.
     With no simulated falls (no rows: none reached the barrier in that slope model) every share is 0, not
     nan: the shares multiply an arrival rate of zero.
     """
     e = np.asarray(energy_kj, dtype=float)
-    over = np.asarray(over, dtype=bool).reshape(-1, *([1] * (e.ndim - 1)))
+    over = np.asarray(over, dtype=bool)
+    if over.ndim < e.ndim:                  # one flag per row; a 2-D ``over`` (per row and column) is used as is
+        over = over.reshape(-1, *([1] * (e.ndim - 1)))
     mel = check_positive(mel_kj, "mel_kj")
     if e.shape[0] == 0:
         zero = np.zeros(e.shape[1:])

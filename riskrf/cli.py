@@ -237,16 +237,25 @@ def _survey_reader(args) -> dict:
 
 
 def _energy_design_masses(args, inventory):
-    """Masses [kg] the energy command reads design values at: the design-block band and the sensitivity's m_max."""
-    from .design_block import design_block_candidates_kg, read_block_survey
+    """Masses [kg] the energy command reads design values at: the design-block band, the sensitivity's m_max and
+    the fragmentation alternative (a function of the site's law, evaluated once the law is fitted)."""
+    from .design_block import design_block_candidates_kg, fragment_block_kg, read_block_survey
     out = [2.0 * args.m_max] if args.m_max else []
     survey_path, pct = getattr(args, "block_survey", None), getattr(args, "design_percentile", None)
     survey = read_block_survey(survey_path, inventory.density_kg_m3, **_survey_reader(args)) if survey_path else None
     if pct is not None or survey is not None:
-        out += design_block_candidates_kg(rule="percentile", percentile=pct or 97.0,
+        out += design_block_candidates_kg(rule="percentile", percentile=97.0 if pct is None else pct,
                                           survey_volumes_m3=survey, inventory=inventory,
                                           density_kg_m3=inventory.density_kg_m3)
-    return out
+    D, gens = getattr(args, "fractal_dimension", None), getattr(args, "fragmentation_iterations", None)
+    if D is None or gens is None:
+        return out
+
+    def with_fragments(law, rate):
+        frag = fragment_block_kg(law, rate, design_T=args.design_period, fractal_dimension=D, iterations=gens,
+                                 percentile=97.0 if pct is None else pct, density_kg_m3=inventory.density_kg_m3)
+        return out + ([frag] if frag is not None else [])
+    return with_fragments
 
 
 def cmd_energy(args) -> int:
@@ -264,13 +273,15 @@ def cmd_energy(args) -> int:
     block = sensitivity = None
     fragmenting = args.fractal_dimension is not None or args.fragmentation_iterations is not None
     if args.design_percentile is not None or args.block_survey or fragmenting:
-        from .design_block import design_block, read_block_survey
+        from .design_block import design_block, read_block_survey, resolve_sizes
         survey = read_block_survey(args.block_survey, inv.density_kg_m3, **_survey_reader(args)) \
             if args.block_survey else None
         rule = "percentile" if (args.design_percentile is not None or survey is not None) else "fragmentation"
-        block = design_block(hazard, rule=rule, percentile=args.design_percentile or 97.0,
+        block = design_block(hazard, rule=rule,
+                             percentile=97.0 if args.design_percentile is None else args.design_percentile,
                              survey_volumes_m3=survey, survey_source=args.block_survey, inventory=inv,
-                             sizes=args.inventory_sizes, design_T=args.design_period, density_kg_m3=inv.density_kg_m3,
+                             sizes=resolve_sizes(args.inventory_sizes, inv), design_T=args.design_period,
+                             density_kg_m3=inv.density_kg_m3,
                              fractal_dimension=args.fractal_dimension, iterations=args.fragmentation_iterations)
     if args.design_period * hazard.arrival_rate > 1:
         from .energy_study import design_energy_sensitivity
@@ -293,9 +304,10 @@ def cmd_energy(args) -> int:
           f"({gr.n_tail} falls, {sig(gr.rate_min, 4)} per year)" + (f", m_max = {sig(gr.m_max, 5)} kg" if gr.m_max else ""))
     print(analysis.summary_text())
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
-        analysis.write(tmp)
-    print("\nWrote energy_summary.json, design_energies.csv, fence_checks.csv"
-          + (", design_energy_tornado.csv" if tornado is not None else "") + f" and figures to {out}/")
+        written = analysis.write(tmp)
+    tables = [p.name for p in written if p.suffix != ".png"]
+    figures = [p.name for p in written if p.suffix == ".png"]
+    print(f"\nWrote {', '.join(tables)} and {len(figures)} figures ({', '.join(figures)}) to {out}/")
     return 0
 
 
@@ -638,8 +650,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "design-period event; the design block is then a percentile of its fragments")
     p.add_argument("--fragmentation-iterations", type=int, default=None, metavar="N",
                    help="fragmentation generations (1-12) with --fractal-dimension")
-    p.add_argument("--inventory-sizes", choices=("event_volumes", "blocks"), default="event_volumes",
-                   help="what the inventory's sizes are (default event_volumes)")
+    p.add_argument("--inventory-sizes", choices=("event_volumes", "blocks"), default=None,
+                   help="what the inventory's sizes are (default: the inventory sidecar's sizes, else event_volumes)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-energy)")
     _add_reader_arguments(p, "the --block-survey table", "", prefix="survey")
     p.set_defaults(func=cmd_energy)

@@ -48,13 +48,22 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .inventory import SIZES  # one home: what an inventory's sizes can be
 from .report.format import sig
 from .units import J_PER_KJ
 
 #: The percentile band of ONR 24810:2021 for the design block [%].
 ONR24810_PERCENTILES = (95.0, 98.0)
 RULES = ("percentile", "return_period", "fragmentation")
-SIZES = ("event_volumes", "blocks")
+
+
+def resolve_sizes(stated, inventory=None) -> str:
+    """What the inventory's sizes are: ``stated`` (site file ``inventory.sizes`` or ``--inventory-sizes``) when
+    given, else the inventory sidecar's ``sizes``, else ``"event_volumes"`` (the default: a detached volume is taken
+    as one block, an upper bound)."""
+    if stated is not None:
+        return stated
+    return getattr(inventory, "sizes", None) or "event_volumes"
 
 
 def sphere_diameter_m(volume_m3):
@@ -312,8 +321,12 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
                            "as one intact block (an upper bound)")
     rows = []
 
+    coupled = bool(getattr(hazard, "mass_coupled", False))
+
     def add(name, mass, note):
         v95 = hazard.velocity_percentile(95, mass_kg=mass) if np.isfinite(mass) else np.nan
+        if coupled and np.isfinite(mass) and not hazard.velocity.contains(mass):
+            note += "; outside the simulated masses (nearest class's speeds)"
         rows.append({"rule": name, "mass_kg": mass, "volume_m3": mass / rho, "diameter_m":
                      float(sphere_diameter_m(mass / rho)), "velocity_p95_ms": v95,
                      "energy_at_v95_kj": 0.5 * mass * v95 ** 2 / J_PER_KJ, "note": note})
@@ -343,6 +356,13 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
     row = alt.loc[alt["chosen"]].iloc[0]
     if not np.isfinite(row["mass_kg"]):
         raise ValueError(f"the {T:g}-year block is undefined: fewer than one fall a {T:g} years at this rate")
+    if coupled and not hazard.velocity.contains(row["mass_kg"]):
+        lo, hi = hazard.velocity.edges_kg[0], hazard.velocity.edges_kg[-1]
+        raise ValueError(f"design block {sig(row['mass_kg'], 4)} kg ({row['rule']}) lies outside the simulated masses "
+                         f"{sig(lo, 4)} - {sig(hi, 4)} kg: its speeds would be the nearest mass class's, not its own.  "
+                         "Choose a design-block rule or parameters whose block lies in that range, or simulate a "
+                         "range that includes it (energy_hazard(..., design_masses_kg=[mass]); riskrf energy and "
+                         "riskrf assess include the design-block candidates, fragmentation too, by themselves)")
     if m_max:
         above = alt["mass_kg"] > m_max * (1 + 1e-12)
         alt.loc[above, "note"] = alt.loc[above, "note"] + "; ABOVE the stated maximum credible block m_max"
@@ -378,7 +398,25 @@ def design_block_candidates_kg(*, rule, percentile, survey_volumes_m3, inventory
     return out
 
 
+def fragment_block_kg(law, rate_per_year: float, *, design_T: float, fractal_dimension, iterations,
+                      percentile: float, density_kg_m3: float) -> float | None:
+    """Mass [kg] of the fragmentation alternative of :func:`design_block` from the site's law alone (before the
+    hazard is simulated): the ``percentile`` fragment of the ``design_T``-year fall at the source.  None when no
+    fragmentation is stated or fewer than one such fall is expected; so that the simulated mass range can
+    include it."""
+    if fractal_dimension is None or iterations is None:
+        return None
+    from .impact_energy import mass_model
+    p = 1.0 / (float(design_T) * float(rate_per_year))
+    if not p < 1:
+        return None
+    source_kg = float(mass_model(law).isf(p))
+    frags = fractal_fragments(source_kg / density_kg_m3, fractal_dimension, iterations)
+    return fragment_percentile(frags, percentile) * density_kg_m3
+
+
 __all__ = ["DesignBlock", "ONR24810_PERCENTILES", "design_block", "design_block_candidates_kg", "fractal_fragments",
+           "fragment_block_kg",
            "fragment_percentile",
-           "line_return_period_mass", "percentile_block", "read_block_survey", "site_design_masses",
+           "line_return_period_mass", "percentile_block", "read_block_survey", "resolve_sizes", "site_design_masses",
            "sphere_diameter_m"]

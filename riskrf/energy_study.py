@@ -130,21 +130,25 @@ class EnergyAnalysis:
                                "design_velocity_ms": self.uni.design_velocity_ms, "factors": self.uni.factors}
         return out
 
-    def write(self, out_dir) -> None:
+    def write(self, out_dir) -> list[Path]:
+        """Write energy_summary.json, the CSV tables and the figures into ``out_dir``; returns every file written."""
         from .report.files import write_energy_figures
         out = Path(out_dir)
-        write_json(self.to_dict(), out / "energy_summary.json")
-        self.design.to_csv(out / "design_energies.csv", index=False)
-        if self.sensitivity is not None:
-            self.sensitivity.to_csv(out / "design_energy_sensitivity.csv", index=False)
-        if self.tornado is not None:
-            self.tornado.table.to_csv(out / "design_energy_tornado.csv", index=False)
-        if self.design_block is not None:
-            self.design_block.alternatives.to_csv(out / "design_block.csv", index=False)
-        if self.fences:
-            pd.concat([t.assign(fence=n) for n, t in self.fences.items()]).to_csv(out / "fence_checks.csv",
-                                                                                index=False)
-        write_energy_figures(self, out, [float(n.split(" kJ")[0]) for n in self.fences])
+        written = [out / "energy_summary.json", out / "design_energies.csv"]
+        write_json(self.to_dict(), written[0])
+        self.design.to_csv(written[1], index=False)
+        tables = [("site_design_masses.csv", self.site_masses),
+                  ("design_energy_sensitivity.csv", self.sensitivity),
+                  ("design_energy_tornado.csv", None if self.tornado is None else self.tornado.table),
+                  ("design_block.csv", None if self.design_block is None else self.design_block.alternatives),
+                  ("fence_checks.csv", pd.concat([t.assign(fence=n) for n, t in self.fences.items()])
+                   if self.fences else None)]
+        for name, table in tables:
+            if table is not None:
+                table.to_csv(out / name, index=False)
+                written.append(out / name)
+        written += write_energy_figures(self, out, [float(n.split(" kJ")[0]) for n in self.fences])
+        return written
 
 def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_board_m: float = 0.5,
                    T=DESIGN_RETURN_PERIODS, design_T: float = 100.0, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,

@@ -127,6 +127,9 @@ class Inventory:
         about it; ``unknown``: no size, NaN) and ``size_text`` (as written).
         They are not in ``events`` (the size fits use exact sizes only) but are
         counted by :meth:`all_events` and the rate models.
+    sizes : str or None
+        What the sizes are, from the sidecar's ``sizes``: ``"event_volumes"`` or ``"blocks"``; None when it does
+        not say (a site file's ``inventory.sizes`` or ``--inventory-sizes`` wins; else event volumes are assumed).
     """
 
     events: pd.DataFrame
@@ -141,6 +144,7 @@ class Inventory:
     site: str = ""
     notes: tuple = field(default_factory=tuple)
     censored: pd.DataFrame = field(default_factory=_empty_censored)
+    sizes: str | None = None
 
     def all_events(self) -> pd.DataFrame:
         """Every event of the record period, exact and censored sizes alike, in date order.
@@ -298,6 +302,9 @@ class Inventory:
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
 
+#: What an inventory's sizes can be: detached event volumes (laser scanning, registers) or individual block sizes.
+SIZES = ("event_volumes", "blocks")
+
 #: Reader options a sidecar ``[record]`` table (or a site file's ``[inventory]``) may give.
 READER_OPTIONS = ("sheet", "header_row", "encoding", "decimal", "date_format", "volume_unit", "mass_unit",
                   "duplicates", "volume_column", "mass_column", "date_column", "location_column")
@@ -317,10 +324,13 @@ def _sidecar(path: Path) -> tuple[dict, Path | None, str | None]:
         return {}, None, (f"{side} is a site file, not a [record] sidecar of {path.name}; it is not read as "
                           "the inventory's sidecar (the site file's [inventory] fields apply)")
     record = data.get("record", data)
-    known = {"start", "end", "duration_years", "density_kg_m3", "site", *READER_OPTIONS}
+    known = {"start", "end", "duration_years", "density_kg_m3", "site", "sizes", *READER_OPTIONS}
     unknown = set(record) - known
     if unknown:
         raise ValueError(f"{side}: unknown field(s) {sorted(unknown)} in [record]; expected {sorted(known)}")
+    if "sizes" in record and record["sizes"] not in SIZES:
+        raise ValueError(f"{side}: [record] sizes = {record['sizes']!r} must be one of {list(SIZES)} (what the "
+                         "inventory's sizes are: detached event volumes, or individual block sizes)")
     return record, side, None
 
 
@@ -621,7 +631,8 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
     return Inventory(events=events, duration_years=duration_years, start=start, end=end,
                      density_kg_m3=density, density_is_default=density_is_default, source=str(path),
                      period_source=period_source, size_column=size_column,
-                     site=str(sidecar.get("site", "")), notes=tuple(notes), censored=censored)
+                     site=str(sidecar.get("site", "")), notes=tuple(notes), censored=censored,
+                     sizes=sidecar.get("sizes"))
 
 
 def _line_list(lines, limit=12) -> str:

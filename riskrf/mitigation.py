@@ -13,8 +13,10 @@ exposure or the vulnerability; one engine computes the losses):
 * ``ditch``: a catchment dug into the profile (``x_m``, ``width_m``, ``depth_m``); its
   retention is derived by re-simulating the scenario with the new profile;
 * ``fence`` / ``attenuator``: a barrier line (``capacity_kj`` = MEL, ``height_m``) at the
-  barrier collector; falls pass over (simulated bounce height above the fence) or through
-  (energy above MEL, from the simulated velocities and the mass model, block by block);
+  barrier collector; falls pass over (the block's underside, simulated centre height minus
+  the radius of a block of that mass, above the fence: the simulator's own barrier rule,
+  ``simulation.kernel.barrier_outcome``) or through (energy above MEL, from the simulated
+  velocities and the mass model, block by block);
 * ``shed``: covers ``covered_length_m`` of the exposed road (``traffic.exposed_length_m``)
   with a capacity ``capacity_kj``;
 * ``realignment``: moves the road to ``road_x_m`` on the profile (share of falls still
@@ -320,7 +322,7 @@ class MitigationStudy:
                 if opt.x_m is None and self._by_mass is not None:
                     out.append(self._damage_by_mass(m, v, h, opt.height_m, cap))
                     continue
-                over = h > opt.height_m
+                over = np.asarray(h)[:, None] - self._radius_m[None, :] > opt.height_m
             # energies of every (block, mass bin) pair [kJ]: E = 1/2 m v^2; damage states from riskrf.barriers
             out.append(damage_state_shares(kinetic_energy_kj(mid[None, :], v[:, None]), over, cap))
         passing, held_sel, destroy = (np.array([o[i] for o in out]) for i in range(3))
@@ -329,6 +331,18 @@ class MitigationStudy:
         return _Stage("barrier", opt.name, passing=passing, held_sel=held_sel, destroy=destroy, coverage=coverage,
                       after_road=opt.kind == "shed",
                       param=f"retention:{opt.name}" if opt.retention is not None else None)
+
+    @cached_property
+    def _radius_m(self) -> np.ndarray:
+        """Radius [m] of a block of each mass bin's representative mass: the scenario's block shape and density
+        (its seeder) when there is a slope model, else a sphere of 2,650 kg/m3.  A block passes over a fence when
+        its underside (centre height - radius) clears the fence top, as in the simulator's barrier."""
+        mid = self._grid[1]
+        seeder = getattr(getattr(self.context, "scenario", None), "seeder", None)
+        if seeder is not None:
+            return np.asarray(seeder.radius(mid), dtype=float)
+        from .units import DEFAULT_DENSITY_KG_M3
+        return (3.0 * mid / (4.0 * np.pi * DEFAULT_DENSITY_KG_M3)) ** (1.0 / 3.0)
 
     @cached_property
     def _by_mass(self):
@@ -380,7 +394,8 @@ class MitigationStudy:
         shares = [np.zeros(mid.size) for _ in range(3)]
         for c, (vc, hc) in self._class_samples(model, v, h).items():
             j = cls == c
-            got = damage_state_shares(kinetic_energy_kj(mid[j][None, :], vc[:, None]), hc > height_m, cap)
+            over = np.asarray(hc)[:, None] - self._radius_m[j][None, :] > height_m
+            got = damage_state_shares(kinetic_energy_kj(mid[j][None, :], vc[:, None]), over, cap)
             for out, part in zip(shares, got):
                 out[j] = part
         return tuple(shares)
@@ -1058,7 +1073,7 @@ class MitigationStudy:
         rows = []
         for p, v in self.central_parameters().items():
             if p == "material_draw":
-                continue                 # material parameters: re-simulated at the ends of their ranges (tornado)
+                continue                 # material parameters: below, from their re-simulated low and high models
             be = self.break_even(p, option_a=a, option_b=b)
             lo, hi = (ranges[p][0], ranges[p][1]) if p in ranges else (np.nan, np.nan)
             inside = bool(be is not None and p in ranges and lo <= be[1] <= hi)
@@ -1066,7 +1081,42 @@ class MitigationStudy:
                          "factor": be[0] if be else np.nan, "range_low": lo, "range_high": hi,
                          "within_stated_range": inside,
                          "note": f"{b!r} ties with {a!r}" if be else "no tie within the searched range"})
+        rows += self._material_break_even(a, b, ranges)
         return pd.DataFrame(rows)
+
+    def _material_break_even(self, a: str, b: str, ranges: dict) -> list:
+        """Break-even rows of the uncertain material parameters.  Each is re-simulated only at the low and high
+        ends of its range (the slope models of the tornado), so the tie of options a and b is found by linear
+        interpolation of their cost difference between the low, base (reference) and high models; the tie
+        nearest the current value, or none within [low, high]."""
+        materials = [p for p in ranges if p.startswith("material:")]
+        if not materials or self.context is None:
+            return []
+        from .measures import material_value
+        names = self._central_result["names"]
+        ia, ib = names.index(a), names.index(b)
+        labels = [m["label"] for m in self._models]
+        rows = []
+        for p in materials:
+            path = p.split(":", 1)[1]
+            lo, hi, _ = ranges[p]
+            current = float(material_value(self.context.scenario, path))
+            draws = [labels.index(f"{path} low"), 0, labels.index(f"{path} high")]
+            t = self._central({"material_draw": draws})["total"]
+            x, d = np.array([lo, current, hi], dtype=float), t[:, ia] - t[:, ib]
+            keep = np.argsort(x, kind="stable")
+            x, d = x[keep], d[keep]
+            ties = [float(x[j]) for j in range(3) if d[j] == 0]
+            ties += [float(x[j] + (x[j + 1] - x[j]) * d[j] / (d[j] - d[j + 1])) for j in range(2)
+                     if d[j] * d[j + 1] < 0]
+            tie = min(ties, key=lambda v: abs(v - current)) if ties else None
+            how = "linear interpolation of the cost difference between the re-simulated low, base and high models"
+            rows.append({"parameter": p, "current": current, "break_even": np.nan if tie is None else tie,
+                         "factor": np.nan if tie is None or not current else tie / current,
+                         "range_low": lo, "range_high": hi, "within_stated_range": tie is not None,
+                         "note": (f"{b!r} ties with {a!r} ({how})" if tie is not None
+                                  else f"no tie within [{lo:g}, {hi:g}] ({how})")})
+        return rows
 
     def value_of_information(self, factors=(0.5, 1.0, 2.0), weights=(0.25, 0.5, 0.25)) -> dict:
         """Expected value of perfect information about the rate of falls (``factors`` x the estimate with

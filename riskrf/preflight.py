@@ -57,6 +57,18 @@ def check_energy_args(args, *, road_collector=None) -> None:
         check_number(args.free_board, "--free-board", low=0, what=" m")
         for cap in args.fence or ():
             check_number(cap, "--fence", low=0, low_open=True, what=" kJ")
+    if hasattr(args, "design_percentile"):
+        check_number(args.design_percentile, "--design-percentile", low=0, high=100, low_open=True, high_open=True,
+                     what=" % (the design block's percentile of the block sizes; ONR 24810: 95-98)")
+        check_number(args.fractal_dimension, "--fractal-dimension", low=0, high=3, low_open=True, high_open=True,
+                     what=" (fractal dimension of the fragments; rock fragmentation typically 2-3)")
+        check_number(args.fragmentation_iterations, "--fragmentation-iterations", low=1, high=12,
+                     what=" (whole fragmentation generations)")
+        if (args.fractal_dimension is None) != (args.fragmentation_iterations is None):
+            given, missing = (("--fractal-dimension", "--fragmentation-iterations") if args.fragmentation_iterations
+                              is None else ("--fragmentation-iterations", "--fractal-dimension"))
+            raise ValueError(f"{given} = {getattr(args, given[2:].replace('-', '_'))}: the fragmentation step needs "
+                             f"{missing} as well")
     if (args.scenario is None) == (args.velocities is None):
         raise ValueError("give exactly one of --scenario (simulate the velocities) or --velocities (a file)")
     if args.velocities is not None and not Path(args.velocities).is_file():

@@ -25,7 +25,7 @@ SITE_FIELDS = {
     "site": {"name": None, "description": ""},
     "inventory": {"path": None, "start": None, "end": None, "duration_years": None, "density_kg_m3": None,
                   "m_min_kg": None, "m_max_kg": None, "rate_scale": 1.0, "annual_maxima": None,
-                  "sizes": "event_volumes",
+                  "sizes": None,          # None: the inventory sidecar's sizes, else event_volumes
                   # reader options (README "Input formats"); None = the reader's rule or the sidecar's value
                   "sheet": None, "header_row": None, "encoding": None, "decimal": None, "date_format": None,
                   "volume_unit": None, "mass_unit": None, "duplicates": None, "volume_column": None,
@@ -192,7 +192,7 @@ def _check_design_block(tables, path):
     """inventory.sizes, hazard.mass_coupling and the [design_block] table (rule, percentile, survey)."""
     from .design_block import RULES, SIZES, check_percentile
     inv, hz, db = tables["inventory"], tables["hazard"], tables["design_block"]
-    if inv["sizes"] not in SIZES:
+    if inv["sizes"] is not None and inv["sizes"] not in SIZES:
         raise SiteError(f"{path}: inventory.sizes = {inv['sizes']!r} must be one of {list(SIZES)} (what the "
                         "inventory's volumes are: detached event volumes, or individual block sizes)")
     if hz["mass_coupling"] not in ("simulated", "independent"):

@@ -46,7 +46,8 @@ def assessed(tmp_path_factory):
 
 def test_assess_writes_everything(assessed):
     site, out = assessed
-    for name in ("report.html", "summary.json", "ranking.csv", "design_energies.csv", "design_masses.csv",
+    for name in ("report.html", "summary.json", "ranking.csv", "design_energies.csv", "whole_wall_design_masses.csv",
+                 "site_design_masses.csv",
                  "break_even.csv", "tornado.csv", "fence_checks.csv", "inputs/run.json", "inputs/site.toml",
                  "figures/energy_exceedance.png", "figures/tree.png", "figures/profile_trajectories.png"):
         assert (out / name).exists(), name
@@ -106,6 +107,96 @@ def test_design_block_site_masses_and_sensitivity_in_outputs(assessed):
         assert text in html, text
     assert (out / "design_energy_sensitivity.csv").exists() and (out / "design_block.csv").exists()
     assert (out / "figures" / "design_energy_sensitivity.png").exists()
+
+
+def _design_mass_values(obj, where=""):
+    """(where, key, value) of every mass [kg] in a JSON value, skipping subtrees labelled as reference fits
+    (keys whole_wall_* / record_*, or records whose basis says "reference only").  Input bounds (m_min, m_max, the
+    simulated classes' edges) are not design masses."""
+    bounds = ("m_max_kg", "m_min_kg", "mass_low_kg", "mass_high_kg", "m_max_kg_range")
+    if isinstance(obj, dict):
+        if "reference only" in str(obj.get("basis", "")):
+            return
+        for k, v in obj.items():
+            if str(k).startswith(("whole_wall_", "record_")):
+                continue
+            if str(k).endswith("_kg") and str(k) not in bounds and isinstance(v, (int, float)):
+                yield where, k, v
+            else:
+                yield from _design_mass_values(v, f"{where}/{k}")
+    elif isinstance(obj, list):
+        for i, v in enumerate(obj):
+            yield from _design_mass_values(v, f"{where}[{i}]")
+
+
+def test_no_design_mass_above_m_max_unless_labelled_whole_wall(assessed):
+    """Issue 10 audit a: every mass in every output (CSV and JSON) is at most m_max, except the tables labelled as the
+    whole monitored wall's (or another record's) untruncated fit; the site's own design masses are written."""
+    import pandas as pd
+    site, out = assessed
+    s = json.loads((out / "summary.json").read_text())
+    m_max = s["hazard"]["power_law_for_hazard"]["m_max_kg"]
+    assert not (out / "design_masses.csv").exists() and "design_masses" not in s
+    whole = pd.read_csv(out / "whole_wall_design_masses.csv")
+    assert whole["basis"].str.contains("whole monitored wall.*untruncated.*reference only").all()
+    assert whole["mass_kg"].max() > m_max                     # the labelled table is the one above m_max
+    freq = json.loads((out / "frequency_summary.json").read_text())
+    assert "design_masses" not in freq and freq["whole_wall_design_masses"][0]["basis"] == s[
+        "whole_wall_design_masses_basis"]
+    site_masses = pd.read_csv(out / "site_design_masses.csv")
+    assert list(site_masses["T_years"]) == [10, 50, 100, 300, 1000]
+    assert site_masses.loc[site_masses["T_years"] == 100, "source_mass_kg"].item() == pytest.approx(
+        [r["source_mass_kg"] for r in s["site_design_masses"] if r["T_years"] == 100][0])
+    checked = 0
+    for f in sorted(out.rglob("*.csv")):
+        if f.name.startswith(("whole_wall_", "record_")) or f.name == "completeness.csv":
+            continue                        # labelled reference fits; recorded (observed) falls per year
+        table = pd.read_csv(f)
+        labelled = "basis" in table and table["basis"].astype(str).str.contains("reference only")
+        for col in (c for c in table.columns if c.endswith("_kg") and c not in ("m_max_kg", "m_min_kg",
+                                                                                 "mass_low_kg", "mass_high_kg")):
+            values = table.loc[~labelled, col] if "basis" in table else table[col]
+            assert not (values > m_max * (1 + 1e-9)).any(), (f.relative_to(out), col, values.max())
+            checked += int(values.notna().sum())
+    for f in sorted(out.rglob("*.json")):
+        for where, key, value in _design_mass_values(json.loads(f.read_text())):
+            assert value <= m_max * (1 + 1e-9), (f.relative_to(out), where, key, value)
+            checked += 1
+    assert checked > 20
+
+
+def test_options_recommendation_and_fence_heights_in_outputs(assessed):
+    """Issue 13 audit k: every option in summary.json carries the required keys, P(best) sums to 1, a ditch's and each
+    fence's derived retention is there, the recommendation gives a reason, and each fence option is checked at its
+    own height_m.  Audit i, j: the report states what the loss engine does with fragmentation and queued vehicles."""
+    import pandas as pd
+    site, out = assessed
+    s = json.loads((out / "summary.json").read_text())
+    required = {"name", "kind", "expected_total_cost", "cost_p05", "cost_p95", "probability_best",
+                "road_falls_per_year", "individual_risk_per_year", "deaths_per_year"}
+    for o in s["options"]:
+        assert required <= set(o), (o["name"], required - set(o))
+        assert o["cost_p05"] <= o["expected_total_cost"] <= o["cost_p95"] or o["cost_p05"] == o["cost_p95"]
+    assert abs(sum(o["probability_best"] for o in s["options"]) - 1.0) <= 1e-9
+    kinds = {o["kind"] for o in s["options"]}
+    assert {"ditch", "fence"} <= kinds
+    for o in s["options"]:
+        if o["kind"] in ("ditch", "fence"):
+            assert o.get("retention") is not None and 0.0 <= o["retention"] <= 1.0, o["name"]
+    rec = s["recommendation"]
+    assert rec["option"] in {o["name"] for o in s["options"]} and rec["reason"].strip()
+    fences = [o for o in load_site(site).mitigation["options"] if o.kind == "fence" and o.x_m is None]
+    assert len({o.height_m for o in fences}) > 1                  # the demo's fences differ in height
+    checks = pd.read_csv(out / "fence_checks.csv")
+    for o in fences:
+        rows = checks[checks["fence"] == f"{o.capacity_kj:g} kJ / {o.height_m:g} m"]
+        heights = rows[rows["unit"] == "m"]
+        assert len(heights) >= 2 and (heights["capacity"] == o.height_m).all(), (o.name, heights)
+    html = (out / "report.html").read_text()
+    for text in ("queued or stopped vehicles behind a blockage", "each event volume one intact block",
+                 "fragmentation: the loss engine takes every event volume as one intact block"):
+        assert text in html, text
+    assert "no fragmentation model" not in html
 
 
 def test_design_energy_tornado_in_outputs(assessed):

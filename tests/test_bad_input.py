@@ -359,6 +359,20 @@ CLI_REFUSALS = [
     ("zero density", ["--density", "0"], r"--density = 0"),
     ("m_min above m_max", ["--m-min", "1e5", "--m-max", "10"], r"--m-min = 100000.*--m-max = 10"),
     ("unknown collector in a scenario", ["--collector", "nope"], r"collector.*'nope'.*barrier"),
+    # issue 10 audit d: the design block's percentile and fragmentation parameters, before the simulation
+    ("design percentile 0", ["--design-percentile", "0"], r"--design-percentile = 0\b.*> 0 and < 100"),
+    ("design percentile 100", ["--design-percentile", "100"], r"--design-percentile = 100\b"),
+    ("design percentile NaN", ["--design-percentile", "nan"], r"--design-percentile = nan"),
+    ("fractal dimension 3", ["--fractal-dimension", "3", "--fragmentation-iterations", "3"],
+     r"--fractal-dimension = 3\b.*< 3"),
+    ("fractal dimension 0", ["--fractal-dimension", "0", "--fragmentation-iterations", "3"],
+     r"--fractal-dimension = 0\b"),
+    ("fragmentation generations 0", ["--fractal-dimension", "2.5", "--fragmentation-iterations", "0"],
+     r"--fragmentation-iterations = 0\b"),
+    ("fragmentation generations 13", ["--fractal-dimension", "2.5", "--fragmentation-iterations", "13"],
+     r"--fragmentation-iterations = 13\b"),
+    ("fractal dimension without generations", ["--fractal-dimension", "2.5"],
+     r"--fractal-dimension = 2.5: .*needs --fragmentation-iterations"),
 ]
 
 

@@ -43,10 +43,28 @@ def test_energy_from_velocity_file(tmp_path, capsys):
     pd.DataFrame({"velocity_ms": rng.normal(15, 2, 2000).clip(1), "height_m": rng.exponential(1, 2000)}).to_csv(
         vel, index=False)
     rc = main(["energy", "--inventory", str(LAUTER), "--velocities", str(vel), "--reach-probability", "0.3",
-               "--bootstrap", "20", "--fence", "1000", "--out", str(tmp_path / "o")])
+               "--bootstrap", "20", "--fence", "1000", "--design-percentile", "95", "--out", str(tmp_path / "o")])
     assert rc == 0
     text = capsys.readouterr().out
     assert "reach probability 0.3 as given" in text and "Fence 1000 kJ" in text
+    # issue 10 audit g: the "Wrote ..." line names every file the command wrote
+    wrote = [line for line in text.splitlines() if line.startswith("Wrote ")]
+    assert len(wrote) == 1
+    files = sorted(p.name for p in (tmp_path / "o").iterdir())
+    assert {"design_block.csv", "design_energy_sensitivity.csv", "site_design_masses.csv"} <= set(files)
+    assert [f for f in files if f not in wrote[0]] == []
+    block = pd.read_csv(tmp_path / "o" / "design_block.csv")
+    assert "percentile p95" in set(block.loc[block["chosen"], "rule"])
+
+
+def test_energy_design_percentile_zero_is_refused_not_replaced(tmp_path, capsys):
+    """issue 10 audit d: --design-percentile 0 once ran with p97 in its place."""
+    vel = tmp_path / "v.csv"
+    pd.DataFrame({"velocity_ms": np.linspace(10, 20, 200)}).to_csv(vel, index=False)
+    rc = main(["energy", "--inventory", str(LAUTER), "--velocities", str(vel), "--design-percentile", "0",
+               "--out", str(tmp_path / "o")])
+    assert rc == 2 and "--design-percentile = 0" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
 
 
 def test_energy_bad_velocity_file_writes_nothing(tmp_path, capsys):
@@ -57,3 +75,19 @@ def test_energy_bad_velocity_file_writes_nothing(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
     rc = main(["energy", "--inventory", str(LAUTER), "--out", str(tmp_path / "o")])
     assert rc == 2 and "exactly one of --scenario" in capsys.readouterr().err
+
+
+def test_energy_simulates_the_fragment_design_block(tmp_path, capsys):
+    """Issue 10 audit b: fractal fragmentation D = 2.9, 5 generations gives a 100-year fragment block far below
+    m_min; riskrf energy widens the simulated masses to it, so its speeds are its own, not the lowest class's."""
+    out = tmp_path / "e"
+    rc = main(["energy", "--inventory", str(LAUTER), "--scenario", str(BARRIER), "-n", "3000", "--m-max", "2e6",
+               "--rate-scale", "0.05", "--bootstrap", "5", "--fractal-dimension", "2.9",
+               "--fragmentation-iterations", "5", "--out", str(out)])
+    assert rc == 0, capsys.readouterr().err
+    s = json.loads((out / "energy_summary.json").read_text())
+    block = s["design_block"]
+    assert block["rule"] == "fragmentation" and block["mass_kg"] < 100.0        # about 24 kg; m_min is 2,836 kg
+    assert s["mass_classes"][0]["mass_low_kg"] <= block["mass_kg"] * (1 + 1e-12)
+    alt = pd.read_csv(out / "design_block.csv")
+    assert not alt["note"].str.contains("outside the simulated masses").any()

@@ -105,6 +105,25 @@ def test_sidecar_toml_gives_period_and_density(tmp_path):
     assert inv.period_source.endswith("site.toml")
 
 
+def test_sidecar_states_what_the_sizes_are_and_the_site_or_cli_wins(tmp_path):
+    """Issue 10 audit e: a sidecar's [record] sizes ("event_volumes" or "blocks") is carried on the Inventory and
+    used when the site file / --inventory-sizes does not say; a bad value names the sidecar."""
+    from riskrf.design_block import resolve_sizes
+    f = tmp_path / "blocks.csv"
+    f.write_text("volume_m3\n1\n2\n")
+    side = tmp_path / "blocks.toml"
+    side.write_text('[record]\nduration_years = 3.5\nsizes = "blocks"\n')
+    inv = read_inventory(f)
+    assert inv.sizes == "blocks"
+    assert resolve_sizes(None, inv) == "blocks" and resolve_sizes("event_volumes", inv) == "event_volumes"
+    side.write_text("[record]\nduration_years = 3.5\n")
+    unstated = read_inventory(f)
+    assert unstated.sizes is None and resolve_sizes(None, unstated) == "event_volumes"
+    side.write_text('[record]\nduration_years = 3.5\nsizes = "boulders"\n')
+    with pytest.raises(ValueError, match=r"blocks.toml: \[record\] sizes = 'boulders' must be one of"):
+        read_inventory(f)
+
+
 def test_excel_and_parquet_read_like_csv(tmp_path):
     df = pd.DataFrame({"date": ["2001-02-03", "2002-03-04"], "volume_m3": [1.5, 2.5]})
     df.to_excel(tmp_path / "a.xlsx", index=False)

@@ -7,6 +7,7 @@ import riskrf
 import simulation
 from riskrf.annual_hazard import EnergyHazard
 from riskrf.design_block import (
+    fragment_block_kg,
     design_block,
     percentile_block,
     read_block_survey,
@@ -102,16 +103,72 @@ def test_energy_hazard_agrees_with_brute_force_monte_carlo(scenario):
     e_block = res.collector("barrier", first_only=True)["energy_kj"].to_numpy()
     energies = np.geomspace(10.0, 1e4, 7)
     bf = np.array([(e_block > e).sum() for e in energies]) / n_bf
-    se = np.sqrt(bf * (1 - bf) / n_bf)
-    tol = 4.0 * se * np.sqrt(1.0 + n_bf / n_c)       # both estimators' noise, the coupled one from n_c blocks
+    se_bf = np.sqrt(bf * (1 - bf) / n_bf)                  # binomial SE of the brute force
+    # SE of the coupled estimate: bootstrap of its simulated blocks (each mass class resampled, reach and speed
+    # together), 200 replicates
+    rng = np.random.default_rng(11)
+    reps = np.array([hz.velocity.resampled_joint_exceedance(rng, energies, mass_model(mass)) for _ in range(200)])
+    se = np.sqrt(se_bf ** 2 + reps.std(axis=0, ddof=1) ** 2)
+    tol = 3.5 * se                                          # 3.5 sigma of the combined noise
     assert np.all(np.abs(hz.annual_frequency(energies) - bf) <= tol)
-    # The mass-independent form from the seeder's masses is systematically further off: its worst error is several
-    # times the coupled one's, and it underestimates the rare energies (on the shipped slope with the material
-    # presets: -32 % at 3,160 kJ and -46 % at 10,000 kJ, against -8 % and -14 % for the coupled form).
+    # The mass-independent form from the seeder's masses fails that same test: it underestimates the rare energies
+    # (measured on the shipped slope with the material presets, 2026-11-23: -25 % at 3,160 kJ and -40 % at
+    # 10,000 kJ, 3.8 and 4.5 sigma, against -7.5 % and -13.9 %, 1.1 and 1.5 sigma, for the coupled form).
     h0 = EnergyHazard.from_simulation(mass, simulation.run(scenario, n=n_c, seed=2), "barrier", rate_per_year=1.0)
     err0, err = np.abs(h0.annual_frequency(energies) - bf), np.abs(hz.annual_frequency(energies) - bf)
-    assert err0.max() > 3 * err.max()
+    assert np.any(err0 > tol)
+    assert err0.max() > 2 * err.max()
     assert h0.annual_frequency(energies)[-1] < 0.7 * bf[-1] < hz.annual_frequency(energies)[-1]
+
+
+def test_design_block_outside_the_simulated_masses_is_refused_or_labelled(demo_hazard, lauterbrunnen):
+    """Issue 10 audit b: fractal fragmentation D = 2.9, 5 generations breaks the 100-year block into fragments far
+    below m_min (the lowest simulated mass): as the chosen block it is refused, as an alternative it is labelled."""
+    inv, gr = lauterbrunnen
+    lo = demo_hazard.velocity.edges_kg[0]
+    with pytest.raises(ValueError, match=r"design block .* kg \(fragmentation of the 100-yr event, p97\) lies outside "
+                                         r"the simulated masses"):
+        design_block(demo_hazard, rule="fragmentation", fractal_dimension=2.9, iterations=5)
+    block = design_block(demo_hazard, rule="percentile", percentile=97, inventory=inv, fractal_dimension=2.9,
+                         iterations=5)
+    alt = block.alternatives.set_index("rule")
+    frag = alt.loc["fragmentation of the 100-yr event, p97"]
+    assert frag["mass_kg"] < lo and "outside the simulated masses" in frag["note"]
+    inside = alt.drop(index="fragmentation of the 100-yr event, p97")
+    assert not inside["note"].str.contains("outside the simulated masses").any()
+    # the same fragments inside the range (D = 2.5, 3 generations, the demo's) carry no such note
+    ok = design_block(demo_hazard, rule="fragmentation", fractal_dimension=2.5, iterations=3)
+    assert demo_hazard.velocity.contains(ok.mass_kg)
+    # the fragment block from the site's law alone (what riskrf energy / assess add to the simulated masses before
+    # simulating) is the design block's fragmentation alternative
+    for D, k in ((2.5, 3), (2.9, 5)):
+        alt = design_block(demo_hazard, rule="percentile", percentile=97, inventory=inv, fractal_dimension=D,
+                           iterations=k).alternatives.set_index("rule")
+        assert fragment_block_kg(demo_hazard.mass, demo_hazard.rate_per_year, design_T=100, fractal_dimension=D,
+                                 iterations=k, percentile=97, density_kg_m3=inv.density_kg_m3) == pytest.approx(
+            alt.loc["fragmentation of the 100-yr event, p97", "mass_kg"], rel=1e-12)
+
+
+def test_block_top_check_adds_radius_and_free_board_to_the_p95_centre_height(demo_hazard, lauterbrunnen):
+    """Issue 10 audit c: the fence check by the design block's top = p95 centre height of blocks of its mass class +
+    its radius + free board, against the fence height; adequate exactly when that fits under the fence."""
+    from riskrf.energy_study import _block_top_check
+    inv, _ = lauterbrunnen
+    block = design_block(demo_hazard, rule="percentile", percentile=97, inventory=inv)
+    h95 = demo_hazard.velocity.height_percentile(95, block.mass_kg)
+    demand = h95 + block.diameter_m / 2 + 0.5
+    assert block.diameter_m == pytest.approx((6 * block.volume_m3 / np.pi) ** (1 / 3))
+    row = _block_top_check(demo_hazard, block, 5.0, 0.5).iloc[0]
+    assert row["demand"] == pytest.approx(demand, rel=1e-12) and row["capacity"] == 5.0 and row["unit"] == "m"
+    assert row["check"].startswith("design block top")
+    assert bool(_block_top_check(demo_hazard, block, demand * 1.001, 0.5)["adequate"].iloc[0])
+    assert not bool(_block_top_check(demo_hazard, block, demand * 0.999, 0.5)["adequate"].iloc[0])
+    # another block: the demand moves by its class's p95 height and its radius
+    other = design_block(demo_hazard, rule="percentile", percentile=95, inventory=inv)
+    d_other = _block_top_check(demo_hazard, other, 5.0, 0.5)["demand"].iloc[0]
+    assert d_other - row["demand"] == pytest.approx(
+        demo_hazard.velocity.height_percentile(95, other.mass_kg) - h95 + (other.diameter_m - block.diameter_m) / 2)
+    assert other.diameter_m < block.diameter_m
 
 
 def test_exceedance_is_monotone_and_reach_by_mass(demo_hazard):

@@ -80,7 +80,11 @@ def test_fence_residual_from_paired_heights_and_energies_with_damage_states():
     edges, mid, _ = s._grid
     pmf = s._mass_pmf()[0]
     e = 0.5 * mid[None, :] * V[:, None] ** 2 / 1000
-    over = (H > 4)[:, None]
+    # over-topping as in the simulator's barrier (simulation.kernel.barrier_outcome): the block's underside, centre
+    # height minus the radius of a sphere of that mass (2,650 kg/m3 without a scenario), clears the 4 m fence
+    radius = (3 * mid / (4 * np.pi * 2650.0)) ** (1 / 3)
+    over = H[:, None] - radius[None, :] > 4
+    assert (over != (H > 4)[:, None]).any()         # the block size matters on this grid
     passing = np.mean(over | (e > 2000), axis=0)
     destroy = np.mean(~over & (e > 2000), axis=0)
     lam_d = 1.0 * float(pmf @ destroy)
@@ -89,6 +93,14 @@ def test_fence_residual_from_paired_heights_and_energies_with_damage_states():
     assert r.road_falls_per_year == pytest.approx(expected, rel=1e-9)
     assert r.replacements_per_year == pytest.approx(lam_d * (1 - down), rel=1e-9)
     assert r.repairs_per_year > 0
+    # the engine's PV of maintenance: pv factor x (maintenance + repairs x repair cost + replacements x replacement
+    # cost; the replacement cost defaults to the capital cost), issue 13 audit k
+    row = s.ranking().set_index("option").loc["fence"]
+    opt = s.option("fence")
+    assert opt.replacement_cost is None
+    assert row["pv_maintenance"] == pytest.approx(pv_factor(0.03, 50) * (
+        opt.annual_maintenance + r.repairs_per_year * opt.repair_cost_per_impact
+        + r.replacements_per_year * opt.capital_cost), rel=1e-9)
 
 
 def test_fence_hit_above_capacity_costs_replacement_and_lets_later_falls_through_until_repaired():
@@ -335,7 +347,8 @@ def test_parse_option_ranges_and_overrides():
 
 
 def test_material_parameters_are_resimulated_jointly_and_at_the_ends_of_their_ranges():
-    opts = (Option("nothing", "none"), Option("ditch", "ditch", 1e5, x_m=31.0, width_m=8.0, depth_m=1.0,
+    # (the ditch's cost makes "nothing" and the fence the two cheapest, tied inside the friction range: below)
+    opts = (Option("nothing", "none"), Option("ditch", "ditch", 1.5e6, x_m=31.0, width_m=8.0, depth_m=1.0,
                                                material="gravel"),
             Option("fence", "fence", 5e5, capacity_kj=2000, height_m=3, repair_days=30))
     sc = simulation.scenario_from_dict(TOE)
@@ -355,6 +368,31 @@ def test_material_parameters_are_resimulated_jointly_and_at_the_ends_of_their_ra
     tornado = s.tornado()
     assert "material:gravel.ground_friction_angle_deg" in set(tornado["parameter"])
     assert s.ranking()["probability_best"].sum() == pytest.approx(1.0)
+    # issue 13 audit h: the break-even table has a row per material parameter, from the low / base / high models
+    be = s.break_even_table().set_index("parameter")
+    row = be.loc["material:gravel.ground_friction_angle_deg"]
+    assert (row["range_low"], row["range_high"]) == (20.0, 45.0)
+    r = s._central_result
+    order = np.argsort(r["total"][0], kind="stable")
+    ia, ib = order[0], order[1]
+    labels = s.material_models()["label"].tolist()
+    t = s._central({"material_draw": [labels.index("gravel.ground_friction_angle_deg low"), 0,
+                                      labels.index("gravel.ground_friction_angle_deg high")]})["total"]
+    x = np.array([20.0, row["current"], 45.0])
+    d = t[:, ia] - t[:, ib]
+    assert d[1] * d[2] < 0                                  # the order flips between the base and the high end
+    assert row["within_stated_range"] and row["current"] < row["break_even"] < 45.0
+    assert np.interp(row["break_even"], x, d) == pytest.approx(0.0, abs=1e-9 * np.abs(d).max())
+    assert "ties with" in row["note"] and row["factor"] == pytest.approx(row["break_even"] / row["current"])
+    # no tie when the two cheapest keep their order over the whole range: the row says so
+    from dataclasses import replace
+    s2 = MitigationStudy(hazard=HAZ, options=(opts[0], replace(opts[1], capital_cost=1e5)), consequences=CONSTANT_V,
+                         uncertainty=s.uncertainty,
+                         context=s.context)
+    s2.__dict__["_models"] = s._models                     # the same slope models, not simulated again
+    row2 = s2.break_even_table().set_index("parameter").loc["material:gravel.ground_friction_angle_deg"]
+    assert np.isnan(row2["break_even"]) and not row2["within_stated_range"]
+    assert "no tie within [20, 45]" in row2["note"]
 
 
 def test_bad_material_uncertainty_names_the_field():

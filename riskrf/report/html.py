@@ -45,6 +45,13 @@ def _assumptions(a, hz, rate_scale) -> pd.DataFrame:
                  else "computed: the inventory's record"))
     if a.rates is not None and a.rates.climate and from_model:
         rows.append(("stated change of climate", a.rates.climate, "typed assumption"))
+    rows.append(("event volume vs block in the loss engine", "each event volume one intact block",
+                 ("model limitation: conservative for fence and shed loads; fragmentation (if stated) is used only "
+                  "for the design block")))
+    rows.append(("queued or stopped vehicles behind a blockage", "not modelled",
+                 ("model limitation: road users meet falls as moving vehicles at the impact point or by striking a "
+                  "rock lying on the road; vehicles queued or stopped behind a blockage and hit by a later fall are "
+                  "not counted")))
     for entry in a.site.defaults_used:
         name, _, value = str(entry).partition(" = ")
         if ": ASSUMPTION" in name or "ASSUMPTION" in value:
