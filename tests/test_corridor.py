@@ -59,8 +59,9 @@ def test_one_and_two_workers_equal_serial(runs):
 
 def test_rates_and_ranking(runs, corridor):
     t = runs[2].table
-    # rate_basis "road": the recorded rate is falls reaching the road, so the do-nothing road falls equal it
-    np.testing.assert_allclose(t["road_falls_per_year"], t["rate_given_per_year"], rtol=1e-9)
+    # rate_basis "road": the recorded rate is falls reaching the road, so the do-nothing road falls equal it (to the
+    # mitigation engine's mass grid: it bins the mass law where the mass-coupled reach uses Gauss-Legendre nodes)
+    np.testing.assert_allclose(t["road_falls_per_year"], t["rate_given_per_year"], rtol=1e-3)
     np.testing.assert_allclose(t["release_falls_per_year"] * t["reach_road"], t["rate_given_per_year"], rtol=1e-12)
     s = runs[2].summary()
     assert list(s["rank_risk"]) == sorted(s["rank_risk"])
@@ -132,7 +133,7 @@ def test_corridor_file_errors(tmp_path):
         p = _write(tmp_path, HEAD + "A,0,100,20,3,1,0.5,\n")
         p.write_text(p.read_text().replace("seed = 7", "sead = 7"))
         cr.load_corridor(p)
-    with pytest.raises(cr.CorridorError, match="exactly one of falls_per_year, falls_per_km_year or falls_per_m2_year"):
+    with pytest.raises(cr.CorridorError, match="exactly one of falls_per_year, falls_per_km_year, falls_per_m2_year or inventory"):
         cr.load_corridor(_write(tmp_path, HEAD.replace(",scenario", ",falls_per_km_year,scenario")
                                 .replace("falls_per_year,falls_per_km_year", "falls_per_year,falls_per_km_year")
                                 + "A,0,100,20,3,1,0.5,2,\n"))
@@ -276,7 +277,22 @@ def test_release_rate_basis(tmp_path):
     row = cr.assess_section(c.sections[0], c, N)
     # released falls as given; those reaching the road = given x simulated share reaching the road line
     assert row["release_falls_per_year"] == 0.5
-    assert row["road_falls_per_year"] == pytest.approx(0.5 * row["reach_road"], rel=1e-9)
+    assert row["road_falls_per_year"] == pytest.approx(0.5 * row["reach_road"], rel=1e-3)
+
+
+def test_hazard_is_mass_coupled_as_in_assess(corridor, runs):
+    """Each section's reach probabilities are those of riskrf.energy_hazard (the engine of ``riskrf assess``) on
+    the section's scenario with the section's seed: blocks across the mass law, reach by mass class."""
+    import riskrf
+    from riskrf.mass_coupling import MassCoupledSamples
+    row = runs["serial"].set_index("id").loc["A"]
+    sec = corridor.section("A")
+    for line, col in (("barrier", "reach_barrier"), ("road", "reach_road")):
+        hz = riskrf.energy_hazard(corridor.mass, sec.scenario, line, rate_per_year=0.5, n=N, seed=int(row["seed"]))
+        assert isinstance(hz.velocity, MassCoupledSamples)
+        assert row[col] == pytest.approx(hz.reach_probability, rel=1e-12)
+    # heavier blocks behave differently: the reach probability differs between the lightest and heaviest class
+    assert hz.velocity.reach_by_class[0] != hz.velocity.reach_by_class[-1]
 
 
 E6 = Path(__file__).resolve().parents[1] / "corridors" / "e6_drivdalen"
