@@ -44,7 +44,9 @@ BUNDLED_MATERIALS = Path(__file__).resolve().parents[1] / "simulation" / "scenar
 #: :data:`riskrf.rhrs.RATE_FIELDS` prefixed with ``rhrs_``.
 GEOMETRY_COLUMNS = ("cut_height_m", "face_angle_deg", "ditch_width_m", "ditch_depth_m", "runout_to_road_m",
                     "road_width_m")
-NUMBER_COLUMNS = GEOMETRY_COLUMNS + ("chainage_from", "chainage_to", "falls_per_year", "falls_per_km_year",
+#: Optional geometry of a generated cut: a horizontal catch bench in the face (width 0: no bench).
+BENCH_COLUMNS = ("bench_width_m", "bench_height_m")
+NUMBER_COLUMNS = GEOMETRY_COLUMNS + BENCH_COLUMNS + ("chainage_from", "chainage_to", "falls_per_year", "falls_per_km_year",
                                      "falls_per_m2_year", "vehicles_per_day", "speed_kmh", "release_zone_share")
 RATE_COLUMNS = ("falls_per_year", "falls_per_km_year", "falls_per_m2_year")
 #: Ways to give a section's rate: one of the rate columns, or ``inventory`` (the section's own inventory file).
@@ -157,19 +159,32 @@ def _section_seed(seed: int, sid: str) -> int:
 
 def cut_scenario_dict(materials: dict, settings: dict, *, cut_height_m, face_angle_deg, ditch_width_m, ditch_depth_m,
                       runout_to_road_m, road_width_m, face_material, ditch_material, road_material, seeder_mass,
-                      release_zone_share=0.3, density_kg_m3=2650.0, name="cut") -> dict:
+                      release_zone_share=0.3, density_kg_m3=2650.0, name="cut", bench_width_m=0.0,
+                      bench_height_m=0.0) -> dict:
     """Scenario dictionary of a generated rock cut (x increases towards the road, z up, metres).
 
     crest plateau (CREST_M) -> rock face of ``cut_height_m`` at ``face_angle_deg`` -> ditch of
     ``ditch_width_m`` x ``ditch_depth_m`` at the toe (walls 0.25H:1V on the face side and 1H:1V on the road
     side, as :mod:`riskrf.measures`) -> flat shoulder ``runout_to_road_m`` -> road ``road_width_m`` -> verge.
-    Blocks are released from the upper ``release_zone_share`` of the face.  Collectors: ``barrier`` at the
-    middle of the shoulder (at the ditch's outer rim without a shoulder), ``road`` 0.01 m onto the road.
+    With ``bench_width_m`` > 0 the face is interrupted at ``bench_height_m`` above the toe by a horizontal catch
+    bench of that width (surface of ``ditch_material``: debris collects on it as in a ditch), both faces at
+    ``face_angle_deg``.  Blocks are released from the upper ``release_zone_share`` of the (upper) face.
+    Collectors: ``barrier`` at the middle of the shoulder (at the ditch's outer rim without a shoulder), ``road``
+    0.01 m onto the road.
     """
     from .measures import DITCH_INNER_SLOPE_HV, DITCH_OUTER_SLOPE_HV
     h, ang = float(cut_height_m), math.radians(float(face_angle_deg))
-    x_toe = CREST_M + h / math.tan(ang)
-    xs, zs, mats = [0.0, CREST_M, x_toe], [h, h, 0.0], [face_material, face_material]
+    wb, hb = float(bench_width_m), float(bench_height_m)
+    if wb > 0 and not 0 < hb < h:
+        raise ValueError(f"bench_height_m = {hb:g} must lie strictly between 0 and cut_height_m = {h:g}")
+    if wb > 0:
+        x_upper = CREST_M + (h - hb) / math.tan(ang)
+        x_toe = x_upper + wb + hb / math.tan(ang)
+        xs, zs = [0.0, CREST_M, x_upper, x_upper + wb, x_toe], [h, h, hb, hb, 0.0]
+        mats = [face_material, face_material, ditch_material, face_material]
+    else:
+        x_toe = x_upper = CREST_M + h / math.tan(ang)
+        xs, zs, mats = [0.0, CREST_M, x_toe], [h, h, 0.0], [face_material, face_material]
     w, d = float(ditch_width_m), float(ditch_depth_m)
     if w > 0 and d > 0:
         a, c = DITCH_INNER_SLOPE_HV * d, DITCH_OUTER_SLOPE_HV * d
@@ -191,8 +206,8 @@ def cut_scenario_dict(materials: dict, settings: dict, *, cut_height_m, face_ang
     zs += [0.0, 0.0]
     mats += [road_material, ditch_material]
     barrier_x = x_rim + r / 2 if r > 0 else x_rim + 0.005
-    face_top = CREST_M + 0.02 * (x_toe - CREST_M)
-    face_low = CREST_M + float(release_zone_share) * (x_toe - CREST_M)
+    face_top = CREST_M + 0.02 * (x_upper - CREST_M)
+    face_low = CREST_M + float(release_zone_share) * (x_upper - CREST_M)
     return {"name": name, "description": "generated rock cut (riskrf.corridor)",
             "profile": {"x": xs, "z": zs, "materials": mats}, "materials": materials,
             "seeder": {"type": "line", "x": [face_top, face_low], "height_m": 0.5, "mass_kg": seeder_mass,
@@ -534,6 +549,13 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                     raise CorridorError(f"{where}: column 'ditch_width_m' = {g['ditch_width_m']:g} is too narrow for "
                                         f"ditch_depth_m = {g['ditch_depth_m']:g} (walls 0.25H:1V and 1H:1V need more "
                                         f"than {1.25 * g['ditch_depth_m']:g} m)")
+                bench = {c: num.get(c, 0.0) for c in BENCH_COLUMNS}
+                if bench["bench_width_m"] < 0:
+                    raise CorridorError(f"{where}: column 'bench_width_m' = {bench['bench_width_m']:g} must be >= 0")
+                if bench["bench_width_m"] > 0 and not 0 < bench["bench_height_m"] < g["cut_height_m"]:
+                    raise CorridorError(f"{where}: column 'bench_height_m' = {bench['bench_height_m']:g} must lie "
+                                        f"strictly between 0 and cut_height_m = {g['cut_height_m']:g} (a bench "
+                                        f"{bench['bench_width_m']:g} m wide is given)")
                 share = num.get("release_zone_share", 0.3)
                 if not 0 < share <= 1:
                     raise CorridorError(f"{where}: column 'release_zone_share' = {share:g} must lie in (0, 1]")
@@ -547,14 +569,16 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                 if "seeder_mass_kg" not in defaults:
                     fallback.add("seeder_mass_kg")
                 try:
-                    sc = scenario_from_dict(cut_scenario_dict(materials, settings, **g, **mats,
+                    sc = scenario_from_dict(cut_scenario_dict(materials, settings, **g, **mats, **bench,
                                                               seeder_mass=seeder_mass, release_zone_share=share,
                                                               name=f"section {sid}"), source=where)
                 except ScenarioError as exc:
                     raise CorridorError(str(exc)) from exc
                 geometry = (f"generated cut {g['cut_height_m']:g} m at {g['face_angle_deg']:g} deg, ditch "
                             f"{g['ditch_width_m']:g} x {g['ditch_depth_m']:g} m, {g['runout_to_road_m']:g} m to a "
-                            f"{g['road_width_m']:g} m road")
+                            f"{g['road_width_m']:g} m road"
+                            + (f", bench {bench['bench_width_m']:g} m wide at {bench['bench_height_m']:g} m"
+                               if bench["bench_width_m"] > 0 else ""))
             opts = tuple(option_names)
             if vals["options"]:
                 opts = tuple(o.strip() for o in str(vals["options"]).split(";") if o.strip())
