@@ -483,3 +483,18 @@ def test_defaults_listed_only_where_used(tmp_path, corridor):
     used = cr.load_corridor(path).defaults_used
     assert "traffic.vehicles_per_day = 4000.0 (default)" in used
     assert not any(u.startswith("traffic.speed_kmh") for u in used)
+
+
+def test_report_with_a_section_without_rhrs(runs, tmp_path):
+    """Integer RHRS ranks with a section that has no RHRS attributes: blank in the report, null in summary.json."""
+    from riskrf.report.corridor_report import render_corridor_html
+    t = runs[2].table.copy()
+    t.loc[t["id"] == "B", "rhrs_score"] = np.nan
+    res = cr.CorridorResult(corridor=runs[2].corridor, table=t)
+    s = res.summary().set_index("id")
+    assert pd.isna(s.loc["B", "rank_rhrs"]) and s.loc["A", "rank_rhrs"] in (1, 2)
+    png = tmp_path / "c.png"
+    png.write_bytes(b"\x89PNG\r\n\x1a\n")
+    html = render_corridor_html(res, png)
+    assert "&lt;NA&gt;" not in html and "NaN" not in html.split("Sections ranked by risk")[1][:3000]
+    assert [r["rank_rhrs"] for r in res.to_json()["top"] if r["id"] == "B"] == [None]
