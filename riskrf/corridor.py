@@ -904,6 +904,10 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
     (the cluster's dashboard address).
     """
     from distributed import as_completed
+    if n_blocks is not None and (isinstance(n_blocks, bool) or not isinstance(n_blocks, (int, np.integer))
+                                 or n_blocks < 100):
+        raise ValueError(f"n_blocks = {n_blocks!r} must be a whole number >= 100 (the mass-coupled hazard needs at "
+                         "least 20 blocks in each of at least 4 mass classes)")
     t0 = time.perf_counter()
     own = client is None
     cluster = None

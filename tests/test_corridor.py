@@ -498,3 +498,11 @@ def test_report_with_a_section_without_rhrs(runs, tmp_path):
     html = render_corridor_html(res, png)
     assert "&lt;NA&gt;" not in html and "NaN" not in html.split("Sections ranked by risk")[1][:3000]
     assert [r["rank_rhrs"] for r in res.to_json()["top"] if r["id"] == "B"] == [None]
+
+
+def test_too_few_blocks_refused_before_connecting(corridor, tmp_path, capsys):
+    with pytest.raises(ValueError, match="n_blocks = 50 must be a whole number >= 100"):
+        cr.run_corridor(corridor, scheduler="tcp://127.0.0.1:9", n_blocks=50)
+    out = tmp_path / "out"
+    assert main(["corridor", str(DATA / "small.toml"), "-n", "50", "--out", str(out)]) == 2
+    assert "n_blocks = 50" in capsys.readouterr().err and not any(tmp_path.iterdir())
