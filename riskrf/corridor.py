@@ -224,6 +224,14 @@ def _unknown(keys, allowed, where, source):
                                                                            else f"; allowed: {sorted(allowed)}"))
 
 
+def _face_area(num: dict, length_m: float, where: str, what: str) -> float:
+    """Rock-face area [m2] of a section: length x the face's slope length (height / sin angle)."""
+    if "cut_height_m" not in num or "face_angle_deg" not in num:
+        raise CorridorError(f"{where}: {what} needs cut_height_m and face_angle_deg (the face area is the section "
+                            "length x the face's slope length)")
+    return length_m * num["cut_height_m"] / math.sin(math.radians(num["face_angle_deg"]))
+
+
 def _shared_rate(table, base: Path, m_min_kg: float, source: str):
     """``[rates]``: a corridor-wide inventory shared among the sections that give no rate of their own, in
     proportion to their length (``share = "km"``) or rock-face area (``share = "m2"``).  ``covered_length_km`` /
@@ -494,19 +502,13 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                                     f"falls_per_m2_year or inventory (own rate or inventory, or a corridor rate per km "
                                     f"of road or per m2 of rock face; or a corridor-wide [rates] inventory); got "
                                     f"{given_rates or 'none'}")
-
-            def face_area(what):
-                if "cut_height_m" not in num or "face_angle_deg" not in num:
-                    raise CorridorError(f"{where}: {what} needs cut_height_m and face_angle_deg (the face area is the "
-                                        "section length x the face's slope length)")
-                return (c1 - c0) * num["cut_height_m"] / math.sin(math.radians(num["face_angle_deg"]))
             rate_source = given_rates[0] if given_rates else "shared"
             if "falls_per_year" in num:
                 rate = num["falls_per_year"]
             elif "falls_per_km_year" in num:
                 rate = num["falls_per_km_year"] * (c1 - c0) / 1000
             elif "falls_per_m2_year" in num:
-                rate = num["falls_per_m2_year"] * face_area("falls_per_m2_year")
+                rate = num["falls_per_m2_year"] * _face_area(num, c1 - c0, where, "falls_per_m2_year")
             elif vals["inventory"]:
                 inv_path = (path.parent / str(vals["inventory"])).resolve()
                 if inv_path not in inv_cache:
@@ -514,7 +516,8 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                                                          f"{where}: column 'inventory' = {vals['inventory']!r}")
                 rate, rate_source = inv_cache[inv_path]
             else:                                  # a share of the corridor-wide inventory, set once all rows are read
-                weight = face_area("rates.share = 'm2'") if shared["share"] == "m2" else (c1 - c0) / 1000
+                weight = _face_area(num, c1 - c0, where, "rates.share = 'm2'") if shared["share"] == "m2" \
+                    else (c1 - c0) / 1000
                 rate = math.nan
             if rate_source != "shared" and not rate > 0:
                 raise CorridorError(f"{where}: the section's rate of falls is {rate:g} per year; a section without "
