@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from .report.format import sig
-from .units import J_PER_KJ
+from .units import J_PER_KJ, kinetic_energy_kj
 
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
 #: Return period [yr] of the largest fall at the source that the default simulated range must include
@@ -135,29 +135,27 @@ class MassCoupledSamples:
         """Quadrature nodes over the mass model: masses [kg], probability weights, class of each."""
         P = np.asarray(mm.sf(self.edges_kg), dtype=float)
         P[0] = 1.0                     # mass below the simulated range: the lowest class
-        m_all, w_all, c_all = [], [], []
-        for c in range(self.n_bins):
-            hi_p, lo_p = P[c], P[c + 1]
-            if c == self.n_bins - 1:
-                lo_p = P[-1]
-            if hi_p - lo_p <= 0:
-                continue
-            edges = np.linspace(lo_p, hi_p, 5)
-            half = 0.5 * np.diff(edges)
-            mid = 0.5 * (edges[:-1] + edges[1:])
-            p = (mid[:, None] + half[:, None] * _GL_NODES[None, :]).ravel()
-            m_all.append(mm.isf(p))
-            w_all.append((half[:, None] * _GL_WEIGHTS[None, :]).ravel())
-            c_all.append(np.full(p.size, c))
+        hi_p, lo_p = P[:-1], P[1:]
+        cls = np.flatnonzero(hi_p - lo_p > 0)
+        # each class's probability interval in 4 panels of Gauss-Legendre nodes, all classes at once
+        frac = np.linspace(0.0, 1.0, 5)
+        edges = lo_p[cls, None] + (hi_p - lo_p)[cls, None] * frac[None, :]
+        half = 0.5 * np.diff(edges, axis=1)
+        mid = 0.5 * (edges[:, :-1] + edges[:, 1:])
+        p = (mid[:, :, None] + half[:, :, None] * _GL_NODES[None, None, :]).reshape(cls.size, -1)
+        w_all = [(half[:, :, None] * _GL_WEIGHTS[None, None, :]).reshape(cls.size, -1).ravel()]
+        p_all = [p.ravel()]
+        c_all = [np.repeat(cls, p.shape[1])]
         if P[-1] > 0:                  # mass above the simulated range (an untruncated law): the top class
             lp = np.linspace(np.log(max(P[-1] * 1e-12, 1e-300)), np.log(P[-1]), 33)
             half = 0.5 * np.diff(lp)
             mid = 0.5 * (lp[:-1] + lp[1:])
             p = np.exp((mid[:, None] + half[:, None] * _GL_NODES[None, :]).ravel())
-            m_all.append(mm.isf(p))
+            p_all.append(p)
             w_all.append((half[:, None] * _GL_WEIGHTS[None, :]).ravel() * p)
             c_all.append(np.full(p.size, self.n_bins - 1))
-        return np.concatenate(m_all), np.concatenate(w_all), np.concatenate(c_all)
+        p = np.concatenate(p_all)
+        return np.asarray(mm.isf(p), dtype=float), np.concatenate(w_all), np.concatenate(c_all)
 
     def _groups(self, mm, arrivals=None):
         """Per mass class with arriving blocks: quadrature masses [kg], their weights, blocks released, sorted
@@ -171,7 +169,12 @@ class MassCoupledSamples:
             reach_by_class[c] = cum[-1] / n_c
             sel = cls == c
             if sel.any() and cum[-1] > 0:
-                groups.append((np.maximum(m[sel], 1e-300), w[sel], n_c, speeds, cum))
+                m_c, w_c = np.maximum(m[sel], 1e-300), w[sel]
+                # below the class's smallest kinetic energy every arrival exceeds e, above its largest none does
+                # (the bounds widened by 1e-9 against rounding): only energies between need the speed search
+                e_low = kinetic_energy_kj(m_c.min(), speeds[0]) * (1.0 - 1e-9)
+                e_high = kinetic_energy_kj(m_c.max(), speeds[-1]) * (1.0 + 1e-9)
+                groups.append((m_c, w_c, n_c, speeds, cum, e_low, e_high, cum[-1] / n_c * w_c.sum()))
         reach = float(np.clip(np.sum(w * reach_by_class[cls]), 0.0, 1.0))
         return groups, reach
 
@@ -179,12 +182,8 @@ class MassCoupledSamples:
     def _joint(e, groups) -> np.ndarray:
         flat = e.ravel()
         out = np.zeros(flat.size)
-        for m, w, n_c, speeds, cum in groups:
-            # below the class's smallest kinetic energy every arrival exceeds e, above its largest none does: only
-            # the energies between need the speed search (the bounds are widened by 1e-9 against rounding)
-            e_low = 0.5 * float(m.min()) * speeds[0] ** 2 / J_PER_KJ * (1.0 - 1e-9)
-            e_high = 0.5 * float(m.max()) * speeds[-1] ** 2 / J_PER_KJ * (1.0 + 1e-9)
-            out[flat < e_low] += cum[-1] / n_c * w.sum()
+        for m, w, n_c, speeds, cum, e_low, e_high, all_above in groups:
+            out[flat < e_low] += all_above
             mid = np.flatnonzero((flat >= e_low) & (flat <= e_high))
             if mid.size:
                 vstar = np.sqrt(2.0 * J_PER_KJ * flat[mid, None] / m[None, :])

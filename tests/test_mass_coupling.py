@@ -346,11 +346,11 @@ def test_joint_exceedance_equals_direct_count_including_class_energy_bounds():
     samples = MassCoupledSamples(m, s, np.where(np.isfinite(s), 1.0, np.nan), edges)
     mm = mass_model(stats.lognorm(1.2, scale=500.0))
     groups = samples._groups(mm)[0]
-    bounds = [0.5 * f(mq) * sp[i] ** 2 / 1000.0 for mq, _, _, sp, _ in groups for f, i in ((np.min, 0), (np.max, -1))]
+    bounds = [0.5 * f(mq) * sp[i] ** 2 / 1000.0 for mq, _, _, sp, *_ in groups for f, i in ((np.min, 0), (np.max, -1))]
     e = np.sort(np.concatenate([np.geomspace(1e-4, 1e6, 400), bounds, np.nextafter(bounds, 0),
                                 np.nextafter(bounds, np.inf)]))
     direct = np.zeros(e.size)
-    for mq, w, n_c, speeds, _ in groups:
+    for mq, w, n_c, speeds, *_ in groups:
         vstar = np.sqrt(2000.0 * e[:, None] / mq[None, :])
         direct += (np.sum(speeds[None, None, :] > vstar[:, :, None], axis=2) / n_c) @ w
     np.testing.assert_allclose(samples.joint_exceedance(e, mm), np.clip(direct, 0, 1), rtol=1e-12, atol=1e-15)

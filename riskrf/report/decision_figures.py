@@ -90,15 +90,15 @@ def plot_tornado(table, ax=None, *, currency: str = "", xlabel: str | None = Non
     base = float(table["base"].iloc[0])
     lo_col = "cost_at_low" if "cost_at_low" in table else "value_at_low"
     hi_col = "cost_at_high" if "cost_at_high" in table else "value_at_high"
-    for i, r in enumerate(table.itertuples()):
-        lo, hi = getattr(r, lo_col), getattr(r, hi_col)
-        ax.barh(i, lo - base, left=base, color="C0", alpha=0.8, label="input low" if i == 0 else None)
-        ax.barh(i, hi - base, left=base, color="C3", alpha=0.8, label="input high" if i == 0 else None)
-        if annotate:
-            for v in (lo, hi):
-                if np.isfinite(v) and v != base:
-                    ax.annotate(_fmt(v), (v, i), xytext=(3 if v > base else -3, 0), textcoords="offset points",
-                                ha="left" if v > base else "right", va="center", fontsize="x-small")
+    lows, highs = table[lo_col].to_numpy(dtype=float), table[hi_col].to_numpy(dtype=float)
+    rows = np.arange(len(table))
+    ax.barh(rows, lows - base, left=base, color="C0", alpha=0.8, label="input low")
+    ax.barh(rows, highs - base, left=base, color="C3", alpha=0.8, label="input high")
+    for i, lo, hi in zip(rows, lows, highs) if annotate else ():
+        for v in (lo, hi):
+            if np.isfinite(v) and v != base:
+                ax.annotate(_fmt(v), (v, i), xytext=(3 if v > base else -3, 0), textcoords="offset points",
+                            ha="left" if v > base else "right", va="center", fontsize="x-small")
     ax.axvline(base, color="k", lw=1)
     ax.set_yticks(range(len(table)), table["parameter"])
     ax.invert_yaxis()
