@@ -7,8 +7,10 @@ names the file, the row, the section id, the column and the value.
 
 Each section's chain is one task on a ``dask.distributed`` client (:func:`run_corridor`):
 
-    generated cut profile (or a scenario file) -> simulation.run (n blocks)
-      -> EnergyHazard at the barrier line (mass law x simulated velocities, rate of the section)
+    generated cut profile (or a scenario file)
+      -> mass-coupled EnergyHazard at the barrier line, as ``riskrf assess`` (n blocks with masses log-uniform
+         over the mass law, reach and speed by mass class; rate of the section; P(reach road) from the same run)
+      -> simulation.run of the scenario's own seeder (n blocks): the reference of the option effects
       -> MitigationStudy: road-user risk of every option, ranking by expected total cost
       -> one result row (RHRS score, risk of doing nothing, best option, its cost)
 
@@ -42,10 +44,15 @@ BUNDLED_MATERIALS = Path(__file__).resolve().parents[1] / "simulation" / "scenar
 #: :data:`riskrf.rhrs.RATE_FIELDS` prefixed with ``rhrs_``.
 GEOMETRY_COLUMNS = ("cut_height_m", "face_angle_deg", "ditch_width_m", "ditch_depth_m", "runout_to_road_m",
                     "road_width_m")
-NUMBER_COLUMNS = GEOMETRY_COLUMNS + ("chainage_from", "chainage_to", "falls_per_year", "falls_per_km_year",
+#: Optional geometry of a generated cut: a horizontal catch bench in the face (width 0: no bench).
+BENCH_COLUMNS = ("bench_width_m", "bench_height_m")
+NUMBER_COLUMNS = GEOMETRY_COLUMNS + BENCH_COLUMNS + ("chainage_from", "chainage_to", "falls_per_year", "falls_per_km_year",
                                      "falls_per_m2_year", "vehicles_per_day", "speed_kmh", "release_zone_share")
 RATE_COLUMNS = ("falls_per_year", "falls_per_km_year", "falls_per_m2_year")
-TEXT_COLUMNS = ("id", "scenario", "face_material", "ditch_material", "road_material", "options", "notes")
+#: Ways to give a section's rate: one of the rate columns, or ``inventory`` (the section's own inventory file).
+RATE_SOURCES = RATE_COLUMNS + ("inventory",)
+TEXT_COLUMNS = ("id", "scenario", "face_material", "ditch_material", "road_material", "options", "inventory",
+                "notes")
 RHRS_COLUMNS = tuple("rhrs_" + f for f in rhrs.RATE_FIELDS)
 ALL_COLUMNS = TEXT_COLUMNS + NUMBER_COLUMNS + RHRS_COLUMNS
 #: Per-metre cost fields of corridor options, multiplied by the section length.
@@ -76,6 +83,7 @@ class Section:
     options: tuple
     rating: rhrs.RHRSRating | None = None
     notes: str = ""
+    rate_source: str = ""
 
     @property
     def length_m(self) -> float:
@@ -151,19 +159,32 @@ def _section_seed(seed: int, sid: str) -> int:
 
 def cut_scenario_dict(materials: dict, settings: dict, *, cut_height_m, face_angle_deg, ditch_width_m, ditch_depth_m,
                       runout_to_road_m, road_width_m, face_material, ditch_material, road_material, seeder_mass,
-                      release_zone_share=0.3, density_kg_m3=2650.0, name="cut") -> dict:
+                      release_zone_share=0.3, density_kg_m3=2650.0, name="cut", bench_width_m=0.0,
+                      bench_height_m=0.0) -> dict:
     """Scenario dictionary of a generated rock cut (x increases towards the road, z up, metres).
 
     crest plateau (CREST_M) -> rock face of ``cut_height_m`` at ``face_angle_deg`` -> ditch of
     ``ditch_width_m`` x ``ditch_depth_m`` at the toe (walls 0.25H:1V on the face side and 1H:1V on the road
     side, as :mod:`riskrf.measures`) -> flat shoulder ``runout_to_road_m`` -> road ``road_width_m`` -> verge.
-    Blocks are released from the upper ``release_zone_share`` of the face.  Collectors: ``barrier`` at the
-    middle of the shoulder (at the ditch's outer rim without a shoulder), ``road`` 0.01 m onto the road.
+    With ``bench_width_m`` > 0 the face is interrupted at ``bench_height_m`` above the toe by a horizontal catch
+    bench of that width (surface of ``ditch_material``: debris collects on it as in a ditch), both faces at
+    ``face_angle_deg``.  Blocks are released from the upper ``release_zone_share`` of the (upper) face.
+    Collectors: ``barrier`` at the middle of the shoulder (at the ditch's outer rim without a shoulder), ``road``
+    0.01 m onto the road.
     """
     from .measures import DITCH_INNER_SLOPE_HV, DITCH_OUTER_SLOPE_HV
     h, ang = float(cut_height_m), math.radians(float(face_angle_deg))
-    x_toe = CREST_M + h / math.tan(ang)
-    xs, zs, mats = [0.0, CREST_M, x_toe], [h, h, 0.0], [face_material, face_material]
+    wb, hb = float(bench_width_m), float(bench_height_m)
+    if wb > 0 and not 0 < hb < h:
+        raise ValueError(f"bench_height_m = {hb:g} must lie strictly between 0 and cut_height_m = {h:g}")
+    if wb > 0:
+        x_upper = CREST_M + (h - hb) / math.tan(ang)
+        x_toe = x_upper + wb + hb / math.tan(ang)
+        xs, zs = [0.0, CREST_M, x_upper, x_upper + wb, x_toe], [h, h, hb, hb, 0.0]
+        mats = [face_material, face_material, ditch_material, face_material]
+    else:
+        x_toe = x_upper = CREST_M + h / math.tan(ang)
+        xs, zs, mats = [0.0, CREST_M, x_toe], [h, h, 0.0], [face_material, face_material]
     w, d = float(ditch_width_m), float(ditch_depth_m)
     if w > 0 and d > 0:
         a, c = DITCH_INNER_SLOPE_HV * d, DITCH_OUTER_SLOPE_HV * d
@@ -185,8 +206,8 @@ def cut_scenario_dict(materials: dict, settings: dict, *, cut_height_m, face_ang
     zs += [0.0, 0.0]
     mats += [road_material, ditch_material]
     barrier_x = x_rim + r / 2 if r > 0 else x_rim + 0.005
-    face_top = CREST_M + 0.02 * (x_toe - CREST_M)
-    face_low = CREST_M + float(release_zone_share) * (x_toe - CREST_M)
+    face_top = CREST_M + 0.02 * (x_upper - CREST_M)
+    face_low = CREST_M + float(release_zone_share) * (x_upper - CREST_M)
     return {"name": name, "description": "generated rock cut (riskrf.corridor)",
             "profile": {"x": xs, "z": zs, "materials": mats}, "materials": materials,
             "seeder": {"type": "line", "x": [face_top, face_low], "height_m": 0.5, "mass_kg": seeder_mass,
@@ -201,6 +222,42 @@ def _unknown(keys, allowed, where, source):
             close = difflib.get_close_matches(str(key), list(allowed), n=1)
             raise CorridorError(f"{source}: unknown field {where}{key!r}" + (f"; did you mean {close[0]!r}?" if close
                                                                            else f"; allowed: {sorted(allowed)}"))
+
+
+def _face_area(num: dict, length_m: float, where: str, what: str) -> float:
+    """Rock-face area [m2] of a section: length x the face's slope length (height / sin angle)."""
+    if "cut_height_m" not in num or "face_angle_deg" not in num:
+        raise CorridorError(f"{where}: {what} needs cut_height_m and face_angle_deg (the face area is the section "
+                            "length x the face's slope length)")
+    return length_m * num["cut_height_m"] / math.sin(math.radians(num["face_angle_deg"]))
+
+
+def _shared_rate(table, base: Path, m_min_kg: float, source: str):
+    """``[rates]``: a corridor-wide inventory shared among the sections that give no rate of their own, in
+    proportion to their length (``share = "km"``) or rock-face area (``share = "m2"``).  ``covered_length_km`` /
+    ``covered_face_area_m2``: what the inventory covers (default: the sharing sections together).
+    Returns None or dict(rate, share, covered, note)."""
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise CorridorError(f"{source}: [rates] must be a table")
+    _unknown(table, {"inventory", "share", "covered_length_km", "covered_face_area_m2"}, "rates.", source)
+    if "inventory" not in table:
+        raise CorridorError(f"{source}: [rates] needs inventory = \"file\" (the corridor-wide inventory)")
+    share = table.get("share")
+    if share not in ("km", "m2"):
+        raise CorridorError(f"{source}: rates.share = {share!r} must be 'km' (by section length) or 'm2' (by "
+                            "rock-face area)")
+    key = "covered_length_km" if share == "km" else "covered_face_area_m2"
+    other = "covered_face_area_m2" if share == "km" else "covered_length_km"
+    if other in table:
+        raise CorridorError(f"{source}: rates.{other} does not apply with share = {share!r} (give {key})")
+    cov = table.get(key)
+    if cov is not None and (isinstance(cov, bool) or not isinstance(cov, (int, float)) or not cov > 0):
+        raise CorridorError(f"{source}: rates.{key} = {cov!r} must be a number > 0")
+    inv_path = (base / str(table["inventory"])).resolve()
+    rate, note = inventory_rate(inv_path, m_min_kg, f"{source}: rates.inventory = {table['inventory']!r}")
+    return {"rate": rate, "share": share, "covered": None if cov is None else float(cov), "note": note}
 
 
 def _mass_law(table: dict, base: Path, source: str):
@@ -238,6 +295,31 @@ def _mass_law(table: dict, base: Path, source: str):
     return gr, note
 
 
+def inventory_rate(path: Path, m_min_kg: float, where: str) -> tuple[float, str]:
+    """Falls >= ``m_min_kg`` per year of an inventory file: :func:`riskrf.read_inventory` (its sidecar gives the
+    record period) and the power law fitted above the corridor's m_min (:func:`riskrf.fit_gutenberg_richter`,
+    whose rate_min is the falls >= m_min over the record length; its b is reported, the corridor's mass law is
+    unchanged).  Falls without a size are left out, as in every size fit.  Returns (rate [1/yr], note)."""
+    import warnings
+
+    from .inventory import read_inventory
+    from .power_law import fit_gutenberg_richter
+    if not path.exists():
+        raise CorridorError(f"{where}: file not found ({path})")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            inv = read_inventory(path)
+        n = int(np.sum(inv.masses >= m_min_kg))
+        if n == 0:
+            raise ValueError(f"no fall of {inv.masses.size} with a size is >= m_min = {m_min_kg:g} kg")
+        fit = fit_gutenberg_richter(inv.masses, inv.duration_years, m_min=m_min_kg)
+    except ValueError as exc:
+        raise CorridorError(f"{where}: {exc}") from None
+    return float(fit.rate_min), (f"inventory {path.name}: {fit.n_tail} falls >= {m_min_kg:g} kg in "
+                                 f"{inv.duration_years:.4g} yr (power law b = {fit.b:.3g}), {fit.rate_min:.4g}/yr")
+
+
 def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int | None = None,
                   decimal: str | None = None, encoding: str | None = None) -> Corridor:
     """Read and check a corridor file and its sections table before any work.
@@ -263,7 +345,7 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
         raise CorridorError(f"{path}: not valid TOML: {exc}") from exc
     src = str(path)
     _unknown(data, {"corridor", "defaults", "mass", "materials", "traffic", "consequences", "economics", "criteria",
-                    "uncertainty", "options"}, "", src)
+                    "uncertainty", "options", "rates"}, "", src)
     cor = data.get("corridor", {})
     _unknown(cor, {"name", "description", "sections", "seed", "n_blocks", "option_blocks", "chainage_unit",
                    "rate_basis", "rhrs_cap_points", "sections_sheet", "sections_header_row", "sections_decimal",
@@ -293,9 +375,11 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
         raise CorridorError(f"{src}: corridor.rate_basis = {basis!r} must be 'road' (rates count falls reaching "
                             "the road, as a road maintenance record does) or 'release' (falls >= m_min released)")
     defaults = data.get("defaults", {})
-    _unknown(defaults, [c for c in ALL_COLUMNS if c not in ("id", "chainage_from", "chainage_to")] + ["seeder_mass_kg"],
+    _unknown(defaults, [c for c in ALL_COLUMNS if c not in ("id", "chainage_from", "chainage_to", "inventory")]
+             + ["seeder_mass_kg"],
              "defaults.", src)
     gr, mass_note = _mass_law(data.get("mass", {}), path.parent, src)
+    shared = _shared_rate(data.get("rates"), path.parent, float(gr.m_min), src)
 
     mat = data.get("materials", {})
     _unknown(mat, {"scenario"}, "materials.", src)
@@ -361,6 +445,10 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
         raise CorridorError(f"{tsrc}: the sections table has no rows")
     scale = 1000.0 if unit == "km" else 1.0
     errors, sections, bad_rows = [], [], set()
+    fallback = set()          # corridor-wide fallbacks that at least one section used
+    inv_cache, weights = {}, {}
+    default_seeder = {"dist": "lognormal", "median": float(gr.m_min) * 2, "sigma": 1.0,
+                      "max": float(gr.m_max or gr.m_min * 1e4)}
     seen = {}
     for i, raw in df.iterrows():
         row = int(file_rows[i])  # file line / spreadsheet row (header row 1 unless header_row says otherwise)
@@ -408,22 +496,30 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                 if c in num and num[c] < 0 or (c == "speed_kmh" and c in num and num[c] == 0):
                     raise CorridorError(f"{where}: column {c!r} = {num[c]:g} must be > 0" if c == "speed_kmh" else
                                         f"{where}: column {c!r} = {num[c]:g} must be >= 0")
-            given_rates = [c for c in RATE_COLUMNS if c in num]
-            if len(given_rates) != 1:
-                raise CorridorError(f"{where}: give exactly one of falls_per_year, falls_per_km_year or "
-                                    f"falls_per_m2_year (own rate, or a corridor rate per km of road or per m2 of rock "
-                                    f"face); got {given_rates or 'none'}")
+            given_rates = [c for c in RATE_COLUMNS if c in num] + (["inventory"] if vals["inventory"] else [])
+            if len(given_rates) > 1 or (not given_rates and shared is None):
+                raise CorridorError(f"{where}: give exactly one of falls_per_year, falls_per_km_year, "
+                                    f"falls_per_m2_year or inventory (own rate or inventory, or a corridor rate per km "
+                                    f"of road or per m2 of rock face; or a corridor-wide [rates] inventory); got "
+                                    f"{given_rates or 'none'}")
+            rate_source = given_rates[0] if given_rates else "shared"
             if "falls_per_year" in num:
                 rate = num["falls_per_year"]
             elif "falls_per_km_year" in num:
                 rate = num["falls_per_km_year"] * (c1 - c0) / 1000
-            else:
-                if "cut_height_m" not in num or "face_angle_deg" not in num:
-                    raise CorridorError(f"{where}: falls_per_m2_year needs cut_height_m and face_angle_deg (the face "
-                                        "area is the section length x the face's slope length)")
-                face_m2 = (c1 - c0) * num["cut_height_m"] / math.sin(math.radians(num["face_angle_deg"]))
-                rate = num["falls_per_m2_year"] * face_m2
-            if not rate > 0:
+            elif "falls_per_m2_year" in num:
+                rate = num["falls_per_m2_year"] * _face_area(num, c1 - c0, where, "falls_per_m2_year")
+            elif vals["inventory"]:
+                inv_path = (path.parent / str(vals["inventory"])).resolve()
+                if inv_path not in inv_cache:
+                    inv_cache[inv_path] = inventory_rate(inv_path, float(gr.m_min),
+                                                         f"{where}: column 'inventory' = {vals['inventory']!r}")
+                rate, rate_source = inv_cache[inv_path]
+            else:                                  # a share of the corridor-wide inventory, set once all rows are read
+                weight = _face_area(num, c1 - c0, where, "rates.share = 'm2'") if shared["share"] == "m2" \
+                    else (c1 - c0) / 1000
+                rate = math.nan
+            if rate_source != "shared" and not rate > 0:
                 raise CorridorError(f"{where}: the section's rate of falls is {rate:g} per year; a section without "
                                     "falls needs no assessment (remove it or give a rate > 0)")
             # geometry
@@ -456,6 +552,13 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                     raise CorridorError(f"{where}: column 'ditch_width_m' = {g['ditch_width_m']:g} is too narrow for "
                                         f"ditch_depth_m = {g['ditch_depth_m']:g} (walls 0.25H:1V and 1H:1V need more "
                                         f"than {1.25 * g['ditch_depth_m']:g} m)")
+                bench = {c: num.get(c, 0.0) for c in BENCH_COLUMNS}
+                if bench["bench_width_m"] < 0:
+                    raise CorridorError(f"{where}: column 'bench_width_m' = {bench['bench_width_m']:g} must be >= 0")
+                if bench["bench_width_m"] > 0 and not 0 < bench["bench_height_m"] < g["cut_height_m"]:
+                    raise CorridorError(f"{where}: column 'bench_height_m' = {bench['bench_height_m']:g} must lie "
+                                        f"strictly between 0 and cut_height_m = {g['cut_height_m']:g} (a bench "
+                                        f"{bench['bench_width_m']:g} m wide is given)")
                 share = num.get("release_zone_share", 0.3)
                 if not 0 < share <= 1:
                     raise CorridorError(f"{where}: column 'release_zone_share' = {share:g} must lie in (0, 1]")
@@ -465,17 +568,20 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                     if m not in materials:
                         raise CorridorError(f"{where}: column {c!r} = {m!r} is not a material of {template_path.name} "
                                             f"({', '.join(materials)})")
-                seeder_mass = defaults.get("seeder_mass_kg", {"dist": "lognormal", "median": float(gr.m_min) * 2,
-                                                              "sigma": 1.0, "max": float(gr.m_max or gr.m_min * 1e4)})
+                seeder_mass = defaults.get("seeder_mass_kg", default_seeder)
+                if "seeder_mass_kg" not in defaults:
+                    fallback.add("seeder_mass_kg")
                 try:
-                    sc = scenario_from_dict(cut_scenario_dict(materials, settings, **g, **mats,
+                    sc = scenario_from_dict(cut_scenario_dict(materials, settings, **g, **mats, **bench,
                                                               seeder_mass=seeder_mass, release_zone_share=share,
                                                               name=f"section {sid}"), source=where)
                 except ScenarioError as exc:
                     raise CorridorError(str(exc)) from exc
                 geometry = (f"generated cut {g['cut_height_m']:g} m at {g['face_angle_deg']:g} deg, ditch "
                             f"{g['ditch_width_m']:g} x {g['ditch_depth_m']:g} m, {g['runout_to_road_m']:g} m to a "
-                            f"{g['road_width_m']:g} m road")
+                            f"{g['road_width_m']:g} m road"
+                            + (f", bench {bench['bench_width_m']:g} m wide at {bench['bench_height_m']:g} m"
+                               if bench["bench_width_m"] > 0 else ""))
             opts = tuple(option_names)
             if vals["options"]:
                 opts = tuple(o.strip() for o in str(vals["options"]).split(";") if o.strip())
@@ -487,6 +593,7 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                     raise CorridorError(f"{where}: column 'options' must name at least two options to compare")
             vpd = num.get("vehicles_per_day", exposure.vehicles_per_day)
             speed = num.get("speed_kmh", exposure.speed_kmh)
+            fallback.update(c for c in ("vehicles_per_day", "speed_kmh") if c not in num)
             rating = None
             given = {c.removeprefix("rhrs_"): num[c] for c in RHRS_COLUMNS if c in num}
             if given:
@@ -500,25 +607,57 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                     rating = rhrs.rate(cap_points=rhrs_cap, **attrs)
                 except (ValueError, TypeError) as exc:
                     raise CorridorError(f"{where}: RHRS: {exc}") from exc
+            if rate_source == "shared":
+                weights[sid] = weight
             sections.append(Section(id=sid, row=row, chainage_from_m=c0, chainage_to_m=c1, scenario=sc,
                                     geometry=geometry, falls_per_year=float(rate), vehicles_per_day=float(vpd),
                                     speed_kmh=float(speed), options=opts, rating=rating,
-                                    notes=str(vals["notes"] or "")))
+                                    notes=str(vals["notes"] or ""), rate_source=rate_source))
         except CorridorError as exc:
             errors.append(str(exc))
             bad_rows.add(row)
+    if weights:
+        unit = "km" if shared["share"] == "km" else "m2 of face"
+        covered = shared["covered"] if shared["covered"] is not None else sum(weights.values())
+        if covered < sum(weights.values()) * (1 - 1e-9):
+            raise CorridorError(f"{src}: rates.covered_{'length_km' if shared['share'] == 'km' else 'face_area_m2'} "
+                                f"= {covered:g} is less than the sharing sections' {sum(weights.values()):g} {unit}")
+        per = shared["rate"] / covered
+        sections = [replace(s, falls_per_year=per * weights[s.id],
+                            rate_source=f"share of the corridor {shared['note']}: {per:.4g}/yr per {unit} x "
+                                        f"{weights[s.id]:.4g} {unit}") if s.id in weights else s for s in sections]
     ordered = sorted(sections, key=lambda s: s.chainage_from_m)
     for a, b in zip(ordered[:-1], ordered[1:]):
         if b.chainage_from_m < a.chainage_to_m:
             errors.append(f"{tsrc}: row {b.row} (section {b.id!r}): chainage {b.chainage_from_m:g}-{b.chainage_to_m:g} "
                           f"m overlaps row {a.row} (section {a.id!r}, {a.chainage_from_m:g}-{a.chainage_to_m:g} m)")
             bad_rows.add(b.row)
+    # a section's seed and partition file are keyed by crc32(id): two ids with one checksum would share both
+    by_key = {}
+    for sec in sorted(sections, key=lambda s: s.row):
+        k = zlib.crc32(sec.id.encode("utf-8"))
+        if k in by_key:
+            first = by_key[k]
+            errors.append(f"{tsrc}: row {sec.row} (section {sec.id!r}): column 'id' = {sec.id!r} has the same crc32 "
+                          f"checksum ({k:08x}) as row {first.row} (section {first.id!r}), so the two would share a "
+                          "seed and a partition file; rename one of them")
+            bad_rows.add(sec.row)
+        else:
+            by_key[k] = sec
     if errors and not keep_going:
         raise CorridorError(f"{len(errors)} bad section row(s) (use --keep-going to run the others):\n  "
                             + "\n  ".join(errors))
     ordered = [s for s in ordered if s.row not in bad_rows]
     if not ordered:
         raise CorridorError(f"{tsrc}: no valid section to assess:\n  " + "\n  ".join(errors))
+    # a default is listed only where a section uses it: traffic per section falls back on [traffic] only when
+    # neither the row nor [defaults] gives it; the exposed length is always the section's length
+    used = [u for u in used if not u.startswith("traffic.exposed_length_m")
+            and not any(u.startswith(f"traffic.{c} ") and c not in fallback for c in ("vehicles_per_day", "speed_kmh"))]
+    if "seeder_mass_kg" in fallback:
+        used.append(f"defaults.seeder_mass_kg = {default_seeder!r} (default; ASSUMPTION: masses [kg] of the "
+                    "generated cuts' own seeder, used only for the option effects (the reference run of the "
+                    "mitigation study); the hazard is mass-coupled over the mass law)")
     return Corridor(name=str(cor.get("name", path.stem)), path=path, sections=tuple(ordered), mass=gr,
                     mass_note=mass_note, rate_basis=basis, study=study, options=options,
                     n_blocks=int(cor.get("n_blocks", 2000)), option_blocks=int(cor.get("option_blocks", 1000)),
@@ -529,29 +668,65 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
 # ---------------------------------------------------------------------------------------------------------
 # one section (a task)
 # ---------------------------------------------------------------------------------------------------------
+def _road_reach(hazard, result, mm) -> float:
+    """P(a fall of mass model ``mm`` reaches the road line) from the mass-coupled run ``result`` behind ``hazard``
+    (the same blocks and mass classes as the hazard's barrier samples, reach counted per class)."""
+    from .mass_coupling import MassCoupledSamples
+    s = hazard.velocity
+    road = np.full(result.n, np.nan)
+    road[np.unique(result.collector("road", first_only=True)["block"].to_numpy())] = 1.0
+    return float(MassCoupledSamples(s.mass_kg, road, road, s.edges_kg, "road").reach_probability(mm))
+
+
 def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = None, seed: int | None = None) -> dict:
     """The whole chain for one section; returns one row of the corridor table (plain numbers and strings).
 
+    The hazard at the barrier line is mass-coupled exactly as in ``riskrf assess``
+    (:func:`riskrf.mass_coupling.simulate_energy_hazard`: ``n`` blocks with masses log-uniform over the corridor's
+    mass law, reach and speed by mass class).  The share of falls reaching the road and, for ``rate_basis = "road"``,
+    the release rate behind the recorded road falls (given / P(reach road)) come from the same mass-coupled run.
+    A second run of ``n`` blocks with the scenario's own seeder is the reference of the option effects
+    (:class:`~riskrf.mitigation.MitigationStudy` ``reference`` and ``context``), as in ``riskrf assess``.
     Deterministic given the corridor seed and the section id (see the module docstring).
     """
     import simulation
 
-    from .annual_hazard import EnergyHazard
-    from .assess import road_share
+    from .impact_energy import mass_model
+    from .mass_coupling import simulate_energy_hazard
     from .measures import SimulationContext
     from .mitigation import MitigationStudy
 
     n = int(n_blocks or corridor.n_blocks)
     s_seed = _section_seed(corridor.seed if seed is None else seed, section.id)
     t0 = time.perf_counter()
-    result = simulation.run(section.scenario, n=n, seed=s_seed, record_paths=0)
-    reach_barrier = float(result.reach_probability("barrier")[0])
-    reach_road = float(result.reach_probability("road")[0])
+    mm = mass_model(corridor.mass)
     row = {"id": section.id, "chainage_from_m": section.chainage_from_m, "chainage_to_m": section.chainage_to_m,
            "length_m": section.length_m, "geometry": section.geometry,
            "rhrs_score": section.rating.total if section.rating is not None else np.nan,
-           "rate_given_per_year": section.falls_per_year, "rate_basis": corridor.rate_basis,
-           "reach_barrier": reach_barrier, "reach_road": reach_road, "n_blocks": n, "seed": s_seed}
+           "rate_given_per_year": section.falls_per_year, "rate_source": section.rate_source,
+           "rate_basis": corridor.rate_basis, "n_blocks": n,
+           "seed": s_seed}
+    try:
+        # the simulated mass range is chosen at the given rate (for a truncated law, as the corridors ship, it is
+        # m_min-m_max whatever the rate; beyond it the hazard's notes state the extrapolated share)
+        hazard, coupled = simulate_energy_hazard(corridor.mass, section.scenario, "barrier",
+                                                 rate_per_year=section.falls_per_year, n=n, seed=s_seed)
+    except ValueError as exc:
+        if "no simulated block reached" not in str(exc):
+            raise
+        if corridor.rate_basis == "road":
+            raise ValueError(f"section {section.id!r}: no simulated block of {n:,} reached the barrier line (nor the "
+                             "road), so the release rate behind the recorded road falls cannot be derived; check "
+                             "the geometry or use rate_basis = 'release'") from None
+        row.update({"reach_barrier": 0.0, "reach_road": 0.0, "release_falls_per_year": section.falls_per_year,
+                    "road_falls_per_year": 0.0, "deaths_per_year": 0.0, "individual_risk": 0.0,
+                    "expected_annual_loss": 0.0, "best_option": "do nothing (no block reaches the barrier line)",
+                    "best_option_capital": 0.0, "best_option_total_cost": 0.0, "best_deaths_per_year": 0.0,
+                    "best_individual_risk": 0.0, "meets_criteria": True, "note": "no simulated block reached the line",
+                    "seconds": time.perf_counter() - t0})
+        return row
+    reach_barrier = float(hazard.reach_probability)
+    reach_road = min(_road_reach(hazard, coupled, mm), reach_barrier)
     lim = corridor.study["criteria"].individual_risk_per_year
     if corridor.rate_basis == "road":
         if reach_road == 0:
@@ -561,15 +736,9 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
         release = section.falls_per_year / reach_road
     else:
         release = section.falls_per_year
-    row["release_falls_per_year"] = release
-    if reach_barrier == 0:
-        row.update({"road_falls_per_year": 0.0, "deaths_per_year": 0.0, "individual_risk": 0.0,
-                    "expected_annual_loss": 0.0, "best_option": "do nothing (no block reaches the barrier line)",
-                    "best_option_capital": 0.0, "best_option_total_cost": 0.0, "best_deaths_per_year": 0.0,
-                    "best_individual_risk": 0.0, "meets_criteria": True, "note": "no simulated block reached the line",
-                    "seconds": time.perf_counter() - t0})
-        return row
-    hazard = EnergyHazard.from_simulation(corridor.mass, result, "barrier", rate_per_year=release)
+    hazard = replace(hazard, rate_per_year=release)
+    row.update({"reach_barrier": reach_barrier, "reach_road": reach_road, "release_falls_per_year": release})
+    result = simulation.run(section.scenario, n=n, seed=s_seed, record_paths=0)    # the seeder's run: option effects
     length = section.length_m
     opts = []
     for o, pm in corridor.options:
@@ -584,7 +753,7 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
     unc = replace(corridor.study["uncertainty"], seed=s_seed % (2 ** 32))
     study = MitigationStudy(hazard=hazard, options=tuple(opts), exposure=exposure,
                             consequences=corridor.study["consequences"], economics=corridor.study["economics"],
-                            road_share=road_share(result, "barrier", "road"), source=str(corridor.path),
+                            road_share=reach_road / reach_barrier, source=str(corridor.path),
                             context=SimulationContext(section.scenario, "barrier", "road",
                                                       n_blocks=corridor.option_blocks, seed=s_seed % (2 ** 32),
                                                       threads=1),     # parallel across sections, not within
@@ -658,8 +827,9 @@ class CorridorResult:
         """Sections ranked by quantitative risk (deaths per year of doing nothing) with the RHRS rank beside it,
         the best option and its cost; ``rank_difference`` = RHRS rank - risk rank (large: they disagree)."""
         t = self.table.copy()
-        t["rank_risk"] = t["deaths_per_year"].rank(ascending=False, method="min").astype(int)
-        t["rank_rhrs"] = t["rhrs_score"].rank(ascending=False, method="min")
+        # ranks of values rounded to 12 significant digits: risks equal but for float noise share a rank, stably
+        t["rank_risk"] = _sig12(t["deaths_per_year"]).rank(ascending=False, method="min").astype(int)
+        t["rank_rhrs"] = _sig12(t["rhrs_score"]).rank(ascending=False, method="min").astype("Int64")
         t["rank_difference"] = t["rank_rhrs"] - t["rank_risk"]
         t["expected_annual_cost_per_km"] = t["expected_annual_loss_pv"] / _pv(self.corridor) / (t["length_m"] / 1000)
         cols = ["rank_risk", "rank_rhrs", "rank_difference", "id", "chainage_from_m", "chainage_to_m", "rhrs_score",
@@ -701,6 +871,14 @@ class CorridorResult:
                 "defaults_used": list(self.corridor.defaults_used)}
 
 
+def _sig12(values: pd.Series) -> pd.Series:
+    """Values rounded to 12 significant digits (NaN kept), for ranking without float-noise ties."""
+    x = values.to_numpy(dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        digits = np.where(np.isfinite(x) & (x != 0), 11 - np.floor(np.log10(np.abs(x))), 0)
+    return pd.Series([round(v, int(d)) if np.isfinite(v) else v for v, d in zip(x, digits)], index=values.index)
+
+
 def _pv(corridor) -> float:
     from .economics import pv_factor
     e = corridor.study["economics"]
@@ -729,6 +907,10 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
     (the cluster's dashboard address).
     """
     from distributed import as_completed
+    if n_blocks is not None and (isinstance(n_blocks, bool) or not isinstance(n_blocks, (int, np.integer))
+                                 or n_blocks < 100):
+        raise ValueError(f"n_blocks = {n_blocks!r} must be a whole number >= 100 (the mass-coupled hazard needs at "
+                         "least 20 blocks in each of at least 4 mass classes)")
     t0 = time.perf_counter()
     own = client is None
     cluster = None

@@ -30,7 +30,11 @@ presence of water, rockfall history) score 3, 9, 27 or 81 for the four published
 
 Scores are not capped (a 130-ft slope scores 3**5.2 = 302); :func:`rate` reports each category
 score and the total.  The formulas and class points are those listed in
-shared/research/domain-methods.md section 4.3 [R] (Pierson & Van Vickle 1993 summary sheet).
+shared/research/domain-methods.md section 4.3 [R] (Pierson & Van Vickle 1993 summary sheet): [R]
+because no page of the manual itself could be read to cite (the copies of FHWA-SA-93-057 and
+FHWA-OR-GI-92-05 found in the reference library hold only their title pages, abstracts, preface and
+contents; see the README's RHRS section).  The 3 / 9 / 27 / 81-point benchmarks of every category
+are checked against the SI criteria printed by Taherynia et al. (2014), Table 9.
 
 Checked against a published rated slope: Taherynia, Mohammadi & Ajalloeian (2014), J. Geol. Res.
 2014:763598, Table 10. With ``cap_points=100`` and scores rounded to integers, as that paper prints

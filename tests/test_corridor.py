@@ -59,8 +59,9 @@ def test_one_and_two_workers_equal_serial(runs):
 
 def test_rates_and_ranking(runs, corridor):
     t = runs[2].table
-    # rate_basis "road": the recorded rate is falls reaching the road, so the do-nothing road falls equal it
-    np.testing.assert_allclose(t["road_falls_per_year"], t["rate_given_per_year"], rtol=1e-9)
+    # rate_basis "road": the recorded rate is falls reaching the road, so the do-nothing road falls equal it (to the
+    # mitigation engine's mass grid: it bins the mass law where the mass-coupled reach uses Gauss-Legendre nodes)
+    np.testing.assert_allclose(t["road_falls_per_year"], t["rate_given_per_year"], rtol=1e-3)
     np.testing.assert_allclose(t["release_falls_per_year"] * t["reach_road"], t["rate_given_per_year"], rtol=1e-12)
     s = runs[2].summary()
     assert list(s["rank_risk"]) == sorted(s["rank_risk"])
@@ -132,7 +133,7 @@ def test_corridor_file_errors(tmp_path):
         p = _write(tmp_path, HEAD + "A,0,100,20,3,1,0.5,\n")
         p.write_text(p.read_text().replace("seed = 7", "sead = 7"))
         cr.load_corridor(p)
-    with pytest.raises(cr.CorridorError, match="exactly one of falls_per_year, falls_per_km_year or falls_per_m2_year"):
+    with pytest.raises(cr.CorridorError, match="exactly one of falls_per_year, falls_per_km_year, falls_per_m2_year or inventory"):
         cr.load_corridor(_write(tmp_path, HEAD.replace(",scenario", ",falls_per_km_year,scenario")
                                 .replace("falls_per_year,falls_per_km_year", "falls_per_year,falls_per_km_year")
                                 + "A,0,100,20,3,1,0.5,2,\n"))
@@ -276,7 +277,22 @@ def test_release_rate_basis(tmp_path):
     row = cr.assess_section(c.sections[0], c, N)
     # released falls as given; those reaching the road = given x simulated share reaching the road line
     assert row["release_falls_per_year"] == 0.5
-    assert row["road_falls_per_year"] == pytest.approx(0.5 * row["reach_road"], rel=1e-9)
+    assert row["road_falls_per_year"] == pytest.approx(0.5 * row["reach_road"], rel=1e-3)
+
+
+def test_hazard_is_mass_coupled_as_in_assess(corridor, runs):
+    """Each section's reach probabilities are those of riskrf.energy_hazard (the engine of ``riskrf assess``) on
+    the section's scenario with the section's seed: blocks across the mass law, reach by mass class."""
+    import riskrf
+    from riskrf.mass_coupling import MassCoupledSamples
+    row = runs["serial"].set_index("id").loc["A"]
+    sec = corridor.section("A")
+    for line, col in (("barrier", "reach_barrier"), ("road", "reach_road")):
+        hz = riskrf.energy_hazard(corridor.mass, sec.scenario, line, rate_per_year=0.5, n=N, seed=int(row["seed"]))
+        assert isinstance(hz.velocity, MassCoupledSamples)
+        assert row[col] == pytest.approx(hz.reach_probability, rel=1e-12)
+    # heavier blocks behave differently: the reach probability differs between the lightest and heaviest class
+    assert hz.velocity.reach_by_class[0] != hz.velocity.reach_by_class[-1]
 
 
 E6 = Path(__file__).resolve().parents[1] / "corridors" / "e6_drivdalen"
@@ -305,3 +321,188 @@ def test_e6_builder_reproduces_the_shipped_tables(tmp_path):
     assert mod.main([str(gml)]) == 0
     for f in ("e6_sections.csv", "e6_rockfalls.csv", "e6_volumes.csv"):
         assert (tmp_path / f).read_text() == (E6 / f).read_text()
+
+
+# ---- rates from inventories (issue 14, Build 1) ----------------------------------------------------------------
+REPO = Path(__file__).resolve().parents[1]
+E6_VOLUMES = REPO / "corridors" / "e6_drivdalen" / "e6_volumes.csv"       # 34 real NVDB volumes, 1-30 m3, 15 yr
+LAUTER_2015 = REPO / "inventories" / "lauterbrunnen" / "lauterbrunnen_tls_2015.csv"   # 122 real TLS falls, 1.5 yr
+HEAD_NR = "id,chainage_from,chainage_to,cut_height_m,ditch_width_m,runout_to_road_m"
+
+
+def test_section_inventory_column_gives_its_rate(tmp_path):
+    # small.toml's mass law has m_min = 100 kg: every fall of both files is heavier (the smallest: 1 m3 = 2650 kg
+    # and 0.055 m3 x 2650 kg/m3 = 145.75 kg), so the rate is the count over the record length of each sidecar:
+    # 34 falls in 2000-01-01..2014-12-31 (5479 days = 15.0007 yr) and 122 falls in 1.5 yr
+    rows = (f"{HEAD_NR},falls_per_year,inventory\nA,0,200,25,3,1,,{E6_VOLUMES}\nB,200,350,12,3,1,,{LAUTER_2015}\n"
+            "C,400,700,40,2,0,1.5,\n")
+    c = cr.load_corridor(_write(tmp_path, rows))
+    assert c.section("A").falls_per_year == pytest.approx(34 / (5479 / 365.25), rel=1e-12)
+    assert c.section("B").falls_per_year == pytest.approx(122 / 1.5, rel=1e-12)
+    assert c.section("C").falls_per_year == 1.5
+    assert "e6_volumes.csv: 34 falls >= 100 kg" in c.section("A").rate_source
+    # a rate column and an inventory on one row; a missing file; an inventory without a fall >= m_min
+    bad = (f"{HEAD_NR},falls_per_year,inventory\nA,0,200,25,3,1,0.5,{E6_VOLUMES}\n"
+           f"B,200,350,12,3,1,,{tmp_path / 'nowhere.csv'}\nC,400,700,40,2,0,,{E6_VOLUMES}\n")
+    path = _write(tmp_path, bad)
+    path.write_text(path.read_text().replace("m_min_kg = 100.0", "m_min_kg = 1.0e5").replace("m_max_kg = 1.0e5",
+                                                                                             "m_max_kg = 1.0e7"))
+    with pytest.raises(cr.CorridorError) as e:
+        cr.load_corridor(path)
+    msg = str(e.value)
+    assert "row 2 (section 'A'): give exactly one of" in msg and "['falls_per_year', 'inventory']" in msg
+    assert "row 3 (section 'B'): column 'inventory' = " in msg and "file not found" in msg
+    assert "row 4 (section 'C'): column 'inventory' = " in msg and "is >= m_min = 100000 kg" in msg
+
+
+def test_corridor_wide_inventory_shared_by_km_and_by_face_area(tmp_path):
+    rate = 34 / (5479 / 365.25)                    # e6_volumes.csv: falls >= 100 kg per year (see above)
+    rows = f"{HEAD_NR}\nA,0,200,25,3,1\nB,200,350,12,3,1\nC,400,700,40,2,0\n"
+    path = _write(tmp_path, rows, f'\n[rates]\ninventory = "{E6_VOLUMES}"\nshare = "km"\n')
+    c = cr.load_corridor(path)
+    # by km: the 0.65 km of the three sections share the rate
+    assert c.section("A").falls_per_year == pytest.approx(rate * 0.200 / 0.650, rel=1e-12)
+    assert sum(s.falls_per_year for s in c.sections) == pytest.approx(rate, rel=1e-12)
+    assert "share of the corridor inventory e6_volumes.csv" in c.section("B").rate_source
+    # the inventory covers 19 km of road, of which these sections are 0.65 km
+    path.write_text(path.read_text() + "covered_length_km = 19\n")
+    assert cr.load_corridor(path).section("C").falls_per_year == pytest.approx(rate * 0.3 / 19, rel=1e-12)
+    # by m2 of rock face: length x height / sin(60 deg) (face_angle_deg 60 in small.toml's defaults)
+    path.write_text(path.read_text().replace('share = "km"', 'share = "m2"').replace("covered_length_km = 19\n", ""))
+    area = {"A": 200 * 25, "B": 150 * 12, "C": 300 * 40}           # / sin(60 deg) cancels in the shares
+    c = cr.load_corridor(path)
+    for sid, a in area.items():
+        assert c.section(sid).falls_per_year == pytest.approx(rate * a / sum(area.values()), rel=1e-12)
+    # a row with its own rate keeps it; bad [rates] fields are named
+    path.write_text(path.read_text().replace('share = "m2"', 'share = "miles"'))
+    with pytest.raises(cr.CorridorError, match=r"rates.share = 'miles' must be 'km'"):
+        cr.load_corridor(path)
+    path.write_text(path.read_text().replace('share = "miles"', 'share = "km"\ncovered_length_km = 0.1'))
+    with pytest.raises(cr.CorridorError, match="covered_length_km = 0.1 is less than the sharing sections' 0.65 km"):
+        cr.load_corridor(path)
+
+
+# ---- load-only checks of further columns (issue 14, Build 1) ---------------------------------------------------
+def test_chainage_in_km(tmp_path):
+    rows = HEAD.replace(",scenario", ",falls_per_km_year,scenario").replace("falls_per_year,", "") + \
+        "A,0,0.2,25,3,1,2.5,\nB,0.2,0.35,12,3,1,2.5,\n"
+    path = _write(tmp_path, rows)
+    path.write_text(path.read_text().replace("[corridor]", '[corridor]\nchainage_unit = "km"'))
+    c = cr.load_corridor(path)
+    b = c.section("B")
+    assert (b.chainage_from_m, b.chainage_to_m) == (pytest.approx(200.0), pytest.approx(350.0))
+    assert b.falls_per_year == pytest.approx(2.5 * 0.15)        # falls per km of road x 0.15 km
+    (tmp_path / "s.csv").write_text((tmp_path / "s.csv").read_text().replace("B,0.2,0.35", "B,0.15,0.35"))
+    with pytest.raises(cr.CorridorError, match=r"chainage 150-350 m overlaps row 2 \(section 'A', 0-200 m\)"):
+        cr.load_corridor(path)
+
+
+def test_face_material_and_options_columns(tmp_path):
+    rows = (f"{HEAD_NR},falls_per_year,face_material,options\n"
+            "A,0,200,25,3,1,0.5,talus,do nothing;fence 1000 kJ\n"
+            "B,200,350,12,3,1,0.5,,\n")
+    c = cr.load_corridor(_write(tmp_path, rows))
+    a, b = c.section("A"), c.section("B")
+    def face(sec):
+        pr = sec.scenario.profile
+        return pr.material_names[pr.material_index[0]]
+    assert face(a) == "talus" and face(b) == "bedrock"
+    assert a.options == ("do nothing", "fence 1000 kJ") and b.options == ("do nothing", "fence 1000 kJ")
+    bad = (f"{HEAD_NR},falls_per_year,face_material,options\n"
+           "A,0,200,25,3,1,0.5,granite,\n"
+           "B,200,350,12,3,1,0.5,,fence 1000 kJ\n"
+           "C,400,700,40,2,0,1.5,,do nothing;net 500 kJ\n")
+    with pytest.raises(cr.CorridorError) as e:
+        cr.load_corridor(_write(tmp_path, bad))
+    msg = str(e.value)
+    assert "row 2 (section 'A'): column 'face_material' = 'granite' is not a material" in msg
+    assert "row 3 (section 'B'): column 'options' must name at least two options" in msg
+    assert "row 4 (section 'C'): column 'options' names ['net 500 kJ']" in msg
+
+
+def test_bench_in_generated_cut(tmp_path):
+    rows = f"{HEAD_NR},falls_per_year,bench_width_m,bench_height_m\nA,0,200,25,3,1,0.5,2,10\n"
+    c = cr.load_corridor(_write(tmp_path, rows))
+    p = c.section("A").scenario.profile
+    run = 1 / np.tan(np.radians(60))
+    x_upper = cr.CREST_M + 15 * run
+    np.testing.assert_allclose(p.x[:5], [0, cr.CREST_M, x_upper, x_upper + 2, x_upper + 2 + 10 * run])
+    np.testing.assert_allclose(p.z[:5], [25, 25, 10, 10, 0])
+    assert p.material_names[p.material_index[2]] == "soil"         # the bench surface: the ditch material
+    seeder_x = c.section("A").scenario.seeder
+    assert "bench 2 m wide at 10 m" in c.section("A").geometry and seeder_x is not None
+    with pytest.raises(cr.CorridorError, match=r"row 2 \(section 'A'\): column 'bench_height_m' = 25 must lie"):
+        cr.load_corridor(_write(tmp_path, rows.replace(",2,10", ",2,25")))
+
+
+def test_dask_scheduler_address_env_unreachable(tmp_path, monkeypatch, capsys):
+    import functools
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", "tcp://127.0.0.1:9")
+    monkeypatch.setattr(cr, "connect", functools.partial(cr.connect, timeout_s=1))
+    out = tmp_path / "out"
+    t0 = time.perf_counter()
+    rc = main(["corridor", str(DATA / "small.toml"), "--out", str(out)])
+    assert rc == 2 and time.perf_counter() - t0 < 15
+    assert "cannot reach the dask scheduler at 'tcp://127.0.0.1:9'" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+
+
+# ---- small errors ----------------------------------------------------------------------------------------------
+def test_crc32_collision_of_ids_refused(tmp_path):
+    # crc32(b"plumless") == crc32(b"buckeroo") == 0x4ddb0c25: they would share a seed and a partition file
+    rows = HEAD + "plumless,0,100,20,3,1,0.5,\nbuckeroo,100,200,20,3,1,0.5,\nC,200,300,20,3,1,0.5,\n"
+    with pytest.raises(cr.CorridorError, match=r"row 3 \(section 'buckeroo'\): column 'id' = 'buckeroo' has the "
+                                               r"same crc32 checksum \(4ddb0c25\) as row 2 \(section 'plumless'\)"):
+        cr.load_corridor(_write(tmp_path, rows))
+    assert [s.id for s in cr.load_corridor(_write(tmp_path, rows), keep_going=True).sections] == ["plumless", "C"]
+
+
+def test_ranks_ignore_float_noise_and_are_integers(runs):
+    res = runs[2]
+    t = res.table.copy()
+    a = t.index[t["id"] == "A"][0]
+    b = t.index[t["id"] == "B"][0]
+    t.loc[b, "deaths_per_year"] = t.loc[a, "deaths_per_year"] * (1 + 1e-15)    # equal but for float noise
+    t.loc[b, "rhrs_score"] = t.loc[a, "rhrs_score"]
+    s = cr.CorridorResult(corridor=res.corridor, table=t).summary().set_index("id")
+    assert s.loc["A", "rank_risk"] == s.loc["B", "rank_risk"]
+    assert s.loc["A", "rank_rhrs"] == s.loc["B", "rank_rhrs"]
+    assert pd.api.types.is_integer_dtype(s["rank_rhrs"]) and pd.api.types.is_integer_dtype(s["rank_risk"])
+    t.loc[b, "deaths_per_year"] = t.loc[a, "deaths_per_year"] * (1 + 1e-9)     # a real difference still counts
+    s = cr.CorridorResult(corridor=res.corridor, table=t).summary().set_index("id")
+    assert s.loc["B", "rank_risk"] < s.loc["A", "rank_risk"]
+
+
+def test_defaults_listed_only_where_used(tmp_path, corridor):
+    # small.toml's [defaults] give vehicles_per_day and speed_kmh: [traffic]'s defaults are used by no section
+    assert not any(u.startswith(("traffic.vehicles_per_day", "traffic.speed_kmh", "traffic.exposed_length_m"))
+                   for u in corridor.defaults_used)
+    assert any(u.startswith("defaults.seeder_mass_kg") and "ASSUMPTION" in u for u in corridor.defaults_used)
+    path = _write(tmp_path, HEAD + "A,0,100,20,3,1,0.5,\n")
+    path.write_text(path.read_text().replace("vehicles_per_day = 3000\n", ""))
+    used = cr.load_corridor(path).defaults_used
+    assert "traffic.vehicles_per_day = 4000.0 (default)" in used
+    assert not any(u.startswith("traffic.speed_kmh") for u in used)
+
+
+def test_report_with_a_section_without_rhrs(runs, tmp_path):
+    """Integer RHRS ranks with a section that has no RHRS attributes: blank in the report, null in summary.json."""
+    from riskrf.report.corridor_report import render_corridor_html
+    t = runs[2].table.copy()
+    t.loc[t["id"] == "B", "rhrs_score"] = np.nan
+    res = cr.CorridorResult(corridor=runs[2].corridor, table=t)
+    s = res.summary().set_index("id")
+    assert pd.isna(s.loc["B", "rank_rhrs"]) and s.loc["A", "rank_rhrs"] in (1, 2)
+    png = tmp_path / "c.png"
+    png.write_bytes(b"\x89PNG\r\n\x1a\n")
+    html = render_corridor_html(res, png)
+    assert "&lt;NA&gt;" not in html and "NaN" not in html.split("Sections ranked by risk")[1][:3000]
+    assert [r["rank_rhrs"] for r in res.to_json()["top"] if r["id"] == "B"] == [None]
+
+
+def test_too_few_blocks_refused_before_connecting(corridor, tmp_path, capsys):
+    with pytest.raises(ValueError, match="n_blocks = 50 must be a whole number >= 100"):
+        cr.run_corridor(corridor, scheduler="tcp://127.0.0.1:9", n_blocks=50)
+    out = tmp_path / "out"
+    assert main(["corridor", str(DATA / "small.toml"), "-n", "50", "--out", str(out)]) == 2
+    assert "n_blocks = 50" in capsys.readouterr().err and not any(tmp_path.iterdir())

@@ -52,7 +52,12 @@ def render_corridor_html(res, figure_png: Path) -> str:
     t = res.table
     money_cols = ("best_option_capital", "best_option_total_cost", "expected_annual_cost_per_km", "spend",
                   "cumulative_spend")
-    disagree = s[s["rank_difference"].abs() >= max(3, len(s) // 5)] if s["rank_rhrs"].notna().any() else s.iloc[0:0]
+    disagree = s[(s["rank_difference"].abs() >= max(3, len(s) // 5)).fillna(False).astype(bool)] \
+        if s["rank_rhrs"].notna().any() else s.iloc[0:0]
+    s = s.copy()
+    for col in ("rank_rhrs", "rank_difference"):           # integer ranks; a section without RHRS attributes: blank
+        s[col] = s[col].astype(object).where(s[col].notna(), "")
+    disagree = disagree.astype({"rank_rhrs": object, "rank_difference": object})
     doc = Document(title=c.name)
     header = (f"<h1>{escape(c.name)}</h1>"
               f"<p>{len(t)} sections assessed on {res.workers} dask worker(s) in {res.seconds:.1f} s, "
@@ -62,8 +67,10 @@ def render_corridor_html(res, figure_png: Path) -> str:
               f"best option: {cell(float(t['best_deaths_per_year'].sum()))}</li>"
               f"<li>Capital of the best options: "
               f"{cell(float(t['best_option_capital'].sum()), money_columns=True, currency=cur)}</li><li>Rates: "
-              + ("falls reaching the road (as recorded), release rate derived per section from the simulated share "
-                 "reaching the road" if c.rate_basis == "road" else "falls released (>= m_min)")
+              + ("falls reaching the road (as recorded), release rate derived per section from the share reaching "
+                 "the road averaged over the mass law" if c.rate_basis == "road" else "falls released (>= m_min)")
+              + "</li><li>Hazard at the barrier line mass-coupled as in riskrf assess (blocks simulated across the "
+                "mass law, reach and speed by mass class); the cut's own seeder only for the option effects"
               + f"</li><li>{escape(c.mass_note)}</li></ul></div>")
     doc.section("Along the chainage")
     doc.add(doc.figure(figure_png, "RHRS score, individual risk and deaths per year per km of each section, doing "
