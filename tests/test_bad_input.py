@@ -378,6 +378,45 @@ def test_energy_refuses_impossible_values_before_work(inputs, tmp_path, capsys, 
     assert snapshot(inputs) == before
 
 
+RATES_REFUSALS = [
+    ("closure threshold negative", ["--closure-mm", "-5"], r"--closure-mm = -5:"),
+    ("closure threshold 0", ["--closure-mm", "0"], r"--closure-mm = 0:"),
+    ("closure threshold NaN", ["--closure-mm", "nan"], r"--closure-mm = nan:"),
+    ("closure window 0", ["--closure-mm", "50", "--closure-window", "0"], r"--closure-window = 0:"),
+    ("negative cost per hour", ["--closure-mm", "50", "--cost-per-hour", "-1"], r"--cost-per-hour = -1:"),
+    ("heavy day 0 mm", ["--heavy-day-mm", "0", "--heavy-day-change", "0.1"], r"--heavy-day-mm = 0:"),
+    ("heavy day change -1", ["--heavy-day-mm", "50", "--heavy-day-change", "-1"], r"--heavy-day-change = -1:"),
+    ("window 0 days", ["--windows", "1,0"], r"--windows = 0:"),
+    ("rainfall header row 0", ["--rainfall-header-row", "0"], r"--rainfall-header-row = 0:"),
+]
+
+
+@pytest.mark.parametrize("case,extra,match", RATES_REFUSALS, ids=[c[0] for c in RATES_REFUSALS])
+def test_rates_refuses_impossible_options_before_reading_files(inputs, tmp_path, capsys, monkeypatch, case, extra,
+                                                              match):
+    """`riskrf rates` checks its numbers first, naming the option (not the Python argument) and the value."""
+    import riskrf.cli
+    import riskrf.rainfall
+    import riskrf.rate_model  # noqa: F401  (the module; the package attribute of that name is the function)
+
+    def boom(*a, **k):
+        raise AssertionError("a file was read or a model fitted before the option was refused")
+    monkeypatch.setattr(riskrf.rainfall, "read_rainfall", boom)
+    monkeypatch.setattr(sys.modules["riskrf.rate_model"], "rate_model", boom)
+    monkeypatch.setattr(riskrf.cli, "_read", boom)
+    inv = write(inputs / "falls.csv", "date,volume_m3\n2001-02-03,1.0\n")
+    rain = write(inputs / "rain.csv", "date,rainfall_mm\n2001-02-03,1.0\n")
+    before = snapshot(inputs)
+    rc = main(["rates", str(inv), "--rainfall", str(rain), "--out", str(tmp_path / "o"), *extra])
+    err = capsys.readouterr().err
+    assert rc == 2, err
+    assert err.startswith("riskrf rates: error:") and len(err.strip().splitlines()) == 1, err
+    assert __import__("re").search(match, err), err
+    assert "threshold_mm" not in err and "cost_per_hour" not in err
+    assert not (tmp_path / "o").exists()
+    assert snapshot(inputs) == before
+
+
 def test_python_api_refuses_design_periods_of_a_year_or_less():
     from riskrf.energy_study import analyse_energy
     for T in (0, 1, -100, 0.5, float("nan")):
