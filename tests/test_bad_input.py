@@ -452,6 +452,44 @@ def test_assess_refuses_impossible_site_values_before_work(inputs, tmp_path, cap
     assert snapshot(inputs) == before
 
 
+BARRIER_REFUSALS = [   # (option index in the demo site, field, value): the demo's options[3] is a 2,000 kJ fence
+    ("fence 0 m high", 3, "height_m", 0, r"options\[3\]\.height_m = 0 must be > 0 m \(option '.*', a fence\)"),
+    ("fence 0 kJ", 3, "capacity_kj", 0, r"options\[3\]\.capacity_kj = 0 must be > 0 kJ"),
+    ("fence negative height", 4, "height_m", -7.0, r"option 'fence 5000 kJ': height_m = -7.0 must be a number >= 0"),
+    ("shed 0 kJ", 5, "capacity_kj", 0, r"options\[5\]\.capacity_kj = 0 must be > 0 kJ \(option '.*', a shed\)"),
+]
+
+
+@pytest.mark.parametrize("case,i,key,value,match", BARRIER_REFUSALS, ids=[c[0] for c in BARRIER_REFUSALS])
+def test_assess_refuses_a_barrier_of_zero_height_or_capacity_before_work(inputs, tmp_path, capsys, no_work, case, i,
+                                                                        key, value, match):
+    import tomllib
+    site = site_file(inputs)
+    data = tomllib.loads(site.read_text())
+    assert data["options"][i]["kind"] in ("fence", "shed") and key in data["options"][i]
+    data["options"][i][key] = value
+    site.write_text(_toml(data))
+    before = snapshot(inputs)
+    rc = main(["assess", str(site), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2, err
+    assert "site.toml" in err and __import__("re").search(match, err), err
+    assert not (tmp_path / "o").exists()
+    assert snapshot(inputs) == before
+
+
+def test_attenuator_of_zero_height_is_refused_by_the_option_parser():
+    from riskrf.mitigation_inputs import MitigationError, parse_option
+    spec = {"name": "att", "kind": "attenuator", "capital_cost": 1, "capacity_kj": 500, "height_m": 0}
+    with pytest.raises(MitigationError, match=r"corridor.toml: options\[2\]\.height_m = 0 must be > 0 m"):
+        parse_option(spec, 2, "corridor.toml")
+    spec.update(height_m=4, capacity_kj=0.0)
+    with pytest.raises(MitigationError, match=r"corridor.toml: options\[2\]\.capacity_kj = 0.0 must be > 0 kJ"):
+        parse_option(spec, 2, "corridor.toml")
+    spec.update(capacity_kj=500)
+    assert parse_option(spec, 2, "corridor.toml").height_m == 4
+
+
 def test_site_file_and_inventory_with_the_same_stem(inputs):
     """A site file 'x.toml' beside its inventory 'x.csv' is not read as the inventory's sidecar."""
     from riskrf.site import load_site
