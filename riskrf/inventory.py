@@ -653,6 +653,8 @@ def _check_duplicates(events, table, path, policy, note):
 
 #: Above these, sizes given "in m3" are probably litres or cm3 (or grams given as kg).
 PLAUSIBLE_MEDIAN_M3 = 100.0
+#: A median above this (and up to PLAUSIBLE_MEDIAN_M3) is possible for m3 but also what litres give: a warning.
+SUSPECT_MEDIAN_M3 = 10.0
 PLAUSIBLE_LARGE_M3 = 1e5
 PLAUSIBLE_LARGE_PER_YEAR = 0.1
 
@@ -673,6 +675,11 @@ def _check_plausible_sizes(events, path, col, is_volume, declared_unit, duration
                 "usually below 10 m3, and a 10^5 m3 fall is a rock avalanche).  Declare the unit: "
                 "volume_unit='l', 'cm3' or, if the volumes are right, 'm3' (CLI --volume-unit, sidecar "
                 "volume_unit)")
+        if med > SUSPECT_MEDIAN_M3:
+            note(f"{path}: column {col!r}: median volume {med:.3g} m3 is unusually large for a rock fall inventory "
+                 f"(usually below {SUSPECT_MEDIAN_M3:g} m3) and is what litres entered as m3 would give (largest "
+                 f"{v.max():.4g} m3).  If the volumes are in litres or cm3, declare volume_unit='l' or 'cm3'; if "
+                 "they are right, declare volume_unit='m3' to silence this (CLI --volume-unit, sidecar volume_unit)")
         return
     m = events["mass_kg"].to_numpy(dtype=float)
     if declared_unit is None and (med > PLAUSIBLE_MEDIAN_M3 or rate > PLAUSIBLE_LARGE_PER_YEAR):

@@ -308,6 +308,32 @@ def test_declared_units_accept_large_volumes_and_duplicates_can_be_dropped(input
     assert inv.n_events == 5
 
 
+def test_litres_with_a_median_between_10_and_100_warn(inputs):
+    """300 falls in litres (median 40 L) typed into volume_m3: too small to refuse, too large to pass in silence."""
+    rng = np.random.default_rng(11)
+    litres = np.round(40 * np.exp(rng.normal(0, 1.4, 300)), 1)
+    litres[0] = 2857.0
+    dates = pd.date_range("2010-01-01", periods=300, freq="11D").strftime("%Y-%m-%d")
+    f = inputs / "litres.csv"
+    pd.DataFrame({"date": dates, "volume_m3": litres}).to_csv(f, index=False)
+    med = float(np.median(litres))
+    assert 10 < med <= 100 and litres.max() < 1e5
+    kw = {"start": "2010-01-01", "end": "2019-12-31", "density_kg_m3": 2650}
+    with pytest.warns(RiskrfWarning, match=rf"litres.csv: column 'volume_m3': median volume {med:.3g} m3 .*"
+                                           r"litres.*volume_unit='l'.*volume_unit='m3'") as rec:
+        inv = read_inventory(f, **kw)
+    assert inv.volumes.max() == 2857.0                     # a warning, not a refusal: read as m3 as written
+    assert any("median volume" in n for n in inv.notes)
+    with __import__("warnings").catch_warnings():
+        __import__("warnings").simplefilter("error", RiskrfWarning)
+        assert read_inventory(f, volume_unit="l", **kw).volumes.max() == pytest.approx(2.857)
+        read_inventory(f, volume_unit="m3", **kw)          # declared: no warning
+        small = inputs / "m3.csv"
+        pd.DataFrame({"date": dates, "volume_m3": litres / 10}).to_csv(small, index=False)   # median 4 m3
+        read_inventory(small, **kw)
+    assert len([w for w in rec if "median volume" in str(w.message)]) == 1
+
+
 def test_undated_real_inventory_with_repeated_sizes_is_not_a_duplicate_error():
     inv = read_inventory(LAUTER)      # volumes only: equal rows are different falls of equal measured size
     assert inv.n_events == 317
