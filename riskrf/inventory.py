@@ -191,10 +191,16 @@ class Inventory:
     def annual_maxima(self, *, unit: str = "kg") -> pd.Series:
         """Largest fall of each calendar year of the record [kg, or m³ with ``unit="m3"``].
 
-        Every year of the record period appears; a year with no recorded fall
-        has NaN (not zero, not dropped), and a warning says how many such years
-        there are.  Partly covered first and last years are kept and named in a
-        warning.  Raises ``ValueError`` for an undated inventory.
+        Every year of the record period appears, except the years whose falls
+        all lack an exact size (censored such as "<1" or no size at all): their
+        maximum is unknown, not zero, so they are left out and named in a
+        warning, and listed in ``series.attrs["years_without_exact_size"]`` (the
+        Gumbel/GEV fits count them as years with a fall when they estimate the
+        share of empty years p0).  A year with no recorded fall at all (exact,
+        censored or missing size) has NaN (not zero, not dropped), and a
+        warning says how many such years there are.  Partly covered first and
+        last years are kept and named in a warning.  Raises ``ValueError`` for
+        an undated inventory.
         """
         if not self.is_dated:
             raise ValueError(
@@ -208,6 +214,15 @@ class Inventory:
         series = maxima.reindex(years)
         series.index.name = "year"
         series.name = f"annual_max_{col}"
+        cens = self.censored
+        with_falls = set() if cens.empty else {int(y) for y in cens["year"].dropna()}
+        unknown = [y for y in series.index[series.isna()] if y in with_falls]
+        if unknown:
+            series = series.drop(unknown)
+            warn(f"{self.source}: {len(unknown)} of {len(years)} years have falls but no exact size "
+                 f"({', '.join(map(str, unknown[:10]))}{' ...' if len(unknown) > 10 else ''}); their maximum is "
+                 "unknown (not zero), so they are left out of the annual maxima and counted as years with a fall")
+        series.attrs["years_without_exact_size"] = [int(y) for y in unknown]
         empty = series.index[series.isna()].tolist()
         if empty:
             warn(f"{self.source}: {len(empty)} of {len(years)} years have no recorded fall "

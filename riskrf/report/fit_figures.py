@@ -107,7 +107,7 @@ def plot_return_levels(fits, ax=None, *, power_law=None, maxima=None, formula: s
                     label=f"implied by power law (b = {power_law.b:.2f})")
     if maxima is not None:
         values = np.asarray(maxima, dtype=float)
-        n = values.size
+        n = values.size + len(getattr(maxima, "attrs", {}).get("years_without_exact_size", ()))
         x = np.sort(values[~np.isnan(values)])
         F = plotting_positions(n, formula)[n - x.size:]
         ax.semilogx(1 / (1 - F), x, "o", ms=4, mfc="none", color="0.3", label=f"annual maxima ({formula})")
