@@ -730,8 +730,11 @@ def test_ctrl_c_ends_with_one_line_and_nothing_written(tmp_path):
         print("ready", flush=True)
         sys.exit(main(["simulate", {str(SCENARIO)!r}, "-n", "5000000", "--out", {str(out)!r}]))
     """)
+    # the child gets the default SIGINT action even when pytest runs with SIGINT ignored (nohup, background
+    # jobs): Python only turns SIGINT into KeyboardInterrupt when it starts with the default action
     proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, cwd=tmp_path)
+                            text=True, cwd=tmp_path,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     assert proc.stdout.readline().strip() == "ready"
     time.sleep(1.5)
     proc.send_signal(signal.SIGINT)
@@ -783,7 +786,8 @@ HOSTILE = [
     ("old .xls", "inv.xls", b"\xd0\xcf\x11\xe0", lambda f, o: ["fit", str(f), "--out", o], "unsupported"),
     ("inventory is a directory", "dir", None, lambda f, o: ["fit", str(f), "--out", o], "is a directory"),
     ("missing inventory", "nope.csv", False, lambda f, o: ["fit", str(f), "--out", o], "nope.csv"),
-    ("tree is a directory", "dir", None, lambda f, o: ["decide", str(f), "--out", o], "dir"),
+    ("tree is a directory", "dir", None, lambda f, o: ["decide", str(f), "--out", o],
+     "is a directory, not a decision tree file"),
     ("tree not JSON", "t.json", b"{not json", lambda f, o: ["decide", str(f), "--out", o], "cannot parse"),
     ("corrupt parquet", "inv.parquet", b"PAR1garbage", lambda f, o: ["fit", str(f), "--out", o], "cannot read"),
     ("out below a file", "inv.csv", b"volume_m3\n1\n",
