@@ -443,6 +443,29 @@ def test_rates_refuses_impossible_options_before_reading_files(inputs, tmp_path,
     assert snapshot(inputs) == before
 
 
+def test_energy_with_fewer_than_one_fall_in_the_design_period_says_so(inputs, tmp_path, capsys):
+    """--rate-scale 0.0001: 21.92 falls a year x 1e-4 x reach 1 = 0.00219 a year, 0.219 in 100 years.
+
+    No fence check may say OK against a 0 kJ 100-year energy, and the UNI 11211-4 line says why it is absent.
+    """
+    rc = main(energy_args(inputs, "--rate-scale", "0.0001", "--out", str(tmp_path / "o")))
+    out = capsys.readouterr().out
+    assert rc == 0, out
+    assert "[OK  ] 100-year energy" not in out and "0 kJ vs" not in out
+    assert out.count("[N/A ] 100-year energy vs MEL: not defined vs") == 2
+    assert "fewer than one fall reaches the line in 100 years (0.219 expected at 0.00219 arrivals per year)" in out
+    assert "UNI 11211-4 design energy not computed: the 100-year block is not defined because fewer than one " \
+           "fall is expected in 100 years (0.219" in out
+    checks = pd.read_csv(tmp_path / "o" / "fence_checks.csv")
+    assert checks.loc[checks["unit"] == "kJ", "demand"].isna().all()
+    summary = json.loads((tmp_path / "o" / "energy_summary.json").read_text())
+    assert "fewer than one fall" in summary["uni11211"]["not_computed"]
+    # control: at the inventory's own rate the 100-year energy exists and is checked
+    rc = main(energy_args(inputs, "--out", str(tmp_path / "p")))
+    out = capsys.readouterr().out
+    assert rc == 0 and "N/A" not in out and "UNI 11211-4 design energy for the 100-year block" in out
+
+
 def test_python_api_refuses_design_periods_of_a_year_or_less():
     from riskrf.energy_study import analyse_energy
     for T in (0, 1, -100, 0.5, float("nan")):
