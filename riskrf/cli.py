@@ -798,7 +798,8 @@ def cmd_rates(args) -> int:
                          "need a daily model (--period day)")
     if (args.heavy_day_change is None) != (args.heavy_day_mm is None):
         raise ValueError("give --heavy-day-mm and --heavy-day-change together")
-    from .preflight import check_inventory_args, check_out
+    from .preflight import check_inventory_args, check_out, check_rates_args
+    check_rates_args(args, windows)
     check_inventory_args(args)
     out = check_out(args, f"{Path(args.inventory).stem}-rates")
     from .rainfall import read_rainfall

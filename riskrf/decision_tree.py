@@ -163,6 +163,8 @@ class DecisionTree:
         path = Path(path)
         if not path.exists():
             raise FileNotFoundError(f"decision tree file not found: {path}")
+        if path.is_dir():
+            raise TreeError(f"{path} is a directory, not a decision tree file (.json or .toml)")
         try:
             if path.suffix.lower() == ".toml":
                 with open(path, "rb") as fh:

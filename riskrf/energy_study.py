@@ -67,6 +67,11 @@ class EnergyAnalysis:
                       f"it covers the {INTERVAL_COVERS}):"]
         d = self.design.copy()
         lines.append(d.to_string(index=False, float_format=lambda v: sig(v, 4)))
+        short = d.loc[d["T_years"] * hz.arrival_rate < 1, "T_years"]
+        if len(short):
+            lines.append(f"  T = {', '.join(sig(t) for t in short)} years: fewer than one fall reaches the line in T "
+                         f"years (T x {sig(hz.arrival_rate, 3)} arrivals per year < 1), so no T-year energy exists "
+                         "there (shown as 0 kJ)")
         if self.site_masses is not None:
             lines += ["", "Design masses of the site's law (the hazard's; nothing above m_max) [kg]:",
                       self.site_masses.drop(columns="law").to_string(index=False, float_format=lambda v: sig(v, 4))]
@@ -95,14 +100,31 @@ class EnergyAnalysis:
                           f"E_k = {sig(u.characteristic_energy_kj, 4)} kJ, E_d = {sig(u.design_energy_kj, 4)} kJ "
                           f"(gamma_Tr {u.factors['gamma_Tr']}, gamma_Dp {u.factors['gamma_Dp']}, "
                           f"gamma_VolF {u.factors['gamma_VolF']}, gamma_gamma {u.factors['gamma_gamma']})"]
+        elif self._uni_missing_reason():
+            lines += ["", f"UNI 11211-4 design energy not computed: {self._uni_missing_reason()}"]
         for name, table in self.fences.items():
             lines += ["", f"Fence {name}:"]
             for _, r in table.iterrows():
-                mark = "OK  " if r["adequate"] else "FAIL"
-                lines.append(f"  [{mark}] {r['check']}: {sig(r['demand'], 4)} {r['unit']} vs {sig(r['capacity'], 4)} "
+                mark = "N/A " if not np.isfinite(r["demand"]) else "OK  " if r["adequate"] else "FAIL"
+                demand = f"{sig(r['demand'], 4)} {r['unit']}" if np.isfinite(r["demand"]) else "not defined"
+                lines.append(f"  [{mark}] {r['check']}: {demand} vs {sig(r['capacity'], 4)} "
                              f"{r['unit']}" + (f" (interval {r['interval']})" if r["interval"] else "")
                              + f"; {r['note']}")
         return "\n".join(lines)
+
+    def _uni_missing_reason(self) -> str:
+        """Why the UNI 11211-4 design energy is absent ('' when it was computed)."""
+        if self.uni is not None:
+            return ""
+        hz = self.hazard
+        expected = self.design_T * hz.rate_per_year
+        if isinstance(hz.mass, GutenbergRichterFit) and expected <= 1:
+            return (f"the {self.design_T:g}-year block is not defined because fewer than one fall is expected in "
+                    f"{self.design_T:g} years ({sig(expected, 3)} at {sig(hz.rate_per_year, 3)} falls per year); "
+                    "a design block (riskrf energy --design-percentile or --block-survey; design_block= in Python) "
+                    "would apply it")
+        return ("it needs a design block (riskrf energy --design-percentile or --block-survey) or a power-law "
+                "mass model for the T-year block")
 
     def to_dict(self) -> dict:
         hz = self.hazard
@@ -123,6 +145,8 @@ class EnergyAnalysis:
             out["design_energy_sensitivity"] = self.sensitivity.to_dict(orient="records")
         if self.tornado is not None:
             out["design_energy_tornado"] = self.tornado.to_dict()
+        if self.uni is None:
+            out["uni11211"] = {"design_return_period_years": self.design_T, "not_computed": self._uni_missing_reason()}
         if self.uni is not None:
             out["uni11211"] = {"design_return_period_years": self.design_T,
                                "characteristic_energy_kj": self.uni.characteristic_energy_kj,
@@ -183,6 +207,7 @@ def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_
     checks = {f"{cap:g} kJ / {h:g} m": check_fence(hazard, cap, h, T=design_T, free_board_m=free_board_m,
                                                     design_energy=e_design)
               for cap, h in zip(fences, heights)}
+    checks = {name: _undefined_design_energy(table, hazard, design_T) for name, table in checks.items()}
     if design_block is not None:
         for (name, table), h in zip(checks.items(), heights):
             checks[name] = pd.concat([table, _block_top_check(hazard, design_block, h, free_board_m)],
@@ -202,6 +227,27 @@ def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_
                           density_kg_m3=density_kg_m3, seed=seed, n_bootstrap=int(n_bootstrap),
                           design_block=design_block, sensitivity=sensitivity, site_masses=site_masses,
                           tornado=tornado)
+
+
+def _undefined_design_energy(table: pd.DataFrame, hazard, design_T: float) -> pd.DataFrame:
+    """Energy checks with no T-year energy: fewer than one fall reaches the line in T years.
+
+    The T-year energy is then not defined (``energy_at_return_period`` gives 0 kJ), so the MEL/SEL rows get
+    demand NaN (printed "N/A", never "OK" with 0 kJ) and a note giving the expected number of arrivals; the
+    annual frequency of impacts above MEL/SEL in the note remains the check.
+    """
+    expected = float(design_T) * float(hazard.arrival_rate)
+    if expected >= 1:
+        return table
+    t = table.copy()
+    rows = (t["unit"] == "kJ") & t["check"].str.startswith(f"{design_T:g}-year energy")
+    t.loc[rows, "demand"] = np.nan
+    t.loc[rows, "interval"] = ""
+    t.loc[rows, "note"] = (f"the {design_T:g}-year energy is not defined: fewer than one fall reaches the line in "
+                           f"{design_T:g} years ({sig(expected, 3)} expected at {sig(hazard.arrival_rate, 3)} "
+                           "arrivals per year); judge the fence by the frequency of impacts above its capacity: "
+                           + t.loc[rows, "note"])
+    return t
 
 
 def _block_top_check(hazard, block, height_m: float, free_board_m: float) -> pd.DataFrame:

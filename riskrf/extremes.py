@@ -118,7 +118,14 @@ def _split_maxima(maxima, zero_years: str, model: str):
     if n_empty and zero_years == "drop":
         warn(f"{n_empty} year(s) without a fall dropped (zero_years='drop'): annual frequencies are overstated")
         return values, 0.0, values.size
-    return values, n_empty / x.size, x.size
+    # years with falls of unknown size (Inventory.annual_maxima leaves them out): not empty, so they count in p0
+    n_years = x.size + _n_unknown_years(maxima)
+    return values, n_empty / n_years, n_years
+
+
+def _n_unknown_years(maxima) -> int:
+    """Years left out of an annual-maxima series because their falls have no exact size (see Inventory.annual_maxima)."""
+    return len(getattr(maxima, "attrs", {}).get("years_without_exact_size", ()))
 
 
 @dataclass(frozen=True)

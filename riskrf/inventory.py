@@ -195,10 +195,16 @@ class Inventory:
     def annual_maxima(self, *, unit: str = "kg") -> pd.Series:
         """Largest fall of each calendar year of the record [kg, or m³ with ``unit="m3"``].
 
-        Every year of the record period appears; a year with no recorded fall
-        has NaN (not zero, not dropped), and a warning says how many such years
-        there are.  Partly covered first and last years are kept and named in a
-        warning.  Raises ``ValueError`` for an undated inventory.
+        Every year of the record period appears, except the years whose falls
+        all lack an exact size (censored such as "<1" or no size at all): their
+        maximum is unknown, not zero, so they are left out and named in a
+        warning, and listed in ``series.attrs["years_without_exact_size"]`` (the
+        Gumbel/GEV fits count them as years with a fall when they estimate the
+        share of empty years p0).  A year with no recorded fall at all (exact,
+        censored or missing size) has NaN (not zero, not dropped), and a
+        warning says how many such years there are.  Partly covered first and
+        last years are kept and named in a warning.  Raises ``ValueError`` for
+        an undated inventory.
         """
         if not self.is_dated:
             raise ValueError(
@@ -212,6 +218,15 @@ class Inventory:
         series = maxima.reindex(years)
         series.index.name = "year"
         series.name = f"annual_max_{col}"
+        cens = self.censored
+        with_falls = set() if cens.empty else {int(y) for y in cens["year"].dropna()}
+        unknown = [y for y in series.index[series.isna()] if y in with_falls]
+        if unknown:
+            series = series.drop(unknown)
+            warn(f"{self.source}: {len(unknown)} of {len(years)} years have falls but no exact size "
+                 f"({', '.join(map(str, unknown[:10]))}{' ...' if len(unknown) > 10 else ''}); their maximum is "
+                 "unknown (not zero), so they are left out of the annual maxima and counted as years with a fall")
+        series.attrs["years_without_exact_size"] = [int(y) for y in unknown]
         empty = series.index[series.isna()].tolist()
         if empty:
             warn(f"{self.source}: {len(empty)} of {len(years)} years have no recorded fall "
@@ -664,6 +679,8 @@ def _check_duplicates(events, table, path, policy, note):
 
 #: Above these, sizes given "in m3" are probably litres or cm3 (or grams given as kg).
 PLAUSIBLE_MEDIAN_M3 = 100.0
+#: A median above this (and up to PLAUSIBLE_MEDIAN_M3) is possible for m3 but also what litres give: a warning.
+SUSPECT_MEDIAN_M3 = 10.0
 PLAUSIBLE_LARGE_M3 = 1e5
 PLAUSIBLE_LARGE_PER_YEAR = 0.1
 
@@ -684,6 +701,11 @@ def _check_plausible_sizes(events, path, col, is_volume, declared_unit, duration
                 "usually below 10 m3, and a 10^5 m3 fall is a rock avalanche).  Declare the unit: "
                 "volume_unit='l', 'cm3' or, if the volumes are right, 'm3' (CLI --volume-unit, sidecar "
                 "volume_unit)")
+        if med > SUSPECT_MEDIAN_M3:
+            note(f"{path}: column {col!r}: median volume {med:.3g} m3 is unusually large for a rock fall inventory "
+                 f"(usually below {SUSPECT_MEDIAN_M3:g} m3) and is what litres entered as m3 would give (largest "
+                 f"{v.max():.4g} m3).  If the volumes are in litres or cm3, declare volume_unit='l' or 'cm3'; if "
+                 "they are right, declare volume_unit='m3' to silence this (CLI --volume-unit, sidecar volume_unit)")
         return
     m = events["mass_kg"].to_numpy(dtype=float)
     if declared_unit is None and (med > PLAUSIBLE_MEDIAN_M3 or rate > PLAUSIBLE_LARGE_PER_YEAR):

@@ -372,6 +372,10 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
     for key in need:
         if spec.get(key) is None:
             raise MitigationError(f"{source}: {where}: a {kind} needs {key}")
+        if spec[key] <= 0:      # a 0 kJ or 0 m barrier stops nothing: a typing mistake, never a design
+            unit = "kJ" if key == "capacity_kj" else "m"
+            raise MitigationError(f"{source}: options[{i}].{key} = {spec[key]!r} must be > 0 {unit} "
+                                  f"({where}, a {kind})")
     if kind == "ditch" and spec.get("retention") is None:
         for key in ("x_m", "width_m", "depth_m"):
             if spec.get(key) is None:

@@ -90,3 +90,17 @@ def check_out(args, default, *, kind="dir") -> Path:
     """The output path of a command, refused up front when it would clobber something."""
     out = Path(args.out) if getattr(args, "out", None) else Path(default)
     return check_output(out, overwrite=getattr(args, "overwrite", False), kind=kind)
+
+
+def check_rates_args(args, windows) -> None:
+    """Every numeric option of `riskrf rates`, checked before any file is read."""
+    for w in windows:
+        check_number(w, "--windows", low=1, what=" days (whole days)")
+    for mm in args.closure_mm or ():
+        check_number(mm, "--closure-mm", low=0, low_open=True, what=" mm")
+    check_number(args.closure_window, "--closure-window", low=1, what=" days")
+    check_number(args.cost_per_hour, "--cost-per-hour", low=0, what=" (money per hour of closure)")
+    check_number(args.heavy_day_mm, "--heavy-day-mm", low=0, low_open=True, what=" mm")
+    check_number(args.heavy_day_change, "--heavy-day-change", low=-1, low_open=True,
+                 what=" (a share: 0.1 = +10 %, -1 would remove every heavy-rain day)")
+    check_number(_num(args, "rainfall_header_row"), "--rainfall-header-row", low=1)

@@ -308,6 +308,32 @@ def test_declared_units_accept_large_volumes_and_duplicates_can_be_dropped(input
     assert inv.n_events == 5
 
 
+def test_litres_with_a_median_between_10_and_100_warn(inputs):
+    """300 falls in litres (median 40 L) typed into volume_m3: too small to refuse, too large to pass in silence."""
+    rng = np.random.default_rng(11)
+    litres = np.round(40 * np.exp(rng.normal(0, 1.4, 300)), 1)
+    litres[0] = 2857.0
+    dates = pd.date_range("2010-01-01", periods=300, freq="11D").strftime("%Y-%m-%d")
+    f = inputs / "litres.csv"
+    pd.DataFrame({"date": dates, "volume_m3": litres}).to_csv(f, index=False)
+    med = float(np.median(litres))
+    assert 10 < med <= 100 and litres.max() < 1e5
+    kw = {"start": "2010-01-01", "end": "2019-12-31", "density_kg_m3": 2650}
+    with pytest.warns(RiskrfWarning, match=rf"litres.csv: column 'volume_m3': median volume {med:.3g} m3 .*"
+                                           r"litres.*volume_unit='l'.*volume_unit='m3'") as rec:
+        inv = read_inventory(f, **kw)
+    assert inv.volumes.max() == 2857.0                     # a warning, not a refusal: read as m3 as written
+    assert any("median volume" in n for n in inv.notes)
+    with __import__("warnings").catch_warnings():
+        __import__("warnings").simplefilter("error", RiskrfWarning)
+        assert read_inventory(f, volume_unit="l", **kw).volumes.max() == pytest.approx(2.857)
+        read_inventory(f, volume_unit="m3", **kw)          # declared: no warning
+        small = inputs / "m3.csv"
+        pd.DataFrame({"date": dates, "volume_m3": litres / 10}).to_csv(small, index=False)   # median 4 m3
+        read_inventory(small, **kw)
+    assert len([w for w in rec if "median volume" in str(w.message)]) == 1
+
+
 def test_undated_real_inventory_with_repeated_sizes_is_not_a_duplicate_error():
     inv = read_inventory(LAUTER)      # volumes only: equal rows are different falls of equal measured size
     assert inv.n_events == 317
@@ -392,6 +418,68 @@ def test_energy_refuses_impossible_values_before_work(inputs, tmp_path, capsys, 
     assert snapshot(inputs) == before
 
 
+RATES_REFUSALS = [
+    ("closure threshold negative", ["--closure-mm", "-5"], r"--closure-mm = -5:"),
+    ("closure threshold 0", ["--closure-mm", "0"], r"--closure-mm = 0:"),
+    ("closure threshold NaN", ["--closure-mm", "nan"], r"--closure-mm = nan:"),
+    ("closure window 0", ["--closure-mm", "50", "--closure-window", "0"], r"--closure-window = 0:"),
+    ("negative cost per hour", ["--closure-mm", "50", "--cost-per-hour", "-1"], r"--cost-per-hour = -1:"),
+    ("heavy day 0 mm", ["--heavy-day-mm", "0", "--heavy-day-change", "0.1"], r"--heavy-day-mm = 0:"),
+    ("heavy day change -1", ["--heavy-day-mm", "50", "--heavy-day-change", "-1"], r"--heavy-day-change = -1:"),
+    ("window 0 days", ["--windows", "1,0"], r"--windows = 0:"),
+    ("rainfall header row 0", ["--rainfall-header-row", "0"], r"--rainfall-header-row = 0:"),
+]
+
+
+@pytest.mark.parametrize("case,extra,match", RATES_REFUSALS, ids=[c[0] for c in RATES_REFUSALS])
+def test_rates_refuses_impossible_options_before_reading_files(inputs, tmp_path, capsys, monkeypatch, case, extra,
+                                                              match):
+    """`riskrf rates` checks its numbers first, naming the option (not the Python argument) and the value."""
+    import riskrf.cli
+    import riskrf.rainfall
+    import riskrf.rate_model  # noqa: F401  (the module; the package attribute of that name is the function)
+
+    def boom(*a, **k):
+        raise AssertionError("a file was read or a model fitted before the option was refused")
+    monkeypatch.setattr(riskrf.rainfall, "read_rainfall", boom)
+    monkeypatch.setattr(sys.modules["riskrf.rate_model"], "rate_model", boom)
+    monkeypatch.setattr(riskrf.cli, "_read", boom)
+    inv = write(inputs / "falls.csv", "date,volume_m3\n2001-02-03,1.0\n")
+    rain = write(inputs / "rain.csv", "date,rainfall_mm\n2001-02-03,1.0\n")
+    before = snapshot(inputs)
+    rc = main(["rates", str(inv), "--rainfall", str(rain), "--out", str(tmp_path / "o"), *extra])
+    err = capsys.readouterr().err
+    assert rc == 2, err
+    assert err.startswith("riskrf rates: error:") and len(err.strip().splitlines()) == 1, err
+    assert __import__("re").search(match, err), err
+    assert "threshold_mm" not in err and "cost_per_hour" not in err
+    assert not (tmp_path / "o").exists()
+    assert snapshot(inputs) == before
+
+
+def test_energy_with_fewer_than_one_fall_in_the_design_period_says_so(inputs, tmp_path, capsys):
+    """--rate-scale 0.0001: 21.92 falls a year x 1e-4 x reach 1 = 0.00219 a year, 0.219 in 100 years.
+
+    No fence check may say OK against a 0 kJ 100-year energy, and the UNI 11211-4 line says why it is absent.
+    """
+    rc = main(energy_args(inputs, "--rate-scale", "0.0001", "--out", str(tmp_path / "o")))
+    out = capsys.readouterr().out
+    assert rc == 0, out
+    assert "[OK  ] 100-year energy" not in out and "0 kJ vs" not in out
+    assert out.count("[N/A ] 100-year energy vs MEL: not defined vs") == 2
+    assert "fewer than one fall reaches the line in 100 years (0.219 expected at 0.00219 arrivals per year)" in out
+    assert "UNI 11211-4 design energy not computed: the 100-year block is not defined because fewer than one " \
+           "fall is expected in 100 years (0.219" in out
+    checks = pd.read_csv(tmp_path / "o" / "fence_checks.csv")
+    assert checks.loc[checks["unit"] == "kJ", "demand"].isna().all()
+    summary = json.loads((tmp_path / "o" / "energy_summary.json").read_text())
+    assert "fewer than one fall" in summary["uni11211"]["not_computed"]
+    # control: at the inventory's own rate the 100-year energy exists and is checked
+    rc = main(energy_args(inputs, "--out", str(tmp_path / "p")))
+    out = capsys.readouterr().out
+    assert rc == 0 and "N/A" not in out and "UNI 11211-4 design energy for the 100-year block" in out
+
+
 def test_python_api_refuses_design_periods_of_a_year_or_less():
     from riskrf.energy_study import analyse_energy
     for T in (0, 1, -100, 0.5, float("nan")):
@@ -425,6 +513,44 @@ def test_assess_refuses_impossible_site_values_before_work(inputs, tmp_path, cap
     assert "site.toml" in err and __import__("re").search(match, err), err
     assert not (tmp_path / "o").exists()
     assert snapshot(inputs) == before
+
+
+BARRIER_REFUSALS = [   # (option index in the demo site, field, value): the demo's options[3] is a 2,000 kJ fence
+    ("fence 0 m high", 3, "height_m", 0, r"options\[3\]\.height_m = 0 must be > 0 m \(option '.*', a fence\)"),
+    ("fence 0 kJ", 3, "capacity_kj", 0, r"options\[3\]\.capacity_kj = 0 must be > 0 kJ"),
+    ("fence negative height", 4, "height_m", -7.0, r"option 'fence 5000 kJ': height_m = -7.0 must be a number >= 0"),
+    ("shed 0 kJ", 5, "capacity_kj", 0, r"options\[5\]\.capacity_kj = 0 must be > 0 kJ \(option '.*', a shed\)"),
+]
+
+
+@pytest.mark.parametrize("case,i,key,value,match", BARRIER_REFUSALS, ids=[c[0] for c in BARRIER_REFUSALS])
+def test_assess_refuses_a_barrier_of_zero_height_or_capacity_before_work(inputs, tmp_path, capsys, no_work, case, i,
+                                                                        key, value, match):
+    import tomllib
+    site = site_file(inputs)
+    data = tomllib.loads(site.read_text())
+    assert data["options"][i]["kind"] in ("fence", "shed") and key in data["options"][i]
+    data["options"][i][key] = value
+    site.write_text(_toml(data))
+    before = snapshot(inputs)
+    rc = main(["assess", str(site), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2, err
+    assert "site.toml" in err and __import__("re").search(match, err), err
+    assert not (tmp_path / "o").exists()
+    assert snapshot(inputs) == before
+
+
+def test_attenuator_of_zero_height_is_refused_by_the_option_parser():
+    from riskrf.mitigation_inputs import MitigationError, parse_option
+    spec = {"name": "att", "kind": "attenuator", "capital_cost": 1, "capacity_kj": 500, "height_m": 0}
+    with pytest.raises(MitigationError, match=r"corridor.toml: options\[2\]\.height_m = 0 must be > 0 m"):
+        parse_option(spec, 2, "corridor.toml")
+    spec.update(height_m=4, capacity_kj=0.0)
+    with pytest.raises(MitigationError, match=r"corridor.toml: options\[2\]\.capacity_kj = 0.0 must be > 0 kJ"):
+        parse_option(spec, 2, "corridor.toml")
+    spec.update(capacity_kj=500)
+    assert parse_option(spec, 2, "corridor.toml").height_m == 4
 
 
 def test_site_file_and_inventory_with_the_same_stem(inputs):
@@ -641,8 +767,11 @@ def test_ctrl_c_ends_with_one_line_and_nothing_written(tmp_path):
         print("ready", flush=True)
         sys.exit(main(["simulate", {str(SCENARIO)!r}, "-n", "5000000", "--out", {str(out)!r}]))
     """)
+    # the child gets the default SIGINT action even when pytest runs with SIGINT ignored (nohup, background
+    # jobs): Python only turns SIGINT into KeyboardInterrupt when it starts with the default action
     proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, cwd=tmp_path)
+                            text=True, cwd=tmp_path,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     assert proc.stdout.readline().strip() == "ready"
     time.sleep(1.5)
     proc.send_signal(signal.SIGINT)
@@ -694,7 +823,8 @@ HOSTILE = [
     ("old .xls", "inv.xls", b"\xd0\xcf\x11\xe0", lambda f, o: ["fit", str(f), "--out", o], "unsupported"),
     ("inventory is a directory", "dir", None, lambda f, o: ["fit", str(f), "--out", o], "is a directory"),
     ("missing inventory", "nope.csv", False, lambda f, o: ["fit", str(f), "--out", o], "nope.csv"),
-    ("tree is a directory", "dir", None, lambda f, o: ["decide", str(f), "--out", o], "dir"),
+    ("tree is a directory", "dir", None, lambda f, o: ["decide", str(f), "--out", o],
+     "is a directory, not a decision tree file"),
     ("tree not JSON", "t.json", b"{not json", lambda f, o: ["decide", str(f), "--out", o], "cannot parse"),
     ("corrupt parquet", "inv.parquet", b"PAR1garbage", lambda f, o: ["fit", str(f), "--out", o], "cannot read"),
     ("out below a file", "inv.csv", b"volume_m3\n1\n",

@@ -257,3 +257,34 @@ def test_direct_construction_with_zero_scale_raises():
     with pytest.raises(ValueError, match=r"scale = 0\.0: the scale of a GEVFit must be finite and > 0"):
         GEVFit(p_zero=0.0, n_years=10, method="mle", level=0.95, cov=None, data=np.arange(10.0),
                loc=1.0, scale=0.0, shape=0.1)
+
+
+def test_return_level_figure_bands_use_the_table_method_and_never_go_below_zero():
+    """return_levels.png: the bands are the intervals of design_masses.csv (profile likelihood for MLE fits),
+    labelled so, and a band whose interval reaches below zero stops above zero on the log axis."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from riskrf.report import plot_return_levels
+    gum = fit_gumbel(PORT_PIRIE)
+    ax = plot_return_levels({"Gumbel": gum}, units="m", T_max=200)
+    assert ax.get_legend().get_title().get_text() == "bands: 95% profile likelihood intervals"
+    T = np.geomspace(1.05, 200, 30)
+    lo, hi = gum.return_level_ci(T)                         # the default (profile) method, as the table
+    y = ax.collections[0].get_paths()[0].vertices[:, 1]
+    assert all(np.isclose(y, v, rtol=1e-9, atol=0).any() for v in np.r_[lo, hi])
+    d_lo, _ = gum.return_level_ci(T, method="delta")        # not the delta band drawn before
+    assert not all(np.isclose(y, v, rtol=1e-9, atol=0).any() for v in d_lo)
+    plt.close(ax.figure)
+    # a moment fit (delta intervals) of very dispersed small maxima: its lower limits fall below zero
+    rng = np.random.default_rng(3)
+    small = rng.gumbel(1.0, 3.0, 12).clip(0.05)
+    mom = fit_gumbel(small, method="moments")
+    lo_d, _ = mom.return_level_ci(np.geomspace(1.05, 1000, 30), method="delta")
+    assert (lo_d <= 0).any()
+    ax = plot_return_levels({"Gumbel": mom}, units="m")
+    assert "delta method" in ax.get_legend().get_title().get_text()
+    y = ax.collections[0].get_paths()[0].vertices[:, 1]
+    assert np.nanmin(y) > 0
+    plt.close(ax.figure)

@@ -86,8 +86,10 @@ def test_ctrl_c_during_a_long_bootstrap_ends_with_one_line_and_writes_nothing(tm
         sys.exit(main(["fit", {str(f)!r}, "--duration-years", "10", "--bootstrap", "1000000", "--workers", "2",
                        "--progress", "--out", {str(out)!r}]))
     """)
+    # the child gets the default SIGINT action even when pytest runs with SIGINT ignored (nohup, background
+    # jobs): Python only turns SIGINT into KeyboardInterrupt when it starts with the default action
     proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            cwd=tmp_path)
+                            cwd=tmp_path, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     seen = b""
     deadline = time.monotonic() + 120
     while b"replicates" not in seen and time.monotonic() < deadline:      # the bar: the bootstrap is running

@@ -85,11 +85,13 @@ def test_censored_maximum_warning_when_a_bound_exceeds_the_years_exact_maximum(t
     f.write_text("date,volume_m3\n2001-05-01,2\n2001-06-01,~50\n2002-03-03,1\n2002-04-04,<0.5\n2003-01-01,<3\n")
     inv = read_inventory(f, start="2001-01-01", end="2003-12-31", density_kg_m3=2600)
     assert inv.n_events == 2 and list(inv.censored["censoring"]) == ["approximate", "below", "below"]
-    with pytest.warns(RiskrfWarning, match=r"2 censored or missing size\(s\) could set or change") as rec:
+    with pytest.warns(RiskrfWarning, match=r"1 censored or missing size\(s\) could set or change") as rec:
         m = inv.annual_maxima(unit="m3")
     msg = " ".join(str(w.message) for w in rec)
-    assert "2001 (~50, row 3)" in msg and "2003 (<3, row 6)" in msg and "2002" not in msg.split("change")[1]
-    assert m[2001] == 2 and np.isnan(m[2003])
+    assert "2001 (~50, row 3)" in msg and "2002" not in msg.split("change")[1]
+    # 2003 has a fall, of unknown exact size (<3): its maximum is unknown, so it is left out, not an empty year
+    assert "1 of 3 years have falls but no exact size (2003)" in msg and "no recorded fall" not in msg
+    assert m[2001] == 2 and 2003 not in m.index and m.attrs["years_without_exact_size"] == [2003]
 
 
 def test_bad_size_text_names_file_row_and_value(tmp_path):
@@ -162,6 +164,31 @@ def test_nvdb_e6_record_road_reference_and_chainage():
     assert raw["chainage_from_m"].astype(int).between(0, 100_000).all()
 
 
+def test_nvdb_e6_empty_years_come_from_every_fall_not_only_the_sized_ones():
+    """2002, 2006 and 2009 have falls (1, 3, 6) but none with a size: unknown maxima, not empty years.
+
+    PROVENANCE.md falls per year 2000-2014: 2,0,1,0,4,0,3,6,7,6,11,10,2,12,12, so exactly 3 of 15
+    years (2001, 2003, 2005) have no fall and the mixed model's p0 is 3/15.
+    """
+    from riskrf.frequency_study import analyse_inventory
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        inv = read_inventory(E6)
+    with pytest.warns(UserWarning) as rec:
+        maxima = inv.annual_maxima()
+    text = " | ".join(str(w.message) for w in rec)
+    assert "3 of 15 years have falls but no exact size (2002, 2006, 2009)" in text
+    assert "3 of 15 years have no recorded fall (2001, 2003, 2005)" in text
+    assert maxima.attrs["years_without_exact_size"] == [2002, 2006, 2009]
+    assert not {2002, 2006, 2009} & set(maxima.index)             # left out: unknown, not zero, not empty
+    assert maxima.index[maxima.isna()].tolist() == [2001, 2003, 2005]
+    assert maxima.notna().sum() == 9
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        analysis = analyse_inventory(inv, n_bootstrap=0)
+    assert analysis.gumbel.p_zero == pytest.approx(3 / 15) and analysis.gumbel.n_years == 15
+
+
 def test_fit_on_the_hong_kong_record_prefers_the_power_law_over_an_infinite_mean_gev():
     from riskrf.frequency_study import analyse_inventory
     with warnings.catch_warnings():
@@ -169,6 +196,7 @@ def test_fit_on_the_hong_kong_record_prefers_the_power_law_over_an_infinite_mean
         inv = read_inventory(HK)
         analysis = analyse_inventory(inv, n_bootstrap=0)
     assert analysis.maxima.notna().sum() == 37 and analysis.gumbel.p_zero == 0   # no empty year
+    assert analysis.maxima.attrs["years_without_exact_size"] == []          # every year has an exact size
     # measured (README, Hong Kong worked example): xi = 1.71, b = 0.691 above m_min 2.5 m3
     assert analysis.gev.shape == pytest.approx(1.712, abs=0.01)
     assert analysis.power_law.b == pytest.approx(0.691, abs=0.005)

@@ -162,3 +162,27 @@ def test_cli_rates_writes_tables_and_figures(tmp_path, capsys):
     for name in ("rate_ratios.csv", "model_comparison.csv", "season.csv", "seasonality.png"):
         assert (out / name).exists()
     assert main(["rates", str(HK), "--rainfall", str(tmp_path / "missing.csv")]) == 2
+
+
+def test_known_freeze_thaw_rate_ratio_recovered_within_its_interval(tmp_path):
+    """A daily covariate other than rainfall: freeze-thaw days (0/1, more often in winter) with a rate ratio of 2.5.
+
+    log mu = log 0.05 + log(2.5) * freeze_thaw; rainfall is given but has no effect (its ratio must cover 1)."""
+    rng = np.random.default_rng(20251123)
+    start, end = "2001-01-01", "2010-12-31"
+    days = pd.date_range(start, end, freq="D")
+    winter = 0.5 * (1 + np.cos(2 * np.pi * (days.day_of_year.to_numpy() - 15) / 365.25))   # 1 mid-January
+    ft = (rng.random(len(days)) < 0.6 * winter).astype(float)
+    counts = rng.poisson(0.05 * 2.5 ** ft)
+    inv = _inventory(tmp_path, _events_from_counts(days, counts), start, end)
+    rain = _rain("2000-12-01", end, rng)
+    cov = pd.DataFrame({"freeze_thaw": ft}, index=days)
+    model = rate_model(inv, cov, rainfall=rainfall_from_series(rain), period="day", windows_days=(1,),
+                       season=None, trend=False)
+    rr = model.rate_ratios.set_index("term")
+    row = rr.loc["freeze_thaw"]
+    assert row["ci_low"] < 2.5 < row["ci_high"]
+    assert row["rate_ratio"] == pytest.approx(2.5, rel=0.25)
+    assert row["ci_low"] > 1.5                              # detected, not merely covered
+    assert rr.loc["rain_d0_mm", "ci_low"] < 1.0 < rr.loc["rain_d0_mm", "ci_high"]
+    assert model.n_events == counts.sum() and model.n_periods == len(days)

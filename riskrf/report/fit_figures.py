@@ -81,25 +81,39 @@ def plot_gumbel(fit, ax=None, *, formula: str = "gringorten", level: float = 0.9
 
 
 def plot_return_levels(fits, ax=None, *, power_law=None, maxima=None, formula: str = "gringorten",
-                       level: float = 0.95, units: str = "kg", T_max: float = 1000.0):
+                       level: float = 0.95, units: str = "kg", T_max: float = 1000.0, ci_method: str | None = None):
     """Return level against return period for one or more annual-maximum fits.
 
     ``fits`` is a fit or a dict ``{label: fit}``.  With ``power_law`` (a
     :class:`~riskrf.GutenbergRichterFit`) the annual-maximum law it implies,
     exp(-N(>=m)) (Frechet when untruncated), is drawn too, so the two models of
     Wyllie's chapter 8 can be compared.  ``maxima`` adds the empirical points.
+    The bands are ``level`` intervals by ``ci_method`` (default: each fit's
+    ``default_ci_method``, the method of ``design_masses.csv``: profile
+    likelihood for maximum-likelihood fits); a lower end at or below zero is
+    drawn at the bottom of the axis (a mass is never negative) and an upper end
+    the data do not bound (inf) is left open.
     """
     ax = _axes(ax)
     if not isinstance(fits, dict):
         fits = {type(fits).__name__[:-3]: fits}
+    methods, bands = [], []
     for i, (label, fit) in enumerate(fits.items()):
         T = np.geomspace(1.05 / (1 - fit.p_zero), T_max, 120)
         ax.semilogx(T, fit.return_level(T), "-", color=f"C{i}", lw=2, label=label)
+        how = ci_method or fit.default_ci_method
+        Tb = np.geomspace(T[0], T_max, 30)         # the profile interval costs ~10-20 ms per return period
         try:
-            lo, hi = fit.return_level_ci(T, level=level, method="delta")
-            ax.fill_between(T, lo, hi, color=f"C{i}", alpha=0.15)
+            lo, hi = fit.return_level_ci(Tb, level=level, method=how)
         except ValueError:
-            pass
+            continue
+        methods.append(how)
+        bands.append((Tb, np.asarray(lo, dtype=float), np.where(np.isfinite(hi), hi, np.nan), f"C{i}"))
+    positive = [lo[lo > 0].min() for _, lo, _, _ in bands if np.any(lo > 0)]
+    floor = 0.5 * min(positive) if positive else np.nan
+    for Tb, lo, hi, color in bands:
+        lo = np.where(lo > 0, lo, floor)               # a mass is never negative: the band stops at the axis
+        ax.fill_between(Tb, lo, hi, color=color, alpha=0.15)
     if power_law is not None:
         T0 = 1.0 / (-np.expm1(-power_law.rate_min))
         T = np.geomspace(max(1.05, T0 * 1.001), T_max, 120)
@@ -107,7 +121,7 @@ def plot_return_levels(fits, ax=None, *, power_law=None, maxima=None, formula: s
                     label=f"implied by power law (b = {power_law.b:.2f})")
     if maxima is not None:
         values = np.asarray(maxima, dtype=float)
-        n = values.size
+        n = values.size + len(getattr(maxima, "attrs", {}).get("years_without_exact_size", ()))
         x = np.sort(values[~np.isnan(values)])
         F = plotting_positions(n, formula)[n - x.size:]
         ax.semilogx(1 / (1 - F), x, "o", ms=4, mfc="none", color="0.3", label=f"annual maxima ({formula})")
@@ -115,7 +129,9 @@ def plot_return_levels(fits, ax=None, *, power_law=None, maxima=None, formula: s
     ax.set_ylabel(f"return level [{units}]")
     ax.set_yscale("log")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize="small", title=f"bands: {level:.0%} delta method")
+    names = {"profile": "profile likelihood", "delta": "delta method", "bootstrap": "parametric bootstrap"}
+    ax.legend(fontsize="small", title=(f"bands: {level:.0%} " + ", ".join(names[m] for m in dict.fromkeys(methods))
+                                       + " intervals") if methods else None)
     return ax
 
 
