@@ -12,6 +12,7 @@ import warnings
 from pathlib import Path
 
 from . import __version__
+from .units import DEFAULT_DENSITY_KG_M3
 
 EPILOG = "Units: mass kg, volume m3, density kg/m3, energy kJ, velocity m/s, time in years."
 
@@ -34,7 +35,8 @@ def _add_fit_arguments(p):
 
 def _add_inventory_arguments(p):
     p.add_argument("--density", type=float, default=None, metavar="KG_M3",
-                   help="rock density in kg/m3 (default: the sidecar TOML, else 2650, reported as default)")
+                   help=f"rock density in kg/m3 (default: the sidecar TOML, else {DEFAULT_DENSITY_KG_M3:g}, reported as "
+                        "default)")
     p.add_argument("--start", default=None, help="start of the record period, YYYY-MM-DD")
     p.add_argument("--end", default=None, help="end of the record period, YYYY-MM-DD")
     p.add_argument("--duration-years", type=float, default=None, metavar="YR",

@@ -35,6 +35,7 @@ import pandas as pd
 
 from . import rhrs
 from .mitigation_inputs import MitigationError, parse_mitigation
+from .units import DEFAULT_DENSITY_KG_M3, M_PER_KM
 
 BUNDLED_MATERIALS = Path(__file__).resolve().parents[1] / "simulation" / "scenarios" / "road_cut_barrier.toml"
 
@@ -151,7 +152,7 @@ def _section_seed(seed: int, sid: str) -> int:
 
 def cut_scenario_dict(materials: dict, settings: dict, *, cut_height_m, face_angle_deg, ditch_width_m, ditch_depth_m,
                       runout_to_road_m, road_width_m, face_material, ditch_material, road_material, seeder_mass,
-                      release_zone_share=0.3, density_kg_m3=2650.0, name="cut") -> dict:
+                      release_zone_share=0.3, density_kg_m3=DEFAULT_DENSITY_KG_M3, name="cut") -> dict:
     """Scenario dictionary of a generated rock cut (x increases towards the road, z up, metres).
 
     crest plateau (CREST_M) -> rock face of ``cut_height_m`` at ``face_angle_deg`` -> ditch of
@@ -359,7 +360,7 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
             raise CorridorError(f"{tsrc}: missing column {c!r}")
     if df.empty:
         raise CorridorError(f"{tsrc}: the sections table has no rows")
-    scale = 1000.0 if unit == "km" else 1.0
+    scale = M_PER_KM if unit == "km" else 1.0
     errors, sections, bad_rows = [], [], set()
     seen = {}
     for i, raw in df.iterrows():
@@ -416,7 +417,7 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
             if "falls_per_year" in num:
                 rate = num["falls_per_year"]
             elif "falls_per_km_year" in num:
-                rate = num["falls_per_km_year"] * (c1 - c0) / 1000
+                rate = num["falls_per_km_year"] * (c1 - c0) / M_PER_KM
             else:
                 if "cut_height_m" not in num or "face_angle_deg" not in num:
                     raise CorridorError(f"{where}: falls_per_m2_year needs cut_height_m and face_angle_deg (the face "
@@ -661,7 +662,7 @@ class CorridorResult:
         t["rank_risk"] = t["deaths_per_year"].rank(ascending=False, method="min").astype(int)
         t["rank_rhrs"] = t["rhrs_score"].rank(ascending=False, method="min")
         t["rank_difference"] = t["rank_rhrs"] - t["rank_risk"]
-        t["expected_annual_cost_per_km"] = t["expected_annual_loss_pv"] / _pv(self.corridor) / (t["length_m"] / 1000)
+        t["expected_annual_cost_per_km"] = t["expected_annual_loss_pv"] / _pv(self.corridor) / (t["length_m"] / M_PER_KM)
         cols = ["rank_risk", "rank_rhrs", "rank_difference", "id", "chainage_from_m", "chainage_to_m", "rhrs_score",
                 "road_falls_per_year", "deaths_per_year", "individual_risk", "expected_annual_cost_per_km",
                 "best_option", "best_option_capital", "best_option_total_cost", "best_individual_risk",

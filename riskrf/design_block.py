@@ -49,7 +49,7 @@ import numpy as np
 import pandas as pd
 
 from .report.format import sig
-from .units import J_PER_KJ
+from .units import DEFAULT_DENSITY_KG_M3, kinetic_energy_kj
 
 #: The percentile band of ONR 24810:2021 for the design block [%].
 ONR24810_PERCENTILES = (95.0, 98.0)
@@ -241,7 +241,7 @@ def _law_text(hazard) -> str:
     return f"{mass_model(m).description}, {sig(hazard.rate_per_year)} falls/yr"
 
 
-def site_design_masses(hazard, T=(10, 50, 100, 300, 1000), density_kg_m3: float = 2650.0) -> pd.DataFrame:
+def site_design_masses(hazard, T=(10, 50, 100, 300, 1000), density_kg_m3: float = DEFAULT_DENSITY_KG_M3) -> pd.DataFrame:
     """Design masses [kg] of the site's law (the hazard's: truncated at m_max, rate scaled to the source above the
     line): the T-year fall at the source and the T-year fall reaching the line; NaN where fewer than one such fall
     is expected in T years.  Never above the law's m_max."""
@@ -258,7 +258,7 @@ def site_design_masses(hazard, T=(10, 50, 100, 300, 1000), density_kg_m3: float 
 
 def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.0, survey_volumes_m3=None,
                  survey_source: str | None = None, inventory=None, sizes: str = "event_volumes",
-                 design_T: float = 100.0, density_kg_m3: float = 2650.0, fractal_dimension: float | None = None,
+                 design_T: float = 100.0, density_kg_m3: float = DEFAULT_DENSITY_KG_M3, fractal_dimension: float | None = None,
                  iterations: int | None = None) -> DesignBlock:
     """The design block by ``rule`` with its alternatives (see module notes).
 
@@ -316,7 +316,7 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
         v95 = hazard.velocity_percentile(95, mass_kg=mass) if np.isfinite(mass) else np.nan
         rows.append({"rule": name, "mass_kg": mass, "volume_m3": mass / rho, "diameter_m":
                      float(sphere_diameter_m(mass / rho)), "velocity_p95_ms": v95,
-                     "energy_at_v95_kj": 0.5 * mass * v95 ** 2 / J_PER_KJ, "note": note})
+                     "energy_at_v95_kj": kinetic_energy_kj(mass, v95), "note": note})
 
     if survey is not None:
         band = sorted(set(ONR24810_PERCENTILES) | {pct})

@@ -13,7 +13,7 @@ from .frequency_study import DESIGN_RETURN_PERIODS
 from .outputs import write_json
 from .power_law import GutenbergRichterFit, fit_gutenberg_richter
 from .report.format import sig
-from .units import DEFAULT_DENSITY_KG_M3
+from .units import DEFAULT_DENSITY_KG_M3, kinetic_energy_kj
 
 #: What the bootstrap interval of a design energy covers, and what it does not (stated with every interval).
 INTERVAL_COVERS = ("sampling uncertainty of the power-law exponent b and of the rate, and the finite number of "
@@ -464,7 +464,7 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
     def block_energy(hz, m, pct):
         if not np.isfinite(m):
             return np.nan
-        return 0.5 * m * hz.velocity_percentile(pct, mass_kg=m) ** 2 / J_PER_KJ
+        return kinetic_energy_kj(m, hz.velocity_percentile(pct, mass_kg=m))
 
     # ---- the perturbed hazards (cheap: the same simulated slope, another mass law or rate) -----------------
     cases = {}                      # input -> (unit, low, base, high, basis, hz_low, hz_high, change_low, change_high)

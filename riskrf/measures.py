@@ -21,6 +21,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .annual_hazard import inertia_factors
+
 #: Horizontal run per unit drop of the ditch wall on the slope side (steep, 0.25H:1V) and of the
 #: foreslope on the road side (1H:1V); defaults of :func:`ditch_profile` [assumption, ODOT-style shape].
 DITCH_INNER_SLOPE_HV = 0.25
@@ -217,6 +219,6 @@ def effective_samples(result, collector: str):
     crossings of ``collector``."""
     df = result.collector(collector, first_only=True)
     v = df["velocity_ms"].to_numpy()
-    k = df["inertia_factor"].to_numpy() if "inertia_factor" in df else np.full(len(df), 0.4)
+    k = inertia_factors(df)
     spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
     return np.sqrt(v ** 2 + k * spin ** 2), df["height_m"].to_numpy()
