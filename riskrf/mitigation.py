@@ -581,8 +581,8 @@ class MitigationStudy:
         if "b" in c and u.sample_power_law:
             n = hz.mass.n_tail
             g = stats.gamma(n, scale=1.0 / n)
-            out["b"] = (c["b"] * g.ppf(0.05), c["b"] * g.ppf(0.95), "b x Gamma(n)/n (sampling law of the MLE)")
-            out["rate_sampling_factor"] = (g.ppf(0.05), g.ppf(0.95), "Gamma(n)/n (Poisson count of the record)")
+            out["b"] = (c["b"] * g.ppf(0.05), c["b"] * g.ppf(0.95), "b x Gamma(n)/n (Jeffreys-prior posterior of b)")
+            out["rate_sampling_factor"] = (g.ppf(0.05), g.ppf(0.95), "Gamma(n)/n (posterior of the rate of n recorded falls, prior 1/rate)")
         if u.rate_factor != (1.0, 1.0):
             out["rate_factor"] = (*u.rate_factor, "uniform, stated (share of the source above the road)")
         if u.m_max_kg and "m_max_kg" in c:

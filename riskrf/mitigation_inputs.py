@@ -94,7 +94,8 @@ class Uncertainty:
 
     ``rate_factor``: the rate of falls relative to the estimate (e.g. the share of the source above the
     road); ``vulnerability_factor`` multiplies both vulnerability curves.  The power law's b and rate are
-    sampled from their sampling laws (b x Gamma(n)/n, rate x Gamma(n)/n) and derived retentions from their
+    sampled from their posteriors given the record of n falls (b x Gamma(n)/n, the Jeffreys-prior posterior of b;
+    rate x Gamma(n)/n, prior 1/rate) and derived retentions from their
     Monte Carlo law (Beta) unless switched off.  ``materials`` gives ranges of slope material parameters
     ("talus.ground_friction_angle_deg" = [20, 30]); the scenario is re-simulated for ``material_draws``
     joint draws (and once at each end of each range, for the tornado) and every sample uses one of the

@@ -374,7 +374,7 @@ def render_report(a, figs: Path) -> str:
             "<h3>Uncertain inputs</h3>",
             doc.table(pd.DataFrame([{"input": k, "low": v["low"], "high": v["high"], "law": v["law"]}
                                     for k, v in unc["inputs"].items()]), "Uncertain inputs sampled jointly"),
-            "<p>Low and high: the ends of a stated range, or the 5th and 95th percentiles of a sampling law.</p>",
+            "<p>Low and high: the ends of a stated range, or the 5th and 95th percentiles of the law it is drawn from.</p>",
             f"<p>Not sampled: {_e('; '.join(unc['not_sampled']))}.</p>",
             doc.figure(figs / "tree.png", "Decision tree at central values; the optimal path in red"),
             "<h3>Break-even: input values at which the two cheapest options at central values tie</h3>",
