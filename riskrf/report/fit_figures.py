@@ -18,7 +18,7 @@ def _axes(ax, figsize=(6.4, 4.8)):
 
 
 def plot_magnitude_frequency(fit, ax=None, *, level_label=True):
-    """Magnitude-cumulative-frequency plot on log-log axes (the plot of Wyllie 2014, section 8.4.1, power-law magnitude-frequency).
+    """Magnitude-cumulative-frequency plot on log-log axes (as in Wyllie 2014, section 8.4.1, the power law).
 
     Points: the observed annual frequency of falls at least as large as each
     recorded size (above 4,000 distinct sizes, 4,000 of them log-spaced in rank).  Line: the fitted law above m_min, with the band spanned by
