@@ -304,6 +304,9 @@ class EnergyHazard:
                              "ci_high_kj": hi, "probability_in_50_years": -np.expm1(-50 / T)})
 
     def summary(self) -> pd.DataFrame:
+        """Key figures of the hazard at the line (one-column table): falls per year, reach probability, arrivals
+        per year [1/yr], the mass model, mass coupling and the 95th/99th-percentile energies [kJ].
+        """
         rows = {"collector": self.collector, "falls per year (mass model)": self.rate_per_year,
                 "reach probability": self.reach_probability, "arrivals per year": self.arrival_rate,
                 "mass model": mass_model(self.mass).description,

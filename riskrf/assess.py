@@ -178,6 +178,15 @@ def _ends(values):
 
 @dataclass
 class Assessment:
+    """Everything one ``riskrf assess`` run computed for a site, in the order of the chain.
+
+    Fields: the :class:`~riskrf.site.Site` read, its :class:`~riskrf.inventory.Inventory`, the frequency analyses
+    (power law, and annual maxima when dated), the simulation ``result`` (:class:`simulation.SimulationResult`),
+    the :class:`~riskrf.energy_study.EnergyAnalysis` at the barrier line, the
+    :class:`~riskrf.mitigation.MitigationStudy` and its ``decision`` (recommendation dict), the ``seed`` and
+    number of simulated blocks, ``warnings`` raised on the way, stage ``timings`` [s] and the site's rate model
+    (``rates``, or None).  Written to files by :func:`write_assessment`; nothing here prints.
+    """
     site: Site
     inventory: Inventory
     frequency: FrequencyAnalysis

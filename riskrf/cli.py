@@ -515,6 +515,9 @@ def cmd_calibrate(args) -> int:
 
 
 def cmd_corridor(args) -> int:
+    """``riskrf corridor FILE``: read and check the corridor (sections table, mass law, study inputs), run every
+    section and write the tables, figures and report to ``--out``.  Returns the exit code (0 on success).
+    """
     from .corridor import load_corridor, run_corridor, write_corridor
 
     corridor = load_corridor(args.corridor, keep_going=args.keep_going, sheet=args.sheet,   # every row checked
@@ -776,6 +779,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def cmd_rates(args) -> int:
+    """``riskrf rates``: fit the rate model of falls (Poisson and negative binomial regressions on rainfall
+    over ``--windows`` days, season and trend) and write its tables and figures.  Returns the exit code.
+    """
     from .outputs import atomic_output_dir
     from .rate_model import rate_model
 

@@ -80,6 +80,7 @@ class Section:
 
     @property
     def length_m(self) -> float:
+        """Length of the section along the chainage [m]."""
         return self.chainage_to_m - self.chainage_from_m
 
 
@@ -103,6 +104,7 @@ class Corridor:
     defaults_used: tuple = ()
 
     def section(self, sid: str) -> Section:
+        """The section with id ``sid`` (StopIteration when there is none)."""
         return next(s for s in self.sections if s.id == sid)
 
 
@@ -689,6 +691,9 @@ class CorridorResult:
         return plot_corridor(self)
 
     def to_json(self) -> dict:
+        """The run as a JSON-ready dict (``corridor_summary.json``): counts, failures, rejected rows, seed, blocks,
+        workers, seconds, units (chainage m, rates 1/yr, money in the corridor's currency) and totals.
+        """
         s = self.summary()
         return {"corridor": self.corridor.name, "sections": int(len(self.table)), "failures": list(self.failures),
                 "rejected_rows": list(self.corridor.errors), "seed": self.corridor.seed, "n_blocks": self.n_blocks,

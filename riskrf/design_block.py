@@ -192,6 +192,9 @@ class DesignBlock:
     inputs: dict = field(default_factory=dict, repr=False, compare=False)
 
     def summary(self) -> pd.DataFrame:
+        """The chosen design block (one-column table): rule, mass [kg], volume [m3], equivalent sphere diameter [m],
+        basis and each assumption.
+        """
         rows = {"rule": self.rule, "design block mass [kg]": self.mass_kg, "volume [m3]": self.volume_m3,
                 "equivalent sphere diameter [m]": self.diameter_m, "basis": self.basis}
         for i, a in enumerate(self.assumptions):
@@ -199,6 +202,7 @@ class DesignBlock:
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
     def to_dict(self) -> dict:
+        """The design block and its alternatives as a JSON-ready dict (mass_kg, volume_m3, diameter_m, ...)."""
         return {"rule": self.rule, "mass_kg": self.mass_kg, "volume_m3": self.volume_m3,
                 "diameter_m": self.diameter_m, "basis": self.basis, "assumptions": list(self.assumptions),
                 "alternatives": self.alternatives.to_dict(orient="records")}
@@ -241,7 +245,8 @@ def _law_text(hazard) -> str:
     return f"{mass_model(m).description}, {sig(hazard.rate_per_year)} falls/yr"
 
 
-def site_design_masses(hazard, T=(10, 50, 100, 300, 1000), density_kg_m3: float = DEFAULT_DENSITY_KG_M3) -> pd.DataFrame:
+def site_design_masses(hazard, T=(10, 50, 100, 300, 1000),
+                       density_kg_m3: float = DEFAULT_DENSITY_KG_M3) -> pd.DataFrame:
     """Design masses [kg] of the site's law (the hazard's: truncated at m_max, rate scaled to the source above the
     line): the T-year fall at the source and the T-year fall reaching the line; NaN where fewer than one such fall
     is expected in T years.  Never above the law's m_max."""
@@ -258,7 +263,8 @@ def site_design_masses(hazard, T=(10, 50, 100, 300, 1000), density_kg_m3: float 
 
 def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.0, survey_volumes_m3=None,
                  survey_source: str | None = None, inventory=None, sizes: str = "event_volumes",
-                 design_T: float = 100.0, density_kg_m3: float = DEFAULT_DENSITY_KG_M3, fractal_dimension: float | None = None,
+                 design_T: float = 100.0, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+                 fractal_dimension: float | None = None,
                  iterations: int | None = None) -> DesignBlock:
     """The design block by ``rule`` with its alternatives (see module notes).
 

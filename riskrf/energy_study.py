@@ -40,6 +40,7 @@ class EnergyAnalysis:
     tornado: object = None               # DesignEnergyTornado or None
 
     def fence_verdicts(self) -> pd.DataFrame:
+        """One row per fence checked: whether every check passed (``adequate``) and the names of those that failed."""
         rows = []
         for name, table in self.fences.items():
             rows.append({"fence": name, "adequate": bool(table["adequate"].all()),
@@ -47,6 +48,9 @@ class EnergyAnalysis:
         return pd.DataFrame(rows)
 
     def summary_text(self) -> str:
+        """The analysis in a few plain-text lines (rates [1/yr], reach probability, design energies [kJ], fence
+        verdicts), for the CLI's closing summary; the caller prints it.
+        """
         hz = self.hazard
         lines = ["Impact energy hazard at the barrier line (Wyllie 2014, 8.1-8.3)",
                  f"  falls per year (mass model)   {sig(hz.rate_per_year, 4)}   [{hz.summary().loc['mass model', 'value']}]",
@@ -105,6 +109,9 @@ class EnergyAnalysis:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
+        """The analysis as a JSON-ready dict (``energy_summary.json``): units, hazard figures, design energies [kJ],
+        fence checks, interval coverage and notes.
+        """
         hz = self.hazard
         out = {"units": {"energy": "kJ", "height": "m", "rate": "1/yr", "return_period": "yr"},
                "hazard": {k: v for k, v in hz.summary()["value"].items()},
@@ -131,6 +138,9 @@ class EnergyAnalysis:
         return out
 
     def write(self, out_dir) -> None:
+        """Write ``energy_summary.json``, the CSV tables (design energies, sensitivity, tornado) and the figures
+        into ``out_dir`` (which must exist).
+        """
         from .report.files import write_energy_figures
         out = Path(out_dir)
         write_json(self.to_dict(), out / "energy_summary.json")
@@ -276,6 +286,7 @@ class DesignEnergyTornado:
     notes: tuple = ()
 
     def summary(self) -> pd.DataFrame:
+        """The tornado table: one row per input and design energy; low/high inputs and the energy [kJ] at each."""
         return self.table
 
     @property
@@ -313,6 +324,7 @@ class DesignEnergyTornado:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
+        """The tornado as a JSON-ready dict: design return period [yr], rows, dominant inputs and notes."""
         return {"design_T_years": self.design_T, "rows": self.table.to_dict(orient="records"),
                 "dominant": self.dominant().to_dict(orient="records"), "notes": list(self.notes)}
 

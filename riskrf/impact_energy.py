@@ -59,6 +59,7 @@ class VelocityFit:
     n: int
 
     def summary(self) -> pd.DataFrame:
+        """The candidate table: distribution, parameters, log-likelihood, AIC and whether it was chosen."""
         return self.table
 
 
@@ -106,9 +107,15 @@ class PairedSamples:
 
     @classmethod
     def from_collector(cls, df: pd.DataFrame, n_bins: int = 10) -> "PairedSamples":
+        """Paired samples from a collector table (columns ``velocity_ms`` [m/s] and ``mass_kg`` [kg], e.g.
+        :meth:`simulation.SimulationResult.collector`), in ``n_bins`` mass classes.
+        """
         return cls(np.asarray(df["velocity_ms"], dtype=float), np.asarray(df["mass_kg"], dtype=float), n_bins)
 
     def classes(self):
+        """Mass classes of equal counts (at most ``n_bins``, at least 20 blocks each): the class edges [kg]
+        (geometric means of neighbouring masses) and the sorted speeds [m/s] of each class.
+        """
         order = np.argsort(self.mass_kg)
         groups = np.array_split(order, min(self.n_bins, max(1, self.mass_kg.size // 20)))
         edges = [np.sqrt(self.mass_kg[g[-1]] * self.mass_kg[h[0]]) for g, h in zip(groups[:-1], groups[1:])]

@@ -90,6 +90,7 @@ class Ditch:
 
     @property
     def span(self):
+        """(start, end) of the ditch along x [m]."""
         return self.x_m, self.x_m + self.width_m
 
 
@@ -157,6 +158,9 @@ class SimulationContext:
     threads: int = 0              # simulations run at once by run_many (0: one per core); corridor workers use 1
 
     def run(self, scenario):
+        """Simulate ``scenario`` with this context's number of blocks and seed (no recorded paths); a
+        :class:`simulation.SimulationResult`.
+        """
         import simulation
         return simulation.run(scenario, n=self.n_blocks, seed=self.seed, record_paths=0)
 

@@ -114,6 +114,9 @@ class OptionResult:
 
     @property
     def held_impacts_above_sel_per_year(self) -> float:
+        """Impacts per year [1/yr] held by the barrier above its service energy level (SEL = MEL / 3), each
+        needing a repair; the same number as ``repairs_per_year``.
+        """
         return self.repairs_per_year
 
 
@@ -169,9 +172,11 @@ class MitigationStudy:
 
     @property
     def currency(self) -> str:
+        """Currency of every money figure of the study (from the consequences)."""
         return self.consequences.currency
 
     def option(self, name: str) -> Option:
+        """The option named ``name``; a MitigationError listing the options when there is none."""
         opt = next((o for o in self.options if o.name == name), None)
         if opt is None:
             raise MitigationError(f"no option named {name!r}; options are {[o.name for o in self.options]}")
@@ -582,7 +587,8 @@ class MitigationStudy:
             n = hz.mass.n_tail
             g = stats.gamma(n, scale=1.0 / n)
             out["b"] = (c["b"] * g.ppf(0.05), c["b"] * g.ppf(0.95), "b x Gamma(n)/n (Jeffreys-prior posterior of b)")
-            out["rate_sampling_factor"] = (g.ppf(0.05), g.ppf(0.95), "Gamma(n)/n (posterior of the rate of n recorded falls, prior 1/rate)")
+            out["rate_sampling_factor"] = (g.ppf(0.05), g.ppf(0.95),
+                                           "Gamma(n)/n (posterior of the rate of n recorded falls, prior 1/rate)")
         if u.rate_factor != (1.0, 1.0):
             out["rate_factor"] = (*u.rate_factor, "uniform, stated (share of the source above the road)")
         if u.m_max_kg and "m_max_kg" in c:
@@ -897,6 +903,7 @@ class MitigationStudy:
                     and row["fn_zone"] in ("ALARP", "broadly acceptable"))
 
     def best(self) -> str:
+        """Name of the first option of :meth:`ranking` (the lowest expected total cost over the joint samples)."""
         return self.ranking()["option"].iloc[0]
 
     def recommendation(self, ranking: pd.DataFrame | None = None) -> dict:

@@ -76,6 +76,9 @@ def closure_cost_per_fall(co: "Consequences", vehicles_per_day):
 
 @dataclass(frozen=True)
 class Economics:
+    """Discounting of the study: ``discount_rate`` (a fraction per year, default 0.03) over ``horizon_years``
+    [yr] (default 50); present values use the uniform-series factor (1 - (1 + r)^-n) / r (Wyllie 2014, 8.5.5).
+    """
     discount_rate: float = 0.03
     horizon_years: float = 50.0
 
@@ -123,6 +126,15 @@ class Uncertainty:
 
 @dataclass(frozen=True)
 class Option:
+    """One mitigation option of a study, as read from the ``[[mitigation.options]]`` tables (README "Mitigation
+    options").  ``kind`` is one of OPTION_KINDS.  Money in the study's currency: ``capital_cost``,
+    ``annual_maintenance`` (per year), ``repair_cost_per_impact``, ``replacement_cost``; ``life_years`` [yr],
+    ``repair_days`` [days] of closure per repair.  Geometry in metres (``x_m``, ``width_m``, ``depth_m``,
+    ``height_m``, ``zone_x_m``, ``covered_length_m``, ``road_x_m``), fence capacity ``capacity_kj`` [kJ],
+    scaling range ``min_mass_kg``/``max_mass_kg`` [kg].  Typed effects (``retention``, ``rate_reduction``,
+    closure ``share_while_closed`` and ``closure_hours_per_year``) are ASSUMPTIONS and labelled as such; the
+    ``*_range`` fields are (low, high) for the uncertainty study.
+    """
     name: str
     kind: str
     capital_cost: float = 0.0
@@ -291,6 +303,11 @@ def _vulnerability(v, where):
 
 
 def parse_option(spec: dict, i: int, source: str) -> Option:
+    """Check and read option ``i`` of a study (a dict from TOML) read from ``source``; an :class:`Option`.
+
+    Every field is checked before any work (kind, costs >= 0, geometry, ranges low <= high); a
+    MitigationError names the source, the option and the field with its value.
+    """
     where = f"options[{i}]"
     if not isinstance(spec, dict):
         raise MitigationError(f"{source}: {where} must be a table")
