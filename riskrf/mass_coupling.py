@@ -54,6 +54,8 @@ class MassCoupledSamples:
     edges_kg : boundaries [kg] of the mass classes (increasing, equal width in ln m).
     representative : indices into the arriving blocks that represent the arriving falls under a mass model
         (systematic resampling with class weights); pooled samples (``velocity_ms``, ``heights_m``) use them.
+
+    The per-class tables are computed on first use and cached (the fields are never changed).
     """
 
     mass_kg: np.ndarray = field(repr=False)

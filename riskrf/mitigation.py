@@ -144,6 +144,11 @@ class MitigationStudy:
     derive the options' effects; ``reference`` the simulation behind the hazard (road
     velocities, run-out).  ``small_fall_masses_kg`` and ``small_falls_per_year``: the
     inventory's falls below the power law's m_min (already scaled to this site).
+
+    Lazy: building the study only checks its inputs.  The options' effects (their simulations), the mass
+    grid, the central result and the uncertainty samples are computed on first use (``functools.cached_property``)
+    by whichever method needs them first (:meth:`ranking`, :meth:`summary`, ...) and kept; the inputs are frozen,
+    so the cached results never go stale and every later call returns the same numbers.
     """
 
     hazard: EnergyHazard
