@@ -31,8 +31,19 @@ def test_barrier_scenario_collector_columns():
     assert (df["height_m"] >= -1e-9).all()
     env = res.envelopes
     assert (env["velocity_max_ms"] >= env["velocity_mean_ms"]).all()
-    path = res.path(0)
-    assert path["x_m"].is_monotonic_increasing or len(path) > 2
+    rec = simulation.run(load_scenario(BARRIER), n=50, seed=1, record_paths=5)
+    for b in range(5):
+        sel = rec.paths["block"] == b
+        t, x, z = rec.paths["t"][sel], rec.paths["x"][sel], rec.paths["z"][sel]
+        assert t[0] == 0.0 and t[-1] > 0.0
+        assert np.all(np.diff(t) >= 0)                            # events in time order
+        moved = (np.diff(x) != 0) | (np.diff(z) != 0)
+        assert moved.any() and np.all(np.diff(t)[moved] > 0)     # moving takes time: no jump between events
+        assert t[-1] == rec.per_block["t"][b]                     # the last event is the stop
+        assert rec.paths["x"][sel][0] == rec.blocks["x"][b] and rec.paths["z"][sel][0] == rec.blocks["z"][b]
+        path = rec.path(b)                                        # the sampled path ends where the block stopped
+        assert (path["x_m"].iloc[-1], path["z_m"].iloc[-1]) == (rec.per_block["x"][b], rec.per_block["z"][b])
+        assert (path["x_m"].iloc[0], path["z_m"].iloc[0]) == (rec.blocks["x"][b], rec.blocks["z"][b])
 
 
 def test_same_seed_same_numbers_whatever_the_chunking():
