@@ -35,7 +35,7 @@ from .frequency_study import FrequencyAnalysis, analyse_inventory
 from .inventory import Inventory, read_inventory
 from .mass_coupling import energy_hazard
 from .mitigation import MitigationStudy
-from .outputs import write_json
+from .outputs import relative_paths, relative_paths_in_json_files, write_json
 from .power_law import fit_gutenberg_richter
 from .site import Site
 from .validation import RiskrfWarning
@@ -467,7 +467,8 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     write_json(summary, out / "summary.json")
     (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
     _copy_inputs(a, out / "inputs")
-    return summary
+    relative_paths_in_json_files(out, a.site.path.parent)          # paths relative to the site file
+    return relative_paths(summary, a.site.path.parent)
 
 
 def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:

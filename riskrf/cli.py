@@ -423,8 +423,9 @@ def cmd_assess(args) -> int:
     print(f"\nStage times: {stages}.")
     if assessment.warnings:
         print(f"{len(assessment.warnings)} warning(s), also listed in the report:")
+        from .outputs import relative_paths
         for w in assessment.warnings:
-            print(f"  - {w}")
+            print(f"  - {relative_paths(w, site.path.parent)}")        # paths relative to the site file
     print(f"Rate of falls from the {s['hazard']['rate_source']}.")
     print(f"Lowest expected total cost: {s['best_option']} (then {s['second_option']}).")
     print(f"Recommendation: {s['recommendation']['option']} ({s['recommendation']['basis']}).")

@@ -82,7 +82,7 @@ from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.mitigati
     parse_option,
 )
 from .power_law import GutenbergRichterFit
-from .report.format import probability
+from .report.format import money, probability
 from .road_risk import (
     commuter_passage_probability,
     commuter_strike_probability,
@@ -924,18 +924,19 @@ class MitigationStudy:
             why = (f"{rec['option']} is the cheapest option that meets the tolerability criteria (individual risk "
                    f"{probability(rec['individual_risk'])}/yr against {probability(lim)}/yr; societal risk {rec['fn_zone']} on the "
                    f"{self.criteria.fn_diagram} F-N diagram). Its expected total cost is "
-                   f"{rec['expected_total_cost']:,.0f} {cur} (5-95 %: {rec['cost_p05']:,.0f} to "
-                   f"{rec['cost_p95']:,.0f} {cur}); it meets them in {rec['probability_meets_criteria']:.0%} of the "
+                   f"{money(rec['expected_total_cost'], cur, sig=3)} (5-95 %: {money(rec['cost_p05'], sig=3)} to "
+                   f"{money(rec['cost_p95'], cur, sig=3)}); it meets them in "
+                   f"{rec['probability_meets_criteria']:.0%} of the "
                    "joint samples of the uncertain inputs.")
             if rec["option"] != cheapest["option"]:
                 intolerable = t[(t["expected_total_cost"] < rec["expected_total_cost"])]
                 why += (f" Cheaper options leave the risk intolerable: {cheapest['option']} costs least "
-                        f"({cheapest['expected_total_cost']:,.0f} {cur}, the cheapest in "
+                        f"({money(cheapest['expected_total_cost'], cur, sig=3)}, the cheapest in "
                         f"{cheapest['probability_best']:.0%} of the joint samples) but leaves individual risk "
                         f"{probability(cheapest['individual_risk'])}/yr and societal risk {cheapest['fn_zone']}"
                         + (f"; so do {', '.join(intolerable['option'].iloc[1:])}" if len(intolerable) > 1 else "")
                         + f". Meeting the criteria costs "
-                        f"{rec['expected_total_cost'] - cheapest['expected_total_cost']:,.0f} {cur} more in "
+                        f"{money(rec['expected_total_cost'] - cheapest['expected_total_cost'], cur, sig=3)} more in "
                         "expectation.")
             else:
                 most = t.loc[t["probability_best"].idxmax()]

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from .measures import Ditch, MeasureError
+from .report.format import money
 from .road_risk import (
     AGS2007_INDIVIDUAL_RISK,
     VULNERABILITY_DIRECT_BY_MASS,
@@ -223,7 +224,7 @@ class Option:
             text = ((f"{self.closure_rule}: " if self.closure_rule else "")
                     + f"road closed {self.closure_hours_per_year:,.1f} h per year ({how}) at "
                     f"{self.cost_per_closure_hour:,.0f}{cur} per hour "
-                    f"({self.closure_hours_per_year * self.cost_per_closure_hour:,.0f}{cur} per year, in the "
+                    f"({money(self.closure_hours_per_year * self.cost_per_closure_hour, sig=3)}{cur} per year, in the "
                     f"annual maintenance); {self.share_while_closed:.1%} of falls occur while closed "
                     f"({how}); protects road users, falls still reach the road")
         else:
