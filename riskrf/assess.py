@@ -363,7 +363,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note)
         timings["simulation"] = round(time.perf_counter() - t, 2)
         if figures is not None:
-            pending.append(InBackground(partial(_simulation_figures, result, hz_cfg["collector"], figures)))
+            pending.append(InBackground(partial(_simulation_figures, result, hz_cfg["collector"], figures,
+                                                fences_to_draw(site))))
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
         block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
@@ -447,7 +448,7 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
             part.result()
     else:
         def simulation_and_decision_outputs():
-            _simulation_figures(a.result, a.site.hazard["collector"], figs)
+            _simulation_figures(a.result, a.site.hazard["collector"], figs, fences_to_draw(a.site))
             write_mitigation_outputs(a.study, a.decision, figs)
 
         beside = InBackground(simulation_and_decision_outputs)
@@ -480,12 +481,27 @@ def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:
         maxima_frequency.write(sub)
 
 
-def _simulation_figures(result, collector: str, figs: Path) -> None:
-    """Trajectories, the barrier line's distributions and the envelopes (nothing for a velocity file)."""
+def fences_to_draw(site) -> list:
+    """(x [m] or None for the barrier line, height [m], label) of the site's fence and attenuator options, else
+    of the candidate fences of ``hazard.fences_kj``: what the profile figure draws at its height."""
+    opts = [o for o in site.mitigation["options"] if o.kind in ("fence", "attenuator")]
+    if opts:
+        return [(o.x_m, o.height_m, f"{o.name} ({o.height_m:g} m high)" if f"{o.capacity_kj:g}" in o.name
+                 else f"{o.name}: {o.capacity_kj:,.0f} kJ, {o.height_m:g} m high") for o in opts]
+    caps, heights = fence_checks_from_site(site)
+    return [(None, h, f"candidate fence {c:,.0f} kJ, {h:g} m") for c, h in zip(caps, heights)]
+
+
+def _simulation_figures(result, collector: str, figs: Path, fences=()) -> None:
+    """Trajectories (with the fences at their height), the barrier line's distributions and the envelopes
+    (nothing for a velocity file).  A fence with x None stands at the ``collector`` line."""
     if result is None:
         return
     from .report.files import write_simulation_figures
-    write_simulation_figures(result, figs, [collector], file_names={collector: "collector_distributions.png"})
+    line_x = result.scenario.collectors[result.scenario.collector_index(collector)].x
+    fences = [(line_x if x is None else x, h, label) for x, h, label in fences]
+    write_simulation_figures(result, figs, [collector], file_names={collector: "collector_distributions.png"},
+                             fences=fences)
 
 def _copy_inputs(a: Assessment, dest: Path) -> None:
     """Copy the site file and everything it names, with the version, seed and command, for exact reruns."""

@@ -110,3 +110,28 @@ def test_bad_run_arguments_and_files(tmp_path):
         load_scenario(bad)
     with pytest.raises(KeyError, match="no collector named 'fence'"):
         simulation.run(sc, n=1).collector("fence")
+
+
+def test_profile_figure_draws_fences_at_their_height_and_keeps_the_legend_outside():
+    import matplotlib
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    from simulation.plotting import plot_profile
+    sc = load_scenario(BARRIER)
+    res = simulation.run(sc, n=30, seed=1, record_paths=5)
+    x = sc.collectors[sc.collector_index("barrier")].x
+    ax = plot_profile(res, fences=[(x, 5.0, "fence A, 5 m"), (x, 7.0, "fence B, 7 m")])
+    try:
+        lines = {ln.get_label(): ln for ln in ax.get_lines()}
+        zg = float(sc.profile.ground(x))
+        for label, h in (("fence A, 5 m", 5.0), ("fence B, 7 m", 7.0)):
+            xs, zs = lines[label].get_data()
+            assert list(xs) == [x, x] and list(zs) == pytest.approx([zg, zg + h])
+        legend = ax.get_legend()
+        ax.figure.canvas.draw()
+        box = legend.get_window_extent()
+        assert box.x0 >= ax.get_window_extent().x1          # beside the axes: hides no curve or label
+        assert {"fence A, 5 m", "fence B, 7 m"} <= {t.get_text() for t in legend.get_texts()}
+    finally:
+        plt.close(ax.figure)
