@@ -295,7 +295,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
     pending = []
     if figures is not None:
         figures.mkdir()
-        import matplotlib.pyplot  # noqa: F401  (once here, not in each process drawing beside; backend unchanged)
+        from .report.files import prepare_drawing
+        prepare_drawing()           # pyplot imported once here, not in each process drawing beside
     from .report.mitigation_text import study_report
 
     seed = site.hazard["seed"] if seed is None else seed

@@ -45,6 +45,12 @@ def _plain_log_labels(fig) -> None:
                                    minor_thresholds=f.minor_thresholds, linthresh=f._linthresh))
 
 
+def prepare_drawing() -> None:
+    """Import matplotlib's pyplot once, in this process, before work that draws in forked processes (so each
+    fork does not import it again).  The backend is not changed: matplotlib picks it as usual."""
+    import matplotlib.pyplot  # noqa: F401
+
+
 def save_figure(fig, path, *, tight_layout: bool = False) -> Path:
     """Write ``fig`` to ``path`` (PNG, :data:`FIGURE_DPI`) and close it; returns the path."""
     import matplotlib.pyplot as plt
