@@ -230,7 +230,7 @@ def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, 
         Velocity model [m/s] at the barrier line.
     angular_velocity : array, optional
         Angular velocities [rad/s] paired with velocity samples; adds the rotational energy
-        1/2 k m r^2 w^2 (Wyllie 2014, eq. 3.2, I = k m r^2), with r [m] the radius of the sphere
+        1/2 k m r^2 w^2 (I = k m r^2), with r [m] the radius of the sphere
         of the same mass and density ``density_kg_m3`` [kg/m^3].
     density_kg_m3 : float
         Rock density [kg/m^3] giving the radius from the mass (only with ``angular_velocity``).
