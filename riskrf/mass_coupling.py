@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from .report.format import sig
-from .units import J_PER_KJ
+from .units import J_PER_KJ, kinetic_energy_kj
 
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
 #: Return period [yr] of the largest fall at the source that the default simulated range must include
@@ -186,8 +186,8 @@ class MassCoupledSamples:
         for m, w, n_c, speeds, cum in groups:
             # below the class's smallest kinetic energy every arrival exceeds e, above its largest none does: only
             # the energies between need the speed search (the bounds are widened by 1e-9 against rounding)
-            e_low = 0.5 * float(m.min()) * speeds[0] ** 2 / J_PER_KJ * (1.0 - 1e-9)
-            e_high = 0.5 * float(m.max()) * speeds[-1] ** 2 / J_PER_KJ * (1.0 + 1e-9)
+            e_low = kinetic_energy_kj(float(m.min()), speeds[0]) * (1.0 - 1e-9)
+            e_high = kinetic_energy_kj(float(m.max()), speeds[-1]) * (1.0 + 1e-9)
             out[flat < e_low] += cum[-1] / n_c * w.sum()
             mid = np.flatnonzero((flat >= e_low) & (flat <= e_high))
             if mid.size:
