@@ -524,6 +524,7 @@ def _copy_inputs(a: Assessment, dest: Path) -> None:
     (dest / site.path.name).write_text(text, encoding="utf-8")   # paths now point at the copies beside it
     (dest / "run.json").write_text(json.dumps({
         "riskrf_version": __version__, "seed": a.seed, "n_blocks": a.n_blocks, "site_file": site.path.name,
-        "command": " ".join(sys.argv), "python": platform.python_version(),
+        "command": " ".join([Path(sys.argv[0]).name, *sys.argv[1:]]),   # the program by name, arguments as typed
+        "python": platform.python_version(),
         "rerun": f"riskrf assess {site.path.name} --seed {a.seed} -n {a.n_blocks} --out DIR"},
         indent=2) + "\n", encoding="utf-8")

@@ -217,10 +217,13 @@ def relative_paths(value, base):
     return value
 
 
-def relative_paths_in_json_files(folder, base) -> None:
+def relative_paths_in_json_files(folder, base, *, skip=("inputs",)) -> None:
     """Rewrite every ``*.json`` below ``folder`` with :func:`relative_paths` (base: the site file's folder), so
-    that no output names a directory of the machine it ran on."""
+    that no output names a directory of the machine it ran on.  Subfolders named in ``skip`` (the copy of the
+    inputs and the command as typed, kept for exact reruns) are left as they are."""
     for path in sorted(Path(folder).rglob("*.json")):
+        if set(path.relative_to(folder).parts[:-1]) & set(skip):
+            continue
         data = json.loads(path.read_text(encoding="utf-8"))
         fixed = relative_paths(data, base)
         if fixed != data:

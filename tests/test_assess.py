@@ -61,6 +61,8 @@ def test_outputs_name_no_directory_of_the_machine(assessed):
     """Paths in the JSON outputs are relative to the site file (or the bundled data's name in the package)."""
     site, out = assessed
     for path in out.rglob("*.json"):
+        if path.parent.name == "inputs":            # the inputs and the command as typed, kept for reruns
+            continue
         text = path.read_text()
         assert str(ROOT) not in text and str(site.parent) not in text and '"/' not in text, path
     s = json.loads((out / "summary.json").read_text())
