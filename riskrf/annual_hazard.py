@@ -210,10 +210,13 @@ class EnergyHazard:
 
     # ---- uncertainty ----------------------------------------------------------------
     def energy_at_return_period_ci(self, T, level: float = 0.95, n_bootstrap: int = 300, seed=None):
-        """Seeded parametric-bootstrap interval of the T-year energy.
+        """Seeded interval of the T-year energy, drawing each uncertain input from its law.
 
         Sources included: the exponent b and the rate of the power law (b* =
-        b x Gamma(n, 1)/n, the exact sampling law of the MLE; rate* = Gamma(n)/T),
+        b x Gamma(n, 1)/n, the posterior of b under the Jeffreys prior 1/b given the
+        MLE b from n masses, exact for the untruncated law; the MLE's own sampling law
+        is the inverse, b n / Gamma(n, 1); rate* = rate x Gamma(n, 1)/n = Gamma(n)/T, the
+        posterior of a Poisson rate of n falls in T years under the scale-invariant prior 1/rate),
         or the parameters of a Gumbel/GEV fit (normal with the fit's covariance);
         the finite number of simulated trajectories (velocities resampled with
         replacement, reach probability binomial; mass-coupled: the blocks of each
@@ -301,6 +304,9 @@ class EnergyHazard:
                              "ci_high_kj": hi, "probability_in_50_years": -np.expm1(-50 / T)})
 
     def summary(self) -> pd.DataFrame:
+        """Key figures of the hazard at the line (one-column table): falls per year, reach probability, arrivals
+        per year [1/yr], the mass model, mass coupling and the 95th/99th-percentile energies [kJ].
+        """
         rows = {"collector": self.collector, "falls per year (mass model)": self.rate_per_year,
                 "reach probability": self.reach_probability, "arrivals per year": self.arrival_rate,
                 "mass model": mass_model(self.mass).description,

@@ -36,7 +36,7 @@ from .frequency_study import FrequencyAnalysis, analyse_inventory
 from .inventory import Inventory, read_inventory
 from .mass_coupling import energy_hazard
 from .mitigation import MitigationStudy
-from .outputs import write_json
+from .outputs import relative_paths, relative_paths_in_json_files, write_json
 from .power_law import fit_gutenberg_richter
 from .site import Site
 from .validation import RiskrfWarning
@@ -182,6 +182,15 @@ def _ends(values):
 
 @dataclass
 class Assessment:
+    """Everything one ``riskrf assess`` run computed for a site, in the order of the chain.
+
+    Fields: the :class:`~riskrf.site.Site` read, its :class:`~riskrf.inventory.Inventory`, the frequency analyses
+    (power law, and annual maxima when dated), the simulation ``result`` (:class:`simulation.SimulationResult`),
+    the :class:`~riskrf.energy_study.EnergyAnalysis` at the barrier line, the
+    :class:`~riskrf.mitigation.MitigationStudy` and its ``decision`` (recommendation dict), the ``seed`` and
+    number of simulated blocks, ``warnings`` raised on the way, stage ``timings`` [s] and the site's rate model
+    (``rates``, or None).  Written to files by :func:`write_assessment`; nothing here prints.
+    """
     site: Site
     inventory: Inventory
     frequency: FrequencyAnalysis
@@ -289,7 +298,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
     pending = []
     if figures is not None:
         figures.mkdir()
-        import matplotlib.pyplot  # noqa: F401  (once here, not in each process drawing beside; backend unchanged)
+        from .report.files import prepare_drawing
+        prepare_drawing()           # pyplot imported once here, not in each process drawing beside
     from .report.mitigation_text import study_report
 
     seed = site.hazard["seed"] if seed is None else seed
@@ -364,7 +374,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note)
         timings["simulation"] = round(time.perf_counter() - t, 2)
         if figures is not None:
-            pending.append(InBackground(partial(_simulation_figures, result, hz_cfg["collector"], figures)))
+            pending.append(InBackground(partial(_simulation_figures, result, hz_cfg["collector"], figures,
+                                                fences_to_draw(site))))
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
         block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
@@ -449,7 +460,7 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
             part.result()
     else:
         def simulation_and_decision_outputs():
-            _simulation_figures(a.result, a.site.hazard["collector"], figs)
+            _simulation_figures(a.result, a.site.hazard["collector"], figs, fences_to_draw(a.site))
             write_mitigation_outputs(a.study, a.decision, figs)
 
         beside = InBackground(simulation_and_decision_outputs)
@@ -477,7 +488,8 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     write_json(summary, out / "summary.json")
     (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
     _copy_inputs(a, out / "inputs")
-    return summary
+    relative_paths_in_json_files(out, a.site.path.parent)          # paths relative to the site file
+    return relative_paths(summary, a.site.path.parent)
 
 
 #: What the inventory fit's design-mass table is, in the outputs of an assessment (issue 10).
@@ -507,12 +519,27 @@ def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:
         maxima_frequency.write(sub)
 
 
-def _simulation_figures(result, collector: str, figs: Path) -> None:
-    """Trajectories, the barrier line's distributions and the envelopes (nothing for a velocity file)."""
+def fences_to_draw(site) -> list:
+    """(x [m] or None for the barrier line, height [m], label) of the site's fence and attenuator options, else
+    of the candidate fences of ``hazard.fences_kj``: what the profile figure draws at its height."""
+    opts = [o for o in site.mitigation["options"] if o.kind in ("fence", "attenuator")]
+    if opts:
+        return [(o.x_m, o.height_m, f"{o.name} ({o.height_m:g} m high)" if f"{o.capacity_kj:g}" in o.name
+                 else f"{o.name}: {o.capacity_kj:,.0f} kJ, {o.height_m:g} m high") for o in opts]
+    caps, heights = fence_checks_from_site(site)
+    return [(None, h, f"candidate fence {c:,.0f} kJ, {h:g} m") for c, h in zip(caps, heights)]
+
+
+def _simulation_figures(result, collector: str, figs: Path, fences=()) -> None:
+    """Trajectories (with the fences at their height), the barrier line's distributions and the envelopes
+    (nothing for a velocity file).  A fence with x None stands at the ``collector`` line."""
     if result is None:
         return
     from .report.files import write_simulation_figures
-    write_simulation_figures(result, figs, [collector], file_names={collector: "collector_distributions.png"})
+    line_x = result.scenario.collectors[result.scenario.collector_index(collector)].x
+    fences = [(line_x if x is None else x, h, label) for x, h, label in fences]
+    write_simulation_figures(result, figs, [collector], file_names={collector: "collector_distributions.png"},
+                             fences=fences)
 
 def _copy_inputs(a: Assessment, dest: Path) -> None:
     """Copy the site file and everything it names, with the version, seed and command, for exact reruns."""
@@ -534,6 +561,7 @@ def _copy_inputs(a: Assessment, dest: Path) -> None:
     (dest / site.path.name).write_text(text, encoding="utf-8")   # paths now point at the copies beside it
     (dest / "run.json").write_text(json.dumps({
         "riskrf_version": __version__, "seed": a.seed, "n_blocks": a.n_blocks, "site_file": site.path.name,
-        "command": " ".join(sys.argv), "python": platform.python_version(),
+        "command": " ".join([Path(sys.argv[0]).name, *sys.argv[1:]]),   # the program by name, arguments as typed
+        "python": platform.python_version(),
         "rerun": f"riskrf assess {site.path.name} --seed {a.seed} -n {a.n_blocks} --out DIR"},
         indent=2) + "\n", encoding="utf-8")

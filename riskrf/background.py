@@ -29,6 +29,9 @@ class InBackground:
                 self.proc = None
 
     def result(self):
+        """The work's return value: waits for the background process (or runs the work here when no process
+        could be started or it failed) and re-raises an exception the work raised.  Computed once, then kept.
+        """
         if self._done is not None:
             return self._done[0]
         value = None

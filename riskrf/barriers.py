@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from .report.format import sig
-from .units import DAYS_PER_YEAR, J_PER_KJ, SEL_PER_MEL
+from .units import DAYS_PER_YEAR, SEL_PER_MEL, kinetic_energy_kj
 from .validation import check_positive
 
 #: ETAG 027 energy classes (MEL and SEL in kJ) [R: confirm against the EAD 340059 table].
@@ -79,8 +79,8 @@ def uni11211_design_energy(volume_m3: float, density_kg_m3: float, velocity_ms: 
             raise ValueError(f"{name} = {value!r}: UNI 11211-4 partial factors lie between 1.0 and 2.0")
     m_d = vol * rho * gamma_VolF * gamma_gamma
     v_d = v * gamma_Tr * gamma_Dp
-    return UNI11211Design(characteristic_energy_kj=0.5 * vol * rho * v * v / J_PER_KJ,
-                          design_energy_kj=0.5 * m_d * v_d * v_d / J_PER_KJ, design_mass_kg=m_d,
+    return UNI11211Design(characteristic_energy_kj=kinetic_energy_kj(vol * rho, v),
+                          design_energy_kj=kinetic_energy_kj(m_d, v_d), design_mass_kg=m_d,
                           design_velocity_ms=v_d, factors=factors)
 
 

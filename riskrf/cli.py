@@ -12,6 +12,7 @@ import warnings
 from pathlib import Path
 
 from . import __version__
+from .units import DEFAULT_DENSITY_KG_M3
 
 EPILOG = "Units: mass kg, volume m3, density kg/m3, energy kJ, velocity m/s, time in years."
 
@@ -34,7 +35,8 @@ def _add_fit_arguments(p):
 
 def _add_inventory_arguments(p):
     p.add_argument("--density", type=float, default=None, metavar="KG_M3",
-                   help="rock density in kg/m3 (default: the sidecar TOML, else 2650, reported as default)")
+                   help=f"rock density in kg/m3 (default: the sidecar TOML, else {DEFAULT_DENSITY_KG_M3:g}, reported as "
+                        "default)")
     p.add_argument("--start", default=None, help="start of the record period, YYYY-MM-DD")
     p.add_argument("--end", default=None, help="end of the record period, YYYY-MM-DD")
     p.add_argument("--duration-years", type=float, default=None, metavar="YR",
@@ -433,8 +435,9 @@ def cmd_assess(args) -> int:
     print(f"\nStage times: {stages}.")
     if assessment.warnings:
         print(f"{len(assessment.warnings)} warning(s), also listed in the report:")
+        from .outputs import relative_paths
         for w in assessment.warnings:
-            print(f"  - {w}")
+            print(f"  - {relative_paths(w, site.path.parent)}")        # paths relative to the site file
     print(f"Rate of falls from the {s['hazard']['rate_source']}.")
     print(f"Lowest expected total cost: {s['best_option']} (then {s['second_option']}).")
     print(f"Recommendation: {s['recommendation']['option']} ({s['recommendation']['basis']}).")
@@ -525,6 +528,9 @@ def cmd_calibrate(args) -> int:
 
 
 def cmd_corridor(args) -> int:
+    """``riskrf corridor FILE``: read and check the corridor (sections table, mass law, study inputs), run every
+    section and write the tables, figures and report to ``--out``.  Returns the exit code (0 on success).
+    """
     from .corridor import load_corridor, run_corridor, write_corridor
 
     corridor = load_corridor(args.corridor, keep_going=args.keep_going, sheet=args.sheet,   # every row checked
@@ -786,6 +792,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def cmd_rates(args) -> int:
+    """``riskrf rates``: fit the rate model of falls (Poisson and negative binomial regressions on rainfall
+    over ``--windows`` days, season and trend) and write its tables and figures.  Returns the exit code.
+    """
     from .outputs import atomic_output_dir
     from .rate_model import rate_model
 

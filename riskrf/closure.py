@@ -76,6 +76,9 @@ class ClosureRule:
         return self.closure_hours_per_year * self.cost_per_hour
 
     def summary(self) -> pd.DataFrame:
+        """Key figures of the rule (one-column table): period evaluated, effectiveness (share of falls while closed,
+        model and recorded), falls per year [1/yr] in all and while closed, hours closed per year.
+        """
         rows = {
             "rule": self.rule,
             "evaluated over": f"{self.start.date()} to {self.end.date()}",

@@ -37,6 +37,7 @@ import pandas as pd
 
 from . import rhrs
 from .mitigation_inputs import MitigationError, parse_mitigation
+from .units import DEFAULT_DENSITY_KG_M3, M_PER_KM
 
 BUNDLED_MATERIALS = Path(__file__).resolve().parents[1] / "simulation" / "scenarios" / "road_cut_barrier.toml"
 
@@ -87,6 +88,7 @@ class Section:
 
     @property
     def length_m(self) -> float:
+        """Length of the section along the chainage [m]."""
         return self.chainage_to_m - self.chainage_from_m
 
 
@@ -110,6 +112,7 @@ class Corridor:
     defaults_used: tuple = ()
 
     def section(self, sid: str) -> Section:
+        """The section with id ``sid`` (StopIteration when there is none)."""
         return next(s for s in self.sections if s.id == sid)
 
 
@@ -159,7 +162,7 @@ def _section_seed(seed: int, sid: str) -> int:
 
 def cut_scenario_dict(materials: dict, settings: dict, *, cut_height_m, face_angle_deg, ditch_width_m, ditch_depth_m,
                       runout_to_road_m, road_width_m, face_material, ditch_material, road_material, seeder_mass,
-                      release_zone_share=0.3, density_kg_m3=2650.0, name="cut", bench_width_m=0.0,
+                      release_zone_share=0.3, density_kg_m3=DEFAULT_DENSITY_KG_M3, name="cut", bench_width_m=0.0,
                       bench_height_m=0.0) -> dict:
     """Scenario dictionary of a generated rock cut (x increases towards the road, z up, metres).
 
@@ -443,7 +446,7 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
             raise CorridorError(f"{tsrc}: missing column {c!r}")
     if df.empty:
         raise CorridorError(f"{tsrc}: the sections table has no rows")
-    scale = 1000.0 if unit == "km" else 1.0
+    scale = M_PER_KM if unit == "km" else 1.0
     errors, sections, bad_rows = [], [], set()
     fallback = set()          # corridor-wide fallbacks that at least one section used
     inv_cache, weights = {}, {}
@@ -506,7 +509,7 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
             if "falls_per_year" in num:
                 rate = num["falls_per_year"]
             elif "falls_per_km_year" in num:
-                rate = num["falls_per_km_year"] * (c1 - c0) / 1000
+                rate = num["falls_per_km_year"] * (c1 - c0) / M_PER_KM
             elif "falls_per_m2_year" in num:
                 rate = num["falls_per_m2_year"] * _face_area(num, c1 - c0, where, "falls_per_m2_year")
             elif vals["inventory"]:
@@ -517,7 +520,7 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                 rate, rate_source = inv_cache[inv_path]
             else:                                  # a share of the corridor-wide inventory, set once all rows are read
                 weight = _face_area(num, c1 - c0, where, "rates.share = 'm2'") if shared["share"] == "m2" \
-                    else (c1 - c0) / 1000
+                    else (c1 - c0) / M_PER_KM
                 rate = math.nan
             if rate_source != "shared" and not rate > 0:
                 raise CorridorError(f"{where}: the section's rate of falls is {rate:g} per year; a section without "
@@ -831,7 +834,7 @@ class CorridorResult:
         t["rank_risk"] = _sig12(t["deaths_per_year"]).rank(ascending=False, method="min").astype(int)
         t["rank_rhrs"] = _sig12(t["rhrs_score"]).rank(ascending=False, method="min").astype("Int64")
         t["rank_difference"] = t["rank_rhrs"] - t["rank_risk"]
-        t["expected_annual_cost_per_km"] = t["expected_annual_loss_pv"] / _pv(self.corridor) / (t["length_m"] / 1000)
+        t["expected_annual_cost_per_km"] = t["expected_annual_loss_pv"] / _pv(self.corridor) / (t["length_m"] / M_PER_KM)
         cols = ["rank_risk", "rank_rhrs", "rank_difference", "id", "chainage_from_m", "chainage_to_m", "rhrs_score",
                 "road_falls_per_year", "deaths_per_year", "individual_risk", "expected_annual_cost_per_km",
                 "best_option", "best_option_capital", "best_option_total_cost", "best_individual_risk",
@@ -858,6 +861,9 @@ class CorridorResult:
         return plot_corridor(self)
 
     def to_json(self) -> dict:
+        """The run as a JSON-ready dict (``corridor_summary.json``): counts, failures, rejected rows, seed, blocks,
+        workers, seconds, units (chainage m, rates 1/yr, money in the corridor's currency) and totals.
+        """
         s = self.summary()
         return {"corridor": self.corridor.name, "sections": int(len(self.table)), "failures": list(self.failures),
                 "rejected_rows": list(self.corridor.errors), "seed": self.corridor.seed, "n_blocks": self.n_blocks,

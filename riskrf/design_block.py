@@ -50,7 +50,7 @@ import pandas as pd
 
 from .inventory import SIZES  # one home: what an inventory's sizes can be
 from .report.format import sig
-from .units import J_PER_KJ
+from .units import DEFAULT_DENSITY_KG_M3, kinetic_energy_kj
 
 #: The percentile band of ONR 24810:2021 for the design block [%].
 ONR24810_PERCENTILES = (95.0, 98.0)
@@ -201,6 +201,9 @@ class DesignBlock:
     inputs: dict = field(default_factory=dict, repr=False, compare=False)
 
     def summary(self) -> pd.DataFrame:
+        """The chosen design block (one-column table): rule, mass [kg], volume [m3], equivalent sphere diameter [m],
+        basis and each assumption.
+        """
         rows = {"rule": self.rule, "design block mass [kg]": self.mass_kg, "volume [m3]": self.volume_m3,
                 "equivalent sphere diameter [m]": self.diameter_m, "basis": self.basis}
         for i, a in enumerate(self.assumptions):
@@ -208,6 +211,7 @@ class DesignBlock:
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
     def to_dict(self) -> dict:
+        """The design block and its alternatives as a JSON-ready dict (mass_kg, volume_m3, diameter_m, ...)."""
         return {"rule": self.rule, "mass_kg": self.mass_kg, "volume_m3": self.volume_m3,
                 "diameter_m": self.diameter_m, "basis": self.basis, "assumptions": list(self.assumptions),
                 "alternatives": self.alternatives.to_dict(orient="records")}
@@ -250,7 +254,8 @@ def _law_text(hazard) -> str:
     return f"{mass_model(m).description}, {sig(hazard.rate_per_year)} falls/yr"
 
 
-def site_design_masses(hazard, T=(10, 50, 100, 300, 1000), density_kg_m3: float = 2650.0) -> pd.DataFrame:
+def site_design_masses(hazard, T=(10, 50, 100, 300, 1000),
+                       density_kg_m3: float = DEFAULT_DENSITY_KG_M3) -> pd.DataFrame:
     """Design masses [kg] of the site's law (the hazard's: truncated at m_max, rate scaled to the source above the
     line): the T-year fall at the source and the T-year fall reaching the line; NaN where fewer than one such fall
     is expected in T years.  Never above the law's m_max."""
@@ -267,7 +272,8 @@ def site_design_masses(hazard, T=(10, 50, 100, 300, 1000), density_kg_m3: float 
 
 def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.0, survey_volumes_m3=None,
                  survey_source: str | None = None, inventory=None, sizes: str = "event_volumes",
-                 design_T: float = 100.0, density_kg_m3: float = 2650.0, fractal_dimension: float | None = None,
+                 design_T: float = 100.0, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+                 fractal_dimension: float | None = None,
                  iterations: int | None = None) -> DesignBlock:
     """The design block by ``rule`` with its alternatives (see module notes).
 
@@ -329,7 +335,7 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
             note += "; outside the simulated masses (nearest class's speeds)"
         rows.append({"rule": name, "mass_kg": mass, "volume_m3": mass / rho, "diameter_m":
                      float(sphere_diameter_m(mass / rho)), "velocity_p95_ms": v95,
-                     "energy_at_v95_kj": 0.5 * mass * v95 ** 2 / J_PER_KJ, "note": note})
+                     "energy_at_v95_kj": kinetic_energy_kj(mass, v95), "note": note})
 
     if survey is not None:
         band = sorted(set(ONR24810_PERCENTILES) | {pct})

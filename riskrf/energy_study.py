@@ -13,7 +13,7 @@ from .frequency_study import DESIGN_RETURN_PERIODS
 from .outputs import write_json
 from .power_law import GutenbergRichterFit, fit_gutenberg_richter
 from .report.format import sig
-from .units import DEFAULT_DENSITY_KG_M3
+from .units import DEFAULT_DENSITY_KG_M3, kinetic_energy_kj
 
 #: What the bootstrap interval of a design energy covers, and what it does not (stated with every interval).
 INTERVAL_COVERS = ("sampling uncertainty of the power-law exponent b and of the rate, and the finite number of "
@@ -40,6 +40,7 @@ class EnergyAnalysis:
     tornado: object = None               # DesignEnergyTornado or None
 
     def fence_verdicts(self) -> pd.DataFrame:
+        """One row per fence checked: whether every check passed (``adequate``) and the names of those that failed."""
         rows = []
         for name, table in self.fences.items():
             rows.append({"fence": name, "adequate": bool(table["adequate"].all()),
@@ -47,6 +48,9 @@ class EnergyAnalysis:
         return pd.DataFrame(rows)
 
     def summary_text(self) -> str:
+        """The analysis in a few plain-text lines (rates [1/yr], reach probability, design energies [kJ], fence
+        verdicts), for the CLI's closing summary; the caller prints it.
+        """
         hz = self.hazard
         lines = ["Impact energy hazard at the barrier line (Wyllie 2014, 8.1-8.3)",
                  f"  falls per year (mass model)   {sig(hz.rate_per_year, 4)}   [{hz.summary().loc['mass model', 'value']}]",
@@ -127,6 +131,9 @@ class EnergyAnalysis:
                 "mass model for the T-year block")
 
     def to_dict(self) -> dict:
+        """The analysis as a JSON-ready dict (``energy_summary.json``): units, hazard figures, design energies [kJ],
+        fence checks, interval coverage and notes.
+        """
         hz = self.hazard
         out = {"units": {"energy": "kJ", "height": "m", "rate": "1/yr", "return_period": "yr"},
                "hazard": {k: v for k, v in hz.summary()["value"].items()},
@@ -155,7 +162,9 @@ class EnergyAnalysis:
         return out
 
     def write(self, out_dir) -> list[Path]:
-        """Write energy_summary.json, the CSV tables and the figures into ``out_dir``; returns every file written."""
+        """Write ``energy_summary.json``, the CSV tables (design energies, sensitivity, tornado) and the figures
+        into ``out_dir`` (which must exist); returns every file written.
+        """
         from .report.files import write_energy_figures
         out = Path(out_dir)
         written = [out / "energy_summary.json", out / "design_energies.csv"]
@@ -326,6 +335,7 @@ class DesignEnergyTornado:
     notes: tuple = ()
 
     def summary(self) -> pd.DataFrame:
+        """The tornado table: one row per input and design energy; low/high inputs and the energy [kJ] at each."""
         return self.table
 
     @property
@@ -363,6 +373,7 @@ class DesignEnergyTornado:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
+        """The tornado as a JSON-ready dict: design return period [yr], rows, dominant inputs and notes."""
         return {"design_T_years": self.design_T, "rows": self.table.to_dict(orient="records"),
                 "dominant": self.dominant().to_dict(orient="records"), "notes": list(self.notes)}
 
@@ -514,7 +525,7 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
     def block_energy(hz, m, pct):
         if not np.isfinite(m):
             return np.nan
-        return 0.5 * m * hz.velocity_percentile(pct, mass_kg=m) ** 2 / J_PER_KJ
+        return kinetic_energy_kj(m, hz.velocity_percentile(pct, mass_kg=m))
 
     # ---- the perturbed hazards (cheap: the same simulated slope, another mass law or rate) -----------------
     cases = {}                      # input -> (unit, low, base, high, basis, hz_low, hz_high, change_low, change_high)

@@ -31,7 +31,14 @@ DESIGN_RETURN_PERIODS = (10, 50, 100, 300, 1000)
 
 @dataclass(frozen=True)
 class FrequencyAnalysis:
-    """Every magnitude-frequency model fitted to one inventory."""
+    """Every magnitude-frequency model fitted to one inventory.
+
+    The fits, the comparison table and the bootstrap are computed when the object is built
+    (:func:`analyse_inventory`).  The design-mass table is lazy: :meth:`design_masses` computes its
+    intervals (profile likelihood and the fits' standard errors) on the first call for a given (T, level) and keeps
+    them in a private cache; later calls, and :meth:`write`, return copies of the same table.  The
+    object is otherwise immutable, so the cache never goes stale.
+    """
 
     inventory: Inventory
     power_law: GutenbergRichterFit

@@ -2,8 +2,9 @@
 
     P(E > e) = integral f_V(v) P(M > 2000 e / v^2) dv,     E = 1/2 m v^2 / 1000  [kJ]
 
-(plus the rotational energy 1/2 I w^2 of a sphere, I = 2/5 m r^2, r from m and the
-density, when angular velocities are given with velocity samples).
+(plus the rotational energy 1/2 I w^2, I = k m r^2 with k = 2/5 for a sphere by default or the
+``inertia_factor`` given (1/2 for a cylinder or disc), r from m and the density, when angular
+velocities are given with velocity samples).
 
 Mass models: a fitted power law (:class:`~riskrf.GutenbergRichterFit`, the truncated
 law between m_min and m_max), a Gumbel/GEV fit of annual maxima (then E is the
@@ -37,8 +38,8 @@ from .extremes import _AnnualMaximumFit
 from .mass_coupling import MassCoupledSamples
 from .power_law import GutenbergRichterFit
 from .report.format import sig
-from .units import DEFAULT_DENSITY_KG_M3, J_PER_KJ, SPHERE_INERTIA
-from .validation import check_choice
+from .units import DEFAULT_DENSITY_KG_M3, J_PER_KJ, SPHERE_INERTIA, kinetic_energy_kj, mass_for_energy_kg
+from .validation import check_choice, check_positive
 
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
 
@@ -58,6 +59,7 @@ class VelocityFit:
     n: int
 
     def summary(self) -> pd.DataFrame:
+        """The candidate table: distribution, parameters, log-likelihood, AIC and whether it was chosen."""
         return self.table
 
 
@@ -105,9 +107,15 @@ class PairedSamples:
 
     @classmethod
     def from_collector(cls, df: pd.DataFrame, n_bins: int = 10) -> "PairedSamples":
+        """Paired samples from a collector table (columns ``velocity_ms`` [m/s] and ``mass_kg`` [kg], e.g.
+        :meth:`simulation.SimulationResult.collector`), in ``n_bins`` mass classes.
+        """
         return cls(np.asarray(df["velocity_ms"], dtype=float), np.asarray(df["mass_kg"], dtype=float), n_bins)
 
     def classes(self):
+        """Mass classes of equal counts (at most ``n_bins``, at least 20 blocks each): the class edges [kg]
+        (geometric means of neighbouring masses) and the sorted speeds [m/s] of each class.
+        """
         order = np.argsort(self.mass_kg)
         groups = np.array_split(order, min(self.n_bins, max(1, self.mass_kg.size // 20)))
         edges = [np.sqrt(self.mass_kg[g[-1]] * self.mass_kg[h[0]]) for g, h in zip(groups[:-1], groups[1:])]
@@ -177,13 +185,17 @@ def mass_model(mass) -> _MassModel:
                       (float(m[0]), float(m[-1])))
 
 
-def _threshold_mass(e_kj, v, w, density):
-    """Mass m with 1/2 m v^2 + 1/2 (2/5) m r(m)^2 w^2 = 1000 e, r = (3m / 4 pi rho)^(1/3); vectorised."""
-    m = 2000.0 * e_kj / np.maximum(v * v, 1e-300)
+def _threshold_mass(e_kj, v, w, density, inertia_factor=SPHERE_INERTIA):
+    """Mass m with 1/2 m v^2 + 1/2 k m r(m)^2 w^2 = J_PER_KJ e, r = (3m / 4 pi rho)^(1/3); vectorised.
+
+    ``k = inertia_factor`` (I / (m r^2): 2/5 sphere, 1/2 cylinder or disc); r is the radius of the
+    sphere of the same mass and density (the equivalent radius).
+    """
+    m = mass_for_energy_kg(e_kj, v)
     if w is None:
         return m
-    c = 0.5 * SPHERE_INERTIA * (3.0 / (4.0 * np.pi * density)) ** (2.0 / 3.0) * w * w   # kJ*1000 per m^(5/3)
-    target = 1000.0 * e_kj
+    c = 0.5 * inertia_factor * (3.0 / (4.0 * np.pi * density)) ** (2.0 / 3.0) * w * w   # J per kg^(5/3)
+    target = J_PER_KJ * e_kj
     lo = np.full(np.broadcast(e_kj, v).shape, -700.0)
     hi = np.log(np.maximum(m, 1e-300)) + 1.0
     for _ in range(80):      # bisection on ln m; the energy is increasing in m
@@ -204,7 +216,8 @@ def _check_energies(energy_kj):
 
 
 def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
-                           method: str = "quad", n_samples: int = 1_000_000, seed=None):
+                           inertia_factor: float = SPHERE_INERTIA, method: str = "quad", n_samples: int = 1_000_000,
+                           seed=None):
     """P(E > e) for one fall: the probability that its impact energy exceeds ``energy_kj``.
 
     Parameters
@@ -216,16 +229,26 @@ def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, 
     velocity : scipy frozen distribution, array, VelocityFit or PairedSamples
         Velocity model [m/s] at the barrier line.
     angular_velocity : array, optional
-        Angular velocities [rad/s] paired with velocity samples; adds the
-        rotational energy of a sphere of density ``density_kg_m3``.
+        Angular velocities [rad/s] paired with velocity samples; adds the rotational energy
+        1/2 k m r^2 w^2 (I = k m r^2), with r [m] the radius of the sphere
+        of the same mass and density ``density_kg_m3`` [kg/m^3].
+    density_kg_m3 : float
+        Rock density [kg/m^3] giving the radius from the mass (only with ``angular_velocity``).
+    inertia_factor : float
+        k = I / (m r^2) of the block shape (only with ``angular_velocity``): the sphere's 2/5
+        by default; ``riskrf.units.INERTIA_FACTORS`` has the cylinder/disc's 1/2.
     method : {"quad", "mc"}
         Numerical integration (default) or Monte Carlo with ``n_samples`` draws.
+    n_samples, seed
+        Draws and seed of ``method="mc"``.
     """
     e = _check_energies(energy_kj)
     check_choice(method, "method", ("quad", "mc"))
+    inertia_factor = check_positive(inertia_factor, "inertia_factor")
     if method == "mc":
         return exceedance_probability_mc(e, mass, velocity, angular_velocity=angular_velocity,
-                                         density_kg_m3=density_kg_m3, n_samples=n_samples, seed=seed)[0]
+                                         density_kg_m3=density_kg_m3, inertia_factor=inertia_factor,
+                                         n_samples=n_samples, seed=seed)[0]
     mm = mass_model(mass)
     if isinstance(velocity, VelocityFit):
         velocity = velocity.dist
@@ -246,7 +269,7 @@ def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, 
             raise ValueError(f"angular_velocity has {w.size} values but velocity has {v.size}: they must be paired")
     out = np.empty(e.size)
     for i, ei in enumerate(e.ravel()):
-        out[i] = np.mean(mm.sf(_threshold_mass(ei, v, w, density_kg_m3)))
+        out[i] = np.mean(mm.sf(_threshold_mass(ei, v, w, density_kg_m3, inertia_factor)))
     return out.reshape(e.shape)
 
 
@@ -280,15 +303,15 @@ def _integrate_velocity_dist(e, mm, vdist):
     ends = np.array([m for m in mm.support if np.isfinite(m) and m > 0], dtype=float)
     out = np.empty(e.size)
     for i, ei in enumerate(e.ravel()):
-        total = np.sum(dens * mm.sf(2000.0 * ei / (v * v)), axis=1)
+        total = np.sum(dens * mm.sf(2.0 * J_PER_KJ * ei / (v * v)), axis=1)
         if ends.size and ei > 0:
-            kinks = 0.5 * np.log(2000.0 * ei / ends)
+            kinks = 0.5 * np.log(2.0 * J_PER_KJ * ei / ends)
             kinks = kinks[(kinks > edges[0]) & (kinks < edges[-1])]
             for j in np.unique(np.searchsorted(edges, kinks) - 1):
                 sub = np.union1d(edges[j:j + 2], kinks)
                 sub = sub[(sub >= edges[j]) & (sub <= edges[j + 1])]
                 vs, ds = _gl_panels(sub, vdist, p_pos)
-                total[j] = np.sum(ds * mm.sf(2000.0 * ei / (vs * vs)))
+                total[j] = np.sum(ds * mm.sf(2.0 * J_PER_KJ * ei / (vs * vs)))
         out[i] = np.sum(total)
     return np.clip(out, 0.0, 1.0).reshape(e.shape)
 
@@ -316,7 +339,7 @@ def _conditional_on_mass(e, mm, paired: PairedSamples):
     cls = np.searchsorted(edges_m, m)
     out = np.empty(e.size)
     for i, ei in enumerate(e.ravel()):
-        vstar = np.sqrt(2000.0 * ei / np.maximum(m, 1e-300))
+        vstar = np.sqrt(2.0 * J_PER_KJ * ei / np.maximum(m, 1e-300))
         cond = np.empty(m.size)
         for c, vs in enumerate(vel):
             sel = cls == c
@@ -326,8 +349,14 @@ def _conditional_on_mass(e, mm, paired: PairedSamples):
 
 
 def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=None, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
-                              n_samples: int = 1_000_000, seed=None, level: float = 0.95):
-    """Monte Carlo estimate of P(E > e) with its Wilson interval: (p, lower, upper) arrays."""
+                              inertia_factor: float = SPHERE_INERTIA, n_samples: int = 1_000_000, seed=None,
+                              level: float = 0.95):
+    """Monte Carlo estimate of P(E > e) with its Wilson interval: (p, lower, upper) arrays.
+
+    Same models and arguments as :func:`exceedance_probability` (``inertia_factor`` k = I / (m r^2),
+    the sphere's 2/5 by default); ``n_samples`` draws with ``seed``; the interval is the Wilson
+    score interval at ``level``.
+    """
     from simulation.result import wilson_interval
 
     e = _check_energies(energy_kj)
@@ -346,7 +375,7 @@ def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=Non
             pick[sel] = members[c][rng.integers(0, members[c].size, int(sel.sum()))]
         v = velocity.speed_ms[pick]
         arrived = np.isfinite(v)
-        energy = np.where(arrived, 0.5 * m * np.where(arrived, v, 0.0) ** 2 / J_PER_KJ, -np.inf)
+        energy = np.where(arrived, kinetic_energy_kj(m, np.where(arrived, v, 0.0)), -np.inf)
         n_arr = int(arrived.sum())
         energy.sort()
         k = n_samples - np.searchsorted(energy, e.ravel(), side="right")
@@ -367,10 +396,11 @@ def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=Non
         v = samples[idx]
         if angular_velocity is not None:
             w = np.asarray(angular_velocity, dtype=float)[idx]
-    energy = 0.5 * m * v * v / J_PER_KJ
-    if w is not None:
+    if w is None:
+        energy = kinetic_energy_kj(m, v)
+    else:
         r = (3.0 * m / (4.0 * np.pi * density_kg_m3)) ** (1.0 / 3.0)
-        energy = energy + 0.5 * SPHERE_INERTIA * m * r * r * w * w / J_PER_KJ
+        energy = kinetic_energy_kj(m, v, w, r, inertia_factor)
     energy.sort()
     k = n_samples - np.searchsorted(energy, e.ravel(), side="right")
     lo, hi = wilson_interval(k, n_samples, level)

@@ -176,6 +176,7 @@ class Inventory:
 
     @property
     def n_events(self) -> int:
+        """Number of events in the inventory."""
         return len(self.events)
 
     @property

@@ -54,6 +54,8 @@ class MassCoupledSamples:
     edges_kg : boundaries [kg] of the mass classes (increasing, equal width in ln m).
     representative : indices into the arriving blocks that represent the arriving falls under a mass model
         (systematic resampling with class weights); pooled samples (``velocity_ms``, ``heights_m``) use them.
+
+    The per-class tables are computed on first use and cached (the fields are never changed).
     """
 
     mass_kg: np.ndarray = field(repr=False)
@@ -84,10 +86,12 @@ class MassCoupledSamples:
     # ---- classes --------------------------------------------------------------------------------
     @property
     def n_bins(self) -> int:
+        """Number of mass classes."""
         return self.edges_kg.size - 1
 
     @property
     def reached(self) -> np.ndarray:
+        """Boolean array: which released blocks reached the line (a finite speed)."""
         return np.isfinite(self.speed_ms)
 
     def class_of(self, mass_kg) -> np.ndarray:
@@ -297,6 +301,9 @@ class MassCoupledSamples:
 
     @property
     def description(self) -> str:
+        """One sentence for reports: blocks simulated, mass range [kg], classes, and how reach probability and
+        median speed [m/s] change from the lightest to the heaviest class.
+        """
         t = self.class_table()
         return (f"mass-coupled: {self.mass_kg.size:,} blocks released with masses log-uniform over "
                 f"{sig(self.edges_kg[0])}-{sig(self.edges_kg[-1])} kg in {self.n_bins} classes; P(reach) "

@@ -21,6 +21,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .annual_hazard import inertia_factors
+
 #: Horizontal run per unit drop of the ditch wall on the slope side (steep, 0.25H:1V) and of the
 #: foreslope on the road side (1H:1V); defaults of :func:`ditch_profile` [assumption, ODOT-style shape].
 DITCH_INNER_SLOPE_HV = 0.25
@@ -88,6 +90,7 @@ class Ditch:
 
     @property
     def span(self):
+        """(start, end) of the ditch along x [m]."""
         return self.x_m, self.x_m + self.width_m
 
 
@@ -155,6 +158,9 @@ class SimulationContext:
     threads: int = 0              # simulations run at once by run_many (0: one per core); corridor workers use 1
 
     def run(self, scenario):
+        """Simulate ``scenario`` with this context's number of blocks and seed (no recorded paths); a
+        :class:`simulation.SimulationResult`.
+        """
         import simulation
         return simulation.run(scenario, n=self.n_blocks, seed=self.seed, record_paths=0)
 
@@ -217,6 +223,6 @@ def effective_samples(result, collector: str):
     crossings of ``collector``."""
     df = result.collector(collector, first_only=True)
     v = df["velocity_ms"].to_numpy()
-    k = df["inertia_factor"].to_numpy() if "inertia_factor" in df else np.full(len(df), 0.4)
+    k = inertia_factors(df)
     spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
     return np.sqrt(v ** 2 + k * spin ** 2), df["height_m"].to_numpy()

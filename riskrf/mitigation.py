@@ -84,7 +84,7 @@ from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.mitigati
     parse_option,
 )
 from .power_law import GutenbergRichterFit
-from .report.format import probability
+from .report.format import money, probability
 from .road_risk import (
     commuter_passage_probability,
     commuter_strike_probability,
@@ -116,6 +116,9 @@ class OptionResult:
 
     @property
     def held_impacts_above_sel_per_year(self) -> float:
+        """Impacts per year [1/yr] held by the barrier above its service energy level (SEL = MEL / 3), each
+        needing a repair; the same number as ``repairs_per_year``.
+        """
         return self.repairs_per_year
 
 
@@ -143,6 +146,11 @@ class MitigationStudy:
     derive the options' effects; ``reference`` the simulation behind the hazard (road
     velocities, run-out).  ``small_fall_masses_kg`` and ``small_falls_per_year``: the
     inventory's falls below the power law's m_min (already scaled to this site).
+
+    Lazy: building the study only checks its inputs.  The options' effects (their simulations), the mass
+    grid, the central result and the uncertainty samples are computed on first use (``functools.cached_property``)
+    by whichever method needs them first (:meth:`ranking`, :meth:`summary`, ...) and kept; the inputs are frozen,
+    so the cached results never go stale and every later call returns the same numbers.
     """
 
     hazard: EnergyHazard
@@ -171,9 +179,11 @@ class MitigationStudy:
 
     @property
     def currency(self) -> str:
+        """Currency of every money figure of the study (from the consequences)."""
         return self.consequences.currency
 
     def option(self, name: str) -> Option:
+        """The option named ``name``; a MitigationError listing the options when there is none."""
         opt = next((o for o in self.options if o.name == name), None)
         if opt is None:
             raise MitigationError(f"no option named {name!r}; options are {[o.name for o in self.options]}")
@@ -596,8 +606,9 @@ class MitigationStudy:
         if "b" in c and u.sample_power_law:
             n = hz.mass.n_tail
             g = stats.gamma(n, scale=1.0 / n)
-            out["b"] = (c["b"] * g.ppf(0.05), c["b"] * g.ppf(0.95), "b x Gamma(n)/n (sampling law of the MLE)")
-            out["rate_sampling_factor"] = (g.ppf(0.05), g.ppf(0.95), "Gamma(n)/n (Poisson count of the record)")
+            out["b"] = (c["b"] * g.ppf(0.05), c["b"] * g.ppf(0.95), "b x Gamma(n)/n (Jeffreys-prior posterior of b)")
+            out["rate_sampling_factor"] = (g.ppf(0.05), g.ppf(0.95),
+                                           "Gamma(n)/n (posterior of the rate of n recorded falls, prior 1/rate)")
         if u.rate_factor != (1.0, 1.0):
             out["rate_factor"] = (*u.rate_factor, "uniform, stated (share of the source above the road)")
         if u.m_max_kg and "m_max_kg" in c:
@@ -912,6 +923,7 @@ class MitigationStudy:
                     and row["fn_zone"] in ("ALARP", "broadly acceptable"))
 
     def best(self) -> str:
+        """Name of the first option of :meth:`ranking` (the lowest expected total cost over the joint samples)."""
         return self.ranking()["option"].iloc[0]
 
     def recommendation(self, ranking: pd.DataFrame | None = None) -> dict:
@@ -927,18 +939,19 @@ class MitigationStudy:
             why = (f"{rec['option']} is the cheapest option that meets the tolerability criteria (individual risk "
                    f"{probability(rec['individual_risk'])}/yr against {probability(lim)}/yr; societal risk {rec['fn_zone']} on the "
                    f"{self.criteria.fn_diagram} F-N diagram). Its expected total cost is "
-                   f"{rec['expected_total_cost']:,.0f} {cur} (5-95 %: {rec['cost_p05']:,.0f} to "
-                   f"{rec['cost_p95']:,.0f} {cur}); it meets them in {rec['probability_meets_criteria']:.0%} of the "
+                   f"{money(rec['expected_total_cost'], cur, sig=3)} (5-95 %: {money(rec['cost_p05'], sig=3)} to "
+                   f"{money(rec['cost_p95'], cur, sig=3)}); it meets them in "
+                   f"{rec['probability_meets_criteria']:.0%} of the "
                    "joint samples of the uncertain inputs.")
             if rec["option"] != cheapest["option"]:
                 intolerable = t[(t["expected_total_cost"] < rec["expected_total_cost"])]
                 why += (f" Cheaper options leave the risk intolerable: {cheapest['option']} costs least "
-                        f"({cheapest['expected_total_cost']:,.0f} {cur}, the cheapest in "
+                        f"({money(cheapest['expected_total_cost'], cur, sig=3)}, the cheapest in "
                         f"{cheapest['probability_best']:.0%} of the joint samples) but leaves individual risk "
                         f"{probability(cheapest['individual_risk'])}/yr and societal risk {cheapest['fn_zone']}"
                         + (f"; so do {', '.join(intolerable['option'].iloc[1:])}" if len(intolerable) > 1 else "")
                         + f". Meeting the criteria costs "
-                        f"{rec['expected_total_cost'] - cheapest['expected_total_cost']:,.0f} {cur} more in "
+                        f"{money(rec['expected_total_cost'] - cheapest['expected_total_cost'], cur, sig=3)} more in "
                         "expectation.")
             else:
                 most = t.loc[t["probability_best"].idxmax()]

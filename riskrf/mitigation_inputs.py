@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from .measures import Ditch, MeasureError
+from .report.format import money
 from .road_risk import (
     AGS2007_INDIVIDUAL_RISK,
     VULNERABILITY_DIRECT_BY_MASS,
@@ -76,6 +77,9 @@ def closure_cost_per_fall(co: "Consequences", vehicles_per_day):
 
 @dataclass(frozen=True)
 class Economics:
+    """Discounting of the study: ``discount_rate`` (a fraction per year, default 0.03) over ``horizon_years``
+    [yr] (default 50); present values use the uniform-series factor (1 - (1 + r)^-n) / r (Wyllie 2014, 8.5.5).
+    """
     discount_rate: float = 0.03
     horizon_years: float = 50.0
 
@@ -94,7 +98,8 @@ class Uncertainty:
 
     ``rate_factor``: the rate of falls relative to the estimate (e.g. the share of the source above the
     road); ``vulnerability_factor`` multiplies both vulnerability curves.  The power law's b and rate are
-    sampled from their sampling laws (b x Gamma(n)/n, rate x Gamma(n)/n) and derived retentions from their
+    sampled from their posteriors given the record of n falls (b x Gamma(n)/n, the Jeffreys-prior posterior of b;
+    rate x Gamma(n)/n, prior 1/rate) and derived retentions from their
     Monte Carlo law (Beta) unless switched off.  ``materials`` gives ranges of slope material parameters
     ("talus.ground_friction_angle_deg" = [20, 30]); the scenario is re-simulated for ``material_draws``
     joint draws (and once at each end of each range, for the tornado) and every sample uses one of the
@@ -122,6 +127,15 @@ class Uncertainty:
 
 @dataclass(frozen=True)
 class Option:
+    """One mitigation option of a study, as read from the ``[[mitigation.options]]`` tables (README "Mitigation
+    options").  ``kind`` is one of OPTION_KINDS.  Money in the study's currency: ``capital_cost``,
+    ``annual_maintenance`` (per year), ``repair_cost_per_impact``, ``replacement_cost``; ``life_years`` [yr],
+    ``repair_days`` [days] of closure per repair.  Geometry in metres (``x_m``, ``width_m``, ``depth_m``,
+    ``height_m``, ``zone_x_m``, ``covered_length_m``, ``road_x_m``), fence capacity ``capacity_kj`` [kJ],
+    scaling range ``min_mass_kg``/``max_mass_kg`` [kg].  Typed effects (``retention``, ``rate_reduction``,
+    closure ``share_while_closed`` and ``closure_hours_per_year``) are ASSUMPTIONS and labelled as such; the
+    ``*_range`` fields are (low, high) for the uncertainty study.
+    """
     name: str
     kind: str
     capital_cost: float = 0.0
@@ -210,7 +224,7 @@ class Option:
             text = ((f"{self.closure_rule}: " if self.closure_rule else "")
                     + f"road closed {self.closure_hours_per_year:,.1f} h per year ({how}) at "
                     f"{self.cost_per_closure_hour:,.0f}{cur} per hour "
-                    f"({self.closure_hours_per_year * self.cost_per_closure_hour:,.0f}{cur} per year, in the "
+                    f"({money(self.closure_hours_per_year * self.cost_per_closure_hour, sig=3)}{cur} per year, in the "
                     f"annual maintenance); {self.share_while_closed:.1%} of falls occur while closed "
                     f"({how}); protects road users, falls still reach the road")
         else:
@@ -290,6 +304,11 @@ def _vulnerability(v, where):
 
 
 def parse_option(spec: dict, i: int, source: str) -> Option:
+    """Check and read option ``i`` of a study (a dict from TOML) read from ``source``; an :class:`Option`.
+
+    Every field is checked before any work (kind, costs >= 0, geometry, ranges low <= high); a
+    MitigationError names the source, the option and the field with its value.
+    """
     where = f"options[{i}]"
     if not isinstance(spec, dict):
         raise MitigationError(f"{source}: {where} must be a table")

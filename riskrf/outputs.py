@@ -6,6 +6,7 @@ import csv
 import json
 import math
 import os
+import re
 import shutil
 import tempfile
 from pathlib import Path
@@ -181,3 +182,49 @@ def _clean(value):
 def write_json(data, path) -> None:
     """Write ``data`` as indented JSON; NaN and infinity become null."""
     Path(path).write_text(json.dumps(_clean(data), indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
+
+
+#: An absolute path in text (POSIX form): a slash-separated run not preceded by a word, a URL or a
+#: fraction ("km/h", "1/yr" and "http://..." are left alone).
+_ABSOLUTE_PATH = re.compile(r"(?<![\w.:/&;+=,<~-])/(?:[\w.-]+/)+[\w.-]+")
+
+
+def shown_path(path, base) -> str:
+    """``path`` as written in outputs: relative to ``base`` (the site file's folder) when it lies there; a file
+    of the installed package (bundled data, shipped scenarios) as its name inside the package
+    (``riskrf/data/NAME``); anything else relative to ``base`` (with ``..``), never the machine's absolute path."""
+    p = Path(os.path.abspath(str(path)))
+    base = Path(os.path.abspath(str(base)))
+    if p.is_relative_to(base):
+        return p.relative_to(base).as_posix()
+    root = Path(__file__).resolve().parent.parent        # the folder holding riskrf/ and simulation/
+    if p.is_relative_to(root):
+        return p.relative_to(root).as_posix()
+    return Path(os.path.relpath(p, base)).as_posix()
+
+
+def relative_paths(value, base):
+    """``value`` (text, or a dict/list of them, e.g. a JSON summary) with every absolute path in its text
+    written by :func:`shown_path` relative to ``base``; other values unchanged."""
+    if isinstance(value, str):
+        return _ABSOLUTE_PATH.sub(lambda m: shown_path(m.group(0), base), value)
+    if isinstance(value, Path):
+        return shown_path(value, base) if value.is_absolute() else value.as_posix()
+    if isinstance(value, dict):
+        return {k: relative_paths(v, base) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [relative_paths(v, base) for v in value]
+    return value
+
+
+def relative_paths_in_json_files(folder, base, *, skip=("inputs",)) -> None:
+    """Rewrite every ``*.json`` below ``folder`` with :func:`relative_paths` (base: the site file's folder), so
+    that no output names a directory of the machine it ran on.  Subfolders named in ``skip`` (the copy of the
+    inputs and the command as typed, kept for exact reruns) are left as they are."""
+    for path in sorted(Path(folder).rglob("*.json")):
+        if set(path.relative_to(folder).parts[:-1]) & set(skip):
+            continue
+        data = json.loads(path.read_text(encoding="utf-8"))
+        fixed = relative_paths(data, base)
+        if fixed != data:
+            write_json(fixed, path)

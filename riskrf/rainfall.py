@@ -66,13 +66,18 @@ class Rainfall:
 
     @property
     def first_day(self) -> pd.Timestamp:
+        """First day of the daily record."""
         return self.daily.index[0]
 
     @property
     def last_day(self) -> pd.Timestamp:
+        """Last day of the daily record."""
         return self.daily.index[-1]
 
     def summary(self) -> pd.DataFrame:
+        """Key figures of the record (one-column table): source, format, first and last day, days, missing days,
+        gaps, trace days, mean annual rainfall [mm] and the wettest day [mm].
+        """
         d = self.daily
         years = d.groupby(d.index.year).sum(min_count=300)
         rows = {

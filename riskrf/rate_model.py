@@ -120,14 +120,17 @@ class RateModel:
     # --- small accessors -------------------------------------------------
     @property
     def n_periods(self) -> int:
+        """Number of periods (rows) in the regression design."""
         return len(self.design)
 
     @property
     def n_events(self) -> int:
+        """Number of falls counted over all periods."""
         return int(self.design["count"].sum())
 
     @property
     def preferred_result(self):
+        """The fitted statsmodels result of the preferred model (negative binomial or Poisson)."""
         return self.negbin if self.preferred == "negative binomial" else self.poisson
 
     def _exog(self, frame: pd.DataFrame) -> pd.DataFrame:

@@ -48,10 +48,11 @@ from dataclasses import dataclass, field
 
 import pandas as pd
 
+from .units import HOURS_PER_DAY, M_PER_KM
+
 FT_M = 0.3048                       # exact (international foot)
 MILE_M = 1609.344                   # exact
 YD3_M3 = 0.764554857984             # exact (0.9144 m)^3
-HOURS_PER_DAY = 24.0
 
 #: The four published classes of each descriptive category, in increasing order of hazard (3, 9, 27, 81 points).
 CLASSES = {
@@ -107,7 +108,7 @@ def average_vehicle_risk(adt_vehicles_per_day: float, slope_length_m: float, spe
     (may exceed 100 %: more than one vehicle on average).  SI inputs: the length/speed ratio is unit-free,
     so L [km] / V [km/h] equals L [mi] / V [mph]."""
     adt = _finite(adt_vehicles_per_day, "adt_vehicles_per_day", lo=0)
-    length_km = _finite(slope_length_m, "slope_length_m", lo=0, lo_open=True) / 1000.0
+    length_km = _finite(slope_length_m, "slope_length_m", lo=0, lo_open=True) / M_PER_KM
     v = _finite(speed_kmh, "speed_kmh", lo=0, lo_open=True)
     return adt * length_km / HOURS_PER_DAY / v * 100.0
 

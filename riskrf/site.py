@@ -47,6 +47,13 @@ OTHER_TABLES = ("rates",)
 
 @dataclass(frozen=True)
 class Site:
+    """A checked site file (``riskrf assess SITE.toml``, README "Site files").
+
+    ``path`` of the file (relative paths inside it resolve against its folder), ``name`` and ``description``,
+    the ``inventory``, ``hazard``, ``mitigation``, ``design_block`` and optional ``rates`` sections as
+    checked dicts with defaults filled in, and ``defaults_used``: the names of the defaults applied, reported
+    as such in every output.
+    """
     path: Path
     name: str
     description: str
@@ -58,6 +65,7 @@ class Site:
     rates: dict | None = None
 
     def resolve(self, relative) -> Path:
+        """A path given in the site file, resolved against the site file's folder."""
         return (self.path.parent / relative).resolve()
 
 

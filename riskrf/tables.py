@@ -182,6 +182,7 @@ def is_blank(table: pd.DataFrame) -> pd.Series:
 
 
 def csv_error():
+    """The csv module's error class (imported on demand), for ``except`` clauses around CSV reading."""
     import csv
     return csv.Error
 

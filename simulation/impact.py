@@ -10,12 +10,15 @@ velocity of the contact point is ``vt - r w``.
 Normal restitution laws (``EN_*`` codes)
 ---------------------------------------
 * ``EN_CONSTANT``: e_N given (sampled per impact when a spread is given).
-* ``EN_WYLLIE``: e_N = 19.5 theta_i^-1.03 with theta_i the impact angle in
-  degrees between the incoming velocity and the surface (Wyllie 2014, eq. 5.x;
-  IJRMMS 67:170).  It exceeds 1 below theta_i = 17.9 deg: Wyllie's definition
-  is kinematic (normal speeds), and at shallow angles the normal rebound is
-  fed by the tangential velocity lost to friction and rotation.  It is capped
-  at ``EN_WYLLIE_MAX`` = 2.5, the largest value Wyllie measured.
+* ``EN_WYLLIE``: e_N = 19.5 theta_i^-1.03 with theta_i the impact angle in degrees between the
+  incoming velocity and the surface (Wyllie 2014, "Calibration of rock fall modeling parameters",
+  IJRMMS 67:170-180: field impacts at five sites; and the "Coefficient of restitution" part of
+  Wyllie's 2014 UBC PhD thesis, "Rock fall engineering: development and calibration of an improved
+  model ...", on which his book Rock Fall Engineering draws; the book's equation number is not cited
+  because no copy was at hand to check it).  It exceeds 1 below theta_i = 17.9 deg: Wyllie's
+  definition is kinematic (normal speeds), and at shallow angles the normal rebound is fed by the
+  tangential velocity lost to friction and rotation.  It is capped at ``EN_WYLLIE_MAX`` = 2.5, the
+  largest value Wyllie measured.
 * ``EN_VELOCITY``: e_N / (1 + (|v_n| / 9.144 m/s)^2), the CRSP "scale by
   velocity" form (Pfeiffer & Bowen 1989; RocFall "scale Rn by velocity").
 

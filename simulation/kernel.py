@@ -275,6 +275,43 @@ def barrier_outcome(energy_kj, centre_height_m, radius_m, capacity_kj, height_m)
 
 
 @njit(cache=True)
+def _kinetic_kj(mass, speed2, inertia, w):
+    """Kinetic energy [kJ] (1/2 m v^2 + 1/2 I w^2) / J_PER_KJ, with ``speed2`` = v^2 and I = k m r^2 [kg m^2].
+
+    The compiled copy of :func:`simulation.units.kinetic_energy_kj` (same formula): that one is a plain
+    Python function, which numba cannot call from compiled code, so the kernel keeps this one copy.
+    """
+    return (0.5 * mass * speed2 + 0.5 * inertia * w * w) / J_PER_KJ
+
+
+@njit(cache=True)
+def _meet_collector(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count, block, coll, t, vx, vz, w, h,
+                    speed2, mass, inertia, r, capacity_kj, barrier_height_m):
+    """A block meets collector ``coll``: at a barrier (capacity not NaN) decide the outcome with
+    :func:`barrier_outcome`, then record the crossing.  One home for the flight and the contact phases.
+
+    ``speed2`` [m^2/s^2] is the squared speed of the centre, ``inertia`` I = k m r^2 [kg m^2].
+    Returns (outcome, share of kinetic energy kept).
+    """
+    outcome = CROSSED
+    keep = 1.0
+    if not math.isnan(capacity_kj):
+        e = _kinetic_kj(mass, speed2, inertia, w)
+        outcome, keep = barrier_outcome(e, h, r, capacity_kj, barrier_height_m)
+    _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count, block, coll, t, vx, vz, w, h,
+                     outcome)
+    return outcome, keep
+
+
+@njit(cache=True)
+def _record_barrier_event(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, block, t, x, z, vx, vz, w, caught,
+                          moving_mode):
+    """Record the state after a barrier: stopped (caught) or moving on in ``moving_mode`` with the energy kept."""
+    _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, block, t, x, z, vx, vz, w,
+                 MODE_STOP if caught else moving_mode, EV_CAUGHT if caught else EV_BARRIER)
+
+
+@njit(cache=True)
 def _envelope(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass, inertia, r, contact_speed0, contact_a,
               contact_dir, cosb, contact, roll):
     """Update per-bin passage count, max/sum of speed, height and energy for bins between xa and xb."""
@@ -297,7 +334,7 @@ def _envelope(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass, inerti
             v = math.sqrt(vx * vx + vzz * vzz)
             h = z0 + vz * t - 0.5 * g * t * t - _ground(px, pz, xc)
             wc = w
-        e = (0.5 * mass * v * v + 0.5 * inertia * wc * wc) / J_PER_KJ
+        e = _kinetic_kj(mass, v * v, inertia, wc)
         env_acc[i, 0] += 1.0
         env_acc[i, 1] = max(env_acc[i, 1], v)
         env_acc[i, 2] = max(env_acc[i, 2], h)
@@ -388,13 +425,9 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     zc = z + vz * tc - 0.5 * g * tc * tc
                     vzc = vz - g * tc
                     h = zc - _ground(px, pz, c_x[j])
-                    outcome = CROSSED
-                    keep = 1.0
-                    if not math.isnan(c_cap[j]):
-                        e = (0.5 * mass * (vx * vx + vzc * vzc) + 0.5 * inertia * w * w) / J_PER_KJ
-                        outcome, keep = barrier_outcome(e, h, r, c_cap[j], c_h[j])
-                    _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
-                                     bid, j, t_abs + tc, vx, vzc, w, h, outcome)
+                    outcome, keep = _meet_collector(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
+                                                    bid, j, t_abs + tc, vx, vzc, w, h, vx * vx + vzc * vzc, mass,
+                                                    inertia, r, c_cap[j], c_h[j])
                     if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
                         if env_x.shape[0] > 0:
                             _envelope(env_x, env_acc, x, c_x[j], x, z, vx, vz, w, g, px, pz, mass, inertia, r,
@@ -408,9 +441,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                             z = _ground(px, pz, x)
                             reason = CAUGHT
                         if record:
-                            _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz,
-                                         w, MODE_STOP if reason == CAUGHT else MODE_FLIGHT,
-                                         EV_CAUGHT if reason == CAUGHT else EV_BARRIER)
+                            _record_barrier_event(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z,
+                                                  vx, vz, w, reason == CAUGHT, MODE_FLIGHT)
                         cut = True
                         break
                 if cut:
@@ -549,13 +581,9 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     tc = (uc - u) / a_dir
                 wc = direction * uc / r if roll else 0.0
                 vxc, vzc = direction * uc * cosb, direction * uc * sinb
-                outcome = CROSSED
-                keep = 1.0
-                if not math.isnan(c_cap[j]):
-                    e = (0.5 * mass * uc * uc + 0.5 * inertia * wc * wc) / J_PER_KJ
-                    outcome, keep = barrier_outcome(e, 0.0, r, c_cap[j], c_h[j])
-                _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
-                                 bid, j, t_abs + tc, vxc, vzc, wc, 0.0, outcome)
+                outcome, keep = _meet_collector(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
+                                                bid, j, t_abs + tc, vxc, vzc, wc, 0.0, uc * uc, mass, inertia, r,
+                                                c_cap[j], c_h[j])
                 if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
                     if env_x.shape[0] > 0:
                         _envelope(env_x, env_acc, x, c_x[j], x, z, 0.0, 0.0, 0.0, g, px, pz, mass, inertia, r, u,
@@ -570,9 +598,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     if outcome == BARRIER_CAUGHT:
                         reason = CAUGHT
                     if record:
-                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z,
-                                     v_along * cosb, v_along * sinb, w, MODE_STOP if reason == CAUGHT else MODE_CONTACT,
-                                     EV_CAUGHT if reason == CAUGHT else EV_BARRIER)
+                        _record_barrier_event(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z,
+                                              v_along * cosb, v_along * sinb, w, reason == CAUGHT, MODE_CONTACT)
                     cut = True
                     break
             if cut:

@@ -15,8 +15,13 @@ def _axes(ax, figsize=(8, 4.5)):
     return plt.figure(figsize=figsize).add_subplot()
 
 
-def plot_profile(result, ax=None, *, n_paths: int = 20):
-    """Slope profile coloured by material, collectors and barriers, and recorded trajectories."""
+def plot_profile(result, ax=None, *, n_paths: int = 20, fences=()):
+    """Slope profile coloured by material, collectors and barriers, and recorded trajectories.
+
+    ``fences``: (x [m], height [m], label) of fences to draw at their height (e.g. a study's fence options
+    at the barrier line), each a vertical bar from the ground to ground + height.  The legend stands
+    outside the axes, so it hides no part of the slope or a label.
+    """
     ax = _axes(ax)
     sc = result.scenario
     prof = sc.profile
@@ -38,13 +43,18 @@ def plot_profile(result, ax=None, *, n_paths: int = 20):
         else:
             ax.axvline(c.x, color="C3", ls=":", lw=1)
             ax.annotate(c.name, (c.x, zmax), fontsize="small", ha="left", va="top", rotation=90)
+    styles = ("-", "--", "-.", ":")
+    for i, (x, h, label) in enumerate(sorted(fences, key=lambda f: -float(f[1]))):   # tallest behind
+        zg = float(prof.ground(x))
+        ax.plot([x, x], [zg, zg + float(h)], color=f"C{(i + 4) % 10}", lw=4 - 0.8 * min(i, 3),
+                ls=styles[i % len(styles)], solid_capstyle="butt", label=label, zorder=3 + i)
     sd = sc.seeder
     ax.axvspan(sd.x_low, max(sd.x_high, sd.x_low + 0.2), color="C1", alpha=0.2, label="release")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("z [m]")
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_ylim(zmin - 0.05 * (zmax - zmin + 1), None)
-    ax.legend(fontsize="small", loc="upper right")
+    ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     ax.set_title(f"{sc.name}: {len(blocks)} of {result.n:,} trajectories")
     return ax
 

@@ -8,7 +8,7 @@ import pandas as pd
 from scipy import stats
 
 from .kernel import EVENTS, MODE_FLIGHT, OUTCOMES, STOP_REASONS
-from .units import J_PER_KJ
+from .units import J_PER_KJ, kinetic_energy_kj
 
 
 def wilson_interval(k, n, level: float = 0.95):
@@ -61,8 +61,8 @@ class SimulationResult:
         radius = self.blocks["radius"][blk]
         k_inertia = self.blocks["inertia_factor"][blk]
         v = np.hypot(vx, vz)
-        e_t = 0.5 * mass * v ** 2 / J_PER_KJ
-        e_r = 0.5 * k_inertia * mass * radius ** 2 * w ** 2 / J_PER_KJ
+        e_t = kinetic_energy_kj(mass, v)
+        e_r = kinetic_energy_kj(mass, 0.0, w, radius, k_inertia)
         df = pd.DataFrame({
             "block": blk, "time_s": self.crossings["t"][sel], "velocity_ms": v, "vx_ms": vx, "vz_ms": vz,
             "angular_velocity_rads": w, "height_m": self.crossings["h"][sel], "mass_kg": mass, "radius_m": radius,
@@ -157,8 +157,8 @@ class SimulationResult:
         mass, radius = self.blocks["mass"][block], self.blocks["radius"][block]
         k_inertia = self.blocks["inertia_factor"][block]
         g = self.scenario.settings.gravity_ms2
-        ev["kinetic_energy_kj"] = (0.5 * mass * (ev["vx_ms"] ** 2 + ev["vz_ms"] ** 2)
-                                   + 0.5 * k_inertia * mass * radius ** 2 * ev["angular_velocity_rads"] ** 2) / J_PER_KJ
+        ev["kinetic_energy_kj"] = kinetic_energy_kj(mass, np.hypot(ev["vx_ms"], ev["vz_ms"]), ev["angular_velocity_rads"],
+                                                    radius, k_inertia)
         ev["potential_energy_kj"] = mass * g * ev["z_m"] / J_PER_KJ
         ev["total_energy_kj"] = ev["kinetic_energy_kj"] + ev["potential_energy_kj"]
         cols = ["t_s", "x_m", "z_m", "vx_ms", "vz_ms", "angular_velocity_rads", "kinetic_energy_kj",

@@ -56,6 +56,10 @@ class Distribution:
 
     @classmethod
     def parse(cls, spec, where: str, source: str, *, lo=-math.inf, hi=math.inf, lo_open=False) -> "Distribution":
+        """A distribution from a scenario field: a number (constant) or a table with ``dist`` (uniform, normal,
+        lognormal, triangular) and its parameters, checked within [lo, hi] (``lo_open``: lo excluded).
+        ``where`` and ``source`` name the field and file in a ScenarioError.
+        """
         if isinstance(spec, (int, float)) and not isinstance(spec, bool):
             return cls("constant", {"value": _number(spec, where, source, lo=lo, hi=hi, lo_open=lo_open)})
         if not isinstance(spec, dict) or "dist" not in spec:
@@ -87,6 +91,8 @@ class Distribution:
         return dist
 
     def bounds(self):
+        """(lowest, highest) value the distribution can draw (-inf/inf for an untruncated normal; 0/inf for a lognormal
+        without ``max``)."""
         p = self.params
         if self.kind == "constant":
             return p["value"], p["value"]
@@ -99,6 +105,7 @@ class Distribution:
 
 
     def sample(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        """``n`` draws with ``rng`` (a NumPy Generator)."""
         p = self.params
         if self.kind == "constant":
             return np.full(n, p["value"])
@@ -149,6 +156,9 @@ class Material:
 
     @classmethod
     def parse(cls, name: str, spec: dict, source: str) -> "Material":
+        """A material from its scenario table ``materials.<name>`` (a preset and/or restitution, tangential,
+        roughness [m], ground motion and friction angle [deg] fields), checked; errors name ``source`` and field.
+        """
         where = f"materials.{name}."
         if not isinstance(spec, dict):
             raise ScenarioError(f"{source}: materials.{name} must be a table of material fields; got {spec!r}")
@@ -240,6 +250,7 @@ class Seeder:
 
     @property
     def inertia_factor(self) -> float:
+        """I / (m r^2) of the block shape (2/5 sphere, 1/2 cylinder; ``simulation.units.INERTIA_FACTORS``)."""
         return INERTIA_FACTORS[self.shape]
 
 
@@ -254,11 +265,19 @@ class Collector:
 
     @property
     def is_barrier(self) -> bool:
+        """True when the collector is a barrier (it has a capacity)."""
         return self.capacity_kj is not None
 
 
 @dataclass(frozen=True)
 class Settings:
+    """Numerical settings of a simulation (scenario table ``[settings]``).
+
+    ``gravity_ms2`` [m/s^2] (default 9.81); ``contact_velocity_ms`` [m/s]: rebounds slower than this, normal to
+    the slope, turn into rolling or sliding; ``stop_velocity_ms`` [m/s]: slower than this with static friction
+    holding, the block stops; ``max_events``: per block (reaching it is reported); ``envelope_bins``: bins along
+    x for the envelopes (0 = off).
+    """
     gravity_ms2: float = STANDARD_GRAVITY_MS2
     contact_velocity_ms: float = 0.5
     stop_velocity_ms: float = 0.05
@@ -268,6 +287,10 @@ class Settings:
 
 @dataclass(frozen=True)
 class Scenario:
+    """A checked trajectory scenario (README "Scenario files"): slope ``profile``, ``materials``, the block
+    ``seeder``, ``collectors`` (lines where crossings are recorded; barriers among them), numerical
+    ``settings``, and the ``source`` file named in errors.  Run it with :func:`simulation.run`.
+    """
     name: str
     description: str
     profile: Profile
@@ -278,6 +301,7 @@ class Scenario:
     source: str = "<dict>"
 
     def collector_index(self, name: str) -> int:
+        """Index of the collector named ``name``; a KeyError listing the collectors when there is none."""
         names = [c.name for c in self.collectors]
         if name not in names:
             raise KeyError(f"{self.source}: no collector named {name!r}; collectors are {names}")

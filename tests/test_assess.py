@@ -58,6 +58,18 @@ def test_assess_writes_everything(assessed):
     assert html.count("data:image/png;base64,") >= 10
 
 
+def test_outputs_name_no_directory_of_the_machine(assessed):
+    """Paths in the JSON outputs are relative to the site file (or the bundled data's name in the package)."""
+    site, out = assessed
+    for path in out.rglob("*.json"):
+        if path.parent.name == "inputs":            # the inputs and the command as typed, kept for reruns
+            continue
+        text = path.read_text()
+        assert str(ROOT) not in text and str(site.parent) not in text and '"/' not in text, path
+    s = json.loads((out / "summary.json").read_text())
+    assert s["inventory"]["source"] == "riskrf/data/lauterbrunnen_tls_2018.csv"
+
+
 def test_summary_matches_the_modules(assessed):
     site, out = assessed
     s = json.loads((out / "summary.json").read_text())
@@ -301,7 +313,12 @@ def test_report_in_headless_chromium(assessed):
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
         assert errors == []
         text = driver.execute_script("return document.body.innerText;")
-        assert not re.search(r"\d\.\d+e[+-]\d\d", text), re.findall(r".{30}\d\.\d+e[+-]\d\d.{10}", text)
+        # no Python float formatting ("6e+05", "3.044e+05"), raw booleans/None or tuple/dict reprs
+        assert not re.search(r"\de[+-]?\d", text), re.findall(r".{0,30}\de[+-]?\d.{0,10}", text)
+        cells = driver.execute_script("return Array.from(document.querySelectorAll('td, th'))"
+                                      ".map(c => c.innerText.trim());")
+        assert not [c for c in cells if c in ("True", "False", "None")]
+        assert "((" not in text and "{'" not in text, re.findall(r".{0,40}(?:\(\(|\{').{0,20}", text)
         assert str(ROOT) not in text and "/home/" not in text and "/tmp/" not in text
         assert "Table 1." in text and "Figure 1." in text and "Contents" in text
         driver.save_screenshot(str(ARTIFACTS / "report_1400px.png"))

@@ -170,3 +170,34 @@ def test_velocity_file_columns(tmp_path):
     pd.DataFrame({"speedy": [1.0]}).to_csv(g, index=False)
     with pytest.raises(ValueError, match=r"bad.csv: no velocity column among \['speedy'\]"):
         read_velocities(g)
+
+
+def test_rotation_of_a_cylinder_uses_its_inertia_factor():
+    """A disc/cylinder (k = 1/2): the threshold follows 1/2 m v^2 + 1/2 (1/2) m r^2 w^2, computed here by hand."""
+    m, v, w, rho = 2000.0, 12.0, 20.0, 2650.0
+    r = (3 * m / (4 * np.pi * rho)) ** (1 / 3)                 # equivalent-sphere radius, as documented
+    e_disc = (0.5 * m * v ** 2 + 0.5 * 0.5 * m * r ** 2 * w ** 2) / 1000
+    e_sphere = (0.5 * m * v ** 2 + 0.5 * 0.4 * m * r ** 2 * w ** 2) / 1000
+    assert e_disc > e_sphere * 1.001
+    point = stats.uniform(m * 0.999999, m * 2e-6)
+    args = dict(angular_velocity=np.array([w]), inertia_factor=0.5)
+    assert exceedance_probability(e_disc * 0.999, point, np.array([v]), **args) == 1.0
+    assert exceedance_probability(e_disc * 1.001, point, np.array([v]), **args) == 0.0
+    # between the two: a sphere does not exceed, a disc does
+    mid = 0.5 * (e_sphere + e_disc)
+    assert exceedance_probability(mid, point, np.array([v]), angular_velocity=np.array([w])) == 0.0
+    assert exceedance_probability(mid, point, np.array([v]), **args) == 1.0
+    # Monte Carlo agrees with a direct sampled computation
+    rng = np.random.default_rng(5)
+    mass = stats.lognorm(0.8, scale=1000.0)
+    vs, ws = rng.uniform(5, 20, 400), rng.uniform(0, 30, 400)
+    p = exceedance_probability(300.0, mass, vs, angular_velocity=ws, inertia_factor=0.5)
+    p_mc = exceedance_probability(300.0, mass, vs, angular_velocity=ws, inertia_factor=0.5, method="mc",
+                                  n_samples=400_000, seed=1)
+    ms = mass.rvs(400_000, random_state=np.random.default_rng(2))
+    idx = np.random.default_rng(3).integers(0, 400, ms.size)
+    rs = (3 * ms / (4 * np.pi * rho)) ** (1 / 3)
+    direct = np.mean((0.5 * ms * vs[idx] ** 2 + 0.25 * ms * rs ** 2 * ws[idx] ** 2) / 1000 > 300.0)
+    assert p == pytest.approx(direct, abs=0.005) and p_mc == pytest.approx(direct, abs=0.005)
+    with pytest.raises(ValueError, match="inertia_factor"):
+        exceedance_probability(300.0, mass, vs, angular_velocity=ws, inertia_factor=-1)

@@ -39,3 +39,25 @@ def test_document_numbers_tables_and_figures_and_escapes_text(tmp_path):
     page = doc.render()
     assert "name='viewport'" in page and "@media print" in page and "href='#s1'" in page
     assert "<b>site</b>" not in page
+
+
+def test_money_rounds_uncertain_amounts_to_significant_figures():
+    from riskrf.report.format import money
+    assert money(775390, "CHF", sig=3) == "775,000 CHF"
+    assert money(6271796, "CHF", sig=3) == "6,270,000 CHF"
+    assert money(999_600, "CHF", sig=3) == "1,000,000 CHF"          # rounding carries into the next digit
+    assert money(-1234.5, sig=2) == "−1,200"
+    assert money(0.0, "CHF", sig=3) == "0 CHF"
+    assert money(1_917_312, "CHF") == "1,917,312 CHF"                # typed amounts stay exact
+
+
+def test_assumption_values_read_as_text():
+    from riskrf.report.html import _field_label, _plain_text
+    curve = "((10.0, 0.05), (100.0, 0.3), (1000.0, 0.7), (10000.0, 1.0))"
+    assert _plain_text(curve, "consequences.vulnerability_moving_vehicle") == \
+        "10 kg: 0.05; 100 kg: 0.3; 1,000 kg: 0.7; 10,000 kg: 1"
+    assert _plain_text("size-dependent curve " + curve, "consequences.vulnerability_moving_vehicle") == \
+        "size-dependent curve 10 kg: 0.05; 100 kg: 0.3; 1,000 kg: 0.7; 10,000 kg: 1"
+    assert [_plain_text(t) for t in ("True", "False", "None", "'inventory'", "[2000.0, 5000.0]")] == \
+        ["yes", "no", "not given", "inventory", "2,000; 5,000"]
+    assert _field_label("hazard.free_board_m").endswith("[m]") and "." not in _field_label("rates.trend")

@@ -65,7 +65,8 @@ def test_lashotor_total_and_the_printed_total_discrepancy(table10):
 def test_roadway_score_shows_the_exact_foot():
     # Table 9 converts with ~0.3 m/ft; at 0.3 m/ft 12 m = 40 ft would score 3^1.5 = 5.2 (printed 5), the exact
     # foot gives 5.67 (printed 6), which is what Table 10 prints.
-    assert round(3 ** ((52 - 12 / 0.3) / 8)) == 5
+    assert rhrs.roadway_width_x(12.0) == pytest.approx((52 - 12 / 0.3048) / 8, rel=1e-12)   # the exact foot
+    assert round(rhrs.score(rhrs.roadway_width_x(40 * 0.3048))) == 5    # 40 ft exactly: 3^1.5 = 5.2
     assert round(rhrs.score(rhrs.roadway_width_x(12.0))) == 6
 
 

@@ -31,8 +31,19 @@ def test_barrier_scenario_collector_columns():
     assert (df["height_m"] >= -1e-9).all()
     env = res.envelopes
     assert (env["velocity_max_ms"] >= env["velocity_mean_ms"]).all()
-    path = res.path(0)
-    assert path["x_m"].is_monotonic_increasing or len(path) > 2
+    rec = simulation.run(load_scenario(BARRIER), n=50, seed=1, record_paths=5)
+    for b in range(5):
+        sel = rec.paths["block"] == b
+        t, x, z = rec.paths["t"][sel], rec.paths["x"][sel], rec.paths["z"][sel]
+        assert t[0] == 0.0 and t[-1] > 0.0
+        assert np.all(np.diff(t) >= 0)                            # events in time order
+        moved = (np.diff(x) != 0) | (np.diff(z) != 0)
+        assert moved.any() and np.all(np.diff(t)[moved] > 0)     # moving takes time: no jump between events
+        assert t[-1] == rec.per_block["t"][b]                     # the last event is the stop
+        assert rec.paths["x"][sel][0] == rec.blocks["x"][b] and rec.paths["z"][sel][0] == rec.blocks["z"][b]
+        path = rec.path(b)                                        # the sampled path ends where the block stopped
+        assert (path["x_m"].iloc[-1], path["z_m"].iloc[-1]) == (rec.per_block["x"][b], rec.per_block["z"][b])
+        assert (path["x_m"].iloc[0], path["z_m"].iloc[0]) == (rec.blocks["x"][b], rec.blocks["z"][b])
 
 
 def test_same_seed_same_numbers_whatever_the_chunking():
@@ -99,3 +110,28 @@ def test_bad_run_arguments_and_files(tmp_path):
         load_scenario(bad)
     with pytest.raises(KeyError, match="no collector named 'fence'"):
         simulation.run(sc, n=1).collector("fence")
+
+
+def test_profile_figure_draws_fences_at_their_height_and_keeps_the_legend_outside():
+    import matplotlib
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    from simulation.plotting import plot_profile
+    sc = load_scenario(BARRIER)
+    res = simulation.run(sc, n=30, seed=1, record_paths=5)
+    x = sc.collectors[sc.collector_index("barrier")].x
+    ax = plot_profile(res, fences=[(x, 5.0, "fence A, 5 m"), (x, 7.0, "fence B, 7 m")])
+    try:
+        lines = {ln.get_label(): ln for ln in ax.get_lines()}
+        zg = float(sc.profile.ground(x))
+        for label, h in (("fence A, 5 m", 5.0), ("fence B, 7 m", 7.0)):
+            xs, zs = lines[label].get_data()
+            assert list(xs) == [x, x] and list(zs) == pytest.approx([zg, zg + h])
+        legend = ax.get_legend()
+        ax.figure.canvas.draw()
+        box = legend.get_window_extent()
+        assert box.x0 >= ax.get_window_extent().x1          # beside the axes: hides no curve or label
+        assert {"fence A, 5 m", "fence B, 7 m"} <= {t.get_text() for t in legend.get_texts()}
+    finally:
+        plt.close(ax.figure)

@@ -4,6 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .. import __version__
+from ..units import M_PER_KM
 from .format import Document, cell, escape
 
 
@@ -12,7 +13,7 @@ def plot_corridor(res):
     best option."""
     import matplotlib.pyplot as plt
     t = res.table.sort_values("chainage_from_m")
-    x0, w = t["chainage_from_m"].to_numpy() / 1000, t["length_m"].to_numpy() / 1000
+    x0, w = t["chainage_from_m"].to_numpy() / M_PER_KM, t["length_m"].to_numpy() / M_PER_KM
     fig, ax = plt.subplots(3, 1, figsize=(10, 7.5), sharex=True)
     ax[0].bar(x0, t["rhrs_score"], width=w, align="edge", color="#8c6d31", edgecolor="k", lw=0.3)
     ax[0].set_ylabel("RHRS score")
@@ -25,7 +26,7 @@ def plot_corridor(res):
     ax[1].set_yscale("log")
     ax[1].set_ylabel("individual risk [1/yr]")
     ax[1].legend(fontsize=8, loc="upper right")
-    km = t["length_m"].to_numpy() / 1000
+    km = t["length_m"].to_numpy() / M_PER_KM
     ax[2].bar(x0, t["deaths_per_year"] / km, width=w, align="edge", color="#d62728", alpha=0.7, edgecolor="k",
               lw=0.3, label="do nothing")
     ax[2].bar(x0, t["best_deaths_per_year"] / km, width=w, align="edge", color="#2ca02c", alpha=0.8,

@@ -45,6 +45,12 @@ def _plain_log_labels(fig) -> None:
                                    minor_thresholds=f.minor_thresholds, linthresh=f._linthresh))
 
 
+def prepare_drawing() -> None:
+    """Import matplotlib's pyplot once, in this process, before work that draws in forked processes (so each
+    fork does not import it again).  The backend is not changed: matplotlib picks it as usual."""
+    import matplotlib.pyplot  # noqa: F401
+
+
 def save_figure(fig, path, *, tight_layout: bool = False) -> Path:
     """Write ``fig`` to ``path`` (PNG, :data:`FIGURE_DPI`) and close it; returns the path."""
     import matplotlib.pyplot as plt
@@ -97,10 +103,11 @@ def write_energy_figures(analysis, out: Path, fence_capacities_kj) -> list[Path]
     return written
 
 
-def write_simulation_figures(result, out: Path, collectors, *, file_names=None) -> list[Path]:
+def write_simulation_figures(result, out: Path, collectors, *, file_names=None, fences=()) -> list[Path]:
     """Profile with trajectories, one distribution figure per collector, and envelopes (when binned).
 
-    ``file_names`` maps a collector name to its file name (default ``collector_<name>.png``).
+    ``file_names`` maps a collector name to its file name (default ``collector_<name>.png``); ``fences``:
+    (x [m], height [m], label) drawn on the profile at their height.
     """
     from simulation.plotting import (
         plot_collector_distributions,
@@ -108,7 +115,7 @@ def write_simulation_figures(result, out: Path, collectors, *, file_names=None) 
         plot_profile,
     )
     file_names = file_names or {}
-    written = [save_figure(plot_profile(result).figure, out / "profile_trajectories.png")]
+    written = [save_figure(plot_profile(result, fences=fences).figure, out / "profile_trajectories.png")]
     for name in collectors:
         axes = plot_collector_distributions(result, name)
         written.append(save_figure(axes[0][0].figure, out / file_names.get(name, f"collector_{name}.png"),

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 
 from ..extremes import gumbel_reduced_variate, plotting_positions
-from ..units import mass_for_energy_kg
+from ..units import KG_PER_TONNE, mass_for_energy_kg
 
 
 def _axes(ax, figsize=(6.4, 4.8)):
@@ -18,7 +18,7 @@ def _axes(ax, figsize=(6.4, 4.8)):
 
 
 def plot_magnitude_frequency(fit, ax=None, *, level_label=True):
-    """Magnitude-cumulative-frequency plot on log-log axes (Wyllie 2014, fig. 8.x style).
+    """Magnitude-cumulative-frequency plot on log-log axes (as in Wyllie 2014, section 8.4.1, the power law).
 
     Points: the observed annual frequency of falls at least as large as each
     recorded size (above 4,000 distinct sizes, 4,000 of them log-spaced in rank).  Line: the fitted law above m_min, with the band spanned by
@@ -199,7 +199,7 @@ def plot_design_energy_sensitivity(table, ax=None):
     ax = _axes(ax)
     for i, (m_max, g) in enumerate(table.groupby("m_max_kg")):
         g = g.sort_values("rate_share")
-        label = f"m_max {m_max / 1000:,.4g} t" if np.isfinite(m_max) else "no m_max"
+        label = f"m_max {m_max / KG_PER_TONNE:,.4g} t" if np.isfinite(m_max) else "no m_max"
         ax.plot(g["rate_share"], g["energy_kj"], "o-", color=f"C{i}", label=label)
     T = float(table["T_years"].iloc[0])
     ax.set_xscale("log")

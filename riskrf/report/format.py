@@ -58,11 +58,19 @@ def sig(x, digits: int = 3) -> str:
     return text.replace("-", "−") if text.startswith("-") else text
 
 
-def money(x, currency: str = "") -> str:
-    """Money for a manager: whole units with thousands separators and the currency, e.g. "1,250,000 CHF"."""
+def money(x, currency: str = "", sig: int | None = None) -> str:
+    """Money for a manager: whole units with thousands separators and the currency, e.g. "1,250,000 CHF".
+
+    ``sig``: round to that many significant figures first, for uncertain amounts (means, intervals, expected
+    losses): ``money(775390, "CHF", sig=3)`` gives "775,000 CHF".  Typed inputs (capital costs) are shown in
+    full (``sig=None``).
+    """
     if x is None or (isinstance(x, float) and math.isnan(x)):
         return ""
-    text = f"{float(x):,.0f}".replace("-", "−")
+    v = float(x)
+    if sig is not None and v != 0 and math.isfinite(v):
+        v = round(v, int(sig) - 1 - math.floor(math.log10(abs(v))))
+    text = f"{v:,.0f}".replace("-", "−")
     return f"{text} {currency}".strip()
 
 

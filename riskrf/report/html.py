@@ -19,7 +19,7 @@ from .. import __version__
 from ..energy_study import INTERVAL_COVERS, sensitivity_grid
 from ..impact_energy import PairedSamples
 from ..road_risk import fn_zone
-from .format import Document, cell, money, probability, sig
+from .format import Document, cell, human_header, money, probability, sig
 from .format import escape as _e
 
 
@@ -33,35 +33,161 @@ def _name(path) -> str:
 _ABSOLUTE_DIRS = re.compile(r"(?<![\w.:/&;+=,<-])/(?:[\w.-]+/)+(?=[\w.-])")
 
 
+#: Reader's names of the site-file fields that can appear in the assumptions table (the field name is kept
+#: beside the label); a field not listed here is named from its own name (``human_header``).
+_FIELD_LABELS = {
+    "inventory.rate_from": "rate of falls taken from",
+    "inventory.rate_scale": "rate share of the inventory at this slope",
+    "inventory.sizes": "what the inventory's sizes measure",
+    "hazard.collector": "collector line of the barrier",
+    "hazard.road_collector": "collector line of the road",
+    "hazard.n_blocks": "simulated blocks",
+    "hazard.reach_probability": "probability of reaching the barrier line (velocity file)",
+    "hazard.fences_kj": "fence capacities checked [kJ]",
+    "hazard.fence_height_m": "fence height [m]",
+    "hazard.free_board_m": "free board above a block's passing height [m]",
+    "hazard.design_period_years": "design return period [yr]",
+    "hazard.bootstrap": "bootstrap replicates",
+    "hazard.seed": "random seed",
+    "hazard.option_blocks": "simulated blocks per option",
+    "hazard.mass_coupling": "mass coupling of reach and speed",
+    "design_block.rule": "design-block rule",
+    "design_block.percentile": "design-block percentile [%]",
+    "rates.record": "rate model: record of falls",
+    "rates.period": "rate model: counting period",
+    "rates.windows_days": "rate model: rainfall windows [days]",
+    "rates.rain_transform": "rate model: rainfall transform",
+    "rates.season": "rate model: seasonal term",
+    "rates.trend": "rate model: trend term",
+    "traffic.vehicles_per_day": "traffic [vehicles/day]",
+    "traffic.vehicle_length_m": "vehicle length [m]",
+    "traffic.speed_kmh": "traffic speed [km/h]",
+    "traffic.occupants_per_vehicle": "occupants per vehicle",
+    "traffic.occupants_distribution": "distribution of occupants per vehicle",
+    "traffic.commuter_trips_per_day": "trips per day of the most exposed commuter",
+    "traffic.hours_rock_on_road": "hours a fallen rock lies on the road",
+    "traffic.p_cannot_stop": "probability a driver cannot stop",
+    "traffic.share_stopping_on_road": "share of falls stopping on the road",
+    "traffic.exposed_length_m": "exposed length of road [m]",
+    "consequences.value_of_statistical_life": "value of a statistical life",
+    "consequences.vulnerability_moving_vehicle": "vulnerability, rock hitting a moving vehicle (P(death), block mass)",
+    "consequences.vulnerability_striking_rock": "vulnerability, vehicle striking a fallen rock (P(death), block mass)",
+    "consequences.vehicle_damage": "vehicle damage per hit",
+    "consequences.closure_days_per_fall": "road closure per fall on the road [days]",
+    "consequences.closure_cost_per_day": "closure cost per day",
+    "consequences.detour_hours": "detour per vehicle during a closure [h]",
+    "consequences.value_of_time_per_hour": "value of road users' time per hour",
+    "consequences.cleanup_cost_per_fall": "clean-up cost per fall on the road",
+    "consequences.currency": "currency",
+    "economics.discount_rate": "discount rate [1/yr]",
+    "economics.horizon_years": "horizon of the study [yr]",
+    "criteria.individual_risk_per_year": "tolerable individual risk [1/yr]",
+    "criteria.fn_diagram": "societal risk (F-N) criterion",
+    "uncertainty.samples": "uncertainty: joint samples",
+    "uncertainty.seed": "uncertainty: random seed",
+    "uncertainty.rate_factor": "uncertainty: range of the rate factor",
+    "uncertainty.m_max_kg": "uncertainty: range of m_max [kg]",
+    "uncertainty.value_of_statistical_life": "uncertainty: range of the value of a statistical life",
+    "uncertainty.vulnerability_factor": "uncertainty: range of the vulnerability factor",
+    "uncertainty.vehicles_per_day": "uncertainty: range of traffic [vehicles/day]",
+    "uncertainty.sample_power_law": "uncertainty: sample the power law's b and rate",
+    "uncertainty.sample_retention": "uncertainty: sample derived retentions",
+}
+
+_TUPLE_REPR = re.compile(r"\((?:\s*\([^()]*\)\s*,?)+\s*\)")   # ((a, b), (c, d), ...) in text
+
+
+def _field_label(field: str) -> str:
+    """A reader's name for a site-file field such as ``hazard.free_board_m``."""
+    if field in _FIELD_LABELS:
+        return _FIELD_LABELS[field]
+    table, _, key = field.rpartition(".")
+    label = human_header(key)
+    label = label[:1].lower() + label[1:]
+    return f"{table}: {label}" if table else label
+
+
+def _plain_value(value, field: str = "") -> str:
+    """A default's value for a reader: yes/no, "not given", numbers to 3 significant figures, a curve of
+    (mass, value) pairs as "10 kg: 0.05; 100 kg: 0.3", lists separated by semicolons; no quotes."""
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if value is None:
+        return "not given"
+    if isinstance(value, str):
+        return value
+    if isinstance(value, (int, np.integer)):
+        return f"{int(value):,}"
+    if isinstance(value, (float, np.floating)):
+        return sig(value)
+    if isinstance(value, dict):
+        return "; ".join(f"{k}: {_plain_value(v)}" for k, v in value.items())
+    if isinstance(value, (list, tuple)):
+        if value and all(isinstance(v, (list, tuple)) and len(v) == 2 for v in value):
+            unit = " kg" if "vulnerability" in field or "mass" in field else ""
+            return "; ".join(f"{_plain_value(m)}{unit}: {_plain_value(y)}" for m, y in value)
+        return "; ".join(_plain_value(v) for v in value)
+    return str(value)
+
+
+def _plain_text(text: str, field: str = "") -> str:
+    """A default's value as written by the site reader (a Python repr, or words around one) for a reader."""
+    import ast
+    text = text.strip()
+    try:
+        return _plain_value(ast.literal_eval(text), field)
+    except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
+        pass
+    quoted = re.fullmatch(r"'([^']*)'(\s.*)?", text, flags=re.S)      # 'x.csv' (inventory.path)
+    if quoted:
+        return quoted.group(1) + (quoted.group(2) or "")
+    return _TUPLE_REPR.sub(lambda m: _plain_value(ast.literal_eval(m.group(0)), field), text)
+
+
 def _assumptions(a, hz, rate_scale) -> pd.DataFrame:
-    """Defaults and judgement inputs of an assessment: input, value, basis."""
-    rows = []
+    """Defaults and judgement inputs of an assessment: input (a reader's name), site-file field, value, basis.
+
+    One row per input: a default that is also labelled a typed assumption (the vulnerability curves) is
+    listed once, with both bases."""
+    rows = {}
+
+    def add(field, label, value, basis):
+        if field in rows:
+            old = rows[field]
+            if basis not in old[3]:
+                rows[field] = (old[0], old[1], old[2], f"{old[3]}; {basis}")
+            return
+        rows[field] = (label, field, value, basis)
+
     if getattr(hz.mass, "m_max", None):
-        rows.append(("maximum credible block m_max [kg]", sig(hz.mass.m_max), "judgement (site file)"))
-    rows.append(("rate share of the inventory at this slope", sig(rate_scale),
-                 "judgement (site file)" if rate_scale != 1 else "whole inventory (no scaling)"))
+        add("inventory.m_max_kg", "maximum credible block m_max [kg]", sig(hz.mass.m_max), "judgement (site file)")
+    add("inventory.rate_scale", _field_label("inventory.rate_scale"), sig(rate_scale),
+        "judgement (site file)" if rate_scale != 1 else "whole inventory (no scaling)")
     from_model = a.site.inventory.get("rate_from") == "rate_model"
-    rows.append(("hazard rate source", a.rate_source, "computed: rate model ([rates])" if from_model
-                 else "computed: the inventory's record"))
+    add("inventory.rate_from", "hazard rate source", a.rate_source, "computed: rate model ([rates])" if from_model
+        else "computed: the inventory's record")
     if a.rates is not None and a.rates.climate and from_model:
-        rows.append(("stated change of climate", a.rates.climate, "typed assumption"))
-    rows.append(("event volume vs block in the loss engine", "each event volume one intact block",
-                 ("model limitation: conservative for fence and shed loads; fragmentation (if stated) is used only "
-                  "for the design block")))
-    rows.append(("queued or stopped vehicles behind a blockage", "not modelled",
-                 ("model limitation: road users meet falls as moving vehicles at the impact point or by striking a "
-                  "rock lying on the road; vehicles queued or stopped behind a blockage and hit by a later fall are "
-                  "not counted")))
+        add("inventory.rain_factor", "stated change of climate", a.rates.climate, "typed assumption")
+    # model limitations (no site-file field)
+    rows["limitation: volumes"] = (
+        "event volume vs block in the loss engine", "\u2014", "each event volume one intact block",
+        "model limitation: conservative for fence and shed loads; fragmentation (if stated) is used only for the "
+        "design block")
+    rows["limitation: queues"] = (
+        "queued or stopped vehicles behind a blockage", "\u2014", "not modelled",
+        "model limitation: road users meet falls as moving vehicles at the impact point or by striking a rock lying "
+        "on the road; vehicles queued or stopped behind a blockage and hit by a later fall are not counted")
     for entry in a.site.defaults_used:
         name, _, value = str(entry).partition(" = ")
         if ": ASSUMPTION" in name or "ASSUMPTION" in value:
             name, _, value = str(entry).partition(": ASSUMPTION ")
-            rows.append((name, value, "typed assumption"))
+            value = value.replace(" (mass_kg, probability of death)", "")
+            add(name, _field_label(name), _plain_text(value, name), "typed assumption")
         elif value.endswith("(default)"):
-            rows.append((name, value[: -len("(default)")].strip(), "riskrf default"))
+            add(name, _field_label(name), _plain_text(value[: -len("(default)")], name), "riskrf default")
         else:
-            rows.append((name, value, "riskrf default"))
-    return pd.DataFrame(rows, columns=["input", "value", "basis"])
+            add(name, _field_label(name), _plain_text(value, name), "riskrf default")
+    return pd.DataFrame(list(rows.values()), columns=["input", "site-file field", "value", "basis"])
 
 
 def _item_table(df: pd.DataFrame) -> pd.DataFrame:
@@ -114,7 +240,12 @@ def render_report(a, figs: Path) -> str:
     rate_scale = site.inventory["rate_scale"]
 
     def money_cur(v):
+        """A typed amount (capital cost), in full."""
         return "" if v is None or pd.isna(v) else money(v, cur)
+
+    def money_est(v):
+        """A computed, uncertain amount (means, intervals, expected losses): 3 significant figures."""
+        return "" if v is None or pd.isna(v) else money(v, cur, sig=3)
 
     # Summary
     verdicts = en.fence_verdicts()
@@ -165,8 +296,8 @@ def render_report(a, figs: Path) -> str:
                    f"10<sup>-4</sup>); societal risk {_e(fn_zone(a.study.fn_curve(best)))} against the Hong Kong "
                    "GEO F-N lines.</li>")
     summary.append(f"<li>Lowest expected total cost: <b>{_e(best)}</b> "
-                   f"({money_cur(ranking['expected_total_cost'].iloc[0])}), then {_e(second)} "
-                   f"({money_cur(ranking['expected_total_cost'].iloc[1])}).</li></ul></div>")
+                   f"({money_est(ranking['expected_total_cost'].iloc[0])}), then {_e(second)} "
+                   f"({money_est(ranking['expected_total_cost'].iloc[1])}).</li></ul></div>")
     header += "".join(summary)
 
     # 1. Site and data
@@ -344,15 +475,15 @@ def render_report(a, figs: Path) -> str:
     unc = a.decision["uncertainty"]
     costs = pd.DataFrame({
         "rank": ranking["rank"], "option": ranking["option"],
-        "expected total cost": ranking["expected_total_cost"].map(money_cur),
-        "5 % - 95 %": [f"{money_cur(x)} - {money_cur(y)}" for x, y in zip(ranking["cost_p05"], ranking["cost_p95"])],
+        "expected total cost": ranking["expected_total_cost"].map(money_est),
+        "5 % - 95 %": [f"{money_est(x)} - {money_est(y)}" for x, y in zip(ranking["cost_p05"], ranking["cost_p95"])],
         "probability cheapest": ranking["probability_best"].map(lambda v: f"{v:.0%}"),
-        "expected regret": ranking["expected_regret"].map(money_cur),
-        "cost at central values": ranking["cost_at_central_values"].map(money_cur),
+        "expected regret": ranking["expected_regret"].map(money_est),
+        "cost at central values": ranking["cost_at_central_values"].map(money_est),
         "capital (central)": ranking["capital"].map(money_cur),
-        "renewals (PV, central)": ranking["pv_renewals"].map(money_cur),
-        "maintenance, repairs, replacements (PV, central)": ranking["pv_maintenance"].map(money_cur),
-        "expected losses (PV, central)": ranking["pv_expected_loss"].map(money_cur),
+        "renewals (PV, central)": ranking["pv_renewals"].map(money_est),
+        "maintenance, repairs, replacements (PV, central)": ranking["pv_maintenance"].map(money_est),
+        "expected losses (PV, central)": ranking["pv_expected_loss"].map(money_est),
         "meets criteria": ranking["meets_criteria"].map(lambda v: "yes" if v else "no"),
         "meets them in (share of samples)": ranking["probability_meets_criteria"].map(lambda v: f"{v:.0%}")})
     opts = a.decision["options_table"].copy()
@@ -381,13 +512,13 @@ def render_report(a, figs: Path) -> str:
             "<h3>Uncertain inputs</h3>",
             doc.table(pd.DataFrame([{"input": k, "low": v["low"], "high": v["high"], "law": v["law"]}
                                     for k, v in unc["inputs"].items()]), "Uncertain inputs sampled jointly"),
-            "<p>Low and high: the ends of a stated range, or the 5th and 95th percentiles of a sampling law.</p>",
+            "<p>Low and high: the ends of a stated range, or the 5th and 95th percentiles of the law it is drawn from.</p>",
             f"<p>Not sampled: {_e('; '.join(unc['not_sampled']))}.</p>",
             doc.figure(figs / "tree.png", "Decision tree at central values; the optimal path in red"),
             "<h3>Break-even: input values at which the two cheapest options at central values tie</h3>",
             f"<p>The break-even values, the tornado and the value of information below are computed at the central "
             f"values of the inputs, where <b>{_e(central_best['option'])}</b> costs least "
-            f"({money_cur(central_best['cost_at_central_values'])})"
+            f"({money_est(central_best['cost_at_central_values'])})"
             + ("" if central_best["meets_criteria"] else
                f"; it does not meet the tolerability criteria (F-N zone {_e(central_best['fn_zone'])}, "
                f"F(N&ge;1) = {probability(central_best['F_N1_per_year'])}/yr; individual risk "
@@ -407,8 +538,8 @@ def render_report(a, figs: Path) -> str:
             "double the estimate, with probabilities 1/4, 1/2, 1/4; at central values, costs only"
             + (f": the cheapest option is {_e(', '.join(f'{v} at {k}' for k, v in voi['best_by_rate'].items()))}"
                if voi.get("best_by_rate") else "") + "): "
-            f"<b>{money_cur(voi['evpi'])}</b>; about all "
-            f"sampled inputs at once: <b>{money_cur(voi['evpi_all_sampled_inputs'])}</b> &mdash; the most that "
+            f"<b>{money_est(voi['evpi'])}</b>; about all "
+            f"sampled inputs at once: <b>{money_est(voi['evpi_all_sampled_inputs'])}</b> &mdash; the most that "
             "investigations settling them are worth.</p>")
 
     # 9. Assumptions

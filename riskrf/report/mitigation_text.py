@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .format import money  # noqa: F401  (money for a manager: "1,250,000 CHF")
+from .format import money, probability   # money for a manager: "1,250,000 CHF"; 3 figures when uncertain
 
 
 def option_entries(study, ranking: pd.DataFrame) -> list:
@@ -47,15 +47,15 @@ def study_report(study) -> dict:
     ranges = study.parameter_ranges()
     show = pd.DataFrame({
         "rank": ranking["rank"], "option": ranking["option"],
-        f"expected total cost [{cur}]": ranking["expected_total_cost"].map(lambda v: f"{v:,.0f}"),
-        "5-95 %": [f"{a:,.0f}-{b:,.0f}" for a, b in zip(ranking["cost_p05"], ranking["cost_p95"])],
+        f"expected total cost [{cur}]": ranking["expected_total_cost"].map(lambda v: money(v, sig=3)),
+        "5-95 %": [f"{money(a, sig=3)}-{money(b, sig=3)}" for a, b in zip(ranking["cost_p05"], ranking["cost_p95"])],
         "P(cheapest)": ranking["probability_best"].map(lambda v: f"{v:.1%}"),
         "capital": ranking["capital"].map(lambda v: f"{v:,.0f}"),
-        "PV renewals": ranking["pv_renewals"].map(lambda v: f"{v:,.0f}"),
+        "PV renewals": ranking["pv_renewals"].map(lambda v: money(v, sig=3)),
         "road falls/yr": ranking["road_falls_per_year"].map(lambda v: f"{v:.3g}"),
         "retention": ranking["retention"].map(lambda v: "" if v is None or pd.isna(v) else f"{v:.1%}"),
-        "deaths/yr": ranking["deaths_per_year"].map(lambda v: f"{v:.2e}"),
-        "indiv. risk/yr": ranking["individual_risk"].map(lambda v: f"{v:.2e}"),
+        "deaths/yr": ranking["deaths_per_year"].map(probability),
+        "indiv. risk/yr": ranking["individual_risk"].map(probability),
         "F-N zone": ranking["fn_zone"]})
     lines = [f"Mitigation ranking by expected total cost ({cur}, present values over "
              f"{study.economics.horizon_years:g} years at {study.economics.discount_rate:.1%}; mean and 5-95 % over "
@@ -80,13 +80,14 @@ def study_report(study) -> dict:
     if n_none:
         lines.append(f"  ({n_none} inputs cannot make them tie within the searched range)")
     lines += ["", f"Value of perfect information: about the fall rate (x0.5 / x1 / x2 with probabilities 1/4, 1/2, "
-                  f"1/4) {voi['evpi']:,.0f} {cur}; about all sampled inputs {voi['evpi_all_sampled_inputs']:,.0f} "
-                  f"{cur}."]
+                  f"1/4) {money(voi['evpi'], cur, sig=3)}; about all sampled inputs "
+                  f"{money(voi['evpi_all_sampled_inputs'], cur, sig=3)}."]
     lines += ["", "Tornado (lowest expected total cost at central values as each input moves over its range; "
                   "inputs that change the best option first):"]
     for r in tornado.itertuples():
-        lines.append(f"  {r.parameter:<38} {r.low:>12,.4g} .. {r.high:<12,.4g} cost {r.cost_at_low:>14,.0f} .. "
-                     f"{r.cost_at_high:>14,.0f}   best: {r.best_at_low} / {r.best_at_high}"
+        lines.append(f"  {r.parameter:<38} {r.low:>12,.4g} .. {r.high:<12,.4g} "
+                     f"cost {money(r.cost_at_low, sig=3):>14} .. "
+                     f"{money(r.cost_at_high, sig=3):>14}   best: {r.best_at_low} / {r.best_at_high}"
                      + ("  CHANGES THE BEST" if r.changes_best else "  changes the order" if r.changes_order
                         else ""))
     if study.defaults_used:

@@ -36,6 +36,7 @@ REPO = HERE.parents[2]
 sys.path.insert(0, str(REPO))
 
 from simulation.profile_extraction import profile_from_points, read_stl  # noqa: E402
+from simulation.units import DEFAULT_DENSITY_KG_M3  # noqa: E402
 
 #: Substrate zones of the source (SOURCE_README "Digital Terrain Model") -> scenario material names.
 ZONES = {"Blue": "vegetated_slope", "Gray": "hard_ground", "Red": "rocky_slope"}
@@ -129,7 +130,7 @@ def build(raw: Path, out_dir: Path = HERE, data_dir: Path = REPO / "tests" / "da
         lines += ["[seeder]", 'type = "point"', "x = 0.0", f"height_m = {drop_h:.3f}",
                   f"mass_kg = {{ dist = \"lognormal\", median = {float(np.exp(ln.mean())):.1f}, "
                   f"sigma = {float(ln.std(ddof=1)):.4f}, max = {float(masses.max()):.1f} }}",
-                  "density_kg_m3 = 2650.0", "", "[settings]", "envelope_bins = 0", ""]
+                  f"density_kg_m3 = {DEFAULT_DENSITY_KG_M3!r}", "", "[settings]", "envelope_bins = 0", ""]
         (out_dir / f"authume_{lo_name}.toml").write_text("\n".join(lines))
     data_dir.mkdir(parents=True, exist_ok=True)
     df = pd.DataFrame(rows)

@@ -1,0 +1,45 @@
+"""Every public function, class and method of riskrf and simulation has a docstring (issue 15).
+
+Public: module-level functions and classes, and methods of public classes, whose names do not start
+with an underscore, in modules whose path has no part starting with an underscore (``__init__``
+aside).  Dunder methods, properties' setters and test/script files under ``scenarios`` are exempt.
+"""
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("riskrf", "simulation")
+
+
+def _public_definitions_without_docstring():
+    missing = []
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            rel = path.relative_to(ROOT)
+            if any(p.startswith("_") and p != "__init__.py" for p in rel.parts) or "scenarios" in rel.parts:
+                continue
+            tree = ast.parse(path.read_text(encoding="utf-8"))
+            for node in tree.body:
+                if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                    continue
+                if node.name.startswith("_"):
+                    continue
+                if ast.get_docstring(node) is None:
+                    missing.append(f"{rel}:{node.lineno} {node.name}")
+                if isinstance(node, ast.ClassDef):
+                    for sub in node.body:
+                        if (isinstance(sub, (ast.FunctionDef, ast.AsyncFunctionDef)) and not sub.name.startswith("_")
+                                and ast.get_docstring(sub) is None
+                                and not any(isinstance(d, ast.Attribute) and d.attr in ("setter", "deleter")
+                                            for d in sub.decorator_list)):
+                            missing.append(f"{rel}:{sub.lineno} {node.name}.{sub.name}")
+    return missing
+
+
+def test_every_public_definition_has_a_docstring():
+    missing = _public_definitions_without_docstring()
+    assert not missing, f"{len(missing)} public definitions lack a docstring:\n" + "\n".join(missing)
+
+
+if __name__ == "__main__":
+    print("\n".join(_public_definitions_without_docstring()))
