@@ -163,10 +163,15 @@ def share_with_at_least(vulnerabilities, occupants_k, occupants_p, max_n: int | 
     Exact binomial sums, vectorised over any array of vulnerabilities: the pmf of Binomial(k, v) is built up one
     occupant at a time (pmf_k(i) = pmf_(k-1)(i) (1 - v) + pmf_(k-1)(i - 1) v), so no power is evaluated.
     """
-    v = np.asarray(vulnerabilities, dtype=float)[..., None]
+    v_all = np.asarray(vulnerabilities, dtype=float)
     k_all = np.asarray(occupants_k, dtype=int)
     p_all = np.asarray(occupants_p, dtype=float)
     max_n = int(k_all.max()) if max_n is None else int(max_n)
+    if v_all.size > 64:               # vulnerabilities repeat (a curve by mass class x a factor): each value once
+        u, inverse = np.unique(v_all, return_inverse=True)
+        if u.size < v_all.size // 2:
+            return share_with_at_least(u, k_all, p_all, max_n)[inverse.ravel()].reshape(v_all.shape + (max_n,))
+    v = v_all[..., None]
     weight = dict(zip(k_all.tolist(), p_all.tolist()))
     out = np.zeros(v.shape[:-1] + (max_n,))
     pmf = np.ones(v.shape)                                            # Binomial(0, v): N = 0

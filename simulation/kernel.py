@@ -236,7 +236,8 @@ def _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_co
         r_count[1] += 1
 
 
-@njit(cache=True)
+# inlined: its call sites pass literal mode and event codes, and numba would compile one version per literal
+@njit(cache=True, inline="always")
 def _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, block, t, x, z, vx, vz, w, mode, event):
     """Append one event of a recorded block: state after the event, the mode that follows and the event code."""
     i = pcount[0]
@@ -311,37 +312,46 @@ def _record_barrier_event(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bl
                  MODE_STOP if caught else moving_mode, EV_CAUGHT if caught else EV_BARRIER)
 
 
+@njit(cache=True, inline="always")
+def _envelope_add(env_acc, i, v, h, e):
+    """Add one passage at bin i: count, max/sum of speed [m/s], height [m] and energy [kJ]."""
+    env_acc[i, 0] += 1.0
+    env_acc[i, 1] = max(env_acc[i, 1], v)
+    env_acc[i, 2] = max(env_acc[i, 2], h)
+    env_acc[i, 3] = max(env_acc[i, 3], e)
+    env_acc[i, 4] += v
+    env_acc[i, 5] += h
+    env_acc[i, 6] += e
+
+
 @njit(cache=True)
-def _envelope(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass, inertia, r, contact_speed0, contact_a,
-              contact_dir, cosb, contact, roll):
-    """Update per-bin passage count, max/sum of speed, height and energy for bins between xa and xb."""
-    lo, hi = (xa, xb) if xa <= xb else (xb, xa)
-    i0 = np.searchsorted(env_x, lo)
-    i1 = np.searchsorted(env_x, hi)
+def _envelope_flight(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass, inertia):
+    """Envelope bins between xa and xb crossed in flight (parabola from x0, z0 with vx, vz; spin w constant)."""
+    i0 = np.searchsorted(env_x, min(xa, xb))
+    i1 = np.searchsorted(env_x, max(xa, xb))
     for i in range(i0, i1):
         xc = env_x[i]
-        if contact:
-            s = contact_dir * (xc - x0) / cosb
-            if abs(contact_a) < 1e-12:
-                sp = contact_speed0
-            else:
-                sp = math.sqrt(max(contact_speed0 * contact_speed0 + 2.0 * contact_a * s, 0.0))
-            v, h = sp, 0.0
-            wc = sp / r if roll else 0.0
+        t = (xc - x0) / vx
+        vzz = vz - g * t
+        v = math.sqrt(vx * vx + vzz * vzz)
+        _envelope_add(env_acc, i, v, z0 + vz * t - 0.5 * g * t * t - _ground(px, pz, xc),
+                      _kinetic_kj(mass, v * v, inertia, w))
+
+
+@njit(cache=True)
+def _envelope_contact(env_x, env_acc, xa, xb, x0, mass, inertia, r, contact_speed0, contact_a, contact_dir, cosb,
+                      roll):
+    """Envelope bins between xa and xb crossed in ground contact (constant acceleration contact_a along the
+    slope from speed contact_speed0 at x0; spin v/r when rolling, none when sliding; height 0)."""
+    i0 = np.searchsorted(env_x, min(xa, xb))
+    i1 = np.searchsorted(env_x, max(xa, xb))
+    for i in range(i0, i1):
+        s = contact_dir * (env_x[i] - x0) / cosb
+        if abs(contact_a) < 1e-12:
+            sp = contact_speed0
         else:
-            t = (xc - x0) / vx
-            vzz = vz - g * t
-            v = math.sqrt(vx * vx + vzz * vzz)
-            h = z0 + vz * t - 0.5 * g * t * t - _ground(px, pz, xc)
-            wc = w
-        e = _kinetic_kj(mass, v * v, inertia, wc)
-        env_acc[i, 0] += 1.0
-        env_acc[i, 1] = max(env_acc[i, 1], v)
-        env_acc[i, 2] = max(env_acc[i, 2], h)
-        env_acc[i, 3] = max(env_acc[i, 3], e)
-        env_acc[i, 4] += v
-        env_acc[i, 5] += h
-        env_acc[i, 6] += e
+            sp = math.sqrt(max(contact_speed0 * contact_speed0 + 2.0 * contact_a * s, 0.0))
+        _envelope_add(env_acc, i, sp, 0.0, _kinetic_kj(mass, sp * sp, inertia, sp / r if roll else 0.0))
 
 
 @njit(cache=True, nogil=True)
@@ -430,8 +440,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                                                     inertia, r, c_cap[j], c_h[j])
                     if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
                         if env_x.shape[0] > 0:
-                            _envelope(env_x, env_acc, x, c_x[j], x, z, vx, vz, w, g, px, pz, mass, inertia, r,
-                                      0.0, 0.0, 1.0, 1.0, False, False)
+                            _envelope_flight(env_x, env_acc, x, c_x[j], x, z, vx, vz, w, g, px, pz, mass, inertia)
                         t_abs += tc
                         x, z = c_x[j], zc
                         seg = _seg_of(px, x)
@@ -448,8 +457,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 if cut:
                     continue
                 if env_x.shape[0] > 0:
-                    _envelope(env_x, env_acc, x, x_end, x, z, vx, vz, w, g, px, pz, mass, inertia, r,
-                              0.0, 0.0, 1.0, 1.0, False, False)
+                    _envelope_flight(env_x, env_acc, x, x_end, x, z, vx, vz, w, g, px, pz, mass, inertia)
                 z_end = z + vz * t_hit - 0.5 * g * t_hit * t_hit
                 vz_end = vz - g * t_hit
                 t_abs += t_hit
@@ -586,8 +594,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                                                 c_cap[j], c_h[j])
                 if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
                     if env_x.shape[0] > 0:
-                        _envelope(env_x, env_acc, x, c_x[j], x, z, 0.0, 0.0, 0.0, g, px, pz, mass, inertia, r, u,
-                                  a_dir, direction, cosb, True, roll)
+                        _envelope_contact(env_x, env_acc, x, c_x[j], x, mass, inertia, r, u, a_dir, direction,
+                                          cosb, roll)
                     t_abs += tc
                     x = c_x[j]
                     z = _ground(px, pz, x)
@@ -605,8 +613,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             if cut:
                 continue
             if env_x.shape[0] > 0:
-                _envelope(env_x, env_acc, x, x_new, x, z, 0.0, 0.0, 0.0, g, px, pz, mass, inertia, r, u, a_dir,
-                          direction, cosb, True, roll)
+                _envelope_contact(env_x, env_acc, x, x_new, x, mass, inertia, r, u, a_dir, direction, cosb, roll)
             t_abs += t_step
             x = x_new
             z = pz[k] + (pz[k + 1] - pz[k]) * (x - px[k]) / (px[k + 1] - px[k])

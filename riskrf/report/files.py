@@ -57,7 +57,8 @@ def save_figure(fig, path, *, tight_layout: bool = False) -> Path:
     _plain_log_labels(fig)
     if tight_layout:
         fig.tight_layout()
-    fig.savefig(path, dpi=FIGURE_DPI, bbox_inches="tight")
+    # PNG with zlib level 3: about 40 % less encoding time than the default 6, files 5-20 % larger
+    fig.savefig(path, dpi=FIGURE_DPI, bbox_inches="tight", pil_kwargs={"compress_level": 3})
     plt.close(fig)
     return Path(path)
 
