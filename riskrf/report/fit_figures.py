@@ -102,7 +102,7 @@ def plot_return_levels(fits, ax=None, *, power_law=None, maxima=None, formula: s
         T = np.geomspace(1.05 / (1 - fit.p_zero), T_max, 120)
         ax.semilogx(T, fit.return_level(T), "-", color=f"C{i}", lw=2, label=label)
         how = ci_method or fit.default_ci_method
-        Tb = np.geomspace(T[0], T_max, 30)         # the profile interval costs ~10-20 ms per return period
+        Tb = np.geomspace(T[0], T_max, 16)         # the profile interval costs ~10-20 ms per return period
         try:
             lo, hi = fit.return_level_ci(Tb, level=level, method=how)
         except ValueError:
