@@ -1153,7 +1153,8 @@ class MitigationStudy:
 
     # ---- decision tree -------------------------------------------------------------------------
     def to_tree(self):
-        """The decision tree of this study at central values (costs in present value), from the same engine.
+        """The decision tree of this study at central values (costs in present value), from the same engine; its
+        root says so (the ranking's expected total costs are means over the joint samples and may rank otherwise).
 
         Under each option a chance node gives the outcome of one fall reaching the road;
         branch costs are that outcome's mean cost (over the sizes reaching the road) times
@@ -1187,8 +1188,9 @@ class MitigationStudy:
                                                              + r["pv_maintenance"][0, k]),
                              "child": {"type": "chance", "name": "each fall reaching the road",
                                        "branches": outcomes}})
-        return DecisionTree.from_dict({"type": "decision", "name": "mitigation", "objective": "min",
-                                       "branches": branches}, source=self.source)
+        return DecisionTree.from_dict({"type": "decision", "objective": "min", "branches": branches,
+                                       "name": "mitigation at central values of the uncertain inputs"},
+                                      source=self.source)
 
     def options_table(self) -> pd.DataFrame:
         """What each option is and assumes, and its effect as used."""

@@ -65,6 +65,7 @@ def plot_collector_distributions(result, name: str, axes=None):
     df = result.collector(name, first_only=True)
     if axes is None:
         fig, axes = plt.subplots(2, 3, figsize=(12, 6.5))
+        fig.subplots_adjust(wspace=0.3, hspace=0.38)     # room for the labels without a layout pass
     cols = (("velocity_ms", "speed [m/s]"), ("height_m", "height above slope [m]"), ("energy_kj", "energy [kJ]"))
     for j, (col, label) in enumerate(cols):
         x = np.sort(df[col].to_numpy())
@@ -97,7 +98,8 @@ def plot_collector_distributions(result, name: str, axes=None):
         for q in (95, 99):
             v = np.percentile(x, q)
             bottom.axvline(v, color="C3", ls=":", lw=1)
-            bottom.annotate(f"p{q} {v:.3g}", (v, 0.5), rotation=90, fontsize="x-small", va="center")
+            bottom.annotate(f"p{q} {v:,.0f}" if abs(v) >= 100 else f"p{q} {v:.3g}", (v, 0.5), rotation=90,
+                            fontsize="x-small", va="center")
         bottom.set_xlabel(label)
         bottom.set_ylabel("P(exceeded | reaches)")
         bottom.grid(True, which="both", alpha=0.3)

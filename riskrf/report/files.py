@@ -135,8 +135,7 @@ def write_simulation_figures(result, out: Path, collectors, *, file_names=None, 
     written = [save_figure(plot_profile(result, fences=fences).figure, out / "profile_trajectories.png")]
     for name in collectors:
         axes = plot_collector_distributions(result, name)
-        written.append(save_figure(axes[0][0].figure, out / file_names.get(name, f"collector_{name}.png"),
-                                   tight_layout=True))
+        written.append(save_figure(axes[0][0].figure, out / file_names.get(name, f"collector_{name}.png")))
     if result.scenario.settings.envelope_bins:
         axes = plot_envelopes(result)
         written.append(save_figure(axes[0].figure, out / "envelopes.png"))
