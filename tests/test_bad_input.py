@@ -503,9 +503,9 @@ SITE_REFUSALS = [
 ]
 
 
-@pytest.mark.parametrize("case,fields,match", SITE_REFUSALS, ids=[c[0] for c in SITE_REFUSALS])
-def test_assess_refuses_impossible_site_values_before_work(inputs, tmp_path, capsys, no_work, case, fields, match):
-    site = site_file(inputs, **fields)
+def _assess_is_refused(site, inputs, tmp_path, capsys, match):
+    """``riskrf assess site`` exits 2 with a one-line error naming site.toml and matching ``match``, before any
+    work: no output folder, inputs untouched."""
     before = snapshot(inputs)
     rc = main(["assess", str(site), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
@@ -513,6 +513,12 @@ def test_assess_refuses_impossible_site_values_before_work(inputs, tmp_path, cap
     assert "site.toml" in err and __import__("re").search(match, err), err
     assert not (tmp_path / "o").exists()
     assert snapshot(inputs) == before
+
+
+@pytest.mark.parametrize("case,fields,match", SITE_REFUSALS, ids=[c[0] for c in SITE_REFUSALS])
+def test_assess_refuses_impossible_site_values_before_work(inputs, tmp_path, capsys, no_work, case, fields, match):
+    site = site_file(inputs, **fields)
+    _assess_is_refused(site, inputs, tmp_path, capsys, match)
 
 
 BARRIER_REFUSALS = [   # (option index in the demo site, field, value): the demo's options[3] is a 2,000 kJ fence
@@ -532,13 +538,7 @@ def test_assess_refuses_a_barrier_of_zero_height_or_capacity_before_work(inputs,
     assert data["options"][i]["kind"] in ("fence", "shed") and key in data["options"][i]
     data["options"][i][key] = value
     site.write_text(_toml(data))
-    before = snapshot(inputs)
-    rc = main(["assess", str(site), "--out", str(tmp_path / "o")])
-    err = capsys.readouterr().err
-    assert rc == 2, err
-    assert "site.toml" in err and __import__("re").search(match, err), err
-    assert not (tmp_path / "o").exists()
-    assert snapshot(inputs) == before
+    _assess_is_refused(site, inputs, tmp_path, capsys, match)
 
 
 def test_attenuator_of_zero_height_is_refused_by_the_option_parser():

@@ -362,17 +362,21 @@ def test_fragmentation_design_block(demo_hazard, lauterbrunnen):
         design_block(demo_hazard, rule="fragmentation", inventory=inv, fractal_dimension=3.5, iterations=3)
 
 
+def _random_blocks(seed, n, n_classes, *, shape, lost):
+    """(rng, masses log-uniform over 10-1e5 kg, gamma speeds with a share ``lost`` not arriving, class edges)."""
+    g = np.random.default_rng(seed)
+    m = np.exp(g.uniform(np.log(10.0), np.log(1e5), n))
+    s = g.gamma(shape, 3.0, n)
+    s[g.uniform(size=n) < lost] = np.nan
+    return g, m, s, np.geomspace(10.0, 1e5, n_classes + 1)
+
+
 def test_bootstrap_replicate_as_multiplicities_equals_the_resampled_blocks():
     """resampled_joint_exceedance counts each class's blocks drawn with replacement as multiplicities of the
     simulated blocks; it must give the joint exceedance of the explicitly resampled blocks (each class's members
     drawn with rng.choice, the replicate before the change) for the same random stream, ties and a class with
     no arrival included."""
-    g = np.random.default_rng(1)
-    n = 400
-    m = np.exp(g.uniform(np.log(10.0), np.log(1e5), n))
-    edges = np.geomspace(10.0, 1e5, 6)
-    s = g.gamma(5.0, 3.0, n)
-    s[g.uniform(size=n) < 0.3] = np.nan
+    g, m, s, edges = _random_blocks(1, 400, 5, shape=5.0, lost=0.3)
     s[5:40] = 10.0                                                    # ties
     k = np.clip(np.searchsorted(edges, m, side="right") - 1, 0, 4)
     s[k == 2] = np.nan                                                # a class where nothing arrives
@@ -394,12 +398,7 @@ def test_joint_exceedance_equals_direct_count_including_class_energy_bounds():
     """joint_exceedance skips the speed search outside each class's kinetic-energy range; it must equal the direct
     count sum_j w_j #(speeds > sqrt(2 e / m_j)) / n_c at every energy, including energies exactly at a class's
     smallest and largest kinetic energy (where the skipped ranges begin)."""
-    g = np.random.default_rng(7)
-    n = 600
-    m = np.exp(g.uniform(np.log(10.0), np.log(1e5), n))
-    edges = np.geomspace(10.0, 1e5, 5)
-    s = g.gamma(4.0, 3.0, n)
-    s[g.uniform(size=n) < 0.4] = np.nan
+    _, m, s, edges = _random_blocks(7, 600, 4, shape=4.0, lost=0.4)
     samples = MassCoupledSamples(m, s, np.where(np.isfinite(s), 1.0, np.nan), edges)
     mm = mass_model(stats.lognorm(1.2, scale=500.0))
     groups = samples._groups(mm)[0]
