@@ -146,8 +146,8 @@ class MassCoupledSamples:
         edges = lo_p[cls, None] + (hi_p - lo_p)[cls, None] * frac[None, :]
         half = 0.5 * np.diff(edges, axis=1)
         mid = 0.5 * (edges[:, :-1] + edges[:, 1:])
-        p = (mid[:, :, None] + half[:, :, None] * _GL_NODES[None, None, :]).reshape(cls.size, -1)
-        w_all = [(half[:, :, None] * _GL_WEIGHTS[None, None, :]).reshape(cls.size, -1).ravel()]
+        p = (mid[:, :, None] + half[:, :, None] * _GL_NODES[None, None, :]).reshape(cls.size, 4 * _GL_NODES.size)
+        w_all = [(half[:, :, None] * _GL_WEIGHTS[None, None, :]).ravel()]
         p_all = [p.ravel()]
         c_all = [np.repeat(cls, p.shape[1])]
         if P[-1] > 0:                  # mass above the simulated range (an untruncated law): the top class
