@@ -570,8 +570,6 @@ class MitigationStudy:
         p = {"rate_factor": 1.0, "value_of_statistical_life": co.value_of_statistical_life,
              "vulnerability_factor": 1.0, "vehicles_per_day": ex.vehicles_per_day,
              "discount_rate": ec.discount_rate}
-        if self.uncertainty.fractal_dimension:
-            p["fractal_dimension"] = float(np.mean(self.uncertainty.fractal_dimension))
         if isinstance(hz.mass, GutenbergRichterFit):
             p["b"] = float(hz.mass.b)
             p["rate_sampling_factor"] = 1.0
@@ -620,9 +618,6 @@ class MitigationStudy:
                 out[name] = (*getattr(u, name), "uniform, stated")
         if u.vulnerability_factor != (1.0, 1.0):
             out["vulnerability_factor"] = (*u.vulnerability_factor, "uniform, stated")
-        if u.fractal_dimension and u.fractal_dimension[0] < u.fractal_dimension[1]:
-            out["fractal_dimension"] = (*u.fractal_dimension, "uniform, stated (fractal fragmentation of each "
-                                        f"event volume, {u.fragmentation_iterations} generations)")
         for o in self.options:
             for fld, rng_name in (("capital_cost", "capital_cost_range"), ("annual_maintenance",
                                                                             "annual_maintenance_range"),
@@ -672,24 +667,6 @@ class MitigationStudy:
         return out
 
     # ---- the loss engine ---------------------------------------------------------------------
-    def _fragment_matrix(self, fractal_dimension) -> np.ndarray:
-        """(S, J, J): expected fragments in mass bin k of one event in mass bin j, by fractal fragmentation
-        (Perfect 1997, :func:`riskrf.design_block.fractal_fragments`) of the bin's middle mass for each sampled
-        D; fragments lighter than the grid count in its lowest bin (conservative).  The fragments' masses add
-        up to the event's."""
-        from .design_block import fractal_fragments
-        edges, mid, _ = self._grid
-        n_gen = self.uncertainty.fragmentation_iterations
-        D = np.atleast_1d(np.asarray(fractal_dimension, dtype=float))
-        share = fractal_fragments(1.0, 2.5, n_gen)["volume_m3"].to_numpy()     # fragment / event volume (any D)
-        counts = np.array([fractal_fragments(1.0, float(d), n_gen)["count"].to_numpy() for d in D])   # (S, G)
-        k = np.clip(np.searchsorted(edges, mid[:, None] * share[None, :], side="right") - 1, 0, mid.size - 1)
-        out = np.zeros((D.size, mid.size, mid.size))
-        rows = np.arange(mid.size)
-        for g in range(share.size):                   # one generation at a time: (row, bin) pairs are distinct
-            out[:, rows, k[:, g]] += counts[:, g][:, None]
-        return out
-
     def _evaluate(self, P: dict, *, per_bin: bool = False) -> dict:
         """The one loss engine: every option for parameter arrays ``P`` (length S); arrays (S, K)."""
         effects = self._effects
@@ -702,8 +679,6 @@ class MitigationStudy:
         rate = hz.rate_per_year * P["rate_factor"] * P.get("rate_sampling_factor", 1.0)
         pmf = self._mass_pmf(P.get("b"), P.get("m_max_kg")) if "b" in P else self._mass_pmf()
         lam = rate[:, None] * pmf + (self.small_falls_per_year * P["rate_factor"])[:, None] * small_pmf[None, :]
-        if "fractal_dimension" in P:                    # events break up: their fragments are the blocks that travel
-            lam = np.einsum("sj,sjk->sk", lam, self._fragment_matrix(P["fractal_dimension"]))
         arrivals = lam * reach_m[d][:, None]                                       # (S, J) at the barrier line
         if self._by_mass is not None:                   # mass-coupled: heavier blocks reach the line more often
             arrivals = arrivals * self._by_mass[2][None, :]

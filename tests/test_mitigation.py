@@ -32,9 +32,8 @@ CONSTANT_V = Consequences(vulnerability_moving_vehicle=0.5, vulnerability_striki
 
 def study(options=OPTIONS, **kw):
     kw.setdefault("consequences", CONSTANT_V)
-    kw.setdefault("uncertainty", Uncertainty(samples=200))
     return MitigationStudy(hazard=HAZ, options=options, exposure=Exposure(vehicles_per_day=5000),
-                           economics=Economics(0.03, 50), **kw)
+                           economics=Economics(0.03, 50), uncertainty=Uncertainty(samples=200), **kw)
 
 
 def test_expected_annual_loss_by_hand_with_strikes_in_individual_risk():
@@ -575,34 +574,3 @@ def test_simulations_on_threads_equal_one_by_one_runs():
             np.testing.assert_array_equal(a.crossings[name], b.crossings[name])
         for name in a.per_block:
             np.testing.assert_array_equal(a.per_block[name], b.per_block[name])
-
-
-def test_fragmentation_breaks_event_volumes_into_the_blocks_that_travel():
-    """uncertainty.fractal_dimension: each event volume breaks into the expected fragments of fractal fragmentation
-    (Perfect 1997).  Here reach and vulnerability do not depend on mass, so the falls reaching the road are the
-    intact case times the expected number of fragments per event, for the central D; the fragment matrix keeps
-    every fragment (lighter ones in the lowest bin) and more fragments come with a larger D; the sampled D is an
-    uncertain input of the ranking."""
-    from riskrf.design_block import fractal_fragments
-    intact = study()
-    frag = study(uncertainty=Uncertainty(samples=200, fractal_dimension=(2.5, 2.5), fragmentation_iterations=3))
-    n_frag = fractal_fragments(1.0, 2.5, 3)["count"].sum()
-    assert n_frag > 8
-    assert frag.evaluate("nothing").road_falls_per_year == pytest.approx(
-        intact.evaluate("nothing").road_falls_per_year * n_frag, rel=1e-9)
-    F = frag._fragment_matrix([2.2, 2.8])
-    assert np.allclose(F.sum(axis=2)[0], fractal_fragments(1.0, 2.2, 3)["count"].sum())
-    assert np.all(F.sum(axis=2)[1] > F.sum(axis=2)[0])
-    # a fragment is lighter than its event: nothing moves to a heavier bin
-    j, k = np.nonzero(F[0])
-    assert np.all(k <= j)
-    ranged = study(uncertainty=Uncertainty(samples=200, fractal_dimension=(2.2, 2.8)))
-    assert "fractal_dimension" in ranged.parameter_ranges()
-    assert ranged.ranking()["probability_best"].sum() == pytest.approx(1.0)
-
-
-@pytest.mark.parametrize("value,match", [([3.2, 3.5], "strictly between 0 and 3"), ([0, 2.5], "strictly between")])
-def test_bad_fractal_dimension_range_names_the_field(value, match):
-    with pytest.raises(MitigationError, match=rf"uncertainty\.fractal_dimension.*{match}"):
-        parse_mitigation({"options": [{"name": "nothing", "kind": "none", "capital_cost": 0}],
-                          "uncertainty": {"fractal_dimension": value}}, source="site.toml")

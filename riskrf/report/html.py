@@ -169,15 +169,10 @@ def _assumptions(a, hz, rate_scale) -> pd.DataFrame:
     if a.rates is not None and a.rates.climate and from_model:
         add("inventory.rain_factor", "stated change of climate", a.rates.climate, "typed assumption")
     # model limitations (no site-file field)
-    frag = a.study.uncertainty.fractal_dimension
     rows["limitation: volumes"] = (
-        ("event volume vs block in the loss engine", "uncertainty.fractal_dimension",
-         f"fractal fragmentation, D {frag[0]:g}-{frag[1]:g}, {a.study.uncertainty.fragmentation_iterations} "
-         "generations", "judgement (site file); clean-up and closure costs counted per block reaching the road")
-        if frag else
-        ("event volume vs block in the loss engine", "\u2014", "each event volume one intact block",
-         "model limitation: conservative for fence and shed loads; fragmentation of the design block (if stated) "
-         "is used only for the design block"))
+        "event volume vs block in the loss engine", "\u2014", "each event volume one intact block",
+        "model limitation: conservative for fence and shed loads; fragmentation (if stated) is used only for the "
+        "design block")
     rows["limitation: queues"] = (
         "queued or stopped vehicles behind a blockage", "\u2014", "not modelled",
         "model limitation: road users meet falls as moving vehicles at the impact point or by striking a rock lying "
