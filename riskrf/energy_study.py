@@ -439,7 +439,6 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
     """
     from .barriers import UNI11211_FACTORS
     from .design_block import check_percentile, design_block as _design_block, fractal_fragments
-    from .units import J_PER_KJ
     from .validation import check_return_periods
     try:
         T = float(check_return_periods(design_T, "design_T"))
