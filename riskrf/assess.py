@@ -361,7 +361,12 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             frag = fragment_block_kg(law, rate, design_T=hz_cfg["design_period_years"],
                                      fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"],
                                      percentile=db_cfg["percentile"], density_kg_m3=inventory.density_kg_m3)
-            return extra + ([frag] if frag is not None else [])
+            finest = []
+            u = site.mitigation["uncertainty"]
+            if u is not None and u.fractal_dimension:     # fragments travel: simulate down to the finest one
+                finest = [min([law.m_min] + [float(m) for m in inventory.masses if m > 0])
+                          / 8.0 ** u.fragmentation_iterations]
+            return extra + ([frag] if frag is not None else []) + finest
         t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
         if compiling is not None:
             compiling.wait()

@@ -199,6 +199,8 @@ class MitigationStudy:
         if self.small_fall_masses_kg is not None and len(self.small_fall_masses_kg):
             lo_candidates.append(float(np.min(self.small_fall_masses_kg)))
         lo = 0.999 * min(lo_candidates)
+        if self.uncertainty.fractal_dimension:     # fragments keep their own masses: down to the finest generation
+            lo /= 8.0 ** self.uncertainty.fragmentation_iterations
         if gr is not None:
             tops = [gr.m_max or gr.m_min * 1e6]
             if self.uncertainty.m_max_kg:
@@ -570,6 +572,8 @@ class MitigationStudy:
         p = {"rate_factor": 1.0, "value_of_statistical_life": co.value_of_statistical_life,
              "vulnerability_factor": 1.0, "vehicles_per_day": ex.vehicles_per_day,
              "discount_rate": ec.discount_rate}
+        if self.uncertainty.fractal_dimension:
+            p["fractal_dimension"] = float(np.mean(self.uncertainty.fractal_dimension))
         if isinstance(hz.mass, GutenbergRichterFit):
             p["b"] = float(hz.mass.b)
             p["rate_sampling_factor"] = 1.0
@@ -618,6 +622,9 @@ class MitigationStudy:
                 out[name] = (*getattr(u, name), "uniform, stated")
         if u.vulnerability_factor != (1.0, 1.0):
             out["vulnerability_factor"] = (*u.vulnerability_factor, "uniform, stated")
+        if u.fractal_dimension and u.fractal_dimension[0] < u.fractal_dimension[1]:
+            out["fractal_dimension"] = (*u.fractal_dimension, "uniform, stated (fractal fragmentation of each "
+                                        f"event volume, {u.fragmentation_iterations} generations)")
         for o in self.options:
             for fld, rng_name in (("capital_cost", "capital_cost_range"), ("annual_maintenance",
                                                                             "annual_maintenance_range"),
@@ -667,6 +674,47 @@ class MitigationStudy:
         return out
 
     # ---- the loss engine ---------------------------------------------------------------------
+    def _fragment_matrix(self, fractal_dimension) -> np.ndarray:
+        """(S, J, J): expected fragments in mass bin k of one event in mass bin j, by fractal fragmentation
+        (Perfect 1997, :func:`riskrf.design_block.fractal_fragments`) of the bin's middle mass for each sampled
+        D.  With fragmentation the mass grid reaches down to the finest generation of its lightest event, so
+        every fragment keeps its own mass (fragments' masses add up to the event's, within the bins' widths)."""
+        from .design_block import fractal_fragments
+        edges, mid, _ = self._grid
+        n_gen = self.uncertainty.fragmentation_iterations
+        D = np.atleast_1d(np.asarray(fractal_dimension, dtype=float))
+        share = fractal_fragments(1.0, 2.5, n_gen)["volume_m3"].to_numpy()     # fragment / event volume (any D)
+        counts = np.array([fractal_fragments(1.0, float(d), n_gen)["count"].to_numpy() for d in D])   # (S, G)
+        k = np.clip(np.searchsorted(edges, mid[:, None] * share[None, :], side="right") - 1, 0, mid.size - 1)
+        out = np.zeros((D.size, mid.size, mid.size))
+        rows = np.arange(mid.size)
+        for g in range(share.size):                   # one generation at a time: (row, bin) pairs are distinct
+            out[:, rows, k[:, g]] += counts[:, g][:, None]
+        return out
+
+    @staticmethod
+    def _events_at_road(frag, x, v_d, v_s):
+        """Fragments reaching the road -> the events they came from: (events per year by event mass bin,
+        vulnerability given the event meets a vehicle, moving and striking), each (S, J).
+
+        ``frag`` = (events per year by mass bin, fragment matrix F (S, J, J), fragments per year by mass bin).  A
+        share tau_k = x_k / fragments_k of bin k's fragments reaches the road under the option; an event's
+        reaching fragments are taken as Poisson, so the event reaches the road with probability
+        1 - exp(-sum_k F_jk tau_k).  A vehicle meets an event's debris once (the exposure is per event, as for an
+        intact block); it is fatal unless every reaching fragment spares it: 1 - exp(-sum_k F_jk tau_k v_k),
+        given the event reaches the road, divided by that probability.  Without a break-up (F the identity) this
+        returns the falls and vulnerabilities unchanged."""
+        lam_events, F, blocks = frag
+        with np.errstate(invalid="ignore", divide="ignore"):
+            tau = np.where(blocks > 0, np.clip(x / blocks, 0.0, 1.0), 0.0)
+        reach = -np.expm1(-np.einsum("sjk,sk->sj", F, tau))
+        out = []
+        for v in (v_d, v_s):
+            lethal = -np.expm1(-np.einsum("sjk,sk->sj", F, tau * v))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                out.append(np.where(reach > 0, np.clip(lethal / reach, 0.0, 1.0), 0.0))
+        return lam_events * reach, out[0], out[1]
+
     def _evaluate(self, P: dict, *, per_bin: bool = False) -> dict:
         """The one loss engine: every option for parameter arrays ``P`` (length S); arrays (S, K)."""
         effects = self._effects
@@ -679,6 +727,11 @@ class MitigationStudy:
         rate = hz.rate_per_year * P["rate_factor"] * P.get("rate_sampling_factor", 1.0)
         pmf = self._mass_pmf(P.get("b"), P.get("m_max_kg")) if "b" in P else self._mass_pmf()
         lam = rate[:, None] * pmf + (self.small_falls_per_year * P["rate_factor"])[:, None] * small_pmf[None, :]
+        frag = None
+        if "fractal_dimension" in P:                    # events break up: their fragments are the blocks that travel
+            F = self._fragment_matrix(P["fractal_dimension"])
+            frag = (lam, F, np.einsum("sj,sjk->sk", lam, F))
+            lam = frag[2]
         arrivals = lam * reach_m[d][:, None]                                       # (S, J) at the barrier line
         if self._by_mass is not None:                   # mass-coupled: heavier blocks reach the line more often
             arrivals = arrivals * self._by_mass[2][None, :]
@@ -704,6 +757,7 @@ class MitigationStudy:
                                               "repairs", "replacements", "retention", "effectiveness",
                                               "user_share")}
         road_bins = np.zeros((S, K, mid.size)) if per_bin else None
+        vd_all, vs_all = (np.zeros((S, K, mid.size)), np.zeros((S, K, mid.size))) if per_bin else (None, None)
         base_road = arrivals.sum(axis=1) * road_share
         for k, opt in enumerate(self.options):
             stages, comps = effects[opt.name]
@@ -757,20 +811,25 @@ class MitigationStudy:
                     x = x * st.factor[d][:, None]
             if not on_road:
                 x = x * road_share[:, None]
+            vd_k, vs_k = v_d, v_s
+            if frag is not None:        # from fragments reaching the road to the events they came from
+                x_blocks = x
+                x, vd_k, vs_k = self._events_at_road(frag, x, v_d, v_s)
             road = x.sum(axis=1)
             if before_structures is not None and any(s.kind in ("ditch", "barrier") for s in stages):
+                passed = road if frag is None else x_blocks.sum(axis=1)     # share of the blocks stopped
                 with np.errstate(invalid="ignore", divide="ignore"):
-                    stopped_by_structures = np.where(before_structures > 0, 1.0 - road / before_structures, 0.0)
+                    stopped_by_structures = np.where(before_structures > 0, 1.0 - passed / before_structures, 0.0)
                     if any(s.kind == "exposure" for s in stages):
                         stopped_by_structures = np.full(S, np.nan)
             else:
                 stopped_by_structures = np.full(S, np.nan)
             hits = x * (p_st * users)[:, None]
             strikes = x * (p_strike * users)[:, None]
-            deaths = occ * ((hits * v_d).sum(axis=1) + (strikes * v_s).sum(axis=1))
+            deaths = occ * ((hits * vd_k).sum(axis=1) + (strikes * vs_k).sum(axis=1))
             eal = deaths * P["value_of_statistical_life"] + (hits.sum(axis=1) + strikes.sum(axis=1)) \
                 * co.vehicle_damage + road * per_fall_cost
-            ir = (x * (p_ts * v_d + p_cs * v_s)).sum(axis=1) * users
+            ir = (x * (p_ts * vd_k + p_cs * vs_k)).sum(axis=1) * users
             pv_m = pvf * (maint + repair_money)
             pv_l = pvf * eal
             for key, val in (("capital", capital), ("pv_renewals", renew), ("pv_maintenance", pv_m),
@@ -784,10 +843,11 @@ class MitigationStudy:
             res["user_share"][:, k] = users
             if per_bin:
                 road_bins[:, k, :] = x
+                vd_all[:, k, :], vs_all[:, k, :] = vd_k, vs_k
         res["names"] = names
         if per_bin:
             res["road_bins"] = road_bins
-            res["p_st"], res["p_strike"], res["v_d"], res["v_s"] = p_st, p_strike, v_d, v_s
+            res["p_st"], res["p_strike"], res["v_d"], res["v_s"] = p_st, p_strike, vd_all, vs_all   # (S, K, J)
         return res
 
     def _central(self, overrides: dict | None = None, **kw) -> dict:
@@ -844,10 +904,10 @@ class MitigationStudy:
         kk, pk = occupancy_distribution(self.exposure.occupants_per_vehicle, self.exposure.occupants_distribution)
         Ns = np.arange(1, int(kk.max()) + 1)
         c_hi, k_hi = HK_GEO_FN_LINES["unacceptable above"]
-        a_d, a_s = share_with_at_least(r["v_d"], kk, pk), share_with_at_least(r["v_s"], kk, pk)   # (S, J, N)
+        a_d, a_s = share_with_at_least(r["v_d"], kk, pk), share_with_at_least(r["v_s"], kk, pk)   # (S, K, J, N)
         x = r["road_bins"] * r["user_share"][:, :, None]               # (S, K, J) falls meeting open road
-        F = np.einsum("skj,sjn->skn", x * r["p_st"][:, None, None], a_d) \
-            + np.einsum("skj,sjn->skn", x * r["p_strike"][:, None, None], a_s)
+        F = np.einsum("skj,skjn->skn", x * r["p_st"][:, None, None], a_d) \
+            + np.einsum("skj,skjn->skn", x * r["p_strike"][:, None, None], a_s)
         return ~np.any(F > c_hi / Ns[None, None, :] ** k_hi, axis=2)
 
     # ---- societal risk -------------------------------------------------------------------------
@@ -859,7 +919,7 @@ class MitigationStudy:
         k = r["names"].index(opt.name)
         x = r["road_bins"][0, k] * r["user_share"][0, k]             # falls meeting open road
         freq = np.concatenate([x * r["p_st"][0], x * r["p_strike"][0]])
-        vul = np.concatenate([r["v_d"][0], r["v_s"][0]])
+        vul = np.concatenate([r["v_d"][0, k], r["v_s"][0, k]])
         kk, pk = occupancy_distribution(self.exposure.occupants_per_vehicle, self.exposure.occupants_distribution)
         return occupant_fn(freq, vul, kk, pk)
 
@@ -993,6 +1053,8 @@ class MitigationStudy:
             return max(value - 0.2, 0.0), min(value + 0.2, 1.0), "+-0.2 (no range stated)"
         if name == "discount_rate":
             return value * 0.5, min(value * 2, 0.2), "x0.5 / x2 (no range stated)"
+        if name == "fractal_dimension":
+            return max(value - 0.25, 0.05), min(value + 0.25, 2.95), "+-0.25 (no range stated)"
         return value * 0.5, value * 2.0, "x0.5 / x2 (no range stated)"
 
     def tornado(self) -> pd.DataFrame:
@@ -1042,6 +1104,8 @@ class MitigationStudy:
             return 0.0, 0.3, False
         if name == "vulnerability_factor":
             return 1e-3, 1e3, True
+        if name == "fractal_dimension":
+            return 1e-6, 3.0 - 1e-9, False
         return max(value, 1.0) * 1e-3 if value > 0 else 0.0, max(value, 1.0) * 1e3, True
 
     def break_even(self, parameter: str, *, option_a: str | None = None, option_b: str | None = None):
@@ -1174,8 +1238,8 @@ class MitigationStudy:
             x = r["road_bins"][0, k]
             road = x.sum()
             n_pv = pvf * road
-            vd = float(np.dot(x, r["v_d"][0]) / road) if road > 0 else 0.0
-            vs = float(np.dot(x, r["v_s"][0]) / road) if road > 0 else 0.0
+            vd = float(np.dot(x, r["v_d"][0, k]) / road) if road > 0 else 0.0
+            vs = float(np.dot(x, r["v_s"][0, k]) / road) if road > 0 else 0.0
             u = float(r["user_share"][0, k])          # a closure: share of falls meeting open road
             outcomes = [
                 {"name": "vehicle hit", "probability": p_st * u,

@@ -107,6 +107,11 @@ class Uncertainty:
     retention change with it.  ``calibration`` (the ``bootstrap.csv`` of ``riskrf calibrate``: one row
     of re-fitted parameters per replicate) gives the material draws instead: rows drawn jointly, so the
     correlation the calibration found is kept; the tornado uses its 5 % and 95 % quantiles.
+    ``fractal_dimension`` (low, high): each event volume breaks up into the expected fragments of fractal
+    fragmentation (Perfect 1997; :func:`riskrf.design_block.fractal_fragments`, ``fragmentation_iterations``
+    generations) with D sampled uniformly in the range (central value its midpoint), and the loss engine counts
+    the fragments as the blocks that travel and reach the road; without it every event volume is one intact
+    block.
     """
 
     samples: int = 1000
@@ -123,6 +128,8 @@ class Uncertainty:
     material_draws: int = 8
     calibration: object = field(default=None, repr=False)   # DataFrame: joint draws of a calibration's bootstrap
     calibration_source: str = ""
+    fractal_dimension: tuple | None = None   # (low, high): event volumes break up by fractal fragmentation
+    fragmentation_iterations: int = 3         # generations of that fragmentation (Perfect 1997)
 
 
 @dataclass(frozen=True)
@@ -476,9 +483,11 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
     vals = {}
     for key, v in data.items():
         w = f"{source}: uncertainty.{key}"
-        if key in ("samples", "seed", "material_draws"):
+        if key in ("samples", "seed", "material_draws", "fragmentation_iterations"):
             if isinstance(v, bool) or not isinstance(v, int) or v < (0 if key == "seed" else 1):
                 raise MitigationError(f"{w} = {v!r} must be a whole number {'>= 0' if key == 'seed' else '>= 1'}")
+            if key == "fragmentation_iterations" and v > 12:
+                raise MitigationError(f"{w} = {v!r} must be a whole number of generations between 1 and 12")
             vals[key] = v
         elif key == "materials":
             if not isinstance(v, dict):
@@ -523,6 +532,9 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
                 raise MitigationError(f"{w} = {v!r}: low must be > 0")
             if key == "discount_rate" and hi >= 1:
                 raise MitigationError(f"{w} = {v!r}: rates lie below 1 (e.g. [0.01, 0.05])")
+            if key == "fractal_dimension" and not 0 < lo <= hi < 3:
+                raise MitigationError(f"{w} = {v!r}: the fractal dimension lies strictly between 0 and 3 "
+                                      "(rock fragmentation typically 2-3)")
             vals[key] = (lo, hi)
     if vals.get("calibration") is not None and vals.get("materials"):
         raise MitigationError(f"{source}: give uncertainty.materials or uncertainty.calibration_bootstrap, not both")

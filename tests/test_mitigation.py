@@ -32,8 +32,9 @@ CONSTANT_V = Consequences(vulnerability_moving_vehicle=0.5, vulnerability_striki
 
 def study(options=OPTIONS, **kw):
     kw.setdefault("consequences", CONSTANT_V)
+    kw.setdefault("uncertainty", Uncertainty(samples=200))
     return MitigationStudy(hazard=HAZ, options=options, exposure=Exposure(vehicles_per_day=5000),
-                           economics=Economics(0.03, 50), uncertainty=Uncertainty(samples=200), **kw)
+                           economics=Economics(0.03, 50), **kw)
 
 
 def test_expected_annual_loss_by_hand_with_strikes_in_individual_risk():
@@ -574,3 +575,53 @@ def test_simulations_on_threads_equal_one_by_one_runs():
             np.testing.assert_array_equal(a.crossings[name], b.crossings[name])
         for name in a.per_block:
             np.testing.assert_array_equal(a.per_block[name], b.per_block[name])
+
+
+def test_fragmentation_breaks_event_volumes_into_the_blocks_that_travel():
+    """uncertainty.fractal_dimension: each event volume breaks into the expected fragments of fractal fragmentation
+    (Perfect 1997); the fragments travel, the road users meet events.  Here every block reaches the road with the
+    same probability tau = 0.5 and the vulnerability is 0.5 whatever the mass, so with N expected fragments an
+    event reaches the road with probability 1 - exp(-N tau) and is fatal to a vehicle it meets with probability
+    (1 - exp(-N tau v)) / (1 - exp(-N tau)).  The fragments keep the event's mass (the grid reaches down to the
+    finest generation); the tree and the F-N curve use the same events and vulnerabilities as the ranking."""
+    from riskrf.design_block import fractal_fragments
+    frag = study(uncertainty=Uncertainty(samples=200, fractal_dimension=(2.5, 2.5), fragmentation_iterations=3))
+    n_frag = fractal_fragments(1.0, 2.5, 3)["count"].sum()
+    reach = -np.expm1(-0.5 * n_frag)
+    r = frag.evaluate("nothing")
+    assert r.road_falls_per_year == pytest.approx(2.0 * reach, rel=1e-9)
+    v_eff = -np.expm1(-0.5 * n_frag * 0.5) / reach
+    ex = frag.exposure
+    k, p = occupancy_distribution(ex.occupants_per_vehicle)
+    p_st = spatial_temporal_probability(5000, ex.vehicle_length_m, ex.speed_kmh)
+    strikes = ex.share_stopping_on_road * stationary_rock_strike_probability(5000, ex.hours_rock_on_road,
+                                                                             ex.p_cannot_stop)
+    v_s_eff = -np.expm1(-0.5 * n_frag * 0.1) / reach
+    assert r.deaths_per_year == pytest.approx(float(np.dot(k, p)) * 2.0 * reach * (p_st * v_eff + strikes * v_s_eff),
+                                              rel=1e-9)
+    # the fragments' masses add up to the event's (bin middles: within a bin's width)
+    edges, mid, _ = frag._grid
+    F = frag._fragment_matrix([2.2, 2.8])
+    j = int(np.searchsorted(mid, 1e4))
+    assert F[0, j] @ mid == pytest.approx(mid[j], rel=0.1)
+    assert np.all(F.sum(axis=2)[1] > F.sum(axis=2)[0])
+    assert np.all(np.nonzero(F[0])[1] <= np.nonzero(F[0])[0])          # a fragment is never heavier than its event
+    # one loss engine: the tree rolls back to the central cost, the F-N curve sums to the deaths
+    c = frag._central_result
+    tree = frag.to_tree()
+    assert tree.rollback().value == pytest.approx(float(c["total"][0].min()), rel=1e-9)
+    fn = frag.fn_curve("nothing")
+    assert fn["F"].sum() == pytest.approx(r.deaths_per_year, rel=1e-9)
+    # sampled D: an uncertain input with its tornado and break-even rows; a fixed D has a tornado row too
+    ranged = study(uncertainty=Uncertainty(samples=200, fractal_dimension=(2.2, 2.8)))
+    assert "fractal_dimension" in ranged.parameter_ranges()
+    assert ranged.ranking()["probability_best"].sum() == pytest.approx(1.0)
+    assert "fractal_dimension" in set(frag.tornado()["parameter"])
+    assert "fractal_dimension" in set(ranged.break_even_table()["parameter"])
+
+
+@pytest.mark.parametrize("value,match", [([3.2, 3.5], "strictly between 0 and 3"), ([0, 2.5], "strictly between")])
+def test_bad_fractal_dimension_range_names_the_field(value, match):
+    with pytest.raises(MitigationError, match=rf"uncertainty\.fractal_dimension.*{match}"):
+        parse_mitigation({"options": [{"name": "nothing", "kind": "none", "capital_cost": 0}],
+                          "uncertainty": {"fractal_dimension": value}}, source="site.toml")

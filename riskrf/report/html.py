@@ -169,10 +169,16 @@ def _assumptions(a, hz, rate_scale) -> pd.DataFrame:
     if a.rates is not None and a.rates.climate and from_model:
         add("inventory.rain_factor", "stated change of climate", a.rates.climate, "typed assumption")
     # model limitations (no site-file field)
+    frag = a.study.uncertainty.fractal_dimension
     rows["limitation: volumes"] = (
-        "event volume vs block in the loss engine", "\u2014", "each event volume one intact block",
-        "model limitation: conservative for fence and shed loads; fragmentation (if stated) is used only for the "
-        "design block")
+        ("event volume vs block in the loss engine", "uncertainty.fractal_dimension",
+         f"fractal fragmentation, D {frag[0]:g}-{frag[1]:g}, {a.study.uncertainty.fragmentation_iterations} "
+         "generations", "judgement (site file); the fragments travel, road users meet each event once (upper-bound "
+         "vulnerability: spared only if every reaching fragment spares them)")
+        if frag else
+        ("event volume vs block in the loss engine", "\u2014", "each event volume one intact block",
+         "model limitation: conservative for fence and shed loads; fragmentation of the design block (if stated) "
+         "is used only for the design block"))
     rows["limitation: queues"] = (
         "queued or stopped vehicles behind a blockage", "\u2014", "not modelled",
         "model limitation: road users meet falls as moving vehicles at the impact point or by striking a rock lying "
@@ -513,7 +519,7 @@ def render_report(a, figs: Path) -> str:
             doc.table(pd.DataFrame([{"input": k, "low": v["low"], "high": v["high"], "law": v["law"]}
                                     for k, v in unc["inputs"].items()]), "Uncertain inputs sampled jointly"),
             "<p>Low and high: the ends of a stated range, or the 5th and 95th percentiles of the law it is drawn from.</p>",
-            f"<p>Not sampled: {_e('; '.join(unc['not_sampled']))}.</p>",
+            f"<p>Not sampled: {_e('; '.join(unc['not_sampled']))}.</p>" if unc["not_sampled"] else "",
             doc.figure(figs / "tree.png", "Decision tree at central values; the optimal path in red"),
             "<h3>Break-even: input values at which the two cheapest options at central values tie</h3>",
             f"<p>The break-even values, the tornado and the value of information below are computed at the central "

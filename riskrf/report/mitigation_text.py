@@ -92,10 +92,11 @@ def study_report(study) -> dict:
                         else ""))
     if study.defaults_used:
         lines += ["", "Defaults used: " + "; ".join(study.defaults_used)]
-    not_sampled = [("fragmentation: the loss engine takes every event volume as one intact block (conservative for "
-                    "fence and shed loads, since one block carries the event's whole energy; the more numerous "
-                    "smaller fragments a road user might meet are not modelled); stated fragmentation parameters are "
-                    "used only for the design block")]
+    not_sampled = [] if u.fractal_dimension else [
+        ("fragmentation: the loss engine takes every event volume as one intact block (conservative for fence and "
+         "shed loads, since one block carries the event's whole energy; the more numerous smaller fragments a road "
+         "user might meet are not modelled; give uncertainty.fractal_dimension to break events up); stated "
+         "fragmentation parameters of the design block are used only for the design block")]
     if not any(k.startswith("material:") for k in ranges):
         not_sampled.insert(0, "slope material parameters (no [uncertainty.materials] ranges given)")
     uncertainty = {"samples": u.samples, "seed": u.seed,
