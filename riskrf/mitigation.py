@@ -702,8 +702,7 @@ class MitigationStudy:
         reaching fragments are taken as Poisson, so the event reaches the road with probability
         1 - exp(-sum_k F_jk tau_k).  A vehicle meets an event's debris once (the exposure is per event, as for an
         intact block); it is fatal unless every reaching fragment spares it: 1 - exp(-sum_k F_jk tau_k v_k),
-        given the event reaches the road, divided by that probability.  Without a break-up (F the identity) this
-        returns the falls and vulnerabilities unchanged."""
+        given the event reaches the road, divided by that probability."""
         lam_events, F, blocks = frag
         with np.errstate(invalid="ignore", divide="ignore"):
             tau = np.where(blocks > 0, np.clip(x / blocks, 0.0, 1.0), 0.0)
@@ -714,6 +713,15 @@ class MitigationStudy:
             with np.errstate(invalid="ignore", divide="ignore"):
                 out.append(np.where(reach > 0, np.clip(lethal / reach, 0.0, 1.0), 0.0))
         return lam_events * reach, out[0], out[1]
+
+    @staticmethod
+    def _released_share(frag, event_scale) -> np.ndarray:
+        """(S, J): share of each fragment mass bin still released when a source measure scales the events by
+        ``event_scale`` (S, J) (by the event's mass bin)."""
+        lam_events, F, blocks = frag
+        released = np.einsum("sj,sjk->sk", lam_events * event_scale, F)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(blocks > 0, released / blocks, 0.0)
 
     def _evaluate(self, P: dict, *, per_bin: bool = False) -> dict:
         """The one loss engine: every option for parameter arrays ``P`` (length S); arrays (S, K)."""
@@ -758,9 +766,11 @@ class MitigationStudy:
                                               "user_share")}
         road_bins = np.zeros((S, K, mid.size)) if per_bin else None
         vd_all, vs_all = (np.zeros((S, K, mid.size)), np.zeros((S, K, mid.size))) if per_bin else (None, None)
-        base_road = arrivals.sum(axis=1) * road_share
+        base_road = arrivals.sum(axis=1) * road_share if frag is None else \
+            self._events_at_road(frag, arrivals * road_share[:, None], v_d, v_s)[0].sum(axis=1)
         for k, opt in enumerate(self.options):
             stages, comps = effects[opt.name]
+            ev_scale, g_prev = 1.0, np.ones_like(lam)       # source measures on events (fragmentation)
             x = arrivals.copy()
             stopped_by_structures = np.zeros(S)
             before_structures = None
@@ -786,7 +796,15 @@ class MitigationStudy:
                     users = users * (1.0 - P[st.param])
                     continue
                 if st.kind == "release":
-                    x = x * (st.multiplier[None, :] if st.multiplier is not None else (1.0 - P[st.param])[:, None])
+                    m = st.multiplier[None, :] if st.multiplier is not None else (1.0 - P[st.param])[:, None]
+                    if frag is None:
+                        x = x * m
+                    else:           # a source measure removes events (by the event's mass), hence their fragments
+                        ev_scale = ev_scale * m
+                        g = self._released_share(frag, ev_scale)
+                        with np.errstate(invalid="ignore", divide="ignore"):
+                            x = np.where(g_prev > 0, x * g / g_prev, 0.0)
+                        g_prev = g
                     continue
                 if before_structures is None:
                     before_structures = x.sum(axis=1) * (1.0 if on_road else road_share)
@@ -814,7 +832,7 @@ class MitigationStudy:
             vd_k, vs_k = v_d, v_s
             if frag is not None:        # from fragments reaching the road to the events they came from
                 x_blocks = x
-                x, vd_k, vs_k = self._events_at_road(frag, x, v_d, v_s)
+                x, vd_k, vs_k = self._events_at_road((frag[0] * ev_scale, frag[1], frag[2] * g_prev), x, v_d, v_s)
             road = x.sum(axis=1)
             if before_structures is not None and any(s.kind in ("ditch", "barrier") for s in stages):
                 passed = road if frag is None else x_blocks.sum(axis=1)     # share of the blocks stopped

@@ -599,6 +599,10 @@ def test_fragmentation_breaks_event_volumes_into_the_blocks_that_travel():
     v_s_eff = -np.expm1(-0.5 * n_frag * 0.1) / reach
     assert r.deaths_per_year == pytest.approx(float(np.dot(k, p)) * 2.0 * reach * (p_st * v_eff + strikes * v_s_eff),
                                               rel=1e-9)
+    # a source measure removes events (and so all their fragments): scaling by half halves the events at the road
+    assert frag.evaluate("scale").road_falls_per_year == pytest.approx(r.road_falls_per_year / 2, rel=1e-9)
+    eff = frag.ranking().set_index("option")["effectiveness"]
+    assert eff["nothing"] == pytest.approx(0.0, abs=1e-12) and eff["scale"] == pytest.approx(0.5, rel=1e-9)
     # the fragments' masses add up to the event's (bin middles: within a bin's width)
     edges, mid, _ = frag._grid
     F = frag._fragment_matrix([2.2, 2.8])
