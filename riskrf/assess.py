@@ -364,7 +364,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             finest = []
             u = site.mitigation["uncertainty"]
             if u is not None and u.fractal_dimension:     # fragments travel: simulate down to the finest one
-                finest = [min([law.m_min] + [float(m) for m in inventory.masses if m > 0])
+                masses = np.asarray(inventory.masses, dtype=float)
+                finest = [min(float(law.m_min), float(masses[masses > 0].min(initial=np.inf)))
                           / 8.0 ** u.fragmentation_iterations]
             return extra + ([frag] if frag is not None else []) + finest
         t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")

@@ -348,8 +348,8 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
     add(f"return period {T:g} yr reaching the line", float(table["line_mass_kg"].iloc[0]),
         "site law x reach probability by mass" if hazard.mass_coupled else "site law x one reach probability")
     if fragmenting and np.isfinite(table["source_mass_kg"].iloc[0]):
-        frags = fractal_fragments(float(table["source_volume_m3"].iloc[0]), fractal_dimension, iterations)
-        add(f"fragmentation of the {T:g}-yr event, p{pct:g}", fragment_percentile(frags, pct) * rho,
+        mass, frags = _fragment_of(float(table["source_mass_kg"].iloc[0]), fractal_dimension, iterations, pct, rho)
+        add(f"fragmentation of the {T:g}-yr event, p{pct:g}", mass,
             f"fractal fragmentation (Perfect 1997), D = {sig(fractal_dimension)}, {iterations} generation(s): "
             f"{sig(frags['count'].sum())} fragments; percentile by count")
     m_max = getattr(hazard.mass, "m_max", None)
@@ -416,9 +416,15 @@ def fragment_block_kg(law, rate_per_year: float, *, design_T: float, fractal_dim
     p = 1.0 / (float(design_T) * float(rate_per_year))
     if not p < 1:
         return None
-    source_kg = float(mass_model(law).isf(p))
+    return _fragment_of(float(mass_model(law).isf(p)), fractal_dimension, iterations, percentile, density_kg_m3)[0]
+
+
+def _fragment_of(source_kg, fractal_dimension, iterations, percentile, density_kg_m3):
+    """(mass [kg] of the ``percentile`` fragment, the fragments table) of a fall of ``source_kg`` broken up by
+    fractal fragmentation: the one computation behind the design block's fragmentation rule and
+    :func:`fragment_block_kg`."""
     frags = fractal_fragments(source_kg / density_kg_m3, fractal_dimension, iterations)
-    return fragment_percentile(frags, percentile) * density_kg_m3
+    return fragment_percentile(frags, percentile) * density_kg_m3, frags
 
 
 __all__ = ["DesignBlock", "ONR24810_PERCENTILES", "design_block", "design_block_candidates_kg", "fractal_fragments",

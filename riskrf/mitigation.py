@@ -683,8 +683,9 @@ class MitigationStudy:
         edges, mid, _ = self._grid
         n_gen = self.uncertainty.fragmentation_iterations
         D = np.atleast_1d(np.asarray(fractal_dimension, dtype=float))
-        share = fractal_fragments(1.0, 2.5, n_gen)["volume_m3"].to_numpy()     # fragment / event volume (any D)
-        counts = np.array([fractal_fragments(1.0, float(d), n_gen)["count"].to_numpy() for d in D])   # (S, G)
+        tables = [fractal_fragments(1.0, float(d), n_gen) for d in D]       # per unit volume of the event
+        share = tables[0]["volume_m3"].to_numpy()                            # fragment / event volume (D-free)
+        counts = np.array([t["count"].to_numpy() for t in tables])          # (S, G)
         k = np.clip(np.searchsorted(edges, mid[:, None] * share[None, :], side="right") - 1, 0, mid.size - 1)
         out = np.zeros((D.size, mid.size, mid.size))
         rows = np.arange(mid.size)
@@ -770,7 +771,7 @@ class MitigationStudy:
             self._events_at_road(frag, arrivals * road_share[:, None], v_d, v_s)[0].sum(axis=1)
         for k, opt in enumerate(self.options):
             stages, comps = effects[opt.name]
-            ev_scale, g_prev = 1.0, np.ones_like(lam)       # source measures on events (fragmentation)
+            ev_scale, g_prev = 1.0, None if frag is None else np.ones_like(lam)   # source measures on events
             x = arrivals.copy()
             stopped_by_structures = np.zeros(S)
             before_structures = None
