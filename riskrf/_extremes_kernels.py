@@ -84,25 +84,35 @@ def profile_nll_min(model, u0, z, ly, x, step, xatol, fatol, maxiter):
 
     Returns (minimum, argmin).
     """
-    lo = x.min()
-    hi = x.max()
+    lo = x[0]
+    hi = x[0]
+    for i in range(1, x.shape[0]):
+        lo = min(lo, x[i])
+        hi = max(hi, x[i])
     k = u0.shape[0]
     sim = np.empty((k + 1, k))
+    row = np.empty(k)
     f = np.empty(k + 1)
     for j in range(k + 1):
         for i in range(k):
             sim[j, i] = u0[i]
         if j > 0:
             sim[j, j - 1] += step
-        f[j] = profile_nll(model, sim[j], z, ly, x, lo, hi)
+        for i in range(k):
+            row[i] = sim[j, i]
+        f[j] = profile_nll(model, row, z, ly, x, lo, hi)
     xr = np.empty(k)
     xe = np.empty(k)
     xc = np.empty(k)
     cen = np.empty(k)
     for _ in range(maxiter):
-        order = np.argsort(f)
-        sim = sim[order]
-        f = f[order]
+        for a in range(1, k + 1):        # insertion sort of the k + 1 vertices by f
+            b = a
+            while b > 0 and f[b] < f[b - 1]:
+                f[b], f[b - 1] = f[b - 1], f[b]
+                for i in range(k):
+                    sim[b, i], sim[b - 1, i] = sim[b - 1, i], sim[b, i]
+                b -= 1
         xspread = 0.0
         fspread = 0.0
         for j in range(1, k + 1):
@@ -123,13 +133,16 @@ def profile_nll_min(model, u0, z, ly, x, step, xatol, fatol, maxiter):
                 xe[i] = cen[i] + 2.0 * (cen[i] - sim[k, i])
             fe = profile_nll(model, xe, z, ly, x, lo, hi)
             if fe < fr:
-                sim[k] = xe
+                for i in range(k):
+                    sim[k, i] = xe[i]
                 f[k] = fe
             else:
-                sim[k] = xr
+                for i in range(k):
+                    sim[k, i] = xr[i]
                 f[k] = fr
         elif fr < f[k - 1]:
-            sim[k] = xr
+            for i in range(k):
+                sim[k, i] = xr[i]
             f[k] = fr
         else:
             if fr < f[k]:
@@ -140,12 +153,19 @@ def profile_nll_min(model, u0, z, ly, x, step, xatol, fatol, maxiter):
                     xc[i] = cen[i] + 0.5 * (sim[k, i] - cen[i])
             fc = profile_nll(model, xc, z, ly, x, lo, hi)
             if fc < min(fr, f[k]):
-                sim[k] = xc
+                for i in range(k):
+                    sim[k, i] = xc[i]
                 f[k] = fc
             else:
                 for j in range(1, k + 1):
                     for i in range(k):
                         sim[j, i] = sim[0, i] + 0.5 * (sim[j, i] - sim[0, i])
-                    f[j] = profile_nll(model, sim[j], z, ly, x, lo, hi)
-    best = np.argmin(f)
-    return f[best], sim[best].copy()
+                        row[i] = sim[j, i]
+                    f[j] = profile_nll(model, row, z, ly, x, lo, hi)
+    best = 0
+    for j in range(1, k + 1):
+        if f[j] < f[best]:
+            best = j
+    for i in range(k):
+        row[i] = sim[best, i]
+    return f[best], row

@@ -145,30 +145,41 @@ def _ks_exact(logx, first, last, k, b, stop, F_buf, hi_buf, lo_buf):
 
 
 @njit(cache=True, nogil=True)
-def ks_scan_best(logx, suffix_log, first, last, candidates):
-    """The candidate of :func:`ks_scan` with the smallest KS distance, found exactly by bounding.
-
-    Each candidate first gets a lower bound of its distance from 32 rank-spaced points of its tail
-    (:func:`_ks_bounds`).  Candidates are then visited in increasing order of that bound; each
-    one's distance is computed exactly (:func:`_ks_exact`, abandoned as soon as it exceeds the best
-    so far), and the visit stops at the first bound above the best distance.  The result equals the
-    first minimum of the exhaustive :func:`ks_scan` (ties go to the lower threshold, as
-    ``argmin`` does), at a cost near O(N log N) on power-law-like samples instead of O(N^2).
-
-    Returns (position in ``candidates``, D, b); position -1 if no candidate has a tail with spread.
-    """
+def ks_lower_bounds(logx, suffix_log, first, last, candidates):
+    """MLE exponent and a lower bound of the KS distance of each candidate, from 32 rank-spaced points of its
+    tail (:func:`_ks_bounds`); (NaN, inf) for a candidate whose tail has no spread.  Returns (B, lb)."""
     N = logx.shape[0]
     C = candidates.shape[0]
-    B = np.full(C, np.nan)
-    lb = np.full(C, np.inf)
+    B = np.empty(C)
+    lb = np.empty(C)
     for c in range(C):
         k = candidates[c]
         n = N - k
         s = suffix_log[k] - n * logx[k]
+        B[c] = np.nan
+        lb[c] = np.inf
         if s > 0.0:
             B[c] = n / s
             lb[c] = _ks_bounds(logx, first, last, k, B[c], 32)[0]
-    order = np.argsort(lb)
+    return B, lb
+
+
+@njit(cache=True, nogil=True)
+def ks_scan_best(logx, first, last, candidates, B, lb, order):
+    """The candidate of :func:`ks_scan` with the smallest KS distance, found exactly by bounding.
+
+    ``B`` and ``lb`` are the exponents and lower bounds of :func:`ks_lower_bounds`; ``order`` sorts ``lb``
+    (done by numpy outside: a sort compiled here would double this kernel's compilation time).  Candidates are
+    visited in increasing order of their bound; each one's distance is computed exactly (:func:`_ks_exact`,
+    abandoned as soon as it exceeds the best so far), and the visit stops at the first bound above the best
+    distance.  The result equals the first minimum of the exhaustive :func:`ks_scan` (ties go to the lower
+    threshold, as ``argmin`` does, whatever the order of equal bounds), at a cost near O(N log N) on
+    power-law-like samples instead of O(N^2).
+
+    Returns (position in ``candidates``, D); position -1 if no candidate has a tail with spread.
+    """
+    N = logx.shape[0]
+    C = candidates.shape[0]
     size = N // 64 + 2
     F_buf = np.empty(size)
     hi_buf = np.empty(size)
@@ -177,11 +188,9 @@ def ks_scan_best(logx, suffix_log, first, last, candidates):
     best_d = np.inf
     for r in range(C):
         c = order[r]
-        if not np.isfinite(lb[c]) or lb[c] > best_d:
+        if not lb[c] < np.inf or lb[c] > best_d:
             break
         d = _ks_exact(logx, first, last, candidates[c], B[c], best_d, F_buf, hi_buf, lo_buf)
         if d < best_d or (d == best_d and c < best):
             best, best_d = c, d
-    if best < 0:
-        return -1, np.inf, np.nan
-    return best, best_d, B[best]
+    return best, best_d

@@ -124,7 +124,7 @@ def find_m_min(masses, *, min_tail: int = 10, exhaustive: bool = False, statisti
 
 
 def _find_m_min_sorted(x, min_tail, exhaustive, statistic, grid=None):
-    from ._power_law_kernels import ks_scan, ks_scan_best
+    from ._power_law_kernels import ks_lower_bounds, ks_scan, ks_scan_best
 
     logx, suffix, first, last = _tail_arrays(x, statistic)
     candidates = _candidates(x, min_tail, grid)
@@ -135,8 +135,9 @@ def _find_m_min_sorted(x, min_tail, exhaustive, statistic, grid=None):
         D, B = ks_scan(logx, suffix, first, last, candidates)
         i = int(np.argmin(D))
         return float(x[candidates[i]]), float(D[i]), float(B[i])
-    i, d, b = ks_scan_best(logx, suffix, first, last, candidates)
-    return float(x[candidates[i]]), float(d), float(b)
+    B, lb = ks_lower_bounds(logx, suffix, first, last, candidates)
+    i, d = ks_scan_best(logx, first, last, candidates, B, lb, np.argsort(lb, kind="stable"))
+    return float(x[candidates[i]]), float(d), float(B[i]) if i >= 0 else np.nan
 
 
 #: Integer data whose threshold lies below this value are fitted as discrete by default (see

@@ -128,6 +128,7 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
     c_x = np.array([c.x for c in cols], dtype=float)
     c_cap = np.array([np.nan if c.capacity_kj is None else c.capacity_kj for c in cols], dtype=float)
     c_h = np.array([np.nan if c.height_m is None else c.height_m for c in cols], dtype=float)
+    c_order = np.argsort(c_x, kind="stable")     # collectors in x order: the order of crossing along the motion
     nb = st.envelope_bins
     edges = np.linspace(prof.x[0], prof.x[-1], nb + 1)
     env_x = 0.5 * (edges[:-1] + edges[1:]) if nb else np.empty(0)
@@ -164,7 +165,7 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
                 blocks["vz"][lo:hi], blocks["w"][lo:hi], blocks["mass"][lo:hi], blocks["radius"][lo:hi],
                 blocks["inertia_factor"][lo:hi],
                 prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.material_index, prof.run_first, prof.run_last,
-                **mats, c_x=c_x, c_cap=c_cap, c_h=c_h, env_x=env_x, env_acc=env_chunk,
+                **mats, c_x=c_x, c_cap=c_cap, c_h=c_h, c_order=c_order, env_x=env_x, env_acc=env_chunk,
                 g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
                 max_events=st.max_events, key=key, n_path_blocks=n_paths,
                 out_x=per_block["x"][lo:hi], out_z=per_block["z"][lo:hi], out_reason=per_block["reason"][lo:hi],

@@ -69,7 +69,7 @@ def _normal(state):
 @njit(cache=True)
 def _seg_of(px, x):
     """Segment index under x by bisection (left segment at a vertex)."""
-    return _seg_in(px, x, 0, px.shape[0] - 2)
+    return _seg_in(px, x, np.int64(0), px.shape[0] - 2)     # int64, not a literal: one compiled version
 
 
 @njit(cache=True)
@@ -81,6 +81,20 @@ def _seg_in(px, x, lo, hi):
             lo = mid
         else:
             hi = mid - 1
+    return lo
+
+
+@njit(cache=True)
+def _first_at_least(a, v):
+    """Index of the first element of the ascending array ``a`` that is >= v (``numpy.searchsorted``, side
+    "left"; written out because numba's version costs about a second of compilation)."""
+    lo, hi = 0, a.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if a[mid] < v:
+            lo = mid + 1
+        else:
+            hi = mid
     return lo
 
 
@@ -327,8 +341,8 @@ def _envelope_add(env_acc, i, v, h, e):
 @njit(cache=True)
 def _envelope_flight(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass, inertia):
     """Envelope bins between xa and xb crossed in flight (parabola from x0, z0 with vx, vz; spin w constant)."""
-    i0 = np.searchsorted(env_x, min(xa, xb))
-    i1 = np.searchsorted(env_x, max(xa, xb))
+    i0 = _first_at_least(env_x, min(xa, xb))
+    i1 = _first_at_least(env_x, max(xa, xb))
     for i in range(i0, i1):
         xc = env_x[i]
         t = (xc - x0) / vx
@@ -343,8 +357,8 @@ def _envelope_contact(env_x, env_acc, xa, xb, x0, mass, inertia, r, contact_spee
                       roll):
     """Envelope bins between xa and xb crossed in ground contact (constant acceleration contact_a along the
     slope from speed contact_speed0 at x0; spin v/r when rolling, none when sliding; height 0)."""
-    i0 = np.searchsorted(env_x, min(xa, xb))
-    i1 = np.searchsorted(env_x, max(xa, xb))
+    i0 = _first_at_least(env_x, min(xa, xb))
+    i1 = _first_at_least(env_x, max(xa, xb))
     for i in range(i0, i1):
         s = contact_dir * (env_x[i] - x0) / cosb
         if abs(contact_a) < 1e-12:
@@ -359,7 +373,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
              px, pz, tree, n_leaves, seg_mat, run_first, run_last,
              m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
              m_roll, m_mu_ground, m_gain,
-             c_x, c_cap, c_h, env_x, env_acc,
+             c_x, c_cap, c_h, c_order, env_x, env_acc,
              g, v_contact, v_stop, max_events, key, n_path_blocks,
              out_x, out_z, out_reason, out_impacts, out_t,
              r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
@@ -370,12 +384,13 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
     and sliding lose mu m g cos(beta) per metre); impacts, the transition to rolling
     (:func:`roll_on_speed`), slope changes in contact (the normal component is lost) and barriers
     only remove energy, unless a material sets ``allow_energy_gain``.
+    ``c_order`` lists the collectors by increasing x, the order in which a block moving downslope crosses them
+    (sorted by the caller: a sort compiled here would add about 2 s to the first compilation).
     """
     n_coll = c_x.shape[0]
     n_seg = px.shape[0] - 1
     state = np.empty(1, np.uint64)
     cross_t = np.empty(n_coll)
-    by_x = np.argsort(c_x)           # collectors in x order: the order of crossing along the motion
     stack = np.empty((3, 128), np.int64)
     for b in range(block_ids.shape[0]):
         bid = block_ids[b]
@@ -428,7 +443,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 for j in range(n_coll):
                     cross_t[j] = (c_x[j] - x) / vx if abs(vx) > 1e-12 else -1.0
                 for jj in range(n_coll):
-                    j = by_x[jj] if vx > 0 else by_x[n_coll - 1 - jj]
+                    j = c_order[jj] if vx > 0 else c_order[n_coll - 1 - jj]
                     tc = cross_t[j]
                     if not (1e-12 < tc <= t_hit):
                         continue
@@ -451,7 +466,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                             reason = CAUGHT
                         if record:
                             _record_barrier_event(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z,
-                                                  vx, vz, w, reason == CAUGHT, MODE_FLIGHT)
+                                                  vx, vz, w, reason == CAUGHT, np.int64(MODE_FLIGHT))
                         cut = True
                         break
                 if cut:
@@ -577,7 +592,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             for j in range(n_coll):
                 cross_t[j] = direction * (c_x[j] - x) / cosb   # distance along the slope to the collector
             for jj in range(n_coll):
-                j = by_x[jj] if direction > 0 else by_x[n_coll - 1 - jj]
+                j = c_order[jj] if direction > 0 else c_order[n_coll - 1 - jj]
                 s_c = cross_t[j]
                 if not (1e-12 < s_c <= d_step):
                     continue
@@ -607,7 +622,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                         reason = CAUGHT
                     if record:
                         _record_barrier_event(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z,
-                                              v_along * cosb, v_along * sinb, w, reason == CAUGHT, MODE_CONTACT)
+                                              v_along * cosb, v_along * sinb, w, reason == CAUGHT,
+                                              np.int64(MODE_CONTACT))
                     cut = True
                     break
             if cut:
