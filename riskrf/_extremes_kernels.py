@@ -82,6 +82,9 @@ def profile_nll(model, u, z, ly, x, lo, hi):
 def profile_nll_min(model, u0, z, ly, x, step, xatol, fatol, maxiter):
     """Nelder-Mead minimum of :func:`profile_nll` from ``u0`` (initial simplex u0 + step e_i).
 
+    Written with scalar loops only (the k + 1 vertices kept in order by insertion, no row slicing, sorting or
+    array reductions): numba then compiles it in about 2 CPU-s instead of 7.
+
     Returns (minimum, argmin).
     """
     lo = x[0]
