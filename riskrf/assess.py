@@ -315,16 +315,18 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         warnings.simplefilter("always", RiskrfWarning)
         inv_cfg = site.inventory
         hz_cfg = site.hazard
-        # The site's rate model (hazard rate, closure rules) is fitted in a child on the other core meanwhile.
+        # On a fresh installation the simulator is compiled once (numba, cached on disk): that takes the other
+        # core while this one fits, fits the rate model and draws the fits' figures (below); otherwise those
+        # two go to forked children on the other core.
+        from simulation.engine import Precompile
+        compiling = Precompile(site.resolve(hz_cfg["scenario"])) if hz_cfg["scenario"] else None
+        beside = compiling is None or not compiling.running
+        # The site's rate model (hazard rate, closure rules).
         rates = None
         if site.rates is not None:
             from .site_rates import evaluate_rates
             rates = InBackground(lambda: evaluate_rates(site.rates, site.path.parent, inv_cfg,
-                                                        site.mitigation["options"]))
-        # On a fresh installation the simulator is compiled once (numba, cached on disk): do it on the other
-        # core while the fits run.
-        from simulation.engine import Precompile
-        compiling = Precompile(site.resolve(hz_cfg["scenario"])) if hz_cfg["scenario"] else None
+                                                        site.mitigation["options"]), fork=beside)
         t = stage(1, "reading the inventory and fitting magnitude-frequency models")
         from .inventory import READER_OPTIONS
         reader = {k: inv_cfg[k] for k in READER_OPTIONS if inv_cfg.get(k) is not None}
@@ -338,7 +340,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
         timings["fits"] = round(time.perf_counter() - t, 2)
         if figures is not None:
-            pending.append(InBackground(partial(_frequency_outputs, frequency, maxima_frequency, figures)))
+            pending.append(InBackground(partial(_frequency_outputs, frequency, maxima_frequency, figures),
+                                        fork=beside))
 
         db_cfg = site.design_block
         survey = read_block_survey(site.resolve(db_cfg["survey"]), inventory.density_kg_m3) \
@@ -370,6 +373,10 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             return extra + ([frag] if frag is not None else []) + finest
         t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
         if compiling is not None:
+            if not beside:          # this core's work while the simulator compiles on the other
+                for part in [rates] + pending:
+                    if part is not None:
+                        part.result()
             compiling.wait()
         gr, hazard, result = energy_hazard_from_inputs(
             inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=rate_scale,

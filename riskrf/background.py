@@ -11,13 +11,14 @@ class InBackground:
     where it is safe (POSIX, no other thread, e.g. not inside a notebook kernel with threads); otherwise, or if
     the child dies, ``work`` runs in this process at :meth:`result`.  An exception raised by ``work`` in the
     child is raised again by :meth:`result`.  The value and the files are the same either way.
+    ``fork=False`` keeps the work in this process (run at :meth:`result`): for when the other core is taken.
     """
 
-    def __init__(self, work):
+    def __init__(self, work, *, fork: bool = True):
         import os
         import threading
         self.work, self.proc, self.conn, self._done = work, None, None, None
-        if hasattr(os, "fork") and threading.active_count() == 1:
+        if fork and hasattr(os, "fork") and threading.active_count() == 1:
             import multiprocessing
             try:
                 ctx = multiprocessing.get_context("fork")

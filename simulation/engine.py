@@ -224,6 +224,11 @@ class Precompile:
         except OSError:
             self._proc = None
 
+    @property
+    def running(self) -> bool:
+        """True while the compiling child runs (False where the cache was warm or no child could start)."""
+        return self._proc is not None and self._proc.poll() is None
+
     def wait(self, timeout: float | None = 300.0) -> bool:
         """Block until the compilation is done; True when the child finished cleanly (or was not needed)."""
         if self._proc is None:
