@@ -12,32 +12,42 @@ Public API (units: mass kg, volume m³, energy kJ, velocity m/s, time yr)::
 """
 __version__ = "0.1.0"
 
-from .annual_hazard import EnergyHazard
-from .decision_tree import DecisionTree
-from .extremes import (
-                       GEVFit,
-                       GumbelFit,
-                       encounter_probability,
-                       fit_gev,
-                       fit_gumbel,
-                       gumbel_frequency_factor,
-                       gumbel_reduced_variate,
-                       plotting_positions,
-)
-from .frequency_study import FrequencyAnalysis, analyse_inventory
-from .impact_energy import exceedance_probability, fit_velocity
-from .inventory import DEFAULT_DENSITY_KG_M3, Inventory, read_inventory
-from .mass_coupling import MassCoupledSamples, energy_hazard
-from .power_law import GutenbergRichterFit, find_m_min, fit_gutenberg_richter
-from .rainfall import Rainfall, read_rainfall
-from .rate_model import RateModel, rate_model
-from .validation import RiskrfWarning
+import importlib
 
-__all__ = [
-    "DEFAULT_DENSITY_KG_M3", "DecisionTree", "EnergyHazard", "FrequencyAnalysis", "GEVFit", "GumbelFit",
-    "GutenbergRichterFit", "Inventory", "MassCoupledSamples", "RiskrfWarning", "analyse_inventory", "energy_hazard",
-    "encounter_probability",
-    "exceedance_probability", "find_m_min", "fit_gev", "fit_gumbel", "fit_gutenberg_richter", "fit_velocity",
-    "gumbel_frequency_factor", "gumbel_reduced_variate", "plotting_positions", "read_inventory",
-    "Rainfall", "RateModel", "rate_model", "read_rainfall",
-]
+#: Public name -> the module that holds it.  Imported on first use (PEP 562), so that ``import riskrf`` and the
+#: ``riskrf`` command start without loading pandas, scipy and numba until a command needs them.
+_EXPORTS = {
+    "EnergyHazard": "annual_hazard",
+    "DecisionTree": "decision_tree",
+    **dict.fromkeys(["GEVFit", "GumbelFit", "encounter_probability", "fit_gev", "fit_gumbel",
+                     "gumbel_frequency_factor", "gumbel_reduced_variate", "plotting_positions"], "extremes"),
+    "FrequencyAnalysis": "frequency_study", "analyse_inventory": "frequency_study",
+    "exceedance_probability": "impact_energy", "fit_velocity": "impact_energy",
+    "DEFAULT_DENSITY_KG_M3": "inventory", "Inventory": "inventory", "read_inventory": "inventory",
+    "MassCoupledSamples": "mass_coupling", "energy_hazard": "mass_coupling",
+    "GutenbergRichterFit": "power_law", "find_m_min": "power_law", "fit_gutenberg_richter": "power_law",
+    "Rainfall": "rainfall", "read_rainfall": "rainfall",
+    "RateModel": "rate_model", "rate_model": "rate_model",
+    "RiskrfWarning": "validation",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str):
+    """A public name, or a submodule, imported on first use."""
+    if name in _EXPORTS:
+        value = getattr(importlib.import_module(f"{__name__}.{_EXPORTS[name]}"), name)
+        globals()[name] = value
+        return value
+    if not name.startswith("__"):
+        try:
+            return importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":
+                raise
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

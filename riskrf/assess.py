@@ -318,8 +318,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         # On a fresh installation the simulator is compiled once (numba, cached on disk): that takes the other
         # core while this one fits, fits the rate model and draws the fits' figures (below); otherwise those
         # two go to forked children on the other core.
-        from simulation.engine import Precompile
-        compiling = Precompile(site.resolve(hz_cfg["scenario"])) if hz_cfg["scenario"] else None
+        from simulation.precompile import precompile
+        compiling = precompile(site.resolve(hz_cfg["scenario"])) if hz_cfg["scenario"] else None
         beside = compiling is None or not compiling.running
         # The site's rate model (hazard rate, closure rules).
         rates = None

@@ -7,16 +7,36 @@
 """
 __version__ = "0.1.0"
 
-from .engine import run
-from .result import SimulationResult, wilson_interval
-from .scenario import Scenario, ScenarioError, load_scenario, scenario_from_dict
+import importlib
 
-__all__ = ["Scenario", "ScenarioError", "SimulationResult", "load_scenario", "run", "scenario_from_dict",
-           "wilson_interval"]
+#: Public name -> the module that holds it, imported on first use (PEP 562): ``simulation.units`` and
+#: ``simulation.precompile`` can then be imported without numpy or numba.
+_EXPORTS = {
+    "run": "engine",
+    "SimulationResult": "result", "wilson_interval": "result",
+    **dict.fromkeys(["Scenario", "ScenarioError", "load_scenario", "scenario_from_dict"], "scenario"),
+    # Calibration to observed stop points and profiles extracted from 3-D terrain (issue 9).
+    **dict.fromkeys(["Calibration", "CalibrationWarning", "calibrate", "read_observed"], "calibration"),
+    **dict.fromkeys(["TerrainProfile", "profile_from_points", "read_stl"], "profile_extraction"),
+}
 
-# Calibration to observed stop points and profiles extracted from 3-D terrain (issue 9).
-from .calibration import Calibration, CalibrationWarning, calibrate, read_observed  # noqa: E402
-from .profile_extraction import TerrainProfile, profile_from_points, read_stl  # noqa: E402
+__all__ = sorted(_EXPORTS)
 
-__all__ += ["Calibration", "CalibrationWarning", "TerrainProfile", "calibrate", "profile_from_points", "read_observed",
-            "read_stl"]
+
+def __getattr__(name: str):
+    """A public name, or a submodule, imported on first use."""
+    if name in _EXPORTS:
+        value = getattr(importlib.import_module(f"{__name__}.{_EXPORTS[name]}"), name)
+        globals()[name] = value
+        return value
+    if not name.startswith("__"):
+        try:
+            return importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":
+                raise
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

@@ -10,8 +10,6 @@ the same numbers whatever the chunk size.
 """
 from __future__ import annotations
 
-import os
-import subprocess
 import sys
 import time
 
@@ -196,46 +194,4 @@ def _warm_up(path: str) -> None:
     run(load_scenario(path), n=4, seed=0, record_paths=4)
 
 
-class Precompile:
-    """The simulator compiled in a background process while the caller does other work.
-
-    numba compiles the trajectory kernel on first use and caches the machine code on disk
-    (``cache=True``); on a fresh installation that first compilation takes 10-20 s.  Started
-    early (``Precompile(scenario_path)``), it runs on the second core during work that does not
-    need the simulator; :meth:`wait` returns when the cache is written, after which the kernel
-    loads in well under a second.  Where the cache is already warm the child finishes at once.
-    A failure in the child only means the kernel is compiled on first use instead.
-    """
-
-    def __init__(self, scenario_path):
-        self._proc = None
-        try:       # a warm on-disk cache: nothing to do (numba internals; if they move, compile anyway)
-            if os.path.exists(kernel.simulate._cache._cache_file._index_path):
-                return
-        except (AttributeError, TypeError):
-            pass
-        # A fresh interpreter (not multiprocessing): it never re-imports the caller's main script, so a user's
-        # script without an ``if __name__ == "__main__"`` guard works unchanged.
-        try:
-            self._proc = subprocess.Popen([sys.executable, "-c", "import sys, simulation.engine as e; "
-                                           "e._warm_up(sys.argv[1])", str(scenario_path)],
-                                          stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                          stderr=subprocess.DEVNULL)
-        except OSError:
-            self._proc = None
-
-    @property
-    def running(self) -> bool:
-        """True while the compiling child runs (False where the cache was warm or no child could start)."""
-        return self._proc is not None and self._proc.poll() is None
-
-    def wait(self, timeout: float | None = 300.0) -> bool:
-        """Block until the compilation is done; True when the child finished cleanly (or was not needed)."""
-        if self._proc is None:
-            return True
-        try:
-            self._proc.wait(timeout)
-        except subprocess.TimeoutExpired:
-            self._proc.kill()
-            return False
-        return self._proc.returncode == 0
+from .precompile import Precompile  # noqa: E402,F401  (its former home; kept for callers)

@@ -1,0 +1,93 @@
+"""The simulator compiled ahead of its first use, in a child process on the other core.
+
+numba compiles the trajectory kernel on first use and caches the machine code on disk (``cache=True``); on a
+fresh installation that first compilation takes 10-15 CPU-s.  :class:`Precompile` runs it in a fresh
+interpreter while the caller does work that does not need the simulator.  This module imports neither numpy
+nor numba, so the ``riskrf`` command can start that child before its own imports (:func:`start_early`).
+"""
+from __future__ import annotations
+
+import glob
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+#: The scenario the early child simulates a few blocks of: the kernel has one compiled version whatever the
+#: scenario, so any will do.
+BUNDLED_SCENARIO = Path(__file__).parent / "scenarios" / "road_cut_barrier.toml"
+
+_early = None
+
+
+class Precompile:
+    """The simulator compiled in a background process while the caller does other work.
+
+    Started early (``Precompile(scenario_path)``), it runs on the second core; :meth:`wait` returns when the
+    cache is written, after which the kernel loads in well under a second.  Where the on-disk cache is
+    already there no child is started (``check_cache=False`` starts one anyway: it then finishes as soon as
+    it has loaded the cache).  A failure in the child only means the kernel is compiled on first use instead.
+    """
+
+    def __init__(self, scenario_path, *, check_cache: bool = True):
+        self._proc = None
+        if check_cache and _cache_exists():
+            return
+        # A fresh interpreter (not multiprocessing): it never re-imports the caller's main script, so a user's
+        # script without an ``if __name__ == "__main__"`` guard works unchanged.
+        try:
+            self._proc = subprocess.Popen([sys.executable, "-c", "import sys, simulation.engine as e; "
+                                           "e._warm_up(sys.argv[1])", str(scenario_path)],
+                                          stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                          stderr=subprocess.DEVNULL)
+        except OSError:
+            self._proc = None
+
+    @property
+    def running(self) -> bool:
+        """True while the compiling child runs (False where the cache was there or no child could start)."""
+        return self._proc is not None and self._proc.poll() is None
+
+    def wait(self, timeout: float | None = 300.0) -> bool:
+        """Block until the compilation is done; True when the child finished cleanly (or was not needed)."""
+        if self._proc is None:
+            return True
+        try:
+            self._proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            self._proc.kill()
+            return False
+        return self._proc.returncode == 0
+
+
+def _cache_exists() -> bool:
+    """True when the kernel's on-disk cache index exists (numba internals; if they move, False: compile)."""
+    try:
+        from . import kernel
+        return os.path.exists(kernel.simulate._cache._cache_file._index_path)
+    except (AttributeError, TypeError):
+        return False
+
+
+def start_early() -> None:
+    """Start compiling the simulator now, before this process imports anything heavy, when its cache is not
+    there (checked by file name, without importing numba: ``simulation/__pycache__/kernel.simulate-*.nbi``;
+    with ``NUMBA_CACHE_DIR`` set the child starts and finishes at once if the cache is warm).  The next
+    :func:`precompile` call takes this child over.  Nothing is started with ``NUMBA_DISABLE_JIT``."""
+    global _early
+    if os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0") or _early is not None:
+        return
+    if not os.environ.get("NUMBA_CACHE_DIR"):
+        tag = f"py{sys.version_info[0]}{sys.version_info[1]}"
+        if glob.glob(str(Path(__file__).parent / "__pycache__" / f"kernel.simulate-*.{tag}.nbi")):
+            return
+    _early = Precompile(BUNDLED_SCENARIO, check_cache=False)
+
+
+def precompile(scenario_path) -> Precompile:
+    """The child :func:`start_early` started, if any (taken over once), else ``Precompile(scenario_path)``."""
+    global _early
+    if _early is not None:
+        started, _early = _early, None
+        return started
+    return Precompile(scenario_path)
