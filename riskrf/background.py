@@ -15,6 +15,7 @@ class InBackground:
     """
 
     def __init__(self, work, *, fork: bool = True):
+        import gc
         import os
         import threading
         self.work, self.proc, self.conn, self._done = work, None, None, None
@@ -24,7 +25,13 @@ class InBackground:
                 ctx = multiprocessing.get_context("fork")
                 self.conn, child = ctx.Pipe(duplex=False)
                 self.proc = ctx.Process(target=_send_result, args=(work, child), daemon=True)
-                self.proc.start()
+                # The objects alive now are frozen out of the garbage collector for the fork: the child's
+                # collections then never walk (and so never copy) the pages it shares with this process.
+                gc.freeze()
+                try:
+                    self.proc.start()
+                finally:
+                    gc.unfreeze()
                 child.close()
             except (OSError, ValueError):
                 self.proc = None
