@@ -12,7 +12,7 @@ Public API (units: mass kg, volume m³, energy kJ, velocity m/s, time yr)::
 """
 __version__ = "0.1.0"
 
-import importlib
+from simulation._lazy import lazy_exports
 
 #: Public name -> the module that holds it.  Imported on first use (PEP 562), so that ``import riskrf`` and the
 #: ``riskrf`` command start without loading pandas, scipy and numba until a command needs them.
@@ -33,21 +33,4 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
-
-def __getattr__(name: str):
-    """A public name, or a submodule, imported on first use."""
-    if name in _EXPORTS:
-        value = getattr(importlib.import_module(f"{__name__}.{_EXPORTS[name]}"), name)
-        globals()[name] = value
-        return value
-    if not name.startswith("__"):
-        try:
-            return importlib.import_module(f"{__name__}.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"{__name__}.{name}":
-                raise
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())

@@ -7,7 +7,7 @@
 """
 __version__ = "0.1.0"
 
-import importlib
+from ._lazy import lazy_exports
 
 #: Public name -> the module that holds it, imported on first use (PEP 562): ``simulation.units`` and
 #: ``simulation.precompile`` can then be imported without numpy or numba.
@@ -22,21 +22,4 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
-
-def __getattr__(name: str):
-    """A public name, or a submodule, imported on first use."""
-    if name in _EXPORTS:
-        value = getattr(importlib.import_module(f"{__name__}.{_EXPORTS[name]}"), name)
-        globals()[name] = value
-        return value
-    if not name.startswith("__"):
-        try:
-            return importlib.import_module(f"{__name__}.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"{__name__}.{name}":
-                raise
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())
