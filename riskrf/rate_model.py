@@ -438,7 +438,11 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
         outside the rainfall record, a rainfall gap inside the period (gaps are
         never filled), a covariate not covering the period.
     """
-    import statsmodels.api as sm
+    # the four model classes used, not statsmodels.api (which imports all of statsmodels: 0.7 s more)
+    from statsmodels.discrete.discrete_model import NegativeBinomial
+    from statsmodels.genmod import families
+    from statsmodels.genmod.generalized_linear_model import GLM
+    from statsmodels.regression.linear_model import OLS
     from statsmodels.tools.sm_exceptions import ConvergenceWarning
 
     if not isinstance(inventory, Inventory):
@@ -610,16 +614,16 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
     offset = np.log(design["exposure_days"].to_numpy(float))
 
     def fit_pair(Xm):
-        pois = sm.GLM(y, Xm, family=sm.families.Poisson(), offset=offset).fit()
+        pois = GLM(y, Xm, family=families.Poisson(), offset=offset).fit()
         nb = None
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ConvergenceWarning)
             try:
                 start_params = np.r_[pois.params.to_numpy(), 0.1]
-                nb = sm.NegativeBinomial(y, Xm, offset=offset, loglike_method="nb2").fit(
+                nb = NegativeBinomial(y, Xm, offset=offset, loglike_method="nb2").fit(
                     start_params=start_params, disp=0, maxiter=300, method="bfgs")
                 if not nb.mle_retvals.get("converged", True):
-                    nb = sm.NegativeBinomial(y, Xm, offset=offset, loglike_method="nb2").fit(
+                    nb = NegativeBinomial(y, Xm, offset=offset, loglike_method="nb2").fit(
                         start_params=nb.params.to_numpy(), disp=0, maxiter=300, method="newton")
             except (np.linalg.LinAlgError, ValueError) as exc:
                 nb = None
@@ -639,7 +643,7 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
     nb_glm = None
     if nb is not None:
         alpha = float(nb.params["alpha"])
-        nb_glm = sm.GLM(y, X, family=sm.families.NegativeBinomial(alpha=max(alpha, 1e-10)), offset=offset).fit()
+        nb_glm = GLM(y, X, family=families.NegativeBinomial(alpha=max(alpha, 1e-10)), offset=offset).fit()
         comparison["negative binomial"] = {"loglik": nb.llf, "aic": nb.aic, "deviance": nb_glm.deviance,
                                            "df_resid": nb.df_resid - 1,
                                            "pearson_chi2_per_df": nb_glm.pearson_chi2 / (nb_glm.df_resid - 1),
@@ -648,7 +652,7 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
         lr = max(2 * (nb.llf - pois.llf), 0.0)
         mu = np.asarray(pois.mu)
         aux = ((y - mu) ** 2 - y) / mu
-        ct = sm.OLS(aux, mu).fit()
+        ct = OLS(aux, mu).fit()
         ct_t = float(ct.tvalues[0])
         overdispersion = {"alpha": alpha, "lr_statistic": lr, "lr_p_value": 0.5 * stats.chi2.sf(lr, 1),
                           "ct_statistic": ct_t, "ct_p_value": float(stats.t.sf(ct_t, ct.df_resid))}
@@ -679,12 +683,12 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
     if trend:
         X0 = X.drop(columns="year_c")
         if preferred == "Poisson":
-            llf0 = sm.GLM(y, X0, family=sm.families.Poisson(), offset=offset).fit().llf
+            llf0 = GLM(y, X0, family=families.Poisson(), offset=offset).fit().llf
         else:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 sp = np.r_[res.params.drop(["year_c"]).to_numpy()]
-                llf0 = sm.NegativeBinomial(y, X0, offset=offset, loglike_method="nb2").fit(
+                llf0 = NegativeBinomial(y, X0, offset=offset, loglike_method="nb2").fit(
                     start_params=sp, disp=0, maxiter=300, method="bfgs").llf
         lr_t = max(2 * (res.llf - llf0), 0.0)
         row = rate_ratios.set_index("term").loc["year_c"]
