@@ -12,7 +12,7 @@ Public API (units: mass kg, volume m³, energy kJ, velocity m/s, time yr)::
 """
 __version__ = "0.1.0"
 
-from simulation._lazy import lazy_exports
+from simulation._lazy import lazy_exports as _lazy_exports
 
 #: Public name -> the module that holds it.  Imported on first use (PEP 562), so that ``import riskrf`` and the
 #: ``riskrf`` command start without loading pandas, scipy and numba until a command needs them.
@@ -33,4 +33,4 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())
+_lazy_exports(__name__, _EXPORTS)

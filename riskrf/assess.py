@@ -321,6 +321,9 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         from simulation.precompile import precompile
         compiling = precompile(site.resolve(hz_cfg["scenario"])) if hz_cfg["scenario"] else None
         beside = compiling is None or not compiling.running
+        if not beside:
+            log("      first run of this installation: the simulator is compiled once on the other core (numba, "
+                "cached on disk for later runs)")
         # The site's rate model (hazard rate, closure rules).
         rates = None
         if site.rates is not None:
@@ -371,13 +374,15 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                 finest = [min(float(law.m_min), float(masses[masses > 0].min(initial=np.inf)))
                           / 8.0 ** u.fragmentation_iterations]
             return extra + ([frag] if frag is not None else []) + finest
-        t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
-        if compiling is not None:
+        if compiling is not None and (not beside or compiling.running):
+            t = time.perf_counter()
             if not beside:          # this core's work while the simulator compiles on the other
                 for part in [rates] + pending:
                     if part is not None:
                         part.result()
             compiling.wait()
+            timings["compilation"] = round(time.perf_counter() - t, 2)
+        t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
         gr, hazard, result = energy_hazard_from_inputs(
             inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=rate_scale,
             scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,

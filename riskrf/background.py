@@ -12,6 +12,8 @@ class InBackground:
     the child dies, ``work`` runs in this process at :meth:`result`.  An exception raised by ``work`` in the
     child is raised again by :meth:`result`.  The value and the files are the same either way.
     ``fork=False`` keeps the work in this process (run at :meth:`result`): for when the other core is taken.
+    Warnings the work raises are not passed on, wherever it ran (a forked child cannot pass them on): work
+    whose warnings matter returns them (the rate model keeps them in its notes).
     """
 
     def __init__(self, work, *, fork: bool = True):
@@ -27,11 +29,14 @@ class InBackground:
                 self.proc = ctx.Process(target=_send_result, args=(work, child), daemon=True)
                 # The objects alive now are frozen out of the garbage collector for the fork: the child's
                 # collections then never walk (and so never copy) the pages it shares with this process.
-                gc.freeze()
+                freeze = gc.get_freeze_count() == 0       # (objects someone else froze stay frozen)
+                if freeze:
+                    gc.freeze()
                 try:
                     self.proc.start()
                 finally:
-                    gc.unfreeze()
+                    if freeze:
+                        gc.unfreeze()
                 child.close()
             except (OSError, ValueError):
                 self.proc = None
@@ -53,16 +58,24 @@ class InBackground:
             if status == "error":
                 raise value
             if status != "ok":
-                value = self.work()
+                value = _quietly(self.work)
         else:
-            value = self.work()
+            value = _quietly(self.work)
         self._done = (value,)
         return value
 
 
+def _quietly(work):
+    """``work()`` with the warnings it raises recorded and dropped (the same in a child and in this process)."""
+    import warnings
+    with warnings.catch_warnings(record=True):
+        warnings.simplefilter("always")
+        return work()
+
+
 def _send_result(work, conn):
     try:
-        value = work()
+        value = _quietly(work)
     except Exception as exc:          # noqa: BLE001  (sent back and raised in the parent)
         conn.send(("error", exc))
     else:

@@ -907,14 +907,26 @@ def _interrupted(args) -> int:
 
 
 def _compile_early(argv) -> None:
-    """For ``riskrf demo`` and ``riskrf assess`` (not their ``--help``), start compiling the simulator on the other
-    core before this process imports pandas, scipy and numba (about 2 s), when its cache is not there yet
-    (:func:`simulation.precompile.start_early`): on a fresh installation that compilation is the longest part of
-    the first run."""
+    """For ``riskrf demo`` and ``riskrf assess SITE.toml`` with a site that simulates (not their ``--help``), start
+    compiling the simulator on the other core before this process imports pandas, scipy and numba (about 2 s),
+    when its cache is not there yet (:func:`simulation.precompile.start_early`): on a fresh installation that
+    compilation is the longest part of the first run.  A child no run takes over is stopped when the command
+    ends (:func:`simulation.precompile.discard_early`)."""
     words = [a for a in argv if not a.startswith("-")]
-    if words and words[0] in ("demo", "assess") and not {"-h", "--help"} & set(argv):
-        from simulation.precompile import start_early
-        start_early()
+    asks_help = any(a == "-h" or (len(a) > 2 and "--help".startswith(a)) for a in argv)
+    if not words or words[0] not in ("demo", "assess") or asks_help:
+        return
+    if words[0] == "assess":          # only for a site that simulates (a readable site file naming a scenario)
+        import tomllib
+        sites = [w for w in words[1:] if w.endswith(".toml")]
+        try:
+            with open(sites[0], "rb") as f:
+                if not tomllib.load(f).get("hazard", {}).get("scenario"):
+                    return
+        except (IndexError, OSError, ValueError, AttributeError):
+            return
+    from simulation.precompile import start_early
+    start_early()
 
 
 def command() -> int:
@@ -923,7 +935,11 @@ def command() -> int:
     garbage collector, so that the interpreter's collection at exit does not walk them one by one (about
     0.7 s after a demo); the process ends right after, nothing is lost."""
     _compile_early(sys.argv[1:])
-    status = main()
+    try:
+        status = main()
+    finally:
+        if "simulation.precompile" in sys.modules:
+            sys.modules["simulation.precompile"].discard_early()
     import gc
     gc.freeze()
     return status

@@ -7,7 +7,7 @@
 """
 __version__ = "0.1.0"
 
-from ._lazy import lazy_exports
+from ._lazy import lazy_exports as _lazy_exports
 
 #: Public name -> the module that holds it, imported on first use (PEP 562): ``simulation.units`` and
 #: ``simulation.precompile`` can then be imported without numpy or numba.
@@ -22,4 +22,4 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())
+_lazy_exports(__name__, _EXPORTS)

@@ -87,7 +87,8 @@ def _seg_in(px, x, lo, hi):
 @njit(cache=True)
 def _first_at_least(a, v):
     """Index of the first element of the ascending array ``a`` that is >= v (``numpy.searchsorted``, side
-    "left"; written out because numba's version costs about a second of compilation)."""
+    "left"; written out because numba's version costs about a second of compilation).  A NaN ``v`` gives 0
+    where numpy gives ``a.size``; the kernel only passes finite positions."""
     lo, hi = 0, a.shape[0]
     while lo < hi:
         mid = (lo + hi) // 2

@@ -85,9 +85,28 @@ def start_early() -> None:
 
 
 def precompile(scenario_path) -> Precompile:
-    """The child :func:`start_early` started, if any (taken over once), else ``Precompile(scenario_path)``."""
+    """The compilation for a run about to simulate: nothing to do where the kernel's cache is there (numba's
+    own lookup, which also knows ``NUMBA_CACHE_DIR`` and its fall-back folder: an early child is then stopped,
+    it was only loading the cache), else the child :func:`start_early` started (taken over once), else
+    ``Precompile(scenario_path)``."""
     global _early
+    if _cache_exists():
+        discard_early()
+        return Precompile(scenario_path)          # starts nothing: the cache is there
     if _early is not None:
         started, _early = _early, None
         return started
-    return Precompile(scenario_path)
+    return Precompile(scenario_path, check_cache=False)
+
+
+def discard_early() -> None:
+    """Stop the child :func:`start_early` started if no run took it over (a command that failed early, a site
+    without a scenario), so that it does not keep compiling after the command has ended."""
+    global _early
+    if _early is not None and _early._proc is not None and _early._proc.poll() is None:
+        _early._proc.terminate()
+        try:
+            _early._proc.wait(5)
+        except subprocess.TimeoutExpired:
+            _early._proc.kill()
+    _early = None

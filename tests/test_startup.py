@@ -30,6 +30,15 @@ def test_every_public_name_resolves(package):
         package.not_a_name
 
 
+def test_public_name_kept_when_its_module_is_imported():
+    """``riskrf.rate_model`` is the function, as with an eager ``__init__``, even after something imports the
+    submodule of the same name (a plain lazy package would then hold the module)."""
+    code = ("import riskrf.closure, riskrf.rate_model as m; from riskrf import rate_model; import riskrf; "
+            "print(callable(rate_model), riskrf.rate_model is rate_model, 'lazy_exports' in dir(riskrf))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["True", "True", "False"]
+
+
 def test_submodules_as_attributes():
     assert riskrf.mitigation.MitigationStudy.__name__ == "MitigationStudy"
     assert simulation.kernel.simulate is not None
@@ -63,9 +72,10 @@ def test_early_child_is_taken_over_once(fake_precompile, monkeypatch, tmp_path):
     early = fake_precompile[0]
     assert early.scenario_path == pc.BUNDLED_SCENARIO and pc.BUNDLED_SCENARIO.exists()
     assert early.check_cache is False
+    monkeypatch.setattr(pc, "_cache_exists", lambda: False)
     assert pc.precompile("site_scenario.toml") is early
     later = pc.precompile("site_scenario.toml")                  # taken over once; then a new one
-    assert later is not early and later.scenario_path == "site_scenario.toml" and later.check_cache
+    assert later is not early and later.scenario_path == "site_scenario.toml"
 
 
 def test_no_early_child_without_jit(fake_precompile, monkeypatch):
@@ -75,10 +85,34 @@ def test_no_early_child_without_jit(fake_precompile, monkeypatch):
 
 
 @pytest.mark.parametrize("argv, started", [
-    (["demo"], True), (["--debug", "assess", "site.toml"], True), (["demo", "--help"], False),
+    (["demo"], True), (["--debug", "assess", "sim.toml"], True), (["assess", "--out", "x", "sim.toml"], True),
+    (["assess", "velocities.toml"], False), (["assess", "missing.toml"], False), (["assess"], False),
+    (["demo", "--help"], False), (["demo", "--he"], False), (["assess", "sim.toml", "-h"], False),
     (["fit", "x.csv"], False), ([], False), (["simulate", "s.toml"], False)])
-def test_command_starts_compiling_only_for_assessments(argv, started, monkeypatch):
+def test_command_starts_compiling_only_for_assessments_that_simulate(argv, started, monkeypatch, tmp_path):
+    (tmp_path / "sim.toml").write_text('[hazard]\nscenario = "s.toml"\n')
+    (tmp_path / "velocities.toml").write_text('[hazard]\nvelocities = "v.csv"\n')
+    monkeypatch.chdir(tmp_path)
     calls = []
     monkeypatch.setattr(pc, "start_early", lambda: calls.append(1))
     cli._compile_early(argv)
     assert bool(calls) is started
+
+
+def test_early_child_stopped_when_not_taken_over(monkeypatch):
+    """A child no run took over (the command failed early, the site has no scenario) is stopped."""
+    child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    early = pc.Precompile.__new__(pc.Precompile)
+    early._proc = child
+    monkeypatch.setattr(pc, "_early", early)
+    pc.discard_early()
+    assert child.poll() is not None and pc._early is None
+
+
+def test_warm_cache_needs_no_child(fake_precompile, monkeypatch):
+    """With the kernel's cache there (numba's own lookup), an early child is stopped and nothing is started."""
+    stopped = []
+    monkeypatch.setattr(pc, "_cache_exists", lambda: True)
+    monkeypatch.setattr(pc, "discard_early", lambda: stopped.append(1))
+    made = pc.precompile("site_scenario.toml")
+    assert stopped == [1] and made.check_cache is True      # Precompile(check_cache=True) finds the cache
