@@ -319,7 +319,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         # core while this one fits, fits the rate model and draws the fits' figures (below); otherwise those
         # two go to forked children on the other core.
         from simulation.precompile import precompile
-        compiling = precompile(site.resolve(hz_cfg["scenario"])) if hz_cfg["scenario"] else None
+        compiling = precompile() if hz_cfg["scenario"] else None
         beside = compiling is None or not compiling.running
         if not beside:
             log("      first run of this installation: the simulator is compiled once on the other core (numba, "

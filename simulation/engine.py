@@ -188,10 +188,4 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
                             paths={name: arr[:k] for name, arr in paths.items()}, elapsed_s=elapsed)
 
 
-def _warm_up(path: str) -> None:
-    """Compile the kernel by simulating a few blocks of the scenario at ``path`` (child-process target)."""
-    from .scenario import load_scenario
-    run(load_scenario(path), n=4, seed=0, record_paths=4)
-
-
 from .precompile import Precompile  # noqa: E402,F401  (its former home; kept for callers)

@@ -2,8 +2,9 @@
 
 numba compiles the trajectory kernel on first use and caches the machine code on disk (``cache=True``); on a
 fresh installation that first compilation takes 10-15 CPU-s.  :class:`Precompile` runs it in a fresh
-interpreter while the caller does work that does not need the simulator.  This module imports neither numpy
-nor numba, so the ``riskrf`` command can start that child before its own imports (:func:`start_early`).
+interpreter while the caller does work that does not need the simulator; the child imports only numpy, numba
+and the kernel (:func:`compile_kernel`), not pandas or scipy.stats.  This module imports neither numpy nor numba at
+its top, so the ``riskrf`` command can start that child before its own imports (:func:`start_early`).
 """
 from __future__ import annotations
 
@@ -13,31 +14,27 @@ import subprocess
 import sys
 from pathlib import Path
 
-#: The scenario the early child simulates a few blocks of: the kernel has one compiled version whatever the
-#: scenario, so any will do.
-BUNDLED_SCENARIO = Path(__file__).parent / "scenarios" / "road_cut_barrier.toml"
-
 _early = None
 
 
 class Precompile:
     """The simulator compiled in a background process while the caller does other work.
 
-    Started early (``Precompile(scenario_path)``), it runs on the second core; :meth:`wait` returns when the
+    Started early (``Precompile()``), it runs on the second core; :meth:`wait` returns when the
     cache is written, after which the kernel loads in well under a second.  Where the on-disk cache is
     already there no child is started (``check_cache=False`` starts one anyway: it then finishes as soon as
     it has loaded the cache).  A failure in the child only means the kernel is compiled on first use instead.
     """
 
-    def __init__(self, scenario_path, *, check_cache: bool = True):
+    def __init__(self, *, check_cache: bool = True):
         self._proc = None
         if check_cache and _cache_exists():
             return
         # A fresh interpreter (not multiprocessing): it never re-imports the caller's main script, so a user's
         # script without an ``if __name__ == "__main__"`` guard works unchanged.
         try:
-            self._proc = subprocess.Popen([sys.executable, "-c", "import sys, simulation.engine as e; "
-                                           "e._warm_up(sys.argv[1])", str(scenario_path)],
+            self._proc = subprocess.Popen([sys.executable, "-c", "import simulation.precompile as p; "
+                                           "p.compile_kernel()"],
                                           stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                           stderr=subprocess.DEVNULL)
         except OSError:
@@ -81,22 +78,22 @@ def start_early() -> None:
         tag = f"py{sys.version_info[0]}{sys.version_info[1]}"
         if glob.glob(str(Path(__file__).parent / "__pycache__" / f"kernel.simulate-*.{tag}.nbi")):
             return
-    _early = Precompile(BUNDLED_SCENARIO, check_cache=False)
+    _early = Precompile(check_cache=False)
 
 
-def precompile(scenario_path) -> Precompile:
+def precompile() -> Precompile:
     """The compilation for a run about to simulate: nothing to do where the kernel's cache is there (numba's
     own lookup, which also knows ``NUMBA_CACHE_DIR`` and its fall-back folder: an early child is then stopped,
-    it was only loading the cache), else the child :func:`start_early` started (taken over once), else
-    ``Precompile(scenario_path)``."""
+    it was only loading the cache), else the child :func:`start_early` started (taken over once), else a new
+    :class:`Precompile`."""
     global _early
     if _cache_exists():
         discard_early()
-        return Precompile(scenario_path)          # starts nothing: the cache is there
+        return Precompile()                       # starts nothing: the cache is there
     if _early is not None:
         started, _early = _early, None
         return started
-    return Precompile(scenario_path, check_cache=False)
+    return Precompile(check_cache=False)
 
 
 def discard_early() -> None:
@@ -110,3 +107,36 @@ def discard_early() -> None:
         except subprocess.TimeoutExpired:
             _early._proc.kill()
     _early = None
+
+
+def compile_kernel() -> None:
+    """Compile the trajectory kernel (or load it from the cache) by calling it on no blocks, with arguments of
+    the types :func:`simulation.engine.run` passes (``tests/test_startup.py`` checks that they are the same, so
+    that the run finds this compiled version).  Imports numpy, numba and the kernel only."""
+    from . import kernel
+    kernel.simulate(**empty_kernel_arguments())
+
+
+def empty_kernel_arguments() -> dict:
+    """Arguments of :func:`simulation.kernel.simulate` for no blocks, by name: empty arrays of each argument's
+    dtype, the envelope accumulator 2-d, scalars of the run's types."""
+    import inspect
+
+    import numpy as np
+
+    from . import kernel
+    ints = {"block_ids", "seg_mat", "run_first", "run_last", "m_en_law", "m_et_law", "c_order",
+            "out_reason", "out_impacts", "r_block", "r_coll", "r_outcome", "r_count", "pb", "pmode", "pev",
+            "pcount"}
+    bools = {"m_roll", "m_gain"}
+    scalars = {"g": 9.81, "v_contact": 0.5, "v_stop": 0.1, "max_events": 1, "n_leaves": 1, "n_path_blocks": 0,
+               "key": np.uint64(1)}
+    out = {}
+    for name in inspect.signature(getattr(kernel.simulate, "py_func", kernel.simulate)).parameters:
+        if name in scalars:
+            out[name] = scalars[name]
+        elif name == "env_acc":
+            out[name] = np.zeros((0, 7))
+        else:
+            out[name] = np.zeros(0, dtype=np.int64 if name in ints else bool if name in bools else float)
+    return out

@@ -50,8 +50,8 @@ def test_submodules_as_attributes():
 class _FakePrecompile:
     made = []
 
-    def __init__(self, scenario_path, *, check_cache=True):
-        self.scenario_path, self.check_cache = scenario_path, check_cache
+    def __init__(self, *, check_cache=True):
+        self.check_cache = check_cache
         _FakePrecompile.made.append(self)
 
 
@@ -70,12 +70,11 @@ def test_early_child_is_taken_over_once(fake_precompile, monkeypatch, tmp_path):
     pc.start_early()                                             # a second call starts nothing more
     assert len(fake_precompile) == 1
     early = fake_precompile[0]
-    assert early.scenario_path == pc.BUNDLED_SCENARIO and pc.BUNDLED_SCENARIO.exists()
     assert early.check_cache is False
     monkeypatch.setattr(pc, "_cache_exists", lambda: False)
-    assert pc.precompile("site_scenario.toml") is early
-    later = pc.precompile("site_scenario.toml")                  # taken over once; then a new one
-    assert later is not early and later.scenario_path == "site_scenario.toml"
+    assert pc.precompile() is early
+    later = pc.precompile()                                      # taken over once; then a new one
+    assert later is not early and len(fake_precompile) == 2
 
 
 def test_no_early_child_without_jit(fake_precompile, monkeypatch):
@@ -114,5 +113,38 @@ def test_warm_cache_needs_no_child(fake_precompile, monkeypatch):
     stopped = []
     monkeypatch.setattr(pc, "_cache_exists", lambda: True)
     monkeypatch.setattr(pc, "discard_early", lambda: stopped.append(1))
-    made = pc.precompile("site_scenario.toml")
+    made = pc.precompile()
     assert stopped == [1] and made.check_cache is True      # Precompile(check_cache=True) finds the cache
+
+
+def test_compile_call_has_the_runs_argument_types(monkeypatch):
+    """The compiling child calls the kernel on no blocks (``compile_kernel``, without pandas or scipy.stats); its
+    arguments must have exactly the numba types of a real run's, or the run would compile a second version."""
+    import inspect
+
+    import numba
+
+    import simulation.kernel as kernel
+    signature = inspect.signature(getattr(kernel.simulate, "py_func", kernel.simulate))
+    empty = pc.empty_kernel_arguments()
+    calls = []
+    monkeypatch.setattr(kernel, "simulate", lambda *a, **kw: calls.append(signature.bind(*a, **kw).arguments))
+    scenario = simulation.load_scenario(pc.Path(simulation.__file__).parent / "scenarios" / "road_cut_barrier.toml")
+    try:
+        simulation.run(scenario, n=3, seed=0, record_paths=3)
+    except Exception:          # the stand-in kernel did nothing, so no result can be built: the calls are what counts
+        pass
+    assert calls and list(empty) == list(signature.parameters)
+    for real in calls:
+        assert list(real) == list(empty)
+        for name in real:
+            assert numba.typeof(real[name]) == numba.typeof(empty[name]), name
+
+
+def test_compile_kernel_runs_on_no_blocks():
+    """``compile_kernel`` in a fresh interpreter: loads (here, from the suite's warm cache) or compiles the kernel
+    and simulates nothing, without importing pandas or scipy.stats."""
+    code = ("import sys, simulation.precompile as p; p.compile_kernel(); "
+            "print(sorted({'pandas', 'scipy.stats'} & set(sys.modules)))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=300)
+    assert out.stdout.strip() == "[]"
