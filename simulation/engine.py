@@ -187,5 +187,3 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
                             crossings=merged, envelope_x=env_x, envelope_acc=env_acc,
                             paths={name: arr[:k] for name, arr in paths.items()}, elapsed_s=elapsed)
 
-
-from .precompile import Precompile  # noqa: E402,F401  (its former home; kept for callers)
