@@ -485,16 +485,8 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
         _frequency_outputs(a.frequency, a.maxima_frequency, figs)
         a.energy.write(figs)
         beside.result()
-    for name in ("summary.json", "completeness.csv"):
+    for name in ("summary.json", "completeness.csv", "whole_wall_design_masses.csv"):
         shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
-    _label_reference_masses(figs / "design_masses.csv", out / "frequency_summary.json", WHOLE_WALL_BASIS,
-                            out / "whole_wall_design_masses.csv")
-    if a.maxima_frequency is not None:
-        sub = figs / "annual_maxima"
-        _label_reference_masses(sub / "design_masses.csv", sub / "summary.json",
-                                f"annual-maximum record {Path(str(a.maxima_frequency.inventory.source)).name}: "
-                                "another record's fit, untruncated: reference only, not this site's design masses",
-                                sub / "record_design_masses.csv")
     for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv", "design_energy_sensitivity.csv",
                  "design_energy_tornado.csv", "design_block.csv", "site_design_masses.csv"):
         if (figs / name).exists():
@@ -515,26 +507,17 @@ WHOLE_WALL_BASIS = ("whole monitored wall (inventory fit), untruncated power law
                     "not the site's design masses (site_design_masses.csv)")
 
 
-def _label_reference_masses(csv: Path, summary_json: Path, basis: str, dest: Path) -> None:
-    """Say what a fit's design-mass table is: a ``basis`` column in the CSV (moved to ``dest``), and in its summary
-    JSON the key ``design_masses`` renamed after ``dest`` (e.g. ``whole_wall_design_masses``) with its basis."""
-    import pandas as pd
-    pd.read_csv(csv).assign(basis=basis).to_csv(dest, index=False)
-    csv.unlink()
-    data = json.loads(summary_json.read_text(encoding="utf-8"))
-    key = dest.stem
-    data[key] = [dict(r, basis=basis) for r in data.pop("design_masses")]
-    data[key + "_basis"] = basis
-    write_json(data, summary_json)
-
-
 def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:
-    """Tables and figures of the inventory's fits (and of the annual-maximum record, in a subfolder)."""
-    frequency.write(figs)
+    """Tables and figures of the inventory's fits (and of the annual-maximum record, in a subfolder), their
+    design-mass tables labelled as references, not the site's design masses."""
+    frequency.write(figs, design_masses_name="whole_wall_design_masses", basis=WHOLE_WALL_BASIS)
     if maxima_frequency is not None:
         sub = figs / "annual_maxima"
         sub.mkdir()
-        maxima_frequency.write(sub)
+        maxima_frequency.write(sub, design_masses_name="record_design_masses",
+                               basis=f"annual-maximum record {Path(str(maxima_frequency.inventory.source)).name}: "
+                                     "another record's fit, untruncated: reference only, not this site's design "
+                                     "masses")
 
 
 def fences_to_draw(site) -> list:

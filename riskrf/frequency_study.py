@@ -245,15 +245,26 @@ class FrequencyAnalysis:
             lines += ["", "Warnings:"] + [f"  - {w}" for w in self.warnings]
         return "\n".join(lines)
 
-    def write(self, out_dir) -> list[Path]:
-        """Write summary.json, design_masses.csv, completeness.csv and PNG figures into ``out_dir``."""
+    def write(self, out_dir, *, design_masses_name: str = "design_masses", basis: str | None = None) -> list[Path]:
+        """Write summary.json, design_masses.csv, completeness.csv and PNG figures into ``out_dir``.
+
+        ``basis``: what the design-mass table is, when it is not the site's own (``riskrf assess`` labels the
+        whole wall's fit and another record's so): a ``basis`` column in the table, written as
+        ``design_masses_name``.csv, and in summary.json the table under ``design_masses_name`` with
+        ``design_masses_name``_basis.
+        """
         from .report.files import write_frequency_figures
 
         out = Path(out_dir)
-        write_json(self.to_dict(), out / "summary.json")
-        self.design_masses().to_csv(out / "design_masses.csv", index=False)
+        data, table = self.to_dict(), self.design_masses()
+        if basis is not None:
+            table = table.assign(basis=basis)
+            data[design_masses_name] = [dict(r, basis=basis) for r in data.pop("design_masses")]
+            data[design_masses_name + "_basis"] = basis
+        write_json(data, out / "summary.json")
+        table.to_csv(out / f"{design_masses_name}.csv", index=False)
         self.inventory.completeness().to_csv(out / "completeness.csv")
-        written = [out / "summary.json", out / "design_masses.csv", out / "completeness.csv"]
+        written = [out / "summary.json", out / f"{design_masses_name}.csv", out / "completeness.csv"]
         written += write_frequency_figures(self, out)
         return written
 
