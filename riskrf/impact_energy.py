@@ -303,7 +303,7 @@ def _integrate_velocity_dist(e, mm, vdist):
     ends = np.array([m for m in mm.support if np.isfinite(m) and m > 0], dtype=float)
     out = np.empty(e.size)
     for i, ei in enumerate(e.ravel()):
-        total = np.sum(dens * mm.sf(2.0 * J_PER_KJ * ei / (v * v)), axis=1)
+        total = np.sum(dens * mm.sf(mass_for_energy_kg(ei, v)), axis=1)
         if ends.size and ei > 0:
             kinks = 0.5 * np.log(2.0 * J_PER_KJ * ei / ends)
             kinks = kinks[(kinks > edges[0]) & (kinks < edges[-1])]
@@ -311,7 +311,7 @@ def _integrate_velocity_dist(e, mm, vdist):
                 sub = np.union1d(edges[j:j + 2], kinks)
                 sub = sub[(sub >= edges[j]) & (sub <= edges[j + 1])]
                 vs, ds = _gl_panels(sub, vdist, p_pos)
-                total[j] = np.sum(ds * mm.sf(2.0 * J_PER_KJ * ei / (vs * vs)))
+                total[j] = np.sum(ds * mm.sf(mass_for_energy_kg(ei, vs)))
         out[i] = np.sum(total)
     return np.clip(out, 0.0, 1.0).reshape(e.shape)
 

@@ -225,13 +225,13 @@ class Inventory:
         if unknown:
             series = series.drop(unknown)
             warn(f"{self.source}: {len(unknown)} of {len(years)} years have falls but no exact size "
-                 f"({', '.join(map(str, unknown[:10]))}{' ...' if len(unknown) > 10 else ''}); their maximum is "
+                 f"({_line_list(unknown, 10)}); their maximum is "
                  "unknown (not zero), so they are left out of the annual maxima and counted as years with a fall")
         series.attrs["years_without_exact_size"] = [int(y) for y in unknown]
         empty = series.index[series.isna()].tolist()
         if empty:
             warn(f"{self.source}: {len(empty)} of {len(years)} years have no recorded fall "
-                 f"({', '.join(map(str, empty[:10]))}{' ...' if len(empty) > 10 else ''}); they are kept "
+                 f"({_line_list(empty, 10)}); they are kept "
                  "as NaN and the Gumbel/GEV fits treat them with the mixed (zero-year) model")
         self._warn_censored_maxima(series, col)
         partial = [y for y in (years[:1] + years[-1:]) if self._coverage(y) < 0.999]
@@ -251,10 +251,8 @@ class Inventory:
             year, value, kind = int(row["year"]), row[col], row["censoring"]
             if year not in series.index:
                 continue
-            top = series.loc[year]
-            if np.isnan(top):
-                changes = True                      # the year has no exact size at all
-            elif kind == "unknown":
+            top = series.loc[year]          # exact: years with falls but no exact size were left out above
+            if kind == "unknown":
                 changes = False                     # no size recorded: nothing to compare
             else:
                 changes = value > top or (kind == "above" and value >= top)

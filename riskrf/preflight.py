@@ -57,7 +57,6 @@ def check_energy_args(args, *, road_collector=None) -> None:
         check_number(args.free_board, "--free-board", low=0, what=" m")
         for cap in args.fence or ():
             check_number(cap, "--fence", low=0, low_open=True, what=" kJ")
-    if hasattr(args, "design_percentile"):
         check_number(args.design_percentile, "--design-percentile", low=0, high=100, low_open=True, high_open=True,
                      what=" % (the design block's percentile of the block sizes; ONR 24810: 95-98)")
         check_number(args.fractal_dimension, "--fractal-dimension", low=0, high=3, low_open=True, high_open=True,

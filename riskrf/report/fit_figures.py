@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..extremes import gumbel_reduced_variate, plotting_positions
+from ..extremes import _n_unknown_years, gumbel_reduced_variate, plotting_positions
 from ..units import KG_PER_TONNE, mass_for_energy_kg
 
 
@@ -121,7 +121,7 @@ def plot_return_levels(fits, ax=None, *, power_law=None, maxima=None, formula: s
                     label=f"implied by power law (b = {power_law.b:.2f})")
     if maxima is not None:
         values = np.asarray(maxima, dtype=float)
-        n = values.size + len(getattr(maxima, "attrs", {}).get("years_without_exact_size", ()))
+        n = values.size + _n_unknown_years(maxima)
         x = np.sort(values[~np.isnan(values)])
         F = plotting_positions(n, formula)[n - x.size:]
         ax.semilogx(1 / (1 - F), x, "o", ms=4, mfc="none", color="0.3", label=f"annual maxima ({formula})")

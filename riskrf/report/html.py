@@ -110,16 +110,8 @@ def _field_label(field: str) -> str:
 def _plain_value(value, field: str = "") -> str:
     """A default's value for a reader: yes/no, "not given", numbers to 3 significant figures, a curve of
     (mass, value) pairs as "10 kg: 0.05; 100 kg: 0.3", lists separated by semicolons; no quotes."""
-    if isinstance(value, (bool, np.bool_)):
-        return "yes" if value else "no"
     if value is None:
         return "not given"
-    if isinstance(value, str):
-        return value
-    if isinstance(value, (int, np.integer)):
-        return f"{int(value):,}"
-    if isinstance(value, (float, np.floating)):
-        return sig(value)
     if isinstance(value, dict):
         return "; ".join(f"{k}: {_plain_value(v)}" for k, v in value.items())
     if isinstance(value, (list, tuple)):
@@ -127,7 +119,7 @@ def _plain_value(value, field: str = "") -> str:
             unit = " kg" if "vulnerability" in field or "mass" in field else ""
             return "; ".join(f"{_plain_value(m)}{unit}: {_plain_value(y)}" for m, y in value)
         return "; ".join(_plain_value(v) for v in value)
-    return str(value)
+    return cell(value)          # yes/no, whole numbers with separators, 3 significant figures, text as it is
 
 
 def _plain_text(text: str, field: str = "") -> str:
