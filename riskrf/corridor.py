@@ -154,9 +154,14 @@ def _read_table(path: Path, reader: dict | None = None) -> tuple[pd.DataFrame, n
     return table, rows
 
 
+def _section_key(sid: str) -> int:
+    """crc32 of a section id: the key of its seed and of its partition file (ids must not share one)."""
+    return zlib.crc32(sid.encode("utf-8"))
+
+
 def _section_seed(seed: int, sid: str) -> int:
     """Seed of one section: the SeedSequence(seed) child at spawn key crc32(id), as an integer."""
-    child = np.random.SeedSequence(int(seed), spawn_key=(zlib.crc32(sid.encode("utf-8")),))
+    child = np.random.SeedSequence(int(seed), spawn_key=(_section_key(sid),))
     return int(child.generate_state(1, dtype=np.uint64)[0]) >> 1          # < 2**63: fits int64 columns
 
 
@@ -638,7 +643,7 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     # a section's seed and partition file are keyed by crc32(id): two ids with one checksum would share both
     by_key = {}
     for sec in sorted(sections, key=lambda s: s.row):
-        k = zlib.crc32(sec.id.encode("utf-8"))
+        k = _section_key(sec.id)
         if k in by_key:
             first = by_key[k]
             errors.append(f"{tsrc}: row {sec.row} (section {sec.id!r}): column 'id' = {sec.id!r} has the same crc32 "
@@ -695,7 +700,7 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
     import simulation
 
     from .impact_energy import mass_model
-    from .mass_coupling import simulate_energy_hazard
+    from .mass_coupling import NoArrivalsError, simulate_energy_hazard
     from .measures import SimulationContext
     from .mitigation import MitigationStudy
 
@@ -714,9 +719,7 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
         # m_min-m_max whatever the rate; beyond it the hazard's notes state the extrapolated share)
         hazard, coupled = simulate_energy_hazard(corridor.mass, section.scenario, "barrier",
                                                  rate_per_year=section.falls_per_year, n=n, seed=s_seed)
-    except ValueError as exc:
-        if "no simulated block reached" not in str(exc):
-            raise
+    except NoArrivalsError:
         if corridor.rate_basis == "road":
             raise ValueError(f"section {section.id!r}: no simulated block of {n:,} reached the barrier line (nor the "
                              "road), so the release rate behind the recorded road falls cannot be derived; check "
@@ -893,7 +896,7 @@ def _pv(corridor) -> float:
 
 def _write_partition(directory: Path, row: dict) -> None:
     directory.mkdir(parents=True, exist_ok=True)
-    name = f"section={zlib.crc32(row['id'].encode()):08x}.parquet"
+    name = f"section={_section_key(row['id']):08x}.parquet"
     tmp = directory / (name + ".partial")
     pd.DataFrame([row]).to_parquet(tmp, index=False)
     os.replace(tmp, directory / name)

@@ -104,8 +104,8 @@ class EnergyAnalysis:
                           f"E_k = {sig(u.characteristic_energy_kj, 4)} kJ, E_d = {sig(u.design_energy_kj, 4)} kJ "
                           f"(gamma_Tr {u.factors['gamma_Tr']}, gamma_Dp {u.factors['gamma_Dp']}, "
                           f"gamma_VolF {u.factors['gamma_VolF']}, gamma_gamma {u.factors['gamma_gamma']})"]
-        elif self._uni_missing_reason():
-            lines += ["", f"UNI 11211-4 design energy not computed: {self._uni_missing_reason()}"]
+        elif (why := self._uni_missing_reason()):
+            lines += ["", f"UNI 11211-4 design energy not computed: {why}"]
         for name, table in self.fences.items():
             lines += ["", f"Fence {name}:"]
             for _, r in table.iterrows():
@@ -154,7 +154,7 @@ class EnergyAnalysis:
             out["design_energy_tornado"] = self.tornado.to_dict()
         if self.uni is None:
             out["uni11211"] = {"design_return_period_years": self.design_T, "not_computed": self._uni_missing_reason()}
-        if self.uni is not None:
+        else:
             out["uni11211"] = {"design_return_period_years": self.design_T,
                                "characteristic_energy_kj": self.uni.characteristic_energy_kj,
                                "design_energy_kj": self.uni.design_energy_kj,

@@ -42,6 +42,11 @@ _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
 RANGE_RETURN_PERIOD_YEARS = 10_000.0
 
 
+class NoArrivalsError(ValueError):
+    """No simulated block reached the collector: the hazard there is nil for the simulated release (a corridor
+    section takes it as such; elsewhere it is an error naming the collector)."""
+
+
 @dataclass(frozen=True, eq=False)
 class MassCoupledSamples:
     """Simulated blocks across a mass range: each block's mass and what it did at one line.
@@ -423,7 +428,7 @@ def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_p
     result = simulation.run(sc, seed=seed, masses_kg=masses)
     df = result.collector(collector, first_only=True)
     if df.empty:
-        raise ValueError(f"no simulated block reached collector {collector!r}: the hazard there is nil for the "
+        raise NoArrivalsError(f"no simulated block reached collector {collector!r}: the hazard there is nil for the "
                          "simulated release; check the scenario")
     speed = np.full(result.n, np.nan)
     height = np.full(result.n, np.nan)

@@ -683,9 +683,10 @@ class MitigationStudy:
         edges, mid, _ = self._grid
         n_gen = self.uncertainty.fragmentation_iterations
         D = np.atleast_1d(np.asarray(fractal_dimension, dtype=float))
-        tables = [fractal_fragments(1.0, float(d), n_gen) for d in D]       # per unit volume of the event
+        Du, which = np.unique(D, return_inverse=True)     # each distinct D once (a scan holds D at one value)
+        tables = [fractal_fragments(1.0, float(d), n_gen) for d in Du]      # per unit volume of the event
         share = tables[0]["volume_m3"].to_numpy()                            # fragment / event volume (D-free)
-        counts = np.array([t["count"].to_numpy() for t in tables])          # (S, G)
+        counts = np.array([t["count"].to_numpy() for t in tables])[which.ravel()]     # (S, G)
         k = np.clip(np.searchsorted(edges, mid[:, None] * share[None, :], side="right") - 1, 0, mid.size - 1)
         out = np.zeros((D.size, mid.size, mid.size))
         rows = np.arange(mid.size)
