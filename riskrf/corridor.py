@@ -248,7 +248,7 @@ def _shared_rate(table, base: Path, m_min_kg: float, source: str):
     if table is None:
         return None
     if not isinstance(table, dict):
-        raise CorridorError(f"{source}: [rates] must be a table")
+        raise CorridorError(f"{source}: rates = {table!r} must be a table ([rates] with inventory = ...)")
     _unknown(table, {"inventory", "share", "covered_length_km", "covered_face_area_m2"}, "rates.", source)
     if "inventory" not in table:
         raise CorridorError(f"{source}: [rates] needs inventory = \"file\" (the corridor-wide inventory)")
