@@ -17,20 +17,24 @@ from simulation._lazy import lazy_exports as _lazy_exports
 #: Public name -> the module that holds it.  Imported on first use (PEP 562), so that ``import riskrf`` and the
 #: ``riskrf`` command start without loading pandas, scipy and numba until a command needs them.
 _EXPORTS = {
-    "EnergyHazard": "annual_hazard",
-    "DecisionTree": "decision_tree",
+    "EnergyHazard": "hazard.annual_hazard",
+    "DecisionTree": "risk.decision_tree",
     **dict.fromkeys(["GEVFit", "GumbelFit", "encounter_probability", "fit_gev", "fit_gumbel",
-                     "gumbel_frequency_factor", "gumbel_reduced_variate", "plotting_positions"], "extremes"),
-    "FrequencyAnalysis": "frequency_study", "analyse_inventory": "frequency_study",
-    "exceedance_probability": "impact_energy", "fit_velocity": "impact_energy",
-    "DEFAULT_DENSITY_KG_M3": "inventory", "Inventory": "inventory", "read_inventory": "inventory",
-    "MassCoupledSamples": "mass_coupling", "energy_hazard": "mass_coupling",
-    "GutenbergRichterFit": "power_law", "find_m_min": "power_law", "fit_gutenberg_richter": "power_law",
-    "Rainfall": "rainfall", "read_rainfall": "rainfall",
-    "RateModel": "rate_model", "rate_model": "rate_model",
-    "RiskrfWarning": "validation",
+                     "gumbel_frequency_factor", "gumbel_reduced_variate", "plotting_positions"], "frequency.extremes"),
+    "FrequencyAnalysis": "frequency.study", "analyse_inventory": "frequency.study",
+    "exceedance_probability": "hazard.impact_energy", "fit_velocity": "hazard.impact_energy",
+    "DEFAULT_DENSITY_KG_M3": "frequency.inventory", "Inventory": "frequency.inventory", "read_inventory": "frequency.inventory",
+    "MassCoupledSamples": "hazard.mass_coupling", "energy_hazard": "hazard.mass_coupling",
+    "GutenbergRichterFit": "frequency.power_law", "find_m_min": "frequency.power_law", "fit_gutenberg_richter": "frequency.power_law",
+    "Rainfall": "io.rainfall", "read_rainfall": "io.rainfall",
+    "RateModel": "frequency.rates", "rate_model": "frequency.rates",
+    "RiskrfWarning": "core.validation",
 }
 
 __all__ = sorted(_EXPORTS)
+
+from . import _compat  # noqa: E402  (old flat module paths, deprecated: riskrf.inventory -> riskrf.frequency.inventory)
+
+_compat.install()
 
 _lazy_exports(__name__, _EXPORTS)

@@ -12,7 +12,7 @@ import warnings
 from pathlib import Path
 
 from . import __version__
-from .units import DEFAULT_DENSITY_KG_M3
+from .core.units import DEFAULT_DENSITY_KG_M3
 
 EPILOG = "Units: mass kg, volume m3, density kg/m3, energy kJ, velocity m/s, time in years."
 
@@ -82,7 +82,7 @@ def _add_reader_arguments(p, what: str, key: str, *, dates: bool = False, prefix
 
 
 def _read(args, path):
-    from .inventory import read_inventory
+    from .frequency.inventory import read_inventory
     if path is None:
         raise ValueError(f"riskrf {args.command} needs --inventory INVENTORY (the rock fall inventory file)")
     reader = {k: getattr(args, k) for k in ("sheet", "header_row", "date_format", "decimal", "encoding",
@@ -94,10 +94,10 @@ def _read(args, path):
 
 def cmd_fit(args) -> int:
     """``riskrf fit``: read an inventory, fit the power law (and Gumbel/GEV when dated), print and write the results."""
-    from .frequency_study import analyse_inventory
-    from .outputs import atomic_output_dir
+    from .frequency.study import analyse_inventory
+    from .io.outputs import atomic_output_dir
 
-    from .preflight import check_inventory_args, check_out
+    from .app.preflight import check_inventory_args, check_out
     check_inventory_args(args)
     out = check_out(args, f"{Path(args.inventory).stem}-fit")
     if args.workers is not None and args.workers < 1:
@@ -173,7 +173,7 @@ def cmd_simulate(args) -> int:
 
     import simulation
 
-    from .outputs import atomic_outputs, check_output
+    from .io.outputs import atomic_outputs, check_output
     out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-crossings.parquet")
     check_output(out, overwrite=args.overwrite, kind="file")
     if out.suffix.lower() not in (".parquet", ".csv"):
@@ -206,8 +206,8 @@ def _drop_height(args):
     if value is None:
         return None
     if str(value).lower().endswith(".toml"):
-        from .units import STANDARD_GRAVITY_MS2
-        from .velocities import free_fall_drop_m
+        from .core.units import STANDARD_GRAVITY_MS2
+        from .io.velocities import free_fall_drop_m
         h, v0 = free_fall_drop_m(value, args.collector or "barrier")
         return h + v0 ** 2 / (2 * STANDARD_GRAVITY_MS2)        # the release speed as an equivalent extra drop
     try:
@@ -221,7 +221,7 @@ def _drop_height(args):
 
 def build_energy_hazard(args, inventory):
     """Power-law fit of the inventory combined with a simulation or a velocity file (energy and decide)."""
-    from .assess import energy_hazard_from_inputs
+    from .app.assess import energy_hazard_from_inputs
     return energy_hazard_from_inputs(
         inventory, m_min=args.m_min, m_max=args.m_max, rate_scale=args.rate_scale, scenario=args.scenario,
         velocities=args.velocities, collector=args.collector, n=args.n, seed=args.seed,
@@ -241,7 +241,7 @@ def _survey_reader(args) -> dict:
 def _energy_design_masses(args, inventory):
     """Masses [kg] the energy command reads design values at: the design-block band, the sensitivity's m_max and
     the fragmentation alternative (a function of the site's law, evaluated once the law is fitted)."""
-    from .design_block import design_block_candidates_kg, fragment_block_kg, read_block_survey
+    from .hazard.design_block import design_block_candidates_kg, fragment_block_kg, read_block_survey
     out = [2.0 * args.m_max] if args.m_max else []
     survey_path, pct = getattr(args, "block_survey", None), getattr(args, "design_percentile", None)
     survey = read_block_survey(survey_path, inventory.density_kg_m3, **_survey_reader(args)) if survey_path else None
@@ -262,10 +262,10 @@ def _energy_design_masses(args, inventory):
 
 def cmd_energy(args) -> int:
     """``riskrf energy``: impact-energy hazard at a barrier line, design energies and fence checks."""
-    from .energy_study import analyse_energy
-    from .outputs import atomic_output_dir
+    from .hazard.energy_study import analyse_energy
+    from .io.outputs import atomic_output_dir
 
-    from .preflight import check_energy_args, check_out
+    from .app.preflight import check_energy_args, check_out
     check_energy_args(args)
     out = check_out(args, f"{Path(args.inventory).stem}-energy")
     inv = _read(args, args.inventory)
@@ -275,7 +275,7 @@ def cmd_energy(args) -> int:
     block = sensitivity = None
     fragmenting = args.fractal_dimension is not None or args.fragmentation_iterations is not None
     if args.design_percentile is not None or args.block_survey or fragmenting:
-        from .design_block import design_block, read_block_survey, resolve_sizes
+        from .hazard.design_block import design_block, read_block_survey, resolve_sizes
         survey = read_block_survey(args.block_survey, inv.density_kg_m3, **_survey_reader(args)) \
             if args.block_survey else None
         rule = "percentile" if (args.design_percentile is not None or survey is not None) else "fragmentation"
@@ -286,13 +286,13 @@ def cmd_energy(args) -> int:
                              density_kg_m3=inv.density_kg_m3,
                              fractal_dimension=args.fractal_dimension, iterations=args.fragmentation_iterations)
     if args.design_period * hazard.arrival_rate > 1:
-        from .energy_study import design_energy_sensitivity
+        from .hazard.energy_study import design_energy_sensitivity
         m_values = [0.5 * gr.m_max, gr.m_max, 2.0 * gr.m_max] if gr.m_max else [None]
         sensitivity = design_energy_sensitivity(hazard, inv.masses, inv.duration_years, m_min=gr.m_min,
                                                 m_max_values=m_values,
                                                 rate_shares=[0.5 * args.rate_scale, args.rate_scale,
                                                              2.0 * args.rate_scale], T=args.design_period)
-    from .energy_study import design_energy_tornado
+    from .hazard.energy_study import design_energy_tornado
     tornado = design_energy_tornado(hazard, design_T=args.design_period, block=block, masses_kg=inv.masses,
                                     duration_years=inv.duration_years, rate_share=args.rate_scale,
                                     sensitivity=sensitivity) \
@@ -315,9 +315,9 @@ def cmd_energy(args) -> int:
 
 def cmd_decide(args) -> int:
     """``riskrf decide``: rank mitigation options (site file) or roll back a decision tree file."""
-    from .decision_tree import DecisionTree
-    from .mitigation import load_mitigation
-    from .outputs import atomic_output_dir, write_json
+    from .risk.decision_tree import DecisionTree
+    from .risk.mitigation import load_mitigation
+    from .io.outputs import atomic_output_dir, write_json
     from .report.decision_figures import plot_risk_profiles, plot_tornado, plot_tree
     from .report.files import save_figure
     from .report.mitigation_text import study_report, write_mitigation_outputs
@@ -325,7 +325,7 @@ def cmd_decide(args) -> int:
     if (args.tree is None) == (args.options is None):
         raise ValueError("give a decision tree file (riskrf decide TREE.json) or --options OPTIONS.toml with "
                          "--inventory and --scenario, not both")
-    from .preflight import check_energy_args, check_number, check_out
+    from .app.preflight import check_energy_args, check_number, check_out
     check_number(args.risk_tolerance, "--risk-tolerance", low=0, low_open=True,
                  what=" (in money; leave it out for expected values)")
     out = check_out(args, "decision")
@@ -368,7 +368,7 @@ def cmd_decide(args) -> int:
 
     inv = _read(args, args.inventory)
     gr, hazard, result = build_energy_hazard(args, inv)
-    from .assess import road_share, study_context
+    from .app.assess import road_share, study_context
     road = args.road_collector or "road"
     study = load_mitigation(args.options, hazard, road_share=road_share(result, hazard.collector, road),
                             **study_context(result, hazard.collector, road, args.option_blocks,
@@ -419,11 +419,11 @@ def _add_energy_arguments(p):
 
 def cmd_assess(args) -> int:
     """``riskrf assess``: the whole chain for a site file, written atomically to ``--out``."""
-    from .assess import run_assessment, write_assessment
-    from .outputs import atomic_output_dir
-    from .site import load_site
+    from .app.assess import run_assessment, write_assessment
+    from .io.outputs import atomic_output_dir
+    from .app.site import load_site
 
-    from .preflight import check_number, check_out
+    from .app.preflight import check_number, check_out
     check_number(args.n, "-n", low=1)
     out = check_out(args, f"{Path(args.site).stem}-assessment")
     site = load_site(args.site)          # every input is checked before anything is computed
@@ -435,7 +435,7 @@ def cmd_assess(args) -> int:
     print(f"\nStage times: {stages}.")
     if assessment.warnings:
         print(f"{len(assessment.warnings)} warning(s), also listed in the report:")
-        from .outputs import relative_paths
+        from .io.outputs import relative_paths
         for w in assessment.warnings:
             print(f"  - {relative_paths(w, site.path.parent)}")        # paths relative to the site file
     print(f"Rate of falls from the {s['hazard']['rate_source']}.")
@@ -463,7 +463,7 @@ def cmd_calibrate(args) -> int:
     import simulation
     from simulation.calibration import read_observed
 
-    from .outputs import atomic_output_dir, write_json
+    from .io.outputs import atomic_output_dir, write_json
     from .report.files import save_figure
 
     parameters = {}
@@ -485,11 +485,11 @@ def cmd_calibrate(args) -> int:
         if not sep:
             raise ValueError(f"--select {item!r}: use COLUMN=VALUE, e.g. profile=P1")
         select[key] = value
-    from .preflight import check_out
+    from .app.preflight import check_out
     check_out(args, f"{Path(args.scenario).stem}-calibration")
     table = None
     if Path(args.observed).is_file():
-        from .tables import read_numeric_table       # separators, decimal commas, encodings, sheets as for inventories
+        from .io.tables import read_numeric_table       # separators, decimal commas, encodings, sheets as for inventories
         table = read_numeric_table(args.observed, what="observed stops", decimal=args.decimal, sheet=args.sheet,
                                    header_row=args.header_row, encoding=args.encoding, numeric=(args.column,))
     observed = read_observed(args.observed, column=args.column, select=select, table=table)
@@ -531,13 +531,13 @@ def cmd_corridor(args) -> int:
     """``riskrf corridor FILE``: read and check the corridor (sections table, mass law, study inputs), run every
     section and write the tables, figures and report to ``--out``.  Returns the exit code (0 on success).
     """
-    from .corridor import load_corridor, run_corridor, write_corridor
+    from .app.corridor import load_corridor, run_corridor, write_corridor
 
     corridor = load_corridor(args.corridor, keep_going=args.keep_going, sheet=args.sheet,   # every row checked
                              header_row=args.header_row, decimal=args.decimal, encoding=args.encoding)
     for e in corridor.errors:
         print(f"skipped (--keep-going): {e}")
-    from .preflight import check_out
+    from .app.preflight import check_out
     out = check_out(args, f"{Path(args.corridor).stem}-corridor")
     parts = out.parent / f".{out.name}.sections"
     n = args.n or corridor.n_blocks
@@ -795,8 +795,8 @@ def cmd_rates(args) -> int:
     """``riskrf rates``: fit the rate model of falls (Poisson and negative binomial regressions on rainfall
     over ``--windows`` days, season and trend) and write its tables and figures.  Returns the exit code.
     """
-    from .outputs import atomic_output_dir
-    from .rate_model import rate_model
+    from .io.outputs import atomic_output_dir
+    from .frequency.rates import rate_model
 
     try:
         windows = tuple(int(w) for w in args.windows.split(","))
@@ -807,11 +807,11 @@ def cmd_rates(args) -> int:
                          "need a daily model (--period day)")
     if (args.heavy_day_change is None) != (args.heavy_day_mm is None):
         raise ValueError("give --heavy-day-mm and --heavy-day-change together")
-    from .preflight import check_inventory_args, check_out, check_rates_args
+    from .app.preflight import check_inventory_args, check_out, check_rates_args
     check_rates_args(args, windows)
     check_inventory_args(args)
     out = check_out(args, f"{Path(args.inventory).stem}-rates")
-    from .rainfall import read_rainfall
+    from .io.rainfall import read_rainfall
     rainfall = read_rainfall(args.rainfall, **{k: getattr(args, f"rainfall_{k}") for k in
                                                ("sheet", "header_row", "decimal", "encoding", "date_format")})
     inv = _read(args, args.inventory)
@@ -827,7 +827,7 @@ def cmd_rates(args) -> int:
               f"({changed / base - 1:+.1%})")
     rules = []
     if args.closure_mm or args.warnings:
-        from .closure import closure_rule, warning_closure
+        from .risk.closure import closure_rule, warning_closure
         rules = [closure_rule(model, mm, window_days=args.closure_window, cost_per_hour=args.cost_per_hour)
                  for mm in (args.closure_mm or [])]
         if args.warnings:

@@ -15,6 +15,7 @@ def lazy_exports(package: str, exports: dict) -> None:
     A public name that is also a submodule's name (``riskrf.rate_model``, the function in the module of that
     name) stays the public object: importing the submodule anywhere does not replace it with the module, as
     it would in a plain lazy package, where the import system sets the package attribute after the import.
+    (The module may sit at another path, as for an old module path answered by ``riskrf._compat``.)
     """
     module = sys.modules[package]
 
@@ -34,7 +35,7 @@ def lazy_exports(package: str, exports: dict) -> None:
             raise AttributeError(f"module {package!r} has no attribute {name!r}")
 
         def __setattr__(self, name: str, value):
-            if name in exports and isinstance(value, types.ModuleType) and value.__name__ == f"{package}.{name}":
+            if name in exports and isinstance(value, types.ModuleType) and hasattr(value, name):
                 value = getattr(value, name)
             super().__setattr__(name, value)
 

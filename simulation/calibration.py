@@ -188,7 +188,7 @@ def read_observed(path, *, column: str = "x_stop_m", select: dict | None = None,
     ``select`` keeps rows whose columns equal the given values (e.g.
     ``{"profile": "P1"}``).  Without an ``x_stop_m`` column, a file with
     exactly one numeric column uses that column.  ``table``: the file already read (by a reader
-    with other rules, e.g. ``riskrf.tables.read_numeric_table`` for separators, decimal commas,
+    with other rules, e.g. ``riskrf.io.tables.read_numeric_table`` for separators, decimal commas,
     encodings, Excel sheets and header rows); ``path`` then only names it and the table's index
     is kept as the row labels of messages (that reader's index holds the file lines).
     """

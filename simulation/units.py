@@ -1,7 +1,7 @@
 """Named physical constants and unit factors shared by :mod:`simulation` and :mod:`riskrf`.
 
 One home for each number: energies are reported in kJ (barrier ratings are in kJ),
-masses in kg, lengths in m.  :mod:`riskrf.units` re-exports everything here.
+masses in kg, lengths in m.  :mod:`riskrf.core.units` re-exports everything here.
 """
 from __future__ import annotations
 

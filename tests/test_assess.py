@@ -8,7 +8,7 @@ import pytest
 import riskrf
 import simulation
 from riskrf.cli import main
-from riskrf.site import load_site
+from riskrf.app.site import load_site
 
 from .conftest import ROOT
 
@@ -255,7 +255,7 @@ def test_design_energy_tornado_in_outputs(assessed):
      "needs design_block.fractal_dimension and design_block.iterations"),
 ])
 def test_design_block_site_fields_are_checked(tmp_path, edit, match):
-    from riskrf.site import SiteError
+    from riskrf.app.site import SiteError
     with pytest.raises(SiteError, match=match):
         load_site(_site_copy(tmp_path, replace=edit))
 
@@ -268,7 +268,7 @@ def test_copied_inputs_rerun_to_the_same_numbers(assessed, tmp_path):
     rerun.mkdir()
     # From Python this time: the figures are all drawn by write_assessment (the command line draws them beside
     # the computation); the same files and numbers either way.
-    from riskrf.assess import run_assessment, write_assessment
+    from riskrf.app.assess import run_assessment, write_assessment
     write_assessment(run_assessment(load_site(inputs / "site.toml")), rerun)
     a = json.loads((out / "summary.json").read_text())
     b = json.loads((rerun / "summary.json").read_text())

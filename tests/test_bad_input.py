@@ -22,9 +22,9 @@ import pandas as pd
 import pytest
 
 from riskrf.cli import main
-from riskrf.inventory import read_inventory
-from riskrf.validation import RiskrfWarning
-from riskrf.velocities import read_velocities
+from riskrf.frequency.inventory import read_inventory
+from riskrf.core.validation import RiskrfWarning
+from riskrf.io.velocities import read_velocities
 
 ROOT = Path(__file__).resolve().parents[1]
 DEMO = ROOT / "riskrf" / "data"
@@ -49,15 +49,15 @@ def inputs(tmp_path):
 @pytest.fixture
 def no_work(monkeypatch):
     """Make every expensive stage fail loudly: a refusal must come before any of them runs."""
-    import riskrf.assess
-    import riskrf.frequency_study
+    import riskrf.app.assess
+    import riskrf.frequency.study
     import simulation
 
     def boom(*a, **k):
         raise AssertionError("work started before the input was refused")
-    monkeypatch.setattr(riskrf.frequency_study, "analyse_inventory", boom)
-    monkeypatch.setattr(riskrf.assess, "energy_hazard_from_inputs", boom)
-    monkeypatch.setattr(riskrf.assess, "run_assessment", boom)
+    monkeypatch.setattr(riskrf.frequency.study, "analyse_inventory", boom)
+    monkeypatch.setattr(riskrf.app.assess, "energy_hazard_from_inputs", boom)
+    monkeypatch.setattr(riskrf.app.assess, "run_assessment", boom)
     monkeypatch.setattr(simulation, "run", boom)
 
 
@@ -436,13 +436,13 @@ def test_rates_refuses_impossible_options_before_reading_files(inputs, tmp_path,
                                                               match):
     """`riskrf rates` checks its numbers first, naming the option (not the Python argument) and the value."""
     import riskrf.cli
-    import riskrf.rainfall
-    import riskrf.rate_model  # noqa: F401  (the module; the package attribute of that name is the function)
+    import riskrf.io.rainfall
+    import riskrf.frequency.rates  # noqa: F401  (the module; the package attribute of that name is the function)
 
     def boom(*a, **k):
         raise AssertionError("a file was read or a model fitted before the option was refused")
-    monkeypatch.setattr(riskrf.rainfall, "read_rainfall", boom)
-    monkeypatch.setattr(sys.modules["riskrf.rate_model"], "rate_model", boom)
+    monkeypatch.setattr(riskrf.io.rainfall, "read_rainfall", boom)
+    monkeypatch.setattr(sys.modules["riskrf.frequency.rates"], "rate_model", boom)
     monkeypatch.setattr(riskrf.cli, "_read", boom)
     inv = write(inputs / "falls.csv", "date,volume_m3\n2001-02-03,1.0\n")
     rain = write(inputs / "rain.csv", "date,rainfall_mm\n2001-02-03,1.0\n")
@@ -481,7 +481,7 @@ def test_energy_with_fewer_than_one_fall_in_the_design_period_says_so(inputs, tm
 
 
 def test_python_api_refuses_design_periods_of_a_year_or_less():
-    from riskrf.energy_study import analyse_energy
+    from riskrf.hazard.energy_study import analyse_energy
     for T in (0, 1, -100, 0.5, float("nan")):
         with pytest.raises(ValueError, match=r"design_T = .*> 1 year"):
             analyse_energy(None, design_T=T)
@@ -542,7 +542,7 @@ def test_assess_refuses_a_barrier_of_zero_height_or_capacity_before_work(inputs,
 
 
 def test_attenuator_of_zero_height_is_refused_by_the_option_parser():
-    from riskrf.mitigation_inputs import MitigationError, parse_option
+    from riskrf.risk.mitigation_inputs import MitigationError, parse_option
     spec = {"name": "att", "kind": "attenuator", "capital_cost": 1, "capacity_kj": 500, "height_m": 0}
     with pytest.raises(MitigationError, match=r"corridor.toml: options\[2\]\.height_m = 0 must be > 0 m"):
         parse_option(spec, 2, "corridor.toml")
@@ -555,7 +555,7 @@ def test_attenuator_of_zero_height_is_refused_by_the_option_parser():
 
 def test_site_file_and_inventory_with_the_same_stem(inputs):
     """A site file 'x.toml' beside its inventory 'x.csv' is not read as the inventory's sidecar."""
-    from riskrf.site import load_site
+    from riskrf.app.site import load_site
     inv = inputs / "lauter.csv"
     inv.write_bytes(LAUTER.read_bytes())
     site = site_file(inputs, name="lauter.toml", inventory={"path": "lauter.csv", "duration_years": 5.2})
@@ -648,17 +648,17 @@ def test_existing_output_directory_is_refused_then_replaced_with_overwrite(tmp_p
     out = tmp_path / "o"
     out.mkdir()
     (out / "old_figure.png").write_text("old")
-    import riskrf.frequency_study
+    import riskrf.frequency.study
 
     def boom(*a, **k):
         raise AssertionError("work started")
-    real = riskrf.frequency_study.analyse_inventory
-    monkeypatch.setattr(riskrf.frequency_study, "analyse_inventory", boom)
+    real = riskrf.frequency.study.analyse_inventory
+    monkeypatch.setattr(riskrf.frequency.study, "analyse_inventory", boom)
     rc = main(fit_args(out))
     err = capsys.readouterr().err
     assert rc == 2 and f"--out {out}" in err and "already exists" in err and "--overwrite" in err
     assert sorted(p.name for p in out.iterdir()) == ["old_figure.png"]
-    monkeypatch.setattr(riskrf.frequency_study, "analyse_inventory", real)
+    monkeypatch.setattr(riskrf.frequency.study, "analyse_inventory", real)
     rc = main(fit_args(out, "--overwrite"))
     assert rc == 0
     names = sorted(p.name for p in out.iterdir())
@@ -746,11 +746,11 @@ def test_spreadsheet_formulas_are_neutralised_in_csv(inputs, tmp_path):
 
 
 def test_unexpected_errors_are_one_line_unless_debug(inputs, tmp_path, capsys, monkeypatch):
-    import riskrf.frequency_study
+    import riskrf.frequency.study
 
     def oserror(*a, **k):
         raise PermissionError(13, "Permission denied", str(tmp_path / "x"))
-    monkeypatch.setattr(riskrf.frequency_study, "analyse_inventory", oserror)
+    monkeypatch.setattr(riskrf.frequency.study, "analyse_inventory", oserror)
     rc = main(fit_args(tmp_path / "o"))
     err = capsys.readouterr().err
     assert rc == 2 and len(err.strip().splitlines()) == 1 and "Permission denied" in err
@@ -789,7 +789,7 @@ def test_real_day_first_export_hong_kong_cedd():
     unmodified in shared/inventories-raw/hong-kong-cedd (see its PROVENANCE.md: a regional record of
     incidents on all man-made slopes, not one slope).
     """
-    from riskrf.tables import parse_dates, read_table
+    from riskrf.io.tables import parse_dates, read_table
     path = ROOT / ".." / "shared" / "inventories-raw" / "hong-kong-cedd" / "cedd_incidents_1984_2020.csv"
     if not path.exists():
         pytest.skip("shared/inventories-raw/hong-kong-cedd not present")
@@ -847,7 +847,7 @@ def test_hostile_files_give_one_line_errors(inputs, tmp_path, capsys, case, name
 
 
 def test_nan_probability_and_tonnes_given_as_kg(inputs):
-    from riskrf.decision_tree import DecisionTree
+    from riskrf.risk.decision_tree import DecisionTree
     spec = {"type": "chance", "branches": [{"name": "a", "probability": float("nan")},
                                            {"name": "b", "probability": 1.0}]}
     with pytest.raises(ValueError, match=r"> a: probability.*nan"):

@@ -7,9 +7,9 @@ import pandas as pd
 import pytest
 
 from riskrf import rate_model, read_inventory
-from riskrf.closure import closure_rule, read_rainstorm_warnings, warning_closure
-from riskrf.mitigation import MitigationError, Option, parse_mitigation, parse_option
-from riskrf.rainfall import rainfall_from_series
+from riskrf.risk.closure import closure_rule, read_rainstorm_warnings, warning_closure
+from riskrf.risk.mitigation import MitigationError, Option, parse_mitigation, parse_option
+from riskrf.io.rainfall import rainfall_from_series
 
 from .test_mitigation import study
 

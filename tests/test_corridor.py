@@ -10,7 +10,7 @@ import pytest
 
 distributed = pytest.importorskip("distributed")
 
-from riskrf import corridor as cr  # noqa: E402
+from riskrf.app import corridor as cr  # noqa: E402
 from riskrf.cli import main  # noqa: E402
 
 DATA = Path(__file__).resolve().parent / "data" / "corridor"
@@ -147,12 +147,12 @@ def test_unreachable_scheduler_fails_fast_and_writes_nothing(tmp_path, capsys):
     out = tmp_path / "out"
     real = cr.connect
     import functools
-    import riskrf.corridor
-    riskrf.corridor.connect = functools.partial(real, timeout_s=1)
+    import riskrf.app.corridor
+    riskrf.app.corridor.connect = functools.partial(real, timeout_s=1)
     try:
         rc = main(["corridor", str(DATA / "small.toml"), "--scheduler", "tcp://127.0.0.1:9", "--out", str(out)])
     finally:
-        riskrf.corridor.connect = real
+        riskrf.app.corridor.connect = real
     assert rc == 2 and "cannot reach the dask scheduler" in capsys.readouterr().err
     assert not out.exists() and not any(tmp_path.iterdir())
 
@@ -284,7 +284,7 @@ def test_hazard_is_mass_coupled_as_in_assess(corridor, runs):
     """Each section's reach probabilities are those of riskrf.energy_hazard (the engine of ``riskrf assess``) on
     the section's scenario with the section's seed: blocks across the mass law, reach by mass class."""
     import riskrf
-    from riskrf.mass_coupling import MassCoupledSamples
+    from riskrf.hazard.mass_coupling import MassCoupledSamples
     row = runs["serial"].set_index("id").loc["A"]
     sec = corridor.section("A")
     for line, col in (("barrier", "reach_barrier"), ("road", "reach_road")):

@@ -7,9 +7,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import riskrf
-from riskrf.decision_tree import DecisionTree, TreeError
-from riskrf.economics import pv_factor, pv_of_renewals
-from riskrf.road_risk import (fn_curve, fn_zone, individual_risk, probability_at_least_one_hit,
+from riskrf.risk.decision_tree import DecisionTree, TreeError
+from riskrf.risk.economics import pv_factor, pv_of_renewals
+from riskrf.risk.road_risk import (fn_curve, fn_zone, individual_risk, probability_at_least_one_hit,
                          spatial_temporal_probability, stationary_rock_strike_probability, vehicle_occupant_fn)
 
 from .conftest import DATA
@@ -188,7 +188,7 @@ def test_public_decision_tree_name():
 def test_share_with_at_least_matches_scipy_binomial():
     from scipy import stats
 
-    from riskrf.road_risk import occupancy_distribution, share_with_at_least
+    from riskrf.risk.road_risk import occupancy_distribution, share_with_at_least
     k, p = occupancy_distribution(1.4)
     v = np.array([0.0, 0.05, 0.3, 0.77, 1.0])
     expected = np.array([[sum(pk * stats.binom.sf(n - 1, kk, vi) for kk, pk in zip(k, p)) for n in range(1, 10)]

@@ -7,10 +7,10 @@ from hypothesis import strategies as st
 from scipy import integrate, stats
 
 import riskrf
-from riskrf.impact_energy import (PairedSamples, energy_quantile, exceedance_probability, exceedance_probability_mc,
+from riskrf.hazard.impact_energy import (PairedSamples, energy_quantile, exceedance_probability, exceedance_probability_mc,
                            fit_velocity)
-from riskrf.annual_hazard import EnergyHazard
-from riskrf.barriers import check_fence, service_energy_level, uni11211_design_energy
+from riskrf.hazard.annual_hazard import EnergyHazard
+from riskrf.hazard.barriers import check_fence, service_energy_level, uni11211_design_energy
 
 # domain-methods.md 3.1 (E16): median m 1000 kg (sigma_ln 0.8), median v 15 m/s (sigma_ln 0.2)
 # => E lognormal with median 112.5 kJ, sigma_ln 0.8944.
@@ -161,7 +161,7 @@ def test_bad_inputs(call, match):
 
 
 def test_velocity_file_columns(tmp_path):
-    from riskrf.velocities import read_velocities
+    from riskrf.io.velocities import read_velocities
     f = tmp_path / "rocfall.csv"
     pd.DataFrame({"Translational Velocity (m/s)": [10.0, 12.0], "Bounce Height (m)": [1.0, 2.0]}).to_csv(f, index=False)
     df = read_velocities(f)

@@ -1,7 +1,7 @@
 """Accuracy of the energy quadrature with a truncated power-law mass model (issue 10).
 
 Exact case: mass M ~ power law with cumulative exponent b on [m0, m1] (Corominas et al. 2018
-truncation, riskrf.power_law), speed V ~ lognormal(mu, s), E = 1/2 M V^2 / 1000 kJ.  With
+truncation, riskrf.frequency.power_law), speed V ~ lognormal(mu, s), E = 1/2 M V^2 / 1000 kJ.  With
 m(v) = 2000 e / v^2,
 
     P(E > e) = P(V > v0) + [ (2000 e)^-b E(V^2b; v1 < V < v0) - m1^-b P(v1 < V < v0) ] / (m0^-b - m1^-b)
@@ -14,7 +14,7 @@ import pytest
 from scipy import stats
 
 from riskrf import exceedance_probability
-from riskrf.power_law import GutenbergRichterFit
+from riskrf.frequency.power_law import GutenbergRichterFit
 
 
 def _exact(e, b, m0, m1, mu, s):
@@ -37,7 +37,7 @@ def _law(b, m0, m1):
 @pytest.mark.parametrize("b,m0,m1,s", [(0.7, 100.0, 2e6, 0.4), (1.2, 10.0, 1e5, 0.1), (0.5, 1000.0, 5e6, 0.25),
                                        (0.9, 50.0, 5e4, 0.6)])
 def test_truncated_power_law_quadrature_meets_documented_accuracy(b, m0, m1, s):
-    # Documented in riskrf.impact_energy: about 1e-6 relative down to probabilities of 1e-8.  Before the
+    # Documented in riskrf.hazard.impact_energy: about 1e-6 relative down to probabilities of 1e-8.  Before the
     # panels were split at the support kinks the error here reached 2e-5.
     e = np.geomspace(0.01, 1e8, 300)
     ref = _exact(e, b, m0, m1, np.log(20.0), s)

@@ -253,7 +253,7 @@ def test_constant_maxima_raise_naming_the_value(fit):
 
 
 def test_direct_construction_with_zero_scale_raises():
-    from riskrf.extremes import GEVFit
+    from riskrf.frequency.extremes import GEVFit
     with pytest.raises(ValueError, match=r"scale = 0\.0: the scale of a GEVFit must be finite and > 0"):
         GEVFit(p_zero=0.0, n_years=10, method="mle", level=0.95, cov=None, data=np.arange(10.0),
                loc=1.0, scale=0.0, shape=0.1)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import riskrf
-from riskrf.power_law import GRID_CANDIDATES, LARGE_SAMPLE, _candidates
+from riskrf.frequency.power_law import GRID_CANDIDATES, LARGE_SAMPLE, _candidates
 
 
 def _sample(n, seed=3, b=0.8):

@@ -12,8 +12,8 @@ import pandas as pd
 import pytest
 
 from riskrf import RiskrfWarning, read_inventory
-from riskrf.rainfall import read_rainfall
-from riskrf.records import read_cedd_incidents
+from riskrf.io.rainfall import read_rainfall
+from riskrf.io.records import read_cedd_incidents
 
 from .conftest import INVENTORIES, ROOT
 
@@ -170,7 +170,7 @@ def test_nvdb_e6_empty_years_come_from_every_fall_not_only_the_sized_ones():
     PROVENANCE.md falls per year 2000-2014: 2,0,1,0,4,0,3,6,7,6,11,10,2,12,12, so exactly 3 of 15
     years (2001, 2003, 2005) have no fall and the mixed model's p0 is 3/15.
     """
-    from riskrf.frequency_study import analyse_inventory
+    from riskrf.frequency.study import analyse_inventory
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         inv = read_inventory(E6)
@@ -190,7 +190,7 @@ def test_nvdb_e6_empty_years_come_from_every_fall_not_only_the_sized_ones():
 
 
 def test_fit_on_the_hong_kong_record_prefers_the_power_law_over_an_infinite_mean_gev():
-    from riskrf.frequency_study import analyse_inventory
+    from riskrf.frequency.study import analyse_inventory
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         inv = read_inventory(HK)
@@ -208,7 +208,7 @@ def test_fit_on_the_hong_kong_record_prefers_the_power_law_over_an_infinite_mean
 
 @pytest.mark.parametrize("kind,expected", [("exp-gumbel", "GEV"), ("gumbel", "Gumbel")])
 def test_preferred_model_wording_for_a_plausible_gev_and_an_adequate_gumbel(tmp_path, kind, expected):
-    from riskrf.frequency_study import analyse_inventory
+    from riskrf.frequency.study import analyse_inventory
     rng = np.random.default_rng(5)
     years = np.arange(1961, 2021)
     z = rng.gumbel(0, 1, years.size)

@@ -108,7 +108,7 @@ def test_sidecar_toml_gives_period_and_density(tmp_path):
 def test_sidecar_states_what_the_sizes_are_and_the_site_or_cli_wins(tmp_path):
     """Issue 10 audit e: a sidecar's [record] sizes ("event_volumes" or "blocks") is carried on the Inventory and
     used when the site file / --inventory-sizes does not say; a bad value names the sidecar."""
-    from riskrf.design_block import resolve_sizes
+    from riskrf.hazard.design_block import resolve_sizes
     f = tmp_path / "blocks.csv"
     f.write_text("volume_m3\n1\n2\n")
     side = tmp_path / "blocks.toml"

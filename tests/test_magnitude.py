@@ -88,7 +88,7 @@ def test_frequency_methods_are_consistent():
 def test_grenoble_law_return_periods():
     # Dussauge-Peisser et al. (2002) Grenoble law N(>=V) = 4.2 V^-0.41 per year (domain-methods.md E14):
     # N(>=1e4 m3) = 0.09622 (T = 10.39 yr); N(>=1e6) = 0.01456 (T = 68.67 yr); exact 100-yr annual max 2.47e6 m3.
-    from riskrf.power_law import GutenbergRichterFit
+    from riskrf.frequency.power_law import GutenbergRichterFit
     law = GutenbergRichterFit(a=np.log10(4.2), b=0.41, b_stderr=0.0, b_ci=(0.41, 0.41), level=0.95, b_ci_method="",
                               m_min=1.0, m_max=None, rate_min=4.2, n_tail=1, n_total=1, duration_years=1.0,
                               method="mle", m_min_method="given", ks_distance=0.0, units="m3")
@@ -167,7 +167,7 @@ def test_ci_coverage_of_b_from_simulated_data():
 @settings(max_examples=40, deadline=None)
 @given(b=st.floats(0.2, 2.0), p=st.floats(1e-9, 1.0), m_max=st.one_of(st.none(), st.floats(1e3, 1e8)))
 def test_sf_isf_round_trip(b, p, m_max):
-    from riskrf.power_law import _truncated_isf, _truncated_sf
+    from riskrf.frequency.power_law import _truncated_isf, _truncated_sf
     m = _truncated_isf(p, b, 1.0, m_max)
     assert _truncated_sf(m, b, 1.0, m_max) == pytest.approx(p, rel=1e-7, abs=1e-12)
 
@@ -278,14 +278,14 @@ def test_bootstrap_pvalue_divides_by_completed_replicates():
     # replicates (it used to divide by all requested, biasing p down).
     rng = np.random.default_rng(12)
     x = np.concatenate([[12.0, 30.0, 95.0], rng.uniform(1, 10, size=37)])
-    with pytest.warns(riskrf.validation.RiskrfWarning, match="only 3 values above m_min"):
+    with pytest.warns(riskrf.core.validation.RiskrfWarning, match="only 3 values above m_min"):
         fit = fit_gutenberg_richter(x, 1.0, m_min=10.0)
-    with pytest.warns(riskrf.validation.RiskrfWarning, match="could not be refitted"):
+    with pytest.warns(riskrf.core.validation.RiskrfWarning, match="could not be refitted"):
         res = fit.bootstrap_test(300, seed=3)
     assert 200 < res.n_completed < 290
     exceed = res.p_value * res.n_completed
     assert exceed == pytest.approx(round(exceed), abs=1e-9) and res.p_value > 0
-    with pytest.warns(riskrf.validation.RiskrfWarning):
+    with pytest.warns(riskrf.core.validation.RiskrfWarning):
         assert fit.bootstrap_pvalue(300, seed=3) == res.p_value
 
 
@@ -294,7 +294,7 @@ def test_integer_data_fitted_as_discrete_words():
     # n_tail = 2958 +- 987, fitted with the discrete law.  Treated as continuous the search gives 26.
     x = np.loadtxt(DATA / "clauset2009" / "words.txt")
     assert riskrf.find_m_min(x)[0] == 26
-    with pytest.warns(riskrf.validation.RiskrfWarning, match="discrete power law"):
+    with pytest.warns(riskrf.core.validation.RiskrfWarning, match="discrete power law"):
         fit = fit_gutenberg_richter(x, 1.0)
     assert fit.discrete and fit.m_min == 6.5 and fit.n_tail == 2958      # integers >= 7
     assert 1 + fit.b == pytest.approx(1.95, abs=0.005)
@@ -310,7 +310,7 @@ def test_discrete_terrorism_threshold():
     # Clauset et al. (2009) Table 6.1, deaths in terrorist attacks: x_min = 12 +- 4, alpha = 2.4 +- 0.2,
     # n_tail = 547 +- 1663 (discrete fit).
     x = np.loadtxt(DATA / "clauset2009" / "terrorism.txt")
-    with pytest.warns(riskrf.validation.RiskrfWarning):
+    with pytest.warns(riskrf.core.validation.RiskrfWarning):
         fit = fit_gutenberg_richter(x, 1.0)
     assert fit.discrete and fit.m_min + 0.5 == 12 and fit.n_tail == 547
     assert 1 + fit.b == pytest.approx(2.4, abs=0.05)

@@ -5,8 +5,8 @@ from scipy import integrate, stats
 
 import riskrf
 import simulation
-from riskrf.annual_hazard import EnergyHazard
-from riskrf.design_block import (
+from riskrf.hazard.annual_hazard import EnergyHazard
+from riskrf.hazard.design_block import (
     fragment_block_kg,
     design_block,
     percentile_block,
@@ -14,9 +14,9 @@ from riskrf.design_block import (
     site_design_masses,
     sphere_diameter_m,
 )
-from riskrf.energy_study import design_energy_sensitivity
-from riskrf.impact_energy import mass_model
-from riskrf.mass_coupling import MassCoupledSamples
+from riskrf.hazard.energy_study import design_energy_sensitivity
+from riskrf.hazard.impact_energy import mass_model
+from riskrf.hazard.mass_coupling import MassCoupledSamples
 
 from .conftest import ROOT
 
@@ -152,7 +152,7 @@ def test_design_block_outside_the_simulated_masses_is_refused_or_labelled(demo_h
 def test_block_top_check_adds_radius_and_free_board_to_the_p95_centre_height(demo_hazard, lauterbrunnen):
     """Issue 10 audit c: the fence check by the design block's top = p95 centre height of blocks of its mass class +
     its radius + free board, against the fence height; adequate exactly when that fits under the fence."""
-    from riskrf.energy_study import _block_top_check
+    from riskrf.hazard.energy_study import _block_top_check
     inv, _ = lauterbrunnen
     block = design_block(demo_hazard, rule="percentile", percentile=97, inventory=inv)
     h95 = demo_hazard.velocity.height_percentile(95, block.mass_kg)
@@ -225,7 +225,7 @@ def test_site_design_masses_follow_the_hazard_law_and_stay_below_m_max(demo_haza
     # The T-year fall reaching the line: rate x P(M > m, reaches) = 1/T.  On the shipped slope (material presets)
     # 29-47 % of the blocks reach the barrier, by mass class, so the line's T-year mass lies below the source's and
     # P(M > m_line) is bracketed by the smallest and largest reach probability of the classes.
-    from riskrf.impact_energy import mass_model
+    from riskrf.hazard.impact_energy import mass_model
     mm = mass_model(demo_hazard.mass)
     line, src = t["line_mass_kg"].to_numpy(), t["source_mass_kg"].to_numpy()
     assert np.all(line <= src * (1 + 1e-9))
@@ -330,7 +330,7 @@ def test_bad_design_block_inputs(tmp_path, demo_hazard, lauterbrunnen):
 def test_fractal_fragmentation_conserves_volume_and_is_fractal():
     """Perfect (1997) fractal fragmentation: fragment volumes add up to the event volume, and the number of
     fragments grows by b^D from one generation to the next (N(>L) ~ L^-D); analytic case D = 2.5, 3 generations."""
-    from riskrf.design_block import fractal_fragments, fragment_percentile
+    from riskrf.hazard.design_block import fractal_fragments, fragment_percentile
     f = fractal_fragments(294.0, 2.5, 3)
     assert (f["count"] * f["volume_m3"]).sum() == pytest.approx(294.0, rel=1e-12)
     np.testing.assert_allclose(f["volume_m3"], 294.0 / 8.0 ** np.arange(1, 4))

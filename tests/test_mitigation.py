@@ -4,15 +4,15 @@ import pytest
 from scipy import stats
 
 import simulation
-from riskrf.annual_hazard import EnergyHazard
-from riskrf.barriers import barrier_history, out_of_service_share
+from riskrf.hazard.annual_hazard import EnergyHazard
+from riskrf.hazard.barriers import barrier_history, out_of_service_share
 from riskrf.cli import main
-from riskrf.economics import pv_factor
-from riskrf.measures import SimulationContext
-from riskrf.mitigation import (Consequences, Economics, Exposure, MitigationError, MitigationStudy, Option,
+from riskrf.risk.economics import pv_factor
+from riskrf.risk.measures import SimulationContext
+from riskrf.risk.mitigation import (Consequences, Economics, Exposure, MitigationError, MitigationStudy, Option,
                                Uncertainty, parse_mitigation, parse_option)
-from riskrf.power_law import fit_gutenberg_richter
-from riskrf.road_risk import (commuter_passage_probability, commuter_strike_probability, fn_zone,
+from riskrf.frequency.power_law import fit_gutenberg_richter
+from riskrf.risk.road_risk import (commuter_passage_probability, commuter_strike_probability, fn_zone,
                               occupancy_distribution, spatial_temporal_probability,
                               stationary_rock_strike_probability)
 
@@ -287,7 +287,7 @@ def test_option_geometry_outside_the_profile_names_option_and_field():
 
 
 def test_site_file_geometry_errors_before_computing(tmp_path):
-    from riskrf.site import SiteError, load_site
+    from riskrf.app.site import SiteError, load_site
     text = (ROOT / "riskrf" / "data" / "demo_site.toml").read_text()
     bad = text.replace("x_m = 85.0", "x_m = 128.0")
     site = tmp_path / "site.toml"
@@ -410,7 +410,7 @@ def test_fence_at_another_position_and_realignment_are_derived_from_simulation()
             Option("move", "realignment", 1e6, road_x_m=75.0))
     s = _toe_study(opts)
     res = s.context.run(s.context.scenario)
-    from riskrf.measures import runout_beyond
+    from riskrf.risk.measures import runout_beyond
     expected = runout_beyond(res, 75.0).sum() / runout_beyond(res, 60.0).sum()
     assert s.evaluate("move").effectiveness == pytest.approx(1 - expected, abs=1e-12)
     assert 0 < s.evaluate("fence").retention <= 1
@@ -484,7 +484,7 @@ def test_property_structures_only_remove_falls_and_combinations_compose(cap, hei
 def test_damage_state_shares_with_no_arrivals_are_zero_not_nan():
     """A slope model (material draw) in which no simulated block reaches the road gave a nan expected cost for the
     rock shed (np.mean over no falls); the shares of no falls multiply a zero arrival rate and are 0."""
-    from riskrf.barriers import damage_state_shares
+    from riskrf.hazard.barriers import damage_state_shares
     passing, held, destroyed = damage_state_shares(np.zeros((0, 4)), np.zeros(0, dtype=bool), 1000.0)
     assert passing.shape == (4,) and not np.isnan(passing).any() and not held.any() and not destroyed.any()
     p, h, d = damage_state_shares(np.array([[500.0], [2000.0]]), np.array([False, False]), 1000.0)
@@ -496,8 +496,8 @@ def test_mass_coupled_hazard_gives_each_mass_its_own_reach_and_speed_at_the_fenc
     always at 30 m/s.  A 4,000 kJ fence holds every light block (E <= 500 kJ, below SEL) and no heavy one
     (E >= 4,500 kJ): the barrier is destroyed by exactly the heavy arrivals, rate x P(heavy) x 1.  Pooled
     speeds (one law for all masses) would let light blocks break it and heavy ones be held."""
-    from riskrf.mass_coupling import MassCoupledSamples
-    from riskrf.impact_energy import mass_model
+    from riskrf.hazard.mass_coupling import MassCoupledSamples
+    from riskrf.hazard.impact_energy import mass_model
     n = 2000
     m = np.geomspace(1e3, 1e5, n + 2)[1:-1]
     heavy = m > 1e4
@@ -527,7 +527,7 @@ def test_material_variant_with_the_central_materials_reproduces_a_mass_coupled_r
     hazard's median, and its heights by a ratio of medians that is 0 when most arriving blocks roll, h = 0:
     no block ever passed over a fence in that variant.)"""
     import riskrf
-    from riskrf.measures import material_value
+    from riskrf.risk.measures import material_value
     sc = simulation.load_scenario(ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml")
     hz = riskrf.energy_hazard(stats.loguniform(50.0, 5e4), sc, "barrier", rate_per_year=1.0, n=2000, seed=1)
     name = "talus.ground_friction_angle_deg"
@@ -552,7 +552,7 @@ def test_material_variant_with_the_central_materials_reproduces_a_mass_coupled_r
 def test_quantile_mapping_of_bounce_heights_keeps_the_rolling_share():
     """The variant's height law is applied by quantile mapping: twice the heights map each height to twice
     itself, rolling blocks (h = 0) stay on the ground, and a variant whose median is 0 still bounces above it."""
-    from riskrf.mitigation import _quantile_map
+    from riskrf.risk.mitigation import _quantile_map
     ref = np.r_[np.zeros(600), np.linspace(0.1, 4.0, 400)]
     x = np.array([0.0, 0.5, 2.0, 3.9, 6.0])
     np.testing.assert_allclose(_quantile_map(x, ref, 2 * ref), 2 * x, rtol=1e-12)
@@ -566,7 +566,7 @@ def test_quantile_mapping_of_bounce_heights_keeps_the_rolling_share():
 
 
 def test_simulations_on_threads_equal_one_by_one_runs():
-    from riskrf.measures import scenario_with_materials
+    from riskrf.risk.measures import scenario_with_materials
     sc = simulation.load_scenario(ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml")
     scs = [scenario_with_materials(sc, {"talus.ground_friction_angle_deg": v}) for v in (15.0, 20.0, 25.0)]
     ctx = SimulationContext(sc, n_blocks=800, seed=3, threads=2)
@@ -584,7 +584,7 @@ def test_fragmentation_breaks_event_volumes_into_the_blocks_that_travel():
     event reaches the road with probability 1 - exp(-N tau) and is fatal to a vehicle it meets with probability
     (1 - exp(-N tau v)) / (1 - exp(-N tau)).  The fragments keep the event's mass (the grid reaches down to the
     finest generation); the tree and the F-N curve use the same events and vulnerabilities as the ranking."""
-    from riskrf.design_block import fractal_fragments
+    from riskrf.hazard.design_block import fractal_fragments
     frag = study(uncertainty=Uncertainty(samples=200, fractal_dimension=(2.5, 2.5), fragmentation_iterations=3))
     n_frag = fractal_fragments(1.0, 2.5, 3)["count"].sum()
     reach = -np.expm1(-0.5 * n_frag)

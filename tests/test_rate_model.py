@@ -9,7 +9,7 @@ import pytest
 
 import riskrf
 from riskrf import read_inventory, rate_model
-from riskrf.rainfall import rainfall_from_series, read_rainfall
+from riskrf.io.rainfall import rainfall_from_series, read_rainfall
 
 from .conftest import INVENTORIES
 

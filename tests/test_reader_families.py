@@ -1,7 +1,7 @@
 """The same reading rules for every table riskrf reads (issue 11, item 1): one European export per reader family.
 
 Inventories and velocity files are covered in test_bad_input.py; here the readers moved onto
-riskrf.tables: corridor sections, generic rainfall, block surveys and observed stops.  Each gets a
+riskrf.io.tables: corridor sections, generic rainfall, block surveys and observed stops.  Each gets a
 semicolon-separated export with decimal commas, written with a UTF-8 byte-order mark or in
 Windows-1252 (``m³`` in a header), and an Excel workbook with the table on sheet 2 below three
 title rows.
@@ -12,9 +12,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from riskrf.design_block import read_block_survey
-from riskrf.rainfall import read_rainfall
-from riskrf.tables import read_numeric_table
+from riskrf.hazard.design_block import read_block_survey
+from riskrf.io.rainfall import read_rainfall
+from riskrf.io.tables import read_numeric_table
 from simulation.calibration import read_observed
 
 DATA = Path(__file__).resolve().parent / "data" / "corridor"
@@ -37,7 +37,7 @@ def _corridor(tmp_path, table_name, extra=""):
 
 
 def test_corridor_sections_from_a_european_export(tmp_path):
-    from riskrf import corridor as cr
+    from riskrf.app import corridor as cr
     reference = cr.load_corridor(DATA / "small.toml")
     text = ("# Abschnitte E6, Export Strassenverwaltung (Höhe in m)\n"
             "id;chainage_from;chainage_to;cut_height_m;ditch_width_m;runout_to_road_m;falls_per_year\n"
@@ -60,7 +60,7 @@ def test_corridor_sections_from_a_european_export(tmp_path):
 
 
 def test_corridor_sections_on_sheet_2_below_title_rows_from_cli_options_or_the_toml(tmp_path, capsys):
-    from riskrf import corridor as cr
+    from riskrf.app import corridor as cr
     from riskrf.cli import main
     body = pd.read_csv(DATA / "small_sections.csv")
     _excel_sheet2(tmp_path / "s.xlsx", body)

@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from riskrf import rhrs
+from riskrf.risk import rhrs
 
 FT = 0.3048
 YD3 = 0.764554857984

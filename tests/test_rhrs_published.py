@@ -12,7 +12,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from riskrf import rhrs
+from riskrf.risk import rhrs
 
 DATA = Path(__file__).resolve().parent / "data" / "taherynia2014"
 FT = 0.3048

@@ -8,12 +8,12 @@ import pandas as pd
 import pytest
 
 from riskrf import read_inventory, rate_model
-from riskrf.assess import run_assessment
-from riskrf.closure import closure_rule, warning_closure
-from riskrf.mitigation import MitigationError, MitigationStudy
-from riskrf.rainfall import read_rainfall
-from riskrf.site import SiteError, load_site
-from riskrf.site_rates import evaluate_rates, resolve_closures
+from riskrf.app.assess import run_assessment
+from riskrf.risk.closure import closure_rule, warning_closure
+from riskrf.risk.mitigation import MitigationError, MitigationStudy
+from riskrf.io.rainfall import read_rainfall
+from riskrf.app.site import SiteError, load_site
+from riskrf.risk.site_rates import evaluate_rates, resolve_closures
 
 WARNINGS = ("color,start time,start date,end time,end date,duration\n"
             "Amber,5:15,12-Apr-01,8:00,12-Apr-01,02 45\n"
@@ -197,7 +197,7 @@ def test_rainfall_file_errors_name_the_site_field_and_row(tmp_path):
 
 
 def test_options_file_with_rates_resolves_closure_rules_for_riskrf_decide(tmp_path):
-    from riskrf.mitigation import load_mitigation
+    from riskrf.risk.mitigation import load_mitigation
     path = write_site(tmp_path / "s")
     study = load_mitigation(path, None)             # riskrf decide --options: a site file works too
     opt = study.option("close on rain")

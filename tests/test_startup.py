@@ -33,17 +33,17 @@ def test_every_public_name_resolves(package):
 def test_public_name_kept_when_its_module_is_imported():
     """``riskrf.rate_model`` is the function, as with an eager ``__init__``, even after something imports the
     submodule of the same name (a plain lazy package would then hold the module)."""
-    code = ("import riskrf.closure, riskrf.rate_model as m; from riskrf import rate_model; import riskrf; "
+    code = ("import riskrf.risk.closure, riskrf.frequency.rates as m; from riskrf import rate_model; import riskrf; "
             "print(callable(rate_model), riskrf.rate_model is rate_model, 'lazy_exports' in dir(riskrf))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["True", "True", "False"]
 
 
 def test_submodules_as_attributes():
-    assert riskrf.mitigation.MitigationStudy.__name__ == "MitigationStudy"
+    assert riskrf.risk.mitigation.MitigationStudy.__name__ == "MitigationStudy"
     assert simulation.kernel.simulate is not None
     from riskrf import fit_gutenberg_richter
-    from riskrf.power_law import fit_gutenberg_richter as same
+    from riskrf.frequency.power_law import fit_gutenberg_richter as same
     assert fit_gutenberg_richter is same
 
 

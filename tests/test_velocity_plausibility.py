@@ -5,8 +5,8 @@ import pytest
 
 import simulation
 from riskrf.cli import main
-from riskrf.validation import RiskrfWarning
-from riskrf.velocities import (
+from riskrf.core.validation import RiskrfWarning
+from riskrf.io.velocities import (
     FREE_FALL_MARGIN,
     PLAUSIBLE_MAX_MS,
     free_fall_drop_m,

@@ -4,7 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .. import __version__
-from ..units import M_PER_KM
+from ..core.units import M_PER_KM
 from .format import Document, cell, escape
 
 

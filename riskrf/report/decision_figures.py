@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..road_risk import HK_GEO_FN_LINES, HK_GEO_N_CUTOFF, HK_GEO_N_LIMIT, HK_GEO_SCRUTINY_F_MIN
+from ..risk.road_risk import HK_GEO_FN_LINES, HK_GEO_N_CUTOFF, HK_GEO_N_LIMIT, HK_GEO_SCRUTINY_F_MIN
 from .fit_figures import _axes
 
 
@@ -63,7 +63,7 @@ def plot_tree(tree, ax=None, *, max_label: int = 28):
             label = b.name if len(b.name) <= max_label else b.name[:max_label - 1] + "…"
             extra = []
             if b.probability is not None:
-                from ..decision_tree import _evaluate
+                from ..risk.decision_tree import _evaluate
                 extra.append(f"p={_evaluate(b.probability, tree.parameters, b.name):.3g}")
             net = tree._net(b)
             if net:

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..extremes import _n_unknown_years, gumbel_reduced_variate, plotting_positions
-from ..units import KG_PER_TONNE, mass_for_energy_kg
+from ..frequency.extremes import _n_unknown_years, gumbel_reduced_variate, plotting_positions
+from ..core.units import KG_PER_TONNE, mass_for_energy_kg
 
 
 def _axes(ax, figsize=(6.4, 4.8)):
@@ -161,7 +161,7 @@ def plot_energy_exceedance(hazard, ax=None, *, fences=(), level: float = 0.95, n
 def plot_mass_velocity(hazard, ax=None, *, energies=(100, 500, 1000, 2000, 5000, 10000), n_points: int = 3000,
                        seed=1):
     """Sampled masses and velocities of falls reaching the line, with iso-energy curves E = 1/2 m v^2."""
-    from ..impact_energy import mass_model
+    from ..hazard.impact_energy import mass_model
     ax = _axes(ax)
     rng = np.random.default_rng(seed)
     m = mass_model(hazard.mass).rvs(n_points, rng)
@@ -195,7 +195,7 @@ def plot_mass_velocity(hazard, ax=None, *, energies=(100, 500, 1000, 2000, 5000,
 
 def plot_design_energy_sensitivity(table, ax=None):
     """The T-year energy [kJ] against the rate share, one line per maximum credible block m_max
-    (a table from :func:`riskrf.energy_study.design_energy_sensitivity`)."""
+    (a table from :func:`riskrf.hazard.energy_study.design_energy_sensitivity`)."""
     ax = _axes(ax)
     for i, (m_max, g) in enumerate(table.groupby("m_max_kg")):
         g = g.sort_values("rate_share")
@@ -212,7 +212,7 @@ def plot_design_energy_sensitivity(table, ax=None):
 
 
 def plot_design_energy_tornado(tornado, axes=None):
-    """One tornado per design energy of a :class:`~riskrf.energy_study.DesignEnergyTornado` (stacked panels,
+    """One tornado per design energy of a :class:`~riskrf.hazard.energy_study.DesignEnergyTornado` (stacked panels,
     each with its own base line and x axis in kJ), drawn by :func:`riskrf.report.decision_figures.plot_tornado`.
 
     Returns the list of axes, one per design energy."""

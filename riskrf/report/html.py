@@ -16,9 +16,9 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
-from ..energy_study import INTERVAL_COVERS, sensitivity_grid
-from ..impact_energy import PairedSamples
-from ..road_risk import fn_zone
+from ..hazard.energy_study import INTERVAL_COVERS, sensitivity_grid
+from ..hazard.impact_energy import PairedSamples
+from ..risk.road_risk import fn_zone
 from .format import Document, cell, human_header, money, probability, sig
 from .format import escape as _e
 

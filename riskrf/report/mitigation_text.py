@@ -118,7 +118,7 @@ def write_tree_figure(study, tmp) -> None:
 def write_mitigation_outputs(study, report, tmp, *, tree_figure: bool = True) -> None:
     """Ranking, tornado, break-even and decision tables, and the tree (unless ``tree_figure`` is False: drawn
     apart by :func:`write_tree_figure`), tornado and F-N figures."""
-    from ..outputs import write_json
+    from ..io.outputs import write_json
     from .decision_figures import plot_fn, plot_tornado
     from .files import save_figure
     report["ranking"].to_csv(tmp / "ranking.csv", index=False)

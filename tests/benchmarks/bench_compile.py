@@ -31,12 +31,12 @@ import simulation, simulation.engine
 t = time.process_time()
 simulation.run(simulation.load_scenario(SCENARIO), n=4, seed=0, record_paths=4)
 """,
-    "power-law threshold search (riskrf._power_law_kernels)": """
+    "power-law threshold search (riskrf.frequency._power_law_kernels)": """
 from riskrf import find_m_min
 t = time.process_time()
 find_m_min(np.random.default_rng(1).pareto(1.0, 500) + 1.0)
 """,
-    "GEV / Gumbel likelihood (riskrf._extremes_kernels)": """
+    "GEV / Gumbel likelihood (riskrf.frequency._extremes_kernels)": """
 from riskrf import fit_gev
 t = time.process_time()
 fit = fit_gev(np.random.default_rng(1).gumbel(10.0, 2.0, 37))

@@ -46,7 +46,7 @@ def make_corridor(directory: Path, sections: int, blocks: int) -> Path:
 
 def _warm():
     import simulation
-    from riskrf import corridor as cr
+    from riskrf.app import corridor as cr
     c = cr.load_corridor(ROOT / "tests" / "data" / "corridor" / "small.toml")
     simulation.run(c.sections[0].scenario, n=50, seed=1, record_paths=0)
     return True
@@ -63,7 +63,7 @@ def main() -> int:
     args = ap.parse_args()
     import distributed
 
-    from riskrf import corridor as cr
+    from riskrf.app import corridor as cr
     with tempfile.TemporaryDirectory() as d:
         path = make_corridor(Path(d), args.sections, args.blocks)
         corridor = cr.load_corridor(path)

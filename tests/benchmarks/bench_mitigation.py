@@ -16,10 +16,10 @@ import time
 import warnings
 from dataclasses import replace
 
-from riskrf.assess import energy_hazard_from_inputs, road_share, study_context
-from riskrf.inventory import read_inventory
-from riskrf.mitigation import MitigationStudy
-from riskrf.site import load_site
+from riskrf.app.assess import energy_hazard_from_inputs, road_share, study_context
+from riskrf.frequency.inventory import read_inventory
+from riskrf.risk.mitigation import MitigationStudy
+from riskrf.app.site import load_site
 
 
 def main(samples: int = 1000):
@@ -35,7 +35,7 @@ def main(samples: int = 1000):
         n=hz_cfg["n_blocks"], seed=hz_cfg["seed"])
     mit = dict(site.mitigation)
     if site.rates is not None:          # closure rules: share and hours from the site's daily rate model
-        from riskrf.site_rates import evaluate_rates, resolve_closures
+        from riskrf.risk.site_rates import evaluate_rates, resolve_closures
         rates = evaluate_rates(site.rates, site.path.parent, inv_cfg, mit["options"])
         mit["options"] = resolve_closures(mit["options"], rates)
     mit["uncertainty"] = replace(mit["uncertainty"], samples=samples)

@@ -1,0 +1,568 @@
+"""The whole chain for one site: inventory -> fits -> simulation -> energy hazard -> mitigation ranking.
+
+``run_assessment(site)`` computes; ``write_assessment(assessment, directory)`` writes
+report.html, summary.json, CSV tables, PNG figures and a copy of the inputs with the
+package version and seed.  ``riskrf assess`` and ``riskrf demo`` call both, writing
+into a temporary directory that is moved into place only when complete.
+"""
+from __future__ import annotations
+
+import json
+import logging
+import platform
+import shutil
+import sys
+import time
+import warnings
+from dataclasses import dataclass, field, replace
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
+from ..hazard.annual_hazard import EnergyHazard, inertia_factors
+from .background import InBackground
+from ..hazard.design_block import (design_block, design_block_candidates_kg, fragment_block_kg, read_block_survey,
+                           resolve_sizes)
+from ..hazard.energy_study import (
+    INTERVAL_COVERS,
+    EnergyAnalysis,
+    analyse_energy,
+    design_energy_sensitivity,
+    design_energy_tornado,
+)
+from ..frequency.study import FrequencyAnalysis, analyse_inventory
+from ..frequency.inventory import Inventory, read_inventory
+from ..hazard.mass_coupling import energy_hazard
+from ..risk.mitigation import MitigationStudy
+from ..io.outputs import relative_paths, relative_paths_in_json_files, write_json
+from ..frequency.power_law import fit_gutenberg_richter
+from .site import Site
+from ..core.validation import RiskrfWarning
+
+logger = logging.getLogger("riskrf")
+
+
+def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, rate_scale: float = 1.0,
+                              scenario=None, velocities=None, collector: str | None = None, n: int = 50_000,
+                              seed=1, reach_probability: float = 1.0, condition_on_mass: bool = False,
+                              mass_coupling: str = "simulated", design_masses_kg=(),
+                              velocity_unit: str | None = None, drop_height_m=None, velocity_reader=None,
+                              rate_note: str | None = None):
+    """Power-law fit of the inventory combined with simulated or given velocities.
+
+    ``collector`` names the barrier line: in a scenario it defaults to "barrier"; a
+    velocity file is filtered to that collector only when one is named.
+
+    With a scenario and ``mass_coupling="simulated"`` (the default) the hazard is
+    :func:`riskrf.energy_hazard`: ``n`` blocks simulated across the power law's mass range
+    (widened to ``design_masses_kg``: masses [kg], or a function of (power-law fit, rate per year) returning
+    them, for masses that follow from the site's law), reach and speed by mass.  ``"independent"`` (or
+    ``condition_on_mass``) is the older form from the seeder's own masses.  The returned
+    simulation is always the scenario's own seeder run (figures, road share, mitigation).
+    ``rate_note`` replaces the hazard's note on ``rate_scale`` (e.g. a rate from the site's rate model).
+
+    Returns (power-law fit, EnergyHazard, SimulationResult or None).
+    """
+    import simulation
+
+    from ..io.velocities import read_velocities
+
+    gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=m_min, m_max=m_max)
+    rate = gr.rate_min * rate_scale
+    if callable(design_masses_kg):
+        design_masses_kg = design_masses_kg(gr, rate)
+    if (scenario is None) == (velocities is None):
+        raise ValueError("give exactly one of --scenario (simulate the velocities) or --velocities (a file)")
+    result = None
+    if scenario is not None:
+        sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
+        collector = collector or "barrier"
+        sc.collector_index(collector)
+        result = simulation.run(sc, n=n, seed=seed)
+        if mass_coupling not in ("simulated", "independent"):
+            raise ValueError(f"mass_coupling = {mass_coupling!r} must be 'simulated' or 'independent'")
+        if mass_coupling == "simulated" and not condition_on_mass:
+            hazard = energy_hazard(gr, sc, collector, rate_per_year=rate, n=n, seed=seed,
+                                   design_masses_kg=design_masses_kg)
+        else:
+            hazard = EnergyHazard.from_simulation(gr, result, collector, rate_per_year=rate,
+                                                  condition_on_mass=condition_on_mass)
+    else:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RiskrfWarning)      # kept in the hazard's notes below
+            df = read_velocities(velocities, collector=collector, velocity_unit=velocity_unit,
+                                 drop_height_m=drop_height_m, **(velocity_reader or {}))
+        v = df["velocity_ms"].to_numpy(dtype=float)
+        note = "; ".join([f"velocities: {len(df):,} samples from {velocities}", *df.attrs.get("warnings", [])])
+        if "angular_velocity_rads" in df and "radius_m" in df:
+            spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
+            v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
+            note += "; rotational energy included"
+        note += f"; reach probability {reach_probability:g} as given" + (
+            " (default: every fall assumed to reach the line)" if reach_probability == 1.0 else "")
+        hazard = EnergyHazard(mass=gr, velocity=v, rate_per_year=rate, reach_probability=reach_probability,
+                              heights_m=df["height_m"].to_numpy(dtype=float) if "height_m" in df else None,
+                              collector=collector or "", notes=(note,))
+    if rate_note is not None:
+        hazard = replace(hazard, notes=hazard.notes + (rate_note,))
+    elif rate_scale != 1.0:
+        hazard = replace(hazard, notes=hazard.notes + (
+            f"rate scaled by {rate_scale:g} (share of the inventoried source above this line)",))
+    return gr, hazard, result
+
+
+def road_share(result, barrier: str, road: str | None) -> float:
+    """P(reaches the road | reaches the barrier line) from a simulation (1 without a road collector)."""
+    if result is None or road is None or road not in [c.name for c in result.scenario.collectors]:
+        return 1.0
+    b = result.reach_probability(barrier)[0]
+    return min(result.reach_probability(road)[0] / b, 1.0) if b > 0 else 1.0
+
+
+def study_context(result, barrier: str, road: str | None, option_blocks: int, seed, inventory, hazard,
+                  rate_scale: float = 1.0) -> dict:
+    """The slope model and small falls a :class:`MitigationStudy` needs to derive option effects.
+
+    Falls below the power law's m_min: the inventory's own (their masses, and their count
+    over the record scaled by ``rate_scale``), so that every size that reaches the road counts.
+    """
+    from ..risk.measures import SimulationContext
+    out = {}
+    if result is not None:
+        names = [c.name for c in result.scenario.collectors]
+        out["context"] = SimulationContext(result.scenario, barrier_collector=barrier,
+                                           road_collector=road if road in names else barrier,
+                                           n_blocks=int(option_blocks), seed=int(seed))
+        out["reference"] = result
+    m_min = getattr(hazard.mass, "m_min", None)
+    if m_min is not None and inventory is not None:
+        small = inventory.masses[inventory.masses < m_min]
+        out["small_fall_masses_kg"] = small
+        out["small_falls_per_year"] = small.size / inventory.duration_years * rate_scale
+    return out
+
+
+def fence_checks_from_site(site) -> tuple:
+    """(capacities kJ, heights m) of the fences to check: those of the site's fence and attenuator options
+    (each at its own height), else hazard.fences_kj at hazard.fence_height_m."""
+    opts = [o for o in site.mitigation["options"] if o.kind in ("fence", "attenuator") and o.x_m is None]
+    if opts:
+        return tuple(o.capacity_kj for o in opts), tuple(o.height_m for o in opts)
+    fh = site.hazard["fence_height_m"]
+    caps = tuple(site.hazard["fences_kj"])
+    return caps, tuple(fh) if isinstance(fh, list) else tuple([fh] * len(caps))
+
+
+def sensitivity_inputs(site, rate_scale: float | None = None) -> tuple:
+    """(m_max values [kg], rate shares [-]) for the design-energy sensitivity: low, stated and high values.
+
+    m_max: the site's uncertainty.m_max_kg range, else x0.5 and x2 of inventory.m_max_kg (only the stated value,
+    None, when the law is not truncated); rate share: inventory.rate_scale x uncertainty.rate_factor, else x0.5
+    and x2.  ``rate_scale`` replaces inventory.rate_scale (a rate from the site's rate model)."""
+    m_max = site.inventory["m_max_kg"]
+    unc = site.mitigation.get("uncertainty")
+    if m_max is None:
+        m_values = [None]
+    elif unc is not None and unc.m_max_kg is not None:
+        m_values = sorted({float(unc.m_max_kg[0]), float(m_max), float(unc.m_max_kg[1])})
+    else:
+        m_values = [0.5 * m_max, float(m_max), 2.0 * m_max]
+    share = float(site.inventory["rate_scale"] if rate_scale is None else rate_scale)
+    lo, hi = (unc.rate_factor if unc is not None and unc.rate_factor[0] != unc.rate_factor[1] else (0.5, 2.0))
+    return m_values, sorted({share * lo, share, share * hi})
+
+
+def _ends(values):
+    """(lowest, highest) of a sensitivity list, None when it holds one value or None (nothing to vary)."""
+    v = [x for x in values if x is not None]
+    return (min(v), max(v)) if len(v) > 1 else None
+
+
+@dataclass
+class Assessment:
+    """Everything one ``riskrf assess`` run computed for a site, in the order of the chain.
+
+    Fields: the :class:`~riskrf.app.site.Site` read, its :class:`~riskrf.frequency.inventory.Inventory`, the frequency analyses
+    (power law, and annual maxima when dated), the simulation ``result`` (:class:`simulation.SimulationResult`),
+    the :class:`~riskrf.hazard.energy_study.EnergyAnalysis` at the barrier line, the
+    :class:`~riskrf.risk.mitigation.MitigationStudy` and its ``decision`` (recommendation dict), the ``seed`` and
+    number of simulated blocks, ``warnings`` raised on the way, stage ``timings`` [s] and the site's rate model
+    (``rates``, or None).  Written to files by :func:`write_assessment`; nothing here prints.
+    """
+    site: Site
+    inventory: Inventory
+    frequency: FrequencyAnalysis
+    maxima_frequency: FrequencyAnalysis | None
+    result: object
+    energy: EnergyAnalysis
+    study: MitigationStudy
+    decision: dict
+    seed: int
+    n_blocks: int
+    warnings: list = field(default_factory=list)
+    timings: dict = field(default_factory=dict)
+    rates: object = None            # SiteRates of the site's [rates] model (riskrf.risk.site_rates), or None
+    #: figures already being drawn beside the computation: {"dir": Path, "pending": [InBackground, ...]} (see
+    #: ``run_assessment(figures_dir=...)``); empty when ``write_assessment`` draws them all.
+    drawing: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def rate_source(self) -> str:
+        """Where the hazard's annual rate comes from, in words."""
+        inv = self.inventory
+        if self.site.inventory.get("rate_from") == "rate_model" and self.rates is not None:
+            text = "rate model: " + self.rates.rate_text()
+        else:
+            text = (f"inventory: {inv.n_events:,} recorded falls in {inv.duration_years:.3g} years "
+                    f"({self.frequency.power_law.rate_min:.4g} per year at or above m_min)")
+        scale = self.site.inventory["rate_scale"]
+        return text + (f"; times rate_scale {scale:g} (typed: share of the recorded source above this road)"
+                       if scale != 1 else "")
+
+    def summary(self) -> dict:
+        """Every headline number, machine-readable, with units."""
+        fr, gr = self.frequency, self.frequency.power_law
+        hz = self.energy.hazard
+        ranking = self.decision["ranking"]
+        nothing = ranking[ranking["kind"] == "none"]
+        out = {
+            "site": self.site.name, "riskrf_version": __version__, "seed": self.seed, "n_blocks": self.n_blocks,
+            "units": {"mass": "kg", "volume": "m3", "energy": "kJ", "height": "m", "velocity": "m/s",
+                      "rate": "1/yr", "return_period": "yr", "money": self.study.currency},
+            "inventory": {"source": self.inventory.source, "events": self.inventory.n_events,
+                          "duration_years": self.inventory.duration_years,
+                          "density_kg_m3": self.inventory.density_kg_m3,
+                          "density_is_default": self.inventory.density_is_default},
+            "power_law": {"b": gr.b, "b_stderr": gr.b_stderr, "b_ci": list(gr.b_ci), "a": gr.a, "m_min_kg": gr.m_min,
+                          "m_min_method": gr.m_min_method, "rate_min_per_year": gr.rate_min,
+                          "bootstrap_p_value": fr.bootstrap_p},
+            "whole_wall_design_masses": fr.design_masses().assign(basis=WHOLE_WALL_BASIS).to_dict(orient="records"),
+            "whole_wall_design_masses_basis": WHOLE_WALL_BASIS,
+            "site_design_masses": self.energy.site_masses.to_dict(orient="records")
+            if self.energy.site_masses is not None else None,
+            "design_block": self.energy.design_block.to_dict() if self.energy.design_block is not None else None,
+            "design_energy_sensitivity": self.energy.sensitivity.to_dict(orient="records")
+            if self.energy.sensitivity is not None else None,
+            "design_energy_tornado": self.energy.tornado.to_dict() if self.energy.tornado is not None else None,
+            "design_energy_interval_covers": INTERVAL_COVERS,
+            "hazard": {"power_law_for_hazard": {"b": float(hz.mass.b), "m_max_kg": hz.mass.m_max,
+                                                "m_min_kg": float(hz.mass.m_min)},
+                       "mass_coupled": hz.mass_coupled,
+                       "falls_per_year": hz.rate_per_year, "rate_source": self.rate_source,
+                       "reach_probability": hz.reach_probability,
+                       "arrivals_per_year": hz.arrival_rate,
+                       "road_share": self.study.road_share,
+                       "energy_p95_kj": float(hz.energy_percentile(95)[0]),
+                       "energy_p99_kj": float(hz.energy_percentile(99)[0]),
+                       "height_p95_m": float(hz.height_percentile(95)) if hz.heights_m is not None else None},
+            "design_energies": self.energy.design.to_dict(orient="records"),
+            "fences": self.energy.fence_verdicts().to_dict(orient="records"),
+            "ranking": ranking.to_dict(orient="records"),
+            "options": self.decision["options"],
+            "recommendation": self.decision["recommendation"],
+            "uncertainty": self.decision["uncertainty"],
+            "best_option": ranking["option"].iloc[0],
+            "second_option": ranking["option"].iloc[1],
+            "break_even": self.decision["break_even"].to_dict(orient="records"),
+            "value_of_information": self.decision["value_of_information"],
+            "individual_risk_do_nothing": float(nothing["individual_risk"].iloc[0]) if len(nothing) else None,
+            "fn_zone": dict(zip(ranking["option"], ranking["fn_zone"])),
+            "defaults_used": list(self.site.defaults_used),
+            "warnings": self.warnings,
+            "timings_s": self.timings,
+        }
+        if self.rates is not None:
+            out["rate_model"] = self.rates.summary()
+        if fr.gumbel is not None or (self.maxima_frequency and self.maxima_frequency.gumbel is not None):
+            src = fr if fr.gumbel is not None else self.maxima_frequency
+            out["annual_maxima"] = {"source": src.inventory.source, "gumbel": dict(zip(src.gumbel.param_names,
+                                                                                      src.gumbel.params)),
+                                    "gev": dict(zip(src.gev.param_names, src.gev.params)) if src.gev else None,
+                                    "deviance_test": src.deviance, "preferred_model": src.preferred_model()}
+        return out
+
+
+def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None = None, log=None,
+                   figures_dir=None) -> Assessment:
+    """Run the whole chain for a validated site; each stage is logged (``logging`` logger ``riskrf``, level INFO,
+    or the callable ``log``) and timed in :attr:`Assessment.timings`.
+
+    ``figures_dir``: a directory (created here, must not exist) that ``write_assessment`` will use as
+    ``OUT/figures``; the figures and tables of each stage are then drawn there beside the later stages (on the
+    second core, where forking is safe) instead of all at the end.  The outputs are the same either way.
+    """
+    log = log or logger.info
+    figures = None if figures_dir is None else Path(figures_dir)
+    pending = []
+    if figures is not None:
+        figures.mkdir()
+        from ..report.files import prepare_drawing
+        prepare_drawing()           # pyplot imported once here, not in each process drawing beside
+    from ..report.mitigation_text import study_report
+
+    seed = site.hazard["seed"] if seed is None else seed
+    n_blocks = site.hazard["n_blocks"] if n_blocks is None else n_blocks
+    timings = {}
+    stages = 5
+
+    def stage(i, text):
+        log(f"[{i}/{stages}] {text}")
+        return time.perf_counter()
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RiskrfWarning)
+        inv_cfg = site.inventory
+        hz_cfg = site.hazard
+        # On a fresh installation the simulator is compiled once (numba, cached on disk): that takes the other
+        # core while this one fits, fits the rate model and draws the fits' figures (below); otherwise those
+        # two go to forked children on the other core.
+        from simulation.precompile import precompile
+        compiling = precompile() if hz_cfg["scenario"] else None
+        beside = compiling is None or not compiling.running
+        if not beside:
+            log("      first run of this installation: the simulator is compiled once on the other core (numba, "
+                "cached on disk for later runs)")
+        # The site's rate model (hazard rate, closure rules).
+        rates = None
+        if site.rates is not None:
+            from ..risk.site_rates import evaluate_rates
+            rates = InBackground(lambda: evaluate_rates(site.rates, site.path.parent, inv_cfg,
+                                                        site.mitigation["options"]), fork=beside)
+        t = stage(1, "reading the inventory and fitting magnitude-frequency models")
+        from ..frequency.inventory import READER_OPTIONS
+        reader = {k: inv_cfg[k] for k in READER_OPTIONS if inv_cfg.get(k) is not None}
+        inventory = read_inventory(site.resolve(inv_cfg["path"]), start=inv_cfg["start"], end=inv_cfg["end"],
+                                   duration_years=inv_cfg["duration_years"], density_kg_m3=inv_cfg["density_kg_m3"],
+                                   **reader)
+        dated = read_inventory(site.resolve(inv_cfg["annual_maxima"])) if inv_cfg["annual_maxima"] else None
+        frequency = analyse_inventory(inventory, m_min=inv_cfg["m_min_kg"], n_bootstrap=500, seed=seed)
+        maxima_frequency = None
+        if dated is not None:
+            maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
+        timings["fits"] = round(time.perf_counter() - t, 2)
+        if figures is not None:
+            pending.append(InBackground(partial(_frequency_outputs, frequency, maxima_frequency, figures),
+                                        fork=beside))
+
+        db_cfg = site.design_block
+        survey = read_block_survey(site.resolve(db_cfg["survey"]), inventory.density_kg_m3) \
+            if db_cfg["survey"] else None
+        rate_scale, rate_note, site_rates = inv_cfg["rate_scale"], None, None
+        if inv_cfg.get("rate_from") == "rate_model":
+            site_rates = rates.result()
+            rate_scale = inv_cfg["rate_scale"] * site_rates.hazard_factor(inventory)
+            rate_note = "rate from the " + site_rates.rate_text() + (
+                f"; times rate_scale {inv_cfg['rate_scale']:g}" if inv_cfg["rate_scale"] != 1 else "")
+        m_max_values, shares = sensitivity_inputs(site, rate_scale)
+        # masses design values are read at: the percentile band of the design block, the largest m_max studied
+        extra = design_block_candidates_kg(rule=db_cfg["rule"], percentile=db_cfg["percentile"],
+                                           survey_volumes_m3=survey, inventory=inventory,
+                                           density_kg_m3=inventory.density_kg_m3)
+        extra += [m for m in m_max_values if m is not None]
+
+        def design_masses(law, rate):
+            """The masses above and the fragmentation alternative of the site's law (simulated, not borrowed)."""
+            frag = fragment_block_kg(law, rate, design_T=hz_cfg["design_period_years"],
+                                     fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"],
+                                     percentile=db_cfg["percentile"], density_kg_m3=inventory.density_kg_m3)
+            finest = []
+            u = site.mitigation["uncertainty"]
+            if u is not None and u.fractal_dimension:     # fragments travel: simulate down to the finest one
+                masses = np.asarray(inventory.masses, dtype=float)
+                finest = [min(float(law.m_min), float(masses[masses > 0].min(initial=np.inf)))
+                          / 8.0 ** u.fragmentation_iterations]
+            return extra + ([frag] if frag is not None else []) + finest
+        if compiling is not None and (not beside or compiling.running):
+            t = time.perf_counter()
+            if not beside:          # this core's work while the simulator compiles on the other
+                for part in [rates] + pending:
+                    if part is not None:
+                        part.result()
+            compiling.wait()
+            timings["compilation"] = round(time.perf_counter() - t, 2)
+        t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
+        gr, hazard, result = energy_hazard_from_inputs(
+            inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=rate_scale,
+            scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
+            velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
+            collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
+            mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=design_masses,
+            velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note)
+        timings["simulation"] = round(time.perf_counter() - t, 2)
+        if figures is not None:
+            pending.append(InBackground(partial(_simulation_figures, result, hz_cfg["collector"], figures,
+                                                fences_to_draw(site))))
+
+        t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
+        block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
+                             survey_source=db_cfg["survey"], inventory=inventory,
+                             sizes=resolve_sizes(inv_cfg["sizes"], inventory),
+                             design_T=hz_cfg["design_period_years"], density_kg_m3=inventory.density_kg_m3,
+                             fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"])
+        sensitivity = design_energy_sensitivity(
+            hazard, inventory.masses, inventory.duration_years, m_min=gr.m_min, m_max_values=m_max_values,
+            rate_shares=shares, T=hz_cfg["design_period_years"]) \
+            if hz_cfg["design_period_years"] * hazard.arrival_rate > 1 else None
+        tornado = design_energy_tornado(
+            hazard, design_T=hz_cfg["design_period_years"], block=block, masses_kg=inventory.masses,
+            duration_years=inventory.duration_years, m_max_range=_ends(m_max_values),
+            rate_share=rate_scale, rate_share_range=_ends(shares), sensitivity=sensitivity,
+            **({"rate_label": "rate factor on the inventory's rate (rate model x rate_scale)"}
+               if site_rates is not None else {})) \
+            if sensitivity is not None else None
+        fences, heights = fence_checks_from_site(site)
+        energy = analyse_energy(hazard, fences=fences, fence_height_m=heights,
+                                free_board_m=hz_cfg["free_board_m"], design_T=hz_cfg["design_period_years"],
+                                density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed,
+                                design_block=block, sensitivity=sensitivity, tornado=tornado)
+        timings["energy"] = round(time.perf_counter() - t, 2)
+        if figures is not None:
+            pending.append(InBackground(partial(energy.write, figures)))
+
+        t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
+        share = road_share(result, hz_cfg["collector"], hz_cfg["road_collector"])
+        mitigation = site.mitigation
+        if rates is not None:
+            from ..risk.site_rates import resolve_closures
+            site_rates = rates.result()
+            mitigation = dict(mitigation, options=resolve_closures(mitigation["options"], site_rates))
+        study = MitigationStudy(hazard=hazard, road_share=share, source=str(site.path),
+                                defaults_used=site.defaults_used,
+                                **study_context(result, hz_cfg["collector"], hz_cfg["road_collector"],
+                                                hz_cfg["option_blocks"], seed, inventory, hazard,
+                                                rate_scale),
+                                **mitigation)
+        decision = study_report(study)
+        timings["decision"] = round(time.perf_counter() - t, 2)
+    notes = []
+    for w in list(frequency.warnings) + [str(c.message) for c in caught] + list(site_rates.notes if site_rates
+                                                                                else ()):
+        if w not in notes:
+            notes.append(w)
+    T_max = float(max(frequency.design_masses()["T_years"]))
+    if T_max > 2 * inventory.duration_years:
+        notes.append(f"design values for {T_max:g} years extrapolate a {inventory.duration_years:.3g}-year "
+                     "record far beyond the data")
+    if frequency.bootstrap_p is not None and frequency.bootstrap_p <= 0.1:
+        notes.append(f"the power law is questionable for this inventory (bootstrap p = {frequency.bootstrap_p:.3f})")
+    if frequency.power_law.n_tail < 50:
+        notes.append(f"only {frequency.power_law.n_tail} falls above m_min: the exponent b is uncertain")
+    return Assessment(site=site, inventory=inventory, frequency=frequency, maxima_frequency=maxima_frequency,
+                      result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
+                      warnings=notes, timings=timings, rates=site_rates,
+                      drawing={"dir": figures, "pending": pending} if figures is not None else {})
+
+
+def write_assessment(a: Assessment, out: Path, log=None) -> dict:
+    """Write every output of an assessment into ``out`` (an empty directory); returns the summary."""
+    log = log or logger.info
+    from ..report.html import render_report
+    from ..report.mitigation_text import write_mitigation_outputs, write_tree_figure
+
+    log("[5/5] writing the report, tables and figures")
+    t = time.perf_counter()
+    out = Path(out)
+    figs = out / "figures"
+    drawn = a.drawing.get("dir") is not None and figs.resolve() == Path(a.drawing["dir"]).resolve()
+    if not drawn:
+        figs.mkdir()
+
+    # The figures are drawn in parts at once on two cores where that is safe (see riskrf.app.background); parts that
+    # run_assessment started beside its later stages are only waited for, while this process draws the decision's.
+    if drawn:
+        tree = InBackground(partial(write_tree_figure, a.study, figs))
+        write_mitigation_outputs(a.study, a.decision, figs, tree_figure=False)
+        for part in a.drawing["pending"] + [tree]:
+            part.result()
+    else:
+        def simulation_and_decision_outputs():
+            _simulation_figures(a.result, a.site.hazard["collector"], figs, fences_to_draw(a.site))
+            write_mitigation_outputs(a.study, a.decision, figs)
+
+        beside = InBackground(simulation_and_decision_outputs)
+        _frequency_outputs(a.frequency, a.maxima_frequency, figs)
+        a.energy.write(figs)
+        beside.result()
+    for name in ("summary.json", "completeness.csv", "whole_wall_design_masses.csv"):
+        shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
+    for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv", "design_energy_sensitivity.csv",
+                 "design_energy_tornado.csv", "design_block.csv", "site_design_masses.csv"):
+        if (figs / name).exists():
+            shutil.move(str(figs / name), str(out / name))
+    for name in ("ranking.csv", "tornado.csv", "break_even.csv", "decision.json"):
+        shutil.move(str(figs / name), str(out / name))
+    a.timings["report"] = round(time.perf_counter() - t, 2)
+    summary = a.summary()
+    write_json(summary, out / "summary.json")
+    (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
+    _copy_inputs(a, out / "inputs")
+    relative_paths_in_json_files(out, a.site.path.parent)          # paths relative to the site file
+    return relative_paths(summary, a.site.path.parent)
+
+
+#: What the inventory fit's design-mass table is, in the outputs of an assessment (issue 10).
+WHOLE_WALL_BASIS = ("whole monitored wall (inventory fit), untruncated power law, rate not scaled: reference only, "
+                    "not the site's design masses (site_design_masses.csv)")
+
+
+def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:
+    """Tables and figures of the inventory's fits (and of the annual-maximum record, in a subfolder), their
+    design-mass tables labelled as references, not the site's design masses."""
+    frequency.write(figs, design_masses_name="whole_wall_design_masses", basis=WHOLE_WALL_BASIS)
+    if maxima_frequency is not None:
+        sub = figs / "annual_maxima"
+        sub.mkdir()
+        maxima_frequency.write(sub, design_masses_name="record_design_masses",
+                               basis=f"annual-maximum record {Path(str(maxima_frequency.inventory.source)).name}: "
+                                     "another record's fit, untruncated: reference only, not this site's design "
+                                     "masses")
+
+
+def fences_to_draw(site) -> list:
+    """(x [m] or None for the barrier line, height [m], label) of the site's fence and attenuator options, else
+    of the candidate fences of ``hazard.fences_kj``: what the profile figure draws at its height."""
+    opts = [o for o in site.mitigation["options"] if o.kind in ("fence", "attenuator")]
+    if opts:
+        return [(o.x_m, o.height_m, f"{o.name} ({o.height_m:g} m high)" if f"{o.capacity_kj:g}" in o.name
+                 else f"{o.name}: {o.capacity_kj:,.0f} kJ, {o.height_m:g} m high") for o in opts]
+    caps, heights = fence_checks_from_site(site)
+    return [(None, h, f"candidate fence {c:,.0f} kJ, {h:g} m") for c, h in zip(caps, heights)]
+
+
+def _simulation_figures(result, collector: str, figs: Path, fences=()) -> None:
+    """Trajectories (with the fences at their height), the barrier line's distributions and the envelopes
+    (nothing for a velocity file).  A fence with x None stands at the ``collector`` line."""
+    if result is None:
+        return
+    from ..report.files import write_simulation_figures
+    line_x = result.scenario.collectors[result.scenario.collector_index(collector)].x
+    fences = [(line_x if x is None else x, h, label) for x, h, label in fences]
+    write_simulation_figures(result, figs, [collector], file_names={collector: "collector_distributions.png"},
+                             fences=fences)
+
+def _copy_inputs(a: Assessment, dest: Path) -> None:
+    """Copy the site file and everything it names, with the version, seed and command, for exact reruns."""
+    dest.mkdir()
+    site = a.site
+    text = site.path.read_text(encoding="utf-8")
+    for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
+                       ("hazard", "velocities"), ("design_block", "survey"), ("rates", "record"),
+                       ("rates", "rainfall"), ("rates", "warnings")):
+        rel = {"inventory": site.inventory, "hazard": site.hazard, "design_block": site.design_block,
+               "rates": site.rates or {}}[table].get(key)
+        if rel:
+            src = site.resolve(rel)
+            shutil.copy2(src, dest / src.name)
+            text = text.replace(f'"{rel}"', f'"{src.name}"').replace(f"'{rel}'", f"'{src.name}'")
+            side = src.with_suffix(".toml")
+            if table in ("inventory", "rates") and side.exists():
+                shutil.copy2(side, dest / side.name)
+    (dest / site.path.name).write_text(text, encoding="utf-8")   # paths now point at the copies beside it
+    (dest / "run.json").write_text(json.dumps({
+        "riskrf_version": __version__, "seed": a.seed, "n_blocks": a.n_blocks, "site_file": site.path.name,
+        "command": " ".join([Path(sys.argv[0]).name, *sys.argv[1:]]),   # the program by name, arguments as typed
+        "python": platform.python_version(),
+        "rerun": f"riskrf assess {site.path.name} --seed {a.seed} -n {a.n_blocks} --out DIR"},
+        indent=2) + "\n", encoding="utf-8")

@@ -1,0 +1,995 @@
+"""Corridor scale: many rock cuts along a road, screened with the RHRS and assessed quantitatively in parallel.
+
+A corridor file (TOML) holds corridor-wide defaults (mass law, traffic, consequences, economics,
+options, simulation size, seed) and names a sections table (CSV, Excel or Parquet) with one row per
+section.  Everything is read and checked by :func:`load_corridor` before any work starts; every error
+names the file, the row, the section id, the column and the value.
+
+Each section's chain is one task on a ``dask.distributed`` client (:func:`run_corridor`):
+
+    generated cut profile (or a scenario file)
+      -> mass-coupled EnergyHazard at the barrier line, as ``riskrf assess`` (n blocks with masses log-uniform
+         over the mass law, reach and speed by mass class; rate of the section; P(reach road) from the same run)
+      -> simulation.run of the scenario's own seeder (n blocks): the reference of the option effects
+      -> MitigationStudy: road-user risk of every option, ranking by expected total cost
+      -> one result row (RHRS score, risk of doing nothing, best option, its cost)
+
+The seed of each section is ``SeedSequence(seed, spawn_key=(crc32(section id),))``: the child that
+``SeedSequence(seed).spawn`` would give at that key, fixed by the section id, so results are identical
+for any number of workers, any order of completion and any subset of sections (``--resume``).
+
+Units: lengths m, chainage m, rates per year, money in the corridor currency.
+"""
+from __future__ import annotations
+
+import difflib
+import math
+import os
+import time
+import tomllib
+import uuid
+import zlib
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..risk import rhrs
+from ..risk.mitigation_inputs import MitigationError, parse_mitigation
+from ..core.units import DEFAULT_DENSITY_KG_M3, M_PER_KM
+
+BUNDLED_MATERIALS = Path(__file__).resolve().parents[2] / "simulation" / "scenarios" / "road_cut_barrier.toml"
+
+#: Columns of the sections table (units in the names); ``rhrs_*`` columns are the RHRS attributes of
+#: :data:`riskrf.risk.rhrs.RATE_FIELDS` prefixed with ``rhrs_``.
+GEOMETRY_COLUMNS = ("cut_height_m", "face_angle_deg", "ditch_width_m", "ditch_depth_m", "runout_to_road_m",
+                    "road_width_m")
+#: Optional geometry of a generated cut: a horizontal catch bench in the face (width 0: no bench).
+BENCH_COLUMNS = ("bench_width_m", "bench_height_m")
+NUMBER_COLUMNS = GEOMETRY_COLUMNS + BENCH_COLUMNS + ("chainage_from", "chainage_to", "falls_per_year", "falls_per_km_year",
+                                     "falls_per_m2_year", "vehicles_per_day", "speed_kmh", "release_zone_share")
+RATE_COLUMNS = ("falls_per_year", "falls_per_km_year", "falls_per_m2_year")
+#: Ways to give a section's rate: one of the rate columns, or ``inventory`` (the section's own inventory file).
+RATE_SOURCES = RATE_COLUMNS + ("inventory",)
+TEXT_COLUMNS = ("id", "scenario", "face_material", "ditch_material", "road_material", "options", "inventory",
+                "notes")
+RHRS_COLUMNS = tuple("rhrs_" + f for f in rhrs.RATE_FIELDS)
+ALL_COLUMNS = TEXT_COLUMNS + NUMBER_COLUMNS + RHRS_COLUMNS
+#: Per-metre cost fields of corridor options, multiplied by the section length.
+PER_M_FIELDS = ("capital_cost_per_m", "annual_maintenance_per_m", "replacement_cost_per_m")
+#: Crest plateau [m] behind the cut and verge [m] beyond the road of a generated profile (room for
+#: the seeder and for blocks crossing the road to come to rest).
+CREST_M = 5.0
+VERGE_M = 10.0
+
+
+class CorridorError(ValueError):
+    """A corridor file or sections table is invalid; the message lists every bad field found."""
+
+
+@dataclass(frozen=True)
+class Section:
+    """One validated section: id, chainage [m], its scenario (generated or read), rate and traffic."""
+
+    id: str
+    row: int
+    chainage_from_m: float
+    chainage_to_m: float
+    scenario: object = field(repr=False)
+    geometry: str
+    falls_per_year: float
+    vehicles_per_day: float
+    speed_kmh: float
+    options: tuple
+    rating: rhrs.RHRSRating | None = None
+    notes: str = ""
+    rate_source: str = ""
+
+    @property
+    def length_m(self) -> float:
+        """Length of the section along the chainage [m]."""
+        return self.chainage_to_m - self.chainage_from_m
+
+
+@dataclass(frozen=True)
+class Corridor:
+    """A validated corridor: sections, mass law, study inputs, simulation size and seed."""
+
+    name: str
+    path: Path
+    sections: tuple
+    mass: object
+    mass_note: str
+    rate_basis: str
+    study: dict = field(repr=False)
+    options: tuple = ()
+    n_blocks: int = 2000
+    option_blocks: int = 1000
+    seed: int = 1
+    currency: str = "CHF"
+    errors: tuple = ()
+    defaults_used: tuple = ()
+
+    def section(self, sid: str) -> Section:
+        """The section with id ``sid`` (StopIteration when there is none)."""
+        return next(s for s in self.sections if s.id == sid)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# reading and validation
+# ---------------------------------------------------------------------------------------------------------
+def _read_table(path: Path, reader: dict | None = None) -> tuple[pd.DataFrame, np.ndarray]:
+    """The sections table as text cells, with the file line of each row (rules of :mod:`riskrf.io.tables`).
+
+    Number columns are converted by the decimal-mark rule of :func:`riskrf.io.tables.parse_numbers`
+    (decided per column: ``1,5`` and ``1.192,5`` read as in a European export); cells that are
+    not numbers stay text so that each row's error names its value.  Wholly empty rows and
+    ``#`` comment lines of a text file are skipped (their lines still count).
+    """
+    from ..io.tables import is_blank, parse_numbers, read_table
+    if not path.exists():
+        raise CorridorError(f"sections table not found: {path}")
+    reader = dict(reader or {})
+    decimal = reader.pop("decimal", None)
+    try:
+        table, first, _ = read_table(path, what="sections table",
+                                     comment="#" if path.suffix.lower() in (".csv", ".txt", ".tsv") else None,
+                                     **reader)
+    except ValueError as exc:
+        raise CorridorError(str(exc)) from None
+    rows = np.arange(len(table)) + first
+    keep = ~is_blank(table).to_numpy() if len(table) else np.ones(0, bool)
+    table, rows = table[keep].reset_index(drop=True), rows[keep]
+    table = table.astype(object)
+    for c in [c for c in table.columns if c in NUMBER_COLUMNS + RHRS_COLUMNS]:
+        cells = table[c]
+        is_class = cells.astype(str).str.contains(r"[A-DF-Za-df-z]", regex=True)    # words (RHRS classes, typos)
+        try:
+            values = parse_numbers(cells.where(~is_class, ""), path, c, rows, decimal=decimal, errors="coerce")
+        except ValueError as exc:          # a column mixing decimal marks: a property of the file
+            raise CorridorError(str(exc)) from None
+        good = values.notna().to_numpy()
+        table[c] = [float(v) if g else cell for v, g, cell in zip(values, good, cells)]
+    return table, rows
+
+
+def _section_key(sid: str) -> int:
+    """crc32 of a section id: the key of its seed and of its partition file (ids must not share one)."""
+    return zlib.crc32(sid.encode("utf-8"))
+
+
+def _section_seed(seed: int, sid: str) -> int:
+    """Seed of one section: the SeedSequence(seed) child at spawn key crc32(id), as an integer."""
+    child = np.random.SeedSequence(int(seed), spawn_key=(_section_key(sid),))
+    return int(child.generate_state(1, dtype=np.uint64)[0]) >> 1          # < 2**63: fits int64 columns
+
+
+def cut_scenario_dict(materials: dict, settings: dict, *, cut_height_m, face_angle_deg, ditch_width_m, ditch_depth_m,
+                      runout_to_road_m, road_width_m, face_material, ditch_material, road_material, seeder_mass,
+                      release_zone_share=0.3, density_kg_m3=DEFAULT_DENSITY_KG_M3, name="cut", bench_width_m=0.0,
+                      bench_height_m=0.0) -> dict:
+    """Scenario dictionary of a generated rock cut (x increases towards the road, z up, metres).
+
+    crest plateau (CREST_M) -> rock face of ``cut_height_m`` at ``face_angle_deg`` -> ditch of
+    ``ditch_width_m`` x ``ditch_depth_m`` at the toe (walls 0.25H:1V on the face side and 1H:1V on the road
+    side, as :mod:`riskrf.risk.measures`) -> flat shoulder ``runout_to_road_m`` -> road ``road_width_m`` -> verge.
+    With ``bench_width_m`` > 0 the face is interrupted at ``bench_height_m`` above the toe by a horizontal catch
+    bench of that width (surface of ``ditch_material``: debris collects on it as in a ditch), both faces at
+    ``face_angle_deg``.  Blocks are released from the upper ``release_zone_share`` of the (upper) face.
+    Collectors: ``barrier`` at the middle of the shoulder (at the ditch's outer rim without a shoulder), ``road``
+    0.01 m onto the road.
+    """
+    from ..risk.measures import DITCH_INNER_SLOPE_HV, DITCH_OUTER_SLOPE_HV
+    h, ang = float(cut_height_m), math.radians(float(face_angle_deg))
+    wb, hb = float(bench_width_m), float(bench_height_m)
+    if wb > 0 and not 0 < hb < h:
+        raise ValueError(f"bench_height_m = {hb:g} must lie strictly between 0 and cut_height_m = {h:g}")
+    if wb > 0:
+        x_upper = CREST_M + (h - hb) / math.tan(ang)
+        x_toe = x_upper + wb + hb / math.tan(ang)
+        xs, zs = [0.0, CREST_M, x_upper, x_upper + wb, x_toe], [h, h, hb, hb, 0.0]
+        mats = [face_material, face_material, ditch_material, face_material]
+    else:
+        x_toe = x_upper = CREST_M + h / math.tan(ang)
+        xs, zs, mats = [0.0, CREST_M, x_toe], [h, h, 0.0], [face_material, face_material]
+    w, d = float(ditch_width_m), float(ditch_depth_m)
+    if w > 0 and d > 0:
+        a, c = DITCH_INNER_SLOPE_HV * d, DITCH_OUTER_SLOPE_HV * d
+        xs += [x_toe + a, x_toe + w - c, x_toe + w]
+        zs += [-d, -d, 0.0]
+        mats += [face_material, ditch_material, ditch_material]
+    elif w > 0:
+        xs.append(x_toe + w)
+        zs.append(0.0)
+        mats.append(ditch_material)
+    x_rim = xs[-1]
+    r = float(runout_to_road_m)
+    if r > 0:
+        xs.append(x_rim + r)
+        zs.append(0.0)
+        mats.append(ditch_material)
+    x_road = xs[-1]
+    xs += [x_road + float(road_width_m), x_road + float(road_width_m) + VERGE_M]
+    zs += [0.0, 0.0]
+    mats += [road_material, ditch_material]
+    barrier_x = x_rim + r / 2 if r > 0 else x_rim + 0.005
+    face_top = CREST_M + 0.02 * (x_upper - CREST_M)
+    face_low = CREST_M + float(release_zone_share) * (x_upper - CREST_M)
+    return {"name": name, "description": "generated rock cut (riskrf.app.corridor)",
+            "profile": {"x": xs, "z": zs, "materials": mats}, "materials": materials,
+            "seeder": {"type": "line", "x": [face_top, face_low], "height_m": 0.5, "mass_kg": seeder_mass,
+                       "density_kg_m3": density_kg_m3, "vx_ms": {"dist": "uniform", "low": 0.2, "high": 1.0}},
+            "collectors": [{"name": "barrier", "x": barrier_x}, {"name": "road", "x": x_road + 0.01}],
+            "settings": settings}
+
+
+def _unknown(keys, allowed, where, source):
+    for key in keys:
+        if key not in allowed:
+            close = difflib.get_close_matches(str(key), list(allowed), n=1)
+            raise CorridorError(f"{source}: unknown field {where}{key!r}" + (f"; did you mean {close[0]!r}?" if close
+                                                                           else f"; allowed: {sorted(allowed)}"))
+
+
+def _face_area(num: dict, length_m: float, where: str, what: str) -> float:
+    """Rock-face area [m2] of a section: length x the face's slope length (height / sin angle)."""
+    if "cut_height_m" not in num or "face_angle_deg" not in num:
+        raise CorridorError(f"{where}: {what} needs cut_height_m and face_angle_deg (the face area is the section "
+                            "length x the face's slope length)")
+    return length_m * num["cut_height_m"] / math.sin(math.radians(num["face_angle_deg"]))
+
+
+def _shared_rate(table, base: Path, m_min_kg: float, source: str):
+    """``[rates]``: a corridor-wide inventory shared among the sections that give no rate of their own, in
+    proportion to their length (``share = "km"``) or rock-face area (``share = "m2"``).  ``covered_length_km`` /
+    ``covered_face_area_m2``: what the inventory covers (default: the sharing sections together).
+    Returns None or dict(rate, share, covered, note)."""
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise CorridorError(f"{source}: rates = {table!r} must be a table ([rates] with inventory = ...)")
+    _unknown(table, {"inventory", "share", "covered_length_km", "covered_face_area_m2"}, "rates.", source)
+    if "inventory" not in table:
+        raise CorridorError(f"{source}: [rates] needs inventory = \"file\" (the corridor-wide inventory)")
+    share = table.get("share")
+    if share not in ("km", "m2"):
+        raise CorridorError(f"{source}: rates.share = {share!r} must be 'km' (by section length) or 'm2' (by "
+                            "rock-face area)")
+    key = "covered_length_km" if share == "km" else "covered_face_area_m2"
+    other = "covered_face_area_m2" if share == "km" else "covered_length_km"
+    if other in table:
+        raise CorridorError(f"{source}: rates.{other} does not apply with share = {share!r} (give {key})")
+    cov = table.get(key)
+    if cov is not None and (isinstance(cov, bool) or not isinstance(cov, (int, float)) or not cov > 0):
+        raise CorridorError(f"{source}: rates.{key} = {cov!r} must be a number > 0")
+    inv_path = (base / str(table["inventory"])).resolve()
+    rate, note = inventory_rate(inv_path, m_min_kg, f"{source}: rates.inventory = {table['inventory']!r}")
+    return {"rate": rate, "share": share, "covered": None if cov is None else float(cov), "note": note}
+
+
+def _mass_law(table: dict, base: Path, source: str):
+    """The corridor's mass law: fitted to an inventory file, or typed (b, m_min_kg, m_max_kg; an ASSUMPTION)."""
+    from ..frequency.power_law import GutenbergRichterFit, fit_gutenberg_richter
+    _unknown(table, {"inventory", "m_min_kg", "m_max_kg", "b"}, "mass.", source)
+    for k in ("m_min_kg", "m_max_kg", "b"):
+        v = table.get(k)
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not v > 0):
+            raise CorridorError(f"{source}: mass.{k} = {v!r} must be a number > 0")
+    if "inventory" in table:
+        if "b" in table:
+            raise CorridorError(f"{source}: give mass.inventory (fitted) or mass.b (typed), not both")
+        from ..frequency.inventory import read_inventory
+        inv_path = (base / table["inventory"]).resolve()
+        if not inv_path.exists():
+            raise CorridorError(f"{source}: mass.inventory = {table['inventory']!r}: file not found ({inv_path})")
+        inv = read_inventory(inv_path)
+        gr = fit_gutenberg_richter(inv.masses, inv.duration_years, m_min=table.get("m_min_kg"),
+                                   m_max=table.get("m_max_kg"))
+        note = (f"mass law fitted to {inv_path.name}: b = {gr.b:.3g} +- {gr.b_stderr:.2g}, m_min = {gr.m_min:.4g} kg "
+                f"({gr.n_tail} falls)")
+        return gr, note
+    if "b" not in table or "m_min_kg" not in table:
+        raise CorridorError(f"{source}: [mass] needs inventory = \"file\" (fitted) or b and m_min_kg (typed)")
+    b, m_min, m_max = float(table["b"]), float(table["m_min_kg"]), table.get("m_max_kg")
+    if m_max is not None and m_max <= m_min:
+        raise CorridorError(f"{source}: mass.m_max_kg = {m_max!r} must exceed mass.m_min_kg = {m_min!r}")
+    gr = GutenbergRichterFit(a=0.0, b=b, b_stderr=0.0, b_ci=(b, b), level=0.95, b_ci_method="typed", m_min=m_min,
+                             m_max=None if m_max is None else float(m_max), rate_min=1.0, n_tail=10 ** 9,
+                             n_total=10 ** 9, duration_years=1.0, method="typed", m_min_method="given", ks_distance=0.0)
+    note = (f"ASSUMPTION: typed mass law b = {b:g}, m_min = {m_min:g} kg"
+            + (f", m_max = {float(m_max):g} kg" if m_max is not None else "")
+            + " (no inventory fitted; no sampling uncertainty of b)")
+    return gr, note
+
+
+def inventory_rate(path: Path, m_min_kg: float, where: str) -> tuple[float, str]:
+    """Falls >= ``m_min_kg`` per year of an inventory file: :func:`riskrf.read_inventory` (its sidecar gives the
+    record period) and the power law fitted above the corridor's m_min (:func:`riskrf.fit_gutenberg_richter`,
+    whose rate_min is the falls >= m_min over the record length; its b is reported, the corridor's mass law is
+    unchanged).  Falls without a size are left out, as in every size fit.  Returns (rate [1/yr], note)."""
+    import warnings
+
+    from ..frequency.inventory import read_inventory
+    from ..frequency.power_law import fit_gutenberg_richter
+    if not path.exists():
+        raise CorridorError(f"{where}: file not found ({path})")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            inv = read_inventory(path)
+        n = int(np.sum(inv.masses >= m_min_kg))
+        if n == 0:
+            raise ValueError(f"no fall of {inv.masses.size} with a size is >= m_min = {m_min_kg:g} kg")
+        fit = fit_gutenberg_richter(inv.masses, inv.duration_years, m_min=m_min_kg)
+    except ValueError as exc:
+        raise CorridorError(f"{where}: {exc}") from None
+    return float(fit.rate_min), (f"inventory {path.name}: {fit.n_tail} falls >= {m_min_kg:g} kg in "
+                                 f"{inv.duration_years:.4g} yr (power law b = {fit.b:.3g}), {fit.rate_min:.4g}/yr")
+
+
+def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int | None = None,
+                  decimal: str | None = None, encoding: str | None = None) -> Corridor:
+    """Read and check a corridor file and its sections table before any work.
+
+    The sections table is read by the rules of :mod:`riskrf.io.tables` (separator, decimal comma,
+    UTF-8 or cp1252, Excel ``sheet`` and ``header_row``, Parquet); ``sheet``, ``header_row``,
+    ``decimal`` and ``encoding`` may also be given in the ``[corridor]`` table (``sections_sheet``,
+    ``sections_header_row``, ``sections_decimal``, ``sections_encoding``); arguments win.
+    Every bad row is reported (file, row, section id, column, value; rows are the file's lines
+    as an editor or spreadsheet numbers them, comment lines ``#`` of a CSV included).  With ``keep_going`` the bad rows
+    are left out and listed in :attr:`Corridor.errors`; otherwise any bad row raises :class:`CorridorError`
+    listing all of them.  Errors in the corridor file itself always raise.
+    """
+    import simulation
+    from simulation.scenario import ScenarioError, scenario_from_dict
+
+    path = Path(path)
+    if not path.exists():
+        raise CorridorError(f"corridor file not found: {path}")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise CorridorError(f"{path}: not valid TOML: {exc}") from exc
+    src = str(path)
+    _unknown(data, {"corridor", "defaults", "mass", "materials", "traffic", "consequences", "economics", "criteria",
+                    "uncertainty", "options", "rates"}, "", src)
+    cor = data.get("corridor", {})
+    _unknown(cor, {"name", "description", "sections", "seed", "n_blocks", "option_blocks", "chainage_unit",
+                   "rate_basis", "rhrs_cap_points", "sections_sheet", "sections_header_row", "sections_decimal",
+                   "sections_encoding"}, "corridor.", src)
+    reader = {"sheet": sheet if sheet is not None else cor.get("sections_sheet"),
+              "header_row": header_row if header_row is not None else cor.get("sections_header_row"),
+              "decimal": decimal if decimal is not None else cor.get("sections_decimal"),
+              "encoding": encoding if encoding is not None else cor.get("sections_encoding")}
+    if reader["decimal"] not in (None, ".", ","):
+        raise CorridorError(f"{src}: corridor.sections_decimal = {reader['decimal']!r} must be '.' or ','")
+    rhrs_cap = cor.get("rhrs_cap_points")
+    if rhrs_cap is not None and (isinstance(rhrs_cap, bool) or not isinstance(rhrs_cap, (int, float))
+                                 or rhrs_cap < 81):
+        raise CorridorError(f"{src}: corridor.rhrs_cap_points = {rhrs_cap!r} must be a number >= 81")
+    if "sections" not in cor:
+        raise CorridorError(f"{src}: [corridor] needs sections = \"table.csv\" (CSV, Excel or Parquet)")
+    for k in ("seed", "n_blocks", "option_blocks"):
+        v = cor.get(k)
+        if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v < (0 if k == "seed" else 100)):
+            raise CorridorError(f"{src}: corridor.{k} = {v!r} must be a whole number"
+                                + (" >= 0" if k == "seed" else " >= 100"))
+    unit = cor.get("chainage_unit", "m")
+    if unit not in ("m", "km"):
+        raise CorridorError(f"{src}: corridor.chainage_unit = {unit!r} must be 'm' or 'km'")
+    basis = cor.get("rate_basis", "road")
+    if basis not in ("road", "release"):
+        raise CorridorError(f"{src}: corridor.rate_basis = {basis!r} must be 'road' (rates count falls reaching "
+                            "the road, as a road maintenance record does) or 'release' (falls >= m_min released)")
+    defaults = data.get("defaults", {})
+    _unknown(defaults, [c for c in ALL_COLUMNS if c not in ("id", "chainage_from", "chainage_to", "inventory")]
+             + ["seeder_mass_kg"],
+             "defaults.", src)
+    gr, mass_note = _mass_law(data.get("mass", {}), path.parent, src)
+    shared = _shared_rate(data.get("rates"), path.parent, float(gr.m_min), src)
+
+    mat = data.get("materials", {})
+    _unknown(mat, {"scenario"}, "materials.", src)
+    template_path = (path.parent / mat["scenario"]).resolve() if "scenario" in mat else BUNDLED_MATERIALS
+    if not template_path.exists():
+        raise CorridorError(f"{src}: materials.scenario = {mat.get('scenario')!r}: file not found ({template_path})")
+    template = tomllib.loads(template_path.read_text(encoding="utf-8"))
+    materials, settings = template["materials"], template.get("settings", {})
+
+    # study inputs: the mitigation tables, with per-metre costs set aside per option
+    opt_specs = data.get("options", [])
+    if not isinstance(opt_specs, list):
+        raise CorridorError(f"{src}: [[options]] must be an array of tables")
+    per_m = []
+    clean = []
+    for i, spec in enumerate(opt_specs):
+        spec = dict(spec)
+        pm = {}
+        for k in PER_M_FIELDS:
+            if k in spec:
+                v = spec.pop(k)
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or v < 0:
+                    raise CorridorError(f"{src}: options[{i}] ({spec.get('name')!r}): {k} = {v!r} must be a number "
+                                        ">= 0")
+                base_k = k.removesuffix("_per_m")
+                if base_k in spec:
+                    raise CorridorError(f"{src}: options[{i}] ({spec.get('name')!r}): give {base_k} or {k}, not both")
+                pm[base_k] = float(v)
+                spec[base_k] = 0.0 if base_k != "replacement_cost" else 1.0      # placeholder for parsing only
+        if spec.get("kind") == "ditch" and spec.get("retention") is None:
+            raise CorridorError(f"{src}: options[{i}] ({spec.get('name')!r}): a corridor ditch option needs a typed "
+                                "retention (ditch geometry differs per section; give the ditch in the section's "
+                                "generated profile instead)")
+        if "x_m" in spec or "road_x_m" in spec or "zone_x_m" in spec:
+            raise CorridorError(f"{src}: options[{i}] ({spec.get('name')!r}): positions (x_m, road_x_m, zone_x_m) "
+                                "differ per section and cannot be given corridor-wide")
+        per_m.append(pm)
+        clean.append(spec)
+    mit = {k: data[k] for k in ("traffic", "consequences", "economics", "criteria", "uncertainty") if k in data}
+    mit["options"] = clean
+    try:
+        options, exposure, consequences, economics, used, uncertainty, criteria = parse_mitigation(mit, src)
+    except MitigationError as exc:
+        raise CorridorError(str(exc)) from exc
+    options = tuple(zip(options, per_m))
+    study = {"exposure": exposure, "consequences": consequences, "economics": economics,
+             "uncertainty": uncertainty, "criteria": criteria}
+    option_names = [o.name for o, _ in options]
+
+    table_path = (path.parent / cor["sections"]).resolve()
+    df, file_rows = _read_table(table_path, reader)
+    tsrc = str(table_path)
+    bad_cols = [c for c in df.columns if c not in ALL_COLUMNS]
+    if bad_cols:
+        c = bad_cols[0]
+        close = difflib.get_close_matches(c, ALL_COLUMNS, n=1)
+        raise CorridorError(f"{tsrc}: unknown column {c!r}" + (f"; did you mean {close[0]!r}?" if close else
+                                                              f"; allowed: {list(ALL_COLUMNS)}"))
+    for c in ("id", "chainage_from", "chainage_to"):
+        if c not in df.columns:
+            raise CorridorError(f"{tsrc}: missing column {c!r}")
+    if df.empty:
+        raise CorridorError(f"{tsrc}: the sections table has no rows")
+    scale = M_PER_KM if unit == "km" else 1.0
+    errors, sections, bad_rows = [], [], set()
+    fallback = set()          # corridor-wide fallbacks that at least one section used
+    inv_cache, weights = {}, {}
+    default_seeder = {"dist": "lognormal", "median": float(gr.m_min) * 2, "sigma": 1.0,
+                      "max": float(gr.m_max or gr.m_min * 1e4)}
+    seen = {}
+    for i, raw in df.iterrows():
+        row = int(file_rows[i])  # file line / spreadsheet row (header row 1 unless header_row says otherwise)
+        sid = str(raw["id"]).strip()
+        where = f"{tsrc}: row {row} (section {sid!r})"
+        try:
+            if not sid:
+                raise CorridorError(f"{tsrc}: row {row}: column 'id' is empty")
+            if sid in seen:
+                raise CorridorError(f"{where}: column 'id' = {sid!r} duplicates row {seen[sid]}")
+            seen[sid] = row
+            vals = {}
+            for c in ALL_COLUMNS:
+                v = str(raw[c]).strip() if c in df.columns else ""
+                if v == "" and c in defaults:
+                    v = defaults[c]
+                vals[c] = v
+            num = {}
+            for c in NUMBER_COLUMNS + RHRS_COLUMNS:
+                v = vals[c]
+                if v == "" or v is None:
+                    continue
+                if isinstance(v, bool):
+                    raise CorridorError(f"{where}: column {c!r} = {v!r} must be a number, not true/false")
+                if isinstance(v, (int, float)):
+                    num[c] = float(v)
+                    continue
+                try:
+                    num[c] = float(v)
+                except (TypeError, ValueError):
+                    if c in RHRS_COLUMNS and c.removeprefix("rhrs_") in rhrs.CLASSES:
+                        num[c] = v          # a class name
+                        continue
+                    raise CorridorError(f"{where}: column {c!r} = {v!r} is not a number") from None
+                if not math.isfinite(num[c]):
+                    raise CorridorError(f"{where}: column {c!r} = {v!r} must be finite")
+            for c in ("chainage_from", "chainage_to"):
+                if c not in num:
+                    raise CorridorError(f"{where}: column {c!r} is empty")
+            c0, c1 = num["chainage_from"] * scale, num["chainage_to"] * scale
+            if c1 <= c0:
+                raise CorridorError(f"{where}: chainage_to = {num['chainage_to']:g} must exceed chainage_from = "
+                                    f"{num['chainage_from']:g} ({unit})")
+            for c in RATE_COLUMNS + ("vehicles_per_day", "speed_kmh"):
+                if c in num and num[c] < 0 or (c == "speed_kmh" and c in num and num[c] == 0):
+                    raise CorridorError(f"{where}: column {c!r} = {num[c]:g} must be > 0" if c == "speed_kmh" else
+                                        f"{where}: column {c!r} = {num[c]:g} must be >= 0")
+            given_rates = [c for c in RATE_COLUMNS if c in num] + (["inventory"] if vals["inventory"] else [])
+            if len(given_rates) > 1 or (not given_rates and shared is None):
+                raise CorridorError(f"{where}: give exactly one of falls_per_year, falls_per_km_year, "
+                                    f"falls_per_m2_year or inventory (own rate or inventory, or a corridor rate per km "
+                                    f"of road or per m2 of rock face; or a corridor-wide [rates] inventory); got "
+                                    f"{given_rates or 'none'}")
+            rate_source = given_rates[0] if given_rates else "shared"
+            if "falls_per_year" in num:
+                rate = num["falls_per_year"]
+            elif "falls_per_km_year" in num:
+                rate = num["falls_per_km_year"] * (c1 - c0) / M_PER_KM
+            elif "falls_per_m2_year" in num:
+                rate = num["falls_per_m2_year"] * _face_area(num, c1 - c0, where, "falls_per_m2_year")
+            elif vals["inventory"]:
+                inv_path = (path.parent / str(vals["inventory"])).resolve()
+                if inv_path not in inv_cache:
+                    inv_cache[inv_path] = inventory_rate(inv_path, float(gr.m_min),
+                                                         f"{where}: column 'inventory' = {vals['inventory']!r}")
+                rate, rate_source = inv_cache[inv_path]
+            else:                                  # a share of the corridor-wide inventory, set once all rows are read
+                weight = _face_area(num, c1 - c0, where, "rates.share = 'm2'") if shared["share"] == "m2" \
+                    else (c1 - c0) / M_PER_KM
+                rate = math.nan
+            if rate_source != "shared" and not rate > 0:
+                raise CorridorError(f"{where}: the section's rate of falls is {rate:g} per year; a section without "
+                                    "falls needs no assessment (remove it or give a rate > 0)")
+            # geometry
+            if vals["scenario"]:
+                sp = (path.parent / str(vals["scenario"])).resolve()
+                if not sp.exists():
+                    raise CorridorError(f"{where}: column 'scenario' = {vals['scenario']!r}: file not found ({sp})")
+                sc = simulation.load_scenario(sp)
+                for cname in ("barrier", "road"):
+                    if cname not in [c.name for c in sc.collectors]:
+                        raise CorridorError(f"{where}: scenario {sp.name} needs collectors named 'barrier' and 'road'")
+                geometry = f"scenario {sp.name}"
+            else:
+                missing = [c for c in GEOMETRY_COLUMNS if c not in num]
+                if missing:
+                    raise CorridorError(f"{where}: columns {missing} are empty (a generated cut needs "
+                                        f"{list(GEOMETRY_COLUMNS)}, or give a scenario file)")
+                g = {c: num[c] for c in GEOMETRY_COLUMNS}
+                if not 1 <= g["cut_height_m"] <= 500:
+                    raise CorridorError(f"{where}: column 'cut_height_m' = {g['cut_height_m']:g} must lie in [1, 500] m")
+                if not 20 <= g["face_angle_deg"] <= 89:
+                    raise CorridorError(f"{where}: column 'face_angle_deg' = {g['face_angle_deg']:g} must lie in "
+                                        "[20, 89] degrees (vertical faces are not supported)")
+                for c in ("ditch_width_m", "ditch_depth_m", "runout_to_road_m"):
+                    if g[c] < 0:
+                        raise CorridorError(f"{where}: column {c!r} = {g[c]:g} must be >= 0")
+                if g["road_width_m"] <= 0:
+                    raise CorridorError(f"{where}: column 'road_width_m' = {g['road_width_m']:g} must be > 0")
+                if g["ditch_depth_m"] > 0 and g["ditch_width_m"] <= 1.25 * g["ditch_depth_m"]:
+                    raise CorridorError(f"{where}: column 'ditch_width_m' = {g['ditch_width_m']:g} is too narrow for "
+                                        f"ditch_depth_m = {g['ditch_depth_m']:g} (walls 0.25H:1V and 1H:1V need more "
+                                        f"than {1.25 * g['ditch_depth_m']:g} m)")
+                bench = {c: num.get(c, 0.0) for c in BENCH_COLUMNS}
+                if bench["bench_width_m"] < 0:
+                    raise CorridorError(f"{where}: column 'bench_width_m' = {bench['bench_width_m']:g} must be >= 0")
+                if bench["bench_width_m"] > 0 and not 0 < bench["bench_height_m"] < g["cut_height_m"]:
+                    raise CorridorError(f"{where}: column 'bench_height_m' = {bench['bench_height_m']:g} must lie "
+                                        f"strictly between 0 and cut_height_m = {g['cut_height_m']:g} (a bench "
+                                        f"{bench['bench_width_m']:g} m wide is given)")
+                share = num.get("release_zone_share", 0.3)
+                if not 0 < share <= 1:
+                    raise CorridorError(f"{where}: column 'release_zone_share' = {share:g} must lie in (0, 1]")
+                mats = {c: str(vals[c] or d) for c, d in (("face_material", "bedrock"), ("ditch_material", "soil"),
+                                                         ("road_material", "asphalt"))}
+                for c, m in mats.items():
+                    if m not in materials:
+                        raise CorridorError(f"{where}: column {c!r} = {m!r} is not a material of {template_path.name} "
+                                            f"({', '.join(materials)})")
+                seeder_mass = defaults.get("seeder_mass_kg", default_seeder)
+                if "seeder_mass_kg" not in defaults:
+                    fallback.add("seeder_mass_kg")
+                try:
+                    sc = scenario_from_dict(cut_scenario_dict(materials, settings, **g, **mats, **bench,
+                                                              seeder_mass=seeder_mass, release_zone_share=share,
+                                                              name=f"section {sid}"), source=where)
+                except ScenarioError as exc:
+                    raise CorridorError(str(exc)) from exc
+                geometry = (f"generated cut {g['cut_height_m']:g} m at {g['face_angle_deg']:g} deg, ditch "
+                            f"{g['ditch_width_m']:g} x {g['ditch_depth_m']:g} m, {g['runout_to_road_m']:g} m to a "
+                            f"{g['road_width_m']:g} m road"
+                            + (f", bench {bench['bench_width_m']:g} m wide at {bench['bench_height_m']:g} m"
+                               if bench["bench_width_m"] > 0 else ""))
+            opts = tuple(option_names)
+            if vals["options"]:
+                opts = tuple(o.strip() for o in str(vals["options"]).split(";") if o.strip())
+                unknown = [o for o in opts if o not in option_names]
+                if unknown:
+                    raise CorridorError(f"{where}: column 'options' names {unknown}, not options of the corridor "
+                                        f"({option_names})")
+                if len(opts) < 2:
+                    raise CorridorError(f"{where}: column 'options' must name at least two options to compare")
+            vpd = num.get("vehicles_per_day", exposure.vehicles_per_day)
+            speed = num.get("speed_kmh", exposure.speed_kmh)
+            fallback.update(c for c in ("vehicles_per_day", "speed_kmh") if c not in num)
+            rating = None
+            given = {c.removeprefix("rhrs_"): num[c] for c in RHRS_COLUMNS if c in num}
+            if given:
+                # what the section's own columns already say; rhrs_* columns override
+                derived = {"slope_height_m": num.get("cut_height_m"), "roadway_width_m": num.get("road_width_m")}
+                if "avr_percent" not in given:
+                    derived.update(slope_length_m=c1 - c0, adt_vehicles_per_day=vpd, speed_kmh=speed)
+                attrs = {k: v for k, v in derived.items() if v is not None}
+                attrs.update(given)
+                try:
+                    rating = rhrs.rate(cap_points=rhrs_cap, **attrs)
+                except (ValueError, TypeError) as exc:
+                    raise CorridorError(f"{where}: RHRS: {exc}") from exc
+            if rate_source == "shared":
+                weights[sid] = weight
+            sections.append(Section(id=sid, row=row, chainage_from_m=c0, chainage_to_m=c1, scenario=sc,
+                                    geometry=geometry, falls_per_year=float(rate), vehicles_per_day=float(vpd),
+                                    speed_kmh=float(speed), options=opts, rating=rating,
+                                    notes=str(vals["notes"] or ""), rate_source=rate_source))
+        except CorridorError as exc:
+            errors.append(str(exc))
+            bad_rows.add(row)
+    if weights:
+        unit = "km" if shared["share"] == "km" else "m2 of face"
+        covered = shared["covered"] if shared["covered"] is not None else sum(weights.values())
+        if covered < sum(weights.values()) * (1 - 1e-9):
+            raise CorridorError(f"{src}: rates.covered_{'length_km' if shared['share'] == 'km' else 'face_area_m2'} "
+                                f"= {covered:g} is less than the sharing sections' {sum(weights.values()):g} {unit}")
+        per = shared["rate"] / covered
+        sections = [replace(s, falls_per_year=per * weights[s.id],
+                            rate_source=f"share of the corridor {shared['note']}: {per:.4g}/yr per {unit} x "
+                                        f"{weights[s.id]:.4g} {unit}") if s.id in weights else s for s in sections]
+    ordered = sorted(sections, key=lambda s: s.chainage_from_m)
+    for a, b in zip(ordered[:-1], ordered[1:]):
+        if b.chainage_from_m < a.chainage_to_m:
+            errors.append(f"{tsrc}: row {b.row} (section {b.id!r}): chainage {b.chainage_from_m:g}-{b.chainage_to_m:g} "
+                          f"m overlaps row {a.row} (section {a.id!r}, {a.chainage_from_m:g}-{a.chainage_to_m:g} m)")
+            bad_rows.add(b.row)
+    # a section's seed and partition file are keyed by crc32(id): two ids with one checksum would share both
+    by_key = {}
+    for sec in sorted(sections, key=lambda s: s.row):
+        k = _section_key(sec.id)
+        if k in by_key:
+            first = by_key[k]
+            errors.append(f"{tsrc}: row {sec.row} (section {sec.id!r}): column 'id' = {sec.id!r} has the same crc32 "
+                          f"checksum ({k:08x}) as row {first.row} (section {first.id!r}), so the two would share a "
+                          "seed and a partition file; rename one of them")
+            bad_rows.add(sec.row)
+        else:
+            by_key[k] = sec
+    if errors and not keep_going:
+        raise CorridorError(f"{len(errors)} bad section row(s) (use --keep-going to run the others):\n  "
+                            + "\n  ".join(errors))
+    ordered = [s for s in ordered if s.row not in bad_rows]
+    if not ordered:
+        raise CorridorError(f"{tsrc}: no valid section to assess:\n  " + "\n  ".join(errors))
+    # a default is listed only where a section uses it: traffic per section falls back on [traffic] only when
+    # neither the row nor [defaults] gives it; the exposed length is always the section's length
+    used = [u for u in used if not u.startswith("traffic.exposed_length_m")
+            and not any(u.startswith(f"traffic.{c} ") and c not in fallback for c in ("vehicles_per_day", "speed_kmh"))]
+    if "seeder_mass_kg" in fallback:
+        used.append(f"defaults.seeder_mass_kg = {default_seeder!r} (default; ASSUMPTION: masses [kg] of the "
+                    "generated cuts' own seeder, used only for the option effects (the reference run of the "
+                    "mitigation study); the hazard is mass-coupled over the mass law)")
+    return Corridor(name=str(cor.get("name", path.stem)), path=path, sections=tuple(ordered), mass=gr,
+                    mass_note=mass_note, rate_basis=basis, study=study, options=options,
+                    n_blocks=int(cor.get("n_blocks", 2000)), option_blocks=int(cor.get("option_blocks", 1000)),
+                    seed=int(cor.get("seed", 1)), currency=consequences.currency, errors=tuple(errors),
+                    defaults_used=tuple(used))
+
+
+# ---------------------------------------------------------------------------------------------------------
+# one section (a task)
+# ---------------------------------------------------------------------------------------------------------
+def _road_reach(hazard, result, mm) -> float:
+    """P(a fall of mass model ``mm`` reaches the road line) from the mass-coupled run ``result`` behind ``hazard``
+    (the same blocks and mass classes as the hazard's barrier samples, reach counted per class)."""
+    from ..hazard.mass_coupling import MassCoupledSamples
+    s = hazard.velocity
+    road = np.full(result.n, np.nan)
+    road[np.unique(result.collector("road", first_only=True)["block"].to_numpy())] = 1.0
+    return float(MassCoupledSamples(s.mass_kg, road, road, s.edges_kg, "road").reach_probability(mm))
+
+
+def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = None, seed: int | None = None) -> dict:
+    """The whole chain for one section; returns one row of the corridor table (plain numbers and strings).
+
+    The hazard at the barrier line is mass-coupled exactly as in ``riskrf assess``
+    (:func:`riskrf.hazard.mass_coupling.simulate_energy_hazard`: ``n`` blocks with masses log-uniform over the corridor's
+    mass law, reach and speed by mass class).  The share of falls reaching the road and, for ``rate_basis = "road"``,
+    the release rate behind the recorded road falls (given / P(reach road)) come from the same mass-coupled run.
+    A second run of ``n`` blocks with the scenario's own seeder is the reference of the option effects
+    (:class:`~riskrf.risk.mitigation.MitigationStudy` ``reference`` and ``context``), as in ``riskrf assess``.
+    Deterministic given the corridor seed and the section id (see the module docstring).
+    """
+    import simulation
+
+    from ..hazard.impact_energy import mass_model
+    from ..hazard.mass_coupling import NoArrivalsError, simulate_energy_hazard
+    from ..risk.measures import SimulationContext
+    from ..risk.mitigation import MitigationStudy
+
+    n = int(n_blocks or corridor.n_blocks)
+    s_seed = _section_seed(corridor.seed if seed is None else seed, section.id)
+    t0 = time.perf_counter()
+    mm = mass_model(corridor.mass)
+    row = {"id": section.id, "chainage_from_m": section.chainage_from_m, "chainage_to_m": section.chainage_to_m,
+           "length_m": section.length_m, "geometry": section.geometry,
+           "rhrs_score": section.rating.total if section.rating is not None else np.nan,
+           "rate_given_per_year": section.falls_per_year, "rate_source": section.rate_source,
+           "rate_basis": corridor.rate_basis, "n_blocks": n,
+           "seed": s_seed}
+    try:
+        # the simulated mass range is chosen at the given rate (for a truncated law, as the corridors ship, it is
+        # m_min-m_max whatever the rate; beyond it the hazard's notes state the extrapolated share)
+        hazard, coupled = simulate_energy_hazard(corridor.mass, section.scenario, "barrier",
+                                                 rate_per_year=section.falls_per_year, n=n, seed=s_seed)
+    except NoArrivalsError:
+        if corridor.rate_basis == "road":
+            raise ValueError(f"section {section.id!r}: no simulated block of {n:,} reached the barrier line (nor the "
+                             "road), so the release rate behind the recorded road falls cannot be derived; check "
+                             "the geometry or use rate_basis = 'release'") from None
+        row.update({"reach_barrier": 0.0, "reach_road": 0.0, "release_falls_per_year": section.falls_per_year,
+                    "road_falls_per_year": 0.0, "deaths_per_year": 0.0, "individual_risk": 0.0,
+                    "expected_annual_loss": 0.0, "best_option": "do nothing (no block reaches the barrier line)",
+                    "best_option_capital": 0.0, "best_option_total_cost": 0.0, "best_deaths_per_year": 0.0,
+                    "best_individual_risk": 0.0, "meets_criteria": True, "note": "no simulated block reached the line",
+                    "seconds": time.perf_counter() - t0})
+        return row
+    reach_barrier = float(hazard.reach_probability)
+    reach_road = min(_road_reach(hazard, coupled, mm), reach_barrier)
+    lim = corridor.study["criteria"].individual_risk_per_year
+    if corridor.rate_basis == "road":
+        if reach_road == 0:
+            raise ValueError(f"section {section.id!r}: no simulated block of {n:,} reached the road, so the release "
+                             "rate behind the recorded road falls cannot be derived; check the geometry or use "
+                             "rate_basis = 'release'")
+        release = section.falls_per_year / reach_road
+    else:
+        release = section.falls_per_year
+    hazard = replace(hazard, rate_per_year=release)
+    row.update({"reach_barrier": reach_barrier, "reach_road": reach_road, "release_falls_per_year": release})
+    result = simulation.run(section.scenario, n=n, seed=s_seed, record_paths=0)    # the seeder's run: option effects
+    length = section.length_m
+    opts = []
+    for o, pm in corridor.options:
+        if o.name not in section.options:
+            continue
+        upd = {k: v * length for k, v in pm.items()}
+        if o.kind == "shed":
+            upd["covered_length_m"] = length
+        opts.append(replace(o, **upd))
+    exposure = replace(corridor.study["exposure"], vehicles_per_day=section.vehicles_per_day,
+                       speed_kmh=section.speed_kmh, exposed_length_m=length)
+    unc = replace(corridor.study["uncertainty"], seed=s_seed % (2 ** 32))
+    study = MitigationStudy(hazard=hazard, options=tuple(opts), exposure=exposure,
+                            consequences=corridor.study["consequences"], economics=corridor.study["economics"],
+                            road_share=reach_road / reach_barrier, source=str(corridor.path),
+                            context=SimulationContext(section.scenario, "barrier", "road",
+                                                      n_blocks=corridor.option_blocks, seed=s_seed % (2 ** 32),
+                                                      threads=1),     # parallel across sections, not within
+                            reference=result, uncertainty=unc, criteria=corridor.study["criteria"])
+    rk = study.ranking()
+    none = rk[rk["kind"] == "none"]
+    base = none.iloc[0] if len(none) else rk.iloc[-1]
+    ok = rk[rk["meets_criteria"]]
+    best = ok.iloc[0] if len(ok) else rk.iloc[0]
+    years = corridor.study["economics"].horizon_years
+    spend = best["capital"] + best["pv_renewals"] + best["pv_maintenance"] \
+        - (base["capital"] + base["pv_renewals"] + base["pv_maintenance"])
+    avoided = float(base["deaths_per_year"] - best["deaths_per_year"])
+    row.update({
+        "road_falls_per_year": float(base["road_falls_per_year"]), "deaths_per_year": float(base["deaths_per_year"]),
+        "individual_risk": float(base["individual_risk"]),
+        "expected_annual_loss_pv": float(base["pv_expected_loss"]),
+        "do_nothing_total_cost": float(base["expected_total_cost"]),
+        "best_option": str(best["option"]), "best_option_kind": str(best["kind"]),
+        "best_option_capital": float(best["capital"]), "best_option_total_cost": float(best["expected_total_cost"]),
+        "best_option_spend": float(spend), "best_deaths_per_year": float(best["deaths_per_year"]),
+        "best_individual_risk": float(best["individual_risk"]), "deaths_avoided_per_year": avoided,
+        "deaths_avoided_per_million": avoided * years / spend * 1e6 if spend > 0 else np.nan,
+        "meets_criteria": bool(best["meets_criteria"]),
+        "cheapest_option": str(rk.iloc[0]["option"]),
+        "note": "" if len(ok) else f"no option meets the criteria (individual risk <= {lim:g}/yr and F-N); "
+                                   "cheapest shown",
+        "seconds": time.perf_counter() - t0})
+    return row
+
+
+# ---------------------------------------------------------------------------------------------------------
+# the whole corridor on a dask client
+# ---------------------------------------------------------------------------------------------------------
+def connect(scheduler: str | None = None, n_workers: int | None = None, *, timeout_s: float = 10.0,
+            processes: bool = True):
+    """A ``dask.distributed`` client: to ``scheduler`` (or ``DASK_SCHEDULER_ADDRESS``) if given, used unchanged;
+    else a new LocalCluster of ``n_workers`` single-threaded workers (default: one per core).
+
+    Returns (client, cluster or None).  An unreachable scheduler raises ConnectionError within ``timeout_s``.
+    """
+    from distributed import Client, LocalCluster
+    address = scheduler or os.environ.get("DASK_SCHEDULER_ADDRESS")
+    if address:
+        try:
+            return Client(address, timeout=f"{timeout_s}s"), None
+        except (OSError, TimeoutError) as exc:
+            raise ConnectionError(f"cannot reach the dask scheduler at {address!r} within {timeout_s:g} s: {exc}") \
+                from None
+    n = int(n_workers or os.cpu_count() or 1)
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=processes, dashboard_address=":0")
+    return Client(cluster), cluster
+
+
+def _task(section, corridor, n_blocks):
+    return assess_section(section, corridor, n_blocks)
+
+
+@dataclass(frozen=True)
+class CorridorResult:
+    """Results of a corridor run: one row per section (``table``), the failures, and how it ran."""
+
+    corridor: Corridor
+    table: pd.DataFrame = field(repr=False)
+    failures: tuple = ()
+    workers: int = 0
+    seconds: float = 0.0
+    n_blocks: int = 0
+
+    def summary(self) -> pd.DataFrame:
+        """Sections ranked by quantitative risk (deaths per year of doing nothing) with the RHRS rank beside it,
+        the best option and its cost; ``rank_difference`` = RHRS rank - risk rank (large: they disagree)."""
+        t = self.table.copy()
+        # ranks of values rounded to 12 significant digits: risks equal but for float noise share a rank, stably
+        t["rank_risk"] = _sig12(t["deaths_per_year"]).rank(ascending=False, method="min").astype(int)
+        t["rank_rhrs"] = _sig12(t["rhrs_score"]).rank(ascending=False, method="min").astype("Int64")
+        t["rank_difference"] = t["rank_rhrs"] - t["rank_risk"]
+        t["expected_annual_cost_per_km"] = t["expected_annual_loss_pv"] / _pv(self.corridor) / (t["length_m"] / M_PER_KM)
+        cols = ["rank_risk", "rank_rhrs", "rank_difference", "id", "chainage_from_m", "chainage_to_m", "rhrs_score",
+                "road_falls_per_year", "deaths_per_year", "individual_risk", "expected_annual_cost_per_km",
+                "best_option", "best_option_capital", "best_option_total_cost", "best_individual_risk",
+                "deaths_avoided_per_million", "meets_criteria", "note"]
+        return t.sort_values(["rank_risk", "id"])[[c for c in cols if c in t]].reset_index(drop=True)
+
+    def budget_curve(self) -> pd.DataFrame:
+        """Sections in order of deaths avoided per unit spent (best option of each): cumulative spend and
+        cumulative deaths avoided per year (how much risk a budget buys)."""
+        t = self.table[self.table["best_option_spend"] > 0].copy() if "best_option_spend" in self.table else \
+            self.table.iloc[0:0].copy()
+        t["avoided_per_spend"] = t["deaths_avoided_per_year"] / t["best_option_spend"]
+        t = t.sort_values(["avoided_per_spend", "id"], ascending=[False, True])
+        return pd.DataFrame({"id": t["id"].to_numpy(), "option": t["best_option"].to_numpy(),
+                             "spend": t["best_option_spend"].to_numpy(),
+                             "cumulative_spend": t["best_option_spend"].cumsum().to_numpy(),
+                             "deaths_avoided_per_year": t["deaths_avoided_per_year"].to_numpy(),
+                             "cumulative_deaths_avoided_per_year": t["deaths_avoided_per_year"].cumsum().to_numpy()})
+
+    def figure(self):
+        """Along chainage: RHRS score, individual risk and deaths per year per km (see
+        :func:`riskrf.report.corridor_report.plot_corridor`)."""
+        from ..report.corridor_report import plot_corridor
+        return plot_corridor(self)
+
+    def to_json(self) -> dict:
+        """The run as a JSON-ready dict (``corridor_summary.json``): counts, failures, rejected rows, seed, blocks,
+        workers, seconds, units (chainage m, rates 1/yr, money in the corridor's currency) and totals.
+        """
+        s = self.summary()
+        return {"corridor": self.corridor.name, "sections": int(len(self.table)), "failures": list(self.failures),
+                "rejected_rows": list(self.corridor.errors), "seed": self.corridor.seed, "n_blocks": self.n_blocks,
+                "workers": self.workers, "seconds": round(self.seconds, 2), "rate_basis": self.corridor.rate_basis,
+                "mass_law": self.corridor.mass_note, "currency": self.corridor.currency,
+                "units": {"chainage": "m", "rate": "1/yr", "individual_risk": "1/yr", "money": self.corridor.currency},
+                "total_deaths_per_year_do_nothing": float(self.table["deaths_per_year"].sum()),
+                "total_deaths_per_year_best_options": float(self.table["best_deaths_per_year"].sum()),
+                "total_capital_best_options": float(self.table["best_option_capital"].sum()),
+                "top": s.head(10).replace({np.nan: None}).to_dict(orient="records"),
+                "defaults_used": list(self.corridor.defaults_used)}
+
+
+def _sig12(values: pd.Series) -> pd.Series:
+    """Values rounded to 12 significant digits (NaN kept), for ranking without float-noise ties."""
+    x = values.to_numpy(dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        digits = np.where(np.isfinite(x) & (x != 0), 11 - np.floor(np.log10(np.abs(x))), 0)
+    return pd.Series([round(v, int(d)) if np.isfinite(v) else v for v, d in zip(x, digits)], index=values.index)
+
+
+def _pv(corridor) -> float:
+    from ..risk.economics import pv_factor
+    e = corridor.study["economics"]
+    return float(pv_factor(e.discount_rate, e.horizon_years))
+
+
+def _write_partition(directory: Path, row: dict) -> None:
+    directory.mkdir(parents=True, exist_ok=True)
+    name = f"section={_section_key(row['id']):08x}.parquet"
+    tmp = directory / (name + ".partial")
+    pd.DataFrame([row]).to_parquet(tmp, index=False)
+    os.replace(tmp, directory / name)
+
+
+def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = None, n_workers: int | None = None,
+                 n_blocks: int | None = None, partitions: Path | None = None, resume: bool = False,
+                 keep_going: bool = False, progress=None, retries: int = 1, log=None) -> CorridorResult:
+    """Assess every section of ``corridor`` as a task on a ``dask.distributed`` client.
+
+    ``client``: an existing Client (used as is); else :func:`connect` (``scheduler`` / DASK_SCHEDULER_ADDRESS, or
+    a LocalCluster of ``n_workers``).  ``partitions``: a directory receiving one Parquet file per finished section
+    (written atomically as sections finish, so memory stays flat and an interrupted run keeps its work);
+    ``resume`` skips sections already there.  A task that fails (or whose worker dies) is retried ``retries``
+    times; then the run stops, or with ``keep_going`` the failure is listed and the rest continue.
+    ``progress(done, total, section_id)`` is called as each section finishes; ``log(text)`` once connected
+    (the cluster's dashboard address).
+    """
+    from distributed import as_completed
+    if n_blocks is not None and (isinstance(n_blocks, bool) or not isinstance(n_blocks, (int, np.integer))
+                                 or n_blocks < 100):
+        raise ValueError(f"n_blocks = {n_blocks!r} must be a whole number >= 100 (the mass-coupled hazard needs at "
+                         "least 20 blocks in each of at least 4 mass classes)")
+    t0 = time.perf_counter()
+    own = client is None
+    cluster = None
+    if own:
+        client, cluster = connect(scheduler, n_workers)
+    if log is not None:
+        log(f"dask dashboard (live progress per worker): {getattr(client, 'dashboard_link', None)}")
+    try:
+        todo = list(corridor.sections)
+        done_rows = []
+        if resume and partitions is not None and Path(partitions).exists():
+            have = {}
+            for f in sorted(Path(partitions).glob("section=*.parquet")):
+                r = pd.read_parquet(f).iloc[0].to_dict()
+                have[r["id"]] = r
+            nb = int(n_blocks or corridor.n_blocks)
+            keep = [s for s in todo if not (s.id in have and int(have[s.id]["n_blocks"]) == nb
+                                            and int(have[s.id]["seed"]) == _section_seed(corridor.seed, s.id))]
+            done_rows = [have[s.id] for s in todo if s not in keep]
+            todo = keep
+        # every worker gets the corridor-wide inputs once, without the sections (each task carries its own)
+        c_future = client.scatter(replace(corridor, sections=()), broadcast=True) if todo else None
+        run = uuid.uuid4().hex[:8]           # fresh keys: a rerun never picks up an earlier run's (failed) result
+        futures = {client.submit(_task, s, c_future, n_blocks, key=f"riskrf-section-{s.id}-{run}", retries=retries):
+                   s.id for s in todo}
+        failures = []
+        total = len(corridor.sections)
+        count = len(done_rows)
+        for fut in as_completed(futures):
+            sid = futures[fut]
+            try:
+                row = fut.result()
+            except Exception as exc:                      # noqa: BLE001 (reported per section)
+                if not keep_going:
+                    for f in futures:
+                        f.cancel()
+                    raise RuntimeError(f"section {sid!r} failed: {type(exc).__name__}: {exc} "
+                                       "(use --keep-going to run the other sections)") from exc
+                failures.append(f"section {sid!r}: {type(exc).__name__}: {exc}")
+                continue
+            if partitions is not None:
+                _write_partition(Path(partitions), row)
+            done_rows.append(row)
+            count += 1
+            if progress is not None:
+                progress(count, total, sid)
+        workers = len(client.scheduler_info().get("workers", {}))
+    finally:
+        if own:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    if not done_rows:
+        raise RuntimeError("no section finished: " + "; ".join(failures))
+    table = pd.DataFrame(done_rows).sort_values("chainage_from_m").reset_index(drop=True)
+    return CorridorResult(corridor=corridor, table=table, failures=tuple(failures), workers=workers,
+                          seconds=time.perf_counter() - t0, n_blocks=int(n_blocks or corridor.n_blocks))
+
+
+def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False) -> None:
+    """Write report.html, corridor.csv (ranked), sections.csv (by chainage), budget_curve.csv, chainage.png and
+    summary.json into ``out`` (a directory that appears only when everything is written; an existing non-empty
+    ``out`` is replaced whole only with ``overwrite``)."""
+    from ..io.outputs import atomic_output_dir, write_json
+    from ..report.corridor_report import render_corridor_html
+    from ..report.files import save_figure
+    with atomic_output_dir(out, overwrite=overwrite) as tmp:
+        res.summary().to_csv(tmp / "corridor.csv", index=False)
+        res.table.to_csv(tmp / "sections.csv", index=False)
+        res.budget_curve().to_csv(tmp / "budget_curve.csv", index=False)
+        save_figure(res.figure(), tmp / "chainage.png")
+        (tmp / "report.html").write_text(render_corridor_html(res, tmp / "chainage.png"), encoding="utf-8")
+        write_json(res.to_json(), tmp / "summary.json")

@@ -1,0 +1,262 @@
+"""Site files: one TOML describing one assessment (inventory, slope, exposure, options, economics).
+
+Every field is documented in the README ("Site files").  Paths are relative to
+the site file.  Unknown fields are errors with a did-you-mean; optional fields
+left out take documented defaults, and :attr:`Site.defaults_used` lists them so
+the report can state them.  Everything is checked before any computing starts.
+"""
+from __future__ import annotations
+
+import difflib
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..risk.mitigation import MitigationError, study_inputs
+from ..risk.site_rates import INVENTORY_RATE_FIELDS, check_closure_options, check_rates
+
+
+class SiteError(ValueError):
+    """A site file is invalid; the message names the file and the field."""
+
+
+SITE_FIELDS = {
+    "site": {"name": None, "description": ""},
+    "inventory": {"path": None, "start": None, "end": None, "duration_years": None, "density_kg_m3": None,
+                  "m_min_kg": None, "m_max_kg": None, "rate_scale": 1.0, "annual_maxima": None,
+                  "sizes": None,          # None: the inventory sidecar's sizes, else event_volumes
+                  # reader options (README "Input formats"); None = the reader's rule or the sidecar's value
+                  "sheet": None, "header_row": None, "encoding": None, "decimal": None, "date_format": None,
+                  "volume_unit": None, "mass_unit": None, "duplicates": None, "volume_column": None,
+                  "mass_column": None, "date_column": None, "location_column": None,
+                  # where the hazard's rate comes from (README "Site files"; riskrf.risk.site_rates)
+                  **INVENTORY_RATE_FIELDS},
+    "hazard": {"scenario": None, "velocities": None, "collector": None, "road_collector": "road",
+               "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
+               "free_board_m": 0.5, "design_period_years": 100.0, "bootstrap": 300, "seed": 1,
+               "option_blocks": 20_000, "mass_coupling": "simulated", "velocity_unit": None,
+               "drop_height_m": None},
+    "design_block": {"rule": "return_period", "percentile": 97.0, "survey": None, "fractal_dimension": None,
+                     "iterations": None},
+}
+MITIGATION_TABLES = ("traffic", "consequences", "economics", "options", "uncertainty", "criteria")
+#: Optional tables checked by their own modules: [rates] (riskrf.risk.site_rates).
+OTHER_TABLES = ("rates",)
+
+
+@dataclass(frozen=True)
+class Site:
+    """A checked site file (``riskrf assess SITE.toml``, README "Site files").
+
+    ``path`` of the file (relative paths inside it resolve against its folder), ``name`` and ``description``,
+    the ``inventory``, ``hazard``, ``mitigation``, ``design_block`` and optional ``rates`` sections as
+    checked dicts with defaults filled in, and ``defaults_used``: the names of the defaults applied, reported
+    as such in every output.
+    """
+    path: Path
+    name: str
+    description: str
+    inventory: dict
+    hazard: dict
+    mitigation: dict
+    defaults_used: tuple = field(default_factory=tuple)
+    design_block: dict = field(default_factory=lambda: dict(SITE_FIELDS["design_block"]))
+    rates: dict | None = None
+
+    def resolve(self, relative) -> Path:
+        """A path given in the site file, resolved against the site file's folder."""
+        return (self.path.parent / relative).resolve()
+
+
+def _unknown(key, allowed, where, source):
+    close = difflib.get_close_matches(key, list(allowed), n=1)
+    return SiteError(f"{source}: unknown field {where}{key!r}"
+                     + (f"; did you mean {close[0]!r}?" if close else f"; allowed: {', '.join(sorted(allowed))}"))
+
+
+def load_site(path) -> Site:
+    """Read and validate a site file; raises :class:`SiteError` before anything is computed."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"site file not found: {path}")
+    if path.is_dir():
+        raise SiteError(f"{path} is a directory; give the site file (.toml) inside it")
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise SiteError(f"{path}: not valid TOML: {exc}") from exc
+    allowed = set(SITE_FIELDS) | set(MITIGATION_TABLES) | set(OTHER_TABLES)
+    for key in data:
+        if key not in allowed:
+            raise _unknown(key, allowed, "", path)
+    used = []
+    tables = {}
+    for table, fields in SITE_FIELDS.items():
+        given = data.get(table, {})
+        if not isinstance(given, dict):
+            raise SiteError(f"{path}: [{table}] must be a table")
+        for key in given:
+            if key not in fields:
+                raise _unknown(key, fields, f"{table}.", path)
+        merged = {}
+        for key, default in fields.items():
+            if key in given:
+                merged[key] = given[key]
+            else:
+                merged[key] = default
+                if default is not None:
+                    used.append(f"{table}.{key} = {default!r}")
+        tables[table] = merged
+    if tables["inventory"]["path"] is None:
+        raise SiteError(f"{path}: inventory.path is required (the rock fall inventory file)")
+    hz = tables["hazard"]
+    if (hz["scenario"] is None) == (hz["velocities"] is None):
+        raise SiteError(f"{path}: give exactly one of hazard.scenario (a slope scenario to simulate) or "
+                        "hazard.velocities (a velocity file)")
+    for key in ("n_blocks", "bootstrap", "option_blocks"):
+        if not isinstance(hz[key], int) or hz[key] < 1:
+            raise SiteError(f"{path}: hazard.{key} = {hz[key]!r} must be a whole number >= 1")
+    if not isinstance(hz["fences_kj"], list) or not all(isinstance(v, (int, float)) and v > 0
+                                                        for v in hz["fences_kj"]):
+        raise SiteError(f"{path}: hazard.fences_kj = {hz['fences_kj']!r} must be a list of capacities > 0")
+    fh = hz["fence_height_m"]
+    if isinstance(fh, list):
+        if len(fh) != len(hz["fences_kj"]) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                      and v > 0 for v in fh):
+            raise SiteError(f"{path}: hazard.fence_height_m = {fh!r} must be one height > 0 or one per fence in "
+                            f"hazard.fences_kj ({len(hz['fences_kj'])})")
+    elif isinstance(fh, bool) or not isinstance(fh, (int, float)) or fh <= 0:
+        raise SiteError(f"{path}: hazard.fence_height_m = {fh!r} must be a number > 0 (or a list, one per fence)")
+    def number(v):
+        return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    if not number(hz["free_board_m"]) or hz["free_board_m"] < 0:
+        raise SiteError(f"{path}: hazard.free_board_m = {hz['free_board_m']!r} must be a number >= 0 m")
+    if not number(hz["design_period_years"]) or hz["design_period_years"] <= 1:
+        raise SiteError(f"{path}: hazard.design_period_years = {hz['design_period_years']!r} must be a number > 1 "
+                        "year (a T-year event has annual probability 1/T)")
+    if not number(hz["reach_probability"]) or not 0 < hz["reach_probability"] <= 1:
+        raise SiteError(f"{path}: hazard.reach_probability = {hz['reach_probability']!r} must be a probability in "
+                        "(0, 1]")
+    if hz["velocity_unit"] not in (None, "m/s", "km/h"):
+        raise SiteError(f"{path}: hazard.velocity_unit = {hz['velocity_unit']!r} is not 'm/s' or 'km/h'")
+    if hz["drop_height_m"] is not None and (not number(hz["drop_height_m"]) or hz["drop_height_m"] <= 0):
+        raise SiteError(f"{path}: hazard.drop_height_m = {hz['drop_height_m']!r} must be a height > 0 m (release "
+                        "to the barrier line, for the velocity plausibility check)")
+    inv = tables["inventory"]
+    for key in ("m_min_kg", "m_max_kg", "density_kg_m3", "duration_years"):
+        if inv[key] is not None and (not number(inv[key]) or inv[key] <= 0):
+            raise SiteError(f"{path}: inventory.{key} = {inv[key]!r} must be a number > 0")
+    if inv["m_min_kg"] is not None and inv["m_max_kg"] is not None and inv["m_min_kg"] >= inv["m_max_kg"]:
+        raise SiteError(f"{path}: inventory.m_min_kg = {inv['m_min_kg']!r} must be below inventory.m_max_kg = "
+                        f"{inv['m_max_kg']!r}")
+    if not isinstance(inv["rate_scale"], (int, float)) or not 0 < inv["rate_scale"] <= 1e6:
+        raise SiteError(f"{path}: inventory.rate_scale = {inv['rate_scale']!r} must be a number > 0")
+    _check_design_block(tables, path)
+    for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
+                       ("hazard", "velocities"), ("design_block", "survey")):
+        rel = tables[table][key]
+        if rel is not None and not (path.parent / rel).exists():
+            raise SiteError(f"{path}: {table}.{key} = {rel!r}: file not found ({(path.parent / rel).resolve()})")
+    rates = check_rates(data.get("rates"), inv, path, error=SiteError)
+    if rates is not None:
+        used += rates.pop("defaults_used")
+    if hz["scenario"] is not None:
+        import simulation
+        if hz["collector"] is None:
+            hz["collector"] = "barrier"
+            used.append("hazard.collector = 'barrier'")
+        scenario = simulation.load_scenario(path.parent / hz["scenario"])
+        names = [c.name for c in scenario.collectors]
+        if hz["collector"] not in names:
+            raise SiteError(f"{path}: hazard.collector = {hz['collector']!r}: scenario {hz['scenario']!r} has no "
+                            f"collector named {hz['collector']!r}; its collectors are {names}")
+        if hz["road_collector"] not in names and "road_collector" in data.get("hazard", {}):
+            raise SiteError(f"{path}: hazard.road_collector = {hz['road_collector']!r}: scenario {hz['scenario']!r} "
+                            f"has no such collector; its collectors are {names}")
+    if hz["velocities"] is not None:         # read now: a bad velocity file is found before the fits run
+        from ..io.velocities import read_velocities
+        try:
+            read_velocities(path.parent / hz["velocities"], collector=hz["collector"],
+                            velocity_unit=hz["velocity_unit"])
+        except ValueError as exc:
+            raise SiteError(f"{path}: hazard.velocities = {hz['velocities']!r}: {exc}") from exc
+    mit = {k: data[k] for k in MITIGATION_TABLES if k in data}
+    try:
+        mitigation = study_inputs(mit, str(path))
+    except MitigationError as exc:
+        raise SiteError(str(exc)) from exc
+    used += list(mitigation.pop("defaults_used"))
+    check_closure_options(mitigation["options"], rates, path, error=SiteError)
+    if hz["scenario"] is not None:
+        _check_option_geometry(mitigation["options"], scenario, hz, path, mitigation["uncertainty"])
+    return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
+                description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
+                mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"], rates=rates)
+
+
+def _check_design_block(tables, path):
+    """inventory.sizes, hazard.mass_coupling and the [design_block] table (rule, percentile, survey)."""
+    from ..hazard.design_block import RULES, SIZES, check_percentile
+    inv, hz, db = tables["inventory"], tables["hazard"], tables["design_block"]
+    if inv["sizes"] is not None and inv["sizes"] not in SIZES:
+        raise SiteError(f"{path}: inventory.sizes = {inv['sizes']!r} must be one of {list(SIZES)} (what the "
+                        "inventory's volumes are: detached event volumes, or individual block sizes)")
+    if hz["mass_coupling"] not in ("simulated", "independent"):
+        raise SiteError(f"{path}: hazard.mass_coupling = {hz['mass_coupling']!r} must be 'simulated' (reach and "
+                        "speed by block mass, the default) or 'independent'")
+    if db["rule"] not in RULES:
+        raise SiteError(f"{path}: design_block.rule = {db['rule']!r} must be one of {list(RULES)}")
+    try:
+        db["percentile"] = check_percentile(db["percentile"], "design_block.percentile")
+    except (TypeError, ValueError) as exc:
+        raise SiteError(f"{path}: {exc}") from exc
+    fragmenting = db["fractal_dimension"] is not None or db["iterations"] is not None
+    if db["rule"] == "fragmentation" and not fragmenting:
+        raise SiteError(f"{path}: design_block.rule = 'fragmentation' needs design_block.fractal_dimension and "
+                        "design_block.iterations (the fragmentation parameters you assume)")
+    if fragmenting:
+        from ..hazard.design_block import fractal_fragments
+        try:
+            fractal_fragments(1.0, db["fractal_dimension"], db["iterations"])
+        except (TypeError, ValueError) as exc:
+            raise SiteError(f"{path}: {exc}") from exc
+    if db["survey"] is not None and not isinstance(db["survey"], str):
+        raise SiteError(f"{path}: design_block.survey = {db['survey']!r} must be a file name")
+
+
+def _check_option_geometry(options, scenario, hz, path, uncertainty=None):
+    """Option geometry against the scenario, before anything is computed: positions inside the profile,
+    ditches that fit, scaling zones inside the release zone, uncertain material parameters that exist."""
+    from ..risk.measures import Ditch, MeasureError, ditch_profile, material_value, seeder_share
+    prof = scenario.profile
+    paths = list(uncertainty.materials) if uncertainty is not None else []
+    if uncertainty is not None and uncertainty.calibration is not None:
+        paths += [c.removeprefix("materials.") for c in uncertainty.calibration.columns]
+    for p in paths:
+        try:
+            material_value(scenario, p, f"{path}: uncertainty.materials")
+        except MeasureError as exc:
+            raise SiteError(str(exc)) from exc
+    for o in options:
+        where = f"{path}: option {o.name!r}"
+        for fld in ("x_m", "road_x_m"):
+            v = getattr(o, fld)
+            if v is not None and not prof.x[0] < v < prof.x[-1]:
+                raise SiteError(f"{where}: {fld} = {v:g} m is outside the profile ({prof.x[0]:g}, {prof.x[-1]:g}) m")
+        try:
+            if o.kind == "ditch" and o.retention is None:
+                d = Ditch(o.x_m, o.width_m, o.depth_m, option=o.name)
+                ditch_profile(prof, d.x_m, d.width_m, d.depth_m, where=where)
+                if o.material is not None and o.material not in prof.material_names:
+                    raise SiteError(f"{where}: material = {o.material!r} is not a material of the scenario "
+                                    f"({', '.join(prof.material_names)})")
+                road = next((c for c in scenario.collectors if c.name == hz["road_collector"]), None)
+                if road is not None and d.span[0] <= road.x <= d.span[1]:
+                    raise SiteError(f"{where}: the ditch ({d.span[0]:g}-{d.span[1]:g} m) would cut through the road "
+                                    f"line (collector {road.name!r} at x = {road.x:g} m)")
+            if o.kind == "scaling" and o.zone_x_m is not None:
+                seeder_share(scenario, o.zone_x_m, where)
+        except MeasureError as exc:
+            raise SiteError(str(exc)) from exc

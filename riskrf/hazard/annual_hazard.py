@@ -1,0 +1,337 @@
+"""Annual impact-energy hazard at a barrier line (Wyllie 2014, 8.1-8.3; Hantz et al. 2021).
+
+    lambda(E > e) = rate of falls x P(a fall reaches the line) x P(E > e | reaches)
+
+The rate and the mass distribution come from a magnitude-frequency fit (falls
+at least m_min per year from the power law); the reach probability, velocities
+(and rotation, and bounce heights) from a trajectory simulation or any velocity
+model.  :class:`EnergyHazard` turns them into annual frequencies, return
+periods, energies for a return period with intervals, and percentiles.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pandas as pd
+from scipy import optimize
+
+from ..frequency.extremes import _AnnualMaximumFit
+from ..frequency.study import DESIGN_RETURN_PERIODS
+from .impact_energy import (
+    PairedSamples,
+    VelocityFit,
+    exceedance_function,
+    exceedance_probability,
+    mass_model,
+)
+from .mass_coupling import MassCoupledSamples
+from ..frequency.power_law import GutenbergRichterFit
+from ..report.format import sig
+from ..core.units import SPHERE_INERTIA
+from ..core.validation import check_positive, check_probability_level, check_return_periods
+
+
+def inertia_factors(df) -> np.ndarray:
+    """I / (m r^2) of each block in a collector table (0.4, a sphere, when the table does not say)."""
+    return df["inertia_factor"].to_numpy(dtype=float) if "inertia_factor" in df else np.full(len(df), SPHERE_INERTIA)
+
+
+_E_GRID = np.geomspace(1e-3, 1e12, 301)     # kJ: the grid on which hazard curves are inverted
+
+
+@dataclass(frozen=True)
+class EnergyHazard:
+    """Impact-energy hazard at one barrier line.
+
+    Attributes
+    ----------
+    mass : mass model (usually a :class:`~riskrf.GutenbergRichterFit`)
+    velocity : velocity model: samples [m/s], scipy distribution, VelocityFit, PairedSamples or
+        MassCoupledSamples (reach, speed and bounce height by block mass: :func:`riskrf.energy_hazard`).
+        With samples from a simulation the effective speed includes rotation:
+        v_eff^2 = v^2 + k (w r)^2 (k = I / m r^2: 0.4 sphere, 0.5 cylinder), so that
+        1/2 m v_eff^2 is the total kinetic energy (exact for a rolling body, whose
+        surface speed w r does not depend on its mass).
+    rate_per_year : falls per year described by the mass model (power law: falls >= m_min).
+    reach_probability : P(a fall reaches the barrier line) (simulation; averaged over the mass model when the
+        velocity model is mass-coupled).
+    n_released : number of simulated blocks behind ``reach_probability`` (for its uncertainty).
+    heights_m : bounce heights [m] at the line (of the block centre above the ground), if known.
+    """
+
+    mass: object
+    velocity: object
+    rate_per_year: float
+    reach_probability: float = 1.0
+    n_released: int | None = None
+    heights_m: np.ndarray | None = field(default=None, repr=False)
+    collector: str = ""
+    notes: tuple = ()
+
+    def __post_init__(self):
+        check_positive(self.rate_per_year, "rate_per_year")
+        if not 0.0 < float(self.reach_probability) <= 1.0:
+            raise ValueError(f"reach_probability must lie in (0, 1]; got {self.reach_probability!r}")
+        mass_model(self.mass)      # validates the mass model
+
+    @classmethod
+    def from_simulation(cls, mass, result, collector: str, *, rate_per_year=None, rotational: bool = True,
+                        condition_on_mass: bool = False) -> "EnergyHazard":
+        """Build the hazard from a mass fit and a :class:`simulation.SimulationResult` (the mass-INDEPENDENT form).
+
+        Uses each block's first crossing of ``collector``; the reach probability is
+        the fraction of released blocks that crossed it, one value for every mass, and the
+        velocities are pooled over the seeder's masses (``condition_on_mass`` classes them by the
+        seeder's masses, without simulating beyond them).  The mass-coupled hazard, which simulates
+        the whole range of the mass model, is :func:`riskrf.energy_hazard`.
+        """
+        if rate_per_year is None:
+            if not isinstance(mass, GutenbergRichterFit):
+                raise ValueError("rate_per_year is needed unless the mass model is a power-law fit")
+            rate_per_year = mass.rate_min
+        df = result.collector(collector, first_only=True)
+        if df.empty:
+            raise ValueError(f"no simulated block reached collector {collector!r}: the hazard there is nil "
+                             "for the simulated release; check the scenario")
+        v = df["velocity_ms"].to_numpy()
+        if rotational:
+            spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
+            v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
+        velocity = PairedSamples(v, df["mass_kg"].to_numpy()) if condition_on_mass else v
+        notes = ("mass-independent form: one reach probability and one velocity law for all masses"
+                 + (" (velocities classed by the seeder's masses)" if condition_on_mass else ""),
+                 f"velocities: first crossings of {collector!r} by {len(df):,} of {result.n:,} simulated blocks"
+                 + ("; rotational energy included (v_eff^2 = v^2 + k (w r)^2)" if rotational else ""),)
+        return cls(mass=mass, velocity=velocity, rate_per_year=float(rate_per_year),
+                   reach_probability=len(df) / result.n, n_released=result.n,
+                   heights_m=df["height_m"].to_numpy(), collector=collector, notes=notes)
+
+    @property
+    def mass_coupled(self) -> bool:
+        """Whether reach, speed and bounce height depend on block mass (:func:`riskrf.energy_hazard`)."""
+        return isinstance(self.velocity, MassCoupledSamples)
+
+    def with_mass(self, mass, rate_per_year: float | None = None) -> "EnergyHazard":
+        """The same slope with another mass model (and rate): a mass-coupled reach probability is recomputed."""
+        rate = self.rate_per_year if rate_per_year is None else check_positive(rate_per_year, "rate_per_year")
+        if self.mass_coupled:
+            mm = mass_model(mass)
+            vel = self.velocity.with_representative(mm)
+            return replace(self, mass=mass, rate_per_year=float(rate), velocity=vel,
+                           reach_probability=max(vel.reach_probability(mm), 1e-300), heights_m=vel.heights_m)
+        return replace(self, mass=mass, rate_per_year=float(rate))
+
+    # ---- per fall -------------------------------------------------------------------
+    def exceedance_probability(self, energy_kj):
+        """P(E > e) for one fall that reaches the line."""
+        return exceedance_probability(energy_kj, self.mass, self.velocity)
+
+    def energy_percentile(self, q):
+        """Energy [kJ] not exceeded by q % of the falls that reach the line (e.g. q = 95, 99)."""
+        q = np.atleast_1d(np.asarray(q, dtype=float))
+        if np.any((q <= 0) | (q >= 100)):
+            raise ValueError(f"percentiles must lie strictly between 0 and 100; got {q.tolist()}")
+        return self._invert(1.0 - q / 100.0, scale=1.0)
+
+    def velocity_percentile(self, q, mass_kg=None) -> float:
+        """Velocity [m/s] not exceeded by q % of the falls reaching the line, whatever the velocity model.
+
+        With a mass-coupled model and ``mass_kg``: of the simulated blocks of that mass (its mass class)."""
+        v = self.velocity
+        if isinstance(v, MassCoupledSamples) and mass_kg is not None:
+            return v.velocity_percentile(q, mass_kg)
+        if isinstance(v, VelocityFit):
+            v = v.dist
+        if hasattr(v, "ppf"):
+            return float(v.ppf(q / 100.0))
+        return float(np.percentile(np.asarray(getattr(v, "velocity_ms", v), dtype=float), q))
+
+    def height_percentile(self, q):
+        """Bounce height [m] not exceeded by q % of the falls reaching the line (from simulated heights)."""
+        if self.heights_m is None:
+            raise ValueError("no bounce heights: build the hazard with EnergyHazard.from_simulation")
+        return np.percentile(self.heights_m, q)
+
+    def height_exceedance(self, height_m):
+        """P(bounce height > h) for a fall reaching the line (the share that would pass over a fence)."""
+        if self.heights_m is None:
+            raise ValueError("no bounce heights: build the hazard with EnergyHazard.from_simulation")
+        h = np.sort(self.heights_m)
+        return 1.0 - np.searchsorted(h, np.asarray(height_m, dtype=float), side="right") / h.size
+
+    # ---- per year -------------------------------------------------------------------
+    @property
+    def arrival_rate(self) -> float:
+        """Falls reaching the line per year [1/yr]."""
+        return self.rate_per_year * self.reach_probability
+
+    def annual_frequency(self, energy_kj):
+        """Impacts with energy above e per year at the line [1/yr]."""
+        return self.arrival_rate * self.exceedance_probability(energy_kj)
+
+    def return_period(self, energy_kj):
+        """Mean time [yr] between impacts above e."""
+        with np.errstate(divide="ignore"):
+            return 1.0 / self.annual_frequency(energy_kj)
+
+    def probability_in(self, years, energy_kj):
+        """P(at least one impact above e in ``years``), Poisson: 1 - exp(-lambda(e) years)."""
+        return -np.expm1(-check_positive(years, "years") * self.annual_frequency(energy_kj))
+
+    def energy_at_return_period(self, T):
+        """Energy [kJ] exceeded on average once in T years at the line."""
+        T = check_return_periods(T)
+        p = 1.0 / (T * self.arrival_rate)
+        if np.any(p >= 1):
+            bad = np.atleast_1d(T)[np.atleast_1d(p) >= 1][0]
+            raise ValueError(f"T = {bad:g} yr is shorter than the mean time between arrivals at the line "
+                             f"({1 / self.arrival_rate:.3g} yr): every arriving fall exceeds the T-year energy")
+        return self._invert(np.atleast_1d(p), scale=1.0).reshape(np.shape(T))
+
+    def _invert(self, p, scale):
+        """Energy where scale x P(E > e) = p: grid interpolation, then refined by root finding."""
+        p = np.atleast_1d(p)
+        fn = exceedance_function(self.mass, self.velocity)
+        curve = fn(_E_GRID) * scale
+        guess = _interp_log_inverse(curve, p)
+        out = guess.copy()
+        for i, (pi, g) in enumerate(zip(p, guess)):
+            if not np.isfinite(g):
+                continue
+            f = lambda le: np.log(max(scale * fn(np.exp(le)).item(), 1e-300)) - np.log(pi)  # noqa: E731
+            lo, hi = np.log(g) - 0.05, np.log(g) + 0.05
+            for _ in range(40):
+                if f(lo) > 0 >= f(hi):
+                    out[i] = np.exp(optimize.brentq(f, lo, hi, xtol=1e-12))
+                    break
+                lo, hi = lo - 0.1, hi + 0.1
+        return out
+
+    # ---- uncertainty ----------------------------------------------------------------
+    def energy_at_return_period_ci(self, T, level: float = 0.95, n_bootstrap: int = 300, seed=None):
+        """Seeded interval of the T-year energy, drawing each uncertain input from its law.
+
+        Sources included: the exponent b and the rate of the power law (b* =
+        b x Gamma(n, 1)/n, the posterior of b under the Jeffreys prior 1/b given the
+        MLE b from n masses, exact for the untruncated law; the MLE's own sampling law
+        is the inverse, b n / Gamma(n, 1); rate* = rate x Gamma(n, 1)/n = Gamma(n)/T, the
+        posterior of a Poisson rate of n falls in T years under the scale-invariant prior 1/rate),
+        or the parameters of a Gumbel/GEV fit (normal with the fit's covariance);
+        the finite number of simulated trajectories (velocities resampled with
+        replacement, reach probability binomial; mass-coupled: the blocks of each
+        mass class resampled).  Not included: the choice of model, the maximum
+        credible block m_max and the rate share of the source (judgement inputs:
+        see ``riskrf.hazard.energy_study.design_energy_sensitivity``), the simulation's
+        physical parameters, the record's completeness.
+        Returns (lower, upper) arrays.
+        """
+        T = check_return_periods(T)
+        level = check_probability_level(level)
+        Tv = np.atleast_1d(T).astype(float)
+        sims = np.empty((int(n_bootstrap), Tv.size))
+        for i, (curve, scale) in enumerate(self._bootstrap_curves(int(n_bootstrap), seed)):
+            sims[i] = _interp_log_inverse(curve, 1.0 / (Tv * scale))
+        q = (1 - level) / 2
+        lo, hi = np.nanquantile(sims, q, axis=0), np.nanquantile(sims, 1 - q, axis=0)
+        return lo.reshape(np.shape(T)), hi.reshape(np.shape(T))
+
+    def _bootstrap_curves(self, n_bootstrap: int, seed):
+        """Replicates (P(E > e) on the energy grid, arrivals per year) of the parametric bootstrap.
+
+        With an integer seed they are kept on the object, so the design table and the exceedance figure
+        draw on the same replicates instead of repeating them.
+        """
+        key = (n_bootstrap, seed) if isinstance(seed, (int, np.integer)) else None
+        cache = self.__dict__.setdefault("_bootstrap_cache", {})
+        if key is not None and key in cache:
+            return cache[key]
+        rng = np.random.default_rng(seed)
+        out = []
+        v_nodes = self._velocity_nodes()
+        for _ in range(n_bootstrap):
+            mass, rate = self._perturbed_mass(rng)
+            if self.mass_coupled:       # blocks resampled within each mass class: reach and speed together
+                out.append((self.velocity.resampled_joint_exceedance(rng, _E_GRID, mass_model(mass)), rate))
+                continue
+            reach = self.reach_probability
+            if self.n_released:
+                reach = max(rng.binomial(self.n_released, self.reach_probability), 1) / self.n_released
+            vel = v_nodes[rng.integers(0, v_nodes.size, v_nodes.size)] if isinstance(v_nodes, np.ndarray) \
+                else v_nodes
+            out.append((exceedance_probability(_E_GRID, mass, vel), rate * reach))
+        if key is not None:
+            cache[key] = out
+        return out
+
+    def _velocity_nodes(self):
+        """Velocity samples compressed to at most 2048 equal-probability quantiles (for the bootstrap)."""
+        v = self.velocity
+        if isinstance(v, (VelocityFit, PairedSamples, MassCoupledSamples)) or hasattr(v, "pdf"):
+            return v
+        v = np.sort(np.asarray(v, dtype=float))
+        if v.size <= 2048:
+            return v
+        return np.quantile(v, (np.arange(2048) + 0.5) / 2048)
+
+    def _perturbed_mass(self, rng):
+        m = self.mass
+        if isinstance(m, GutenbergRichterFit):
+            n = m.n_tail
+            b = m.b * rng.gamma(n) / n
+            rate = self.rate_per_year * rng.gamma(n) / n
+            return replace(m, b=float(b), a=float(np.log10(rate) + b * np.log10(m.m_min)), rate_min=float(rate)), \
+                rate
+        if isinstance(m, _AnnualMaximumFit) and m.cov is not None:
+            params = rng.multivariate_normal(np.asarray(m.params), m.cov)
+            if params[1] <= 0:
+                params[1] = m.params[1]
+            return replace(m, **dict(zip(m.param_names, map(float, params)))), self.rate_per_year
+        return m, self.rate_per_year
+
+    # ---- tables ---------------------------------------------------------------------
+    def design_table(self, T=DESIGN_RETURN_PERIODS, level: float = 0.95, n_bootstrap: int = 300,
+                     seed=1) -> pd.DataFrame:
+        """Energy [kJ] for each return period, with bootstrap intervals."""
+        T = np.asarray(T, dtype=float)
+        ok = T * self.arrival_rate > 1
+        e = np.full(T.size, 0.0)
+        lo, hi = np.full(T.size, 0.0), np.full(T.size, 0.0)
+        if ok.any():
+            e[ok] = self.energy_at_return_period(T[ok])
+            lo[ok], hi[ok] = self.energy_at_return_period_ci(T[ok], level, n_bootstrap, seed)
+        return pd.DataFrame({"T_years": T, "annual_exceedance": 1 / T, "energy_kj": e, "ci_low_kj": lo,
+                             "ci_high_kj": hi, "probability_in_50_years": -np.expm1(-50 / T)})
+
+    def summary(self) -> pd.DataFrame:
+        """Key figures of the hazard at the line (one-column table): falls per year, reach probability, arrivals
+        per year [1/yr], the mass model, mass coupling and the 95th/99th-percentile energies [kJ].
+        """
+        rows = {"collector": self.collector, "falls per year (mass model)": self.rate_per_year,
+                "reach probability": self.reach_probability, "arrivals per year": self.arrival_rate,
+                "mass model": mass_model(self.mass).description,
+                "mass coupling": ("reach, speed and bounce height by block mass (simulated "
+                                  f"{sig(self.velocity.edges_kg[0])}-{sig(self.velocity.edges_kg[-1])} kg)")
+                if self.mass_coupled else "none: one reach probability and velocity law for all masses"}
+        for q, e in zip((95, 99), self.energy_percentile([95, 99])):
+            rows[f"energy p{q} per arriving fall [kJ]"] = e
+        if self.heights_m is not None:
+            for q in (95, 99):
+                rows[f"bounce height p{q} [m]"] = float(self.height_percentile(q))
+        return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
+
+
+def _interp_log_inverse(curve, p):
+    """Energy on _E_GRID where the non-increasing curve P(E > e) crosses p (log-log interpolation)."""
+    p = np.asarray(p, dtype=float)
+    valid = curve > 0
+    if not valid.any():
+        return np.full(p.shape, np.nan)
+    le = np.log(_E_GRID[valid])
+    lp = np.log(np.maximum.accumulate(curve[valid][::-1])[::-1])   # enforce monotone
+    # np.interp needs increasing x: use -log p.
+    x = -lp
+    order = np.argsort(x, kind="stable")
+    x, le = x[order], le[order]
+    x, idx = np.unique(x, return_index=True)
+    return np.exp(np.interp(-np.log(p), x, le[idx], left=np.nan, right=np.nan))

@@ -1,0 +1,627 @@
+"""The impact-energy analysis behind ``riskrf energy``: hazard, design energies, fence checks."""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .annual_hazard import EnergyHazard
+from .barriers import UNI11211_FACTORS, check_fence, uni11211_design_energy
+from ..frequency.study import DESIGN_RETURN_PERIODS
+from ..io.outputs import write_json
+from ..frequency.power_law import GutenbergRichterFit, fit_gutenberg_richter
+from ..report.format import sig
+from ..core.units import DEFAULT_DENSITY_KG_M3, kinetic_energy_kj
+
+#: What the bootstrap interval of a design energy covers, and what it does not (stated with every interval).
+INTERVAL_COVERS = ("sampling uncertainty of the power-law exponent b and of the rate, and the finite number of "
+                   "simulated trajectories; NOT the maximum credible block m_max nor the rate share of the source "
+                   "above the line (judgement inputs: see the sensitivity table), nor the slope's material "
+                   "parameters or the choice of model")
+
+
+@dataclass(frozen=True)
+class EnergyAnalysis:
+    """An energy hazard with its design table, fence checks and UNI 11211-4 design energy."""
+
+    hazard: EnergyHazard
+    design: pd.DataFrame
+    fences: dict            # {"2000 kJ / 5 m": check table}
+    uni: object             # UNI11211Design or None
+    design_T: float
+    density_kg_m3: float
+    seed: int | None
+    n_bootstrap: int
+    design_block: object = None          # riskrf.hazard.design_block.DesignBlock or None
+    sensitivity: pd.DataFrame | None = None
+    site_masses: pd.DataFrame | None = None
+    tornado: object = None               # DesignEnergyTornado or None
+
+    def fence_verdicts(self) -> pd.DataFrame:
+        """One row per fence checked: whether every check passed (``adequate``) and the names of those that failed."""
+        rows = []
+        for name, table in self.fences.items():
+            rows.append({"fence": name, "adequate": bool(table["adequate"].all()),
+                         "failed checks": "; ".join(table.loc[~table["adequate"], "check"]) or "none"})
+        return pd.DataFrame(rows)
+
+    def summary_text(self) -> str:
+        """The analysis in a few plain-text lines (rates [1/yr], reach probability, design energies [kJ], fence
+        verdicts), for the CLI's closing summary; the caller prints it.
+        """
+        hz = self.hazard
+        lines = ["Impact energy hazard at the barrier line (Wyllie 2014, 8.1-8.3)",
+                 f"  falls per year (mass model)   {sig(hz.rate_per_year, 4)}   [{hz.summary().loc['mass model', 'value']}]",
+                 f"  reach probability             {hz.reach_probability:.4f}"
+                 + (f"  ({hz.n_released:,} simulated blocks)" if hz.n_released else ""),
+                 f"  arrivals per year             {sig(hz.arrival_rate, 4)}"]
+        for note in hz.notes:
+            lines.append(f"  {note}")
+        e95, e99 = hz.energy_percentile([95, 99])
+        lines.append(f"  energy per arriving fall      p95 {sig(e95, 4)} kJ, p99 {sig(e99, 4)} kJ")
+        if hz.heights_m is not None:
+            lines.append(f"  bounce height                 p95 {hz.height_percentile(95):.3g} m, "
+                         f"p99 {hz.height_percentile(99):.3g} m (block centre above the slope)")
+        if hz.mass_coupled:
+            lines += ["", "Reach, speed and bounce height by block mass (simulated across the mass range):",
+                      hz.velocity.class_table().to_string(index=False, float_format=lambda v: sig(v, 4))]
+        lines += ["", f"Design energies (interval: {self.n_bootstrap} bootstrap replicates, seed {self.seed}; "
+                      f"it covers the {INTERVAL_COVERS}):"]
+        d = self.design.copy()
+        lines.append(d.to_string(index=False, float_format=lambda v: sig(v, 4)))
+        short = d.loc[d["T_years"] * hz.arrival_rate < 1, "T_years"]
+        if len(short):
+            lines.append(f"  T = {', '.join(sig(t) for t in short)} years: fewer than one fall reaches the line in T "
+                         f"years (T x {sig(hz.arrival_rate, 3)} arrivals per year < 1), so no T-year energy exists "
+                         "there (shown as 0 kJ)")
+        if self.site_masses is not None:
+            lines += ["", "Design masses of the site's law (the hazard's; nothing above m_max) [kg]:",
+                      self.site_masses.drop(columns="law").to_string(index=False, float_format=lambda v: sig(v, 4))]
+        if self.design_block is not None:
+            b = self.design_block
+            lines += ["", f"Design block: {sig(b.mass_kg, 4)} kg ({sig(b.volume_m3, 4)} m3, sphere diameter "
+                          f"{b.diameter_m:.3g} m) by rule {b.rule!r}: {b.basis}"]
+            lines += [f"  {a}" for a in b.assumptions]
+            lines.append(b.alternatives.to_string(index=False, float_format=lambda v: sig(v, 4)))
+        if self.sensitivity is not None:
+            lines += ["", f"Sensitivity of the {self.design_T:g}-year energy [kJ] to the judgement inputs "
+                          "(m_max: rows; rate share: columns):",
+                      sensitivity_grid(self.sensitivity).to_string(float_format=lambda v: sig(v, 4))]
+        if self.tornado is not None:
+            lines += ["", "One-way sensitivity (tornado) of the design energies: each input at low and high, the "
+                          "others at base [kJ]:", self.tornado.text()]
+            for _, r in self.tornado.dominant().iterrows():
+                lines.append(f"  dominant for the {r['design_energy']}: {r['input']} "
+                             f"({sig(r['energy_low_kj'], 3)} - {sig(r['energy_high_kj'], 3)} kJ)")
+        if self.uni is not None:
+            u = self.uni
+            block = u.design_mass_kg / (u.factors["gamma_VolF"] * u.factors["gamma_gamma"])
+            what = "design block" if self.design_block is not None else f"{self.design_T:g}-year block"
+            lines += ["", f"UNI 11211-4 design energy for the {what} "
+                          f"({sig(block, 4)} kg) at the p95 velocity: "
+                          f"E_k = {sig(u.characteristic_energy_kj, 4)} kJ, E_d = {sig(u.design_energy_kj, 4)} kJ "
+                          f"(gamma_Tr {u.factors['gamma_Tr']}, gamma_Dp {u.factors['gamma_Dp']}, "
+                          f"gamma_VolF {u.factors['gamma_VolF']}, gamma_gamma {u.factors['gamma_gamma']})"]
+        elif (why := self._uni_missing_reason()):
+            lines += ["", f"UNI 11211-4 design energy not computed: {why}"]
+        for name, table in self.fences.items():
+            lines += ["", f"Fence {name}:"]
+            for _, r in table.iterrows():
+                mark = "N/A " if not np.isfinite(r["demand"]) else "OK  " if r["adequate"] else "FAIL"
+                demand = f"{sig(r['demand'], 4)} {r['unit']}" if np.isfinite(r["demand"]) else "not defined"
+                lines.append(f"  [{mark}] {r['check']}: {demand} vs {sig(r['capacity'], 4)} "
+                             f"{r['unit']}" + (f" (interval {r['interval']})" if r["interval"] else "")
+                             + f"; {r['note']}")
+        return "\n".join(lines)
+
+    def _uni_missing_reason(self) -> str:
+        """Why the UNI 11211-4 design energy is absent ('' when it was computed)."""
+        if self.uni is not None:
+            return ""
+        hz = self.hazard
+        expected = self.design_T * hz.rate_per_year
+        if isinstance(hz.mass, GutenbergRichterFit) and expected <= 1:
+            return (f"the {self.design_T:g}-year block is not defined because fewer than one fall is expected in "
+                    f"{self.design_T:g} years ({sig(expected, 3)} at {sig(hz.rate_per_year, 3)} falls per year); "
+                    "a design block (riskrf energy --design-percentile or --block-survey; design_block= in Python) "
+                    "would apply it")
+        return ("it needs a design block (riskrf energy --design-percentile or --block-survey) or a power-law "
+                "mass model for the T-year block")
+
+    def to_dict(self) -> dict:
+        """The analysis as a JSON-ready dict (``energy_summary.json``): units, hazard figures, design energies [kJ],
+        fence checks, interval coverage and notes.
+        """
+        hz = self.hazard
+        out = {"units": {"energy": "kJ", "height": "m", "rate": "1/yr", "return_period": "yr"},
+               "hazard": {k: v for k, v in hz.summary()["value"].items()},
+               "design_energies": self.design.to_dict(orient="records"),
+               "fences": {name: t.to_dict(orient="records") for name, t in self.fences.items()},
+               "design_energy_interval_covers": INTERVAL_COVERS,
+               "mass_coupled": hz.mass_coupled,
+               "notes": list(hz.notes)}
+        if hz.mass_coupled:
+            out["mass_classes"] = hz.velocity.class_table().to_dict(orient="records")
+        if self.site_masses is not None:
+            out["site_design_masses"] = self.site_masses.to_dict(orient="records")
+        if self.design_block is not None:
+            out["design_block"] = self.design_block.to_dict()
+        if self.sensitivity is not None:
+            out["design_energy_sensitivity"] = self.sensitivity.to_dict(orient="records")
+        if self.tornado is not None:
+            out["design_energy_tornado"] = self.tornado.to_dict()
+        if self.uni is None:
+            out["uni11211"] = {"design_return_period_years": self.design_T, "not_computed": self._uni_missing_reason()}
+        else:
+            out["uni11211"] = {"design_return_period_years": self.design_T,
+                               "characteristic_energy_kj": self.uni.characteristic_energy_kj,
+                               "design_energy_kj": self.uni.design_energy_kj,
+                               "design_velocity_ms": self.uni.design_velocity_ms, "factors": self.uni.factors}
+        return out
+
+    def write(self, out_dir) -> list[Path]:
+        """Write ``energy_summary.json``, the CSV tables (design energies, sensitivity, tornado) and the figures
+        into ``out_dir`` (which must exist); returns every file written.
+        """
+        from ..report.files import write_energy_figures
+        out = Path(out_dir)
+        written = [out / "energy_summary.json", out / "design_energies.csv"]
+        write_json(self.to_dict(), written[0])
+        self.design.to_csv(written[1], index=False)
+        tables = [("site_design_masses.csv", self.site_masses),
+                  ("design_energy_sensitivity.csv", self.sensitivity),
+                  ("design_energy_tornado.csv", None if self.tornado is None else self.tornado.table),
+                  ("design_block.csv", None if self.design_block is None else self.design_block.alternatives),
+                  ("fence_checks.csv", pd.concat([t.assign(fence=n) for n, t in self.fences.items()])
+                   if self.fences else None)]
+        for name, table in tables:
+            if table is not None:
+                table.to_csv(out / name, index=False)
+                written.append(out / name)
+        written += write_energy_figures(self, out, [float(n.split(" kJ")[0]) for n in self.fences])
+        return written
+
+def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_board_m: float = 0.5,
+                   T=DESIGN_RETURN_PERIODS, design_T: float = 100.0, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+                   n_bootstrap: int = 300, seed=1, uni_factors: dict | None = None, design_block=None,
+                   sensitivity: pd.DataFrame | None = None, tornado=None) -> EnergyAnalysis:
+    """Design table, fence checks (each capacity in ``fences`` at ``fence_height_m``: one height [m] for all, or
+    one per fence) and UNI 11211-4 energy.
+
+    ``design_block`` (a :class:`~riskrf.hazard.design_block.DesignBlock`): the UNI 11211-4 energy uses it (at the p95
+    speed of simulated blocks of its mass when the hazard is mass-coupled) instead of the T-year block, and each
+    fence gets an over-topping check by the block's top.  ``sensitivity``: a table from
+    :func:`design_energy_sensitivity`, carried into the outputs; ``tornado``: a :class:`DesignEnergyTornado`
+    (:func:`design_energy_tornado`), likewise."""
+    from ..core.validation import check_return_periods
+    try:
+        check_return_periods(design_T, "design_T")
+    except (TypeError, ValueError):
+        raise ValueError(f"design_T = {design_T!r}: the design return period must be a finite number > 1 year "
+                         "(a T-year event has annual probability 1/T)") from None
+    if not (np.isfinite(free_board_m) and free_board_m >= 0):
+        raise ValueError(f"free_board_m = {free_board_m!r} must be a finite number >= 0 m")
+    if any(not (np.isfinite(h) and h > 0) for h in np.atleast_1d(np.asarray(fence_height_m, dtype=float))):
+        raise ValueError(f"fence_height_m = {fence_height_m!r}: every height must be a finite number > 0 m")
+    T_all = np.union1d(np.asarray(T, dtype=float), [design_T])
+    table = hazard.design_table(T_all, n_bootstrap=n_bootstrap, seed=seed)
+    row = table.loc[table["T_years"] == design_T].iloc[0]
+    e_design = (float(row["energy_kj"]), float(row["ci_low_kj"]), float(row["ci_high_kj"]))
+    design = table.loc[table["T_years"].isin(np.asarray(T, dtype=float))].reset_index(drop=True)
+    heights = list(fence_height_m) if np.ndim(fence_height_m) else [fence_height_m] * len(fences)
+    if len(heights) != len(fences):
+        raise ValueError(f"fence_height_m = {fence_height_m!r}: give one height or one per fence ({len(fences)})")
+    checks = {f"{cap:g} kJ / {h:g} m": check_fence(hazard, cap, h, T=design_T, free_board_m=free_board_m,
+                                                    design_energy=e_design)
+              for cap, h in zip(fences, heights)}
+    checks = {name: _undefined_design_energy(table, hazard, design_T) for name, table in checks.items()}
+    if design_block is not None:
+        for (name, table), h in zip(checks.items(), heights):
+            checks[name] = pd.concat([table, _block_top_check(hazard, design_block, h, free_board_m)],
+                                     ignore_index=True)
+    uni = None
+    block = None
+    if design_block is not None:
+        block = design_block.mass_kg
+    elif isinstance(hazard.mass, GutenbergRichterFit) and design_T * hazard.rate_per_year > 1:
+        block = float(hazard.mass.isf(1.0 / (design_T * hazard.rate_per_year)))   # the T-year block at this line
+    if block is not None:
+        v95 = hazard.velocity_percentile(UNI11211_FACTORS["velocity_percentile"], mass_kg=block)
+        uni = uni11211_design_energy(block / density_kg_m3, density_kg_m3, v95, **(uni_factors or {}))
+    from .design_block import site_design_masses
+    site_masses = site_design_masses(hazard, DESIGN_RETURN_PERIODS, density_kg_m3)
+    return EnergyAnalysis(hazard=hazard, design=design, fences=checks, uni=uni, design_T=float(design_T),
+                          density_kg_m3=density_kg_m3, seed=seed, n_bootstrap=int(n_bootstrap),
+                          design_block=design_block, sensitivity=sensitivity, site_masses=site_masses,
+                          tornado=tornado)
+
+
+def _undefined_design_energy(table: pd.DataFrame, hazard, design_T: float) -> pd.DataFrame:
+    """Energy checks with no T-year energy: fewer than one fall reaches the line in T years.
+
+    The T-year energy is then not defined (``energy_at_return_period`` gives 0 kJ), so the MEL/SEL rows get
+    demand NaN (printed "N/A", never "OK" with 0 kJ) and a note giving the expected number of arrivals; the
+    annual frequency of impacts above MEL/SEL in the note remains the check.
+    """
+    expected = float(design_T) * float(hazard.arrival_rate)
+    if expected >= 1:
+        return table
+    t = table.copy()
+    rows = (t["unit"] == "kJ") & t["check"].str.startswith(f"{design_T:g}-year energy")
+    t.loc[rows, "demand"] = np.nan
+    t.loc[rows, "interval"] = ""
+    t.loc[rows, "note"] = (f"the {design_T:g}-year energy is not defined: fewer than one fall reaches the line in "
+                           f"{design_T:g} years ({sig(expected, 3)} expected at {sig(hazard.arrival_rate, 3)} "
+                           "arrivals per year); judge the fence by the frequency of impacts above its capacity: "
+                           + t.loc[rows, "note"])
+    return t
+
+
+def _block_top_check(hazard, block, height_m: float, free_board_m: float) -> pd.DataFrame:
+    """Over-topping by the design block's top: p95 centre height of blocks of its mass + its radius + free board
+    against the fence height [m]."""
+    vel = hazard.velocity
+    if hazard.mass_coupled:
+        h95, how = vel.height_percentile(95, block.mass_kg), "simulated blocks of its mass class"
+    elif hazard.heights_m is not None:
+        h95, how = float(hazard.height_percentile(95)), "all arriving blocks (mass-independent form)"
+    else:
+        return pd.DataFrame()
+    r = block.diameter_m / 2.0
+    demand = h95 + r + free_board_m
+    return pd.DataFrame([{"check": "design block top: p95 centre height + radius + free board vs height",
+                          "demand": demand, "capacity": float(height_m), "unit": "m", "interval": "",
+                          "adequate": bool(demand <= height_m),
+                          "note": f"design block {sig(block.mass_kg)} kg, diameter {sig(block.diameter_m)} m; p95 "
+                                  f"centre height {sig(h95)} m of {how}"}])
+
+
+def design_energy_sensitivity(hazard: EnergyHazard, masses_kg, duration_years: float, *, m_min: float,
+                              m_max_values, rate_shares, T: float = 100.0) -> pd.DataFrame:
+    """The T-year energy [kJ] over the judgement inputs: maximum credible block m_max [kg] x rate share [-].
+
+    For each m_max the power law is refitted to the inventory's masses (``masses_kg`` over ``duration_years``,
+    above ``m_min``) with that truncation; its rate is multiplied by each share; the slope model (the hazard's
+    simulated reach and speeds, by mass when mass-coupled) stays.  ``simulated`` says whether the m_max lies
+    inside the simulated masses (else its heaviest blocks borrow the top mass class's speeds).
+    """
+    rows = []
+    top = hazard.velocity.edges_kg[-1] if hazard.mass_coupled else None
+    for m_max in m_max_values:
+        gr = fit_gutenberg_richter(masses_kg, duration_years, m_min=m_min, m_max=m_max)
+        for share in rate_shares:
+            rate = gr.rate_min * float(share)
+            hz = hazard.with_mass(gr, rate)
+            e = float(hz.energy_at_return_period(T)) if T * hz.arrival_rate > 1 else 0.0
+            rows.append({"m_max_kg": m_max if m_max is not None else np.inf, "rate_share": float(share),
+                         "falls_per_year": rate, "b": gr.b, "T_years": float(T), "energy_kj": e,
+                         "simulated": bool(top is None or (m_max is not None and m_max <= top * (1 + 1e-9)))})
+    out = pd.DataFrame(rows)
+    return out
+
+
+def sensitivity_grid(table: pd.DataFrame) -> pd.DataFrame:
+    """The sensitivity table as a grid: m_max [kg] rows, rate share columns, T-year energy [kJ] values."""
+    g = table.pivot(index="m_max_kg", columns="rate_share", values="energy_kj")
+    g.index = [f"m_max {sig(v)} kg" if np.isfinite(v) else "m_max none" for v in g.index]
+    g.columns = [f"share {c:g}" for c in g.columns]
+    return g
+
+
+#: Default ranges of the one-way sensitivity where the user states none (typed, labelled in every output).
+TORNADO_DEFAULTS = {"m_max_factors": (0.5, 2.0), "rate_share_factors": (0.5, 2.0),
+                    "velocity_percentile_range": (90.0, 99.0), "fractal_dimension_step": 0.25,
+                    "iterations_step": 1}
+
+
+@dataclass(frozen=True)
+class DesignEnergyTornado:
+    """One-way sensitivity of the design energies: each input at its low and high value, the others at base.
+
+    Attributes
+    ----------
+    table : DataFrame, one row per (design energy, input): ``design_energy`` (which energy the row moves),
+        ``input``, ``unit`` (of low/base/high), ``low``, ``base``, ``high``, ``range_basis`` (where low and high
+        come from), ``energy_low_kj``, ``energy_base_kj``, ``energy_high_kj`` (the design energy with the input at
+        low, base and high) and ``swing_kj`` (|high - low|); rows of one design energy sorted by swing.
+    design_T : return period [yr] of the T-year energy
+    notes : what was left out and why
+    """
+
+    table: pd.DataFrame
+    design_T: float
+    notes: tuple = ()
+
+    def summary(self) -> pd.DataFrame:
+        """The tornado table: one row per input and design energy; low/high inputs and the energy [kJ] at each."""
+        return self.table
+
+    @property
+    def design_energies(self) -> list:
+        """The design energies studied, in order (the T-year energy at the line first)."""
+        return list(dict.fromkeys(self.table["design_energy"]))
+
+    def dominant(self) -> pd.DataFrame:
+        """Per design energy: the input with the largest swing [kJ], its low-high energies and its share of the
+        sum of swings."""
+        rows = []
+        for name in self.design_energies:
+            sub = self.table[self.table["design_energy"] == name]
+            if not np.isfinite(sub["swing_kj"]).any():
+                continue
+            r = sub.loc[sub["swing_kj"].idxmax()]
+            total = float(np.nansum(sub["swing_kj"]))
+            rows.append({"design_energy": name, "input": r["input"], "energy_base_kj": r["energy_base_kj"],
+                         "energy_low_kj": r["energy_low_kj"], "energy_high_kj": r["energy_high_kj"],
+                         "swing_kj": r["swing_kj"], "share_of_swings": r["swing_kj"] / total if total > 0 else np.nan})
+        return pd.DataFrame(rows)
+
+    def text(self) -> str:
+        """The table for a terminal, numbers by :func:`sig`."""
+        lines = []
+        for name in self.design_energies:
+            sub = self.table[self.table["design_energy"] == name]
+            lines.append(f"  {name} (base {sig(sub['energy_base_kj'].iloc[0], 4)} kJ):")
+            for _, r in sub.iterrows():
+                lines.append(f"    {r['input']:<52s} {_value(r['low'], r['unit']):>12s} -> "
+                             f"{sig(r['energy_low_kj'], 4):>9s} kJ"
+                             f"   {_value(r['high'], r['unit']):>12s} -> {sig(r['energy_high_kj'], 4):>9s} kJ"
+                             f"   swing {sig(r['swing_kj'], 3)} kJ   [{r['range_basis']}]")
+        lines += [f"  note: {n}" for n in self.notes]
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        """The tornado as a JSON-ready dict: design return period [yr], rows, dominant inputs and notes."""
+        return {"design_T_years": self.design_T, "rows": self.table.to_dict(orient="records"),
+                "dominant": self.dominant().to_dict(orient="records"), "notes": list(self.notes)}
+
+
+#: Unit label of a dimensionless input in the tornado table.
+NO_UNIT = "dimensionless"
+
+
+def _value(v, unit) -> str:
+    return f"{sig(v, 4)} {unit}".strip() if unit not in (NO_UNIT, "") else sig(v, 4)
+
+
+def _pair(values, name, check):
+    """(low, high) of a range argument, each checked by ``check(value, f"{name}[i]")``."""
+    try:
+        lo, hi = values
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} = {values!r} must be a pair (low, high)") from None
+    return check(lo, f"{name}[0]"), check(hi, f"{name}[1]")
+
+
+def _positive(v, name) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(v) and v > 0):
+        raise ValueError(f"{name} = {v!r} must be a finite number > 0")
+    return float(v)
+
+
+def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, block=None, masses_kg=None,
+                          duration_years: float | None = None, m_max_range=None, rate_share: float = 1.0,
+                          rate_share_range=None, velocity_percentile: float | None = None,
+                          velocity_percentile_range=None, fractal_dimension_range=None, iterations_range=None,
+                          sensitivity: pd.DataFrame | None = None,
+                          rate_label: str = "rate share of the source above the line") -> DesignEnergyTornado:
+    """One-way sensitivity (tornado) of the design energies [kJ] to the judgement and uncertain inputs.
+
+    Design energies (each row says which one it moves):
+
+    * the T-year energy at the barrier line, ``hazard.energy_at_return_period(design_T)``;
+    * the design-block energy 1/2 m v_p^2 of ``block`` (:class:`~riskrf.hazard.design_block.DesignBlock`), v_p the
+      ``velocity_percentile`` speed (default the UNI 11211-4 95th) of blocks of its mass at the line;
+    * when fragmentation parameters are stated but another rule chose the block: the fragmentation
+      alternative's energy 1/2 m v_p^2, its own output.
+
+    Inputs, each at low and high with the others at base; every row is a re-evaluation of the same simulated
+    slope (:meth:`EnergyHazard.with_mass`), nothing is re-simulated:
+
+    * maximum credible block m_max [kg] (``m_max_range``; default x0.5 and x2 of the law's): the power law refitted
+      to ``masses_kg`` over ``duration_years`` with that truncation (as :func:`design_energy_sensitivity`), or,
+      without the masses, re-truncated with b kept;
+    * rate share [-] (``rate_share_range`` around ``rate_share``; default x0.5 and x2): the rate scaled (its row is
+      named ``rate_label``: a rate from a rate model makes it a factor on the inventory's rate, not a share);
+    * power-law exponent b [-] at the ends of the fit's interval ``hazard.mass.b_ci``: the law re-scaled with b
+      fixed, the rate of falls above m_min kept;
+    * fractal dimension D [-] and fragmentation generations (``fractal_dimension_range``, ``iterations_range``;
+      default D +- 0.25, generations +- 1, typed): only when the block's fragmentation parameters are stated;
+    * the velocity percentile [%] of the design-block energy (``velocity_percentile_range``, default 90 and 99).
+
+    An input enters a row only where it enters that design energy: the velocity percentile does not enter the
+    T-year energy (which integrates over every speed), and the law's inputs do not move a percentile block taken
+    from a survey.  ``sensitivity``: a :func:`design_energy_sensitivity` table whose T-year energies at
+    (m_max, rate share) are reused instead of recomputed.
+    """
+    from .barriers import UNI11211_FACTORS
+    from .design_block import check_percentile, design_block as _design_block, fractal_fragments
+    from ..core.validation import check_return_periods
+    try:
+        T = float(check_return_periods(design_T, "design_T"))
+    except (TypeError, ValueError):
+        raise ValueError(f"design_T = {design_T!r}: the design return period must be a finite number > 1 year") \
+            from None
+    share = _positive(rate_share, "rate_share")
+    s_lo, s_hi = (_pair(rate_share_range, "rate_share_range", _positive) if rate_share_range is not None
+                  else tuple(share * f for f in TORNADO_DEFAULTS["rate_share_factors"]))
+    q = check_percentile(UNI11211_FACTORS["velocity_percentile"] if velocity_percentile is None
+                         else velocity_percentile, "velocity_percentile")
+    q_range = velocity_percentile_range if velocity_percentile_range is not None \
+        else TORNADO_DEFAULTS["velocity_percentile_range"]
+    q_lo, q_hi = _pair(q_range, "velocity_percentile_range", check_percentile)
+    gr = hazard.mass if isinstance(hazard.mass, GutenbergRichterFit) else None
+    m_max = getattr(gr, "m_max", None)
+    masses = None
+    if masses_kg is not None:
+        masses = np.asarray(masses_kg, dtype=float)
+        duration_years = _positive(duration_years, "duration_years")
+    mm_lo = mm_hi = None
+    if m_max_range is not None:
+        mm_lo, mm_hi = _pair(m_max_range, "m_max_range", _positive)
+        if masses is not None:
+            for i, v in enumerate((mm_lo, mm_hi)):
+                if v < masses.max():
+                    raise ValueError(f"m_max_range[{i}] = {v:g} kg is below the largest recorded mass "
+                                     f"{masses.max():g} kg: a maximum credible block cannot be smaller")
+    elif m_max:
+        mm_lo, mm_hi = (m_max * f for f in TORNADO_DEFAULTS["m_max_factors"])
+        if masses is not None:
+            mm_lo = max(mm_lo, float(masses.max()))
+    inputs = dict(block.inputs) if block is not None else {}
+    D, n_gen = inputs.get("fractal_dimension"), inputs.get("iterations")
+    fragmenting = D is not None and n_gen is not None
+    d_lo = d_hi = g_lo = g_hi = None
+    if fragmenting:
+        if fractal_dimension_range is not None:
+            d_lo, d_hi = _pair(fractal_dimension_range, "fractal_dimension_range", _positive)
+        else:
+            step = TORNADO_DEFAULTS["fractal_dimension_step"]
+            d_lo, d_hi = (D - step if D - step > 0 else D / 2), (D + step if D + step < 3 else (D + 3) / 2)
+        for i, v in enumerate((d_lo, d_hi)):
+            if not 0 < v < 3:
+                raise ValueError(f"fractal_dimension_range[{i}] = {v!r} must lie strictly between 0 and 3")
+        if iterations_range is not None:
+            g_lo, g_hi = iterations_range
+        else:
+            g_lo, g_hi = max(1, n_gen - TORNADO_DEFAULTS["iterations_step"]), \
+                min(12, n_gen + TORNADO_DEFAULTS["iterations_step"])
+        for i, v in enumerate((g_lo, g_hi)):
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 1 <= v <= 12:
+                raise ValueError(f"iterations_range[{i}] = {v!r} must be a whole number of generations from 1 to 12")
+        fractal_fragments(1.0, d_lo, int(g_lo))
+        fractal_fragments(1.0, d_hi, int(g_hi))
+
+    notes = []
+
+    def t_energy(hz, key=None):
+        if key is not None and sensitivity is not None:
+            hit = sensitivity[np.isclose(sensitivity["m_max_kg"], key[0] if key[0] is not None else np.inf,
+                                         rtol=1e-9) & np.isclose(sensitivity["rate_share"], key[1], rtol=1e-9)
+                              & np.isclose(sensitivity["T_years"], T)]
+            if len(hit) == 1:
+                return float(hit["energy_kj"].iloc[0])
+        return float(hz.energy_at_return_period(T)) if T * hz.arrival_rate > 1 else 0.0
+
+    def block_masses(hz, **change):
+        """(chosen block, fragmentation alternative) masses [kg] under hazard ``hz`` with changed rule inputs."""
+        if block is None:
+            return np.nan, np.nan
+        if not change and hz is hazard:
+            alt = block.alternatives
+        else:
+            try:
+                alt = _design_block(hz, **{**inputs, **change}).alternatives
+            except ValueError as exc:
+                notes.append(f"design block undefined with {change or 'the changed law'}: {exc}")
+                return np.nan, np.nan
+        frag = alt.loc[alt["rule"].str.startswith("fragmentation"), "mass_kg"]
+        return float(alt.loc[alt["chosen"], "mass_kg"].iloc[0]), float(frag.iloc[0]) if len(frag) else np.nan
+
+    def block_energy(hz, m, pct):
+        if not np.isfinite(m):
+            return np.nan
+        return kinetic_energy_kj(m, hz.velocity_percentile(pct, mass_kg=m))
+
+    # ---- the perturbed hazards (cheap: the same simulated slope, another mass law or rate) -----------------
+    cases = {}                      # input -> (unit, low, base, high, basis, hz_low, hz_high, change_low, change_high)
+    if mm_lo is not None:
+        if masses is not None:
+            def law(v):
+                return fit_gutenberg_richter(masses, duration_years, m_min=gr.m_min, m_max=v)
+            how = "law refitted to the inventory with each m_max"
+        else:
+            def law(v):
+                return replace(gr, m_max=float(v))
+            how = "law re-truncated, b kept"
+        basis = ("given" if m_max_range is not None else "typed: x0.5 and x2 of the stated m_max (ASSUMPTION)") \
+            + f"; {how}"
+        cases["maximum credible block m_max"] = ("kg", mm_lo, m_max, mm_hi, basis,
+                                                 hazard.with_mass(law(mm_lo), hazard.rate_per_year),
+                                                 hazard.with_mass(law(mm_hi), hazard.rate_per_year),
+                                                 (mm_lo, share), (mm_hi, share))
+    elif gr is not None:
+        notes.append("m_max: the law is not truncated (no maximum credible block stated); no m_max row")
+    cases[rate_label] = (
+        NO_UNIT, s_lo, share, s_hi, "given" if rate_share_range is not None else "typed: x0.5 and x2 (ASSUMPTION)",
+        hazard.with_mass(hazard.mass, hazard.rate_per_year * s_lo / share),
+        hazard.with_mass(hazard.mass, hazard.rate_per_year * s_hi / share), (m_max, s_lo), (m_max, s_hi))
+    if gr is not None:
+        b_lo, b_hi = gr.b_ci
+
+        def with_b(b):
+            law = replace(gr, b=float(b), a=float(np.log10(gr.rate_min) + b * np.log10(gr.m_min)))
+            return hazard.with_mass(law, hazard.rate_per_year)
+        cases["power-law exponent b"] = (NO_UNIT, b_lo, gr.b, b_hi,
+                                         f"{gr.level:.0%} interval of the fit ({gr.b_ci_method}); rate at m_min kept",
+                                         with_b(b_lo), with_b(b_hi), None, None)
+    else:
+        notes.append("b: the mass model is not a power-law fit; no b row")
+
+    t_name = f"{T:g}-year energy at the barrier line"
+    rule = inputs.get("rule")
+    b_name = f"design-block energy 1/2 m v_p{q:g}^2 ({rule} rule)" if block is not None else None
+    f_name = (f"fragmentation alternative 1/2 m v_p{q:g}^2 (not the chosen block)"
+              if fragmenting and rule != "fragmentation" else None)
+    base_t = t_energy(hazard, (m_max, share))
+    base_chosen, base_frag = block_masses(hazard)
+    base_b, base_f = block_energy(hazard, base_chosen, q), block_energy(hazard, base_frag, q)
+    rows = []
+
+    def add(output, name, unit, lo, base, hi, basis, e_lo, e_base, e_hi):
+        rows.append({"design_energy": output, "input": name, "unit": unit, "low": lo, "base": base, "high": hi,
+                     "range_basis": basis, "energy_low_kj": e_lo, "energy_base_kj": e_base, "energy_high_kj": e_hi,
+                     "swing_kj": abs(e_hi - e_lo)})
+
+    law_moves_block = rule in ("return_period", "fragmentation")
+    for name, (unit, lo, base, hi, basis, hz_lo, hz_hi, key_lo, key_hi) in cases.items():
+        label = f"{name} [{unit}]" if unit != NO_UNIT else name
+        add(t_name, label, unit, lo, base, hi, basis, t_energy(hz_lo, key_lo), base_t, t_energy(hz_hi, key_hi))
+        if b_name and law_moves_block or f_name:
+            (c_lo, fr_lo), (c_hi, fr_hi) = block_masses(hz_lo), block_masses(hz_hi)
+            if b_name and law_moves_block:
+                add(b_name, label, unit, lo, base, hi, basis, block_energy(hz_lo, c_lo, q), base_b,
+                    block_energy(hz_hi, c_hi, q))
+            if f_name:
+                add(f_name, label, unit, lo, base, hi, basis, block_energy(hz_lo, fr_lo, q), base_f,
+                    block_energy(hz_hi, fr_hi, q))
+    if block is not None:
+        basis = "given" if velocity_percentile_range is not None else "typed: p90 and p99 (ASSUMPTION)"
+        label = "velocity percentile of the block energy [%]"
+        add(b_name, label, "%", q_lo, q, q_hi, basis, block_energy(hazard, base_chosen, q_lo), base_b,
+            block_energy(hazard, base_chosen, q_hi))
+        if f_name:
+            add(f_name, label, "%", q_lo, q, q_hi, basis, block_energy(hazard, base_frag, q_lo), base_f,
+                block_energy(hazard, base_frag, q_hi))
+    else:
+        notes.append("no design block given: only the T-year energy is studied")
+    if fragmenting:
+        basis_d = "given" if fractal_dimension_range is not None else "typed: stated D +- 0.25 (ASSUMPTION)"
+        basis_g = "given" if iterations_range is not None else "typed: stated generations +- 1 (ASSUMPTION)"
+        for name, unit, lo, base, hi, basis, key in (
+                ("fractal dimension D", NO_UNIT, d_lo, D, d_hi, basis_d, "fractal_dimension"),
+                ("fragmentation generations", NO_UNIT, g_lo, n_gen, g_hi, basis_g, "iterations")):
+            (c_lo, fr_lo), (c_hi, fr_hi) = block_masses(hazard, **{key: lo}), block_masses(hazard, **{key: hi})
+            if rule == "fragmentation":
+                add(b_name, name, unit, lo, base, hi, basis, block_energy(hazard, c_lo, q), base_b,
+                    block_energy(hazard, c_hi, q))
+            else:
+                add(f_name, name, unit, lo, base, hi, basis, block_energy(hazard, fr_lo, q), base_f,
+                    block_energy(hazard, fr_hi, q))
+    elif block is not None:
+        notes.append("fragmentation not configured: no fractal-dimension or generations rows")
+    if block is not None and not law_moves_block:
+        notes.append(f"the {rule} design block is taken from the block sizes, not the law: m_max, the rate share "
+                     "and b do not move it")
+    table = pd.DataFrame(rows)
+    order = {name: i for i, name in enumerate(n for n in (t_name, b_name, f_name) if n)}
+    table = (table.assign(_o=table["design_energy"].map(order), _s=-table["swing_kj"].fillna(-1))
+             .sort_values(["_o", "_s"], kind="stable").drop(columns=["_o", "_s"]).reset_index(drop=True))
+    return DesignEnergyTornado(table=table, design_T=T, notes=tuple(dict.fromkeys(notes)))
+
+
+__all__ = ["DesignEnergyTornado", "EnergyAnalysis", "INTERVAL_COVERS", "TORNADO_DEFAULTS", "analyse_energy",
+           "design_energy_sensitivity", "design_energy_tornado", "sensitivity_grid"]

@@ -1,0 +1,425 @@
+"""Impact energy of one fall: combining a mass model with a velocity model (Wyllie 2014, 8.1-8.3).
+
+    P(E > e) = integral f_V(v) P(M > 2000 e / v^2) dv,     E = 1/2 m v^2 / 1000  [kJ]
+
+(plus the rotational energy 1/2 I w^2, I = k m r^2 with k = 2/5 for a sphere by default or the
+``inertia_factor`` given (1/2 for a cylinder or disc), r from m and the density, when angular
+velocities are given with velocity samples).
+
+Mass models: a fitted power law (:class:`~riskrf.GutenbergRichterFit`, the truncated
+law between m_min and m_max), a Gumbel/GEV fit of annual maxima (then E is the
+energy of the year's largest block), any scipy frozen distribution, or an array of
+masses (empirical).  Velocity models: a scipy frozen distribution, an array of
+samples (a simulator collector, or a RocFall/RAMMS export), a :class:`VelocityFit`
+(parametric model chosen by AIC), :class:`PairedSamples` (velocity samples with
+the mass of each block, to condition on mass), or
+:class:`~riskrf.hazard.mass_coupling.MassCoupledSamples` (blocks simulated across the
+mass range: reach and speed both depend on mass; P(E > e) is then per arriving fall).
+
+The default ``method="quad"`` integrates in log space: Gauss-Legendre panels on
+ln v for a parametric velocity, an exact average over velocity samples, or
+panels on ln P(M > m) when conditioning on mass.  Panels are split where the
+integrand has a kink (the energy at which a given speed needs exactly m_min or
+m_max of a truncated power law).  With a parametric velocity it is accurate to
+about 1e-6 relative down to probabilities of 1e-8: tested against the exact
+lognormal case and the exact truncated-power-law x lognormal-velocity case
+(measured 1e-9 or better there; 2e-5 before the split).  It takes a fraction of
+a millisecond per energy.  ``method="mc"`` samples instead, for cross-checks.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy import optimize, stats
+
+from ..frequency.extremes import _AnnualMaximumFit
+from .mass_coupling import MassCoupledSamples
+from ..frequency.power_law import GutenbergRichterFit
+from ..report.format import sig
+from ..core.units import DEFAULT_DENSITY_KG_M3, J_PER_KJ, SPHERE_INERTIA, kinetic_energy_kj, mass_for_energy_kg
+from ..core.validation import check_choice, check_positive
+
+_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
+
+
+# ---------------------------------------------------------------- velocity models
+@dataclass(frozen=True)
+class VelocityFit:
+    """A parametric velocity model chosen among candidates by AIC.
+
+    ``name`` is the chosen family, ``dist`` the frozen scipy distribution,
+    ``table`` the AIC and Kolmogorov-Smirnov statistic of every candidate.
+    """
+
+    name: str
+    dist: object
+    table: pd.DataFrame
+    n: int
+
+    def summary(self) -> pd.DataFrame:
+        """The candidate table: distribution, parameters, log-likelihood, AIC and whether it was chosen."""
+        return self.table
+
+
+def fit_velocity(samples, candidates=("normal", "lognormal", "gamma", "weibull")) -> VelocityFit:
+    """Fit candidate distributions to velocity samples [m/s] by maximum likelihood and keep the lowest AIC.
+
+    The table reports for each candidate its parameters, log-likelihood, AIC,
+    ΔAIC and the KS distance and p-value (the p-value is optimistic because the
+    parameters were fitted to the same data).
+    """
+    v = _positive_samples(samples, "velocity")
+    families = {"normal": stats.norm, "lognormal": stats.lognorm, "gamma": stats.gamma,
+                "weibull": stats.weibull_min}
+    rows, fitted = [], {}
+    for name in candidates:
+        check_choice(name, "candidates", tuple(families))
+        fam = families[name]
+        params = fam.fit(v) if name == "normal" else fam.fit(v, floc=0)
+        dist = fam(*params)
+        ll = float(np.sum(dist.logpdf(v)))
+        k = len(params) - (0 if name == "normal" else 1)
+        ks = stats.kstest(v, dist.cdf)
+        fitted[name] = dist
+        rows.append({"model": name, "params": tuple(round(float(p), 6) for p in params), "loglik": ll,
+                     "aic": 2 * k - 2 * ll, "ks_distance": ks.statistic, "ks_p_value": ks.pvalue})
+    table = pd.DataFrame(rows).set_index("model").sort_values("aic")
+    table["delta_aic"] = table["aic"] - table["aic"].min()
+    best = table.index[0]
+    return VelocityFit(name=best, dist=fitted[best], table=table, n=v.size)
+
+
+@dataclass(frozen=True)
+class PairedSamples:
+    """Velocity samples [m/s] with the mass [kg] of each block, to condition velocity on mass.
+
+    Use when velocity depends on block size (roughness scaled by radius,
+    rotation).  The exceedance probability then averages, over the mass model,
+    the conditional exceedance of the blocks of similar mass (``n_bins``
+    mass classes of equal counts).
+    """
+
+    velocity_ms: np.ndarray
+    mass_kg: np.ndarray
+    n_bins: int = 10
+
+    @classmethod
+    def from_collector(cls, df: pd.DataFrame, n_bins: int = 10) -> "PairedSamples":
+        """Paired samples from a collector table (columns ``velocity_ms`` [m/s] and ``mass_kg`` [kg], e.g.
+        :meth:`simulation.SimulationResult.collector`), in ``n_bins`` mass classes.
+        """
+        return cls(np.asarray(df["velocity_ms"], dtype=float), np.asarray(df["mass_kg"], dtype=float), n_bins)
+
+    def classes(self):
+        """Mass classes of equal counts (at most ``n_bins``, at least 20 blocks each): the class edges [kg]
+        (geometric means of neighbouring masses) and the sorted speeds [m/s] of each class.
+        """
+        order = np.argsort(self.mass_kg)
+        groups = np.array_split(order, min(self.n_bins, max(1, self.mass_kg.size // 20)))
+        edges = [np.sqrt(self.mass_kg[g[-1]] * self.mass_kg[h[0]]) for g, h in zip(groups[:-1], groups[1:])]
+        return np.array(edges), [np.sort(self.velocity_ms[g]) for g in groups]
+
+
+def _positive_samples(values, name):
+    arr = np.asarray(values, dtype=float).ravel()
+    if arr.size == 0:
+        raise ValueError(f"{name} samples are empty")
+    bad = ~np.isfinite(arr) | (arr < 0)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(f"{name} sample [{i}] = {float(arr[i])!r}: samples must be finite and >= 0")
+    return arr
+
+
+# ---------------------------------------------------------------- mass models
+@dataclass(frozen=True)
+class _MassModel:
+    sf: object           # callable m [kg] -> P(M > m)
+    isf: object          # callable p -> m
+    rvs: object          # callable (n, rng) -> masses
+    description: str
+    support: tuple
+
+
+def mass_model(mass) -> _MassModel:
+    """Wrap any accepted mass description in a uniform interface (sf, isf, rvs)."""
+    if isinstance(mass, GutenbergRichterFit):
+        if mass.units != "kg":
+            raise ValueError(f"the power-law fit is in {mass.units!r}; convert it with .to_mass(density) first")
+        return _MassModel(mass.sf, mass.isf, lambda n, rng: mass.rvs(n, rng),
+                          f"power law b = {sig(mass.b)} above {sig(mass.m_min)} kg"
+                          + (f", truncated at {sig(mass.m_max)} kg" if mass.m_max else ""), mass.support)
+    if isinstance(mass, _AnnualMaximumFit):
+        d = mass.dist
+        lo = float(d.ppf(1e-12))
+        if lo <= 0:
+            # Annual-maximum laws fitted to masses can put a little probability below zero: condition on m > 0.
+            p0 = float(d.cdf(0.0))
+            return _MassModel(lambda m: np.minimum(d.sf(np.maximum(m, 0.0)) / (1 - p0), 1.0),
+                              lambda p: d.isf(np.asarray(p) * (1 - p0)),
+                              lambda n, rng: d.isf(rng.uniform(size=n) * (1 - p0)),
+                              f"{type(mass).__name__[:-3]} annual maximum (conditioned on m > 0)", (0.0, np.inf))
+        return _MassModel(d.sf, d.isf, lambda n, rng: d.rvs(size=n, random_state=rng),
+                          f"{type(mass).__name__[:-3]} annual maximum", (lo, float(d.isf(1e-12))))
+    if hasattr(mass, "sf") and hasattr(mass, "isf") and hasattr(mass, "rvs"):
+        lo = float(mass.ppf(0.0)) if hasattr(mass, "ppf") else 0.0
+        if not np.isfinite(lo) or lo < 0:
+            raise ValueError(f"mass model {getattr(mass.dist, 'name', mass)!r} has support reaching {lo:g} kg: "
+                             "masses must be positive; use a positive distribution (lognormal, gamma, ...) or "
+                             "truncate it")
+        return _MassModel(mass.sf, mass.isf, lambda n, rng: mass.rvs(size=n, random_state=rng),
+                          f"scipy {getattr(getattr(mass, 'dist', None), 'name', 'distribution')}",
+                          (lo, float(mass.isf(0.0))))
+    m = np.sort(_positive_samples(mass, "mass"))
+    if np.any(m <= 0):
+        raise ValueError(f"mass samples must be > 0; found {int(np.sum(m <= 0))} zero masses")
+
+    def sf(x):
+        return 1.0 - np.searchsorted(m, x, side="right") / m.size
+
+    def isf(p):
+        return np.quantile(m, 1.0 - np.asarray(p), method="inverted_cdf")
+    return _MassModel(sf, isf, lambda n, rng: rng.choice(m, size=n), f"empirical ({m.size:,} masses)",
+                      (float(m[0]), float(m[-1])))
+
+
+def _threshold_mass(e_kj, v, w, density, inertia_factor=SPHERE_INERTIA):
+    """Mass m with 1/2 m v^2 + 1/2 k m r(m)^2 w^2 = J_PER_KJ e, r = (3m / 4 pi rho)^(1/3); vectorised.
+
+    ``k = inertia_factor`` (I / (m r^2): 2/5 sphere, 1/2 cylinder or disc); r is the radius of the
+    sphere of the same mass and density (the equivalent radius).
+    """
+    m = mass_for_energy_kg(e_kj, v)
+    if w is None:
+        return m
+    c = 0.5 * inertia_factor * (3.0 / (4.0 * np.pi * density)) ** (2.0 / 3.0) * w * w   # J per kg^(5/3)
+    target = J_PER_KJ * e_kj
+    lo = np.full(np.broadcast(e_kj, v).shape, -700.0)
+    hi = np.log(np.maximum(m, 1e-300)) + 1.0
+    for _ in range(80):      # bisection on ln m; the energy is increasing in m
+        mid = 0.5 * (lo + hi)
+        mm = np.exp(mid)
+        f = 0.5 * mm * v * v + c * mm ** (5.0 / 3.0) - target
+        lo = np.where(f < 0, mid, lo)
+        hi = np.where(f < 0, hi, mid)
+    return np.exp(0.5 * (lo + hi))
+
+
+def _check_energies(energy_kj):
+    e = np.asarray(energy_kj, dtype=float)
+    bad = ~np.isfinite(e) | (e < 0)
+    if bad.any():
+        raise ValueError(f"energy_kj = {float(e[bad].ravel()[0])!r}: energies must be finite and >= 0 kJ")
+    return e
+
+
+def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+                           inertia_factor: float = SPHERE_INERTIA, method: str = "quad", n_samples: int = 1_000_000,
+                           seed=None):
+    """P(E > e) for one fall: the probability that its impact energy exceeds ``energy_kj``.
+
+    Parameters
+    ----------
+    energy_kj : float or array
+        Energies [kJ], finite and >= 0.
+    mass : GutenbergRichterFit, GumbelFit, GEVFit, scipy frozen distribution or array
+        Mass model [kg] (see module notes).
+    velocity : scipy frozen distribution, array, VelocityFit or PairedSamples
+        Velocity model [m/s] at the barrier line.
+    angular_velocity : array, optional
+        Angular velocities [rad/s] paired with velocity samples; adds the rotational energy
+        1/2 k m r^2 w^2 (I = k m r^2), with r [m] the radius of the sphere
+        of the same mass and density ``density_kg_m3`` [kg/m^3].
+    density_kg_m3 : float
+        Rock density [kg/m^3] giving the radius from the mass (only with ``angular_velocity``).
+    inertia_factor : float
+        k = I / (m r^2) of the block shape (only with ``angular_velocity``): the sphere's 2/5
+        by default; ``riskrf.core.units.INERTIA_FACTORS`` has the cylinder/disc's 1/2.
+    method : {"quad", "mc"}
+        Numerical integration (default) or Monte Carlo with ``n_samples`` draws.
+    n_samples, seed
+        Draws and seed of ``method="mc"``.
+    """
+    e = _check_energies(energy_kj)
+    check_choice(method, "method", ("quad", "mc"))
+    inertia_factor = check_positive(inertia_factor, "inertia_factor")
+    if method == "mc":
+        return exceedance_probability_mc(e, mass, velocity, angular_velocity=angular_velocity,
+                                         density_kg_m3=density_kg_m3, inertia_factor=inertia_factor,
+                                         n_samples=n_samples, seed=seed)[0]
+    mm = mass_model(mass)
+    if isinstance(velocity, VelocityFit):
+        velocity = velocity.dist
+    if isinstance(velocity, PairedSamples):
+        return _conditional_on_mass(e, mm, velocity)
+    if isinstance(velocity, MassCoupledSamples):
+        # per arriving fall: P(E > e, reach) / P(reach), both integrated over the mass model
+        return velocity.exceedance_function(mm)(e)
+    if hasattr(velocity, "pdf") and hasattr(velocity, "isf"):
+        if angular_velocity is not None:
+            raise ValueError("angular_velocity needs velocity samples paired with it, not a distribution")
+        return _integrate_velocity_dist(e, mm, velocity)
+    v = _positive_samples(velocity, "velocity")
+    w = None
+    if angular_velocity is not None:
+        w = np.asarray(angular_velocity, dtype=float).ravel()
+        if w.size != v.size:
+            raise ValueError(f"angular_velocity has {w.size} values but velocity has {v.size}: they must be paired")
+    out = np.empty(e.size)
+    for i, ei in enumerate(e.ravel()):
+        out[i] = np.mean(mm.sf(_threshold_mass(ei, v, w, density_kg_m3, inertia_factor)))
+    return out.reshape(e.shape)
+
+
+def exceedance_function(mass, velocity):
+    """e [kJ] -> P(E > e) for one fall, with whatever does not depend on e prepared once.
+
+    The same values as :func:`exceedance_probability` (default quadrature); use it where one
+    curve is evaluated many times (root finding for design energies).
+    """
+    if isinstance(velocity, MassCoupledSamples):
+        return velocity.exceedance_function(mass_model(mass))
+    return lambda energy_kj: exceedance_probability(energy_kj, mass, velocity)
+
+
+def _integrate_velocity_dist(e, mm, vdist):
+    p_pos = float(vdist.sf(0.0))
+    if p_pos <= 0:
+        raise ValueError(f"velocity model {getattr(getattr(vdist, 'dist', None), 'name', vdist)!r} puts no "
+                         "probability on positive speeds")
+    lo = max(float(vdist.ppf(max(1e-15, 1 - p_pos + 1e-15))), 1e-6)
+    hi = float(vdist.isf(1e-17))
+    if not np.isfinite(hi):
+        hi = float(vdist.isf(1e-12))
+    edges = np.linspace(np.log(lo), np.log(hi), 513)
+    v, dens = _gl_panels(edges, vdist, p_pos)
+    dens = dens.reshape(512, -1)
+    v = v.reshape(512, -1)
+    # P(M > 2000 e / v^2) has a kink where 2000 e / v^2 crosses an end of the mass model's support
+    # (m_min and m_max of a truncated power law): a Gauss-Legendre panel straddling it converges
+    # only slowly (1e-5 relative error measured), so such a panel is split at the kink.
+    ends = np.array([m for m in mm.support if np.isfinite(m) and m > 0], dtype=float)
+    out = np.empty(e.size)
+    for i, ei in enumerate(e.ravel()):
+        total = np.sum(dens * mm.sf(mass_for_energy_kg(ei, v)), axis=1)
+        if ends.size and ei > 0:
+            kinks = 0.5 * np.log(2.0 * J_PER_KJ * ei / ends)
+            kinks = kinks[(kinks > edges[0]) & (kinks < edges[-1])]
+            for j in np.unique(np.searchsorted(edges, kinks) - 1):
+                sub = np.union1d(edges[j:j + 2], kinks)
+                sub = sub[(sub >= edges[j]) & (sub <= edges[j + 1])]
+                vs, ds = _gl_panels(sub, vdist, p_pos)
+                total[j] = np.sum(ds * mm.sf(mass_for_energy_kg(ei, vs)))
+        out[i] = np.sum(total)
+    return np.clip(out, 0.0, 1.0).reshape(e.shape)
+
+
+def _gl_panels(edges, vdist, p_pos):
+    """Nodes v [m/s] and weights f_V(v) v dw / P(V > 0) of 8-point Gauss-Legendre panels on ln v."""
+    half = 0.5 * np.diff(edges)
+    mid = 0.5 * (edges[:-1] + edges[1:])
+    u = (mid[:, None] + half[:, None] * _GL_NODES[None, :]).ravel()
+    wts = (half[:, None] * _GL_WEIGHTS[None, :]).ravel()
+    v = np.exp(u)
+    return v, vdist.pdf(v) * v * wts / p_pos
+
+
+def _conditional_on_mass(e, mm, paired: PairedSamples):
+    """Integrate over ln P(M > m): P = int_0^1 P(V > sqrt(2000 e / m(p)) | m(p)) dp."""
+    edges_m, vel = paired.classes()
+    lp = np.linspace(np.log(1e-14), 0.0, 257)
+    half = 0.5 * np.diff(lp)
+    mid = 0.5 * (lp[:-1] + lp[1:])
+    u = (mid[:, None] + half[:, None] * _GL_NODES[None, :]).ravel()
+    p = np.exp(u)
+    wts = (half[:, None] * _GL_WEIGHTS[None, :]).ravel() * p
+    m = mm.isf(p)
+    cls = np.searchsorted(edges_m, m)
+    out = np.empty(e.size)
+    for i, ei in enumerate(e.ravel()):
+        vstar = np.sqrt(2.0 * J_PER_KJ * ei / np.maximum(m, 1e-300))
+        cond = np.empty(m.size)
+        for c, vs in enumerate(vel):
+            sel = cls == c
+            cond[sel] = 1.0 - np.searchsorted(vs, vstar[sel], side="right") / vs.size
+        out[i] = np.sum(wts * cond) + 1e-14 * cond[0]
+    return np.clip(out, 0.0, 1.0).reshape(e.shape)
+
+
+def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=None, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+                              inertia_factor: float = SPHERE_INERTIA, n_samples: int = 1_000_000, seed=None,
+                              level: float = 0.95):
+    """Monte Carlo estimate of P(E > e) with its Wilson interval: (p, lower, upper) arrays.
+
+    Same models and arguments as :func:`exceedance_probability` (``inertia_factor`` k = I / (m r^2),
+    the sphere's 2/5 by default); ``n_samples`` draws with ``seed``; the interval is the Wilson
+    score interval at ``level``.
+    """
+    from simulation.result import wilson_interval
+
+    e = _check_energies(energy_kj)
+    rng = np.random.default_rng(seed)
+    mm = mass_model(mass)
+    m = mm.rvs(n_samples, rng)
+    w = None
+    if isinstance(velocity, VelocityFit):
+        velocity = velocity.dist
+    if isinstance(velocity, MassCoupledSamples):
+        cls = velocity.class_of(m)
+        members = [np.flatnonzero(velocity.class_of(velocity.mass_kg) == c) for c in range(velocity.n_bins)]
+        pick = np.empty(m.size, dtype=np.int64)
+        for c in range(velocity.n_bins):
+            sel = cls == c
+            pick[sel] = members[c][rng.integers(0, members[c].size, int(sel.sum()))]
+        v = velocity.speed_ms[pick]
+        arrived = np.isfinite(v)
+        energy = np.where(arrived, kinetic_energy_kj(m, np.where(arrived, v, 0.0)), -np.inf)
+        n_arr = int(arrived.sum())
+        energy.sort()
+        k = n_samples - np.searchsorted(energy, e.ravel(), side="right")
+        lo, hi = wilson_interval(k, max(n_arr, 1), level)
+        return (k / max(n_arr, 1)).reshape(e.shape), lo.reshape(e.shape), hi.reshape(e.shape)
+    if isinstance(velocity, PairedSamples):
+        edges_m, vel = velocity.classes()
+        cls = np.searchsorted(edges_m, m)
+        v = np.empty(n_samples)
+        for c, vs in enumerate(vel):
+            sel = cls == c
+            v[sel] = rng.choice(vs, size=int(sel.sum()))
+    elif hasattr(velocity, "rvs"):
+        v = np.abs(velocity.rvs(size=n_samples, random_state=rng))
+    else:
+        samples = _positive_samples(velocity, "velocity")
+        idx = rng.integers(0, samples.size, n_samples)
+        v = samples[idx]
+        if angular_velocity is not None:
+            w = np.asarray(angular_velocity, dtype=float)[idx]
+    if w is None:
+        energy = kinetic_energy_kj(m, v)
+    else:
+        r = (3.0 * m / (4.0 * np.pi * density_kg_m3)) ** (1.0 / 3.0)
+        energy = kinetic_energy_kj(m, v, w, r, inertia_factor)
+    energy.sort()
+    k = n_samples - np.searchsorted(energy, e.ravel(), side="right")
+    lo, hi = wilson_interval(k, n_samples, level)
+    return (k / n_samples).reshape(e.shape), lo.reshape(e.shape), hi.reshape(e.shape)
+
+
+def energy_quantile(p, mass, velocity, **kwargs):
+    """Energy [kJ] exceeded with probability p by one fall (inverse of :func:`exceedance_probability`)."""
+    p = np.atleast_1d(np.asarray(p, dtype=float))
+    if np.any((p <= 0) | (p >= 1)):
+        raise ValueError(f"p = {p[(p <= 0) | (p >= 1)][0]!r}: probabilities must lie strictly between 0 and 1")
+    out = []
+    for pi in p:
+        f = lambda le: np.log(max(exceedance_probability(np.exp(le), mass, velocity, **kwargs).item(),  # noqa: E731
+                                  1e-300)) - np.log(pi)
+        lo, hi = -10.0, 5.0
+        while f(hi) > 0:
+            hi += 5.0
+        while f(lo) < 0:
+            lo -= 5.0
+        out.append(np.exp(optimize.brentq(f, lo, hi, xtol=1e-10)))
+    return np.array(out)

@@ -1,0 +1,230 @@
+"""Writing results: all-or-nothing output directories and JSON that carries units."""
+from __future__ import annotations
+
+import contextlib
+import csv
+import json
+import math
+import os
+import re
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def check_output(path, *, overwrite: bool = False, kind: str = "dir", option: str = "--out") -> Path:
+    """Refuse an output that would clobber something, before any work starts.
+
+    ``kind="dir"``: an existing file is always refused; an existing non-empty
+    directory is refused unless ``overwrite`` (it is then replaced whole, see
+    :func:`atomic_outputs`); an empty one is used.  ``kind="file"``: an existing
+    directory is always refused, an existing file unless ``overwrite``.
+    """
+    path = Path(path)
+    for parent in path.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(f"{option} {path}: {parent} is a file, not a directory")
+            break
+    if kind == "dir":
+        if path.exists() and not path.is_dir():
+            raise ValueError(f"{option} {path} is a file; name a new directory for the outputs (an existing file "
+                             "is never replaced by a directory, even with --overwrite)")
+        if path.is_dir() and any(path.iterdir()) and not overwrite:
+            raise ValueError(f"{option} {path} already exists and is not empty; choose a new name, or pass "
+                             "--overwrite to replace it whole (its current files are removed)")
+    else:
+        if path.is_dir():
+            raise ValueError(f"{option} {path} is a directory; name a .parquet or .csv file")
+        if path.exists() and not overwrite:
+            raise ValueError(f"{option} {path} already exists; choose a new name, or pass --overwrite to replace it")
+    return path
+
+
+_FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
+
+
+def _neutralise_cell(cell: str) -> str:
+    if cell and cell.startswith(_FORMULA_START):
+        try:
+            float(cell)
+            return cell
+        except ValueError:
+            return "'" + cell
+    return cell
+
+
+def neutralise_csv(path) -> None:
+    """Prefix with ``'`` every text cell that a spreadsheet would execute as a formula (=, +, -, @)."""
+    path = Path(path)
+    with open(path, newline="", encoding="utf-8", errors="surrogateescape") as fh:
+        rows = list(csv.reader(fh))
+    changed = False
+    for row in rows:
+        for j, cell in enumerate(row):
+            new = _neutralise_cell(cell)
+            if new is not cell:
+                row[j] = new
+                changed = True
+    if changed:
+        with open(path, "w", newline="", encoding="utf-8", errors="surrogateescape") as fh:
+            csv.writer(fh, lineterminator="\n").writerows(rows)
+
+
+def _finish(tmp: Path) -> None:
+    """Permissions by the user's umask (temporary names are created private) and safe CSV cells."""
+    mode_dir, mode_file = 0o777 & ~_umask(), 0o666 & ~_umask()
+    items = [tmp] + (sorted(tmp.rglob("*")) if tmp.is_dir() else [])
+    for item in items:
+        if item.is_dir():
+            os.chmod(item, mode_dir)
+        elif item.is_file():
+            os.chmod(item, mode_file)
+            if item.suffix.lower() == ".csv":
+                neutralise_csv(item)
+
+
+@contextlib.contextmanager
+def atomic_outputs(targets, *, overwrite: bool = False, option: str = "--out"):
+    """Write several outputs (directories and files) that appear together or not at all.
+
+    ``targets`` is a list of ``(path, kind)`` with kind ``"dir"`` or ``"file"``.  Yields the
+    list of temporary siblings to write into (a directory, or a file name for a file).  On
+    success each is renamed into place; an existing target is replaced only with ``overwrite``
+    (it is renamed aside first and restored if a later rename fails).  On any exception,
+    including Ctrl-C, the temporary siblings are removed and the targets are left as they were.
+    """
+    targets = [(Path(p), k) for p, k in targets]
+    for p, k in targets:
+        check_output(p, overwrite=overwrite, kind=k, option=option)
+    tmps = []
+    try:
+        for p, k in targets:
+            p.parent.mkdir(parents=True, exist_ok=True)
+            if k == "dir":
+                tmps.append(Path(tempfile.mkdtemp(prefix=f".{p.name}.partial-", dir=p.parent)))
+            else:
+                fd, name = tempfile.mkstemp(prefix=f".{p.stem}.partial-", suffix=p.suffix, dir=p.parent)
+                os.close(fd)
+                tmps.append(Path(name))
+        yield tmps if len(tmps) > 1 else tmps[0]
+        for (p, k), tmp in zip(targets, tmps):
+            check_output(p, overwrite=overwrite, kind=k, option=option)    # nothing appeared meanwhile
+            _finish(tmp)
+        moved, aside = [], []
+        try:
+            for (p, k), tmp in zip(targets, tmps):
+                if p.exists() and (k == "file" or any(p.iterdir())):
+                    old = p.with_name(f".{p.name}.replaced-{os.getpid()}")
+                    os.replace(p, old)
+                    aside.append((p, old))
+                elif p.is_dir():
+                    p.rmdir()
+                os.replace(tmp, p)
+                moved.append(p)
+        except BaseException:
+            for p in moved:
+                shutil.rmtree(p, ignore_errors=True) if p.is_dir() else p.unlink(missing_ok=True)
+            for p, old in aside:
+                os.replace(old, p)
+            raise
+        for _, old in aside:
+            shutil.rmtree(old, ignore_errors=True) if old.is_dir() else old.unlink(missing_ok=True)
+    finally:
+        for tmp in tmps:
+            if tmp.is_dir():
+                shutil.rmtree(tmp, ignore_errors=True)
+            else:
+                tmp.unlink(missing_ok=True)
+
+
+@contextlib.contextmanager
+def atomic_output_dir(path, *, overwrite: bool = False):
+    """Yield a temporary directory that replaces ``path`` only on success (see :func:`atomic_outputs`).
+
+    An existing non-empty ``path`` is refused unless ``overwrite``, and then replaced whole
+    (never merged); an existing file is always refused.
+    """
+    with atomic_outputs([(path, "dir")], overwrite=overwrite) as tmp:
+        yield tmp
+
+
+def _clean(value):
+    if isinstance(value, dict):
+        return {str(k): _clean(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_clean(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return [_clean(v) for v in value.tolist()]
+    if isinstance(value, (np.floating, float)):
+        v = float(value)
+        return None if math.isnan(v) or math.isinf(v) else v
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (np.bool_,)):
+        return bool(value)
+    if isinstance(value, pd.DataFrame):
+        return _clean(value.reset_index().to_dict(orient="records"))
+    if isinstance(value, Path):
+        return str(value)
+    return value
+
+
+def write_json(data, path) -> None:
+    """Write ``data`` as indented JSON; NaN and infinity become null."""
+    Path(path).write_text(json.dumps(_clean(data), indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
+
+
+#: An absolute path in text (POSIX form): a slash-separated run not preceded by a word, a URL or a
+#: fraction ("km/h", "1/yr" and "http://..." are left alone).
+_ABSOLUTE_PATH = re.compile(r"(?<![\w.:/&;+=,<~-])/(?:[\w.-]+/)+[\w.-]+")
+
+
+def shown_path(path, base) -> str:
+    """``path`` as written in outputs: relative to ``base`` (the site file's folder) when it lies there; a file
+    of the installed package (bundled data, shipped scenarios) as its name inside the package
+    (``riskrf/data/NAME``); anything else relative to ``base`` (with ``..``), never the machine's absolute path."""
+    p = Path(os.path.abspath(str(path)))
+    base = Path(os.path.abspath(str(base)))
+    if p.is_relative_to(base):
+        return p.relative_to(base).as_posix()
+    root = Path(__file__).resolve().parents[2]           # the folder holding riskrf/ and simulation/
+    if p.is_relative_to(root):
+        return p.relative_to(root).as_posix()
+    return Path(os.path.relpath(p, base)).as_posix()
+
+
+def relative_paths(value, base):
+    """``value`` (text, or a dict/list of them, e.g. a JSON summary) with every absolute path in its text
+    written by :func:`shown_path` relative to ``base``; other values unchanged."""
+    if isinstance(value, str):
+        return _ABSOLUTE_PATH.sub(lambda m: shown_path(m.group(0), base), value)
+    if isinstance(value, Path):
+        return shown_path(value, base) if value.is_absolute() else value.as_posix()
+    if isinstance(value, dict):
+        return {k: relative_paths(v, base) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [relative_paths(v, base) for v in value]
+    return value
+
+
+def relative_paths_in_json_files(folder, base, *, skip=("inputs",)) -> None:
+    """Rewrite every ``*.json`` below ``folder`` with :func:`relative_paths` (base: the site file's folder), so
+    that no output names a directory of the machine it ran on.  Subfolders named in ``skip`` (the copy of the
+    inputs and the command as typed, kept for exact reruns) are left as they are."""
+    for path in sorted(Path(folder).rglob("*.json")):
+        if set(path.relative_to(folder).parts[:-1]) & set(skip):
+            continue
+        data = json.loads(path.read_text(encoding="utf-8"))
+        fixed = relative_paths(data, base)
+        if fixed != data:
+            write_json(fixed, path)

@@ -1,0 +1,602 @@
+"""Inputs of a mitigation study: options, traffic, consequences, economics, criteria, uncertainty, and the
+parser of the TOML tables that hold them (every field is checked before anything is computed; errors name
+the file, the option and the field).  See :mod:`riskrf.risk.mitigation` for what the options do.
+"""
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .measures import Ditch, MeasureError
+from ..report.format import money
+from .road_risk import (
+    AGS2007_INDIVIDUAL_RISK,
+    VULNERABILITY_DIRECT_BY_MASS,
+    VULNERABILITY_STRIKE_BY_MASS,
+    occupancy_distribution,
+)
+
+OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "closure", "combined")
+BARRIER_KINDS = ("fence", "attenuator", "shed")
+#: Days a destroyed structure stays out of service (ASSUMPTION; override with ``repair_days``).
+DEFAULT_REPAIR_DAYS = {"fence": 30.0, "attenuator": 30.0, "shed": 180.0}
+MASS_BINS = 120
+
+
+class MitigationError(ValueError):
+    """A mitigation file or option is invalid; the message names the option and field."""
+
+
+@dataclass(frozen=True)
+class Exposure:
+    """Traffic on the exposed road section."""
+
+    vehicles_per_day: float = 4000.0
+    vehicle_length_m: float = 5.0
+    speed_kmh: float = 80.0
+    occupants_per_vehicle: float = 1.5
+    commuter_trips_per_day: float = 2.0
+    hours_rock_on_road: float = 0.5
+    p_cannot_stop: float = 0.002
+    share_stopping_on_road: float = 0.3
+    exposed_length_m: float = 100.0
+    occupants_distribution: dict | None = None
+
+
+@dataclass(frozen=True)
+class Consequences:
+    """Costs of consequences (in ``currency``) and vulnerabilities (probability of death).
+
+    A vulnerability is a number or pairs (mass_kg, probability) interpolated in log mass.
+    """
+
+    value_of_statistical_life: float = 5.0e6
+    vulnerability_moving_vehicle: object = VULNERABILITY_DIRECT_BY_MASS
+    vulnerability_striking_rock: object = VULNERABILITY_STRIKE_BY_MASS
+    vehicle_damage: float = 25000.0
+    closure_days_per_fall: float = 0.5
+    closure_cost_per_day: float = 20000.0
+    detour_hours: float = 0.0
+    value_of_time_per_hour: float = 0.0
+    cleanup_cost_per_fall: float = 3000.0
+    currency: str = "CHF"
+
+
+def closure_cost_per_fall(co: "Consequences", vehicles_per_day):
+    """Cost of one fall reaching the road besides injuries and vehicle damage [currency]: the agency's closure
+    cost per day and the road users' delay (each of the vehicles_per_day x closure days detours for
+    ``detour_hours`` at ``value_of_time_per_hour``), plus clean-up."""
+    days = co.closure_days_per_fall
+    return days * co.closure_cost_per_day + days * np.asarray(vehicles_per_day, dtype=float) * co.detour_hours \
+        * co.value_of_time_per_hour + co.cleanup_cost_per_fall
+
+
+@dataclass(frozen=True)
+class Economics:
+    """Discounting of the study: ``discount_rate`` (a fraction per year, default 0.03) over ``horizon_years``
+    [yr] (default 50); present values use the uniform-series factor (1 - (1 + r)^-n) / r (Wyllie 2014, 8.5.5).
+    """
+    discount_rate: float = 0.03
+    horizon_years: float = 50.0
+
+
+@dataclass(frozen=True)
+class Criteria:
+    """Tolerability: individual risk of the person most at risk [1/yr] and the societal (F-N) diagram."""
+
+    individual_risk_per_year: float = AGS2007_INDIVIDUAL_RISK["existing slope"]
+    fn_diagram: str = "Hong Kong GEO Report 75 (1998)"
+
+
+@dataclass(frozen=True)
+class Uncertainty:
+    """Epistemic inputs sampled jointly (uniform within the stated ranges; m_max log-uniform).
+
+    ``rate_factor``: the rate of falls relative to the estimate (e.g. the share of the source above the
+    road); ``vulnerability_factor`` multiplies both vulnerability curves.  The power law's b and rate are
+    sampled from their posteriors given the record of n falls (b x Gamma(n)/n, the Jeffreys-prior posterior of b;
+    rate x Gamma(n)/n, prior 1/rate) and derived retentions from their
+    Monte Carlo law (Beta) unless switched off.  ``materials`` gives ranges of slope material parameters
+    ("talus.ground_friction_angle_deg" = [20, 30]); the scenario is re-simulated for ``material_draws``
+    joint draws (and once at each end of each range, for the tornado) and every sample uses one of the
+    draws: reach probability, velocities and heights at the barrier, the road share and every derived
+    retention change with it.  ``calibration`` (the ``bootstrap.csv`` of ``riskrf calibrate``: one row
+    of re-fitted parameters per replicate) gives the material draws instead: rows drawn jointly, so the
+    correlation the calibration found is kept; the tornado uses its 5 % and 95 % quantiles.
+    ``fractal_dimension`` (low, high): each event volume breaks up into the expected fragments of fractal
+    fragmentation (Perfect 1997; :func:`riskrf.hazard.design_block.fractal_fragments`, ``fragmentation_iterations``
+    generations) with D sampled uniformly in the range (central value its midpoint), and the loss engine counts
+    the fragments as the blocks that travel and reach the road; without it every event volume is one intact
+    block.
+    """
+
+    samples: int = 1000
+    seed: int = 1
+    rate_factor: tuple = (1.0, 1.0)
+    m_max_kg: tuple | None = None
+    value_of_statistical_life: tuple | None = None
+    vulnerability_factor: tuple = (1.0, 1.0)
+    vehicles_per_day: tuple | None = None
+    discount_rate: tuple | None = None
+    sample_power_law: bool = True
+    sample_retention: bool = True
+    materials: dict = field(default_factory=dict)    # {"material.field": (low, high)} of the slope scenario
+    material_draws: int = 8
+    calibration: object = field(default=None, repr=False)   # DataFrame: joint draws of a calibration's bootstrap
+    calibration_source: str = ""
+    fractal_dimension: tuple | None = None   # (low, high): event volumes break up by fractal fragmentation
+    fragmentation_iterations: int = 3         # generations of that fragmentation (Perfect 1997)
+
+
+@dataclass(frozen=True)
+class Option:
+    """One mitigation option of a study, as read from the ``[[mitigation.options]]`` tables (README "Mitigation
+    options").  ``kind`` is one of OPTION_KINDS.  Money in the study's currency: ``capital_cost``,
+    ``annual_maintenance`` (per year), ``repair_cost_per_impact``, ``replacement_cost``; ``life_years`` [yr],
+    ``repair_days`` [days] of closure per repair.  Geometry in metres (``x_m``, ``width_m``, ``depth_m``,
+    ``height_m``, ``zone_x_m``, ``covered_length_m``, ``road_x_m``), fence capacity ``capacity_kj`` [kJ],
+    scaling range ``min_mass_kg``/``max_mass_kg`` [kg].  Typed effects (``retention``, ``rate_reduction``,
+    closure ``share_while_closed`` and ``closure_hours_per_year``) are ASSUMPTIONS and labelled as such; the
+    ``*_range`` fields are (low, high) for the uncertainty study.
+    """
+    name: str
+    kind: str
+    capital_cost: float = 0.0
+    annual_maintenance: float = 0.0
+    life_years: float | None = None
+    repair_cost_per_impact: float = 0.0
+    replacement_cost: float | None = None
+    repair_days: float | None = None
+    rate_reduction: float | None = None
+    retention: float | None = None
+    x_m: float | None = None
+    width_m: float | None = None
+    depth_m: float | None = None
+    inner_slope_hv: float | None = None
+    outer_slope_hv: float | None = None
+    material: str | None = None
+    capacity_kj: float | None = None
+    height_m: float | None = None
+    min_mass_kg: float | None = None
+    max_mass_kg: float | None = None
+    zone_x_m: tuple | None = None
+    covered_length_m: float | None = None
+    road_x_m: float | None = None
+    options: tuple = ()
+    capital_cost_range: tuple | None = None
+    annual_maintenance_range: tuple | None = None
+    retention_range: tuple | None = None
+    rate_reduction_range: tuple | None = None
+    share_while_closed: float | None = None       # closure: share of falls while the road is closed
+    closure_hours_per_year: float | None = None   # closure: hours closed per year
+    cost_per_closure_hour: float = 0.0            # closure: cost of one hour of closure
+    threshold_mm: float | None = None             # closure rule: rainfall over window_days that closes the road
+    window_days: float | None = None              # closure rule: rainfall window [days] (default 1)
+    warning_levels: tuple | None = None           # closure rule: close under these rainstorm warning levels
+    closure_rule: str = ""                        # the rule in words and its source, once computed (site_rates)
+    description: str = ""
+
+    @property
+    def has_closure_rule(self) -> bool:
+        """A closure given as a rule, whose share and hours are computed from the site's rate model."""
+        return self.threshold_mm is not None or self.warning_levels is not None
+
+    @property
+    def typed(self) -> bool:
+        """Does a typed effectiveness (an assumption) replace the derived one?"""
+        return self.retention is not None or self.rate_reduction is not None or (
+            self.kind == "closure" and not self.has_closure_rule)
+
+    def describe(self, currency: str = "") -> str:
+        """What the option is and assumes, in words (money in ``currency``)."""
+        k = self.kind
+        if k == "none":
+            text = "the site as it is"
+        elif k == "scaling":
+            if self.rate_reduction is not None:
+                text = f"scaling and bolting; ASSUMED to prevent {self.rate_reduction:.0%} of falls (typed)"
+            else:
+                size = (f"{self.min_mass_kg or 0:,.0f}-{self.max_mass_kg:,.0f} kg" if self.max_mass_kg
+                        else f"above {self.min_mass_kg:,.0f} kg" if self.min_mass_kg else "of every size")
+                zone = f" from x = {self.zone_x_m[0]:g}-{self.zone_x_m[1]:g} m" if self.zone_x_m else ""
+                text = f"scaling and bolting: removes the release of blocks {size}{zone}"
+        elif k == "ditch":
+            if self.retention is not None:
+                text = f"catchment ditch; ASSUMED to retain {self.retention:.0%} of falls (typed)"
+            else:
+                text = (f"catchment ditch {self.width_m:g} m wide and {self.depth_m:g} m deep from x = {self.x_m:g} m; "
+                        "retention derived by simulation")
+        elif k in ("fence", "attenuator"):
+            text = (f"{k} of {self.capacity_kj:,.0f} kJ (MEL), {self.height_m:g} m high"
+                    + (f" at x = {self.x_m:g} m" if self.x_m is not None else " at the barrier line")
+                    + (f"; ASSUMED to retain {self.retention:.0%} (typed)" if self.retention is not None
+                       else "; passing falls from simulated heights and energies")
+                    + f"; out of service {self.repair_days:g} days after an impact above MEL (assumption)")
+        elif k == "shed":
+            text = (f"rock shed of {self.capacity_kj:,.0f} kJ over "
+                    + (f"{self.covered_length_m:g} m of road" if self.covered_length_m else "the exposed road")
+                    + f"; out of service {self.repair_days:g} days after an impact above capacity (assumption)")
+        elif k == "realignment":
+            text = (f"road moved to x = {self.road_x_m:g} m" if self.road_x_m is not None
+                    else "road moved away from the slope (no exposure)")
+        elif k == "closure" and self.share_while_closed is None:
+            text = f"{self.rule_text()}; share and hours not yet computed (needs the site's rate model, [rates])"
+        elif k == "closure":
+            how = "computed from the rate model" if self.has_closure_rule else "ASSUMED (typed)"
+            cur = f" {currency}" if currency else ""
+            text = ((f"{self.closure_rule}: " if self.closure_rule else "")
+                    + f"road closed {self.closure_hours_per_year:,.1f} h per year ({how}) at "
+                    f"{self.cost_per_closure_hour:,.0f}{cur} per hour "
+                    f"({money(self.closure_hours_per_year * self.cost_per_closure_hour, sig=3)}{cur} per year, in the "
+                    f"annual maintenance); {self.share_while_closed:.1%} of falls occur while closed "
+                    f"({how}); protects road users, falls still reach the road")
+        else:
+            text = "combination of " + " + ".join(self.options)
+        return (self.description + ": " if self.description else "") + text
+
+    def rule_text(self) -> str:
+        """A closure rule in words (rainfall or warning rule)."""
+        if self.threshold_mm is not None:
+            w = int(self.window_days or 1)
+            return f"close while the {w}-day rainfall reaches {self.threshold_mm:g} mm (whole day)"
+        if self.warning_levels is not None:
+            return f"close while a {' or '.join(self.warning_levels)} rainstorm warning is in force"
+        return ""
+
+
+# ---- parsing -------------------------------------------------------------------------------------
+NUMBER_FIELDS = ("capital_cost", "annual_maintenance", "life_years", "repair_cost_per_impact", "replacement_cost",
+                 "repair_days", "rate_reduction", "retention", "x_m", "width_m", "depth_m", "inner_slope_hv",
+                 "outer_slope_hv", "capacity_kj", "height_m", "min_mass_kg", "max_mass_kg", "covered_length_m",
+                 "road_x_m", "share_while_closed", "closure_hours_per_year", "cost_per_closure_hour",
+                 "threshold_mm", "window_days")
+RANGE_FIELDS = ("capital_cost_range", "annual_maintenance_range", "retention_range", "rate_reduction_range",
+                "zone_x_m")
+
+
+def _range(v, where: str, *, share: bool = False):
+    if not (isinstance(v, (list, tuple)) and len(v) == 2 and all(isinstance(x, (int, float))
+                                                                 and not isinstance(x, bool) for x in v)):
+        raise MitigationError(f"{where} = {v!r} must be [low, high]")
+    lo, hi = float(v[0]), float(v[1])
+    if not (np.isfinite(lo) and np.isfinite(hi)) or lo < 0:
+        raise MitigationError(f"{where} = {v!r}: values must be finite numbers >= 0")
+    if lo > hi:
+        raise MitigationError(f"{where} = {v!r}: low {lo:g} is greater than high {hi:g}")
+    if share and hi > 1:
+        raise MitigationError(f"{where} = {v!r} is a share and must lie in [0, 1]")
+    return lo, hi
+
+
+def _table(data: dict, cls, where: str, source: str, used: list, special=()):
+    names = {f.name for f in fields(cls)}
+    if not isinstance(data, dict):
+        raise MitigationError(f"{source}: [{where}] must be a table")
+    unknown = set(data) - names
+    if unknown:
+        key = sorted(unknown)[0]
+        close = difflib.get_close_matches(key, names, n=1)
+        raise MitigationError(f"{source}: unknown field {where}.{key}" + (f"; did you mean {close[0]!r}?" if close
+                                                                         else f"; allowed: {sorted(names)}"))
+    for f in fields(cls):
+        if f.name not in data:
+            used.append(f"{where}.{f.name} = {getattr(cls(), f.name)!r} (default)")
+        elif f.name in special:
+            continue
+        elif f.name != "currency" and f.type not in ("bool",):
+            v = data[f.name]
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or v < 0:
+                raise MitigationError(f"{source}: {where}.{f.name} = {v!r} must be a number >= 0")
+    return data
+
+
+def _vulnerability(v, where):
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        if not 0 <= v <= 1:
+            raise MitigationError(f"{where} = {v!r} must be a probability in [0, 1]")
+        return float(v)
+    try:
+        arr = np.asarray(v, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.empty((0,))
+    if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1 or np.any(arr[:, 0] <= 0) \
+            or np.any((arr[:, 1] < 0) | (arr[:, 1] > 1)) or np.any(np.diff(arr[:, 0]) <= 0):
+        raise MitigationError(f"{where} = {v!r} must be a probability or [[mass_kg, probability], ...] with "
+                              "increasing masses > 0 and probabilities in [0, 1]")
+    return tuple(map(tuple, arr.tolist()))
+
+
+def parse_option(spec: dict, i: int, source: str) -> Option:
+    """Check and read option ``i`` of a study (a dict from TOML) read from ``source``; an :class:`Option`.
+
+    Every field is checked before any work (kind, costs >= 0, geometry, ranges low <= high); a
+    MitigationError names the source, the option and the field with its value.
+    """
+    where = f"options[{i}]"
+    if not isinstance(spec, dict):
+        raise MitigationError(f"{source}: {where} must be a table")
+    name = spec.get("name")
+    if not name:
+        raise MitigationError(f"{source}: {where} needs a name")
+    where = f"option {name!r}"
+    allowed = {f.name for f in fields(Option)} - {"closure_rule"}     # closure_rule: filled when computed
+    unknown = set(spec) - allowed
+    if unknown:
+        key = sorted(unknown)[0]
+        close = difflib.get_close_matches(key, allowed, n=1)
+        raise MitigationError(f"{source}: {where}: unknown field {key!r}" + (f"; did you mean {close[0]!r}?"
+                                                                            if close else ""))
+    kind = spec.get("kind")
+    if kind not in OPTION_KINDS:
+        raise MitigationError(f"{source}: {where}: kind = {kind!r} is not one of {', '.join(OPTION_KINDS)}")
+    if "capital_cost" not in spec and kind != "combined":
+        raise MitigationError(f"{source}: {where}: missing field 'capital_cost' (use 0 for none)")
+    for key in NUMBER_FIELDS:
+        v = spec.get(key)
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or v < 0):
+            raise MitigationError(f"{source}: {where}: {key} = {v!r} must be a number >= 0")
+    vals = {k: (float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else v) for k, v in spec.items()}
+    for key in RANGE_FIELDS:
+        if key in spec:
+            vals[key] = _range(spec[key], f"{source}: {where}: {key}",
+                               share=key in ("retention_range", "rate_reduction_range"))
+    rule_keys = ("threshold_mm", "window_days", "warning_levels")
+    typed_keys = ("share_while_closed", "closure_hours_per_year")
+    if kind == "closure":
+        if spec.get("warning_levels") is not None:
+            lv = spec["warning_levels"]
+            if not (isinstance(lv, list) and lv and all(isinstance(x, str) and x.strip() for x in lv)):
+                raise MitigationError(f"{source}: {where}: warning_levels = {lv!r} must be a list of warning levels, "
+                                      "e.g. [\"Red\", \"Black\"]")
+            vals["warning_levels"] = tuple(x.strip().capitalize() for x in lv)
+        rule = [k for k in rule_keys if spec.get(k) is not None]
+        typed = [k for k in typed_keys if spec.get(k) is not None]
+        if rule and typed:
+            raise MitigationError(f"{source}: {where}: give a closure rule ({', '.join(rule)}; its share and hours are "
+                                  f"computed from the site's rate model) or typed {', '.join(typed)} (an assumption), "
+                                  "not both")
+        if rule:
+            if spec.get("threshold_mm") is not None and spec.get("warning_levels") is not None:
+                raise MitigationError(f"{source}: {where}: give threshold_mm (a rainfall rule) or warning_levels (a "
+                                      "warning rule), not both")
+            if spec.get("window_days") is not None and spec.get("threshold_mm") is None:
+                raise MitigationError(f"{source}: {where}: window_days = {spec['window_days']!r} belongs to a rainfall "
+                                      "rule: give threshold_mm too")
+            if spec.get("threshold_mm") is not None and not spec["threshold_mm"] > 0:
+                raise MitigationError(f"{source}: {where}: threshold_mm = {spec['threshold_mm']!r} must be a rainfall "
+                                      "> 0 mm")
+            wd = spec.get("window_days")
+            if wd is not None and (isinstance(wd, bool) or int(wd) != wd or wd < 1):
+                raise MitigationError(f"{source}: {where}: window_days = {wd!r} must be a whole number of days >= 1")
+            if spec.get("threshold_mm") is not None and wd is None:
+                vals["window_days"] = 1.0
+        else:
+            for key in typed_keys:
+                if spec.get(key) is None:
+                    raise MitigationError(
+                        f"{source}: {where}: a closure needs a rule (threshold_mm [+ window_days], or warning_levels; "
+                        "computed from the site's [rates] model) or typed share_while_closed and "
+                        "closure_hours_per_year (an assumption; riskrf.risk.closure.closure_rule gives both: "
+                        f"ClosureRule.option_spec); {key} is missing")
+            if spec["closure_hours_per_year"] > 8766:
+                raise MitigationError(f"{source}: {where}: closure_hours_per_year = "
+                                      f"{spec['closure_hours_per_year']!r} exceeds the hours of a year (8766)")
+            vals["annual_maintenance"] = float(spec.get("annual_maintenance", 0.0)) + \
+                float(spec["closure_hours_per_year"]) * float(spec.get("cost_per_closure_hour", 0.0))
+    elif any(spec.get(k) is not None for k in typed_keys + rule_keys + ("cost_per_closure_hour",)):
+        raise MitigationError(f"{source}: {where}: share_while_closed, closure_hours_per_year, threshold_mm, "
+                              "window_days, warning_levels and cost_per_closure_hour are only for kind = 'closure'")
+    for key in ("rate_reduction", "retention", "share_while_closed"):
+        if spec.get(key) is not None and spec[key] > 1:
+            raise MitigationError(f"{source}: {where}: {key} = {spec[key]!r} is a share and must lie in [0, 1]")
+    need = {"fence": ("capacity_kj", "height_m"), "attenuator": ("capacity_kj", "height_m"),
+            "shed": ("capacity_kj",)}.get(kind, ())
+    for key in need:
+        if spec.get(key) is None:
+            raise MitigationError(f"{source}: {where}: a {kind} needs {key}")
+        if spec[key] <= 0:      # a 0 kJ or 0 m barrier stops nothing: a typing mistake, never a design
+            unit = "kJ" if key == "capacity_kj" else "m"
+            raise MitigationError(f"{source}: options[{i}].{key} = {spec[key]!r} must be > 0 {unit} "
+                                  f"({where}, a {kind})")
+    if kind == "ditch" and spec.get("retention") is None:
+        for key in ("x_m", "width_m", "depth_m"):
+            if spec.get(key) is None:
+                raise MitigationError(f"{source}: {where}: a ditch needs {key} (its geometry; its retention is "
+                                      "derived by simulation) or a typed retention (an assumption)")
+    if kind == "scaling" and spec.get("rate_reduction") is None and not any(
+            spec.get(k) is not None for k in ("min_mass_kg", "max_mass_kg", "zone_x_m")):
+        raise MitigationError(f"{source}: {where}: scaling needs the blocks it removes (min_mass_kg, max_mass_kg "
+                              "and/or zone_x_m) or a typed rate_reduction (an assumption)")
+    if spec.get("min_mass_kg") is not None and spec.get("max_mass_kg") is not None \
+            and spec["min_mass_kg"] > spec["max_mass_kg"]:
+        raise MitigationError(f"{source}: {where}: min_mass_kg = {spec['min_mass_kg']!r} is greater than "
+                              f"max_mass_kg = {spec['max_mass_kg']!r}")
+    if spec.get("retention_range") is not None and spec.get("retention") is None:
+        raise MitigationError(f"{source}: {where}: retention_range needs a typed retention (a derived retention "
+                              "carries its own Monte Carlo uncertainty)")
+    if spec.get("rate_reduction_range") is not None and spec.get("rate_reduction") is None:
+        raise MitigationError(f"{source}: {where}: rate_reduction_range needs a typed rate_reduction")
+    for fld in ("capital_cost", "annual_maintenance", "retention", "rate_reduction"):
+        rng = vals.get(f"{fld}_range")
+        if rng is not None and spec.get(fld) is not None and not rng[0] <= spec[fld] <= rng[1]:
+            raise MitigationError(f"{source}: {where}: {fld} = {spec[fld]!r} lies outside {fld}_range = "
+                                  f"{list(rng)}")
+    if spec.get("life_years") == 0:
+        raise MitigationError(f"{source}: {where}: life_years must be > 0")
+    if kind == "combined":
+        comps = spec.get("options")
+        if not isinstance(comps, list) or len(comps) < 2 or not all(isinstance(c, str) for c in comps):
+            raise MitigationError(f"{source}: {where}: a combined option needs options = [\"name\", \"name\", ...] "
+                                  "(two or more)")
+        extra = {k for k in spec if k not in ("name", "kind", "options", "description")}
+        if extra:
+            raise MitigationError(f"{source}: {where}: a combined option takes its costs and effects from its "
+                                  f"components; remove {sorted(extra)}")
+        vals["options"] = tuple(comps)
+    elif "options" in spec:
+        raise MitigationError(f"{source}: {where}: options = ... is only for kind = 'combined'")
+    if kind in BARRIER_KINDS and vals.get("repair_days") is None:
+        vals["repair_days"] = DEFAULT_REPAIR_DAYS[kind]
+    return Option(**vals)
+
+
+def _check_combinations(options, source):
+    names = [o.name for o in options]
+    for o in options:
+        if o.kind != "combined":
+            continue
+        for c in o.options:
+            if c not in names:
+                close = difflib.get_close_matches(c, names, n=1)
+                raise MitigationError(f"{source}: option {o.name!r}: options names unknown option {c!r}"
+                                      + (f"; did you mean {close[0]!r}?" if close else f"; options are {names}"))
+            comp = options[names.index(c)]
+            if comp.kind in ("combined", "none"):
+                raise MitigationError(f"{source}: option {o.name!r}: component {c!r} is of kind {comp.kind!r}; "
+                                      "combine measures only")
+        if len(set(o.options)) != len(o.options):
+            raise MitigationError(f"{source}: option {o.name!r}: options lists a component twice")
+        ditches = [options[names.index(c)] for c in o.options if options[names.index(c)].kind == "ditch"
+                   and options[names.index(c)].retention is None]
+        try:
+            from .measures import check_ditches_disjoint
+            check_ditches_disjoint([Ditch(d.x_m, d.width_m, d.depth_m, option=d.name) for d in ditches],
+                                   f"{source}: option {o.name!r}")
+        except MeasureError as exc:
+            raise MitigationError(str(exc)) from exc
+
+
+def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
+    allowed = ({f.name for f in fields(Uncertainty)} - {"calibration", "calibration_source"}) \
+        | {"calibration_bootstrap"}
+    if not isinstance(data, dict):
+        raise MitigationError(f"{source}: [uncertainty] must be a table")
+    for key in data:
+        if key not in allowed:
+            close = difflib.get_close_matches(key, allowed, n=1)
+            raise MitigationError(f"{source}: unknown field uncertainty.{key}"
+                                  + (f"; did you mean {close[0]!r}?" if close else f"; allowed: {sorted(allowed)}"))
+    vals = {}
+    for key, v in data.items():
+        w = f"{source}: uncertainty.{key}"
+        if key in ("samples", "seed", "material_draws", "fragmentation_iterations"):
+            if isinstance(v, bool) or not isinstance(v, int) or v < (0 if key == "seed" else 1):
+                raise MitigationError(f"{w} = {v!r} must be a whole number {'>= 0' if key == 'seed' else '>= 1'}")
+            if key == "fragmentation_iterations" and v > 12:
+                raise MitigationError(f"{w} = {v!r} must be a whole number of generations between 1 and 12")
+            vals[key] = v
+        elif key == "materials":
+            if not isinstance(v, dict):
+                raise MitigationError(f"{w} must be a table of \"material.parameter\" = [low, high]")
+            mats = {}
+            for path, rng in v.items():
+                name, _, fld = str(path).partition(".")
+                from .measures import MATERIAL_FIELDS
+                if not name or fld not in MATERIAL_FIELDS:
+                    raise MitigationError(f"{w}: {path!r} must be \"material.parameter\" with parameter one of "
+                                          f"{', '.join(MATERIAL_FIELDS)}")
+                mats[str(path)] = _range(rng, f"{w}.{path}")
+            vals[key] = mats
+        elif key == "calibration_bootstrap":
+            base = Path(source).parent if Path(source).is_file() else Path(".")
+            path = base / str(v)
+            if not path.is_file():
+                raise MitigationError(f"{w} = {v!r}: file not found ({path.resolve()}); give the bootstrap.csv "
+                                      "written by riskrf calibrate")
+            df = pd.read_csv(path)
+            from .measures import MATERIAL_FIELDS
+            if len(df) < 2:
+                raise MitigationError(f"{w} = {v!r}: needs at least 2 bootstrap rows; got {len(df)}")
+            for col in df.columns:
+                parts = col.split(".", 2)
+                if len(parts) != 3 or parts[0] != "materials" or parts[2] not in MATERIAL_FIELDS:
+                    raise MitigationError(f"{w} = {v!r}: column {col!r} is not a material parameter "
+                                          "(materials.NAME.FIELD with FIELD one of "
+                                          f"{', '.join(MATERIAL_FIELDS)})")
+                if not np.all(np.isfinite(pd.to_numeric(df[col], errors="coerce"))):
+                    raise MitigationError(f"{w} = {v!r}: column {col!r} has values that are not finite numbers")
+            vals["calibration"] = df.astype(float)
+            vals["calibration_source"] = str(v)
+        elif key in ("sample_power_law", "sample_retention"):
+            if not isinstance(v, bool):
+                raise MitigationError(f"{w} = {v!r} must be true or false")
+            vals[key] = v
+        else:
+            lo, hi = _range(v, w)
+            if key in ("rate_factor", "m_max_kg", "vehicles_per_day", "value_of_statistical_life",
+                       "vulnerability_factor") and lo <= 0:
+                raise MitigationError(f"{w} = {v!r}: low must be > 0")
+            if key == "discount_rate" and hi >= 1:
+                raise MitigationError(f"{w} = {v!r}: rates lie below 1 (e.g. [0.01, 0.05])")
+            if key == "fractal_dimension" and not 0 < lo <= hi < 3:
+                raise MitigationError(f"{w} = {v!r}: the fractal dimension lies strictly between 0 and 3 "
+                                      "(rock fragmentation typically 2-3)")
+            vals[key] = (lo, hi)
+    if vals.get("calibration") is not None and vals.get("materials"):
+        raise MitigationError(f"{source}: give uncertainty.materials or uncertainty.calibration_bootstrap, not both")
+    for f in fields(Uncertainty):
+        if f.name in ("calibration", "calibration_source"):
+            continue
+        if f.name not in vals:
+            used.append(f"uncertainty.{f.name} = {getattr(Uncertainty(), f.name)!r} (default)")
+    return Uncertainty(**vals)
+
+
+def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
+    """Validate a mitigation table: returns (options, exposure, consequences, economics, defaults_used,
+    uncertainty, criteria)."""
+    allowed = {"options", "traffic", "consequences", "economics", "uncertainty", "criteria"}
+    for key in data:
+        if key not in allowed:
+            close = difflib.get_close_matches(key, allowed, n=1)
+            raise MitigationError(f"{source}: unknown table [{key}]" + (f"; did you mean [{close[0]}]?" if close
+                                                                       else f"; allowed: {sorted(allowed)}"))
+    used: list = []
+    tr = dict(_table(data.get("traffic", {}), Exposure, "traffic", source, used,
+                     special=("occupants_distribution",)))
+    if "occupants_distribution" in tr:
+        try:
+            occupancy_distribution(tr.get("occupants_per_vehicle", 1.5), tr["occupants_distribution"])
+        except (ValueError, TypeError) as exc:
+            raise MitigationError(f"{source}: traffic.{exc}") from exc
+    if tr.get("occupants_per_vehicle", 1.5) < 1:
+        raise MitigationError(f"{source}: traffic.occupants_per_vehicle = {tr['occupants_per_vehicle']!r} must be "
+                              ">= 1 (the driver)")
+    exposure = Exposure(**tr)
+    cq = dict(_table(data.get("consequences", {}), Consequences, "consequences", source, used,
+                     special=("vulnerability_moving_vehicle", "vulnerability_striking_rock")))
+    for key in ("vulnerability_moving_vehicle", "vulnerability_striking_rock"):
+        if key in cq:
+            cq[key] = _vulnerability(cq[key], f"{source}: consequences.{key}")
+    consequences = Consequences(**cq)
+    for key in ("vulnerability_moving_vehicle", "vulnerability_striking_rock"):
+        if key not in cq:
+            used[-1:] = used[-1:]
+            used.append(f"consequences.{key}: ASSUMPTION size-dependent curve {getattr(consequences, key)} "
+                        "(mass_kg, probability of death)")
+    economics = Economics(**_table(data.get("economics", {}), Economics, "economics", source, used))
+    if not economics.horizon_years > 0:
+        raise MitigationError(f"{source}: economics.horizon_years = {economics.horizon_years!r} must be > 0 years "
+                              "(the period over which costs and losses are counted)")
+    if economics.discount_rate >= 1:
+        raise MitigationError(f"{source}: economics.discount_rate = {economics.discount_rate!r} must be a rate "
+                              "below 1 (e.g. 0.03)")
+    criteria = Criteria(**_table(data.get("criteria", {}), Criteria, "criteria", source, used,
+                                 special=("fn_diagram",)))
+    uncertainty = _uncertainty(data.get("uncertainty", {}), source, used)
+    specs = data.get("options", [])
+    if not isinstance(specs, list) or len(specs) < 2:
+        raise MitigationError(f"{source}: [[options]] needs at least two options to compare")
+    options = tuple(parse_option(s, i, source) for i, s in enumerate(specs))
+    names = [o.name for o in options]
+    dup = {n for n in names if names.count(n) > 1}
+    if dup:
+        raise MitigationError(f"{source}: duplicate option name(s) {sorted(dup)}")
+    _check_combinations(options, source)
+    return options, exposure, consequences, economics, tuple(used), uncertainty, criteria
+
+

@@ -1,0 +1,270 @@
+"""Rockfall Hazard Rating System (RHRS) category scores (Pierson et al. 1990; Pierson 1991, FHWA-OR-GI-92-05;
+Pierson & Van Vickle 1993, FHWA-SA-93-057).
+
+The RHRS screens the rock cuts of a corridor: every category scores on the exponential scale
+3, 9, 27, 81 (``score = 3**x``), and the section's rating is the sum of the category scores.
+The continuous categories have published formulas for ``x`` (in the manual's US units; this
+module takes SI inputs and converts them exactly, 1 ft = 0.3048 m, 1 yd3 = 0.764554857984 m3):
+
+====================================  ==================================  ========================
+category                              x                                   3 / 9 / 27 / 81 points at
+====================================  ==================================  ========================
+slope height                          H [ft] / 25                         25 / 50 / 75 / 100 ft
+average vehicle risk (AVR)            AVR [%] / 25                        25 / 50 / 75 / 100 %
+percent decision sight distance       (120 - %DSD) / 20                   100 / 80 / 60 / 40 %
+roadway width (incl. paved shoulders) (52 - W [ft]) / 8                   44 / 36 / 28 / 20 ft
+block size                            size [ft]                           1 / 2 / 3 / 4 ft
+volume per event                      volume [yd3] / 3                    3 / 6 / 9 / 12 yd3
+====================================  ==================================  ========================
+
+    AVR [%] = ADT [vehicles/day] x slope length [mi] / 24 [h/day] / posted speed [mph] x 100
+
+(the length/speed ratio carries no units, so slope length in km over speed in km/h gives the same
+number).  %DSD = actual sight distance / decision sight distance x 100.
+
+The descriptive categories (ditch effectiveness, geologic character: structural condition and rock
+friction [case 1] or structural condition and difference in erosion rates [case 2], climate and
+presence of water, rockfall history) score 3, 9, 27 or 81 for the four published classes
+(:data:`CLASSES`); a rater may place a slope between two classes with a fractional level
+``x`` in [1, 4] (score 3**x), as the exponential scale allows.
+
+Scores are not capped (a 130-ft slope scores 3**5.2 = 302); :func:`rate` reports each category
+score and the total.  The formulas and class points are those listed in
+shared/research/domain-methods.md section 4.3 [R] (Pierson & Van Vickle 1993 summary sheet): [R]
+because no page of the manual itself could be read to cite (the copies of FHWA-SA-93-057 and
+FHWA-OR-GI-92-05 found in the reference library hold only their title pages, abstracts, preface and
+contents; see the README's RHRS section).  The 3 / 9 / 27 / 81-point benchmarks of every category
+are checked against the SI criteria printed by Taherynia et al. (2014), Table 9.
+
+Checked against a published rated slope: Taherynia, Mohammadi & Ajalloeian (2014), J. Geol. Res.
+2014:763598, Table 10. With ``cap_points=100`` and scores rounded to integers, as that paper prints
+them, all ten category ratings are reproduced (tests/test_rhrs_published.py;
+tests/data/taherynia2014/README.md).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import pandas as pd
+
+from ..core.units import HOURS_PER_DAY, M_PER_KM
+
+FT_M = 0.3048                       # exact (international foot)
+MILE_M = 1609.344                   # exact
+YD3_M3 = 0.764554857984             # exact (0.9144 m)^3
+
+#: The four published classes of each descriptive category, in increasing order of hazard (3, 9, 27, 81 points).
+CLASSES = {
+    "ditch_effectiveness": ("good catchment", "moderate catchment", "limited catchment", "no catchment"),
+    "structural_condition_case1": ("discontinuous joints, favorable orientation",
+                                   "discontinuous joints, random orientation",
+                                   "discontinuous joints, adverse orientation",
+                                   "continuous joints, adverse orientation"),
+    "rock_friction": ("rough, irregular", "undulating", "planar", "clay infilling or slickensided"),
+    "structural_condition_case2": ("few differential erosion features", "occasional erosion features",
+                                   "many erosion features", "major erosion features"),
+    "difference_in_erosion_rates": ("small difference", "moderate difference", "large difference",
+                                    "extreme difference"),
+    "climate_and_water": ("low to moderate precipitation; no freezing periods; no water on slope",
+                          "moderate precipitation or short freezing periods or intermittent water on slope",
+                          "high precipitation or long freezing periods or continual water on slope",
+                          "high precipitation and long freezing periods or continual water on slope and long "
+                          "freezing periods"),
+    "rockfall_history": ("few falls", "occasional falls", "many falls", "constant falls"),
+}
+#: Short names accepted for the classes: the first word of a class when no other class of the category shares it
+#: (e.g. "good", "limited", "occasional").
+def _short_names(names):
+    first = [n.replace(",", " ").replace(";", " ").split()[0].lower() for n in names]
+    return {w: i + 1 for i, w in enumerate(first) if first.count(w) == 1}
+
+
+_SHORT = {cat: _short_names(names) for cat, names in CLASSES.items()}
+
+
+def _finite(value, name: str, *, lo: float | None = None, lo_open: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise TypeError(f"{name} must be a number; got {value!r}")
+    v = float(value)
+    if not math.isfinite(v) or (lo is not None and (v < lo or (lo_open and v == lo))):
+        bound = "" if lo is None else f" {'>' if lo_open else '>='} {lo:g}"
+        raise ValueError(f"{name} must be a finite number{bound}; got {value!r}")
+    return v
+
+
+def score(x: float) -> float:
+    """Exponential RHRS score 3**x (x = 1, 2, 3, 4 give 3, 9, 27, 81 points)."""
+    return 3.0 ** _finite(x, "x")
+
+
+def slope_height_x(height_m: float) -> float:
+    """x = H [ft] / 25 for the vertical slope height H (25 ft -> 3 points, 100 ft -> 81)."""
+    return _finite(height_m, "slope_height_m", lo=0) / FT_M / 25.0
+
+
+def average_vehicle_risk(adt_vehicles_per_day: float, slope_length_m: float, speed_kmh: float) -> float:
+    """AVR [%] = ADT x slope length / 24 / posted speed x 100: the share of time a vehicle is below the slope
+    (may exceed 100 %: more than one vehicle on average).  SI inputs: the length/speed ratio is unit-free,
+    so L [km] / V [km/h] equals L [mi] / V [mph]."""
+    adt = _finite(adt_vehicles_per_day, "adt_vehicles_per_day", lo=0)
+    length_km = _finite(slope_length_m, "slope_length_m", lo=0, lo_open=True) / M_PER_KM
+    v = _finite(speed_kmh, "speed_kmh", lo=0, lo_open=True)
+    return adt * length_km / HOURS_PER_DAY / v * 100.0
+
+
+def avr_x(avr_percent: float) -> float:
+    """x = AVR [%] / 25 (25 % -> 3 points, 100 % -> 81)."""
+    return _finite(avr_percent, "avr_percent", lo=0) / 25.0
+
+
+def percent_decision_sight_distance(sight_distance_m: float, decision_sight_distance_m: float) -> float:
+    """%DSD = actual sight distance / decision sight distance x 100."""
+    return _finite(sight_distance_m, "sight_distance_m", lo=0) / _finite(
+        decision_sight_distance_m, "decision_sight_distance_m", lo=0, lo_open=True) * 100.0
+
+
+def dsd_x(percent_dsd: float) -> float:
+    """x = (120 - %DSD) / 20 (100 % -> 3 points, 40 % -> 81)."""
+    return (120.0 - _finite(percent_dsd, "percent_dsd", lo=0)) / 20.0
+
+
+def roadway_width_x(width_m: float) -> float:
+    """x = (52 - W [ft]) / 8 for the roadway width W including paved shoulders (44 ft -> 3 points, 20 ft -> 81)."""
+    return (52.0 - _finite(width_m, "roadway_width_m", lo=0, lo_open=True) / FT_M) / 8.0
+
+
+def block_size_x(size_m: float) -> float:
+    """x = block size [ft] (1 ft -> 3 points, 4 ft -> 81)."""
+    return _finite(size_m, "block_size_m", lo=0, lo_open=True) / FT_M
+
+
+def volume_x(volume_m3: float) -> float:
+    """x = volume per event [yd3] / 3 (3 yd3 -> 3 points, 12 yd3 -> 81)."""
+    return _finite(volume_m3, "volume_m3", lo=0, lo_open=True) / YD3_M3 / 3.0
+
+
+def class_x(category: str, value) -> float:
+    """Level x of a descriptive category: a class name of :data:`CLASSES` (or its first word), or a number in
+    [1, 4] (fractional allowed: between two classes)."""
+    if category not in CLASSES:
+        raise ValueError(f"unknown RHRS category {category!r}; categories: {sorted(CLASSES)}")
+    if isinstance(value, str):
+        key = value.strip().lower()
+        for i, name in enumerate(CLASSES[category]):
+            if key == name.lower():
+                return float(i + 1)
+        if key in _SHORT[category]:
+            return float(_SHORT[category][key])
+        raise ValueError(f"{category} = {value!r} is not one of {list(CLASSES[category])} "
+                         f"(or {sorted(_SHORT[category])})")
+    x = _finite(value, category)
+    if not 1.0 <= x <= 4.0:
+        raise ValueError(f"{category} = {value!r}: a class level must lie in [1, 4] (3 to 81 points)")
+    return x
+
+
+@dataclass(frozen=True)
+class RHRSRating:
+    """RHRS rating of one slope: level x and score 3**x of each category, and the total.
+
+    ``inputs`` keeps what was given (SI units) and derived quantities (AVR %, %DSD).
+    """
+
+    x: dict
+    inputs: dict = field(default_factory=dict)
+    cap_points: float | None = None
+
+    @property
+    def scores(self) -> dict:
+        """Score of each category, 3**x, limited to ``cap_points`` when a cap was chosen."""
+        cap = math.inf if self.cap_points is None else self.cap_points
+        return {k: min(3.0 ** v, cap) for k, v in self.x.items()}
+
+    @property
+    def total(self) -> float:
+        """The RHRS rating: sum of the category scores."""
+        return float(sum(self.scores.values()))
+
+    def summary(self) -> pd.DataFrame:
+        """One row per category: x, score (points); last row the total."""
+        df = pd.DataFrame({"category": list(self.x), "x": list(self.x.values()),
+                           "score": list(self.scores.values())})
+        return pd.concat([df, pd.DataFrame({"category": ["total"], "x": [float("nan")], "score": [self.total]})],
+                         ignore_index=True)
+
+
+#: Attribute names accepted by :func:`rate` (SI units); the geologic character is case 1 (structural condition +
+#: rock friction) or case 2 (structural condition + difference in erosion rates).
+RATE_FIELDS = ("slope_height_m", "ditch_effectiveness", "adt_vehicles_per_day", "slope_length_m", "speed_kmh",
+               "avr_percent", "sight_distance_m", "decision_sight_distance_m", "percent_dsd", "roadway_width_m",
+               "structural_condition_case1", "rock_friction", "structural_condition_case2",
+               "difference_in_erosion_rates", "block_size_m", "volume_m3", "climate_and_water", "rockfall_history")
+
+
+def rate(*, cap_points: float | None = None, **attrs) -> RHRSRating:
+    """Rate one slope from its attributes (names in :data:`RATE_FIELDS`, SI units).
+
+    Needed: slope_height_m; ditch_effectiveness; the AVR (``avr_percent``, or ``adt_vehicles_per_day``,
+    ``slope_length_m`` and ``speed_kmh``); the %DSD (``percent_dsd``, or ``sight_distance_m`` and
+    ``decision_sight_distance_m``); roadway_width_m; the geologic character (case 1 or case 2 pair);
+    block_size_m or volume_m3 (the larger score counts when both are given, as the manual rates the
+    greater of the two); climate_and_water; rockfall_history.
+
+    ``cap_points``: optional upper limit of each category score (a user's choice, e.g. 100, so that one
+    continuous category far beyond the 81-point class cannot dominate the total); default uncapped.
+    """
+    if cap_points is not None:
+        cap_points = _finite(cap_points, "cap_points", lo=81)
+    unknown = sorted(set(attrs) - set(RATE_FIELDS))
+    if unknown:
+        raise ValueError(f"unknown RHRS attribute(s) {unknown}; allowed: {list(RATE_FIELDS)}")
+    a = {k: v for k, v in attrs.items() if v is not None and not (isinstance(v, float) and math.isnan(v))}
+
+    def need(*names):
+        missing = [n for n in names if n not in a]
+        if missing:
+            raise ValueError(f"RHRS rating needs {', '.join(missing)}")
+
+    x, inputs = {}, dict(a)
+    need("slope_height_m")
+    x["slope_height"] = slope_height_x(a["slope_height_m"])
+    need("ditch_effectiveness")
+    x["ditch_effectiveness"] = class_x("ditch_effectiveness", a["ditch_effectiveness"])
+    if "avr_percent" in a:
+        avr = _finite(a["avr_percent"], "avr_percent", lo=0)
+    else:
+        need("adt_vehicles_per_day", "slope_length_m", "speed_kmh")
+        avr = average_vehicle_risk(a["adt_vehicles_per_day"], a["slope_length_m"], a["speed_kmh"])
+    inputs["avr_percent"] = avr
+    x["average_vehicle_risk"] = avr_x(avr)
+    if "percent_dsd" in a:
+        dsd = _finite(a["percent_dsd"], "percent_dsd", lo=0)
+    else:
+        need("sight_distance_m", "decision_sight_distance_m")
+        dsd = percent_decision_sight_distance(a["sight_distance_m"], a["decision_sight_distance_m"])
+    inputs["percent_dsd"] = dsd
+    x["percent_decision_sight_distance"] = dsd_x(dsd)
+    need("roadway_width_m")
+    x["roadway_width"] = roadway_width_x(a["roadway_width_m"])
+    case1 = "structural_condition_case1" in a or "rock_friction" in a
+    case2 = "structural_condition_case2" in a or "difference_in_erosion_rates" in a
+    if case1 == case2:
+        raise ValueError("RHRS geologic character: give case 1 (structural_condition_case1 and rock_friction) or "
+                         "case 2 (structural_condition_case2 and difference_in_erosion_rates), not both or neither")
+    if case1:
+        need("structural_condition_case1", "rock_friction")
+        x["structural_condition"] = class_x("structural_condition_case1", a["structural_condition_case1"])
+        x["rock_friction"] = class_x("rock_friction", a["rock_friction"])
+    else:
+        need("structural_condition_case2", "difference_in_erosion_rates")
+        x["structural_condition"] = class_x("structural_condition_case2", a["structural_condition_case2"])
+        x["difference_in_erosion_rates"] = class_x("difference_in_erosion_rates", a["difference_in_erosion_rates"])
+    if "block_size_m" not in a and "volume_m3" not in a:
+        raise ValueError("RHRS rating needs block_size_m or volume_m3")
+    xs = [f(a[k]) for k, f in (("block_size_m", block_size_x), ("volume_m3", volume_x)) if k in a]
+    x["block_size_or_volume"] = max(xs)
+    need("climate_and_water", "rockfall_history")
+    x["climate_and_water"] = class_x("climate_and_water", a["climate_and_water"])
+    x["rockfall_history"] = class_x("rockfall_history", a["rockfall_history"])
+    return RHRSRating(x=x, inputs=inputs, cap_points=cap_points)

@@ -1,0 +1,352 @@
+"""A site's rate model (the ``[rates]`` table): the hazard's annual rate and closure options computed from it.
+
+A site file may name a dated record and a daily rainfall record (``[rates]``).
+:func:`evaluate_rates` fits :func:`riskrf.frequency.rates` to them once per run and
+computes from that one model
+
+* the **expected annual rate** over the record's rainfall climate (trend at the
+  end of the record), :meth:`RateModel.expected_annual_rate`, optionally under
+  a stated change of climate (``rain_factor``; ``heavy_day_mm`` with
+  ``heavy_day_change``; an assumption, labelled as one), used as the hazard's
+  rate when ``[inventory] rate_from = "rate_model"``;
+* each **closure option given as a rule** (``threshold_mm`` + ``window_days``,
+  or ``warning_levels``): the share of falls while closed and the closure hours
+  per year, :func:`riskrf.risk.closure.closure_rule` / :func:`~riskrf.risk.closure.warning_closure`.
+
+How the rate enters the hazard (``rate_from = "rate_model"``).  The rate model
+counts recorded events of any size; the hazard needs the rate of falls of at
+least ``m_min`` (the power law's lower bound).  The share at or above ``m_min``
+is taken from the site inventory's sized falls, so the hazard's rate is
+
+.. math::  \\lambda_{\\ge m_{min}} = \\lambda_{model} \\cdot \\frac{n_{\\ge m_{min}}}{n_{sized}} \\cdot s,
+
+with :math:`\\lambda_{model}` the expected annual rate, :math:`s` the site's
+``rate_scale`` (the share of the recorded source above this road; it still
+applies).  The falls below ``m_min`` are scaled in the same way.  In practice
+this is a factor :math:`f = \\lambda_{model} / (n_{sized} / D)` (D the
+inventory's duration) multiplying ``rate_scale`` wherever the inventory's
+rate is used.  The record should be the site's own (the default: ``record``
+left out means ``inventory.path``); another record's absolute rate is
+applied as given.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import pandas as pd
+
+#: Fields of ``[rates]`` and their defaults (those of ``riskrf rates``).
+RATES_FIELDS = {"record": None, "start": None, "end": None, "rainfall": None, "warnings": None, "period": "day",
+                "windows_days": [1, 3, 15], "rain_transform": "linear", "season": "harmonic", "trend": True}
+#: Fields ``[inventory]`` gains for the rate source.
+INVENTORY_RATE_FIELDS = {"rate_from": "inventory", "rain_factor": None, "heavy_day_mm": None,
+                         "heavy_day_change": None}
+RATE_SOURCES = ("inventory", "rate_model")
+
+
+def check_rates(given, inventory: dict, path, error=ValueError) -> dict | None:
+    """Validate ``[rates]`` (``given``; None when absent) and the rate fields of ``[inventory]`` (in place).
+
+    Returns the merged ``[rates]`` table (defaults filled, the rainfall record read into ``"_rainfall"``,
+    the warning list into ``"_warnings"``) or None.  Raises ``error`` naming the file, field and value.
+    """
+    from .closure import read_rainstorm_warnings
+    from ..io.rainfall import read_rainfall
+    from ..frequency.rates import _PERIODS, _SEASONS, _TRANSFORMS
+
+    path = Path(path)
+    base = path.parent
+
+    def number(v):
+        return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+    src = inventory.get("rate_from", "inventory")
+    if src not in RATE_SOURCES:
+        raise error(f"{path}: inventory.rate_from = {src!r} must be one of {list(RATE_SOURCES)} (the inventory's "
+                    "mean rate, or the expected rate of the [rates] model)")
+    climate = [k for k in ("rain_factor", "heavy_day_mm", "heavy_day_change") if inventory.get(k) is not None]
+    if climate and src != "rate_model":
+        raise error(f"{path}: inventory.{climate[0]} = {inventory[climate[0]]!r} states a change of climate for the "
+                    "rate model's rate; it needs inventory.rate_from = \"rate_model\"")
+    rf = inventory.get("rain_factor")
+    if rf is not None and (not number(rf) or rf <= 0):
+        raise error(f"{path}: inventory.rain_factor = {rf!r} must be a number > 0 (1.1: every rainfall 10 % heavier)")
+    hm, hc = inventory.get("heavy_day_mm"), inventory.get("heavy_day_change")
+    if (hm is None) != (hc is None):
+        raise error(f"{path}: inventory.heavy_day_mm = {hm!r} and inventory.heavy_day_change = {hc!r}: give both "
+                    "(the daily rainfall of a heavy-rain day and the change of their frequency, 0.1 = +10 %)")
+    if hm is not None and (not number(hm) or hm <= 0):
+        raise error(f"{path}: inventory.heavy_day_mm = {hm!r} must be a daily rainfall > 0 mm")
+    if hc is not None and (not number(hc) or hc <= -1):
+        raise error(f"{path}: inventory.heavy_day_change = {hc!r} must be a number > -1 (0.1 = heavy days 10 % "
+                    "more frequent)")
+    if given is None:
+        if src == "rate_model":
+            raise error(f"{path}: inventory.rate_from = \"rate_model\" needs a [rates] table (record, rainfall) to "
+                        "fit the rate model")
+        return None
+    if not isinstance(given, dict):
+        raise error(f"{path}: [rates] must be a table")
+    import difflib
+    for key in given:
+        if key not in RATES_FIELDS:
+            close = difflib.get_close_matches(key, list(RATES_FIELDS), n=1)
+            raise error(f"{path}: unknown field rates.{key!r}"
+                        + (f"; did you mean {close[0]!r}?" if close else f"; allowed: {', '.join(RATES_FIELDS)}"))
+    r = {k: given.get(k, v) for k, v in RATES_FIELDS.items()}
+    r["defaults_used"] = [f"rates.{k} = {v!r}" for k, v in RATES_FIELDS.items() if k not in given and v is not None]
+    if r["rainfall"] is None:
+        raise error(f"{path}: rates.rainfall is required (a daily rainfall file: the Hong Kong Observatory layout or "
+                    "the generic date,rainfall_mm CSV)")
+    if r["record"] is None and inventory.get("path") is None:
+        raise error(f"{path}: rates.record is required (the dated inventory the rate model counts)")
+    if r["record"] is None:
+        r["record"] = inventory.get("path")
+        for k in ("start", "end"):
+            r[k] = r[k] if r[k] is not None else inventory.get(k)
+        r["record_is_inventory"] = True
+        r["defaults_used"].append(f"rates.record = {r['record']!r} (inventory.path)")
+    else:
+        r["record_is_inventory"] = False
+    for key in ("record", "rainfall", "warnings"):
+        v = r[key]
+        if v is None:
+            continue
+        if not isinstance(v, str):
+            raise error(f"{path}: rates.{key} = {v!r} must be a file name")
+        if not (base / v).is_file():
+            raise error(f"{path}: rates.{key} = {v!r}: file not found ({(base / v).resolve()})")
+    for key in ("start", "end"):
+        if r[key] is not None:
+            try:
+                pd.Timestamp(str(r[key]))
+            except ValueError:
+                raise error(f"{path}: rates.{key} = {r[key]!r} is not a date YYYY-MM-DD") from None
+    if r["period"] not in _PERIODS:
+        raise error(f"{path}: rates.period = {r['period']!r} must be one of {list(_PERIODS)}")
+    w = r["windows_days"]
+    if not (isinstance(w, list) and w and all(isinstance(x, int) and not isinstance(x, bool) and x >= 1 for x in w)
+            and w == sorted(set(w))):
+        raise error(f"{path}: rates.windows_days = {w!r} must be increasing whole numbers of days >= 1, e.g. "
+                    "[1, 3, 15]")
+    if r["rain_transform"] not in _TRANSFORMS:
+        raise error(f"{path}: rates.rain_transform = {r['rain_transform']!r} must be one of {list(_TRANSFORMS)}")
+    season = None if r["season"] == "none" else r["season"]
+    if season not in _SEASONS:
+        raise error(f"{path}: rates.season = {r['season']!r} must be one of harmonic, wet, month, none")
+    r["season"] = season
+    if not isinstance(r["trend"], bool):
+        raise error(f"{path}: rates.trend = {r['trend']!r} must be true or false")
+    if hm is not None and (r["period"] != "day" or r["windows_days"][0] != 1):
+        raise error(f"{path}: inventory.heavy_day_mm needs a daily rate model whose first window is the day itself "
+                    f"(rates.period = 'day', windows_days starting with 1); got period {r['period']!r}, windows "
+                    f"{r['windows_days']!r}")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")       # gaps are reported again when the model is fitted
+            r["_rainfall"] = read_rainfall(base / r["rainfall"])
+    except ValueError as exc:
+        raise error(f"{path}: rates.rainfall = {r['rainfall']!r}: {exc}") from exc
+    # the record and its period against the rainfall (gaps, coverage with the antecedent window), read now
+    from ..frequency.inventory import READER_OPTIONS, read_inventory
+    reader = {k: inventory[k] for k in READER_OPTIONS if inventory.get(k) is not None} \
+        if r["record_is_inventory"] else {}
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")       # the reader's notes come again with the model's
+            record = read_inventory(base / r["record"], start=r["start"], end=r["end"], **reader)
+    except (ValueError, TypeError) as exc:
+        raise error(f"{path}: rates.record = {r['record']!r}: {exc}") from exc
+    if record.start is None or record.end is None:
+        raise error(f"{path}: rates.record = {r['record']!r}: its record period is unknown; give rates.start and "
+                    "rates.end (or a sidecar .toml with [record] start, end)")
+    lead = max(w) - 1 if r["period"] == "day" else 0
+    start = pd.Timestamp(record.start) - pd.Timedelta(days=lead)
+    try:
+        r["_rainfall"].check_covers(start, record.end, f"rates.record {r['record']!r} ({pd.Timestamp(record.start).date()} "
+                                    f"to {pd.Timestamp(record.end).date()}" + (f", with its {max(w)}-day antecedent "
+                                                                               "window)" if lead else ")"))
+    except ValueError as exc:
+        raise error(f"{path}: rates.rainfall = {r['rainfall']!r}: {exc}") from exc
+    r["_record"] = record
+    r["_warnings"] = None
+    if r["warnings"] is not None:
+        try:
+            r["_warnings"] = read_rainstorm_warnings(base / r["warnings"])
+        except ValueError as exc:
+            raise error(f"{path}: rates.warnings = {r['warnings']!r}: {exc}") from exc
+    return r
+
+
+def check_closure_options(options, rates: dict | None, path, error=ValueError) -> None:
+    """Closure options given as rules need a daily ``[rates]`` model, and warning rules its warning list."""
+    for o in options:
+        if o.kind != "closure" or not o.has_closure_rule:
+            continue
+        where = f"{path}: option {o.name!r}"
+        if rates is None:
+            raise error(f"{where}: a closure rule ({o.rule_text()}) is computed from the site's rate model: add a "
+                        "[rates] table (record, rainfall), or type share_while_closed and closure_hours_per_year "
+                        "(an assumption)")
+        if rates["period"] != "day":
+            raise error(f"{where}: a closure rule needs a daily rate model; rates.period = {rates['period']!r}")
+        if o.warning_levels is not None:
+            if rates["_warnings"] is None:
+                raise error(f"{where}: warning_levels = {list(o.warning_levels)!r} needs the rainstorm warning list: "
+                            "give rates.warnings (a file)")
+            known = set(rates["_warnings"]["level"])
+            bad = [v for v in o.warning_levels if v not in known]
+            if bad:
+                raise error(f"{where}: warning_levels {bad!r} do not occur in rates.warnings = "
+                            f"{rates['warnings']!r} (levels: {sorted(known)})")
+
+
+@dataclass(frozen=True)
+class SiteRates:
+    """What a run takes from the site's rate model (see the module docstring).
+
+    Attributes
+    ----------
+    record, rainfall : str
+        The dated record and the rainfall file the model was fitted to.
+    period : str
+        Counting period of the model.
+    preferred : str
+        The preferred count model (``"negative binomial"`` or ``"Poisson"``).
+    start, end : pandas.Timestamp
+        The record period.
+    observed_rate : float
+        Recorded events per year in the model's record [1/yr].
+    expected_rate : float
+        Expected events per year over the record's rainfall climate, trend at the end of the record [1/yr].
+    climate_rate : float
+        The same under the stated change of climate (= ``expected_rate`` when none) [1/yr].
+    climate : str
+        The stated change of climate in words ("" when none).
+    closures : dict
+        Option name -> :class:`riskrf.risk.closure.ClosureRule` for the closure options given as rules.
+    model_summary : pandas.DataFrame
+        :meth:`RateModel.summary` of the fitted model.
+    notes : tuple of str
+        Warnings raised while fitting.
+    """
+
+    record: str
+    rainfall: str
+    period: str
+    preferred: str
+    start: pd.Timestamp
+    end: pd.Timestamp
+    observed_rate: float
+    expected_rate: float
+    climate_rate: float
+    climate: str
+    closures: dict
+    model_summary: pd.DataFrame
+    notes: tuple = field(default_factory=tuple)
+
+    def rate_text(self) -> str:
+        """Where the hazard's rate comes from, in words, for rate_from = "rate_model"."""
+        every = {"day": "daily", "month": "monthly", "year": "yearly"}.get(self.period, self.period)
+        text = (f"expected rate of the {self.preferred} {every} rate model of {Path(self.record).name} "
+                f"({self.start.year}-{self.end.year}) on the rainfall of {Path(self.rainfall).name}: "
+                f"{self.expected_rate:.4g} events per year over the record's rainfall climate, trend at "
+                f"{self.end.year} (recorded mean {self.observed_rate:.4g})")
+        if self.climate:
+            text += (f"; under the stated change of climate ({self.climate}; an ASSUMPTION) "
+                     f"{self.climate_rate:.4g} events per year")
+        return text
+
+    def hazard_factor(self, inventory) -> float:
+        """Factor on ``rate_scale`` making the inventory's rate the model's: climate_rate / (sized falls / duration)."""
+        n = int(len(inventory.masses))
+        if n == 0:
+            raise ValueError(f"{inventory.source}: no sized falls; the rate model's rate cannot be split by size")
+        return self.climate_rate / (n / inventory.duration_years)
+
+    def summary(self) -> dict:
+        """Machine-readable figures (summary.json)."""
+        return {"record": self.record, "rainfall": self.rainfall, "period": self.period,
+                "preferred_model": self.preferred, "start": str(self.start.date()), "end": str(self.end.date()),
+                "observed_rate_per_year": self.observed_rate, "expected_rate_per_year": self.expected_rate,
+                "climate_change": self.climate or None, "climate_rate_per_year": self.climate_rate,
+                "closures": {name: {"rule": c.rule, "share_while_closed": c.effectiveness,
+                                    "recorded_share_while_closed": c.observed_share,
+                                    "closure_hours_per_year": c.closure_hours_per_year,
+                                    "closures_per_year": c.closures_per_year, "cost_per_hour": c.cost_per_hour,
+                                    "evaluated_from": str(c.start.date()), "evaluated_to": str(c.end.date())}
+                             for name, c in self.closures.items()},
+                "notes": list(self.notes)}
+
+
+def evaluate_rates(rates: dict, base, inventory: dict, options=()) -> SiteRates:
+    """Fit the rate model of a checked ``[rates]`` table (:func:`check_rates`) and compute the expected rates and
+    every closure rule among ``options``.  ``base`` is the directory paths are relative to."""
+    from .closure import closure_rule, warning_closure
+    from ..frequency.inventory import READER_OPTIONS, read_inventory
+    from ..frequency.rates import rate_model
+
+    base = Path(base)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        record = rates.get("_record")          # read by check_rates
+        if record is None:
+            reader = {}
+            if rates.get("record_is_inventory"):
+                reader = {k: inventory[k] for k in READER_OPTIONS if inventory.get(k) is not None}
+            record = read_inventory(base / rates["record"], start=rates["start"], end=rates["end"], **reader)
+        model = rate_model(record, rates["_rainfall"], period=rates["period"],
+                           windows_days=tuple(rates["windows_days"]), season=rates["season"], trend=rates["trend"],
+                           rain_transform=rates["rain_transform"])
+        expected = model.expected_annual_rate()
+        rf, hm, hc = inventory.get("rain_factor"), inventory.get("heavy_day_mm"), inventory.get("heavy_day_change")
+        climate = []
+        if rf is not None and rf != 1:
+            climate.append(f"every rainfall x {rf:g}")
+        if hm is not None and hc:
+            climate.append(f"days with >= {hm:g} mm {hc:+.0%} as frequent")
+        changed = model.expected_annual_rate(rain_factor=rf if rf is not None else 1.0, heavy_day_mm=hm,
+                                             heavy_day_change=hc or 0.0) if climate else expected
+        closures = {}
+        for o in options:
+            if o.kind != "closure" or not o.has_closure_rule:
+                continue
+            if o.threshold_mm is not None:
+                closures[o.name] = closure_rule(model, o.threshold_mm, window_days=int(o.window_days or 1),
+                                                cost_per_hour=o.cost_per_closure_hour)
+            else:
+                closures[o.name] = warning_closure(model, rates["_warnings"], levels=o.warning_levels,
+                                                   cost_per_hour=o.cost_per_closure_hour)
+    notes = []
+    for w in [str(c.message) for c in caught if issubclass(c.category, UserWarning)] + list(model.notes):
+        if w not in notes:
+            notes.append(w)
+    years = model.design["exposure_days"].sum() / 365.25
+    return SiteRates(record=str(base / rates["record"]), rainfall=str(base / rates["rainfall"]), period=model.period,
+                     preferred=model.preferred, start=model.start, end=model.end,
+                     observed_rate=float(model.n_events / years), expected_rate=float(expected),
+                     climate_rate=float(changed), climate="; ".join(climate), closures=closures,
+                     model_summary=model.summary(), notes=tuple(notes))
+
+
+def resolve_closures(options, site_rates: SiteRates | None) -> tuple:
+    """The options with each closure rule's share and hours filled in from ``site_rates`` (costs added to the
+    annual maintenance, the rule and its source in ``closure_rule``); other options unchanged."""
+    out = []
+    for o in options:
+        if o.kind == "closure" and o.has_closure_rule:
+            if site_rates is None or o.name not in site_rates.closures:
+                raise ValueError(f"option {o.name!r}: its closure rule was not evaluated (no rate model)")
+            c = site_rates.closures[o.name]
+            o = replace(o, share_while_closed=float(c.effectiveness),
+                        closure_hours_per_year=float(c.closure_hours_per_year),
+                        annual_maintenance=o.annual_maintenance + c.annual_cost,
+                        closure_rule=(f"{c.rule}, computed from the {site_rates.preferred} daily rate model of "
+                                      f"{Path(site_rates.record).name} and {Path(site_rates.rainfall).name} over "
+                                      f"{c.start.year}-{c.end.year} (recorded falls on closed time: "
+                                      f"{c.observed_share:.1%})"))
+        out.append(o)
+    return tuple(out)
