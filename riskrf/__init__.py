@@ -24,11 +24,11 @@ _EXPORTS = {
     "FrequencyAnalysis": "frequency.study", "analyse_inventory": "frequency.study",
     "exceedance_probability": "hazard.impact_energy", "fit_velocity": "hazard.impact_energy",
     "DEFAULT_DENSITY_KG_M3": "frequency.inventory", "Inventory": "frequency.inventory", "read_inventory": "frequency.inventory",
-    "MassCoupledSamples": "hazard.mass_coupling", "energy_hazard": "hazard.mass_coupling",
+    "MassCoupledSamples": "hazard.mass_coupling", "energy_hazard": "hazard.simulated",
     "GutenbergRichterFit": "frequency.power_law", "find_m_min": "frequency.power_law", "fit_gutenberg_richter": "frequency.power_law",
     "Rainfall": "io.rainfall", "read_rainfall": "io.rainfall",
     "RateModel": "frequency.rates", "rate_model": "frequency.rates",
-    "RiskrfWarning": "core.validation",
+    "RiskrfError": "core.validation", "RiskrfWarning": "core.validation",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -117,8 +117,9 @@ def cmd_fit(args) -> int:
             sys.stderr.write("\n")          # end the bar's line: the error or "interrupted" gets its own
         raise
     print(analysis.summary_text())
+    from .report.files import write_frequency_study
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
-        analysis.write(tmp)
+        write_frequency_study(analysis, tmp)
     print(f"\nWrote summary.json, design_masses.csv, completeness.csv and figures to {out}/")
     return 0
 
@@ -305,8 +306,9 @@ def cmd_energy(args) -> int:
     print(f"Inventory {inv.source}: power law b = {gr.b:.4f} ± {gr.b_stderr:.4f} above m_min = {sig(gr.m_min, 5)} kg "
           f"({gr.n_tail} falls, {sig(gr.rate_min, 4)} per year)" + (f", m_max = {sig(gr.m_max, 5)} kg" if gr.m_max else ""))
     print(analysis.summary_text())
+    from .report.files import write_energy_study
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
-        written = analysis.write(tmp)
+        written = write_energy_study(analysis, tmp)
     tables = [p.name for p in written if p.suffix != ".png"]
     figures = [p.name for p in written if p.suffix == ".png"]
     print(f"\nWrote {', '.join(tables)} and {len(figures)} figures ({', '.join(figures)}) to {out}/")
@@ -837,8 +839,9 @@ def cmd_rates(args) -> int:
         table = pd.concat([r.summary()["value"].rename(f"rule {i + 1}") for i, r in enumerate(rules)], axis=1)
         print("\nClosure rules (effectiveness = share of falls while closed, from the rate model):")
         print(table.to_string())
+    from .report.rate_figures import write_rate_study
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
-        model.write(tmp)
+        write_rate_study(model, tmp)
         if rules:
             pd.concat([r.summary()["value"].rename(f"rule {i + 1}") for i, r in enumerate(rules)], axis=1).to_csv(
                 tmp / "closure_rules.csv")

@@ -148,3 +148,47 @@ def test_compile_kernel_runs_on_no_blocks():
             "print(sorted({'pandas', 'scipy.stats'} & set(sys.modules)))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=300)
     assert out.stdout.strip() == "[]"
+
+
+def test_old_module_paths_still_import_with_a_deprecation_warning():
+    """The flat module paths of before the stage layout (``riskrf.assess``, ``riskrf.rate_model``, ...) import the
+    module at its new path, the same object, with a DeprecationWarning naming that path; the public function
+    ``riskrf.rate_model`` stays the function."""
+    code = ("import warnings, sys; warnings.simplefilter('error', DeprecationWarning)\n"
+            "import riskrf, riskrf.app.assess as new\n"
+            "try:\n    import riskrf.assess\nexcept DeprecationWarning as w:\n    print(w)\n"
+            "warnings.simplefilter('ignore', DeprecationWarning)\n"
+            "import riskrf.assess, riskrf.rate_model\n"
+            "from riskrf.inventory import read_inventory\n"
+            "print(sys.modules['riskrf.assess'] is new, new.__spec__.name, callable(riskrf.rate_model),\n"
+            "      sys.modules['riskrf.rate_model'].__name__, read_inventory is riskrf.read_inventory)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
+    assert "riskrf.assess is deprecated" in out[0] and "import riskrf.app.assess" in out[0]
+    assert out[1].split() == ["True", "riskrf.app.assess", "True", "riskrf.frequency.rates", "True"]
+
+
+def test_old_module_paths_cover_every_moved_module():
+    """Each old path of the alias table names a module that exists at its new path, and no file is left at it."""
+    import importlib.util
+    from pathlib import Path
+
+    from riskrf._compat import MOVED
+    root = Path(riskrf.__file__).parent
+    for old, new in MOVED.items():
+        assert importlib.util.find_spec(new) is not None, new
+        assert not (root / f"{old.split('.', 1)[1]}.py").exists(), old
+
+
+def test_every_input_error_is_a_riskrf_error():
+    """One base for riskrf's input errors; each keeps the built-in base it had (ValueError)."""
+    from riskrf.app.corridor import CorridorError
+    from riskrf.app.site import SiteError
+    from riskrf.hazard.mass_coupling import NoArrivalsError
+    from riskrf.risk.decision_tree import TreeError
+    from riskrf.risk.measures import MeasureError
+    from riskrf.risk.mitigation_inputs import MitigationError
+    assert "RiskrfError" in riskrf.__all__
+    for cls in (CorridorError, SiteError, NoArrivalsError, TreeError, MeasureError, MitigationError):
+        assert issubclass(cls, riskrf.RiskrfError) and issubclass(cls, ValueError), cls
+    with pytest.raises(riskrf.RiskrfError, match="node type 'nonsense'"):
+        riskrf.DecisionTree.from_dict({"name": "tree", "type": "nonsense"})

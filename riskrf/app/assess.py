@@ -34,7 +34,7 @@ from ..hazard.energy_study import (
 )
 from ..frequency.study import FrequencyAnalysis, analyse_inventory
 from ..frequency.inventory import Inventory, read_inventory
-from ..hazard.mass_coupling import energy_hazard
+from ..hazard.simulated import energy_hazard
 from ..risk.mitigation import MitigationStudy
 from ..io.outputs import relative_paths, relative_paths_in_json_files, write_json
 from ..frequency.power_law import fit_gutenberg_richter
@@ -419,7 +419,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                                 design_block=block, sensitivity=sensitivity, tornado=tornado)
         timings["energy"] = round(time.perf_counter() - t, 2)
         if figures is not None:
-            pending.append(InBackground(partial(energy.write, figures)))
+            from ..report.files import write_energy_study
+            pending.append(InBackground(partial(write_energy_study, energy, figures)))
 
         t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
         share = road_share(result, hz_cfg["collector"], hz_cfg["road_collector"])
@@ -460,6 +461,7 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     log = log or logger.info
     from ..report.html import render_report
     from ..report.mitigation_text import write_mitigation_outputs, write_tree_figure
+    from ..report.files import write_energy_study
 
     log("[5/5] writing the report, tables and figures")
     t = time.perf_counter()
@@ -483,7 +485,7 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
 
         beside = InBackground(simulation_and_decision_outputs)
         _frequency_outputs(a.frequency, a.maxima_frequency, figs)
-        a.energy.write(figs)
+        write_energy_study(a.energy, figs)
         beside.result()
     for name in ("summary.json", "completeness.csv", "whole_wall_design_masses.csv"):
         shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
@@ -510,11 +512,12 @@ WHOLE_WALL_BASIS = ("whole monitored wall (inventory fit), untruncated power law
 def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:
     """Tables and figures of the inventory's fits (and of the annual-maximum record, in a subfolder), their
     design-mass tables labelled as references, not the site's design masses."""
-    frequency.write(figs, design_masses_name="whole_wall_design_masses", basis=WHOLE_WALL_BASIS)
+    from ..report.files import write_frequency_study
+    write_frequency_study(frequency, figs, design_masses_name="whole_wall_design_masses", basis=WHOLE_WALL_BASIS)
     if maxima_frequency is not None:
         sub = figs / "annual_maxima"
         sub.mkdir()
-        maxima_frequency.write(sub, design_masses_name="record_design_masses",
+        write_frequency_study(maxima_frequency, sub, design_masses_name="record_design_masses",
                                basis=f"annual-maximum record {Path(str(maxima_frequency.inventory.source)).name}: "
                                      "another record's fit, untruncated: reference only, not this site's design "
                                      "masses")

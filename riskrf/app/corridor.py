@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..core.validation import RiskrfError
 from ..risk import rhrs
 from ..risk.mitigation_inputs import MitigationError, parse_mitigation
 from ..core.units import DEFAULT_DENSITY_KG_M3, M_PER_KM
@@ -64,7 +65,7 @@ CREST_M = 5.0
 VERGE_M = 10.0
 
 
-class CorridorError(ValueError):
+class CorridorError(RiskrfError, ValueError):
     """A corridor file or sections table is invalid; the message lists every bad field found."""
 
 
@@ -690,7 +691,7 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
     """The whole chain for one section; returns one row of the corridor table (plain numbers and strings).
 
     The hazard at the barrier line is mass-coupled exactly as in ``riskrf assess``
-    (:func:`riskrf.hazard.mass_coupling.simulate_energy_hazard`: ``n`` blocks with masses log-uniform over the corridor's
+    (:func:`riskrf.hazard.simulated.simulate_energy_hazard`: ``n`` blocks with masses log-uniform over the corridor's
     mass law, reach and speed by mass class).  The share of falls reaching the road and, for ``rate_basis = "road"``,
     the release rate behind the recorded road falls (given / P(reach road)) come from the same mass-coupled run.
     A second run of ``n`` blocks with the scenario's own seeder is the reference of the option effects
@@ -700,7 +701,8 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
     import simulation
 
     from ..hazard.impact_energy import mass_model
-    from ..hazard.mass_coupling import NoArrivalsError, simulate_energy_hazard
+    from ..hazard.mass_coupling import NoArrivalsError
+    from ..hazard.simulated import simulate_energy_hazard
     from ..risk.measures import SimulationContext
     from ..risk.mitigation import MitigationStudy
 

@@ -13,11 +13,12 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..core.validation import RiskrfError
 from ..risk.mitigation import MitigationError, study_inputs
 from ..risk.site_rates import INVENTORY_RATE_FIELDS, check_closure_options, check_rates
 
 
-class SiteError(ValueError):
+class SiteError(RiskrfError, ValueError):
     """A site file is invalid; the message names the file and the field."""
 
 

@@ -25,5 +25,8 @@ HOURS_PER_DAY = 24.0
 DAYS_PER_YEAR = 365.25
 M_PER_KM = 1000.0
 
-__all__ = ["CYLINDER_INERTIA", "DAYS_PER_YEAR", "DEFAULT_DENSITY_KG_M3", "HOURS_PER_DAY", "INERTIA_FACTORS", "J_PER_KJ", "KG_PER_TONNE",
+#: Return periods of the design tables (design masses, design energies) [yr].
+DESIGN_RETURN_PERIODS = (10, 50, 100, 300, 1000)
+
+__all__ = ["CYLINDER_INERTIA", "DAYS_PER_YEAR", "DEFAULT_DENSITY_KG_M3", "DESIGN_RETURN_PERIODS", "HOURS_PER_DAY", "INERTIA_FACTORS", "J_PER_KJ", "KG_PER_TONNE",
            "M_PER_KM", "SEL_PER_MEL", "SPHERE_INERTIA", "STANDARD_GRAVITY_MS2", "kinetic_energy_kj", "mass_for_energy_kg"]

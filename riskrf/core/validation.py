@@ -6,6 +6,12 @@ import warnings
 import numpy as np
 
 
+class RiskrfError(Exception):
+    """Base of every riskrf input error (site, corridor, mitigation, measures, decision tree, nil hazard), so that
+    ``except riskrf.RiskrfError`` catches them all.  Each concrete error also derives from the built-in it was
+    before (:class:`ValueError`), so existing ``except ValueError`` code keeps working."""
+
+
 class RiskrfWarning(UserWarning):
     """A result was computed, but a user should know something about it."""
 

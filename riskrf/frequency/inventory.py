@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from ..io.tables import is_blank, parse_dates, parse_numbers, read_table, sniff_delimiter  # noqa: F401 (re-exported)
-from ..report.format import sig
+from ..core.format import sig
 from ..core.units import DEFAULT_DENSITY_KG_M3, KG_PER_TONNE
 from ..core.validation import check_positive, warn
 

@@ -320,7 +320,9 @@ class RateModel:
 
     def write(self, out_dir) -> list[Path]:
         """Write rate_ratios.csv, model_comparison.csv, season.csv, design.csv, rainfall_response.csv
-        (daily models) and the figures seasonality.png and rainfall_response.png into ``out_dir``."""
+        (daily models with rainfall terms) into ``out_dir``; returns the files written.  The figures
+        (seasonality.png, rainfall_response.png) are drawn by :func:`riskrf.report.rate_figures.write_rate_study`,
+        which calls this first."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         written = []
@@ -331,14 +333,18 @@ class RateModel:
         for name, table, index in tables:
             table.to_csv(out / name, index=index)
             written.append(out / name)
-        response = None
-        if self.period == "day" and any(self.terms["term"].str.startswith("rain_")):
-            response = self.predicted_by_rainfall()
+        response = self.rainfall_response()
+        if response is not None:
             response.to_csv(out / "rainfall_response.csv", index=False)
             written.append(out / "rainfall_response.csv")
-        from ..report.rate_figures import write_rate_figures
-        written += write_rate_figures(self, out, response)
         return written
+
+    def rainfall_response(self):
+        """:meth:`predicted_by_rainfall` for a daily model with rainfall terms, else None (the table and figure
+        ``rainfall_response`` are written only then)."""
+        if self.period == "day" and any(self.terms["term"].str.startswith("rain_")):
+            return self.predicted_by_rainfall()
+        return None
 
 
 _TRANSFORMS = {"linear": lambda x: x, "sqrt": np.sqrt, "log1p": np.log1p}

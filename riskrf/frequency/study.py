@@ -22,11 +22,10 @@ from .power_law import (
     PowerLawBootstrap,
     fit_gutenberg_richter,
 )
-from ..report.format import sig
+from ..core.format import sig
+from ..core.units import DESIGN_RETURN_PERIODS  # noqa: F401  (also importable from here, as before)
 from ..core.validation import RiskrfWarning
 
-#: Return periods of the design-mass table [yr].
-DESIGN_RETURN_PERIODS = (10, 50, 100, 300, 1000)
 
 
 @dataclass(frozen=True)
@@ -246,15 +245,14 @@ class FrequencyAnalysis:
         return "\n".join(lines)
 
     def write(self, out_dir, *, design_masses_name: str = "design_masses", basis: str | None = None) -> list[Path]:
-        """Write summary.json, design_masses.csv, completeness.csv and PNG figures into ``out_dir``.
+        """Write summary.json, design_masses.csv and completeness.csv into ``out_dir``; returns the files written.
+        The figures are drawn by :func:`riskrf.report.files.write_frequency_study`, which calls this first.
 
         ``basis``: what the design-mass table is, when it is not the site's own (``riskrf assess`` labels the
         whole wall's fit and another record's so): a ``basis`` column in the table, written as
         ``design_masses_name``.csv, and in summary.json the table under ``design_masses_name`` with
         ``design_masses_name``_basis.
         """
-        from ..report.files import write_frequency_figures
-
         out = Path(out_dir)
         data, table = self.to_dict(), self.design_masses()
         if basis is not None:
@@ -264,9 +262,7 @@ class FrequencyAnalysis:
         write_json(data, out / "summary.json")
         table.to_csv(out / f"{design_masses_name}.csv", index=False)
         self.inventory.completeness().to_csv(out / "completeness.csv")
-        written = [out / "summary.json", out / f"{design_masses_name}.csv", out / "completeness.csv"]
-        written += write_frequency_figures(self, out)
-        return written
+        return [out / "summary.json", out / f"{design_masses_name}.csv", out / "completeness.csv"]
 
 
 def analyse_inventory(inventory: Inventory, *, m_min=None, method: str = "mle", m_max=None,

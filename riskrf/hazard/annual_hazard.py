@@ -17,18 +17,17 @@ import pandas as pd
 from scipy import optimize
 
 from ..frequency.extremes import _AnnualMaximumFit
-from ..frequency.study import DESIGN_RETURN_PERIODS
 from .impact_energy import (
     PairedSamples,
     VelocityFit,
     exceedance_function,
     exceedance_probability,
+    is_mass_coupled,
     mass_model,
 )
-from .mass_coupling import MassCoupledSamples
 from ..frequency.power_law import GutenbergRichterFit
-from ..report.format import sig
-from ..core.units import SPHERE_INERTIA
+from ..core.format import sig
+from ..core.units import DESIGN_RETURN_PERIODS, SPHERE_INERTIA
 from ..core.validation import check_positive, check_probability_level, check_return_periods
 
 
@@ -110,7 +109,7 @@ class EnergyHazard:
     @property
     def mass_coupled(self) -> bool:
         """Whether reach, speed and bounce height depend on block mass (:func:`riskrf.energy_hazard`)."""
-        return isinstance(self.velocity, MassCoupledSamples)
+        return is_mass_coupled(self.velocity)
 
     def with_mass(self, mass, rate_per_year: float | None = None) -> "EnergyHazard":
         """The same slope with another mass model (and rate): a mass-coupled reach probability is recomputed."""
@@ -139,7 +138,7 @@ class EnergyHazard:
 
         With a mass-coupled model and ``mass_kg``: of the simulated blocks of that mass (its mass class)."""
         v = self.velocity
-        if isinstance(v, MassCoupledSamples) and mass_kg is not None:
+        if is_mass_coupled(v) and mass_kg is not None:
             return v.velocity_percentile(q, mass_kg)
         if isinstance(v, VelocityFit):
             v = v.dist
@@ -267,7 +266,7 @@ class EnergyHazard:
     def _velocity_nodes(self):
         """Velocity samples compressed to at most 2048 equal-probability quantiles (for the bootstrap)."""
         v = self.velocity
-        if isinstance(v, (VelocityFit, PairedSamples, MassCoupledSamples)) or hasattr(v, "pdf"):
+        if isinstance(v, (VelocityFit, PairedSamples)) or is_mass_coupled(v) or hasattr(v, "pdf"):
             return v
         v = np.sort(np.asarray(v, dtype=float))
         if v.size <= 2048:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..report.format import sig
+from ..core.format import sig
 from ..core.units import DAYS_PER_YEAR, SEL_PER_MEL, kinetic_energy_kj
 from ..core.validation import check_positive
 

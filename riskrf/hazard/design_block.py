@@ -49,8 +49,8 @@ import numpy as np
 import pandas as pd
 
 from ..frequency.inventory import SIZES  # one home: what an inventory's sizes can be
-from ..report.format import sig
-from ..core.units import DEFAULT_DENSITY_KG_M3, kinetic_energy_kj
+from ..core.format import sig
+from ..core.units import DEFAULT_DENSITY_KG_M3, DESIGN_RETURN_PERIODS, kinetic_energy_kj
 
 #: The percentile band of ONR 24810:2021 for the design block [%].
 ONR24810_PERCENTILES = (95.0, 98.0)
@@ -254,7 +254,7 @@ def _law_text(hazard) -> str:
     return f"{mass_model(m).description}, {sig(hazard.rate_per_year)} falls/yr"
 
 
-def site_design_masses(hazard, T=(10, 50, 100, 300, 1000),
+def site_design_masses(hazard, T=DESIGN_RETURN_PERIODS,
                        density_kg_m3: float = DEFAULT_DENSITY_KG_M3) -> pd.DataFrame:
     """Design masses [kg] of the site's law (the hazard's: truncated at m_max, rate scaled to the source above the
     line): the T-year fall at the source and the T-year fall reaching the line; NaN where fewer than one such fall

@@ -9,11 +9,10 @@ import pandas as pd
 
 from .annual_hazard import EnergyHazard
 from .barriers import UNI11211_FACTORS, check_fence, uni11211_design_energy
-from ..frequency.study import DESIGN_RETURN_PERIODS
 from ..io.outputs import write_json
 from ..frequency.power_law import GutenbergRichterFit, fit_gutenberg_richter
-from ..report.format import sig
-from ..core.units import DEFAULT_DENSITY_KG_M3, kinetic_energy_kj
+from ..core.format import sig
+from ..core.units import DEFAULT_DENSITY_KG_M3, DESIGN_RETURN_PERIODS, kinetic_energy_kj
 
 #: What the bootstrap interval of a design energy covers, and what it does not (stated with every interval).
 INTERVAL_COVERS = ("sampling uncertainty of the power-law exponent b and of the rate, and the finite number of "
@@ -162,10 +161,10 @@ class EnergyAnalysis:
         return out
 
     def write(self, out_dir) -> list[Path]:
-        """Write ``energy_summary.json``, the CSV tables (design energies, sensitivity, tornado) and the figures
-        into ``out_dir`` (which must exist); returns every file written.
+        """Write ``energy_summary.json`` and the CSV tables (design energies, sensitivity, tornado) into ``out_dir``
+        (which must exist); returns every file written.  The figures are drawn by
+        :func:`riskrf.report.files.write_energy_study`, which calls this first.
         """
-        from ..report.files import write_energy_figures
         out = Path(out_dir)
         written = [out / "energy_summary.json", out / "design_energies.csv"]
         write_json(self.to_dict(), written[0])
@@ -180,7 +179,6 @@ class EnergyAnalysis:
             if table is not None:
                 table.to_csv(out / name, index=False)
                 written.append(out / name)
-        written += write_energy_figures(self, out, [float(n.split(" kJ")[0]) for n in self.fences])
         return written
 
 def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_board_m: float = 0.5,

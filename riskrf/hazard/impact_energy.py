@@ -35,9 +35,8 @@ import pandas as pd
 from scipy import optimize, stats
 
 from ..frequency.extremes import _AnnualMaximumFit
-from .mass_coupling import MassCoupledSamples
 from ..frequency.power_law import GutenbergRichterFit
-from ..report.format import sig
+from ..core.format import sig
 from ..core.units import DEFAULT_DENSITY_KG_M3, J_PER_KJ, SPHERE_INERTIA, kinetic_energy_kj, mass_for_energy_kg
 from ..core.validation import check_choice, check_positive
 
@@ -62,6 +61,17 @@ class VelocityFit:
         """The candidate table: distribution, parameters, log-likelihood, AIC and whether it was chosen."""
         return self.table
 
+
+def is_mass_coupled(velocity) -> bool:
+    """Whether ``velocity`` is a mass-coupled velocity model: reach, speed and bounce height by block mass class
+    (:class:`~riskrf.hazard.mass_coupling.MassCoupledSamples`, from :func:`riskrf.energy_hazard`).
+
+    Such a model declares ``mass_coupled_velocity = True`` and provides ``exceedance_function(mass_model)``
+    (e [kJ] -> P(E > e) per arriving fall), ``velocity_percentile(q, mass_kg)``, ``class_of(mass_kg)``,
+    ``n_bins`` and ``mass_kg``.  A declared flag, not the class, so that this module does not import the
+    module that builds such models from simulations.
+    """
+    return getattr(type(velocity), "mass_coupled_velocity", False) is True
 
 def fit_velocity(samples, candidates=("normal", "lognormal", "gamma", "weibull")) -> VelocityFit:
     """Fit candidate distributions to velocity samples [m/s] by maximum likelihood and keep the lowest AIC.
@@ -254,7 +264,7 @@ def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, 
         velocity = velocity.dist
     if isinstance(velocity, PairedSamples):
         return _conditional_on_mass(e, mm, velocity)
-    if isinstance(velocity, MassCoupledSamples):
+    if is_mass_coupled(velocity):
         # per arriving fall: P(E > e, reach) / P(reach), both integrated over the mass model
         return velocity.exceedance_function(mm)(e)
     if hasattr(velocity, "pdf") and hasattr(velocity, "isf"):
@@ -279,7 +289,7 @@ def exceedance_function(mass, velocity):
     The same values as :func:`exceedance_probability` (default quadrature); use it where one
     curve is evaluated many times (root finding for design energies).
     """
-    if isinstance(velocity, MassCoupledSamples):
+    if is_mass_coupled(velocity):
         return velocity.exceedance_function(mass_model(mass))
     return lambda energy_kj: exceedance_probability(energy_kj, mass, velocity)
 
@@ -366,7 +376,7 @@ def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=Non
     w = None
     if isinstance(velocity, VelocityFit):
         velocity = velocity.dist
-    if isinstance(velocity, MassCoupledSamples):
+    if is_mass_coupled(velocity):
         cls = velocity.class_of(m)
         members = [np.flatnonzero(velocity.class_of(velocity.mass_kg) == c) for c in range(velocity.n_bins)]
         pick = np.empty(m.size, dtype=np.int64)

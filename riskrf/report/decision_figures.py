@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..risk.road_risk import HK_GEO_FN_LINES, HK_GEO_N_CUTOFF, HK_GEO_N_LIMIT, HK_GEO_SCRUTINY_F_MIN
-from .fit_figures import _axes
+from .axes import _axes
 
 
 def _fmt(v):

@@ -140,3 +140,16 @@ def write_simulation_figures(result, out: Path, collectors, *, file_names=None, 
         axes = plot_envelopes(result)
         written.append(save_figure(axes[0].figure, out / "envelopes.png"))
     return written
+
+
+def write_frequency_study(analysis, out: Path, **options) -> list[Path]:
+    """Every file of a :class:`~riskrf.FrequencyAnalysis`: its data files (:meth:`~riskrf.FrequencyAnalysis.write`,
+    ``options`` passed on) then its figures; returns every file written."""
+    return analysis.write(out, **options) + write_frequency_figures(analysis, Path(out))
+
+
+def write_energy_study(analysis, out: Path) -> list[Path]:
+    """Every file of an energy study (:class:`~riskrf.hazard.energy_study.EnergyAnalysis`): its data files, then
+    the figures, with the checked fences' capacities drawn on the exceedance curve; returns every file written."""
+    written = analysis.write(out)
+    return written + write_energy_figures(analysis, Path(out), [float(n.split(" kJ")[0]) for n in analysis.fences])

@@ -8,13 +8,7 @@ import pandas as pd
 
 from ..frequency.extremes import _n_unknown_years, gumbel_reduced_variate, plotting_positions
 from ..core.units import KG_PER_TONNE, mass_for_energy_kg
-
-
-def _axes(ax, figsize=(6.4, 4.8)):
-    if ax is not None:
-        return ax
-    import matplotlib.pyplot as plt
-    return plt.figure(figsize=figsize).add_subplot()
+from .axes import _axes
 
 
 def plot_magnitude_frequency(fit, ax=None, *, level_label=True):

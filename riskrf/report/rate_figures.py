@@ -1,4 +1,4 @@
-"""Figures of a rate model (riskrf.rate_model): seasonality and the response to rainfall."""
+"""Figures of a rate model (riskrf.frequency.rates): seasonality and the response to rainfall."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -41,3 +41,10 @@ def write_rate_figures(model, out: Path, response) -> list[Path]:
         ax.legend(fontsize=8)
         written.append(save_figure(fig, out / "rainfall_response.png", tight_layout=True))
     return written
+
+
+def write_rate_study(model, out: Path) -> list[Path]:
+    """Every file of a :class:`~riskrf.RateModel`: its tables (:meth:`~riskrf.RateModel.write`), then the
+    seasonality and (daily models with rainfall terms) rainfall-response figures."""
+    written = model.write(out)
+    return written + write_rate_figures(model, Path(out), model.rainfall_response())

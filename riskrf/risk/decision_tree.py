@@ -37,13 +37,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..core.validation import RiskrfError
+
 PROBABILITY_TOLERANCE = 1e-6
 
 _OPS = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
         ast.Pow: operator.pow, ast.USub: operator.neg, ast.UAdd: operator.pos}
 
 
-class TreeError(ValueError):
+class TreeError(RiskrfError, ValueError):
     """A decision tree is malformed; the message names the node path and the field."""
 
 

@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..core.validation import RiskrfError
 from ..hazard.annual_hazard import inertia_factors
 
 #: Horizontal run per unit drop of the ditch wall on the slope side (steep, 0.25H:1V) and of the
@@ -29,7 +30,7 @@ DITCH_INNER_SLOPE_HV = 0.25
 DITCH_OUTER_SLOPE_HV = 1.0
 
 
-class MeasureError(ValueError):
+class MeasureError(RiskrfError, ValueError):
     """An option's geometry does not fit the site; the message names the option and field."""
 
 

@@ -84,7 +84,7 @@ from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.risk.mit
     parse_option,
 )
 from ..frequency.power_law import GutenbergRichterFit
-from ..report.format import money, probability
+from ..core.format import money, probability
 from .road_risk import (
     commuter_passage_probability,
     commuter_strike_probability,

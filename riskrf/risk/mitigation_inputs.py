@@ -11,8 +11,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..core.validation import RiskrfError
 from .measures import Ditch, MeasureError
-from ..report.format import money
+from ..core.format import money
 from .road_risk import (
     AGS2007_INDIVIDUAL_RISK,
     VULNERABILITY_DIRECT_BY_MASS,
@@ -27,7 +28,7 @@ DEFAULT_REPAIR_DAYS = {"fence": 30.0, "attenuator": 30.0, "shed": 180.0}
 MASS_BINS = 120
 
 
-class MitigationError(ValueError):
+class MitigationError(RiskrfError, ValueError):
     """A mitigation file or option is invalid; the message names the option and field."""
 
 

@@ -1,0 +1,139 @@
+"""The impact-energy hazard at a line from trajectories simulated across the whole mass range.
+
+:func:`energy_hazard` runs the simulator (:mod:`simulation`) with block masses spread log-uniformly over the
+mass model's range and builds an :class:`~riskrf.hazard.annual_hazard.EnergyHazard` whose velocity model is a
+:class:`~riskrf.hazard.mass_coupling.MassCoupledSamples` (reach, speed and bounce height by mass class; the
+method and its references are in :mod:`riskrf.hazard.mass_coupling`).  The only hazard module that runs the
+simulator.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+import simulation
+
+from ..core.format import sig
+from ..core.units import DESIGN_RETURN_PERIODS
+from ..core.validation import check_positive
+from ..frequency.power_law import GutenbergRichterFit
+from .annual_hazard import EnergyHazard, inertia_factors
+from .impact_energy import mass_model
+from .mass_coupling import MassCoupledSamples, NoArrivalsError, default_mass_range, stratified_log_uniform
+
+
+def energy_hazard(mass, scenario, collector: str = "barrier", *, rate_per_year=None, n: int = 20_000, seed=1,
+                  mass_range_kg=None, design_masses_kg=(), n_bins: int | None = None, rotational: bool = True,
+                  return_periods=DESIGN_RETURN_PERIODS):
+    """Annual impact-energy hazard at a line with reach, speed and bounce height coupled to block mass.
+
+    Parameters
+    ----------
+    mass : GutenbergRichterFit (usually truncated at m_max), Gumbel/GEV fit or scipy distribution
+        Mass model [kg] of the falls at the source.
+    scenario : simulation.Scenario or path to a scenario TOML
+        The slope; its seeder's mass distribution is replaced by the simulated mass range.
+    collector : str
+        The line (a collector of the scenario).
+    rate_per_year : float, optional
+        Falls per year described by ``mass`` (default: the power law's rate above m_min).
+    n : int
+        Blocks simulated (masses log-uniform over the range, stratified).
+    seed : int
+        Seed of the simulation (same seed, same numbers).
+    mass_range_kg : (low, high), optional
+        Simulated masses [kg]; default :func:`default_mass_range`, widened to include ``design_masses_kg``.
+    design_masses_kg : sequence of float
+        Masses [kg] that design values will be read at (a design block, a larger m_max of a sensitivity
+        study): they must lie inside the simulated range (an error names the first that does not).
+    n_bins : int, optional
+        Mass classes (default n // 400 within 4-24).
+    rotational : bool
+        Include the rotational energy (V_eff^2 = v^2 + k (w r)^2).
+    return_periods : sequence of float
+        Return periods [yr] whose T-year blocks at the source (``mass.isf(1 / (T rate))``) must also lie inside
+        the simulated range.
+
+    Returns
+    -------
+    EnergyHazard with ``velocity`` a :class:`~riskrf.hazard.mass_coupling.MassCoupledSamples` and the mass-averaged reach probability.
+    """
+    return simulate_energy_hazard(mass, scenario, collector, rate_per_year=rate_per_year, n=n, seed=seed,
+                                  mass_range_kg=mass_range_kg, design_masses_kg=design_masses_kg, n_bins=n_bins,
+                                  rotational=rotational, return_periods=return_periods)[0]
+
+
+def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_per_year=None, n: int = 20_000,
+                           seed=1, mass_range_kg=None, design_masses_kg=(), n_bins: int | None = None,
+                           rotational: bool = True, return_periods=DESIGN_RETURN_PERIODS):
+    """:func:`energy_hazard` that also returns the :class:`simulation.SimulationResult`: (hazard, result)."""
+    mm = mass_model(mass)
+    if rate_per_year is None:
+        if not isinstance(mass, GutenbergRichterFit):
+            raise ValueError("rate_per_year is needed unless the mass model is a power-law fit")
+        rate_per_year = mass.rate_min
+    rate = check_positive(rate_per_year, "rate_per_year")
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 100:
+        raise ValueError(f"n = {n!r}: simulate at least 100 blocks across the mass range")
+    design = np.atleast_1d(np.asarray(design_masses_kg, dtype=float))
+    if design.size and np.any(~np.isfinite(design) | (design <= 0)):
+        raise ValueError(f"design_masses_kg = {design.tolist()}: masses must be finite and > 0 kg")
+    T = np.atleast_1d(np.asarray(return_periods, dtype=float))
+    T = T[T * rate > 1]
+    t_blocks = np.asarray(mm.isf(1.0 / (T * rate)), dtype=float) if T.size else np.empty(0)
+    if mass_range_kg is None:
+        lo, hi = default_mass_range(mm, rate)
+        hi = max([hi] + design.tolist())
+        lo = min([lo] + design.tolist())
+    else:
+        try:
+            lo, hi = (float(v) for v in mass_range_kg)
+        except (TypeError, ValueError):
+            raise ValueError(f"mass_range_kg = {mass_range_kg!r} must be (low, high) in kg") from None
+        if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
+            raise ValueError(f"mass_range_kg = {mass_range_kg!r} must satisfy 0 < low < high (finite, kg)")
+        for what, values in (("design mass", design), ("T-year block", t_blocks)):
+            for v in values:
+                if not lo <= v <= hi:
+                    raise ValueError(f"mass_range_kg = ({sig(lo, 4)}, {sig(hi, 4)}): the {what} {sig(v, 4)} kg lies outside the "
+                                     "simulated masses; widen the range so that no design value is extrapolated")
+    if n_bins is None:
+        n_bins = int(np.clip(n // 400, 4, 24))
+    if isinstance(n_bins, bool) or not isinstance(n_bins, (int, np.integer)) or not 1 <= n_bins <= n // 20:
+        raise ValueError(f"n_bins = {n_bins!r} must be a whole number between 1 and n / 20 = {n // 20}")
+    sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
+    sc.collector_index(collector)
+    rng = np.random.default_rng(np.random.SeedSequence([0 if seed is None else int(seed), 10]))
+    masses = stratified_log_uniform(lo, hi, int(n), rng)
+    result = simulation.run(sc, seed=seed, masses_kg=masses)
+    df = result.collector(collector, first_only=True)
+    if df.empty:
+        raise NoArrivalsError(f"no simulated block reached collector {collector!r}: the hazard there is nil for the "
+                         "simulated release; check the scenario")
+    speed = np.full(result.n, np.nan)
+    height = np.full(result.n, np.nan)
+    v = df["velocity_ms"].to_numpy()
+    if rotational:
+        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
+        v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
+    blk = df["block"].to_numpy()
+    speed[blk] = v
+    height[blk] = df["height_m"].to_numpy()
+    edges = np.exp(np.linspace(np.log(lo), np.log(hi), n_bins + 1))
+    edges[0], edges[-1] = lo, hi
+    samples = MassCoupledSamples(masses, speed, height, edges, collector).with_representative(mm)
+    reach = samples.reach_probability(mm)
+    below, above = samples.outside_range(mm)
+    notes = [samples.description + "; the seeder's own mass distribution is not used"
+             + ("; rotational energy included (v_eff^2 = v^2 + k (w r)^2)" if rotational else ""),
+             f"reach probability {reach:.4f} averaged over the mass model (by mass class: "
+             f"{samples.reach_by_class.min():.3f}-{samples.reach_by_class.max():.3f})"]
+    if below > 1e-9 or above > 1e-9:
+        notes.append(f"mass model beyond the simulated masses: P(M < {sig(edges[0])} kg) = {sig(below, 2)}, "
+                     f"P(M > {sig(edges[-1])} kg) = {sig(above, 2)}; they take the behaviour of the nearest mass class "
+                     "(an extrapolation, stated)")
+    hz = EnergyHazard(mass=mass, velocity=samples, rate_per_year=rate, reach_probability=max(reach, 1e-300),
+                      n_released=result.n, heights_m=samples.heights_m, collector=collector, notes=tuple(notes))
+    return hz, result
+
+
+__all__ = ["energy_hazard", "simulate_energy_hazard"]

@@ -1,0 +1,113 @@
+"""The layout of :mod:`riskrf` by stage, checked from the source: imports go one way only.
+
+Every ``import`` and ``from ... import`` of every module under ``riskrf/`` is read with :mod:`ast` (imports made
+inside functions included), resolved to the riskrf module it names, and checked against the stage order
+``core < io < frequency < hazard < risk < report < app < cli``: a module imports only its own stage and the
+stages before it, the science (core .. risk) never imports ``riskrf.report`` or ``riskrf.app``, and the
+module graph has no cycle.
+"""
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1] / "riskrf"
+STAGES = ("core", "io", "frequency", "hazard", "risk", "report", "app", "cli")
+SCIENCE = ("core", "io", "frequency", "hazard", "risk")
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT.parent).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def _modules() -> dict[str, Path]:
+    return {_module_name(p): p for p in sorted(ROOT.rglob("*.py"))}
+
+
+def _imports(name: str, path: Path, known: set[str]) -> set[str]:
+    """The riskrf modules (other than the top package) that the module ``name`` imports anywhere."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+        if isinstance(node, ast.Import):
+            targets = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - (node.level - 1)]
+                source = ".".join(base + ([node.module] if node.module else []))
+            else:
+                source = node.module or ""
+            # ``from riskrf.risk import rhrs`` names the module riskrf.risk.rhrs
+            targets = [source] + [f"{source}.{alias.name}" for alias in node.names]
+        else:
+            continue
+        for target in targets:
+            while target and target not in known:       # ``import a.b.c`` of a name inside a module
+                target = target.rpartition(".")[0]
+            if target.startswith("riskrf.") and target != name:
+                found.add(target)
+    return found
+
+
+def _stage(module: str) -> str | None:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 and parts[1] in STAGES else None
+
+
+@pytest.fixture(scope="module")
+def graph():
+    modules = _modules()
+    return {name: _imports(name, path, set(modules)) for name, path in modules.items()}
+
+
+def test_every_module_sits_in_a_stage(graph):
+    loose = sorted(m for m in graph if m != "riskrf" and _stage(m) is None and m != "riskrf._compat")
+    assert loose == [], f"modules outside the stage packages: {loose}"
+
+
+def test_science_never_imports_report_or_app(graph):
+    bad = sorted((m, t) for m, targets in graph.items() if _stage(m) in SCIENCE
+                 for t in targets if _stage(t) in ("report", "app", "cli"))
+    assert bad == [], "science modules importing report/app/cli:\n" + "\n".join(f"{m} -> {t}" for m, t in bad)
+
+
+def test_stages_import_only_earlier_stages(graph):
+    bad = sorted((m, t) for m, targets in graph.items() for t in targets
+                 if _stage(m) and _stage(t) and STAGES.index(_stage(t)) > STAGES.index(_stage(m)))
+    assert bad == [], "imports against the stage order:\n" + "\n".join(f"{m} -> {t}" for m, t in bad)
+
+
+def test_no_import_cycle(graph):
+    order, state = [], {}
+
+    def visit(node, path):
+        state[node] = "open"
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == "open":
+                cycle = path[path.index(nxt):] + [nxt]
+                pytest.fail("import cycle: " + " -> ".join(cycle))
+            if nxt not in state:
+                visit(nxt, path + [nxt])
+        state[node] = "done"
+        order.append(node)
+
+    for node in sorted(graph):
+        if node not in state:
+            visit(node, [node])
+    assert len(order) == len(graph)
+
+
+def test_the_checker_sees_imports():
+    """The parser finds relative, absolute and function-level imports (so the tests above can fail)."""
+    modules = _modules()
+    known = set(modules)
+    cli = _imports("riskrf.cli", modules["riskrf.cli"], known)
+    assert {"riskrf.app.assess", "riskrf.io.outputs", "riskrf.core.units"} <= cli
+    corridor = _imports("riskrf.app.corridor", modules["riskrf.app.corridor"], known)
+    assert "riskrf.risk.rhrs" in corridor                       # ``from ..risk import rhrs``
+    assert "riskrf.report.corridor_report" in corridor          # imported inside a function
