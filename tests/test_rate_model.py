@@ -186,3 +186,53 @@ def test_known_freeze_thaw_rate_ratio_recovered_within_its_interval(tmp_path):
     assert row["ci_low"] > 1.5                              # detected, not merely covered
     assert rr.loc["rain_d0_mm", "ci_low"] < 1.0 < rr.loc["rain_d0_mm", "ci_high"]
     assert model.n_events == counts.sum() and model.n_periods == len(days)
+
+
+def test_negative_binomial_is_the_exact_nb2_maximum_likelihood(tmp_path):
+    # The profile fit must reach the NB2 log-likelihood maximum found by a direct numerical maximisation of
+    # sum log NB(y | mu = exp(b0 + log exposure), alpha) (scipy.stats.nbinom with n = 1/alpha, p = n/(n + mu)).
+    from scipy import optimize, stats
+    rng = np.random.default_rng(5)
+    start, end = "1995-01-01", "2004-12-31"
+    months = pd.date_range(start, end, freq="MS")
+    counts = rng.poisson(1.5 * rng.gamma(1 / 0.6, 0.6, len(months)))
+    inv = _inventory(tmp_path, _events_from_counts(months + pd.Timedelta(days=3), counts), start, end)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = rate_model(inv, period="month", season=None, trend=False)
+    y = model.design["count"].to_numpy(float)
+    expo = model.design["exposure_days"].to_numpy(float)
+
+    def nll(p):
+        mu, n = np.exp(p[0]) * expo, 1 / np.exp(p[1])
+        return -stats.nbinom.logpmf(y, n, n / (n + mu)).sum()
+
+    best = optimize.minimize(nll, [np.log(y.sum() / expo.sum()), np.log(0.5)], method="Nelder-Mead",
+                             options={"xatol": 1e-8, "fatol": 1e-10, "maxiter": 4000})
+    assert model.comparison.loc["negative binomial", "loglik"] == pytest.approx(-best.fun, abs=1e-5)
+    assert model.overdispersion["alpha"] == pytest.approx(np.exp(best.x[1]), rel=1e-3)
+
+
+def test_short_record_without_overdispersion_fits_on_every_statsmodels(tmp_path):
+    # Three months of daily counts with no overdispersion: the NB2 dispersion lies on its boundary (alpha -> 0,
+    # the Poisson model).  statsmodels 0.15's quasi-Newton search from a fixed guess returned NaN here and the
+    # command failed with statsmodels' own message; the profile fit gives the Poisson model, noted, no error.
+    rng = np.random.default_rng(2)
+    days = pd.date_range("2019-02-01", "2019-04-30")
+    rain = pd.Series(rng.gamma(0.5, 8, len(days)).round(1), index=days)
+    events = pd.DatetimeIndex(rng.choice(days[20:], 30))
+    inv = _inventory(tmp_path, events, "2019-02-21", "2019-04-30")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = rate_model(inv, rainfall=rainfall_from_series(rain, "rain.csv"), season=None, trend=False)
+    assert model.preferred == "Poisson"
+    assert np.isfinite(model.comparison["loglik"]).all()
+    assert model.comparison.loc["negative binomial", "loglik"] >= model.comparison.loc["Poisson", "loglik"] - 1e-6
+
+
+def test_a_daily_rainfall_above_the_world_record_is_refused_naming_file_row_and_value(tmp_path):
+    f = tmp_path / "rain.csv"
+    f.write_text("date,rainfall_mm\n2019-02-01,3.2\n2019-02-02,1000000000\n2019-02-03,0\n")
+    with pytest.raises(ValueError, match=r"rain\.csv: row 3, 2019-02-02: daily rainfall 1e\+09 mm is above the "
+                                         r"largest ever measured \(1825 mm"):
+        read_rainfall(f)

@@ -2,6 +2,12 @@
 from __future__ import annotations
 
 
+#: Longest wait for a background child [s]; past it the child is stopped and the work runs in this process.
+#: A child forked from a process whose native threads held a lock can wait on that lock for ever; this
+#: bounds the cost of that rare case to a repeat of the work instead of a hung run.
+CHILD_TIMEOUT_S = 240.0
+
+
 class InBackground:
     """Run ``work()`` (returning a picklable value) in a forked child on the other core; :meth:`result` returns it.
 
@@ -49,11 +55,16 @@ class InBackground:
             return self._done[0]
         value = None
         if self.proc is not None:
+            status = "failed"
             try:
-                status, value = self.conn.recv()
+                if self.conn.poll(CHILD_TIMEOUT_S):
+                    status, value = self.conn.recv()
             except (EOFError, OSError):
                 status = "failed"
-            self.proc.join()
+            self.proc.join(timeout=5.0)
+            if self.proc.is_alive():          # hung (or slow past the limit): stopped, the work is done here
+                self.proc.kill()
+                self.proc.join(timeout=5.0)
             self.conn.close()
             if status == "error":
                 raise value

@@ -350,6 +350,55 @@ class RateModel:
 _TRANSFORMS = {"linear": lambda x: x, "sqrt": np.sqrt, "log1p": np.log1p}
 
 
+_NB_ALPHA_MIN = 1e-8   # smallest dispersion searched: NB2 with alpha below it is the Poisson model in practice
+_NB_ALPHA_MAX = 1e3    # largest dispersion searched (a variance 1,000 mu^2 above the mean)
+
+
+def _fit_negbin(y, X, offset, pois, GLM, families, NegativeBinomial):
+    """Maximum-likelihood NB2 regression, found by profiling the dispersion alpha.
+
+    At a fixed alpha the NB2 model is a generalised linear model fitted by IRLS, which is stable;
+    the profile log-likelihood is maximised over log(alpha) in [1e-8, 1e3] (bounded Brent search),
+    then a few Newton steps from that optimum polish coefficients and alpha jointly and give the
+    usual standard errors.  Started instead from the Poisson fit with a fixed alpha guess,
+    quasi-Newton search diverged to NaN on short records (statsmodels 0.15).
+
+    Returns
+    -------
+    statsmodels NegativeBinomialResults
+        With finite parameters; raises ValueError otherwise.
+    """
+    from scipy.optimize import minimize_scalar
+
+    start = pois.params.to_numpy()
+
+    def profile(log_alpha):
+        g = GLM(y, X, family=families.NegativeBinomial(alpha=float(np.exp(log_alpha))), offset=offset).fit(
+            start_params=start)
+        return -g.llf if np.isfinite(g.llf) else np.inf
+
+    opt = minimize_scalar(profile, bounds=(np.log(_NB_ALPHA_MIN), np.log(_NB_ALPHA_MAX)), method="bounded",
+                          options={"xatol": 1e-4})
+    alpha = float(np.exp(opt.x))
+    beta = np.asarray(GLM(y, X, family=families.NegativeBinomial(alpha=alpha), offset=offset).fit(
+        start_params=start).params)
+    model = NegativeBinomial(y, X, offset=offset, loglike_method="nb2")
+    at_bound = opt.x < np.log(_NB_ALPHA_MIN) + 0.5
+    if not at_bound:
+        nb = model.fit(start_params=np.r_[beta, alpha], disp=0, maxiter=100, method="newton")
+        if np.all(np.isfinite(nb.params)) and np.all(np.isfinite(nb.bse)) and nb.llf >= -opt.fun - 1e-6:
+            return nb
+    # alpha at its lower bound (no overdispersion: NB2 reduces to the Poisson model) or Newton left the
+    # profile optimum: the profile optimum itself, evaluated without further iterations
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        nb = model.fit(start_params=np.r_[beta, alpha], disp=0, maxiter=0, method="nm")
+    nb.mle_retvals["converged"] = bool(np.isfinite(nb.llf))
+    if not np.all(np.isfinite(nb.params)):
+        raise ValueError("no finite negative binomial estimate")
+    return nb
+
+
 def _exog(frame: pd.DataFrame, terms: pd.DataFrame) -> pd.DataFrame:
     """Model matrix: constant plus each term transformed and divided so that exp(coef) is its rate ratio."""
     X = pd.DataFrame({"const": 1.0}, index=frame.index)
@@ -620,27 +669,30 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
     offset = np.log(design["exposure_days"].to_numpy(float))
 
     def fit_pair(Xm):
-        pois = GLM(y, Xm, family=families.Poisson(), offset=offset).fit()
-        nb = None
+        try:
+            pois = GLM(y, Xm, family=families.Poisson(), offset=offset).fit()
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            raise ValueError(f"{src}: the Poisson rate model cannot be fitted to these counts and covariates "
+                             f"({exc}); check the rainfall record for impossible values") from None
+        if not np.all(np.isfinite(pois.params)):
+            raise ValueError(f"{src}: the Poisson rate model has no finite estimate for these counts and "
+                             f"covariates; check the rainfall record for impossible values")
+        trouble = []
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ConvergenceWarning)
             try:
-                start_params = np.r_[pois.params.to_numpy(), 0.1]
-                nb = NegativeBinomial(y, Xm, offset=offset, loglike_method="nb2").fit(
-                    start_params=start_params, disp=0, maxiter=300, method="bfgs")
-                if not nb.mle_retvals.get("converged", True):
-                    nb = NegativeBinomial(y, Xm, offset=offset, loglike_method="nb2").fit(
-                        start_params=nb.params.to_numpy(), disp=0, maxiter=300, method="newton")
+                nb = _fit_negbin(y, Xm, offset, pois, GLM, families, NegativeBinomial)
             except (np.linalg.LinAlgError, ValueError) as exc:
                 nb = None
-                caught.append(warnings.WarningMessage(str(exc), RuntimeWarning, "", 0))
-        bad = [str(w.message) for w in caught if issubclass(w.category, (ConvergenceWarning, RuntimeWarning))]
-        return pois, nb, bad
+                trouble.append(str(exc))
+        trouble += [str(w.message) for w in caught if issubclass(w.category, (ConvergenceWarning, RuntimeWarning))]
+        return pois, nb, trouble
 
     pois, nb, trouble = fit_pair(X)
-    if nb is None or (trouble and not nb.mle_retvals.get("converged", False)):
-        note(f"negative binomial model did not converge ({'; '.join(trouble)[:200]}); the Poisson model is used")
-        nb = None if nb is None or not np.all(np.isfinite(nb.params)) else nb
+    if nb is None or not np.all(np.isfinite(nb.params)) or (trouble and not nb.mle_retvals.get("converged", False)):
+        note(f"negative binomial model did not converge ({'; '.join(trouble)[:200] or 'no finite estimate'}); "
+             f"the Poisson model is used")
+        nb = None
 
     comparison = {"Poisson": {"loglik": pois.llf, "aic": pois.aic, "deviance": pois.deviance,
                               "df_resid": pois.df_resid, "pearson_chi2_per_df": pois.pearson_chi2 / pois.df_resid,
@@ -649,7 +701,10 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
     nb_glm = None
     if nb is not None:
         alpha = float(nb.params["alpha"])
-        nb_glm = GLM(y, X, family=families.NegativeBinomial(alpha=max(alpha, 1e-10)), offset=offset).fit()
+        # the NB2 model at its fitted alpha as a GLM (deviance, Pearson chi2, predictions with intervals),
+        # started from the maximum-likelihood coefficients so IRLS begins at the solution
+        nb_glm = GLM(y, X, family=families.NegativeBinomial(alpha=max(alpha, _NB_ALPHA_MIN)), offset=offset).fit(
+            start_params=nb.params.drop("alpha").to_numpy())
         comparison["negative binomial"] = {"loglik": nb.llf, "aic": nb.aic, "deviance": nb_glm.deviance,
                                            "df_resid": nb.df_resid - 1,
                                            "pearson_chi2_per_df": nb_glm.pearson_chi2 / (nb_glm.df_resid - 1),

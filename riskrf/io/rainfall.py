@@ -144,7 +144,19 @@ def _gaps(daily: pd.Series, rows: pd.Series) -> pd.DataFrame:
     return pd.DataFrame(out, columns=["start", "end", "n_days", "row_before", "row_after"])
 
 
+#: Largest daily rainfall ever measured [mm]: 1,825 mm in 24 h at Foc-Foc, La Réunion, 7-8 January 1966
+#: (WMO World Weather and Climate Extremes Archive).  A larger daily total is a unit or typing error.
+MAX_DAILY_RAINFALL_MM = 1825.0
+
+
 def _build(dates, values, flags, lines, path, fmt, notes) -> Rainfall:
+    big = np.asarray(values, float) > MAX_DAILY_RAINFALL_MM
+    if big.any():
+        i = int(np.argmax(big))
+        where = f"row {lines[i]}, " if lines[i] else ""
+        raise ValueError(f"{path}: {where}{pd.Timestamp(dates[i]).date()}: daily rainfall {values[i]:g} mm is above "
+                         f"the largest ever measured ({MAX_DAILY_RAINFALL_MM:g} mm in 24 h, La Réunion 1966); "
+                         "check the unit (the column is mm per day)")
     frame = pd.DataFrame({"value": values, "flag": flags, "row": lines}, index=pd.DatetimeIndex(dates))
     dup = frame.index.duplicated(keep=False)
     if dup.any():
