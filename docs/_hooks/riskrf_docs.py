@@ -8,6 +8,8 @@ At build time they
   replaced by the script's printed output and its figures.  A failing example fails the build.
 - replace ``<!-- riskrf-help -->`` by the ``--help`` text of the ``riskrf`` command and of every
   sub-command, taken from the command's own argument parser, so the reference cannot drift;
+- complete the API reference: ``<!-- api-other PACKAGE -->`` becomes an entry for every name of
+  ``PACKAGE.__all__`` the page does not document yet, so a newly exported name is never missing;
 - add the figures the repository already holds (``inventories/*/figures``, the scenario and
   corridor figures) to the site as ``repo/PATH``, so pages show them without copies.
 
@@ -15,6 +17,7 @@ Examples run once per process: ``mkdocs serve`` re-uses their output on later re
 """
 from __future__ import annotations
 
+import importlib
 import os
 import re
 import subprocess
@@ -31,6 +34,10 @@ REPO_FIGURES = ("inventories/*/figures/*.png", "simulation/scenarios/figures/*.p
                 "simulation/scenarios/*/figures/*.png", "corridors/*/*.png")
 #: Seconds an example may take at build time before the build fails (they take about 10 s each).
 EXAMPLE_TIMEOUT_S = 600
+
+#: ``RISKRF_DOCS_SKIP_EXAMPLES=1 mkdocs serve`` previews the pages without running the examples (their pages
+#: then say so); a strict build runs them.
+SKIP_EXAMPLES = os.environ.get("RISKRF_DOCS_SKIP_EXAMPLES", "") not in ("", "0")
 
 _examples: dict[str, tuple[str, list[Path]]] = {}
 _help: list[str] = []
@@ -56,6 +63,8 @@ def _env() -> dict:
 
 def run_example(name: str) -> tuple[str, list[Path]]:
     """Run ``docs/examples/NAME.py`` into its own output folder; its printed output and figures."""
+    if SKIP_EXAMPLES:
+        return "(not run: RISKRF_DOCS_SKIP_EXAMPLES is set)", []
     if name not in _examples:
         out = _out / name
         proc = subprocess.run([sys.executable, str(EXAMPLES / f"{name}.py"), str(out)], cwd=ROOT, env=_env(),
@@ -74,6 +83,12 @@ def command_help() -> list[tuple[str, str]]:
         _help.extend(proc.stdout.split("\x00"))
     first, *rest = _help
     return [("riskrf", first)] + [(part.split("\n", 1)[0], part.split("\n", 1)[1]) for part in rest]
+
+
+def on_config(config):
+    if str(ROOT) not in sys.path:           # the pages document this checkout's riskrf and simulation
+        sys.path.insert(0, str(ROOT))
+    return config
 
 
 def on_files(files, config):
@@ -104,10 +119,37 @@ def _help_text(match: re.Match) -> str:
     sections = []
     for name, text in command_help():
         title = "riskrf" if name == "riskrf" else f"riskrf {name}"
-        sections.append(f"## `{title}`\n\n{_fence(text)}")
+        sections.append(f"### `{title}`\n\n{_fence(text)}")
     return "\n".join(sections)
 
 
+def _api_other(match: re.Match, markdown: str) -> str:
+    """Entries for the public names of a package that the page does not document yet (names added since)."""
+    package = match.group(1)
+    names = importlib.import_module(package).__all__
+    missing = [n for n in names if not re.search(rf"^::: {package}\.{n}$", markdown, re.M)]
+    if not missing:
+        return ""
+    entries = "".join(f"::: {package}.{n}\n    options:\n      heading_level: 4\n\n" for n in missing)
+    return f"### Other public names\n\n{entries}"
+
+
+def _module_path(match: re.Match) -> str:
+    """``::: riskrf.NAME`` -> ``::: MODULE.NAME``, the module that holds the public name today.
+
+    The pages name public objects by their stable public name; the modules behind them may move.  The package's
+    export table (``_EXPORTS``, the same one its lazy ``__getattr__`` uses) says where each name lives.
+    """
+    package, name = match.group(1), match.group(2)
+    module = importlib.import_module(package)
+    where = getattr(module, "_EXPORTS", {}).get(name)
+    if where is None:
+        where = getattr(getattr(module, name), "__module__", package).removeprefix(f"{package}.")
+    return f"::: {package}.{where}.{name}" if where != package else match.group(0)
+
+
 def on_page_markdown(markdown, page, config, files):
+    markdown = re.sub(r"<!-- api-other (\w+) -->", lambda m: _api_other(m, markdown), markdown)
+    markdown = re.sub(r"^::: (riskrf|simulation)\.(\w+)$", _module_path, markdown, flags=re.M)
     markdown = re.sub(r"<!-- example-output (\w+) -->", _example_output, markdown)
     return re.sub(r"<!-- riskrf-help -->", _help_text, markdown)
