@@ -103,7 +103,8 @@ def on_files(files, config):
 
 
 def _fence(text: str, indent: str = "") -> str:
-    body = "\n".join(indent + line if line else line for line in text.rstrip().splitlines())
+    lines = [line.rsplit("\r", 1)[-1] for line in text.rstrip().split("\n")]   # a progress bar's last state
+    body = "\n".join(indent + line if line else line for line in lines)
     return f"{indent}```text\n{body}\n{indent}```\n"
 
 
