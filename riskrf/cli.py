@@ -41,7 +41,8 @@ def _add_inventory_arguments(p):
     p.add_argument("--end", default=None, help="end of the record period, YYYY-MM-DD")
     p.add_argument("--duration-years", type=float, default=None, metavar="YR",
                    help="length of the record in years, for undated inventories")
-    g = p.add_argument_group("reading the inventory (README 'Input formats'; each may also be in the sidecar)")
+    g = p.add_argument_group("reading the inventory (docs: File formats, 'Input formats'; each may also be in the "
+                             "sidecar)")
     g.add_argument("--sheet", default=None, help="Excel sheet: name, or number counting from 1")
     g.add_argument("--header-row", type=int, default=None, metavar="ROW",
                    help="1-based row holding the column names (default 1), e.g. 4 below three title rows")
@@ -64,8 +65,8 @@ def _add_inventory_arguments(p):
 
 def _add_reader_arguments(p, what: str, key: str, *, dates: bool = False, prefix: str = ""):
     """--sheet, --header-row, --decimal, --encoding (and --date-format) for one table a command reads."""
-    g = p.add_argument_group(f"reading {what} (README 'Input formats'; also {key}sheet, ... in the file)"
-                             if key else f"reading {what} (README 'Input formats')")
+    g = p.add_argument_group(f"reading {what} (docs: File formats, 'Input formats'; also {key}sheet, ... in the file)"
+                             if key else f"reading {what} (docs: File formats, 'Input formats')")
     opt = f"--{prefix}-" if prefix else "--"
     dest = f"{prefix.replace('-', '_')}_" if prefix else ""
     g.add_argument(f"{opt}sheet", dest=f"{dest}sheet", default=None, metavar="SHEET",
@@ -602,7 +603,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_fit_arguments(p)
     p.add_argument("--out", default=None, metavar="DIR",
                    help="output directory (default: <inventory name>-fit); written only when complete")
-    g = p.add_argument_group("bootstrap of large inventories (README 'Scale of the fits')")
+    g = p.add_argument_group("bootstrap of large inventories (docs: Inventories, 'Scale of the fits')")
     g.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="show the bootstrap's progress bar (default: on when standard error is a terminal)")
     g.add_argument("--workers", type=int, default=None, metavar="N",
@@ -618,8 +619,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_fit)
 
     p = sub.add_parser("simulate", help="Monte Carlo rock fall trajectories on a slope scenario",
-                       description="Simulate blocks released by a scenario's seeder (TOML; see the README section "
-                       "'Scenario files') and write one row per collector crossing (velocity_ms, "
+                       description="Simulate blocks released by a scenario's seeder (TOML; see the docs: File "
+                       "formats, 'Scenario files') and write one row per collector crossing (velocity_ms, "
                        "angular_velocity_rads, height_m, energy_kj, ...) to a Parquet or CSV file, with figures: "
                        "the profile and trajectories, distributions at each collector, envelopes.", epilog=EPILOG)
     p.add_argument("scenario", help="scenario TOML file, e.g. simulation/scenarios/road_cut_barrier.toml")
@@ -666,10 +667,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("decide", help="rank mitigation options, or roll back any decision tree",
                        description="Two uses.  (1) riskrf decide TREE.json|TREE.toml: roll back a decision tree "
-                       "(format in the README), print the ranking, optimal policy and EVPI, and draw the tree, risk "
-                       "profiles and tornado.  (2) riskrf decide --options OPTIONS.toml --inventory INV --scenario "
-                       "SCENARIO: build the energy hazard, evaluate each mitigation option's residual hazard and rank "
-                       "them by expected total cost, with break-even values, tornado chart and F-N curves.",
+                       "(format in the docs: Risk and mitigation decisions), print the ranking, optimal policy and "
+                       "EVPI, and draw the tree, risk profiles and tornado.  (2) riskrf decide --options OPTIONS.toml "
+                       "--inventory INV --scenario SCENARIO: build the energy hazard, evaluate each mitigation "
+                       "option's residual hazard and rank them by expected total cost, with break-even values, tornado "
+                       "chart and F-N curves.",
                        epilog=EPILOG)
     p.add_argument("tree", nargs="?", default=None, help="decision tree file (.json or .toml)")
     p.add_argument("--options", default=None, metavar="TOML", help="mitigation options file")
@@ -686,9 +688,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_decide)
 
     p = sub.add_parser("assess", help="the whole chain for one site file: fits, simulation, energy, decision",
-                       description="Run the whole assessment of one site described by a TOML file (see the README "
-                       "section 'Site files'): magnitude-frequency fits, trajectory simulation, impact-energy hazard "
-                       "and fence checks, risk to road users and the ranking of mitigation options.  Writes "
+                       description="Run the whole assessment of one site described by a TOML file (see the docs: File "
+                       "formats, 'Site files'): magnitude-frequency fits, trajectory simulation, impact-energy "
+                       "hazard and fence checks, risk to road users and the ranking of mitigation options.  Writes "
                        "report.html (self-contained), summary.json, CSV tables, PNG figures and a copy of the inputs "
                        "with the version and seed; the directory appears only when everything succeeded.",
                        epilog=EPILOG)
@@ -712,8 +714,8 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Fit scenario values named by dotted paths (e.g. "
                        "materials.talus.ground_friction_angle_deg) within bounds so that simulated stop positions "
                        "match observed ones (1-Wasserstein distance, common random numbers, differential evolution, "
-                       "bootstrap intervals; see the README section 'Calibration').  Writes the calibrated scenario "
-                       "TOML, parameter and comparison tables and a figure.", epilog=EPILOG)
+                       "bootstrap intervals; see the docs: Trajectories and simulation, 'Calibration').  Writes the "
+                       "calibrated scenario TOML, parameter and comparison tables and a figure.", epilog=EPILOG)
     p.add_argument("scenario", help="scenario TOML file")
     p.add_argument("observed", help="observed stops: CSV/Parquet/XLSX with an x_stop_m column [m along the profile]")
     p.add_argument("--parameter", action="append", metavar="NAME=LOW:HIGH",
@@ -734,8 +736,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("rates", help="rock fall rates against rainfall, season and trend (Poisson / negative binomial)",
                        description="Count the events of a dated inventory per day, month or year and fit Poisson and "
-                       "negative-binomial regressions on antecedent rainfall, season and a year trend (see the README "
-                       "section 'Rate models').  Prints the model comparison (AIC, deviance, overdispersion tests), "
+                       "negative-binomial regressions on antecedent rainfall, season and a year trend (see the docs: "
+                       "Rates and rainfall).  Prints the model comparison (AIC, deviance, overdispersion tests), "
                        "rate ratios with intervals, the trend test and expected rates by month; writes CSV tables and "
                        "the figures seasonality.png and rainfall_response.png.", epilog=EPILOG)
     p.add_argument("inventory", help="dated inventory file with its record period (sidecar .toml or --start/--end)")
@@ -774,7 +776,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "(simulation, energy hazard, road-user risk, option ranking) as a task on dask.distributed: "
                        "a local cluster sized to the machine by default, or an existing scheduler unchanged.  "
                        "Writes report.html, corridor.csv (ranked by risk beside the RHRS rank), sections.csv, "
-                       "budget_curve.csv, chainage.png and summary.json (see the README section 'Corridor').", epilog=EPILOG)
+                       "budget_curve.csv, chainage.png and summary.json (see the docs: Corridor).", epilog=EPILOG)
     p.add_argument("corridor", help="corridor file (.toml); paths in it are relative to it")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <corridor>-corridor)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",

@@ -1,6 +1,6 @@
 """Scenarios: slope profile, materials, seeder, collectors and settings, read from TOML.
 
-See the README section "Scenario files" for every field.  Unknown fields are an
+The documentation (File formats, "Scenario files") describes every field.  Unknown fields are an
 error (with a did-you-mean), and every error names the file and the field.
 """
 from __future__ import annotations
@@ -287,7 +287,7 @@ class Settings:
 
 @dataclass(frozen=True)
 class Scenario:
-    """A checked trajectory scenario (README "Scenario files"): slope ``profile``, ``materials``, the block
+    """A checked trajectory scenario (docs: File formats, "Scenario files"): slope ``profile``, ``materials``, the block
     ``seeder``, ``collectors`` (lines where crossings are recorded; barriers among them), numerical
     ``settings``, and the ``source`` file named in errors.  Run it with :func:`simulation.run`.
     """
@@ -425,7 +425,7 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
 
 
 def load_scenario(path) -> Scenario:
-    """Read a scenario TOML file (see the README section "Scenario files")."""
+    """Read a scenario TOML file (documentation: File formats, "Scenario files")."""
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"scenario file not found: {path}")

@@ -1,6 +1,6 @@
 """Site files: one TOML describing one assessment (inventory, slope, exposure, options, economics).
 
-Every field is documented in the README ("Site files").  Paths are relative to
+Every field is described in the documentation (File formats, "Site files").  Paths are relative to
 the site file.  Unknown fields are errors with a did-you-mean; optional fields
 left out take documented defaults, and :attr:`Site.defaults_used` lists them so
 the report can state them.  Everything is checked before any computing starts.
@@ -31,7 +31,7 @@ SITE_FIELDS = {
                   "sheet": None, "header_row": None, "encoding": None, "decimal": None, "date_format": None,
                   "volume_unit": None, "mass_unit": None, "duplicates": None, "volume_column": None,
                   "mass_column": None, "date_column": None, "location_column": None,
-                  # where the hazard's rate comes from (README "Site files"; riskrf.risk.site_rates)
+                  # where the hazard's rate comes from (documentation: File formats, "Site files"; riskrf.risk.site_rates)
                   **INVENTORY_RATE_FIELDS},
     "hazard": {"scenario": None, "velocities": None, "collector": None, "road_collector": "road",
                "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
@@ -48,7 +48,7 @@ OTHER_TABLES = ("rates",)
 
 @dataclass(frozen=True)
 class Site:
-    """A checked site file (``riskrf assess SITE.toml``, README "Site files").
+    """A checked site file (``riskrf assess SITE.toml``, documentation: File formats, "Site files").
 
     ``path`` of the file (relative paths inside it resolve against its folder), ``name`` and ``description``,
     the ``inventory``, ``hazard``, ``mitigation``, ``design_block`` and optional ``rates`` sections as

@@ -457,7 +457,7 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
     Every reader option (``sheet`` ... ``duplicates``, the column names and units)
     may also be given in the sidecar's ``[record]`` table; arguments win.  Numbers
     with decimal commas, dates and encodings follow the rules of
-    :mod:`riskrf.io.tables` (README, "Input formats").
+    :mod:`riskrf.io.tables` (documentation: File formats, "Input formats").
 
     Plausibility: when the volume unit was not declared (``volume_unit`` or a unit
     in the column name such as ``Volume [l]``), volumes whose median exceeds

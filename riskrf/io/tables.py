@@ -1,6 +1,6 @@
 """Reading tables as practitioners export them: one set of rules for every table riskrf reads.
 
-The rules (also in the README, "Input formats"):
+The rules (also in the documentation, File formats, "Input formats"):
 
 * **Files**: CSV/TXT/TSV, Excel (``.xlsx``/``.xlsm``; ``sheet`` by name or 1-based number,
   ``header_row`` the 1-based spreadsheet row holding the column names) and Parquet.

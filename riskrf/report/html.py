@@ -317,7 +317,7 @@ def render_report(a, figs: Path) -> str:
         transferred = _name(r.record) != _name(inv.source)
         doc.add(f"<h3>Rate model ({_e(_name(r.record))}, rainfall {_e(_name(r.rainfall))})</h3>"
                 "<p>Counts of the dated record against antecedent rainfall, season and trend (Poisson and negative "
-                "binomial regression; README 'Rate models'). Closure options given as rules take their share of "
+                "binomial regression; docs: Rates and rainfall). Closure options given as rules take their share of "
                 "falls while closed and their closure hours from this model."
                 + (" The record is not this site's inventory: its rates, and the closure shares and hours computed "
                    "from it, are transferred to this site (an assumption; see the site description)."
