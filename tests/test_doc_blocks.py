@@ -68,3 +68,13 @@ def test_block_runs(path, line, body, tmp_path, monkeypatch):
         exec(code, namespace)
     import matplotlib.pyplot as plt
     plt.close("all")
+
+
+def test_readme_is_a_front_door():
+    """README.md stays short (the reference lives in docs/) and carries no dated measurement."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert 100 <= len(text.splitlines()) <= 200 and len(text) < 30_000
+    assert re.search(r"\b20\d\d-\d\d-\d\d\b", text) is None, "dated figures go to CHANGELOG.md"
+    for command in ('python3 -m venv .venv && . .venv/bin/activate && pip install . && riskrf demo',
+                    'python3 -m venv .venv && . .venv/bin/activate && pip install ".[test]" && python -m pytest'):
+        assert f"```bash\n{command}\n```" in text
