@@ -31,7 +31,7 @@ SITE_FIELDS = {
                   "sheet": None, "header_row": None, "encoding": None, "decimal": None, "date_format": None,
                   "volume_unit": None, "mass_unit": None, "duplicates": None, "volume_column": None,
                   "mass_column": None, "date_column": None, "location_column": None,
-                  # where the hazard's rate comes from (documentation: File formats, "Site files"; riskrf.risk.site_rates)
+                  # where the hazard's rate comes from (docs: File formats, "Site files"; riskrf.risk.site_rates)
                   **INVENTORY_RATE_FIELDS},
     "hazard": {"scenario": None, "velocities": None, "collector": None, "road_collector": "road",
                "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
