@@ -5,6 +5,7 @@ working directory that holds links to the repository's data folders (``inventori
 ``tests``, ``corridors``, ``riskrf``), so that the paths the documentation uses (``inventories/...``)
 resolve and whatever a block writes lands in the temporary directory, never in the repository.  Blocks
 that are not meant to run are fenced as something else (```text for output, ```toml, ```bash, ```json).
+A block that imports a deprecated module path (``riskrf.inventory`` for ``riskrf.frequency.inventory``) fails.
 A block made only of ``--8<--`` includes shows an example script, which ``tests/test_examples.py`` runs.
 """
 from __future__ import annotations
@@ -64,7 +65,8 @@ def test_block_runs(path, line, body, tmp_path, monkeypatch):
     code = compile(body, f"{path.relative_to(ROOT).as_posix()}:{line}", "exec")
     namespace = {"__name__": "__doc_block__"}
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")            # a block shows what a user sees; warnings are not failures
+        warnings.simplefilter("ignore")            # a block shows what a user sees; warnings are not failures,
+        warnings.filterwarnings("error", message="old module path")   # but the documentation uses current paths
         exec(code, namespace)
     import matplotlib.pyplot as plt
     plt.close("all")
