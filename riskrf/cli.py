@@ -577,6 +577,21 @@ def cmd_corridor(args) -> int:
     return 0
 
 
+def cmd_hazard_map(args) -> int:
+    """``riskrf hazard-map``: run a 3-D ``[terrain]`` scenario and write hazard GeoTIFFs on the DEM's grid, stop
+    points and trajectories (GeoPackage) and a hillshade figure."""
+    from .app.hazard_map import hazard_map
+    from .outputs import check_output
+    out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-hazard-map")
+    check_output(out, overwrite=args.overwrite, kind="dir")
+    hm = hazard_map(args.scenario, n=args.n, seed=args.seed, crs=args.crs, workers=args.workers)
+    print(f"Scenario {hm.scenario.name} ({hm.scenario.source}): {hm.result.n:,} blocks, seed {args.seed}")
+    print(hm.result.summary().to_string(index=False, header=False))
+    hm.write(out, overwrite=args.overwrite)
+    print(f"Wrote hazard rasters (GeoTIFF, {hm.scenario.terrain.crs}), hazard_map.gpkg and hillshade.png to {out}/")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``riskrf`` argument parser with one sub-command per task."""
     parser = argparse.ArgumentParser(
@@ -785,6 +800,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="skip sections already finished by an earlier run")
     _add_reader_arguments(p, "the sections table", "corridor.sections_")
     p.set_defaults(func=cmd_corridor)
+    p = sub.add_parser("hazard-map", help="3-D rock fall hazard rasters on a DEM (GeoTIFF, GeoPackage)",
+                       description="Run a 3-D scenario (TOML with a [terrain] table: DEM raster, materials, "
+                       "[sources] points or polygon, plan collectors) and write GeoTIFFs on the DEM's grid and CRS "
+                       "(passage count, reach probability, kinetic energy p50/p95/p99, jump height p95, deposition "
+                       "density), stop points and trajectories as GeoPackage layers and a hillshade figure.",
+                       epilog=EPILOG)
+    p.add_argument("scenario", help="3-D scenario TOML, e.g. simulation/scenarios/authume/authume_3d.toml")
+    p.add_argument("-n", type=int, default=10_000, help="number of blocks to release (default 10,000)")
+    p.add_argument("--seed", type=int, default=1, help="random seed; the same seed gives identical results")
+    p.add_argument("--crs", default=None, help="the DEM's CRS when its file has none, e.g. EPSG:2154")
+    p.add_argument("--workers", type=int, default=1, help="threads running the kernel (results do not depend on it)")
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <scenario>-hazard-map)")
+    p.set_defaults(func=cmd_hazard_map)
+
     for p in sub.choices.values():       # every command with outputs: never clobber without --overwrite
         if any("--out" in a.option_strings for a in p._actions):
             p.add_argument("--overwrite", action="store_true",

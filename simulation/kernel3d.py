@@ -509,7 +509,9 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                 ax_, ay_, az_ = factor * gtx - fr * vx, factor * gty - fr * vy, factor * gtz - fr * vz
             else:
                 ax_, ay_, az_ = factor * gtx, factor * gty, factor * gtz
-            dt = min(step_len / max(u, 1e-6), math.sqrt(2.0 * step_len / g))
+            # at most about half a cell per step: u dt <= step and 1/2 |a| dt^2 <= step
+            a_mag = math.sqrt(ax_ * ax_ + ay_ * ay_ + az_ * az_)
+            dt = min(step_len / max(u, 1e-6), math.sqrt(2.0 * step_len / max(a_mag, 1e-3)))
             vx1, vy1, vz1 = vx + ax_ * dt, vy + ay_ * dt, vz + az_ * dt
             xn = x + 0.5 * (vx + vx1) * dt
             yn = y + 0.5 * (vy + vy1) * dt
