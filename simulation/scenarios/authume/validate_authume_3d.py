@@ -32,10 +32,11 @@ from scipy import stats
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[2]
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(HERE))
 
 import simulation  # noqa: E402
 from simulation.profile_extraction import TerrainProfile, _polyline  # noqa: E402
-from simulation.scenarios.authume.build_authume_3d import _raw_dir, release_point  # noqa: E402
+from build_authume_3d import _raw_dir, release_point  # noqa: E402
 
 DOCS = REPO / "docs" / "validation"
 APRIORI = {"vegetated_slope": {"preset": "soil"},
