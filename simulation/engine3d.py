@@ -60,7 +60,8 @@ _PATH = (("block", np.int64), ("t", float), ("x", float), ("y", float), ("z", fl
 def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap):
     m = hi - lo
     out = {k: np.empty(m, dtype=dt) for k, dt in (("x", float), ("y", float), ("z", float), ("reason", np.int64),
-                                                   ("impacts", np.int64), ("t", float), ("excess", float))}
+                                                   ("impacts", np.int64), ("t", float), ("excess", float),
+                                                   ("events", np.int64))}
     cap_r = max(4 * m * max(len(cols["c_id"]), 1), 16)
     cap_p = max(300 * m, 16) if hazard else 1
     pth_cap = path_cap if lo < n_paths else 1
@@ -76,7 +77,7 @@ def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_
             *grid, **mats, **cols, g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
             max_events=st.max_events, key=key, n_path_blocks=n_paths, rec_pass=hazard,
             out_x=out["x"], out_y=out["y"], out_z=out["z"], out_reason=out["reason"], out_impacts=out["impacts"],
-            out_t=out["t"], out_excess=out["excess"],
+            out_t=out["t"], out_excess=out["excess"], out_events=out["events"],
             r_block=r["block"], r_coll=r["coll"], r_s=r["s"], r_t=r["t"], r_x=r["x"], r_y=r["y"], r_vx=r["vx"],
             r_vy=r["vy"], r_vz=r["vz"], r_w=r["w"], r_h=r["h"], r_count=r_count,
             p_block=p["block"], p_cell=p["cell"], p_e=p["e"], p_h=p["h"], p_count=p_count,
@@ -228,6 +229,7 @@ class TerrainResult:
         for reason, cnt in st["reason"].value_counts(sort=False).items():
             rows.append((f"blocks {reason}", int(cnt), ""))
         rows.append(("mean impacts per block", float(st["impacts"].mean()), ""))
+        rows.append(("mean events per block (impacts and contact steps)", float(self.per_block["events"].mean()), ""))
         rows.append(("largest energy rise between events", float(np.max(self.energy_excess_j())) / J_PER_KJ, "kJ"))
         for c in self.scenario.collectors:
             k = self.collector(c.name, first_only=True).shape[0]

@@ -14,11 +14,10 @@ Bilinear cells rather than two triangles per cell because
   the triangulation, not of the terrain);
 * the cell holding a point is found in O(1) from the regular grid, with no triangle mesh to store.
 
-The cost is that a parabola meets a bilinear patch at the root of a quartic; the kernel does not solve it
-in closed form but marches the flight with steps that provably cannot cross the ground (a Lipschitz bound
-on the surface slope, :func:`_safe_step`) and, near the ground, steps of at most half a cell, then refines
-the crossing by regula falsi to 1e-7 m.  A flight that dips below the surface and comes back out within
-half a cell is missed (the block grazes a corner); that is the stated resolution of the kernel.
+The impact of a flight is found exactly: along the straight plan line of a flight, one bilinear cell is a
+quadratic in time, as is the parabola, so the kernel visits the cells under the flight in order and solves
+one quadratic per cell (:func:`_find_impact`); high above the ground it skips ahead by steps that provably
+cannot reach it (a Lipschitz bound on the surface slope, :func:`_safe_step`).
 
 Physics (shared with the 2-D kernel :mod:`simulation.kernel`)
 -------------------------------------------------------------
@@ -234,67 +233,108 @@ def _record_path(pb, pt, px, py, pz, pv, pmode, pcount, bid, t, x, y, z, v, mode
         pcount[0] = i + 1
 
 
-@njit(cache=True)
-def _find_impact(zg, x0, y0, dx, dy, lip, step_len, x, y, z, vx, vy, vz, g):
-    """First time t > 0 at which the flight from (x, y, z) meets the surface.
+@njit(cache=True, inline="always")
+def _first_descending_root(A, B, C, hi):
+    """Smallest tau in [0, hi] where A tau^2 + B tau + C crosses zero going down (derivative <= 0), or -1."""
+    best = -1.0
+    if A == 0.0:
+        if B != 0.0:
+            r = -C / B
+            if 0.0 <= r <= hi and B <= 0.0:
+                best = r
+        return best
+    disc = B * B - 4.0 * A * C
+    if disc < 0.0:
+        return -1.0
+    sq = math.sqrt(disc)
+    q = -0.5 * (B + sq) if B >= 0.0 else -0.5 * (B - sq)
+    r1 = q / A
+    r2 = C / q if q != 0.0 else r1
+    lo_r, hi_r = min(r1, r2), max(r1, r2)
+    for r in (lo_r, hi_r):
+        if 0.0 <= r <= hi and 2.0 * A * r + B <= 0.0 and (C > 0.0 or r > 0.0 or B < 0.0):
+            return r
+    return -1.0
 
-    Returns (t, status): status 0 an impact at t; 1 the flight leaves the grid's edge at t; 2 it
-    reaches a nodata hole at t (still in the air)."""
+
+@njit(cache=True)
+def _find_impact(zg, x0, y0, dx, dy, lip, x, y, z, vx, vy, vz, g):
+    """First time t >= 0 at which the flight from (x, y, z) meets the surface, exactly.
+
+    Along a straight plan line the bilinear surface of one cell is a quadratic in time (u and v are linear
+    in t, z = z00 + a u + b v + c u v), and so is the parabola: within each cell the height above ground is a
+    quadratic whose first descending root is the impact.  The cells along the plan line are visited in
+    order (a grid traversal, Amanatides & Woo 1987); high above the ground whole stretches are skipped with
+    :func:`_safe_step`.  Returns (t, status): 0 an impact at t; 1 the flight leaves the grid at t; 2 it
+    reaches a cell touching a nodata hole at t (still in the air)."""
     ny, nx = zg.shape
     vh = math.sqrt(vx * vx + vy * vy)
-    sp = math.sqrt(vh * vh + vz * vz)
+    au, av = vx / dx, vy / dy
+    cell = min(dx, dy)
     t = 0.0
-    h = _height(zg, x0, y0, dx, dy, x, y, z)
-    if not h == h:
-        return 0.0, 2
-    for _ in range(1_000_000):
+    relocate = True
+    i = j = 0
+    for _ in range(100_000_000):
+        px = x + vx * t
+        py = y + vy * t
+        u = (px - x0) / dx
+        v = (py - y0) / dy
+        if relocate:
+            if not (u >= -1e-9 and v >= -1e-9 and u <= nx - 1 + 1e-9 and v <= ny - 1 + 1e-9):
+                return t, 1
+            j = min(max(int(math.floor(u)), 0), nx - 2)
+            i = min(max(int(math.floor(v)), 0), ny - 2)
+            if u - j <= 0.0 and au < 0.0 and j > 0:
+                j -= 1
+            if v - i <= 0.0 and av < 0.0 and i > 0:
+                i -= 1
+            relocate = False
+        if i < 0 or j < 0 or i > ny - 2 or j > nx - 2:
+            return t, 1
+        fu0 = min(max(u - j, 0.0), 1.0)
+        fv0 = min(max(v - i, 0.0), 1.0)
+        z00 = zg[i, j]
+        z10 = zg[i, j + 1]
+        z01 = zg[i + 1, j]
+        z11 = zg[i + 1, j + 1]
+        a = z10 - z00
+        b = z01 - z00
+        c = z11 - z10 - z01 + z00
+        C = z + vz * t - 0.5 * g * t * t - (z00 + a * fu0 + b * fv0 + c * fu0 * fv0)
+        if not C == C:
+            return t, 2
         vzt = vz - g * t
-        dt = max(_safe_step(max(h, 0.0), vh, vzt, g, lip), step_len / max(sp + g * t, 1e-3))
-        t1 = t + dt
-        h1 = _height(zg, x0, y0, dx, dy, x + vx * t1, y + vy * t1, z + vz * t1 - 0.5 * g * t1 * t1)
-        if not h1 == h1:
-            # Off the terrain before t1: find the last time on it by bisection, and whether the flight came
-            # down before that.
-            ta, tb = t, t1
-            for _k in range(60):
-                tm = 0.5 * (ta + tb)
-                hm = _height(zg, x0, y0, dx, dy, x + vx * tm, y + vy * tm, z + vz * tm - 0.5 * g * tm * tm)
-                if hm == hm:
-                    ta = tm
-                else:
-                    tb = tm
-                if (tb - ta) * (sp + g * tb) < 1e-9:
-                    break
-            ha = _height(zg, x0, y0, dx, dy, x + vx * ta, y + vy * ta, z + vz * ta - 0.5 * g * ta * ta)
-            if ha > 0.0:
-                xe, ye = x + vx * tb, y + vy * tb
-                ue, ve = (xe - x0) / dx, (ye - y0) / dy
-                edge = ue < 0.0 or ve < 0.0 or ue > nx - 1 or ve > ny - 1
-                return ta, 1 if edge else 2
-            t1, h1 = ta, ha
-        if h1 <= 0.0:
-            # Regula falsi (Illinois) between t (above) and t1 (at or below) to 1e-7 m.
-            ta, tb, fa, fb = t, t1, h, h1
-            side = 0
-            for _k in range(100):
-                tm = tb - fb * (tb - ta) / (fb - fa) if fb != fa else 0.5 * (ta + tb)
-                if not (ta < tm < tb):
-                    tm = 0.5 * (ta + tb)
-                fm = _height(zg, x0, y0, dx, dy, x + vx * tm, y + vy * tm, z + vz * tm - 0.5 * g * tm * tm)
-                if fm > 0.0:
-                    ta, fa = tm, fm
-                    if side == 1:
-                        fb *= 0.5
-                    side = 1
-                else:
-                    tb, fb = tm, fm
-                    if side == -1:
-                        fa *= 0.5
-                    side = -1
-                if (tb - ta) * (sp + g * tb) < 1e-7:
-                    break
-            return tb, 0
-        t, h = t1, h1
+        if C > 2.0 * cell * (1.0 + lip):
+            ts = _safe_step(C, vh, vzt, g, lip)
+            if ts * vh > cell:
+                t += ts
+                relocate = True
+                continue
+        tu = math.inf
+        if au > 0.0:
+            tu = max((1.0 - fu0) / au, 0.0)
+        elif au < 0.0:
+            tu = max(-fu0 / au, 0.0)
+        tv = math.inf
+        if av > 0.0:
+            tv = max((1.0 - fv0) / av, 0.0)
+        elif av < 0.0:
+            tv = max(-fv0 / av, 0.0)
+        te = min(tu, tv)
+        A = -0.5 * g - c * au * av
+        B = vzt - (a * au + b * av + c * (fu0 * av + fv0 * au))
+        if C <= 0.0 and B <= 0.0:
+            return t, 0           # at (or rounding-below) the ground and moving into it: the impact is now
+        r = _first_descending_root(A, B, C, te)
+        if r >= 0.0:
+            return t + r, 0
+        if te == math.inf:
+            return t, 1
+        t += te
+        if tu <= tv:
+            j += 1 if au > 0.0 else -1
+        if tv <= tu:
+            i += 1 if av > 0.0 else -1
     return t, 1
 
 
@@ -305,7 +345,7 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                m_roll, m_mu_ground, m_gain,
                c_ax, c_ay, c_bx, c_by, c_id, c_s0,
                g, v_contact, v_stop, max_events, key, n_path_blocks, rec_pass,
-               out_x, out_y, out_z, out_reason, out_impacts, out_t, out_excess,
+               out_x, out_y, out_z, out_reason, out_impacts, out_t, out_excess, out_events,
                r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_count,
                p_block, p_cell, p_e, p_h, p_count,
                pb, pt, ppx, ppy, ppz, ppv, pmode, pcount):
@@ -368,13 +408,14 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
         impacts = 0
         events = 0
         last_rest_x, last_rest_y = math.inf, math.inf
+        have_s, c_gx, c_gy = False, 0.0, 0.0
         while reason == RUNNING:
             events += 1
             if events > max_events:
                 reason = MAX_EVENTS
                 break
             if not contact:
-                t_hit, status = _find_impact(zg, x0, y0, dx, dy, lip, step_len, x, y, z, vx, vy, vz, g)
+                t_hit, status = _find_impact(zg, x0, y0, dx, dy, lip, x, y, z, vx, vy, vz, g)
                 # collectors and hazard pixels along the flight (its plan path is a straight line)
                 if n_cseg > 0 and t_hit > 0:
                     n_h = _collector_hits(c_ax, c_ay, c_bx, c_by, c_id, c_s0, x, y, x + vx * t_hit,
@@ -483,7 +524,11 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                 continue
 
             # ---- ground contact: one step along the surface ----
-            zs, gx, gy = _surface(zg, x0, y0, dx, dy, x, y)
+            if have_s:            # the surface here was evaluated at the end of the previous step
+                gx, gy = c_gx, c_gy
+            else:
+                zs, gx, gy = _surface(zg, x0, y0, dx, dy, x, y)
+            have_s = False
             mat = mat_grid[min(max(int(round((y - y0) / dy)), 0), ny - 1),
                            min(max(int(round((x - x0) / dx)), 0), nx - 1)]
             nl = math.sqrt(gx * gx + gy * gy + 1.0)
@@ -566,12 +611,14 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
             dn = dxv * nxn + dyv * nyn + dzv * nzn
             t_abs += dt
             x, y, z = xn, yn, zn
+            have_s, c_gx, c_gy = True, gxn, gyn
             if dn * u2 >= v_contact:
                 # convex edge: the block leaves the ground with its velocity
                 contact = False
                 vx, vy, vz = u2 * dxv, u2 * dyv, u2 * dzv
                 w = u2 / r if roll else 0.0
                 z = zn + 1e-9
+                have_s = False
                 sx, sy, sz = dxv, dyv, dzv
             else:
                 px_, py_, pz_ = dxv - dn * nxn, dyv - dn * nyn, dzv - dn * nzn
@@ -607,3 +654,4 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                          math.sqrt(vx * vx + vy * vy + vz * vz), MODE_STOP)
         out_x[b], out_y[b], out_z[b], out_reason[b], out_impacts[b], out_t[b] = x, y, z, reason, impacts, t_abs
         out_excess[b] = excess
+        out_events[b] = events

@@ -71,7 +71,8 @@ def main() -> None:
     rate = args.n / cpu
     print(f"3-D: {args.n:,} trajectories in {cpu:.2f} CPU-s on one thread: {rate:,.0f} trajectories/s per core "
           f"(goal >= 20,000: {'PASS' if rate >= 20_000 else 'FAIL'})")
-    print(f"     mean impacts per block {st['impacts'].mean():.1f}, median runout {st['runout_m'].median():.0f} m, "
+    print(f"     mean impacts per block {st['impacts'].mean():.1f}, events (impacts and contact steps) "
+          f"{r.per_block['events'].mean():.0f}, median runout {st['runout_m'].median():.0f} m, "
           f"reach road {r.collector('road', first_only=True).shape[0] / args.n:.3f}, "
           f"stop reasons {st['reason'].value_counts().to_dict()}")
     if args.hazard:
