@@ -7,12 +7,14 @@ The compiled kernel releases the GIL, so ``workers`` threads run chunks in paral
 """
 from __future__ import annotations
 
+import math
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
+from numba import njit
 
 from . import kernel3d
 from .engine import _material_arrays, check_masses
@@ -57,13 +59,15 @@ _PATH = (("block", np.int64), ("t", float), ("x", float), ("y", float), ("z", fl
          ("mode", np.int64))
 
 
-def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap):
+def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap, hint=None):
     m = hi - lo
     out = {k: np.empty(m, dtype=dt) for k, dt in (("x", float), ("y", float), ("z", float), ("reason", np.int64),
                                                    ("impacts", np.int64), ("t", float), ("excess", float),
                                                    ("events", np.int64))}
     cap_r = max(4 * m * max(len(cols["c_id"]), 1), 16)
-    cap_p = max(300 * m, 16) if hazard else 1
+    # pixel passages per block: a guess, then what the chunks run so far needed (a rerun when short)
+    per_block = hint.get("passages", 300.0) if hint is not None else 300.0
+    cap_p = max(int(per_block * m), 16) if hazard else 1
     pth_cap = path_cap if lo < n_paths else 1
     while True:
         r = {k: np.empty(cap_r, dtype=dt) for k, dt in _CROSS}
@@ -89,6 +93,8 @@ def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_
         cap_r = int(r_count.sum()) if r_count[1] else cap_r
         cap_p = int(p_count.sum()) if p_count[1] else cap_p
     k_r, k_p, k_t = int(r_count[0]), int(p_count[0]), int(pcount[0])
+    if hazard and hint is not None and m > 0:
+        hint["passages"] = max(hint.get("passages", 0.0), 1.25 * k_p / m)
     return (out, {k: v[:k_r].copy() for k, v in r.items()}, {k: v[:k_p].copy() for k, v in p.items()},
             {k: v[:k_t].copy() for k, v in pth.items()})
 
@@ -139,33 +145,80 @@ def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, m
     path_cap = max(n_paths * 4000, 16)
     # compile (or load from cache) untimed
     _run_chunk(0, 0, blocks, grid, mats, cols, st, key, 0, hazard, 1)
-    chunks = [(lo, min(lo + chunk_size, n)) for lo in range(0, n, chunk_size)]
+    # with hazard pixels, a small first chunk measures how many pixels a block crosses (the buffer size of
+    # the others); chunk boundaries do not change any result
+    first = min(500, chunk_size, n) if hazard else min(chunk_size, n)
+    chunks = [(0, first)] + [(lo, min(lo + chunk_size, n)) for lo in range(first, n, chunk_size)]
     started = time.perf_counter()
-    job = lambda c: _run_chunk(c[0], c[1], blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap)  # noqa: E731
+    hint = {}
+    job = lambda c: _run_chunk(c[0], c[1], blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap,  # noqa: E731
+                               hint)
     if workers == 1 or len(chunks) == 1:
         parts = [job(c) for c in chunks]
     else:
+        parts = [job(chunks[0])]
         with ThreadPoolExecutor(max_workers=workers) as pool:
-            parts = list(pool.map(job, chunks))
+            parts += list(pool.map(job, chunks[1:]))
     elapsed = time.perf_counter() - started
     cat = lambda i: {k: np.concatenate([p[i][k] for p in parts]) for k in parts[0][i]}  # noqa: E731
     return TerrainResult(scenario=scenario, n=n, seed=seed, blocks=blocks, per_block=cat(0), crossings=cat(1),
                          passages=cat(2) if hazard else None, paths=cat(3), elapsed_s=elapsed, workers=workers)
 
 
-def _group_quantiles(keys: np.ndarray, values: np.ndarray, qs) -> tuple[np.ndarray, np.ndarray]:
-    """Per distinct key, the linear-interpolation quantiles ``qs`` of its values (numpy's default method)."""
-    order = np.lexsort((values, keys))
-    k, v = keys[order], values[order].astype(float)
-    uniq, start, count = np.unique(k, return_index=True, return_counts=True)
-    out = np.empty((len(qs), len(uniq)))
-    for i, q in enumerate(qs):
-        pos = q * (count - 1)
-        lo = np.floor(pos).astype(np.int64)
-        hi = np.minimum(lo + 1, count - 1)
-        frac = pos - lo
-        out[i] = v[start + lo] * (1 - frac) + v[start + hi] * frac
-    return uniq, out
+@njit(cache=True)
+def _quantile_sorted(v, n, q):
+    """The q-quantile of the first n values of the sorted array v (linear interpolation, numpy's default)."""
+    pos = q * (n - 1)
+    lo = int(math.floor(pos))
+    hi = min(lo + 1, n - 1)
+    return v[lo] + (v[hi] - v[lo]) * (pos - lo)
+
+
+@njit(cache=True)
+def aggregate_passages(cell, block, e, h, ncell, qs_e, q_h):
+    """Per pixel: blocks that passed (a block re-entering a pixel counts once, with its largest energy and
+    height), quantiles ``qs_e`` of their energies and ``q_h`` of their heights (NaN where none passed).
+
+    A counting sort by pixel keeps the passages' block order, which is non-decreasing (chunks are
+    concatenated in block order), so a block's visits to one pixel are adjacent and merge in one pass.
+    """
+    count_raw = np.zeros(ncell + 1, np.int64)
+    for k in range(cell.shape[0]):
+        count_raw[cell[k] + 1] += 1
+    start = np.cumsum(count_raw)
+    fill = start[:-1].copy()
+    order = np.empty(cell.shape[0], np.int64)
+    for k in range(cell.shape[0]):
+        c = cell[k]
+        order[fill[c]] = k
+        fill[c] += 1
+    count = np.zeros(ncell)
+    eq = np.full((qs_e.shape[0], ncell), np.nan)
+    hq = np.full(ncell, np.nan)
+    te = np.empty(cell.shape[0])
+    th = np.empty(cell.shape[0])
+    for c in range(ncell):
+        a, b = start[c], start[c + 1]
+        if a == b:
+            continue
+        m = 0
+        last = -1
+        for idx in range(a, b):
+            k = order[idx]
+            if block[k] == last:
+                te[m - 1] = max(te[m - 1], e[k])
+                th[m - 1] = max(th[m - 1], h[k])
+            else:
+                te[m], th[m] = e[k], h[k]
+                last = block[k]
+                m += 1
+        count[c] = m
+        se = np.sort(te[:m])
+        sh = np.sort(th[:m])
+        for i in range(qs_e.shape[0]):
+            eq[i, c] = _quantile_sorted(se, m, qs_e[i])
+        hq[c] = _quantile_sorted(sh, m, q_h)
+    return count, eq, hq
 
 
 @dataclass(frozen=True)
@@ -257,23 +310,12 @@ class TerrainResult:
         ny, nx = ter.shape
         ncell = ny * nx
         p = self.passages
-        # one value per (block, pixel): a block that re-enters a pixel keeps its largest energy and height
-        key = p["block"].astype(np.int64) * ncell + p["cell"]
-        order = np.argsort(key, kind="stable")
-        k_sorted = key[order]
-        uniq, start = np.unique(k_sorted, return_index=True)
-        e = np.maximum.reduceat(p["e"][order].astype(float), start) if len(start) else np.empty(0)
-        h = np.maximum.reduceat(p["h"][order].astype(float), start) if len(start) else np.empty(0)
-        cell = uniq % ncell
-        count = np.bincount(cell, minlength=ncell).astype(float)
+        count, eq, hq = aggregate_passages(p["cell"], p["block"], p["e"].astype(float), p["h"].astype(float), ncell,
+                                           np.array([0.5, 0.95, 0.99]), 0.95)
         out = {"passage_count": count.reshape(ny, nx), "reach_probability": (count / self.n).reshape(ny, nx)}
-        cells, qe = _group_quantiles(cell, e, (0.5, 0.95, 0.99))
-        _, qh = _group_quantiles(cell, h, (0.95,))
-        for name, row in (("energy_p50_kj", qe[0]), ("energy_p95_kj", qe[1]), ("energy_p99_kj", qe[2]),
-                          ("jump_height_p95_m", qh[0])):
-            g = np.full(ncell, np.nan)
-            g[cells] = row
-            out[name] = g.reshape(ny, nx)
+        for name, row in (("energy_p50_kj", eq[0]), ("energy_p95_kj", eq[1]), ("energy_p99_kj", eq[2]),
+                          ("jump_height_p95_m", hq)):
+            out[name] = row.reshape(ny, nx)
         pb = self.per_block
         stopped = pb["reason"] == kernel3d.STOPPED
         j = np.clip(np.floor((pb["x"][stopped] - ter.x0) / ter.dx + 0.5).astype(np.int64), 0, nx - 1)
