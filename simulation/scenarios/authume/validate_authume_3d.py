@@ -97,7 +97,7 @@ observed stops; star: release point.*
   runout and lateral offset are both consistent with the observations (KS p above 0.05 for each, energy
   distance p well above 0.05), and a real stop lies beyond the farthest of 100 simulated blocks about 1 % of
   the time.  The lateral spread comes from the terrain and the roughness tilts alone (no lateral parameter was
-  fitted); it is narrower than observed on the left of the path (offset p90 3.9 m simulated, 8.8 m observed),
+  fitted); it is narrower than observed on the left of the path (offset p90 4.0 m simulated, 8.8 m observed),
   so a 3-D calibration would also fit the lateral spread.  The "beyond farthest" shares (about 1 % in 2-D and
   3-D) are in-sample: the calibration was fitted to these same stops.
 * **P2 (curved corridor, soft ground), calibrated on P2:** the 2-D fit (8 deg rolling resistance on the gray
