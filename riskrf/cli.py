@@ -581,7 +581,7 @@ def cmd_hazard_map(args) -> int:
     """``riskrf hazard-map``: run a 3-D ``[terrain]`` scenario and write hazard GeoTIFFs on the DEM's grid, stop
     points and trajectories (GeoPackage) and a hillshade figure."""
     from .app.hazard_map import hazard_map
-    from .outputs import check_output
+    from .io.outputs import check_output
     out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-hazard-map")
     check_output(out, overwrite=args.overwrite, kind="dir")
     hm = hazard_map(args.scenario, n=args.n, seed=args.seed, crs=args.crs, workers=args.workers)

@@ -74,7 +74,7 @@ class HazardMap:
 
     def write(self, out, *, overwrite: bool = False) -> Path:
         """Write every layer to directory ``out`` (all or nothing; see the module docstring)."""
-        from ..outputs import atomic_output_dir
+        from ..io.outputs import atomic_output_dir
         out = Path(out)
         ter = self.scenario.terrain
         with atomic_output_dir(out, overwrite=overwrite) as tmp:
