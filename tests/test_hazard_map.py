@@ -116,3 +116,25 @@ def test_hazard_map_is_identical_for_one_and_two_workers(tmp_path):
     for k in a.grids:
         np.testing.assert_array_equal(a.grids[k], b.grids[k])
     assert set(a.summary()["layer"]) == set(RASTERS)
+
+
+def test_cli_profile_cuts_a_section_from_the_dem(tmp_path, capsys):
+    import tomllib
+
+    import simulation
+    _dem(tmp_path / "dem.tif")
+    out = tmp_path / "section.toml"
+    assert main(["profile", str(tmp_path / "dem.tif"), "--path", "900002,6600040", "900150,6600040",
+                 "--spacing", "2", "--out", str(out)]) == 0
+    prof = tomllib.loads(out.read_text())["profile"]
+    assert prof["x"][0] == 0 and prof["x"][-1] == pytest.approx(148.0) and len(prof["x"]) == 75
+    # bilinear on the DEM: the first sample lies on the 35 deg plane 2 m from the grid's west edge, plus the
+    # cross-slope V term 0.1 |y - 6600040| = 0.1 m at the centres of the two rows either side (y = 39, 41)
+    assert prof["z"][0] == pytest.approx(400 - np.tan(np.radians(35)) * 2.0 + 0.1, abs=1e-3)
+    sc = simulation.scenario_from_dict({**tomllib.loads(out.read_text()),
+                                        "materials": {"talus": {"preset": "talus"}},
+                                        "seeder": {"x": 1.0, "mass_kg": 1000}})
+    assert sc.profile.x[-1] == pytest.approx(148.0)
+    assert main(["profile", str(tmp_path / "dem.tif"), "--path", "900002,6600040", "900300,6600040",
+                 "--out", str(tmp_path / "far.toml")]) == 2
+    assert "leaves the DEM" in capsys.readouterr().err
