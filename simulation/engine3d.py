@@ -54,7 +54,7 @@ def _collector_segments(scenario: TerrainScenario):
 
 _CROSS = (("block", np.int64), ("coll", np.int64), ("s", float), ("t", float), ("x", float), ("y", float),
           ("vx", float), ("vy", float), ("vz", float), ("w", float), ("h", float))
-_PASS = (("block", np.int64), ("cell", np.int64), ("e", np.float32), ("h", np.float32))
+_PASS = (("block", np.int32), ("cell", np.int32), ("e", np.float32), ("h", np.float32))   # 16 bytes a passage
 _PATH = (("block", np.int64), ("t", float), ("x", float), ("y", float), ("z", float), ("v", float),
          ("mode", np.int64))
 
@@ -71,7 +71,8 @@ def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_
     pth_cap = path_cap if lo < n_paths else 1
     while True:
         r = {k: np.empty(cap_r, dtype=dt) for k, dt in _CROSS}
-        p = {k: np.empty(cap_p, dtype=dt) for k, dt in _PASS}
+        big = grid[0].size >= 2 ** 31          # pixel indices beyond int32: a DEM of more than 2.1e9 cells
+        p = {k: np.empty(cap_p, dtype=np.int64 if (big and k == "cell") else dt) for k, dt in _PASS}
         pth = {k: np.empty(pth_cap, dtype=dt) for k, dt in _PATH}
         r_count, p_count, pcount = np.zeros(2, np.int64), np.zeros(2, np.int64), np.zeros(1, np.int64)
         kernel3d.simulate3d(
@@ -119,7 +120,7 @@ def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, m
     workers : int
         Threads running chunks (the kernel releases the GIL).
     hazard : bool
-        Record every DEM pixel each block crosses (for :meth:`TerrainResult.hazard_grids`; about 12 bytes per
+        Record every DEM pixel each block crosses (for :meth:`TerrainResult.hazard_grids`; about 16 bytes per
         pixel crossed).
     record_paths : int
         Keep the event sequence of the first ``record_paths`` blocks (plots, trajectory layers).
