@@ -188,7 +188,7 @@ def aggregate_passages(cell, block, e, h, ncell, qs_e, q_h):
         count_raw[cell[k] + 1] += 1
     start = np.cumsum(count_raw)
     fill = start[:-1].copy()
-    order = np.empty(cell.shape[0], np.int64)
+    order = np.empty(cell.shape[0], np.int32)         # < 2^31 passages (34 GB of them) by far
     for k in range(cell.shape[0]):
         c = cell[k]
         order[fill[c]] = k
@@ -196,8 +196,11 @@ def aggregate_passages(cell, block, e, h, ncell, qs_e, q_h):
     count = np.zeros(ncell)
     eq = np.full((qs_e.shape[0], ncell), np.nan)
     hq = np.full(ncell, np.nan)
-    te = np.empty(cell.shape[0])
-    th = np.empty(cell.shape[0])
+    longest = 0
+    for c in range(ncell):
+        longest = max(longest, start[c + 1] - start[c])
+    te = np.empty(longest, np.float32)
+    th = np.empty(longest, np.float32)
     for c in range(ncell):
         a, b = start[c], start[c + 1]
         if a == b:
@@ -311,7 +314,7 @@ class TerrainResult:
         ny, nx = ter.shape
         ncell = ny * nx
         p = self.passages
-        count, eq, hq = aggregate_passages(p["cell"], p["block"], p["e"].astype(float), p["h"].astype(float), ncell,
+        count, eq, hq = aggregate_passages(p["cell"], p["block"], p["e"], p["h"], ncell,
                                            np.array([0.5, 0.95, 0.99]), 0.95)
         out = {"passage_count": count.reshape(ny, nx), "reach_probability": (count / self.n).reshape(ny, nx)}
         for name, row in (("energy_p50_kj", eq[0]), ("energy_p95_kj", eq[1]), ("energy_p99_kj", eq[2]),
