@@ -14,8 +14,8 @@ crosses and returns a :class:`HazardMap`; :meth:`HazardMap.write` writes, all or
 * ``hillshade.png``: the reach probability over a hillshade of the DEM with the stop points and paths;
 * ``summary.csv`` and ``crossings.csv`` (one row per crossing of each plan collector).
 
-The percentiles are those of the blocks that reached the pixel (conditional on reaching it), as in
-Rockyfor3D's and RAMMS' energy maps; combine them with ``reach_probability`` for unconditional figures.
+The percentiles are those of the blocks that reached the pixel (conditional on reaching it); combine them
+with ``reach_probability`` for unconditional figures.
 """
 from __future__ import annotations
 
