@@ -22,6 +22,8 @@ from .scenario3d import TerrainScenario, _lipschitz, fall_line, sample_sources
 from .units import J_PER_KJ, kinetic_energy_kj
 
 DEFAULT_CHUNK_3D = 20_000
+_KERNEL3D_MATERIALS = ("m_en_law", "m_en_mean", "m_en_std", "m_et_law", "m_et_mean", "m_et_std", "m_phi", "m_phi_std",
+                       "m_rough", "m_roll", "m_mu_ground", "m_gain")
 
 
 def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> dict:
@@ -139,7 +141,8 @@ def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, m
     blocks = seed_blocks_3d(scenario, n, seed, masses_kg)
     ter = scenario.terrain
     grid = (ter.z, ter.x0, ter.y0, ter.dx, ter.dy, _lipschitz(ter.z, ter.dx, ter.dy), scenario.material_grid.index)
-    mats = _material_arrays(scenario)
+    # only the material arrays the 3-D kernel takes (the 2-D engine may prepare more for its own kernel)
+    mats = {k: v for k, v in _material_arrays(scenario).items() if k in _KERNEL3D_MATERIALS}
     cols = _collector_segments(scenario)
     st = scenario.settings
     n_paths = min(int(record_paths), n)
