@@ -578,6 +578,49 @@ def cmd_corridor(args) -> int:
     return 0
 
 
+def cmd_hazard_map(args) -> int:
+    """``riskrf hazard-map``: run a 3-D ``[terrain]`` scenario and write hazard GeoTIFFs on the DEM's grid, stop
+    points and trajectories (GeoPackage) and a hillshade figure."""
+    from .app.hazard_map import hazard_map
+    from .io.outputs import check_output
+    out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-hazard-map")
+    check_output(out, overwrite=args.overwrite, kind="dir")
+    hm = hazard_map(args.scenario, n=args.n, seed=args.seed, crs=args.crs, workers=args.workers)
+    print(f"Scenario {hm.scenario.name} ({hm.scenario.source}): {hm.result.n:,} blocks, seed {args.seed}")
+    print(hm.result.summary().to_string(index=False, header=False))
+    hm.write(out, overwrite=args.overwrite)
+    print(f"Wrote hazard rasters (GeoTIFF, {hm.scenario.terrain.crs}), hazard_map.gpkg and hillshade.png to {out}/")
+    return 0
+
+
+def cmd_profile(args) -> int:
+    """``riskrf profile``: cut a 2-D slope profile from a DEM raster along a plan polyline and write it as the
+    ``[profile]`` table of a scenario (TOML)."""
+    import simulation
+
+    from .io.outputs import atomic_outputs, check_output
+    out = Path(args.out) if args.out else Path(f"{Path(args.dem).stem}-profile.toml")
+    check_output(out, overwrite=args.overwrite, kind="file")
+    try:
+        path = [tuple(float(v) for v in p.split(",")) for p in args.path]
+    except ValueError:
+        raise ValueError(f"--path {' '.join(args.path)}: give plan vertices as X,Y X,Y ... (numbers)") from None
+    if any(len(p) != 2 for p in path) or len(path) < 2:
+        raise ValueError(f"--path {' '.join(args.path)}: give at least two plan vertices as X,Y")
+    dem = simulation.read_dem(args.dem, crs=args.crs)
+    prof = simulation.profile_from_grid(dem, path, spacing=args.spacing)
+    d = prof.to_dict()
+    fmt = lambda xs: "[" + ", ".join(repr(float(v)) for v in xs) + "]"  # noqa: E731  (to_dict: 1 mm)
+    text = (f"# 2-D section of {args.dem} ({dem.crs.to_string() if dem.crs else 'no CRS'}) along "
+            f"{' -> '.join(f'({x:g}, {y:g})' for x, y in path)}, every {prof.spacing_m:g} m (riskrf profile)\n"
+            f"[profile]\nx = {fmt(d['x'])}\nz = {fmt(d['z'])}\nmaterial = \"{args.material}\"\n")
+    with atomic_outputs([(out, "file")], overwrite=args.overwrite) as tmp:
+        tmp.write_text(text)
+    print(f"{len(d['x'])} vertices over {d['x'][-1]:g} m, elevation {min(d['z']):g}-{max(d['z']):g} m; wrote the "
+          f"[profile] table to {out} (add [materials.{args.material}] and a [seeder] to make a scenario)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``riskrf`` argument parser with one sub-command per task."""
     parser = argparse.ArgumentParser(
@@ -787,6 +830,34 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="skip sections already finished by an earlier run")
     _add_reader_arguments(p, "the sections table", "corridor.sections_")
     p.set_defaults(func=cmd_corridor)
+    p = sub.add_parser("hazard-map", help="3-D rock fall hazard rasters on a DEM (GeoTIFF, GeoPackage)",
+                       description="Run a 3-D scenario (TOML with a [terrain] table: DEM raster, materials, "
+                       "[sources] points or polygon, plan collectors) and write GeoTIFFs on the DEM's grid and CRS "
+                       "(passage count, reach probability, kinetic energy p50/p95/p99, jump height p95, deposition "
+                       "density), stop points and trajectories as GeoPackage layers and a hillshade figure.",
+                       epilog=EPILOG)
+    p.add_argument("scenario", help="3-D scenario TOML, e.g. simulation/scenarios/authume/authume_3d.toml")
+    p.add_argument("-n", type=int, default=10_000, help="number of blocks to release (default 10,000)")
+    p.add_argument("--seed", type=int, default=1, help="random seed; the same seed gives identical results")
+    p.add_argument("--crs", default=None, help="the DEM's CRS when its file has none, e.g. EPSG:2154")
+    p.add_argument("--workers", type=int, default=1, help="threads running the kernel (results do not depend on it)")
+    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <scenario>-hazard-map)")
+    p.set_defaults(func=cmd_hazard_map)
+
+    p = sub.add_parser("profile", help="cut a 2-D slope profile from a DEM raster along a plan polyline",
+                       description="Sample a DEM (GeoTIFF, ESRI ASCII grid) every --spacing metres along a plan "
+                       "polyline (bilinear, the surface the 3-D simulator uses) and write the [profile] table of a "
+                       "2-D scenario.  A path leaving the DEM or crossing a nodata hole is refused, naming the "
+                       "distance.", epilog=EPILOG)
+    p.add_argument("dem", help="DEM raster file")
+    p.add_argument("--path", nargs="+", required=True, metavar="X,Y",
+                   help="plan vertices of the section, top of the slope first, in the DEM's CRS")
+    p.add_argument("--spacing", type=float, default=None, help="vertex spacing [m] (default: the DEM's cell size)")
+    p.add_argument("--material", default="talus", help="material name given to every segment (default talus)")
+    p.add_argument("--crs", default=None, help="the DEM's CRS when its file has none, e.g. EPSG:2154")
+    p.add_argument("--out", default=None, metavar="FILE", help="output TOML (default <dem>-profile.toml)")
+    p.set_defaults(func=cmd_profile)
+
     for p in sub.choices.values():       # every command with outputs: never clobber without --overwrite
         if any("--out" in a.option_strings for a in p._actions):
             p.add_argument("--overwrite", action="store_true",

@@ -18,6 +18,10 @@ _EXPORTS = {
     # Calibration to observed stop points and profiles extracted from 3-D terrain (issue 9).
     **dict.fromkeys(["Calibration", "CalibrationWarning", "calibrate", "read_observed"], "calibration"),
     **dict.fromkeys(["TerrainProfile", "profile_from_points", "read_stl"], "profile_extraction"),
+    # 3-D terrain: DEM rasters, profiles cut from them, 3-D scenarios and the 3-D kernel's runs.
+    **dict.fromkeys(["Terrain", "TerrainError", "read_dem", "read_material_raster", "profile_from_grid"], "terrain"),
+    **dict.fromkeys(["TerrainScenario", "load_terrain_scenario", "terrain_scenario_from_dict"], "scenario3d"),
+    **dict.fromkeys(["run_terrain", "TerrainResult"], "engine3d"),
 }
 
 __all__ = sorted(_EXPORTS)

@@ -1,0 +1,355 @@
+"""Running a 3-D terrain scenario: seeding, chunking (and threads), collecting the kernel's outputs.
+
+As in 2-D (:mod:`simulation.engine`): every block's initial state is drawn up front with NumPy generators
+spawned from ``SeedSequence(seed)`` (one per quantity), and per-impact random numbers come from a stream
+keyed by (seed, block index), so results are identical whatever the chunk size or number of threads.
+The compiled kernel releases the GIL, so ``workers`` threads run chunks in parallel.
+"""
+from __future__ import annotations
+
+import math
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+from numba import njit
+
+from . import kernel3d
+from .engine import _material_arrays, check_masses
+from .scenario3d import TerrainScenario, _lipschitz, fall_line, sample_sources
+from .units import J_PER_KJ, kinetic_energy_kj
+
+DEFAULT_CHUNK_3D = 20_000
+_KERNEL3D_MATERIALS = ("m_en_law", "m_en_mean", "m_en_std", "m_et_law", "m_et_mean", "m_et_std", "m_phi", "m_phi_std",
+                       "m_rough", "m_roll", "m_mu_ground", "m_gain")
+
+
+def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> dict:
+    """Initial state of n blocks: plan position and elevation [m], velocity [m/s] (``speed_ms`` horizontally
+    along the local fall line, ``vz_ms`` vertically), spin [rad/s], mass [kg], radius [m], I / (m r^2)."""
+    sd = scenario.sources
+    ss = np.random.SeedSequence(seed)
+    g_xy, g_h, g_m, g_v, g_vz, g_w = (np.random.default_rng(c) for c in ss.spawn(6))
+    xy = sample_sources(sd, scenario.terrain, g_xy, n)
+    x, y = xy[:, 0].copy(), xy[:, 1].copy()
+    h = sd.height_m.sample(g_h, n)
+    mass = sd.mass_kg.sample(g_m, n) if masses_kg is None else check_masses(masses_kg, n).copy()
+    speed = sd.speed_ms.sample(g_v, n)
+    ux, uy = fall_line(scenario.terrain, x, y)
+    return {"x": x, "y": y, "z": scenario.terrain.elevation(x, y) + h, "vx": speed * ux, "vy": speed * uy,
+            "vz": sd.vz_ms.sample(g_vz, n), "w": sd.angular_velocity_rads.sample(g_w, n), "mass": mass,
+            "radius": sd.radius(mass), "inertia_factor": np.full(n, sd.inertia_factor)}
+
+
+def _collector_segments(scenario: TerrainScenario):
+    ax, ay, bx, by, cid, s0 = [], [], [], [], [], []
+    for j, c in enumerate(scenario.collectors):
+        cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(c.line, axis=0).T))])
+        for k in range(len(c.line) - 1):
+            ax.append(c.line[k, 0]), ay.append(c.line[k, 1]), bx.append(c.line[k + 1, 0]), by.append(c.line[k + 1, 1])
+            cid.append(j), s0.append(cum[k])
+    f = lambda v: np.asarray(v, dtype=float)  # noqa: E731
+    return dict(c_ax=f(ax), c_ay=f(ay), c_bx=f(bx), c_by=f(by), c_id=np.asarray(cid, dtype=np.int64), c_s0=f(s0))
+
+
+_CROSS = (("block", np.int64), ("coll", np.int64), ("s", float), ("t", float), ("x", float), ("y", float),
+          ("vx", float), ("vy", float), ("vz", float), ("w", float), ("h", float))
+_PASS = (("block", np.int32), ("cell", np.int32), ("e", np.float32), ("h", np.float32))   # 16 bytes a passage
+_PATH = (("block", np.int64), ("t", float), ("x", float), ("y", float), ("z", float), ("v", float),
+         ("mode", np.int64))
+
+
+def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap, hint=None):
+    m = hi - lo
+    out = {k: np.empty(m, dtype=dt) for k, dt in (("x", float), ("y", float), ("z", float), ("reason", np.int64),
+                                                   ("impacts", np.int64), ("t", float), ("excess", float),
+                                                   ("events", np.int64))}
+    cap_r = max(4 * m * max(len(cols["c_id"]), 1), 16)
+    # pixel passages per block: a guess, then what the chunks run so far needed (a rerun when short)
+    per_block = hint.get("passages", 300.0) if hint is not None else 300.0
+    cap_p = max(int(per_block * m), 16) if hazard else 1
+    pth_cap = path_cap if lo < n_paths else 1
+    while True:
+        r = {k: np.empty(cap_r, dtype=dt) for k, dt in _CROSS}
+        big = grid[0].size >= 2 ** 31          # pixel indices beyond int32: a DEM of more than 2.1e9 cells
+        p = {k: np.empty(cap_p, dtype=np.int64 if (big and k == "cell") else dt) for k, dt in _PASS}
+        pth = {k: np.empty(pth_cap, dtype=dt) for k, dt in _PATH}
+        r_count, p_count, pcount = np.zeros(2, np.int64), np.zeros(2, np.int64), np.zeros(1, np.int64)
+        kernel3d.simulate3d(
+            np.arange(lo, hi, dtype=np.int64), *(blocks[k][lo:hi] for k in
+                                                  ("x", "y", "z", "vx", "vy", "vz", "w", "mass", "radius",
+                                                   "inertia_factor")),
+            *grid, **mats, **cols, g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
+            max_events=st.max_events, key=key, n_path_blocks=n_paths, rec_pass=hazard,
+            out_x=out["x"], out_y=out["y"], out_z=out["z"], out_reason=out["reason"], out_impacts=out["impacts"],
+            out_t=out["t"], out_excess=out["excess"], out_events=out["events"],
+            r_block=r["block"], r_coll=r["coll"], r_s=r["s"], r_t=r["t"], r_x=r["x"], r_y=r["y"], r_vx=r["vx"],
+            r_vy=r["vy"], r_vz=r["vz"], r_w=r["w"], r_h=r["h"], r_count=r_count,
+            p_block=p["block"], p_cell=p["cell"], p_e=p["e"], p_h=p["h"], p_count=p_count,
+            pb=pth["block"], pt=pth["t"], ppx=pth["x"], ppy=pth["y"], ppz=pth["z"], ppv=pth["v"],
+            pmode=pth["mode"], pcount=pcount)
+        if r_count[1] == 0 and p_count[1] == 0:
+            break
+        # a buffer was too small: run the chunk again with the exact sizes (same numbers: keyed by block)
+        cap_r = int(r_count.sum()) if r_count[1] else cap_r
+        cap_p = int(p_count.sum()) if p_count[1] else cap_p
+    k_r, k_p, k_t = int(r_count[0]), int(p_count[0]), int(pcount[0])
+    if hazard and hint is not None and m > 0:
+        hint["passages"] = max(hint.get("passages", 0.0), 1.25 * k_p / m)
+    return (out, {k: v[:k_r].copy() for k, v in r.items()}, {k: v[:k_p].copy() for k, v in p.items()},
+            {k: v[:k_t].copy() for k, v in pth.items()})
+
+
+def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, masses_kg=None,
+                chunk_size: int = DEFAULT_CHUNK_3D, workers: int = 1, hazard: bool = False,
+                record_paths: int = 20) -> "TerrainResult":
+    """Simulate ``n`` blocks released from the scenario's sources on its DEM.
+
+    Parameters
+    ----------
+    scenario : TerrainScenario
+        From :func:`simulation.load_terrain_scenario`.
+    n : int
+        Number of blocks (10,000 when neither it nor ``masses_kg`` is given).
+    seed : int, optional
+        The same seed gives identical results for any ``chunk_size`` and ``workers``.
+    masses_kg : array, optional
+        The mass [kg] of each block (the sources' mass distribution is then ignored).
+    chunk_size : int
+        Blocks per kernel call.
+    workers : int
+        Threads running chunks (the kernel releases the GIL).
+    hazard : bool
+        Record every DEM pixel each block crosses (for :meth:`TerrainResult.hazard_grids`; about 16 bytes per
+        pixel crossed).
+    record_paths : int
+        Keep the event sequence of the first ``record_paths`` blocks (plots, trajectory layers).
+    """
+    if masses_kg is not None:
+        masses_kg = check_masses(masses_kg, None if n is None else n)
+        n = masses_kg.size
+    elif n is None:
+        n = 10_000
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
+        raise ValueError(f"n must be a positive whole number of blocks; got {n!r}")
+    if chunk_size <= 0 or workers <= 0:
+        raise ValueError(f"chunk_size and workers must be > 0; got {chunk_size!r}, {workers!r}")
+    n = int(n)
+    key = np.random.SeedSequence(seed).generate_state(1, dtype=np.uint64)[0]
+    blocks = seed_blocks_3d(scenario, n, seed, masses_kg)
+    ter = scenario.terrain
+    grid = (ter.z, ter.x0, ter.y0, ter.dx, ter.dy, _lipschitz(ter.z, ter.dx, ter.dy), scenario.material_grid.index)
+    # only the material arrays the 3-D kernel takes (the 2-D engine may prepare more for its own kernel)
+    mats = {k: v for k, v in _material_arrays(scenario).items() if k in _KERNEL3D_MATERIALS}
+    cols = _collector_segments(scenario)
+    st = scenario.settings
+    n_paths = min(int(record_paths), n)
+    path_cap = max(n_paths * 4000, 16)
+    # compile (or load from cache) untimed
+    _run_chunk(0, 0, blocks, grid, mats, cols, st, key, 0, hazard, 1)
+    # with hazard pixels, a small first chunk measures how many pixels a block crosses (the buffer size of
+    # the others); chunk boundaries do not change any result
+    first = min(500, chunk_size, n) if hazard else min(chunk_size, n)
+    chunks = [(0, first)] + [(lo, min(lo + chunk_size, n)) for lo in range(first, n, chunk_size)]
+    started = time.perf_counter()
+    hint = {}
+    job = lambda c: _run_chunk(c[0], c[1], blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap,  # noqa: E731
+                               hint)
+    if workers == 1 or len(chunks) == 1:
+        parts = [job(c) for c in chunks]
+    else:
+        parts = [job(chunks[0])]
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            parts += list(pool.map(job, chunks[1:]))
+    elapsed = time.perf_counter() - started
+    cat = lambda i: {k: np.concatenate([p[i][k] for p in parts]) for k in parts[0][i]}  # noqa: E731
+    return TerrainResult(scenario=scenario, n=n, seed=seed, blocks=blocks, per_block=cat(0), crossings=cat(1),
+                         passages=cat(2) if hazard else None, paths=cat(3), elapsed_s=elapsed, workers=workers)
+
+
+@njit(cache=True)
+def _quantile_sorted(v, n, q):
+    """The q-quantile of the first n values of the sorted array v (linear interpolation, numpy's default)."""
+    pos = q * (n - 1)
+    lo = int(math.floor(pos))
+    hi = min(lo + 1, n - 1)
+    return v[lo] + (v[hi] - v[lo]) * (pos - lo)
+
+
+@njit(cache=True)
+def aggregate_passages(cell, block, e, h, ncell, qs_e, q_h):
+    """Per pixel: blocks that passed (a block re-entering a pixel counts once, with its largest energy and
+    height), quantiles ``qs_e`` of their energies and ``q_h`` of their heights (NaN where none passed).
+
+    A counting sort by pixel keeps the passages' block order, which is non-decreasing (chunks are
+    concatenated in block order), so a block's visits to one pixel are adjacent and merge in one pass.
+    """
+    count_raw = np.zeros(ncell + 1, np.int64)
+    for k in range(cell.shape[0]):
+        count_raw[cell[k] + 1] += 1
+    start = np.cumsum(count_raw)
+    fill = start[:-1].copy()
+    order = np.empty(cell.shape[0], np.int32)         # < 2^31 passages (34 GB of them) by far
+    for k in range(cell.shape[0]):
+        c = cell[k]
+        order[fill[c]] = k
+        fill[c] += 1
+    count = np.zeros(ncell)
+    eq = np.full((qs_e.shape[0], ncell), np.nan)
+    hq = np.full(ncell, np.nan)
+    longest = 0
+    for c in range(ncell):
+        longest = max(longest, start[c + 1] - start[c])
+    te = np.empty(longest, np.float32)
+    th = np.empty(longest, np.float32)
+    for c in range(ncell):
+        a, b = start[c], start[c + 1]
+        if a == b:
+            continue
+        m = 0
+        last = -1
+        for idx in range(a, b):
+            k = order[idx]
+            if block[k] == last:
+                te[m - 1] = max(te[m - 1], e[k])
+                th[m - 1] = max(th[m - 1], h[k])
+            else:
+                te[m], th[m] = e[k], h[k]
+                last = block[k]
+                m += 1
+        count[c] = m
+        se = np.sort(te[:m])
+        sh = np.sort(th[:m])
+        for i in range(qs_e.shape[0]):
+            eq[i, c] = _quantile_sorted(se, m, qs_e[i])
+        hq[c] = _quantile_sorted(sh, m, q_h)
+    return count, eq, hq
+
+
+@dataclass(frozen=True)
+class TerrainResult:
+    """Everything a 3-D run produced.  Units: m, m/s, rad/s, kg, kJ, s; plan coordinates in the DEM's CRS."""
+
+    scenario: object
+    n: int
+    seed: object
+    blocks: dict = field(repr=False)
+    per_block: dict = field(repr=False)
+    crossings: dict = field(repr=False)
+    passages: dict | None = field(repr=False, default=None)
+    paths: dict | None = field(repr=False, default=None)
+    elapsed_s: float = 0.0
+    workers: int = 1
+
+    def stops(self) -> pd.DataFrame:
+        """One row per block: release point, final point (x_m, y_m, z_m), reason, impacts, time, mass, and
+        the horizontal runout from the release point [m]."""
+        pb, b = self.per_block, self.blocks
+        reasons = [kernel3d.STOP_REASONS[i] for i in sorted(kernel3d.STOP_REASONS)]
+        return pd.DataFrame({
+            "block": np.arange(self.n), "x0_m": b["x"], "y0_m": b["y"], "x_m": pb["x"], "y_m": pb["y"], "z_m": pb["z"],
+            "runout_m": np.hypot(pb["x"] - b["x"], pb["y"] - b["y"]),
+            "reason": pd.Categorical.from_codes(pb["reason"] - 1, reasons), "impacts": pb["impacts"],
+            "time_s": pb["t"], "mass_kg": b["mass"]})
+
+    def energy_excess_j(self) -> np.ndarray:
+        """Per block, the largest rise [J] of its total energy (kinetic + m g z) from one impact or contact step
+        to the next (the energy audit: 0 or rounding-small unless a material allows energy gain)."""
+        return self.per_block["excess"]
+
+    def collector(self, name: str, *, first_only: bool = False) -> pd.DataFrame:
+        """One row per crossing of the plan collector ``name``: ``block``, ``position_m`` (distance along the
+        line), ``x_m``, ``y_m``, ``time_s``, ``velocity_ms``, ``vx_ms``, ``vy_ms``, ``vz_ms``,
+        ``angular_velocity_rads``, ``height_m`` (centre above the ground), ``mass_kg``, ``energy_kj``."""
+        j = self.scenario.collector_index(name)
+        c = self.crossings
+        sel = c["coll"] == j
+        blk = c["block"][sel]
+        v = np.sqrt(c["vx"][sel] ** 2 + c["vy"][sel] ** 2 + c["vz"][sel] ** 2)
+        mass, radius, k = self.blocks["mass"][blk], self.blocks["radius"][blk], self.blocks["inertia_factor"][blk]
+        df = pd.DataFrame({"block": blk, "position_m": c["s"][sel], "x_m": c["x"][sel], "y_m": c["y"][sel],
+                           "time_s": c["t"][sel], "velocity_ms": v, "vx_ms": c["vx"][sel], "vy_ms": c["vy"][sel],
+                           "vz_ms": c["vz"][sel], "angular_velocity_rads": c["w"][sel], "height_m": c["h"][sel],
+                           "mass_kg": mass,
+                           "energy_kj": kinetic_energy_kj(mass, v, c["w"][sel], radius, k)})
+        df = df.sort_values(["block", "time_s"])
+        if first_only:
+            df = df.drop_duplicates("block", keep="first")
+        return df.reset_index(drop=True)
+
+    def summary(self) -> pd.DataFrame:
+        """Runout quantiles, stop reasons, impacts, energy audit and speed of the run, one row per quantity."""
+        st = self.stops()
+        rows = [("blocks", self.n, ""), ("seconds", self.elapsed_s, "s"),
+                ("trajectories per second", self.n / max(self.elapsed_s, 1e-12), "1/s")]
+        for q in (0.5, 0.95, 0.99):
+            rows.append((f"runout p{int(q * 100)}", float(np.quantile(st["runout_m"], q)), "m"))
+        for reason, cnt in st["reason"].value_counts(sort=False).items():
+            rows.append((f"blocks {reason}", int(cnt), ""))
+        rows.append(("mean impacts per block", float(st["impacts"].mean()), ""))
+        rows.append(("mean events per block (impacts and contact steps)", float(self.per_block["events"].mean()), ""))
+        rows.append(("largest energy rise between events", float(np.max(self.energy_excess_j())) / J_PER_KJ, "kJ"))
+        for c in self.scenario.collectors:
+            k = self.collector(c.name, first_only=True).shape[0]
+            rows.append((f"reach {c.name}", k / self.n, ""))
+        return pd.DataFrame(rows, columns=["quantity", "value", "unit"])
+
+    def __repr__(self) -> str:
+        return (f"TerrainResult({self.scenario.name!r}, n={self.n}, seed={self.seed}, "
+                f"{self.elapsed_s:.2f} s, {len(self.scenario.collectors)} collectors)")
+
+    # ---- hazard rasters ----------------------------------------------------------------------------
+    def hazard_grids(self) -> dict:
+        """Hazard rasters on the DEM's grid (internal order, NaN where no block passed), from the pixels each
+        block crossed (run with ``hazard=True``):
+
+        ``passage_count`` blocks that passed through the pixel (each counted once); ``reach_probability`` that
+        count / n; ``energy_p50_kj``, ``energy_p95_kj``, ``energy_p99_kj`` percentiles over those blocks of each
+        block's largest kinetic energy in the pixel [kJ]; ``jump_height_p95_m`` the 95th percentile of each
+        block's largest height of its centre above the ground there [m]; ``deposition_density`` blocks stopped
+        in the pixel per released block per m^2 [1/m^2].
+        """
+        if self.passages is None:
+            raise ValueError("this run recorded no pixel passages: run_terrain(..., hazard=True)")
+        ter = self.scenario.terrain
+        ny, nx = ter.shape
+        ncell = ny * nx
+        p = self.passages
+        count, eq, hq = aggregate_passages(p["cell"], p["block"], p["e"], p["h"], ncell,
+                                           np.array([0.5, 0.95, 0.99]), 0.95)
+        out = {"passage_count": count.reshape(ny, nx), "reach_probability": (count / self.n).reshape(ny, nx)}
+        for name, row in (("energy_p50_kj", eq[0]), ("energy_p95_kj", eq[1]), ("energy_p99_kj", eq[2]),
+                          ("jump_height_p95_m", hq)):
+            out[name] = row.reshape(ny, nx)
+        pb = self.per_block
+        stopped = pb["reason"] == kernel3d.STOPPED
+        j = np.clip(np.floor((pb["x"][stopped] - ter.x0) / ter.dx + 0.5).astype(np.int64), 0, nx - 1)
+        i = np.clip(np.floor((pb["y"][stopped] - ter.y0) / ter.dy + 0.5).astype(np.int64), 0, ny - 1)
+        dep = np.bincount(i * nx + j, minlength=ncell).astype(float) / (self.n * ter.dx * ter.dy)
+        out["deposition_density"] = dep.reshape(ny, nx)
+        return out
+
+    def plot(self, ax=None, paths: bool = True):
+        """Plan view: hillshade of the DEM, recorded paths, stop points and collectors (matplotlib axes)."""
+        import matplotlib.pyplot as plt
+        ter = self.scenario.terrain
+        if ax is None:
+            _, ax = plt.subplots(figsize=(7, 6))
+        x0, y0, x1, y1 = ter.bounds
+        ext = (x0 - ter.dx / 2, x1 + ter.dx / 2, y0 - ter.dy / 2, y1 + ter.dy / 2)
+        ax.imshow(ter.hillshade(), origin="lower", extent=ext, cmap="gray", vmin=0, vmax=1)
+        if paths and self.paths is not None and len(self.paths["block"]):
+            for b in np.unique(self.paths["block"]):
+                s = self.paths["block"] == b
+                ax.plot(self.paths["x"][s], self.paths["y"][s], lw=0.6, color="tab:blue", alpha=0.7)
+        st = self.stops()
+        ax.scatter(st["x_m"], st["y_m"], s=3, color="tab:red", label="simulated stops", zorder=3)
+        for c in self.scenario.collectors:
+            ax.plot(c.line[:, 0], c.line[:, 1], color="gold", lw=2, label=c.name)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_aspect("equal")
+        ax.legend(loc="best", fontsize=8)
+        return ax

@@ -1,0 +1,657 @@
+"""The compiled 3-D trajectory kernel: lumped-mass blocks on a raster DEM surface.
+
+Surface: bilinear cells
+-----------------------
+The ground is the bilinear interpolant of the DEM's cell-centre elevations: in the cell between centres
+(i, j) and (i+1, j+1), z = z00 (1-u)(1-v) + z10 u (1-v) + z01 (1-u) v + z11 u v with u, v in [0, 1].
+Bilinear cells rather than two triangles per cell because
+
+* the raster *is* the data: the surface passes through every DEM value and is what GIS tools (GDAL's
+  bilinear resampling, :func:`simulation.profile_from_grid`) report, so a 2-D section cut from the DEM and
+  the 3-D kernel move on the same ground;
+* it has no arbitrary diagonal: splitting each square into two triangles picks one diagonal, which carves
+  a systematic ridge or furrow along it and steers blocks along 45 deg directions (a direction bias of
+  the triangulation, not of the terrain);
+* the cell holding a point is found in O(1) from the regular grid, with no triangle mesh to store.
+
+The impact of a flight is found exactly: along the straight plan line of a flight, one bilinear cell is a
+quadratic in time, as is the parabola, so the kernel visits the cells under the flight in order and solves
+one quadratic per cell (:func:`_find_impact`); high above the ground it skips ahead by steps that provably
+cannot reach it (a Lipschitz bound on the surface slope, :func:`_safe_step`).
+
+Physics (shared with the 2-D kernel :mod:`simulation.kernel`)
+-------------------------------------------------------------
+* Flight: exact parabola (no drag).
+* Impact: in the frame of the local 3-D normal of the bilinear surface, tilted by the material's
+  roughness (two angles, along and across the direction of travel, each uniform in +-atan(roughness /
+  radius) as in 2-D), the normal and tangential restitution laws of :func:`simulation.impact.impact_body`
+  (the same compiled function the 2-D kernel calls) act on the normal speed, the tangential speed and the
+  spin.  Spin is carried as a scalar about the horizontal axis normal to the direction of travel; when
+  the direction of travel turns, only the component of the spin about the new axis is kept (w cos of the
+  turn), which never adds energy.
+* Ground contact (rolling or sliding, as the material says): the rebound normal speed below
+  ``v_contact`` turns the block into contact, with :func:`simulation.kernel.roll_on_speed` for the
+  transition to rolling; the block then moves along the surface in steps of at most half a cell with the
+  gravity component in the tangent plane and the rolling-resistance (or sliding) friction of the 2-D
+  contact law, a = f (g_t - tan(phi_g) g cos(theta) v/|v|), f = 1 / (1 + k) rolling (5/7 for a sphere), 1
+  sliding.  The speed after each step comes from the work-energy balance over the step's 3-D path (drop
+  minus friction work), so no step can gain energy; the velocity is re-projected onto the new tangent
+  plane and its normal component lost (the 2-D rule at a slope change); where that normal component
+  points away from the ground and exceeds ``v_contact``, the block takes off.
+* Stop: slower than ``v_stop`` where the slope angle is within the ground friction angle; a block at
+  momentary rest on a steeper slope restarts down the fall line, and one that comes to rest a second
+  time within half a cell of its previous rest is held there (a pit or trough between flanks).
+* A block that reaches the DEM's edge or a nodata hole leaves the simulation there.
+
+Energy audit: each block's total energy E = 1/2 m v^2 + 1/2 I w^2 + m g z is evaluated after every impact
+and contact step; ``out_excess`` returns the largest rise of E from one such event to the next [J] (0 when
+E never rose; rounding-small unless a material allows energy gain).  Between events, flight conserves E
+exactly.
+
+Random numbers come from the 2-D kernel's counter-based stream keyed by (run seed, block index): a
+block's trajectory is the same whatever chunk or thread it is run in.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .impact import EN_WYLLIE, impact_body
+from .kernel import _GOLDEN, _normal, _uniform, roll_on_speed
+
+RUNNING, STOPPED, LEFT_TERRAIN, NODATA, MAX_EVENTS = 0, 1, 2, 3, 4
+STOP_REASONS = {STOPPED: "stopped", LEFT_TERRAIN: "left terrain (edge)", NODATA: "left terrain (nodata)",
+                MAX_EVENTS: "event limit reached"}
+MODE_FLIGHT, MODE_CONTACT, MODE_STOP = 0, 1, 2
+
+
+@njit(cache=True, inline="always")
+def _surface(zg, x0, y0, dx, dy, x, y):
+    """(z, dz/dx, dz/dy) of the bilinear surface at (x, y); z is NaN outside the grid or on a hole."""
+    ny, nx = zg.shape
+    u = (x - x0) / dx
+    v = (y - y0) / dy
+    if not (u >= 0.0 and v >= 0.0 and u <= nx - 1 and v <= ny - 1):
+        return math.nan, 0.0, 0.0
+    j = min(int(u), nx - 2)
+    i = min(int(v), ny - 2)
+    fu = u - j
+    fv = v - i
+    z00 = zg[i, j]
+    z10 = zg[i, j + 1]
+    z01 = zg[i + 1, j]
+    z11 = zg[i + 1, j + 1]
+    a = z10 - z00
+    b = z01 - z00
+    c = z11 - z10 - z01 + z00
+    z = z00 + a * fu + b * fv + c * fu * fv
+    return z, (a + c * fv) / dx, (b + c * fu) / dy
+
+
+@njit(cache=True, inline="always")
+def _height(zg, x0, y0, dx, dy, x, y, z):
+    """Height [m] of (x, y, z) above the surface (NaN off the terrain)."""
+    zs, _, _ = _surface(zg, x0, y0, dx, dy, x, y)
+    return z - zs
+
+
+@njit(cache=True, inline="always")
+def _cell_of(x0, y0, dx, dy, nx, ny, x, y):
+    """Flat index (row * nx + column, internal order) of the DEM pixel containing (x, y), or -1."""
+    j = int(math.floor((x - x0) / dx + 0.5))
+    i = int(math.floor((y - y0) / dy + 0.5))
+    if i < 0 or j < 0 or i >= ny or j >= nx:
+        return -1
+    return i * nx + j
+
+
+@njit(cache=True, inline="always")
+def _axis_cos(sx, sy, tx, ty):
+    """Cosine between the spin axes of travel directions s and t: each axis is horizontal and normal to the
+    direction's horizontal part, so a change of pitch keeps the spin and a turn in plan by phi keeps w cos phi
+    (1 when either direction is vertical)."""
+    ls = math.sqrt(sx * sx + sy * sy)
+    lt = math.sqrt(tx * tx + ty * ty)
+    if ls < 1e-12 or lt < 1e-12:
+        return 1.0
+    return (sx * tx + sy * ty) / (ls * lt)
+
+
+@njit(cache=True)
+def _safe_step(h, vh, vz, g, lip):
+    """Longest time [s] a flight at height h [m] above the ground, horizontal speed vh and vertical speed vz
+    [m/s], can go without meeting a ground whose slope is at most ``lip``: the root of
+    1/2 g t^2 + (lip vh - vz) t = h (the parabola's drop plus the steepest possible rise of the ground)."""
+    b = lip * vh - vz
+    return (-b + math.sqrt(b * b + 2.0 * g * h)) / g
+
+
+@njit(cache=True)
+def _pass_flush(acc, p_block, p_cell, p_e, p_h, p_count, bid):
+    """Write the block's accumulated passage of its current pixel (max energy [kJ] and height [m])."""
+    cell = int(acc[0])
+    if cell >= 0:
+        i = p_count[0]
+        if i < p_block.shape[0]:
+            p_block[i], p_cell[i], p_e[i], p_h[i] = bid, cell, acc[1], acc[2]
+            p_count[0] = i + 1
+        else:
+            p_count[1] += 1
+    acc[0], acc[1], acc[2] = -1.0, 0.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def _pass_add(acc, p_block, p_cell, p_e, p_h, p_count, bid, cell, e_kj, h):
+    if cell != int(acc[0]):
+        _pass_flush(acc, p_block, p_cell, p_e, p_h, p_count, bid)
+        acc[0] = cell
+    acc[1] = max(acc[1], e_kj)
+    acc[2] = max(acc[2], h)
+
+
+@njit(cache=True)
+def _flight_passages(zg, x0, y0, dx, dy, xa, ya, za, vx, vy, vz, w, t_end, g, mass, inertia,
+                     acc, p_block, p_cell, p_e, p_h, p_count, bid):
+    """Every pixel the flight from (xa, ya, za) crosses in plan during [0, t_end] (a grid traversal along the
+    straight plan path, Amanatides & Woo 1987), with the block's kinetic energy [kJ] and height above ground
+    [m] at the entry, middle and exit of each pixel (the maxima are kept)."""
+    ny, nx = zg.shape
+    xb, yb = xa + vx * t_end, ya + vy * t_end
+    ua, va = (xa - x0) / dx + 0.5, (ya - y0) / dy + 0.5
+    ub, vb = (xb - x0) / dx + 0.5, (yb - y0) / dy + 0.5
+    j, i = int(math.floor(ua)), int(math.floor(va))
+    jb, ib = int(math.floor(ub)), int(math.floor(vb))
+    du, dv = ub - ua, vb - va
+    sj = 1 if du > 0 else -1
+    si = 1 if dv > 0 else -1
+    tdu = abs(1.0 / du) if du != 0.0 else math.inf
+    tdv = abs(1.0 / dv) if dv != 0.0 else math.inf
+    tmu = ((j + 1 - ua) if du > 0 else (ua - j)) * tdu if du != 0.0 else math.inf
+    tmv = ((i + 1 - va) if dv > 0 else (va - i)) * tdv if dv != 0.0 else math.inf
+    s_in = 0.0
+    for _ in range(4 * (nx + ny) + 4):
+        s_out = min(tmu, tmv, 1.0)
+        if 0 <= i < ny and 0 <= j < nx:
+            for f in (s_in, 0.5 * (s_in + s_out), s_out):
+                t = f * t_end
+                zc = za + vz * t - 0.5 * g * t * t
+                hh = _height(zg, x0, y0, dx, dy, xa + vx * t, ya + vy * t, zc)
+                vzz = vz - g * t
+                e = (0.5 * mass * (vx * vx + vy * vy + vzz * vzz) + 0.5 * inertia * w * w) / 1000.0
+                _pass_add(acc, p_block, p_cell, p_e, p_h, p_count, bid, i * nx + j, e,
+                          hh if hh == hh else 0.0)
+        if (i == ib and j == jb) or s_out >= 1.0:
+            break
+        s_in = s_out
+        if tmu < tmv:
+            j += sj
+            tmu += tdu
+        else:
+            i += si
+            tmv += tdv
+
+
+@njit(cache=True)
+def _collector_hits(c_ax, c_ay, c_bx, c_by, c_id, c_s0, xa, ya, xb, yb, s_hit, j_hit, lam_hit):
+    """Collector segments crossed by the plan segment (xa, ya) -> (xb, yb): fills s_hit (fraction along the
+    motion, in (0, 1]), j_hit (segment) and lam_hit (fraction along the collector segment); returns the count."""
+    n = 0
+    ex, ey = xb - xa, yb - ya
+    for k in range(c_ax.shape[0]):
+        fx, fy = c_bx[k] - c_ax[k], c_by[k] - c_ay[k]
+        den = ex * fy - ey * fx
+        if den == 0.0:
+            continue
+        gx, gy = c_ax[k] - xa, c_ay[k] - ya
+        s = (gx * fy - gy * fx) / den
+        lam = (gx * ey - gy * ex) / den
+        if 0.0 < s <= 1.0 and 0.0 <= lam <= 1.0:
+            s_hit[n], j_hit[n], lam_hit[n] = s, k, lam
+            n += 1
+    return n
+
+
+@njit(cache=True)
+def _record_cross(r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_count,
+                  bid, coll, s_along, t, x, y, vx, vy, vz, w, h):
+    i = r_count[0]
+    if i < r_block.shape[0]:
+        r_block[i], r_coll[i], r_s[i], r_t[i], r_x[i], r_y[i] = bid, coll, s_along, t, x, y
+        r_vx[i], r_vy[i], r_vz[i], r_w[i], r_h[i] = vx, vy, vz, w, h
+        r_count[0] = i + 1
+    else:
+        r_count[1] += 1
+
+
+@njit(cache=True, inline="always")
+def _record_path(pb, pt, px, py, pz, pv, pmode, pcount, bid, t, x, y, z, v, mode):
+    i = pcount[0]
+    if i < pb.shape[0]:
+        pb[i], pt[i], px[i], py[i], pz[i], pv[i], pmode[i] = bid, t, x, y, z, v, mode
+        pcount[0] = i + 1
+
+
+@njit(cache=True, inline="always")
+def _first_descending_root(A, B, C, hi):
+    """Smallest tau in [0, hi] where A tau^2 + B tau + C crosses zero going down (derivative <= 0), or -1."""
+    best = -1.0
+    if A == 0.0:
+        if B != 0.0:
+            r = -C / B
+            if 0.0 <= r <= hi and B <= 0.0:
+                best = r
+        return best
+    disc = B * B - 4.0 * A * C
+    if disc < 0.0:
+        return -1.0
+    sq = math.sqrt(disc)
+    q = -0.5 * (B + sq) if B >= 0.0 else -0.5 * (B - sq)
+    r1 = q / A
+    r2 = C / q if q != 0.0 else r1
+    lo_r, hi_r = min(r1, r2), max(r1, r2)
+    for r in (lo_r, hi_r):
+        if 0.0 <= r <= hi and 2.0 * A * r + B <= 0.0 and (C > 0.0 or r > 0.0 or B < 0.0):
+            return r
+    return -1.0
+
+
+@njit(cache=True)
+def _find_impact(zg, x0, y0, dx, dy, lip, x, y, z, vx, vy, vz, g):
+    """First time t >= 0 at which the flight from (x, y, z) meets the surface, exactly.
+
+    Along a straight plan line the bilinear surface of one cell is a quadratic in time (u and v are linear
+    in t, z = z00 + a u + b v + c u v), and so is the parabola: within each cell the height above ground is a
+    quadratic whose first descending root is the impact.  The cells along the plan line are visited in
+    order (a grid traversal, Amanatides & Woo 1987); high above the ground whole stretches are skipped with
+    :func:`_safe_step`.  Returns (t, status): 0 an impact at t; 1 the flight leaves the grid at t; 2 it
+    reaches a cell touching a nodata hole at t (still in the air)."""
+    ny, nx = zg.shape
+    vh = math.sqrt(vx * vx + vy * vy)
+    au, av = vx / dx, vy / dy
+    cell = min(dx, dy)
+    t = 0.0
+    relocate = True
+    i = j = 0
+    for _ in range(100_000_000):
+        px = x + vx * t
+        py = y + vy * t
+        u = (px - x0) / dx
+        v = (py - y0) / dy
+        if relocate:
+            if not (u >= -1e-9 and v >= -1e-9 and u <= nx - 1 + 1e-9 and v <= ny - 1 + 1e-9):
+                return t, 1
+            j = min(max(int(math.floor(u)), 0), nx - 2)
+            i = min(max(int(math.floor(v)), 0), ny - 2)
+            if u - j <= 0.0 and au < 0.0 and j > 0:
+                j -= 1
+            if v - i <= 0.0 and av < 0.0 and i > 0:
+                i -= 1
+            relocate = False
+        if i < 0 or j < 0 or i > ny - 2 or j > nx - 2:
+            return t, 1
+        fu0 = min(max(u - j, 0.0), 1.0)
+        fv0 = min(max(v - i, 0.0), 1.0)
+        z00 = zg[i, j]
+        z10 = zg[i, j + 1]
+        z01 = zg[i + 1, j]
+        z11 = zg[i + 1, j + 1]
+        a = z10 - z00
+        b = z01 - z00
+        c = z11 - z10 - z01 + z00
+        C = z + vz * t - 0.5 * g * t * t - (z00 + a * fu0 + b * fv0 + c * fu0 * fv0)
+        if not C == C:
+            return t, 2
+        vzt = vz - g * t
+        if C > 2.0 * cell * (1.0 + lip):
+            ts = _safe_step(C, vh, vzt, g, lip)
+            if ts * vh > cell:
+                t += ts
+                relocate = True
+                continue
+        tu = math.inf
+        if au > 0.0:
+            tu = max((1.0 - fu0) / au, 0.0)
+        elif au < 0.0:
+            tu = max(-fu0 / au, 0.0)
+        tv = math.inf
+        if av > 0.0:
+            tv = max((1.0 - fv0) / av, 0.0)
+        elif av < 0.0:
+            tv = max(-fv0 / av, 0.0)
+        te = min(tu, tv)
+        A = -0.5 * g - c * au * av
+        B = vzt - (a * au + b * av + c * (fu0 * av + fv0 * au))
+        if C <= 0.0 and B <= 0.0:
+            return t, 0           # at (or rounding-below) the ground and moving into it: the impact is now
+        r = _first_descending_root(A, B, C, te)
+        if r >= 0.0:
+            return t + r, 0
+        if te == math.inf:
+            return t, 1
+        t += te
+        if tu <= tv:
+            j += 1 if au > 0.0 else -1
+        if tv <= tu:
+            i += 1 if av > 0.0 else -1
+    return t, 1
+
+
+@njit(cache=True, nogil=True)
+def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
+               zg, x0, y0, dx, dy, lip, mat_grid,
+               m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
+               m_roll, m_mu_ground, m_gain,
+               c_ax, c_ay, c_bx, c_by, c_id, c_s0,
+               g, v_contact, v_stop, max_events, key, n_path_blocks, rec_pass,
+               out_x, out_y, out_z, out_reason, out_impacts, out_t, out_excess, out_events,
+               r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_count,
+               p_block, p_cell, p_e, p_h, p_count,
+               pb, pt, ppx, ppy, ppz, ppv, pmode, pcount):
+    """Run every block of a chunk on the DEM surface; fill the output arrays in place.
+
+    Grid: ``zg`` (ny, nx) elevations [m] (NaN holes), centre of cell (0, 0) at (x0, y0), cell size dx, dy [m];
+    ``lip`` an upper bound of the surface slope (|grad z|) used to step flights safely; ``mat_grid`` material
+    index per cell.  Collectors: plan segments (c_ax, c_ay)-(c_bx, c_by) of collector ``c_id``, starting at
+    distance ``c_s0`` [m] along their polyline.  With ``rec_pass`` every pixel a block crosses is recorded once
+    per visit with the block's largest kinetic energy [kJ] and height above ground [m] there (hazard maps).
+    Buffers that fill up count the rows that did not fit (``r_count[1]``, ``p_count[1]``): the caller reruns
+    the chunk with larger ones (results depend only on the seed and block index).
+    """
+    ny, nx = zg.shape
+    step_len = 0.5 * min(dx, dy)
+    n_cseg = c_ax.shape[0]
+    s_hit = np.empty(max(n_cseg, 1))
+    lam_hit = np.empty(max(n_cseg, 1))
+    j_hit = np.empty(max(n_cseg, 1), np.int64)
+    state = np.empty(1, np.uint64)
+    acc = np.empty(3)
+    for b in range(block_ids.shape[0]):
+        bid = block_ids[b]
+        state[0] = key ^ (np.uint64(bid + 1) * _GOLDEN)
+        mass, r, k_in = bmass[b], bradius[b], bk[b]
+        inertia = k_in * mass * r * r
+        x, y, z = bx[b], by[b], bz[b]
+        vx, vy, vz, w = bvx[b], bvy[b], bvz[b], bw[b]
+        # spin axis: horizontal, normal to the direction of travel; sx, sy, sz = the travel direction it rolls
+        vh0 = math.sqrt(vx * vx + vy * vy)
+        sx, sy, sz = (vx / vh0, vy / vh0, 0.0) if vh0 > 0 else (1.0, 0.0, 0.0)
+        e0 = 0.5 * mass * (vx * vx + vy * vy + vz * vz) + 0.5 * inertia * w * w + mass * g * z
+        excess = 0.0
+        e_prev = e0
+        t_abs = 0.0
+        record = bid < n_path_blocks
+        acc[0], acc[1], acc[2] = -1.0, 0.0, 0.0
+        zs, gx, gy = _surface(zg, x0, y0, dx, dy, x, y)
+        contact = z - zs <= 1e-9
+        if contact:
+            z = zs
+            # project the start velocity on the tangent plane
+            nl = math.sqrt(gx * gx + gy * gy + 1.0)
+            nxv, nyv, nzv = -gx / nl, -gy / nl, 1.0 / nl
+            vn = vx * nxv + vy * nyv + vz * nzv
+            vx, vy, vz = vx - vn * nxv, vy - vn * nyv, vz - vn * nzv
+            u = math.sqrt(vx * vx + vy * vy + vz * vz)
+            if m_roll[mat_grid[min(max(int(round((y - y0) / dy)), 0), ny - 1),
+                               min(max(int(round((x - x0) / dx)), 0), nx - 1)]]:
+                u2 = roll_on_speed(u, w, r, k_in)
+                if u > 0:
+                    vx, vy, vz = vx * u2 / u, vy * u2 / u, vz * u2 / u
+                w = abs(u2) / r
+            else:
+                w = 0.0
+        if record:
+            _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, 0.0, x, y, z,
+                         math.sqrt(vx * vx + vy * vy + vz * vz), MODE_CONTACT if contact else MODE_FLIGHT)
+        reason = RUNNING
+        impacts = 0
+        events = 0
+        last_rest_x, last_rest_y = math.inf, math.inf
+        have_s, c_gx, c_gy = False, 0.0, 0.0
+        while reason == RUNNING:
+            events += 1
+            if events > max_events:
+                reason = MAX_EVENTS
+                break
+            if not contact:
+                t_hit, status = _find_impact(zg, x0, y0, dx, dy, lip, x, y, z, vx, vy, vz, g)
+                # collectors and hazard pixels along the flight (its plan path is a straight line)
+                if n_cseg > 0 and t_hit > 0:
+                    n_h = _collector_hits(c_ax, c_ay, c_bx, c_by, c_id, c_s0, x, y, x + vx * t_hit,
+                                          y + vy * t_hit, s_hit, j_hit, lam_hit)
+                    for q in range(n_h):
+                        tc = s_hit[q] * t_hit
+                        k = j_hit[q]
+                        xc, yc = x + vx * tc, y + vy * tc
+                        zc = z + vz * tc - 0.5 * g * tc * tc
+                        hc = _height(zg, x0, y0, dx, dy, xc, yc, zc)
+                        seg_len = math.sqrt((c_bx[k] - c_ax[k]) ** 2 + (c_by[k] - c_ay[k]) ** 2)
+                        _record_cross(r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_count,
+                                      bid, c_id[k], c_s0[k] + lam_hit[q] * seg_len, t_abs + tc, xc, yc,
+                                      vx, vy, vz - g * tc, w, hc if hc == hc else 0.0)
+                if rec_pass and t_hit > 0:
+                    _flight_passages(zg, x0, y0, dx, dy, x, y, z, vx, vy, vz, w, t_hit, g, mass, inertia,
+                                     acc, p_block, p_cell, p_e, p_h, p_count, bid)
+                x, y = x + vx * t_hit, y + vy * t_hit
+                z = z + vz * t_hit - 0.5 * g * t_hit * t_hit
+                vz = vz - g * t_hit
+                t_abs += t_hit
+                if status == 1 or status == 2:
+                    reason = LEFT_TERRAIN if status == 1 else NODATA
+                    break
+                impacts += 1
+                zs, gx, gy = _surface(zg, x0, y0, dx, dy, x, y)
+                z = zs
+                mat = mat_grid[min(max(int(round((y - y0) / dy)), 0), ny - 1),
+                               min(max(int(round((x - x0) / dx)), 0), nx - 1)]
+                nl = math.sqrt(gx * gx + gy * gy + 1.0)
+                nx0, ny0, nz0 = -gx / nl, -gy / nl, 1.0 / nl
+                vn_t = vx * nx0 + vy * ny0 + vz * nz0
+                # travel direction in the tangent plane, and the lateral direction n x t1
+                t1x, t1y, t1z = vx - vn_t * nx0, vy - vn_t * ny0, vz - vn_t * nz0
+                tl = math.sqrt(t1x * t1x + t1y * t1y + t1z * t1z)
+                if tl < 1e-12:          # head-on: take the fall line (on flat ground, +x) as the travel direction
+                    t1x, t1y, t1z = nz0 * nx0, nz0 * ny0, nz0 * nz0 - 1.0
+                    tl = math.sqrt(t1x * t1x + t1y * t1y + t1z * t1z)
+                    if tl < 1e-12:
+                        t1x, t1y, t1z, tl = 1.0, 0.0, 0.0, 1.0
+                t1x, t1y, t1z = t1x / tl, t1y / tl, t1z / tl
+                t2x, t2y, t2z = ny0 * t1z - nz0 * t1y, nz0 * t1x - nx0 * t1z, nx0 * t1y - ny0 * t1x
+                theta_max = math.atan(m_rough[mat] / r) if r > 0 else 0.0
+                d1 = (2.0 * _uniform(state) - 1.0) * theta_max
+                d2 = (2.0 * _uniform(state) - 1.0) * theta_max
+                a1, a2 = math.tan(d1), math.tan(d2)
+                nnx, nny, nnz = nx0 + a1 * t1x + a2 * t2x, ny0 + a1 * t1y + a2 * t2y, nz0 + a1 * t1z + a2 * t2z
+                nnl = math.sqrt(nnx * nnx + nny * nny + nnz * nnz)
+                nnx, nny, nnz = nnx / nnl, nny / nnl, nnz / nnl
+                vn = vx * nnx + vy * nny + vz * nnz
+                if vn >= 0.0:
+                    nnx, nny, nnz = nx0, ny0, nz0
+                    vn = vn_t
+                gain = m_gain[mat]
+                cap = 10.0 if gain else 1.0
+                if m_en_law[mat] == EN_WYLLIE:
+                    en = m_en_std[mat] * _normal(state) if m_en_std[mat] > 0 else 0.0
+                else:
+                    en = min(max(m_en_mean[mat] + m_en_std[mat] * _normal(state), 0.0), cap) \
+                        if m_en_std[mat] > 0 else m_en_mean[mat]
+                et = min(max(m_et_mean[mat] + m_et_std[mat] * _normal(state), 0.0), cap) \
+                    if m_et_std[mat] > 0 else m_et_mean[mat]
+                phi = m_phi[mat] + (m_phi_std[mat] * _normal(state) if m_phi_std[mat] > 0 else 0.0)
+                mu = math.tan(math.radians(min(max(phi, 0.0), 89.0)))
+                # tangential velocity in the (tilted) impact frame
+                tx, ty, tz = vx - vn * nnx, vy - vn * nny, vz - vn * nnz
+                vt = math.sqrt(tx * tx + ty * ty + tz * tz)
+                if vt > 1e-12:
+                    tx, ty, tz = tx / vt, ty / vt, tz / vt
+                else:
+                    tx, ty, tz = sx, sy, sz
+                w_eff = w * _axis_cos(sx, sy, tx, ty)      # spin about the axis normal to the travel
+                if vn < 0.0:
+                    vn2, vt2, w2, _ = impact_body(vn, vt, w_eff, r, m_en_law[mat], en, m_et_law[mat], et, mu, gain,
+                                                  k_in)
+                else:
+                    vn2, vt2, w2 = 0.0, vt, w_eff
+                vx, vy, vz = vt2 * tx + vn2 * nnx, vt2 * ty + vn2 * nny, vt2 * tz + vn2 * nnz
+                w = w2
+                sx, sy, sz = tx, ty, tz
+                vn_true = vx * nx0 + vy * ny0 + vz * nz0
+                if vn_true < v_contact:
+                    contact = True
+                    vx, vy, vz = vx - vn_true * nx0, vy - vn_true * ny0, vz - vn_true * nz0
+                    u = math.sqrt(vx * vx + vy * vy + vz * vz)
+                    if u > 1e-12:
+                        dxv, dyv, dzv = vx / u, vy / u, vz / u
+                    else:
+                        dxv, dyv, dzv = sx, sy, sz
+                    if m_roll[mat]:
+                        u2 = roll_on_speed(u, w * _axis_cos(sx, sy, dxv, dyv), r, k_in)
+                        if u2 < 0:
+                            dxv, dyv, dzv, u2 = -dxv, -dyv, -dzv, -u2
+                        w = u2 / r
+                    else:
+                        u2 = u
+                        w = 0.0
+                    vx, vy, vz = u2 * dxv, u2 * dyv, u2 * dzv
+                    sx, sy, sz = dxv, dyv, dzv
+                e = 0.5 * mass * (vx * vx + vy * vy + vz * vz) + 0.5 * inertia * w * w + mass * g * z
+                excess = max(excess, e - e_prev)
+                e_prev = e
+                if record:
+                    _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, t_abs, x, y, z,
+                                 math.sqrt(vx * vx + vy * vy + vz * vz), MODE_CONTACT if contact else MODE_FLIGHT)
+                continue
+
+            # ---- ground contact: one step along the surface ----
+            if have_s:            # the surface here was evaluated at the end of the previous step
+                gx, gy = c_gx, c_gy
+            else:
+                zs, gx, gy = _surface(zg, x0, y0, dx, dy, x, y)
+            have_s = False
+            mat = mat_grid[min(max(int(round((y - y0) / dy)), 0), ny - 1),
+                           min(max(int(round((x - x0) / dx)), 0), nx - 1)]
+            nl = math.sqrt(gx * gx + gy * gy + 1.0)
+            nx0, ny0, nz0 = -gx / nl, -gy / nl, 1.0 / nl
+            mu = m_mu_ground[mat]
+            roll = m_roll[mat]
+            factor = 1.0 / (1.0 + k_in) if roll else 1.0
+            u = math.sqrt(vx * vx + vy * vy + vz * vz)
+            if u < v_stop:
+                near = abs(x - last_rest_x) <= 0.5 * dx and abs(y - last_rest_y) <= 0.5 * dy
+                if math.sqrt(gx * gx + gy * gy) <= mu or near:
+                    reason = STOPPED
+                    vx, vy, vz, w = 0.0, 0.0, 0.0, 0.0
+                    break
+                last_rest_x, last_rest_y = x, y
+                vx, vy, vz, u = 0.0, 0.0, 0.0, 0.0
+                if record:
+                    _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, t_abs, x, y, z, 0.0, MODE_CONTACT)
+            # tangential gravity g_t = g (n_z n - e_z) (down the fall line, magnitude g sin theta)
+            gtx, gty, gtz = g * nz0 * nx0, g * nz0 * ny0, g * (nz0 * nz0 - 1.0)
+            if u > 1e-12:
+                fr = factor * mu * g * nz0 / u
+                ax_, ay_, az_ = factor * gtx - fr * vx, factor * gty - fr * vy, factor * gtz - fr * vz
+            else:
+                ax_, ay_, az_ = factor * gtx, factor * gty, factor * gtz
+            # at most about half a cell per step: u dt <= step and 1/2 |a| dt^2 <= step
+            a_mag = math.sqrt(ax_ * ax_ + ay_ * ay_ + az_ * az_)
+            dt = min(step_len / max(u, 1e-6), math.sqrt(2.0 * step_len / max(a_mag, 1e-3)))
+            vx1, vy1, vz1 = vx + ax_ * dt, vy + ay_ * dt, vz + az_ * dt
+            xn = x + 0.5 * (vx + vx1) * dt
+            yn = y + 0.5 * (vy + vy1) * dt
+            zn, gxn, gyn = _surface(zg, x0, y0, dx, dy, xn, yn)
+            if not zn == zn:
+                ue, ve = (xn - x0) / dx, (yn - y0) / dy
+                edge = ue < 0.0 or ve < 0.0 or ue > nx - 1 or ve > ny - 1
+                reason = LEFT_TERRAIN if edge else NODATA
+                break
+            ds = math.sqrt((xn - x) ** 2 + (yn - y) ** 2 + (zn - z) ** 2)
+            nln = math.sqrt(gxn * gxn + gyn * gyn + 1.0)
+            nz_avg = 0.5 * (nz0 + 1.0 / nln)
+            # work-energy balance over the step (per unit mass, rolling share f = 1/(1+k))
+            u2sq = u * u + 2.0 * factor * (g * (z - zn) - mu * g * nz_avg * ds)
+            # collectors crossed on this step (speed interpolated, height 0: in contact)
+            if n_cseg > 0:
+                n_h = _collector_hits(c_ax, c_ay, c_bx, c_by, c_id, c_s0, x, y, xn, yn, s_hit, j_hit, lam_hit)
+                for q in range(n_h):
+                    fq = s_hit[q]
+                    k = j_hit[q]
+                    seg_len = math.sqrt((c_bx[k] - c_ax[k]) ** 2 + (c_by[k] - c_ay[k]) ** 2)
+                    uq = math.sqrt(max(u * u + fq * (u2sq - u * u), 0.0))
+                    ul = max(math.sqrt(vx1 * vx1 + vy1 * vy1 + vz1 * vz1), 1e-300)
+                    _record_cross(r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_count,
+                                  bid, c_id[k], c_s0[k] + lam_hit[q] * seg_len, t_abs + fq * dt,
+                                  x + fq * (xn - x), y + fq * (yn - y), vx1 / ul * uq, vy1 / ul * uq, vz1 / ul * uq,
+                                  uq / r if roll else 0.0, 0.0)
+            if u2sq <= 0.0:
+                # the block comes to rest within the step: where the balance reaches zero, if that point is
+                # not above what the energy allows; else it stays (a momentary rest decides next)
+                fz = u * u / (u * u - u2sq) if u * u - u2sq > 0 else 0.0
+                xr, yr = x + fz * (xn - x), y + fz * (yn - y)
+                zr, _, _ = _surface(zg, x0, y0, dx, dy, xr, yr)
+                if zr == zr and zr <= z + u * u / (2.0 * factor * g):
+                    x, y, z = xr, yr, zr
+                t_abs += fz * dt
+                vx, vy, vz, w = 0.0, 0.0, 0.0, 0.0
+                if rec_pass:
+                    _pass_add(acc, p_block, p_cell, p_e, p_h, p_count, bid,
+                              _cell_of(x0, y0, dx, dy, nx, ny, x, y), 0.0, 0.0)
+                continue
+            u2 = math.sqrt(u2sq)
+            # direction: the Euler velocity re-projected on the new tangent plane; its normal share is lost
+            nxn, nyn, nzn = -gxn / nln, -gyn / nln, 1.0 / nln
+            l1 = math.sqrt(vx1 * vx1 + vy1 * vy1 + vz1 * vz1)
+            if l1 > 1e-12:
+                dxv, dyv, dzv = vx1 / l1, vy1 / l1, vz1 / l1
+            else:
+                dxv, dyv, dzv = gtx, gty, gtz
+                ll = max(math.sqrt(dxv * dxv + dyv * dyv + dzv * dzv), 1e-300)
+                dxv, dyv, dzv = dxv / ll, dyv / ll, dzv / ll
+            dn = dxv * nxn + dyv * nyn + dzv * nzn
+            t_abs += dt
+            x, y, z = xn, yn, zn
+            have_s, c_gx, c_gy = True, gxn, gyn
+            if dn * u2 >= v_contact:
+                # convex edge: the block leaves the ground with its velocity
+                contact = False
+                vx, vy, vz = u2 * dxv, u2 * dyv, u2 * dzv
+                w = u2 / r if roll else 0.0
+                z = zn + 1e-9
+                have_s = False
+                sx, sy, sz = dxv, dyv, dzv
+            else:
+                px_, py_, pz_ = dxv - dn * nxn, dyv - dn * nyn, dzv - dn * nzn
+                pl = math.sqrt(px_ * px_ + py_ * py_ + pz_ * pz_)
+                u3 = u2 * pl
+                if pl > 1e-12:
+                    px_, py_, pz_ = px_ / pl, py_ / pl, pz_ / pl
+                    if roll:
+                        # the 2-D rule at a slope change: a rolling block re-rolls conserving angular momentum
+                        # about the new contact point (its spin about the new axis is kept)
+                        u3 = roll_on_speed(u3, u2 / r * _axis_cos(dxv, dyv, px_, py_), r, k_in)
+                        if u3 < 0.0:
+                            px_, py_, pz_, u3 = -px_, -py_, -pz_, -u3
+                    vx, vy, vz = u3 * px_, u3 * py_, u3 * pz_
+                    sx, sy, sz = px_, py_, pz_
+                else:
+                    vx, vy, vz, u3 = 0.0, 0.0, 0.0, 0.0
+                w = u3 / r if roll else 0.0
+            if rec_pass:
+                sp = math.sqrt(vx * vx + vy * vy + vz * vz)
+                _pass_add(acc, p_block, p_cell, p_e, p_h, p_count, bid, _cell_of(x0, y0, dx, dy, nx, ny, x, y),
+                          (0.5 * mass * sp * sp + 0.5 * inertia * w * w) / 1000.0, 0.0)
+            e = 0.5 * mass * (vx * vx + vy * vy + vz * vz) + 0.5 * inertia * w * w + mass * g * z
+            excess = max(excess, e - e_prev)
+            e_prev = e
+            if record:
+                _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, t_abs, x, y, z,
+                             math.sqrt(vx * vx + vy * vy + vz * vz), MODE_CONTACT if contact else MODE_FLIGHT)
+        if rec_pass:
+            _pass_flush(acc, p_block, p_cell, p_e, p_h, p_count, bid)
+        if record:
+            _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, t_abs, x, y, z,
+                         math.sqrt(vx * vx + vy * vy + vz * vz), MODE_STOP)
+        out_x[b], out_y[b], out_z[b], out_reason[b], out_impacts[b], out_t[b] = x, y, z, reason, impacts, t_abs
+        out_excess[b] = excess
+        out_events[b] = events

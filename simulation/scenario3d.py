@@ -1,0 +1,299 @@
+"""Scenarios on 3-D terrain: a ``[terrain]`` table (a DEM raster and its materials), ``[sources]`` and plan
+collectors, read from TOML.
+
+::
+
+    name = "authume_p1_3d"
+    [terrain]
+    dem = "authume_dem.tif"          # GeoTIFF or ESRI ASCII grid, path relative to this file
+    crs = "EPSG:2154"                # only when the DEM has no CRS of its own
+    material = "soil"                # one material everywhere, or:
+    # material_raster = "materials.tif"        # integer codes on the DEM's grid
+    # material_codes = { 1 = "soil", 2 = "bedrock" }
+
+    [materials.soil]                 # as in 2-D scenarios (presets, laws, roughness, ground friction)
+    preset = "soil"
+
+    [sources]                        # release points (chosen uniformly) or a polygon (uniform inside)
+    points = [[x, y], ...]           # or polygon = [[x, y], ...]
+    height_m = 1.0                   # above the ground [m]; numbers or distribution tables as in 2-D
+    mass_kg = { dist = "lognormal", median = 800, sigma = 0.5 }
+    density_kg_m3 = 2650
+    speed_ms = 0.5                   # initial horizontal speed along the local fall line [m/s]
+    vz_ms = 0.0
+    angular_velocity_rads = 0.0
+
+    [[collectors]]                   # polylines in plan: crossings are recorded (position along the line,
+    name = "road"                    # velocity, height above ground, mass)
+    line = [[x, y], [x, y], ...]
+
+    [settings]                       # gravity_ms2, contact_velocity_ms, stop_velocity_ms, max_events
+
+Every error names the file and the field; sources or collector vertices off the DEM (or on a nodata
+hole) and a material raster on another grid are refused before any simulation.
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .scenario import Distribution, Material, ScenarioError, Settings, _check_keys, _number
+from .terrain import MaterialGrid, Terrain, TerrainError, read_dem, read_material_raster
+from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2
+
+#: Contact steps are events in 3-D (one per half cell rolled), so the default limit is higher than in 2-D.
+DEFAULT_MAX_EVENTS_3D = 200_000
+
+
+@dataclass(frozen=True)
+class Sources:
+    """Where blocks start: ``points`` (n, 2) chosen uniformly, or inside ``polygon`` (k, 2) uniformly."""
+
+    points: np.ndarray | None = field(repr=False)
+    polygon: np.ndarray | None = field(repr=False)
+    height_m: Distribution
+    mass_kg: Distribution
+    density_kg_m3: float
+    speed_ms: Distribution
+    vz_ms: Distribution
+    angular_velocity_rads: Distribution
+    shape: str = "sphere"
+
+    def radius(self, mass):
+        """Radius [m] of spheres (or cylinders of aspect ratio 1) of the given masses [kg]."""
+        if self.shape == "cylinder":
+            return (mass / (2.0 * np.pi * self.density_kg_m3)) ** (1.0 / 3.0)
+        return (3.0 * mass / (4.0 * np.pi * self.density_kg_m3)) ** (1.0 / 3.0)
+
+    @property
+    def inertia_factor(self) -> float:
+        """I / (m r^2) of the block shape."""
+        return INERTIA_FACTORS[self.shape]
+
+
+@dataclass(frozen=True)
+class PlanCollector:
+    """A polyline in plan [m, the DEM's CRS]; crossings are recorded with their distance along it."""
+
+    name: str
+    line: np.ndarray = field(repr=False)
+
+    @property
+    def length_m(self) -> float:
+        """Length of the polyline in plan [m]."""
+        return float(np.sum(np.hypot(*np.diff(self.line, axis=0).T)))
+
+
+@dataclass(frozen=True)
+class TerrainScenario:
+    """A checked 3-D scenario: ``terrain`` (DEM), ``materials``, ``material_grid`` (material per cell),
+    ``sources``, plan ``collectors`` and ``settings``; run it with :func:`simulation.run_terrain`."""
+
+    name: str
+    description: str
+    terrain: Terrain
+    materials: tuple
+    material_grid: MaterialGrid
+    sources: Sources
+    collectors: tuple
+    settings: Settings
+    source: str = "<dict>"
+
+    def collector_index(self, name: str) -> int:
+        """Index of collector ``name``; a KeyError listing the collectors when there is none."""
+        names = [c.name for c in self.collectors]
+        if name not in names:
+            raise KeyError(f"{self.source}: no collector named {name!r}; collectors are {names}")
+        return names.index(name)
+
+
+def _plan_points(value, where: str, source: str, min_points: int = 1) -> np.ndarray:
+    try:
+        p = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"{source}: {where} must be a list of [x, y] plan points; got {value!r}") from None
+    if p.ndim != 2 or p.shape[1] != 2 or len(p) < min_points or not np.all(np.isfinite(p)):
+        raise ScenarioError(f"{source}: {where} must be a list of at least {min_points} [x, y] plan points; "
+                            f"got {value!r}")
+    return p
+
+
+def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None = None, *,
+                               terrain: Terrain | None = None, crs=None) -> TerrainScenario:
+    """Build and check a :class:`TerrainScenario` from a parsed TOML dictionary.
+
+    ``terrain`` gives the DEM directly (then ``[terrain] dem`` may be left out); ``crs`` states the DEM's CRS
+    when the file has none (it overrides ``[terrain] crs``).
+    """
+    _check_keys(data, {"name", "description", "terrain", "materials", "sources", "collectors", "settings"}, "",
+                source)
+    for key in ("terrain", "materials", "sources"):
+        if key not in data:
+            raise ScenarioError(f"{source}: missing [{key}] table")
+    mats = data["materials"]
+    if not isinstance(mats, dict) or not mats:
+        raise ScenarioError(f"{source}: [materials] must define at least one material table")
+    materials = tuple(Material.parse(name, spec, source) for name, spec in mats.items())
+    names = [m.name for m in materials]
+
+    tt = data["terrain"]
+    _check_keys(tt, {"dem", "crs", "material", "material_raster", "material_codes"}, "terrain.", source)
+    base = Path(base_dir) if base_dir is not None else Path(".")
+    try:
+        if terrain is None:
+            if "dem" not in tt:
+                raise ScenarioError(f"{source}: terrain.dem (the DEM raster file) is required")
+            dem_path = base / str(tt["dem"])
+            if not dem_path.exists():
+                raise ScenarioError(f"{source}: terrain.dem = {tt['dem']!r}: file not found ({dem_path})")
+            terrain = read_dem(dem_path, crs=crs if crs is not None else tt.get("crs"))
+        if "material_raster" in tt:
+            if "material_codes" not in tt or not isinstance(tt["material_codes"], dict):
+                raise ScenarioError(f"{source}: terrain.material_raster needs terrain.material_codes = "
+                                    "{ code = \"material\", ... }")
+            codes = {}
+            for k, v in tt["material_codes"].items():
+                try:
+                    codes[int(k)] = str(v)
+                except ValueError:
+                    raise ScenarioError(f"{source}: terrain.material_codes key {k!r} is not an integer code") \
+                        from None
+            grid = read_material_raster(base / str(tt["material_raster"]), terrain, codes, names)
+        else:
+            mname = tt.get("material", names[0])
+            if mname not in names:
+                raise ScenarioError(f"{source}: terrain.material = {mname!r} is not a defined material "
+                                    f"({', '.join(names)})")
+            grid = MaterialGrid(index=np.full(terrain.shape, names.index(mname), dtype=np.int64), names=tuple(names))
+    except TerrainError as exc:
+        raise ScenarioError(f"{source}: [terrain]: {exc}") from None
+
+    sd = data["sources"]
+    _check_keys(sd, {"points", "polygon", "height_m", "mass_kg", "density_kg_m3", "speed_ms", "vz_ms",
+                     "angular_velocity_rads", "shape"}, "sources.", source)
+    if ("points" in sd) == ("polygon" in sd):
+        raise ScenarioError(f"{source}: [sources] needs exactly one of points = [[x, y], ...] or "
+                            "polygon = [[x, y], ...]")
+    points = polygon = None
+    try:
+        if "points" in sd:
+            points = terrain.check_points(_plan_points(sd["points"], "sources.points", source),
+                                          f"{source}: sources.points")
+        else:
+            polygon = _plan_points(sd["polygon"], "sources.polygon", source, min_points=3)
+            terrain.check_points(polygon, f"{source}: sources.polygon")
+    except TerrainError as exc:
+        raise ScenarioError(str(exc)) from None
+    if "mass_kg" not in sd:
+        raise ScenarioError(f"{source}: sources.mass_kg is required (a number or a distribution table)")
+    shape = sd.get("shape", "sphere")
+    if shape not in INERTIA_FACTORS:
+        raise ScenarioError(f"{source}: sources.shape = {shape!r} is not one of {sorted(INERTIA_FACTORS)}")
+    sources = Sources(
+        points=points, polygon=polygon,
+        height_m=Distribution.parse(sd.get("height_m", 1.0), "sources.height_m", source, lo=0.0, hi=1e4),
+        mass_kg=Distribution.parse(sd["mass_kg"], "sources.mass_kg", source, lo=0.0, hi=1e9, lo_open=True),
+        density_kg_m3=_number(sd.get("density_kg_m3", DEFAULT_DENSITY_KG_M3), "sources.density_kg_m3", source,
+                              lo=500, hi=6000),
+        speed_ms=Distribution.parse(sd.get("speed_ms", 0.0), "sources.speed_ms", source, lo=0.0, hi=200),
+        vz_ms=Distribution.parse(sd.get("vz_ms", 0.0), "sources.vz_ms", source, lo=-200, hi=200),
+        angular_velocity_rads=Distribution.parse(sd.get("angular_velocity_rads", 0.0),
+                                                 "sources.angular_velocity_rads", source, lo=-1e3, hi=1e3),
+        shape=shape)
+
+    collectors = []
+    for i, c in enumerate(data.get("collectors", [])):
+        where = f"collectors[{i}]"
+        if not isinstance(c, dict):
+            raise ScenarioError(f"{source}: {where} must be a table with name and line")
+        _check_keys(c, {"name", "line"}, f"{where}.", source)
+        if "name" not in c or "line" not in c:
+            raise ScenarioError(f"{source}: {where} needs a name and a line = [[x, y], ...]")
+        line = _plan_points(c["line"], f"{where}.line", source, min_points=2)
+        if np.any(np.hypot(*np.diff(line, axis=0).T) == 0):
+            raise ScenarioError(f"{source}: {where}.line ({c['name']!r}) has two coinciding vertices")
+        collectors.append(PlanCollector(str(c["name"]), line))
+    cnames = [c.name for c in collectors]
+    if len(set(cnames)) != len(cnames):
+        raise ScenarioError(f"{source}: collector names must be unique; got {cnames}")
+
+    st = data.get("settings", {})
+    _check_keys(st, {"gravity_ms2", "contact_velocity_ms", "stop_velocity_ms", "max_events"}, "settings.", source)
+    settings = Settings(
+        gravity_ms2=_number(st.get("gravity_ms2", STANDARD_GRAVITY_MS2), "settings.gravity_ms2", source, lo=0.0,
+                            lo_open=True),
+        contact_velocity_ms=_number(st.get("contact_velocity_ms", 0.5), "settings.contact_velocity_ms", source,
+                                    lo=0.0, lo_open=True),
+        stop_velocity_ms=_number(st.get("stop_velocity_ms", 0.05), "settings.stop_velocity_ms", source, lo=0.0),
+        max_events=int(_number(st.get("max_events", DEFAULT_MAX_EVENTS_3D), "settings.max_events", source, lo=1)),
+        envelope_bins=0)
+    return TerrainScenario(name=str(data.get("name", Path(source).stem)), description=str(data.get("description", "")),
+                           terrain=terrain, materials=materials, material_grid=grid, sources=sources,
+                           collectors=tuple(collectors), settings=settings, source=source)
+
+
+def load_terrain_scenario(path, crs=None) -> TerrainScenario:
+    """Read a 3-D scenario TOML file (a ``[terrain]`` table; see this module's docstring)."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"scenario file not found: {path}")
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{path}: not valid TOML: {exc}") from exc
+    return terrain_scenario_from_dict(data, source=str(path), base_dir=path.parent, crs=crs)
+
+
+def _in_polygon(poly: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Even-odd rule: True for plan points inside the polygon."""
+    inside = np.zeros(x.shape, dtype=bool)
+    px, py = poly[:, 0], poly[:, 1]
+    for k in range(len(poly)):
+        xa, ya, xb, yb = px[k - 1], py[k - 1], px[k], py[k]
+        cond = (ya > y) != (yb > y)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xc = xa + (y - ya) * (xb - xa) / (yb - ya)
+        inside ^= cond & (x < xc)
+    return inside
+
+
+def sample_sources(sources: Sources, terrain: Terrain, rng: np.random.Generator, n: int) -> np.ndarray:
+    """n plan release points (n, 2): uniform among ``points``, or uniform inside ``polygon`` (rejection
+    sampling in its bounding box; points on nodata holes are rejected too)."""
+    if sources.points is not None:
+        return sources.points[rng.integers(0, len(sources.points), n)]
+    poly = sources.polygon
+    lo, hi = poly.min(axis=0), poly.max(axis=0)
+    out = np.empty((0, 2))
+    for _ in range(1000):
+        m = max(2 * (n - len(out)), 64)
+        cand = rng.uniform(lo, hi, size=(m, 2))
+        ok = _in_polygon(poly, cand[:, 0], cand[:, 1]) & terrain.contains(cand[:, 0], cand[:, 1])
+        out = np.vstack([out, cand[ok]])
+        if len(out) >= n:
+            return out[:n]
+    raise ScenarioError(f"sources.polygon: could not place {n} release points on the terrain inside the polygon "
+                        "(is it on nodata, or degenerate?)")
+
+
+def fall_line(terrain: Terrain, x, y) -> tuple[np.ndarray, np.ndarray]:
+    """Unit horizontal direction of steepest descent at plan points (+x where the ground is flat)."""
+    gx, gy = terrain.gradient(x, y)
+    n = np.hypot(gx, gy)
+    flat = ~(n > 1e-12)
+    ux = np.where(flat, 1.0, -gx / np.where(flat, 1.0, n))
+    uy = np.where(flat, 0.0, -gy / np.where(flat, 1.0, n))
+    return ux, uy
+
+
+def _lipschitz(z: np.ndarray, dx: float, dy: float) -> float:
+    """Upper bound of |grad z| on the bilinear surface: within a cell dz/dx lies between its two x-edge
+    differences and dz/dy between its y-edge ones, so sqrt(max|dz/dx|^2 + max|dz/dy|^2) bounds the slope."""
+    gx = np.nanmax(np.abs(np.diff(z, axis=1))) / dx
+    gy = np.nanmax(np.abs(np.diff(z, axis=0))) / dy
+    return float(math.hypot(gx, gy)) * (1.0 + 1e-9) + 1e-12
