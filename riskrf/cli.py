@@ -444,6 +444,8 @@ def cmd_assess(args) -> int:
     print(f"Rate of falls from the {s['hazard']['rate_source']}.")
     print(f"Lowest expected total cost: {s['best_option']} (then {s['second_option']}).")
     print(f"Recommendation: {s['recommendation']['option']} ({s['recommendation']['basis']}).")
+    if "resolution" in s["recommendation"]:
+        print(f"Resolution: {s['recommendation']['resolution']['text']}")
     print(f"Report: {(out / 'report.html').resolve()}")
     return 0
 

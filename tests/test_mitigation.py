@@ -42,9 +42,11 @@ def test_expected_annual_loss_by_hand_with_strikes_in_individual_risk():
     r = s.evaluate("nothing")
     ex, co = s.exposure, s.consequences
     road = 2.0 * 0.5
-    p_st = spatial_temporal_probability(5000, ex.vehicle_length_m, ex.speed_kmh)
-    strikes = road * ex.share_stopping_on_road * stationary_rock_strike_probability(5000, ex.hours_rock_on_road,
-                                                                                    ex.p_cannot_stop)
+    # per lane (Bunce et al. 1997 for the lane a fall lands in): 2 lanes of 2,500 vehicles/day, 5 m, 80 km/h
+    p_st = 2500 * 5.0 / (24 * 1000 * 80)
+    assert p_st == pytest.approx(spatial_temporal_probability(5000, ex.vehicle_length_m, ex.speed_kmh) / 2)
+    # the first vehicle of the lane arriving within 0.5 h fails to stop with probability 0.002
+    strikes = road * ex.share_stopping_on_road * 0.002 * -np.expm1(-2500 * 0.5 / 24)
     k, p = occupancy_distribution(ex.occupants_per_vehicle)
     occ = float(np.dot(k, p))
     deaths = occ * (road * p_st * 0.5 + strikes * 0.1)
@@ -222,9 +224,28 @@ def test_wider_ditch_on_the_same_profile_retains_more_derived_by_simulation():
 
 
 def test_scaling_removes_the_release_share_of_its_zone_and_size_range():
-    opts = (Option("nothing", "none"), Option("scale", "scaling", 1e5, zone_x_m=(6.0, 7.5), max_mass_kg=1e12))
+    # a perfect, lasting scaling (typed: effectiveness 1, no decay) removes the release of its zone
+    opts = (Option("nothing", "none"), Option("scale", "scaling", 1e5, zone_x_m=(6.0, 7.5), max_mass_kg=1e12,
+                                              effectiveness=1.0, effectiveness_half_life_years=1e15))
     s = _toe_study(opts)
     assert s.evaluate("scale").effectiveness == pytest.approx(0.5, rel=1e-9)     # half of the 6-9 m release line
+
+
+def test_scaling_effectiveness_is_below_100_percent_decays_and_is_labelled_assumed():
+    opts = (Option("nothing", "none"), Option("scale", "scaling", 1e5, zone_x_m=(6.0, 7.5), max_mass_kg=1e12)
+            , Option("scale15", "scaling", 1e5, zone_x_m=(6.0, 7.5), max_mass_kg=1e12, life_years=15,
+                     effectiveness_half_life_years=5))
+    s = _toe_study(opts)
+    # default: 80 % when new, halving every 10 years (no life_years: a 10-year cycle): mean e0 h (1 - 2^-(L/h)) /
+    # (L ln 2) = 0.8 x 10 x 0.5 / (10 ln 2) = 0.57708; times the zone's half of the release line
+    assert s.evaluate("scale").effectiveness == pytest.approx(0.5 * 0.8 * 0.5 / np.log(2), rel=1e-9)
+    # 15-year cycle, half-life 5 years: 0.8 x 5 x (1 - 1/8) / (15 ln 2) = 0.33665
+    assert s.evaluate("scale15").effectiveness == pytest.approx(0.5 * 0.8 * 5 * 0.875 / (15 * np.log(2)), rel=1e-9)
+    ranges = s.parameter_ranges()
+    lo, hi, how = ranges["scaling_effectiveness:scale"]
+    assert (lo, hi) == pytest.approx((0.6 * 0.5 / np.log(2), 0.95 * 0.5 / np.log(2))) and "ASSUMED" in how
+    basis = s.ranking().set_index("option").loc["scale", "effect_basis"]
+    assert "ASSUMED effectiveness" in basis and "80% when new" in basis
 
 
 def test_combined_option_does_not_double_count():
@@ -353,7 +374,9 @@ def test_material_parameters_are_resimulated_jointly_and_at_the_ends_of_their_ra
                                                material="gravel"),
             Option("fence", "fence", 5e5, capacity_kj=2000, height_m=3, repair_days=30))
     sc = simulation.scenario_from_dict(TOE)
+    # one lane and 15.3 % of first arrivals unable to stop: the losses this tie was built on
     s = MitigationStudy(hazard=HAZ, options=opts, consequences=CONSTANT_V,
+                        exposure=Exposure(lanes=1, p_cannot_stop=0.153),
                         uncertainty=Uncertainty(samples=100, material_draws=3,
                                                 materials={"gravel.ground_friction_angle_deg": (20.0, 45.0)}),
                         context=SimulationContext(sc, n_blocks=1000, seed=3))
@@ -593,9 +616,8 @@ def test_fragmentation_breaks_event_volumes_into_the_blocks_that_travel():
     v_eff = -np.expm1(-0.5 * n_frag * 0.5) / reach
     ex = frag.exposure
     k, p = occupancy_distribution(ex.occupants_per_vehicle)
-    p_st = spatial_temporal_probability(5000, ex.vehicle_length_m, ex.speed_kmh)
-    strikes = ex.share_stopping_on_road * stationary_rock_strike_probability(5000, ex.hours_rock_on_road,
-                                                                             ex.p_cannot_stop)
+    p_st = 2500 * 5.0 / (24 * 1000 * 80)                     # per lane: 2 lanes of 2,500 vehicles/day
+    strikes = ex.share_stopping_on_road * 0.002 * -np.expm1(-2500 * 0.5 / 24)
     v_s_eff = -np.expm1(-0.5 * n_frag * 0.1) / reach
     assert r.deaths_per_year == pytest.approx(float(np.dot(k, p)) * 2.0 * reach * (p_st * v_eff + strikes * v_s_eff),
                                               rel=1e-9)

@@ -49,7 +49,7 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
                               seed=1, reach_probability: float = 1.0, condition_on_mass: bool = False,
                               mass_coupling: str = "simulated", design_masses_kg=(),
                               velocity_unit: str | None = None, drop_height_m=None, velocity_reader=None,
-                              rate_note: str | None = None):
+                              rate_note: str | None = None, road_collector: str | None = None):
     """Power-law fit of the inventory combined with simulated or given velocities.
 
     ``collector`` names the barrier line: in a scenario it defaults to "barrier"; a
@@ -62,8 +62,10 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
     ``condition_on_mass``) is the older form from the seeder's own masses.  The returned
     simulation is always the scenario's own seeder run (figures, road share, mitigation).
     ``rate_note`` replaces the hazard's note on ``rate_scale`` (e.g. a rate from the site's rate model).
+    ``road_collector``: also return, per block of the mass-coupled run, whether it crossed that line (a boolean
+    array, None without a mass-coupled run or such a line) as a fourth element: the road share by block size.
 
-    Returns (power-law fit, EnergyHazard, SimulationResult or None).
+    Returns (power-law fit, EnergyHazard, SimulationResult or None[, road crossings or None]).
     """
     import simulation
 
@@ -76,6 +78,7 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
     if (scenario is None) == (velocities is None):
         raise ValueError("give exactly one of --scenario (simulate the velocities) or --velocities (a file)")
     result = None
+    road_hits = None
     if scenario is not None:
         sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
         collector = collector or "barrier"
@@ -84,8 +87,12 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
         if mass_coupling not in ("simulated", "independent"):
             raise ValueError(f"mass_coupling = {mass_coupling!r} must be 'simulated' or 'independent'")
         if mass_coupling == "simulated" and not condition_on_mass:
-            hazard = energy_hazard(gr, sc, collector, rate_per_year=rate, n=n, seed=seed,
-                                   design_masses_kg=design_masses_kg)
+            from ..hazard.simulated import simulate_energy_hazard
+            hazard, coupled = simulate_energy_hazard(gr, sc, collector, rate_per_year=rate, n=n, seed=seed,
+                                                     design_masses_kg=design_masses_kg)
+            if road_collector is not None and road_collector in [c.name for c in sc.collectors]:
+                road_hits = np.zeros(coupled.n, dtype=bool)
+                road_hits[coupled.collector(road_collector, first_only=True)["block"].to_numpy()] = True
         else:
             hazard = EnergyHazard.from_simulation(gr, result, collector, rate_per_year=rate,
                                                   condition_on_mass=condition_on_mass)
@@ -110,6 +117,8 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
     elif rate_scale != 1.0:
         hazard = replace(hazard, notes=hazard.notes + (
             f"rate scaled by {rate_scale:g} (share of the inventoried source above this line)",))
+    if road_collector is not None:
+        return gr, hazard, result, road_hits
     return gr, hazard, result
 
 
@@ -122,11 +131,12 @@ def road_share(result, barrier: str, road: str | None) -> float:
 
 
 def study_context(result, barrier: str, road: str | None, option_blocks: int, seed, inventory, hazard,
-                  rate_scale: float = 1.0) -> dict:
+                  rate_scale: float = 1.0, road_hits=None) -> dict:
     """The slope model and small falls a :class:`MitigationStudy` needs to derive option effects.
 
     Falls below the power law's m_min: the inventory's own (their masses, and their count
-    over the record scaled by ``rate_scale``), so that every size that reaches the road counts.
+    over the record scaled by ``rate_scale``), so that every size that reaches the road counts.  ``road_hits``:
+    per block of the hazard's mass-coupled run, did it cross the road line (road share by block size).
     """
     from ..risk.measures import SimulationContext
     out = {}
@@ -136,6 +146,8 @@ def study_context(result, barrier: str, road: str | None, option_blocks: int, se
                                            road_collector=road if road in names else barrier,
                                            n_blocks=int(option_blocks), seed=int(seed))
         out["reference"] = result
+    if road_hits is not None:
+        out["coupled_road_hits"] = road_hits
     m_min = getattr(hazard.mass, "m_min", None)
     if m_min is not None and inventory is not None:
         small = inventory.masses[inventory.masses < m_min]
@@ -153,6 +165,41 @@ def fence_checks_from_site(site) -> tuple:
     fh = site.hazard["fence_height_m"]
     caps = tuple(site.hazard["fences_kj"])
     return caps, tuple(fh) if isinstance(fh, list) else tuple([fh] * len(caps))
+
+
+def release_factor_for_road_record(hazard, share: float, context: dict, source: str = "",
+                                   uncertainty=None) -> float:
+    """Factor from falls recorded on the road to falls released: recorded / P(road | release), with P(road |
+    release) from the same engine as the ranking (reach of the barrier line by mass, road share by mass, the
+    inventory's small falls), so that doing nothing reproduces the recorded road falls exactly.  The released
+    sizes are taken to follow the recorded law (an approximation: large blocks reach the road more often)."""
+    from ..risk.mitigation import MitigationStudy, Option
+    from .site import SiteError
+    kw = {} if uncertainty is None else {"uncertainty": replace(uncertainty, materials={}, calibration=None)}
+    probe = MitigationStudy(hazard=hazard, options=(Option("as recorded", "none"), Option("probe", "none")),
+                            road_share=share, source=source or "rate_basis = 'road'", **context, **kw)
+    road = probe.evaluate("as recorded").road_falls_per_year
+    recorded = float(hazard.rate_per_year) + float(context.get("small_falls_per_year", 0.0))
+    if not road > 0:
+        raise SiteError(f"{source}: inventory.rate_basis = 'road': no simulated fall reaches the road, so the release "
+                        "rate behind the recorded road falls cannot be derived; check the geometry or use "
+                        "rate_basis = 'release'")
+    return recorded / road
+
+
+def fence_design_checks(options, energy) -> dict:
+    """Option name -> verdict of its fence checks in ``energy`` (an EnergyAnalysis): "adequate" or "NOT ADEQUATE:
+    <failed checks>", for the fence and attenuator options checked there; shown in the ranking itself."""
+    out = {}
+    for o in options:
+        if o.kind not in ("fence", "attenuator") or o.capacity_kj is None or o.height_m is None:
+            continue
+        table = energy.fences.get(f"{o.capacity_kj:g} kJ / {o.height_m:g} m")
+        if table is None:
+            continue
+        failed = "; ".join(table.loc[~table["adequate"], "check"])
+        out[o.name] = "NOT ADEQUATE: " + failed if failed else "adequate"
+    return out
 
 
 def sensitivity_inputs(site, rate_scale: float | None = None) -> tuple:
@@ -204,6 +251,7 @@ class Assessment:
     warnings: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
     rates: object = None            # SiteRates of the site's [rates] model (riskrf.risk.site_rates), or None
+    release_factor: float = 1.0     # rate_basis = "road": released falls per fall recorded on the road
     #: figures already being drawn beside the computation: {"dir": Path, "pending": [InBackground, ...]} (see
     #: ``run_assessment(figures_dir=...)``); empty when ``write_assessment`` draws them all.
     drawing: dict = field(default_factory=dict, repr=False)
@@ -218,8 +266,13 @@ class Assessment:
             text = (f"inventory: {inv.n_events:,} recorded falls in {inv.duration_years:.3g} years "
                     f"({self.frequency.power_law.rate_min:.4g} per year at or above m_min)")
         scale = self.site.inventory["rate_scale"]
-        return text + (f"; times rate_scale {scale:g} (typed: share of the recorded source above this road)"
-                       if scale != 1 else "")
+        text += (f"; times rate_scale {scale:g} (typed: share of the recorded source above this road)"
+                 if scale != 1 else "")
+        if self.site.inventory.get("rate_basis", "release") == "road":
+            return text + (f"; rate_basis = 'road': the record counts falls that reached the road, so the release "
+                           f"rate is {self.release_factor:.4g} times it (1 / P(road | release), simulated; doing "
+                           "nothing reproduces the recorded road falls)")
+        return text + "; rate_basis = 'release': the record counts falls released from the slope"
 
     def summary(self) -> dict:
         """Every headline number, machine-readable, with units."""
@@ -251,6 +304,8 @@ class Assessment:
                                                 "m_min_kg": float(hz.mass.m_min)},
                        "mass_coupled": hz.mass_coupled,
                        "falls_per_year": hz.rate_per_year, "rate_source": self.rate_source,
+                       "rate_basis": self.site.inventory.get("rate_basis", "release"),
+                       "release_factor": self.release_factor,
                        "reach_probability": hz.reach_probability,
                        "arrivals_per_year": hz.arrival_rate,
                        "road_share": self.study.road_share,
@@ -383,14 +438,26 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             compiling.wait()
             timings["compilation"] = round(time.perf_counter() - t, 2)
         t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
-        gr, hazard, result = energy_hazard_from_inputs(
+        gr, hazard, result, road_hits = energy_hazard_from_inputs(
             inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=rate_scale,
             scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
             velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
             collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
             mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=design_masses,
-            velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note)
+            velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note,
+            road_collector=hz_cfg["road_collector"])
         timings["simulation"] = round(time.perf_counter() - t, 2)
+        release_factor = 1.0
+        if inv_cfg.get("rate_basis", "release") == "road":
+            # the record counts falls that reached the road: release rate = recorded / P(road | release)
+            release_factor = release_factor_for_road_record(
+                hazard, road_share(result, hz_cfg["collector"], hz_cfg["road_collector"]),
+                study_context(result, hz_cfg["collector"], hz_cfg["road_collector"], hz_cfg["option_blocks"], seed,
+                              inventory, hazard, rate_scale, road_hits), str(site.path),
+                uncertainty=site.mitigation.get("uncertainty"))
+            hazard = replace(hazard, rate_per_year=hazard.rate_per_year * release_factor)
+            rate_scale = rate_scale * release_factor
+            m_max_values, shares = sensitivity_inputs(site, rate_scale)
         if figures is not None:
             pending.append(InBackground(partial(_simulation_figures, result, hz_cfg["collector"], figures,
                                                 fences_to_draw(site))))
@@ -433,8 +500,9 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                                 defaults_used=site.defaults_used,
                                 **study_context(result, hz_cfg["collector"], hz_cfg["road_collector"],
                                                 hz_cfg["option_blocks"], seed, inventory, hazard,
-                                                rate_scale),
+                                                rate_scale, road_hits),
                                 **mitigation)
+        study = replace(study, design_checks=fence_design_checks(study.options, energy))
         decision = study_report(study)
         timings["decision"] = round(time.perf_counter() - t, 2)
     notes = []
@@ -452,7 +520,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         notes.append(f"only {frequency.power_law.n_tail} falls above m_min: the exponent b is uncertain")
     return Assessment(site=site, inventory=inventory, frequency=frequency, maxima_frequency=maxima_frequency,
                       result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
-                      warnings=notes, timings=timings, rates=site_rates,
+                      warnings=notes, timings=timings, rates=site_rates, release_factor=release_factor,
                       drawing={"dir": figures, "pending": pending} if figures is not None else {})
 
 

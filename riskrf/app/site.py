@@ -26,6 +26,7 @@ SITE_FIELDS = {
     "site": {"name": None, "description": ""},
     "inventory": {"path": None, "start": None, "end": None, "duration_years": None, "density_kg_m3": None,
                   "m_min_kg": None, "m_max_kg": None, "rate_scale": 1.0, "annual_maxima": None,
+                  "rate_basis": "release",   # "release": falls released; "road": falls recorded on the road
                   "sizes": None,          # None: the inventory sidecar's sizes, else event_volumes
                   # reader options (README "Input formats"); None = the reader's rule or the sidecar's value
                   "sheet": None, "header_row": None, "encoding": None, "decimal": None, "date_format": None,
@@ -154,6 +155,10 @@ def load_site(path) -> Site:
                         f"{inv['m_max_kg']!r}")
     if not isinstance(inv["rate_scale"], (int, float)) or not 0 < inv["rate_scale"] <= 1e6:
         raise SiteError(f"{path}: inventory.rate_scale = {inv['rate_scale']!r} must be a number > 0")
+    if inv["rate_basis"] not in ("release", "road"):
+        raise SiteError(f"{path}: inventory.rate_basis = {inv['rate_basis']!r} must be 'release' (the inventory "
+                        "counts falls released from the slope) or 'road' (it counts falls that reached the road, "
+                        "e.g. a patrol record)")
     _check_design_block(tables, path)
     for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
                        ("hazard", "velocities"), ("design_block", "survey")):

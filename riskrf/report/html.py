@@ -450,7 +450,7 @@ def render_report(a, figs: Path) -> str:
     risk = ranking[["option", "road_falls_per_year", "deaths_per_year", "individual_risk"]].copy()
     risk[f"meets {probability(ir_limit)}/yr"] = risk["individual_risk"] <= ir_limit
     risk["F(N≥1) [1/yr]"] = ranking["F_N1_per_year"]
-    risk["Hong Kong GEO F-N zone"] = ranking["fn_zone"]
+    risk[f"F-N zone ({a.study.criteria.fn_diagram})"] = ranking["fn_zone"]
     risk = risk.rename(columns={"individual_risk": "individual risk [1/yr]", "deaths_per_year": "deaths [1/yr]",
                                 "road_falls_per_year": "falls reaching the road [1/yr]"})
     doc.section("Risk to road users")
@@ -483,7 +483,9 @@ def render_report(a, figs: Path) -> str:
         "maintenance, repairs, replacements (PV, central)": ranking["pv_maintenance"].map(money_est),
         "expected losses (PV, central)": ranking["pv_expected_loss"].map(money_est),
         "meets criteria": ranking["meets_criteria"].map(lambda v: "yes" if v else "no"),
-        "meets them in (share of samples)": ranking["probability_meets_criteria"].map(lambda v: f"{v:.0%}")})
+        "meets them in (share of samples)": ranking["probability_meets_criteria"].map(lambda v: f"{v:.0%}"),
+        **({"design check": ranking["design_check"]} if "design_check" in ranking else {}),
+        **({"ALARP test": ranking["alarp"]} if "alarp" in ranking else {})})
     opts = a.decision["options_table"].copy()
     opts["retention"] = opts["retention"].map(lambda v: "" if v is None or pd.isna(v) else f"{v:.0%}")
     opts["effectiveness"] = opts["effectiveness"].map(lambda v: f"{v:.0%}")

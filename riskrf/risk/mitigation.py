@@ -71,6 +71,7 @@ from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.risk.mit
     DEFAULT_REPAIR_DAYS,
     MASS_BINS,
     OPTION_KINDS,
+    SLOPE_KINDS,
     Consequences,
     Criteria,
     Economics,
@@ -85,14 +86,12 @@ from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.risk.mit
 )
 from ..frequency.power_law import GutenbergRichterFit
 from ..core.format import money, probability
+from .road_users import lane_hit_probability, lane_strike_probability
 from .road_risk import (
     commuter_passage_probability,
     commuter_strike_probability,
-    fn_zone,
     occupancy_distribution,
     occupant_fn,
-    spatial_temporal_probability,
-    stationary_rock_strike_probability,
     vulnerability_by_mass,
 )
 from ..core.units import kinetic_energy_kj
@@ -167,6 +166,8 @@ class MitigationStudy:
     small_falls_per_year: float = 0.0
     uncertainty: Uncertainty = Uncertainty()
     criteria: Criteria = Criteria()
+    design_checks: dict = field(default_factory=dict)   # option name -> verdict of its design checks (fences)
+    coupled_road_hits: np.ndarray | None = field(default=None, repr=False)   # per block of the mass-coupled run
 
     def __post_init__(self):
         _check_combinations(self.options, self.source)
@@ -381,6 +382,40 @@ class MitigationStudy:
         return cls, samples, profile
 
     @cached_property
+    def _road_profile(self) -> np.ndarray:
+        """Per mass bin: P(road | barrier line) of the bin's simulated mass class over the study's ``road_share``
+        (ones without a mass-coupled hazard or its road crossings).
+
+        One road share for all block sizes over-counts small falls at the road and under-counts large ones (large
+        blocks run further); the blocks of each mass class of the hazard's mass-coupled run that crossed the barrier
+        line and then the road line (``coupled_road_hits``) give each class its own share.  A class with fewer than
+        20 blocks at the barrier line keeps the overall share."""
+        mid = self._grid[1]
+        ones = np.ones(mid.size)
+        hits = self.coupled_road_hits
+        if self._by_mass is None or hits is None or self.road_share <= 0:
+            return ones
+        vel = self.hazard.velocity
+        hits = np.asarray(hits, dtype=bool)
+        if hits.size != np.size(vel.mass_kg):
+            raise MitigationError(f"{self.source}: coupled_road_hits has {hits.size} blocks; the hazard's mass-coupled "
+                                  f"run has {np.size(vel.mass_kg)}")
+        at_b = np.asarray(vel.reached, dtype=bool)
+        k_blocks = vel.class_of(vel.mass_kg)
+        cls = self._by_mass[0]
+        out = ones.copy()
+        for c in np.unique(cls):
+            n_b = int((at_b & (k_blocks == c)).sum())
+            if n_b >= 20:
+                out[cls == c] = (hits & at_b & (k_blocks == c)).sum() / n_b / self.road_share
+        return out
+
+    def road_share_by_mass(self) -> pd.DataFrame:
+        """P(reaches the road | reaches the barrier line) used for each mass bin [kg] of the reference model."""
+        mid = self._grid[1]
+        return pd.DataFrame({"mass_kg": mid, "road_share": np.minimum(self.road_share * self._road_profile, 1.0)})
+
+    @cached_property
     def _variant_classes(self) -> dict:
         """id(slope model) -> per mass class (speeds [m/s], bounce heights [m]) at the barrier line as that model
         changes them (see :attr:`_by_mass`); filled once per model, shared by every barrier option."""
@@ -445,11 +480,18 @@ class MitigationStudy:
         return road_crossings(self._reference_run, self.context.road_collector)
 
     def _ditch_retentions(self, ditches) -> list:
-        """:meth:`_ditch_retention` for every slope model (the ditched profiles simulated at once)."""
+        """:meth:`_ditch_retention` for every slope model (the changed profiles simulated at once): ditches
+        (:class:`~riskrf.measures.Ditch`) and benches, bunds and drapes
+        (:class:`~riskrf.risk.geometry_measures.SlopeMeasure`)."""
+        from .geometry_measures import scenario_with_measures
         ctx = self.context
         try:
-            scenarios = [scenario_with_ditches(m["scenario"], ditches, where=self.source,
-                                               road_collector=ctx.road_collector) for m in self._models]
+            if all(isinstance(d, Ditch) for d in ditches):
+                scenarios = [scenario_with_ditches(m["scenario"], ditches, where=self.source,
+                                                   road_collector=ctx.road_collector) for m in self._models]
+            else:
+                scenarios = [scenario_with_measures(m["scenario"], ditches, where=self.source,
+                                                    road_collector=ctx.road_collector) for m in self._models]
         except (MeasureError, ValueError) as exc:
             raise MitigationError(str(exc)) from exc
         return [self._ditch_retention(m, i, res) for i, (m, res) in
@@ -517,16 +559,22 @@ class MitigationStudy:
                             raise MitigationError(str(exc)) from exc
                     lo, hi = c.min_mass_kg or 0.0, c.max_mass_kg or np.inf
                     inside = (mid >= lo) & (mid <= hi)
-                    stages.append(_Stage("release", c.name, multiplier=1.0 - share * inside))
-        ditches = [c for c in comps if c.kind == "ditch"]
+                    # the targeted releases (derived: zone and mass range) times the ASSUMED mean effectiveness
+                    stages.append(_Stage("release", c.name, param=f"scaling_effectiveness:{c.name}",
+                                         factor=share * inside.astype(float)))
+        ditches = [c for c in comps if c.kind in ("ditch",) + SLOPE_KINDS]
         typed = [c for c in ditches if c.retention is not None]
         for c in typed:
             stages.append(_Stage("ditch", c.name, param=f"retention:{c.name}"))
         geo = [c for c in ditches if c.retention is None]
         if geo:
             self._need_context(geo[0], "x_m")
+            from .geometry_measures import SlopeMeasure
             ds = [Ditch(c.x_m, c.width_m, c.depth_m, c.inner_slope_hv or 0.25,
-                        1.0 if c.outer_slope_hv is None else c.outer_slope_hv, c.material, c.name) for c in geo]
+                        1.0 if c.outer_slope_hv is None else c.outer_slope_hv, c.material, c.name)
+                  if c.kind == "ditch" else
+                  SlopeMeasure(c.kind, c.name, c.x_m, c.width_m, c.height_m, c.zone_x_m, c.inner_slope_hv,
+                               c.outer_slope_hv, c.material) for c in geo]
             key = "+".join(c.name for c in geo)
             if key not in self._derived:
                 per_model = self._ditch_retentions(ds)
@@ -586,6 +634,8 @@ class MitigationStudy:
             p[f"annual_maintenance:{o.name}"] = o.annual_maintenance
             if o.rate_reduction is not None:
                 p[f"rate_reduction:{o.name}"] = o.rate_reduction
+            elif o.kind == "scaling":
+                p[f"scaling_effectiveness:{o.name}"] = o.scaling_effect()[3]
             if o.retention is not None:
                 p[f"retention:{o.name}"] = o.retention
             if o.kind == "closure":
@@ -621,7 +671,9 @@ class MitigationStudy:
             if getattr(u, name):
                 out[name] = (*getattr(u, name), "uniform, stated")
         if u.vulnerability_factor != (1.0, 1.0):
-            out["vulnerability_factor"] = (*u.vulnerability_factor, "uniform, stated")
+            out["vulnerability_factor"] = (*u.vulnerability_factor,
+                                           "log-uniform, stated (default: the vulnerability model's range, "
+                                           "riskrf.risk.road_users.DEFAULT_VULNERABILITY)")
         if u.fractal_dimension and u.fractal_dimension[0] < u.fractal_dimension[1]:
             out["fractal_dimension"] = (*u.fractal_dimension, "uniform, stated (fractal fragmentation of each "
                                         f"event volume, {u.fragmentation_iterations} generations)")
@@ -634,6 +686,13 @@ class MitigationStudy:
                     out[f"{fld}:{o.name}"] = (*rng, "uniform, stated" + (" (typed effectiveness: assumption)"
                                                                          if fld in ("retention", "rate_reduction")
                                                                          else ""))
+        for o in self.options:
+            if o.kind == "scaling" and o.rate_reduction is None:
+                e0, (a, b), h, _, (lo, hi) = o.scaling_effect()
+                if hi > lo:
+                    out[f"scaling_effectiveness:{o.name}"] = (
+                        lo, hi, f"uniform, ASSUMED (removes {a:.0%}-{b:.0%} of the targeted releases when new, "
+                        f"halving every {h:g} years; mean over the cycle)")
         if self.context is not None:
             for path, rng in sorted(self._material_ranges().items()):
                 out[f"material:{path}"] = rng
@@ -733,7 +792,9 @@ class MitigationStudy:
         hz, ex, co, ec = self.hazard, self.exposure, self.consequences, self.economics
         d = P["material_draw"].astype(int) if "material_draw" in P else np.zeros(S, dtype=int)
         reach_m, share_m = self._model_arrays
-        road_share = share_m[d]                                                     # (S,)
+        # P(road | barrier line) per sample and mass bin: the slope model's share times the reference run's profile
+        # by block mass (heavier blocks run further; :attr:`_road_profile`)
+        road_share = np.minimum(share_m[d][:, None] * self._road_profile[None, :], 1.0)   # (S, J)
         rate = hz.rate_per_year * P["rate_factor"] * P.get("rate_sampling_factor", 1.0)
         pmf = self._mass_pmf(P.get("b"), P.get("m_max_kg")) if "b" in P else self._mass_pmf()
         lam = rate[:, None] * pmf + (self.small_falls_per_year * P["rate_factor"])[:, None] * small_pmf[None, :]
@@ -745,10 +806,12 @@ class MitigationStudy:
         arrivals = lam * reach_m[d][:, None]                                       # (S, J) at the barrier line
         if self._by_mass is not None:                   # mass-coupled: heavier blocks reach the line more often
             arrivals = arrivals * self._by_mass[2][None, :]
-        p_st = np.broadcast_to(spatial_temporal_probability(P["vehicles_per_day"], ex.vehicle_length_m,
-                                                            ex.speed_kmh), (S,))
-        p_strike = ex.share_stopping_on_road * np.broadcast_to(stationary_rock_strike_probability(
-            P["vehicles_per_day"], ex.hours_rock_on_road, ex.p_cannot_stop), (S,))
+        # Bunce et al. (1997) per lane: a fall lands in one lane and only that lane's vehicles can be hit
+        lanes = ex.lane_list()
+        traffic = np.asarray(P["vehicles_per_day"], dtype=float) / ex.vehicles_per_day
+        p_st = np.broadcast_to(lane_hit_probability(lanes, ex.vehicle_length_m, traffic), (S,))
+        p_strike = ex.share_stopping_on_road * np.broadcast_to(lane_strike_probability(
+            lanes, ex.hours_rock_on_road, ex.p_cannot_stop, traffic), (S,))
         vf = P["vulnerability_factor"][:, None]
         v_d = np.minimum(vulnerability_by_mass(mid, co.vulnerability_moving_vehicle)[None, :] * vf, 1.0)
         v_s = np.minimum(vulnerability_by_mass(mid, co.vulnerability_striking_rock)[None, :] * vf, 1.0)
@@ -768,8 +831,8 @@ class MitigationStudy:
                                               "user_share")}
         road_bins = np.zeros((S, K, mid.size)) if per_bin else None
         vd_all, vs_all = (np.zeros((S, K, mid.size)), np.zeros((S, K, mid.size))) if per_bin else (None, None)
-        base_road = arrivals.sum(axis=1) * road_share if frag is None else \
-            self._events_at_road(frag, arrivals * road_share[:, None], v_d, v_s)[0].sum(axis=1)
+        base_road = (arrivals * road_share).sum(axis=1) if frag is None else \
+            self._events_at_road(frag, arrivals * road_share, v_d, v_s)[0].sum(axis=1)
         for k, opt in enumerate(self.options):
             stages, comps = effects[opt.name]
             ev_scale, g_prev = 1.0, None if frag is None else np.ones_like(lam)   # source measures on events
@@ -792,13 +855,18 @@ class MitigationStudy:
             users = np.ones(S)          # share of falls meeting open road (a closure protects users only)
             for st in stages:
                 if st.after_road and not on_road:
-                    x = x * road_share[:, None]
+                    x = x * road_share
                     on_road = True
                 if st.kind == "closure":
                     users = users * (1.0 - P[st.param])
                     continue
                 if st.kind == "release":
-                    m = st.multiplier[None, :] if st.multiplier is not None else (1.0 - P[st.param])[:, None]
+                    if st.multiplier is not None:
+                        m = st.multiplier[None, :]
+                    elif st.param.startswith("scaling_effectiveness:"):
+                        m = 1.0 - np.clip(P[st.param], 0.0, 1.0)[:, None] * st.factor[None, :]
+                    else:
+                        m = (1.0 - P[st.param])[:, None]
                     if frag is None:
                         x = x * m
                     else:           # a source measure removes events (by the event's mass), hence their fragments
@@ -809,7 +877,7 @@ class MitigationStudy:
                         g_prev = g
                     continue
                 if before_structures is None:
-                    before_structures = x.sum(axis=1) * (1.0 if on_road else road_share)
+                    before_structures = x.sum(axis=1) if on_road else (x * road_share).sum(axis=1)
                 if st.kind == "ditch":
                     ret = P[st.param][:, None] + (st.factor[d] if isinstance(st.factor, np.ndarray) else 0.0)
                     x = x * (1.0 - np.clip(ret, 0.0, 1.0))
@@ -830,7 +898,7 @@ class MitigationStudy:
                 elif st.kind == "exposure":
                     x = x * st.factor[d][:, None]
             if not on_road:
-                x = x * road_share[:, None]
+                x = x * road_share
             vd_k, vs_k = v_d, v_s
             if frag is not None:        # from fragments reaching the road to the events they came from
                 x_blocks = x
@@ -918,17 +986,20 @@ class MitigationStudy:
                 "samples": total.shape[0]}
 
     def _fn_tolerable(self, r) -> np.ndarray:
-        """Per sample and option: is the F-N curve outside the GEO "unacceptable" region (N <= 1,000 here, the
-        occupancy of one vehicle)?  The same F(N) as :meth:`fn_curve`, for every joint sample at once."""
-        from .road_risk import HK_GEO_FN_LINES, share_with_at_least
+        """Per sample and option: is the F-N curve outside the selected criteria's unacceptable region (N up to
+        the occupancy of one vehicle here)?  The same F(N) as :meth:`fn_curve`, for every joint sample at once;
+        always True for a criteria set without F-N lines."""
+        from .road_risk import share_with_at_least
+        cs = self.criteria.criteria_set
+        if cs.fn_unacceptable is None:
+            return np.ones(r["total"].shape, dtype=bool)
         kk, pk = occupancy_distribution(self.exposure.occupants_per_vehicle, self.exposure.occupants_distribution)
         Ns = np.arange(1, int(kk.max()) + 1)
-        c_hi, k_hi = HK_GEO_FN_LINES["unacceptable above"]
         a_d, a_s = share_with_at_least(r["v_d"], kk, pk), share_with_at_least(r["v_s"], kk, pk)   # (S, K, J, N)
         x = r["road_bins"] * r["user_share"][:, :, None]               # (S, K, J) falls meeting open road
         F = np.einsum("skj,skjn->skn", x * r["p_st"][:, None, None], a_d) \
             + np.einsum("skj,skjn->skn", x * r["p_strike"][:, None, None], a_s)
-        return ~np.any(F > c_hi / Ns[None, None, :] ** k_hi, axis=2)
+        return cs.fn_exceedance(F, Ns) <= 1.0
 
     # ---- societal risk -------------------------------------------------------------------------
     def fn_curve(self, option: str) -> pd.DataFrame:
@@ -967,7 +1038,10 @@ class MitigationStudy:
                 "deaths_per_year": r["deaths"][0, k], "individual_risk": r["ir"][0, k],
                 "probability_meets_individual_risk": u["probability_meets_individual_risk"][k],
                 "probability_meets_criteria": u["probability_meets_criteria"][k],
-                "fn_zone": fn_zone(fn), "F_N1_per_year": float(fn["F"].iloc[0]) if len(fn) else 0.0})
+                "fn_zone": self.criteria.criteria_set.fn_zone(fn),
+                "F_N1_per_year": float(fn["F"].iloc[0]) if len(fn) else 0.0,
+                "fn_ratio_to_limit": float(self.criteria.criteria_set.fn_exceedance(
+                    fn["F"].to_numpy()[None, :], fn["N"].to_numpy())[0]) if len(fn) else 0.0})
         df = pd.DataFrame(rows)
         base = df[df["kind"] == "none"]
         if len(base):
@@ -981,6 +1055,8 @@ class MitigationStudy:
                     spend > 0, (b["deaths_per_year"] - df["deaths_per_year"]) * self.economics.horizon_years
                     / spend * 1e6, np.nan)
         df["meets_criteria"] = [self._meets(row) for _, row in df.iterrows()]
+        df["design_check"] = [self._design_check(o) for o in self.options]
+        self._alarp(df)
         df = df.sort_values("expected_total_cost", kind="stable").reset_index(drop=True)
         df["rank"] = np.arange(1, len(df) + 1)
         return df
@@ -996,11 +1072,99 @@ class MitigationStudy:
             return "geometry: the road leaves the slope"
         if all(c.kind == "closure" for c in comps):
             return "computed: closure rule on the rate model and rainfall record"
+        if any(c.kind == "drape" for c in comps):
+            return ("derived by re-simulation of the draped surface, whose material is ASSUMED "
+                    "(riskrf.risk.geometry_measures.DRAPE_MATERIAL)")
+        scaled = [c for c in comps if c.kind == "scaling"]
+        if scaled:
+            e0, _, h, mean, _ = scaled[0].scaling_effect()
+            return (f"derived zone and mass range, ASSUMED effectiveness ({scaled[0].name}: {e0:.0%} when new, "
+                    f"halving every {h:g} yr, {mean:.0%} on average)"
+                    + ("; others derived (simulation and site geometry)" if len(comps) > 1 else ""))
         return "derived (simulation and site geometry)"
+
+    def _design_check(self, opt: Option) -> str:
+        """The verdict of an option's design checks (``design_checks``, e.g. a fence's 100-year energy against its
+        MEL): "-" when it has none to pass, "not checked" for a barrier without one."""
+        comps = [self.option(n) for n in opt.options] if opt.kind == "combined" else [opt]
+        verdicts = [f"{c.name}: {self.design_checks[c.name]}" if opt.kind == "combined" else self.design_checks[c.name]
+                    for c in comps if c.name in self.design_checks]
+        if verdicts:
+            return "; ".join(verdicts)
+        return "not checked" if any(c.kind in ("fence", "attenuator") for c in comps) else "-"
 
     def _meets(self, row) -> bool:
         return bool(row["individual_risk"] <= self.criteria.individual_risk_per_year
-                    and row["fn_zone"] in ("ALARP", "broadly acceptable"))
+                    and row["fn_zone"] in ("ALARP", "broadly acceptable", "no societal criterion"))
+
+    def _alarp(self, df: pd.DataFrame) -> None:
+        """Cost per statistical life saved (against doing nothing) and the ALARP test of every option, in place.
+
+        A tolerable option is ALARP when no option with fewer expected deaths saves lives at an incremental cost
+        per statistical life (net of the other losses it saves) at most the threshold: the criteria's marginal
+        cost per life (Swiss practice) or else the value of a statistical life, times ``disproportion_factor``."""
+        from .tolerability import cost_per_statistical_life_saved
+        cs = self.criteria.criteria_set
+        vsl = self.consequences.value_of_statistical_life
+        limit = (cs.marginal_cost_per_life or vsl) * self.criteria.disproportion_factor
+        spend = (df["capital"] + df["pv_renewals"] + df["pv_maintenance"]).to_numpy()
+        pvf = float(pv_factor(self.economics.discount_rate, self.economics.horizon_years))
+        other = (df["pv_expected_loss"] - df["deaths_per_year"] * vsl * pvf).to_numpy()   # non-fatal losses, PV
+        deaths = df["deaths_per_year"].to_numpy()
+        hz = self.economics.horizon_years
+        base = df.index[df["kind"] == "none"]
+        if len(base):
+            b = base[0]
+            df["cost_per_life_saved"] = cost_per_statistical_life_saved(spend - spend[b], other[b] - other,
+                                                                        deaths[b] - deaths, hz)
+        notes = []
+        for i in range(len(df)):
+            if not df["meets_criteria"].iloc[i]:
+                notes.append("not tolerable")
+                continue
+            better = [j for j in range(len(df)) if deaths[j] < deaths[i]]
+            csls = {j: float(cost_per_statistical_life_saved(spend[j] - spend[i], other[i] - other[j],
+                                                             deaths[i] - deaths[j], hz)) for j in better}
+            cheap = [j for j, c in csls.items() if c <= limit]
+            if cheap:
+                j = min(cheap, key=lambda j: csls[j])
+                cur = self.currency
+                notes.append(f"not ALARP: {df['option'].iloc[j]} is safer at no extra net cost" if csls[j] <= 0 else
+                             f"not ALARP: {df['option'].iloc[j]} saves lives at {money(csls[j], cur, sig=3)} per "
+                             f"statistical life (threshold {money(limit, cur, sig=3)})")
+            else:
+                notes.append(f"ALARP: no safer option saves lives at {money(limit, self.currency, sig=3)} per "
+                             "statistical life or less")
+        df["alarp"] = notes
+
+    def resolution(self, ranking: pd.DataFrame | None = None) -> dict:
+        """Can the joint samples tell the two cheapest options apart?
+
+        Paired over the joint samples: the difference of their total costs, its Monte Carlo standard error
+        sd / sqrt(S), and the standard error of P(best) of the cheapest, sqrt(p (1 - p) / S).  They are
+        "distinguishable" when the mean difference exceeds twice its standard error and P(best) is known within
+        +-0.03 (two standard errors).  The slope re-simulations (``material_draws``) add an error these samples do
+        not show; more draws and samples (``[uncertainty]``) narrow both."""
+        t = self.ranking() if ranking is None else ranking
+        u = self.uncertain
+        names = u["names"]
+        a, b = t["option"].iloc[0], t["option"].iloc[1]
+        d = u["total"][:, names.index(b)] - u["total"][:, names.index(a)]
+        S = d.size
+        se = float(d.std(ddof=1) / np.sqrt(S)) if S > 1 else np.inf
+        p = float(u["probability_best"][names.index(a)])
+        se_p = float(np.sqrt(p * (1 - p) / S))
+        ok = bool(abs(d.mean()) > 2 * se and 2 * se_p <= 0.03)
+        draws = self.uncertainty.material_draws if any(k.startswith("material:") for k in self.parameter_ranges()) \
+            else 0
+        text = (f"{a} and {b} {'are' if ok else 'are NOT'} distinguishable at the stated effort ({S:,} joint samples"
+                + (f", {draws} slope re-simulations" if draws else "") + f"): {b} costs "
+                f"{money(d.mean(), self.currency, sig=3)} more in expectation (+- {money(2 * se, sig=2)}, two "
+                f"standard errors); P({a} cheapest) = {p:.2f} +- {2 * se_p:.2f}")
+        if not ok:
+            text += "; more samples and re-simulations, or better information, are needed to separate them"
+        return {"first": a, "second": b, "difference": float(d.mean()), "difference_se": se,
+                "probability_best": p, "probability_best_se": se_p, "distinguishable": ok, "text": text + "."}
 
     def best(self) -> str:
         """Name of the first option of :meth:`ranking` (the lowest expected total cost over the joint samples)."""
@@ -1040,23 +1204,41 @@ class MitigationStudy:
                     f"({most['option']}: {most['probability_best']:.0%})." if most["option"] != rec["option"]
                     else f", and is the cheapest in {rec['probability_best']:.0%} of the joint samples.")
             basis = "cheapest tolerable option"
+            if "alarp" in rec and str(rec["alarp"]).startswith("not ALARP"):
+                why += f" ALARP test: {rec['alarp']}."
         else:
+            crit = self.criteria.describe()
+            safest = t.sort_values(["individual_risk", "deaths_per_year"], kind="stable").iloc[0]
+            ir_factor = safest["individual_risk"] / lim if lim > 0 else np.inf
+            fn_factor = float(safest.get("fn_ratio_to_limit", 0.0))
+            factor = max(ir_factor, fn_factor, 1.0)
+            need = (f"NO OPTION IS TOLERABLE under {crit}. What would be needed: the safest option, "
+                    f"{safest['option']}, leaves individual risk {probability(safest['individual_risk'])}/yr "
+                    f"(limit {probability(lim)}/yr)"
+                    + (f" and an F-N curve up to {fn_factor:.3g} times the unacceptable line" if fn_factor > 1 else "")
+                    + f"; its risk would have to fall by a factor of {factor:.3g} (a further measure removing "
+                    f"{1 - 1 / factor:.1%} of the falls that still reach the road, or fewer people exposed). ")
             cand = t[t["kind"] != "none"].dropna(subset=["deaths_avoided_per_million"])
             cand = cand[cand["deaths_avoided_per_million"] > 0]
             if len(cand) == 0:
-                rec, basis = cheapest, "lowest expected total cost (no option reduces the risk)"
-                why = f"No option meets the criteria or reduces the risk; {rec['option']} costs least."
+                rec, basis = cheapest, "no option is tolerable; lowest expected total cost (no option reduces the risk)"
+                why = need + f"No option reduces the risk; {rec['option']} costs least."
             else:
                 rec = cand.sort_values("deaths_avoided_per_million", ascending=False).iloc[0]
-                basis = "largest risk reduction per unit cost (no option meets the criteria)"
-                why = (f"No option meets the tolerability criteria (individual risk {probability(lim)}/yr and the F-N "
-                       f"diagram). {rec['option']} reduces the risk most per unit cost: "
-                       f"{rec['deaths_avoided_per_million']:.3g} statistical lives saved over "
-                       f"{self.economics.horizon_years:g} years per million {cur} spent; residual individual risk "
-                       f"{probability(rec['individual_risk'])}/yr.")
-        if "ASSUMPTION" in str(rec["effect_basis"]):
+                basis = "no option is tolerable; largest risk reduction per unit cost"
+                why = need + (f"Among the options given, {rec['option']} reduces the risk most per unit cost: "
+                              f"{rec['deaths_avoided_per_million']:.3g} statistical lives saved over "
+                              f"{self.economics.horizon_years:g} years per million {cur} spent; residual individual "
+                              f"risk {probability(rec['individual_risk'])}/yr. It is not tolerable either.")
+        if "NOT ADEQUATE" in str(rec.get("design_check", "")):
+            why += f" Warning: it fails its design checks ({rec['design_check']})."
+        if "ASSUMED" in str(rec["effect_basis"]):
+            why += f" Note: its effect is partly assumed ({rec['effect_basis']})."
+        elif "ASSUMPTION" in str(rec["effect_basis"]):
             why += f" Note: its effectiveness is typed, not derived ({rec['effect_basis']})."
-        return {"option": str(rec["option"]), "basis": basis, "reason": why,
+        res = self.resolution(t)
+        why += " " + res["text"][0].upper() + res["text"][1:]
+        return {"option": str(rec["option"]), "basis": basis, "reason": why, "resolution": res,
                 "expected_total_cost": float(rec["expected_total_cost"]),
                 "probability_best": float(rec["probability_best"])}
 
@@ -1069,7 +1251,7 @@ class MitigationStudy:
         ranges = self.parameter_ranges()
         if name in ranges:
             return ranges[name][0], ranges[name][1], ranges[name][2]
-        if name.startswith(("retention:", "rate_reduction:")):
+        if name.startswith(("retention:", "rate_reduction:", "scaling_effectiveness:")):
             return max(value - 0.2, 0.0), min(value + 0.2, 1.0), "+-0.2 (no range stated)"
         if name == "discount_rate":
             return value * 0.5, min(value * 2, 0.2), "x0.5 / x2 (no range stated)"
@@ -1116,7 +1298,7 @@ class MitigationStudy:
                               ).reset_index(drop=True)
 
     def _bracket(self, name, value):
-        if name.startswith(("retention:", "rate_reduction:")):
+        if name.startswith(("retention:", "rate_reduction:", "scaling_effectiveness:")):
             return 0.0, 1.0, False
         if name == "b":
             return 0.2, 3.0, False

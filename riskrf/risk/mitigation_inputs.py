@@ -14,18 +14,25 @@ import pandas as pd
 from ..core.validation import RiskrfError
 from .measures import Ditch, MeasureError
 from ..core.format import money
-from .road_risk import (
-    AGS2007_INDIVIDUAL_RISK,
-    VULNERABILITY_DIRECT_BY_MASS,
-    VULNERABILITY_STRIKE_BY_MASS,
-    occupancy_distribution,
-)
+from .road_users import DEFAULT_VULNERABILITY
+from .tolerability import CRITERIA_SETS, CriteriaSet, user_criteria
+from .road_risk import occupancy_distribution
 
-OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "closure", "combined")
+OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "closure", "combined",
+                "bench", "bund", "drape")
+#: Options that change the slope's geometry or surface; their effect is derived by re-simulation (like a ditch).
+SLOPE_KINDS = ("bench", "bund", "drape")
 BARRIER_KINDS = ("fence", "attenuator", "shed")
 #: Days a destroyed structure stays out of service (ASSUMPTION; override with ``repair_days``).
 DEFAULT_REPAIR_DAYS = {"fence": 30.0, "attenuator": 30.0, "shed": 180.0}
 MASS_BINS = 120
+#: Scaling and bolting by zone and mass: share of the targeted releases removed when the work is new, its range,
+#: and the cycle over which the effect is averaged without a life_years.  ASSUMPTIONS (no published effectiveness
+#: of scaling was found): labelled "assumed" in every output; override with effectiveness, effectiveness_range and
+#: effectiveness_half_life_years.
+SCALING_EFFECTIVENESS = 0.8
+SCALING_EFFECTIVENESS_RANGE = (0.6, 0.95)
+SCALING_DEFAULT_CYCLE_YEARS = 10.0
 
 
 class MitigationError(RiskrfError, ValueError):
@@ -34,7 +41,10 @@ class MitigationError(RiskrfError, ValueError):
 
 @dataclass(frozen=True)
 class Exposure:
-    """Traffic on the exposed road section."""
+    """Traffic on the exposed road section: ``vehicles_per_day`` two-way over ``lanes`` lanes (half each way),
+    split ``directional_split`` : 1 - split between the directions; a fall lands in one lane (``lane_fall_shares``,
+    nearest the slope first; default: evenly), so only that lane's vehicles can be hit (Bunce et al. 1997 per
+    lane, :mod:`riskrf.risk.road_users`)."""
 
     vehicles_per_day: float = 4000.0
     vehicle_length_m: float = 5.0
@@ -46,6 +56,15 @@ class Exposure:
     share_stopping_on_road: float = 0.3
     exposed_length_m: float = 100.0
     occupants_distribution: dict | None = None
+    lanes: int = 2
+    directional_split: float = 0.5
+    lane_fall_shares: tuple | None = None
+
+    def lane_list(self) -> tuple:
+        """The lanes (:class:`riskrf.risk.road_users.Lane`) carrying this traffic."""
+        from .road_users import lanes_from_traffic
+        return lanes_from_traffic(self.vehicles_per_day, self.speed_kmh, int(self.lanes), self.directional_split,
+                                  self.lane_fall_shares)
 
 
 @dataclass(frozen=True)
@@ -56,8 +75,8 @@ class Consequences:
     """
 
     value_of_statistical_life: float = 5.0e6
-    vulnerability_moving_vehicle: object = VULNERABILITY_DIRECT_BY_MASS
-    vulnerability_striking_rock: object = VULNERABILITY_STRIKE_BY_MASS
+    vulnerability_moving_vehicle: object = DEFAULT_VULNERABILITY.direct
+    vulnerability_striking_rock: object = DEFAULT_VULNERABILITY.strike
     vehicle_damage: float = 25000.0
     closure_days_per_fall: float = 0.5
     closure_cost_per_day: float = 20000.0
@@ -87,10 +106,56 @@ class Economics:
 
 @dataclass(frozen=True)
 class Criteria:
-    """Tolerability: individual risk of the person most at risk [1/yr] and the societal (F-N) diagram."""
+    """Tolerability, selected in the site file's ``[criteria]``: ``set`` one of
+    :data:`riskrf.risk.tolerability.CRITERIA_SETS` ("hong-kong-geo-1998", the default; "ags-2007"; "uk-hse-r2p2";
+    "swiss-planat") or "user"; ``slope`` "existing" or "new".  ``individual_risk_per_year`` [1/yr] overrides the
+    set's limit (and is required for "user", with optional ``fn_c``, ``fn_k``, ``fn_acceptable_c`` and
+    ``marginal_cost_per_life``).  ``disproportion_factor``: the ALARP test calls a further measure reasonably
+    practicable while its cost per statistical life saved is at most this factor times the marginal cost of the
+    set (or, without one, the value of a statistical life).  After construction ``individual_risk_per_year`` holds
+    the limit in force and ``fn_diagram`` the set's name."""
 
-    individual_risk_per_year: float = AGS2007_INDIVIDUAL_RISK["existing slope"]
-    fn_diagram: str = "Hong Kong GEO Report 75 (1998)"
+    set: str = "hong-kong-geo-1998"
+    slope: str = "existing"
+    individual_risk_per_year: float | None = None
+    fn_diagram: str = ""
+    fn_c: float | None = None
+    fn_k: float = 1.0
+    fn_acceptable_c: float | None = None
+    marginal_cost_per_life: float | None = None
+    disproportion_factor: float = 1.0
+
+    def __post_init__(self):
+        if self.set != "user" and self.set not in CRITERIA_SETS:
+            raise MitigationError(f"criteria.set = {self.set!r} is not one of {sorted(CRITERIA_SETS) + ['user']}")
+        if self.slope not in ("existing", "new"):
+            raise MitigationError(f"criteria.slope = {self.slope!r} must be 'existing' or 'new'")
+        if self.set == "user" and self.individual_risk_per_year is None:
+            raise MitigationError("criteria.set = 'user' needs individual_risk_per_year (and optionally fn_c, fn_k, "
+                                  "fn_acceptable_c, marginal_cost_per_life)")
+        cs = self.criteria_set
+        if self.individual_risk_per_year is None:
+            object.__setattr__(self, "individual_risk_per_year", cs.individual_limit(self.slope))
+        if not self.fn_diagram:
+            object.__setattr__(self, "fn_diagram", cs.name)
+
+    @property
+    def criteria_set(self) -> CriteriaSet:
+        """The selected :class:`~riskrf.risk.tolerability.CriteriaSet` (a user set built from these fields)."""
+        if self.set == "user":
+            return user_criteria(self.individual_risk_per_year, self.fn_c, self.fn_k, self.fn_acceptable_c,
+                                 self.marginal_cost_per_life)
+        cs = CRITERIA_SETS[self.set]
+        if self.marginal_cost_per_life is not None:
+            from dataclasses import replace
+            cs = replace(cs, marginal_cost_per_life=self.marginal_cost_per_life)
+        return cs
+
+    def describe(self) -> str:
+        """The criteria in force in one sentence."""
+        cs = self.criteria_set
+        return cs.describe(self.slope).replace(f"{cs.individual_limit(self.slope):.0e}/yr",
+                                               f"{self.individual_risk_per_year:.0e}/yr")
 
 
 @dataclass(frozen=True)
@@ -120,7 +185,7 @@ class Uncertainty:
     rate_factor: tuple = (1.0, 1.0)
     m_max_kg: tuple | None = None
     value_of_statistical_life: tuple | None = None
-    vulnerability_factor: tuple = (1.0, 1.0)
+    vulnerability_factor: tuple = DEFAULT_VULNERABILITY.factor_range
     vehicles_per_day: tuple | None = None
     discount_rate: tuple | None = None
     sample_power_law: bool = True
@@ -180,6 +245,23 @@ class Option:
     warning_levels: tuple | None = None           # closure rule: close under these rainstorm warning levels
     closure_rule: str = ""                        # the rule in words and its source, once computed (site_rates)
     description: str = ""
+    effectiveness: float | None = None            # scaling: share of the targeted releases removed when new
+    effectiveness_range: tuple | None = None      # scaling: (low, high) of that share
+    effectiveness_half_life_years: float | None = None   # scaling: years for the effect to halve
+
+    def scaling_effect(self) -> tuple:
+        """Scaling and bolting by zone and mass: (initial effectiveness, its range, half-life [yr], mean over a
+        renewal cycle, mean at the range's ends).  ASSUMED defaults: 0.8 of the targeted releases removed when new
+        (range 0.6-0.95), halving every ``life_years`` (10 years without one): loosening, new joints opening and
+        missed blocks make scaling neither complete nor lasting.  Mean over a cycle of length L of e0 2^(-t/h):
+        e0 h (1 - 2^(-L/h)) / (L ln 2)."""
+        e0 = SCALING_EFFECTIVENESS if self.effectiveness is None else self.effectiveness
+        rng = self.effectiveness_range or ((SCALING_EFFECTIVENESS_RANGE if self.effectiveness is None
+                                            else (self.effectiveness, self.effectiveness)))
+        life = self.life_years or SCALING_DEFAULT_CYCLE_YEARS
+        h = self.effectiveness_half_life_years or life
+        k = h * -np.expm1(-np.log(2.0) * life / h) / (life * np.log(2.0))
+        return e0, tuple(rng), h, e0 * k, (rng[0] * k, rng[1] * k)
 
     @property
     def has_closure_rule(self) -> bool:
@@ -204,7 +286,9 @@ class Option:
                 size = (f"{self.min_mass_kg or 0:,.0f}-{self.max_mass_kg:,.0f} kg" if self.max_mass_kg
                         else f"above {self.min_mass_kg:,.0f} kg" if self.min_mass_kg else "of every size")
                 zone = f" from x = {self.zone_x_m[0]:g}-{self.zone_x_m[1]:g} m" if self.zone_x_m else ""
-                text = f"scaling and bolting: removes the release of blocks {size}{zone}"
+                e0, rng, h, mean, _ = self.scaling_effect()
+                text = (f"scaling and bolting: removes {e0:.0%} (ASSUMED, {rng[0]:.0%}-{rng[1]:.0%}) of the release of "
+                        f"blocks {size}{zone} when new, halving every {h:g} years (ASSUMED): {mean:.0%} on average")
         elif k == "ditch":
             if self.retention is not None:
                 text = f"catchment ditch; ASSUMED to retain {self.retention:.0%} of falls (typed)"
@@ -221,6 +305,17 @@ class Option:
             text = (f"rock shed of {self.capacity_kj:,.0f} kJ over "
                     + (f"{self.covered_length_m:g} m of road" if self.covered_length_m else "the exposed road")
                     + f"; out of service {self.repair_days:g} days after an impact above capacity (assumption)")
+        elif k in SLOPE_KINDS and self.retention is not None:
+            text = f"{k}; ASSUMED to retain {self.retention:.0%} of falls (typed)"
+        elif k == "bench":
+            text = f"catch bench {self.width_m:g} m wide cut into the slope from x = {self.x_m:g} m; retention derived by " \
+                   "simulation"
+        elif k == "bund":
+            text = (f"bund {self.height_m:g} m high on the ground from x = {self.x_m:g} m over {self.width_m:g} m; "
+                    "retention derived by simulation")
+        elif k == "drape":
+            text = (f"drape (secured mesh) over x = {self.zone_x_m[0]:g}-{self.zone_x_m[1]:g} m: the surface takes "
+                    "an ASSUMED low-bounce, high-friction material; retention derived by simulation")
         elif k == "realignment":
             text = (f"road moved to x = {self.road_x_m:g} m" if self.road_x_m is not None
                     else "road moved away from the slope (no exposure)")
@@ -254,9 +349,9 @@ NUMBER_FIELDS = ("capital_cost", "annual_maintenance", "life_years", "repair_cos
                  "repair_days", "rate_reduction", "retention", "x_m", "width_m", "depth_m", "inner_slope_hv",
                  "outer_slope_hv", "capacity_kj", "height_m", "min_mass_kg", "max_mass_kg", "covered_length_m",
                  "road_x_m", "share_while_closed", "closure_hours_per_year", "cost_per_closure_hour",
-                 "threshold_mm", "window_days")
+                 "threshold_mm", "window_days", "effectiveness", "effectiveness_half_life_years")
 RANGE_FIELDS = ("capital_cost_range", "annual_maintenance_range", "retention_range", "rate_reduction_range",
-                "zone_x_m")
+                "zone_x_m", "effectiveness_range")
 
 
 def _range(v, where: str, *, share: bool = False):
@@ -344,7 +439,7 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
     for key in RANGE_FIELDS:
         if key in spec:
             vals[key] = _range(spec[key], f"{source}: {where}: {key}",
-                               share=key in ("retention_range", "rate_reduction_range"))
+                               share=key in ("retention_range", "rate_reduction_range", "effectiveness_range"))
     rule_keys = ("threshold_mm", "window_days", "warning_levels")
     typed_keys = ("share_while_closed", "closure_hours_per_year")
     if kind == "closure":
@@ -391,7 +486,14 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
     elif any(spec.get(k) is not None for k in typed_keys + rule_keys + ("cost_per_closure_hour",)):
         raise MitigationError(f"{source}: {where}: share_while_closed, closure_hours_per_year, threshold_mm, "
                               "window_days, warning_levels and cost_per_closure_hour are only for kind = 'closure'")
-    for key in ("rate_reduction", "retention", "share_while_closed"):
+    if kind != "scaling" and any(spec.get(k) is not None for k in ("effectiveness", "effectiveness_range",
+                                                                    "effectiveness_half_life_years")):
+        raise MitigationError(f"{source}: {where}: effectiveness, effectiveness_range and "
+                              "effectiveness_half_life_years are only for kind = 'scaling'")
+    if spec.get("effectiveness_half_life_years") is not None and not spec["effectiveness_half_life_years"] > 0:
+        raise MitigationError(f"{source}: {where}: effectiveness_half_life_years = "
+                              f"{spec['effectiveness_half_life_years']!r} must be > 0 years")
+    for key in ("rate_reduction", "retention", "share_while_closed", "effectiveness"):
         if spec.get(key) is not None and spec[key] > 1:
             raise MitigationError(f"{source}: {where}: {key} = {spec[key]!r} is a share and must lie in [0, 1]")
     need = {"fence": ("capacity_kj", "height_m"), "attenuator": ("capacity_kj", "height_m"),
@@ -403,6 +505,12 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
             unit = "kJ" if key == "capacity_kj" else "m"
             raise MitigationError(f"{source}: options[{i}].{key} = {spec[key]!r} must be > 0 {unit} "
                                   f"({where}, a {kind})")
+    slope_need = {"bench": ("x_m", "width_m"), "bund": ("x_m", "width_m", "height_m"), "drape": ("zone_x_m",)}
+    if kind in slope_need and spec.get("retention") is None:
+        for key in slope_need[kind]:
+            if spec.get(key) is None:
+                raise MitigationError(f"{source}: {where}: a {kind} needs {key} (its geometry; its retention is "
+                                      "derived by simulation) or a typed retention (an assumption)")
     if kind == "ditch" and spec.get("retention") is None:
         for key in ("x_m", "width_m", "depth_m"):
             if spec.get(key) is None:
@@ -558,7 +666,21 @@ def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
                                                                        else f"; allowed: {sorted(allowed)}"))
     used: list = []
     tr = dict(_table(data.get("traffic", {}), Exposure, "traffic", source, used,
-                     special=("occupants_distribution",)))
+                     special=("occupants_distribution", "lane_fall_shares")))
+    if "lanes" in tr and (int(tr["lanes"]) != tr["lanes"] or tr["lanes"] < 1):
+        raise MitigationError(f"{source}: traffic.lanes = {tr['lanes']!r} must be a whole number >= 1")
+    if tr.get("directional_split", 0.5) > 1:
+        raise MitigationError(f"{source}: traffic.directional_split = {tr['directional_split']!r} must lie in [0, 1]")
+    if "lane_fall_shares" in tr:
+        fs = tr["lane_fall_shares"]
+        ok = isinstance(fs, list) and len(fs) == int(tr.get("lanes", 2)) and all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) and 0 <= x <= 1 for x in fs)
+        if not ok or abs(sum(fs) - 1) > 1e-6:
+            raise MitigationError(f"{source}: traffic.lane_fall_shares = {fs!r} must list one share in [0, 1] per "
+                                  f"lane ({int(tr.get('lanes', 2))}), nearest the slope first, summing to 1")
+        tr["lane_fall_shares"] = tuple(float(x) for x in fs)
+    if "lanes" in tr:
+        tr["lanes"] = int(tr["lanes"])
     if "occupants_distribution" in tr:
         try:
             occupancy_distribution(tr.get("occupants_per_vehicle", 1.5), tr["occupants_distribution"])
@@ -577,8 +699,9 @@ def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
     for key in ("vulnerability_moving_vehicle", "vulnerability_striking_rock"):
         if key not in cq:
             used[-1:] = used[-1:]
-            used.append(f"consequences.{key}: ASSUMPTION size-dependent curve {getattr(consequences, key)} "
-                        "(mass_kg, probability of death)")
+            used.append(f"consequences.{key}: size-dependent curve {getattr(consequences, key)} "
+                        "(mass_kg, probability of death), chosen to match the Hong Kong CEDD/GEO register "
+                        "(riskrf.risk.road_users.DEFAULT_VULNERABILITY)")
     economics = Economics(**_table(data.get("economics", {}), Economics, "economics", source, used))
     if not economics.horizon_years > 0:
         raise MitigationError(f"{source}: economics.horizon_years = {economics.horizon_years!r} must be > 0 years "
@@ -586,8 +709,20 @@ def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
     if economics.discount_rate >= 1:
         raise MitigationError(f"{source}: economics.discount_rate = {economics.discount_rate!r} must be a rate "
                               "below 1 (e.g. 0.03)")
-    criteria = Criteria(**_table(data.get("criteria", {}), Criteria, "criteria", source, used,
-                                 special=("fn_diagram",)))
+    crit = dict(_table(data.get("criteria", {}), Criteria, "criteria", source, used,
+                       special=("fn_diagram", "set", "slope", "individual_risk_per_year", "fn_c", "fn_acceptable_c",
+                                "marginal_cost_per_life")))
+    for key in ("individual_risk_per_year", "fn_c", "fn_acceptable_c", "marginal_cost_per_life"):
+        v = crit.get(key)
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or v <= 0):
+            raise MitigationError(f"{source}: criteria.{key} = {v!r} must be a number > 0")
+    for key in ("set", "slope"):
+        if key in crit and not isinstance(crit[key], str):
+            raise MitigationError(f"{source}: criteria.{key} = {crit[key]!r} must be a string")
+    try:
+        criteria = Criteria(**crit)
+    except MitigationError as exc:
+        raise MitigationError(f"{source}: {exc}") from None
     uncertainty = _uncertainty(data.get("uncertainty", {}), source, used)
     specs = data.get("options", [])
     if not isinstance(specs, list) or len(specs) < 2:
