@@ -38,6 +38,7 @@ from ..hazard.simulated import energy_hazard
 from ..risk.mitigation import MitigationStudy
 from ..io.outputs import relative_paths, relative_paths_in_json_files, write_json
 from ..frequency.power_law import fit_gutenberg_richter
+from .site_design import design_for_site, with_recommended_run
 from .site import Site
 from ..core.validation import RiskrfWarning
 
@@ -252,6 +253,8 @@ class Assessment:
     timings: dict = field(default_factory=dict)
     rates: object = None            # SiteRates of the site's [rates] model (riskrf.risk.site_rates), or None
     release_factor: float = 1.0     # rate_basis = "road": released falls per fall recorded on the road
+    #: the governing design basis's requirement at the barrier line and along the profile (SiteDesign), or None
+    design: object = None
     #: figures already being drawn beside the computation: {"dir": Path, "pending": [InBackground, ...]} (see
     #: ``run_assessment(figures_dir=...)``); empty when ``write_assessment`` draws them all.
     drawing: dict = field(default_factory=dict, repr=False)
@@ -330,6 +333,8 @@ class Assessment:
         }
         if self.rates is not None:
             out["rate_model"] = self.rates.summary()
+        if self.design is not None:
+            out.update(self.design.to_dict())
         if fr.gumbel is not None or (self.maxima_frequency and self.maxima_frequency.gumbel is not None):
             src = fr if fr.gumbel is not None else self.maxima_frequency
             out["annual_maxima"] = {"source": src.inventory.source, "gumbel": dict(zip(src.gumbel.param_names,
@@ -484,6 +489,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                                 free_board_m=hz_cfg["free_board_m"], design_T=hz_cfg["design_period_years"],
                                 density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed,
                                 design_block=block, sensitivity=sensitivity, tornado=tornado)
+        site_design = design_for_site(site, hazard, block, result, inventory.density_kg_m3, seed)
         timings["energy"] = round(time.perf_counter() - t, 2)
         if figures is not None:
             from ..report.files import write_energy_study
@@ -504,6 +510,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                                 **mitigation)
         study = replace(study, design_checks=fence_design_checks(study.options, energy))
         decision = study_report(study)
+        site_design = with_recommended_run(site_design, site, result, decision["recommendation"]["option"], seed)
         timings["decision"] = round(time.perf_counter() - t, 2)
     notes = []
     for w in list(frequency.warnings) + [str(c.message) for c in caught] + list(site_rates.notes if site_rates
@@ -521,6 +528,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
     return Assessment(site=site, inventory=inventory, frequency=frequency, maxima_frequency=maxima_frequency,
                       result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
                       warnings=notes, timings=timings, rates=site_rates, release_factor=release_factor,
+                      design=site_design,
                       drawing={"dir": figures, "pending": pending} if figures is not None else {})
 
 
@@ -566,7 +574,11 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     a.timings["report"] = round(time.perf_counter() - t, 2)
     summary = a.summary()
     write_json(summary, out / "summary.json")
+    if a.design is not None:
+        _design_outputs(a, out, figs)
     (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
+    from ..report.pdf import write_pdf_report
+    write_pdf_report(a, out / "report.pdf", figs)
     _copy_inputs(a, out / "inputs")
     relative_paths_in_json_files(out, a.site.path.parent)          # paths relative to the site file
     return relative_paths(summary, a.site.path.parent)
@@ -612,6 +624,38 @@ def _simulation_figures(result, collector: str, figs: Path, fences=()) -> None:
     fences = [(line_x if x is None else x, h, label) for x, h, label in fences]
     write_simulation_figures(result, figs, [collector], file_names={collector: "collector_distributions.png"},
                              fences=fences)
+
+def _design_outputs(a: Assessment, out: Path, figs: Path) -> None:
+    """The design basis's tables (design_requirement.csv, design_checks.csv, barrier_positions.csv) and figures
+    (options on the profile, stop points, barrier positions, catchment retention)."""
+    from ..report.design_figures import (catchment_figure, options_profile_figure, position_search_figure,
+                                        stop_points_figure)
+    from ..report.files import save_figure
+    d = a.design
+    d.summary().to_csv(out / "design_requirement.csv")
+    if d.requirement is not None:
+        d.requirement.candidates.to_csv(out / "design_checks.csv", index=False)
+    if d.positions is not None:
+        d.positions.table.to_csv(out / "barrier_positions.csv", index=False)
+        save_figure(position_search_figure(d.positions), figs / "barrier_positions.png")
+    if a.result is not None:
+        sc = a.result.scenario
+        save_figure(options_profile_figure(sc, a.site.mitigation["options"], barrier_x=d.barrier_x_m,
+                                           road_x=d.road_x_m, requirement=d.requirement),
+                    figs / "options_profile.png")
+        ditches = [(o.x_m, o.x_m + o.width_m, o.name) for o in a.site.mitigation["options"]
+                   if o.kind == "ditch" and o.x_m is not None and o.width_m is not None]
+        save_figure(stop_points_figure(a.result, road_x=d.road_x_m, ditches=ditches,
+                                       option=d.recommended), figs / "stop_points.png")
+        if d.recommended is not None:
+            from simulation.plotting import plot_profile
+            ax = plot_profile(d.recommended[1])
+            ax.set_title(f"Trajectories with the recommended option: {d.recommended[0]}", fontsize=10)
+            save_figure(ax.figure, figs / "recommended_trajectories.png")
+    if d.catchment is not None:
+        d.catchment.curve.to_csv(out / "catchment_retention.csv", index=False)
+        save_figure(catchment_figure(d.catchment), figs / "catchment_retention.png")
+
 
 def _copy_inputs(a: Assessment, dest: Path) -> None:
     """Copy the site file and everything it names, with the version, seed and command, for exact reruns."""

@@ -7,6 +7,7 @@ the report can state them.  Everything is checked before any computing starts.
 """
 from __future__ import annotations
 
+import datetime
 import difflib
 import math
 import tomllib
@@ -41,6 +42,16 @@ SITE_FIELDS = {
                "drop_height_m": None},
     "design_block": {"rule": "return_period", "percentile": 97.0, "survey": None, "fractal_dimension": None,
                      "iterations": None},
+    # the standard that governs the barrier design (riskrf.hazard.design_basis); factors left out take the basis's
+    # defaults, named in every output
+    "design": {"basis": "UNI 11211-4", "frequent_T_years": 30.0, "residual_category": "A", "clearance_m": None,
+               "mel_classes_kj": None, "elongation_m": None, "positions_x_m": None, "position_blocks": None,
+               "gamma_Tr": None, "gamma_Dp": None, "gamma_VolF": None, "gamma_gamma": None, "gamma_E": None,
+               "gamma_d": None, "gamma_m": None, "gamma_v": None, "velocity_percentile": None,
+               "height_percentile": None},
+    # the report's title block (report.pdf, report.html)
+    "report": {"project": None, "location": None, "revision": "A", "date": None, "author": "not stated",
+               "checker": "not stated", "client": None},
 }
 MITIGATION_TABLES = ("traffic", "consequences", "economics", "options", "uncertainty", "criteria")
 #: Optional tables checked by their own modules: [rates] (riskrf.risk.site_rates).
@@ -65,6 +76,8 @@ class Site:
     defaults_used: tuple = field(default_factory=tuple)
     design_block: dict = field(default_factory=lambda: dict(SITE_FIELDS["design_block"]))
     rates: dict | None = None
+    design: dict = field(default_factory=lambda: dict(SITE_FIELDS["design"]))
+    report: dict = field(default_factory=lambda: dict(SITE_FIELDS["report"]))
 
     def resolve(self, relative) -> Path:
         """A path given in the site file, resolved against the site file's folder."""
@@ -160,6 +173,7 @@ def load_site(path) -> Site:
                         "counts falls released from the slope) or 'road' (it counts falls that reached the road, "
                         "e.g. a patrol record)")
     _check_design_block(tables, path)
+    _check_design(tables, path)
     for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
                        ("hazard", "velocities"), ("design_block", "survey")):
         rel = tables[table][key]
@@ -199,7 +213,31 @@ def load_site(path) -> Site:
         _check_option_geometry(mitigation["options"], scenario, hz, path, mitigation["uncertainty"])
     return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
                 description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
-                mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"], rates=rates)
+                mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"], rates=rates,
+                design=tables["design"], report=tables["report"])
+
+
+def _check_design(tables, path):
+    """The [design] table (a valid basis with factors of that basis) and the [report] title block (text)."""
+    from ..hazard.design_basis import design_basis_from_site
+    d = tables["design"]
+    for key in ("positions_x_m", "mel_classes_kj"):
+        v = d[key]
+        if v is not None and (not isinstance(v, list) or not v or not all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)):
+            raise SiteError(f"{path}: design.{key} = {v!r} must be a list of numbers")
+    pb = d["position_blocks"]
+    if pb is not None and (isinstance(pb, bool) or not isinstance(pb, int) or pb < 100):
+        raise SiteError(f"{path}: design.position_blocks = {pb!r} must be a whole number >= 100")
+    cfg = {k: v for k, v in d.items() if k not in ("positions_x_m", "position_blocks")}
+    try:
+        design_basis_from_site(cfg, design_T=tables["hazard"]["design_period_years"],
+                               free_board_m=tables["hazard"]["free_board_m"])
+    except (TypeError, ValueError) as exc:
+        raise SiteError(f"{path}: {exc}") from exc
+    for key, v in tables["report"].items():
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (str, int, datetime.date))):
+            raise SiteError(f"{path}: report.{key} = {v!r} must be text")
 
 
 def _check_design_block(tables, path):

@@ -57,6 +57,15 @@ def human_header(name: str) -> str:
     return f"{text} {unit}".strip()
 
 
+#: Columns holding years, return periods or identifiers: whole numbers printed without thousands separators.
+_PLAIN_INTEGER_COLUMN = re.compile(r"(^|_)(year|years|t_years|seed|block|id|row|vertex)$", re.IGNORECASE)
+
+
+def plain_integer_column(name) -> bool:
+    """Whether a column holds years or identifiers (printed "2020", "1000", never "2,020")."""
+    return bool(_PLAIN_INTEGER_COLUMN.search(str(name)))
+
+
 def cell(value, *, digits: int = 3, money_columns: bool = False, currency: str = "") -> str:
     """One table cell as text: numbers to ``digits`` significant figures (or money), booleans as yes/no,
     dictionaries and lists as readable text."""
@@ -125,7 +134,11 @@ class Document:
         for rec in d.itertuples(index=False):
             cells = []
             for c, v in zip(cols, rec):
-                text = cell(v, digits=digits, money_columns=c in money_columns, currency=currency)
+                if plain_integer_column(c) and isinstance(v, (int, float, np.integer, np.floating)) \
+                        and not isinstance(v, (bool, np.bool_)) and np.isfinite(v) and float(v).is_integer():
+                    text = f"{int(v)}"              # a year or an identifier: 2020, not 2,020
+                else:
+                    text = cell(v, digits=digits, money_columns=c in money_columns, currency=currency)
                 numeric = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
                 cells.append(f"<td class='{'num' if numeric else 'txt'}'>{escape(text)}</td>")
             rows.append("<tr>" + "".join(cells) + "</tr>")

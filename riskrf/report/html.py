@@ -223,6 +223,10 @@ def _tornado_section(doc, tornado, figs: Path) -> None:
             doc.table(table, "One-way sensitivity of the design energies", digits=3))
 
 
+#: Rows of the simulation's summary that measure the software, not the slope: kept out of the engineering tables.
+SOFTWARE_METRICS = ("run time [s]", "impacts per second", "blocks per second")
+
+
 def render_report(a, figs: Path) -> str:
     """HTML of the hazard and mitigation report for assessment ``a`` (figures read from ``figs``)."""
     site, inv, fr, gr = a.site, a.inventory, a.frequency, a.frequency.power_law
@@ -283,6 +287,12 @@ def render_report(a, figs: Path) -> str:
         summary.append(f"<li>Design block: <b>{sig(b.mass_kg)} kg ({sig(b.volume_m3)} m&sup3;, diameter "
                        f"{sig(b.diameter_m)} m)</b> by the {_e(b.rule)} rule"
                        + "".join(f"; {_e(x)}" for x in b.assumptions[:1]) + ".</li>")
+    if getattr(a, "design", None) is not None and a.design.requirement is None:
+        summary.append(f"<li>Design basis {_e(a.design.basis.basis)}: {_e('; '.join(a.design.notes))}.</li>")
+    elif getattr(a, "design", None) is not None:
+        summary.append(f"<li>Design basis: <b>{_e(a.design.requirement.text())}</b>.  The fence checks below "
+                       "(the design-period energy against MEL and SEL) are shown for comparison; the design basis "
+                       "governs.</li>")
     for _, r in verdicts.iterrows():
         cls = "ok" if r["adequate"] else "fail"
         summary.append(f"<li>Fence {_e(r['fence'])}: <span class='{cls}'>"
@@ -386,8 +396,14 @@ def render_report(a, figs: Path) -> str:
     if a.result is not None:
         res = a.result
         sc = res.scenario
+        which = ("the design basis (section 'Design basis') designs with the site's mass law; "
+                 if getattr(a, "design", None) is not None else "the design values come from the site's mass law; ")
         doc.add(f"<p>Scenario <b>{_e(sc.name)}</b>: {_e(sc.description)}</p>",
-                doc.table(_item_table(res.summary()), "Simulation summary"),
+                "<p>The speeds, heights and energies of this table are of the scenario seeder's own masses: they "
+                f"describe how the slope behaves, they design nothing ({_e(which)}the energy hazard below gives the "
+                "percentiles of the falls under that law).</p>",
+                doc.table(_item_table(res.summary().drop(index=list(SOFTWARE_METRICS), errors="ignore")),
+                          "Simulation summary"),
                 doc.figure(figs / "profile_trajectories.png", "Slope profile and a sample of trajectories"),
                 doc.figure(figs / "collector_distributions.png",
                            "Speed, bounce height and energy at the barrier line (of the simulated blocks)"),
@@ -441,7 +457,22 @@ def render_report(a, figs: Path) -> str:
                 f"{sig(u.design_energy_kj, 2)} kJ with factors {_e(cell(u.factors))}.</p>")
 
     # 6. Fences
-    doc.section("Fence checks (ETAG 027 / EAD 340059: MEL, SEL = MEL/3)")
+    if getattr(a, "design", None) is not None:
+        d = a.design
+        doc.section(f"Design basis: {d.basis.basis} governs")
+        doc.add(f"<p>{_e(d.basis.text())}</p>",
+                doc.table(d.summary().reset_index().rename(columns={"index": "quantity"}),
+                          "What the design basis requires at the barrier line"),
+                doc.table(d.requirement.candidates if d.requirement is not None else None,
+                          "Checks of the candidate fences against the design basis"))
+        if d.positions is not None:
+            doc.add(doc.table(d.positions.table, "Required MEL and net height by barrier position"),
+                    doc.figure(figs / "barrier_positions.png", "Barrier position search"))
+        doc.add(doc.figure(figs / "options_profile.png", "Every option's geometry on the slope profile"),
+                doc.figure(figs / "stop_points.png", "Stop points of the simulated blocks"))
+        if d.catchment is not None:
+            doc.add(doc.figure(figs / "catchment_retention.png", "Catchment retention against width from the toe"))
+    doc.section("Fence checks (ETAG 027 / EAD 340059: MEL, SEL = MEL/3; for comparison, the design basis governs)")
     for name, table in en.fences.items():
         doc.add(f"<h3>{_e(name)}</h3>", doc.table(table, f"Checks of {name}"))
 

@@ -1516,7 +1516,8 @@ def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0, **kw
         except tomllib.TOMLDecodeError as exc:
             raise MitigationError(f"{path}: not valid TOML: {exc}") from exc
     raw = data
-    data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard", "design_block", "rates")}
+    data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard", "design_block", "rates",
+                                                      "design", "report")}
     inputs = study_inputs(data, str(path))         # a site file works too
     if any(o.kind == "closure" and o.has_closure_rule for o in inputs["options"]):
         # closure rules: share and hours from the file's [rates] model (riskrf.risk.site_rates)

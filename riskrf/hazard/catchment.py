@@ -1,0 +1,161 @@
+"""Catchment (ditch) retention by re-simulation, laid beside a published catchment design chart.
+
+The Oregon DOT / FHWA Rockfall Catchment Area Design Guide (Pierson, Gullixson & Chassie 2001,
+FHWA-OR-RD-02-04) rolled about 11,250 rocks off cuts 40, 60 and 80 ft high (vertical to 1H:1V) into flat,
+6H:1V and 4H:1V catchments and plots the cumulative percentage of rocks retained against the catchment width
+measured from the toe.  :func:`catchment_retention` computes the same curve for a scenario by simulation: a
+block is retained within width w when it stops no farther than w beyond the toe of the cut.  The widths that
+retain 90, 95 and 99 % are read off it; chart values (width, percent retained), when the user gives them
+with their source, are set beside the simulated percentages at the same widths.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+RETENTION_LEVELS = (90.0, 95.0, 99.0)
+#: Segments at least this steep [deg] next to the steepest one belong to the cut face (1H:1V, the flattest
+#: face of the ODOT tests).
+CUT_FACE_MIN_DEG = 45.0
+
+
+@dataclass(frozen=True)
+class CatchmentStudy:
+    """Retention against catchment width for one cut.
+
+    ``title``; ``toe_x_m`` of the cut; ``cut_height_m`` and ``face_angle_deg``; ``n`` blocks simulated;
+    ``curve`` (width_m, retained share); ``widths`` {percent: width [m]} (NaN when the simulated catchment never
+    retains that share, e.g. blocks leave the profile); ``chart`` (width_m, retained_percent, simulated_percent,
+    difference_points) or None; ``chart_source``.  Its figure is :func:`riskrf.report.design_figures.catchment_figure`.
+    """
+
+    title: str
+    toe_x_m: float
+    cut_height_m: float
+    face_angle_deg: float
+    n: int
+    curve: pd.DataFrame
+    widths: dict
+    chart: pd.DataFrame | None = None
+    chart_source: str = ""
+
+    def retained_at(self, width_m) -> np.ndarray:
+        """Share [-] of the released blocks retained within ``width_m`` of the toe."""
+        return np.interp(np.asarray(width_m, dtype=float), self.curve["width_m"], self.curve["retained"])
+
+    def summary(self) -> pd.DataFrame:
+        """Width [m] for each retention level, the geometry and (when given) the chart comparison rows."""
+        rows = [{"retention_percent": q, "width_m": w} for q, w in self.widths.items()]
+        return pd.DataFrame(rows)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary: geometry, widths for 90/95/99 %, chart comparison (or why there is none)."""
+        return {"title": self.title, "toe_x_m": self.toe_x_m, "cut_height_m": self.cut_height_m,
+                "face_angle_deg": self.face_angle_deg, "blocks_simulated": self.n,
+                "width_for_retention_m": {f"{q:g}": (None if not np.isfinite(w) else w)
+                                          for q, w in self.widths.items()},
+                "chart_source": self.chart_source or None,
+                "odot_chart_geometry": odot_chart_applies(self.cut_height_m, self.face_angle_deg)
+                or "within the ODOT charts' cut heights and face angles",
+                "chart_comparison": (self.chart.to_dict(orient="records") if self.chart is not None else
+                                     "no chart values given: the Pierson et al. (2001) chart values were not "
+                                     "available to riskrf; pass them as chart= with their source")}
+
+
+def cut_geometry(profile) -> tuple:
+    """(toe x [m], cut height [m], overall face angle [deg]) of the cut face: the steepest segment of a profile with
+    the segments of at least :data:`CUT_FACE_MIN_DEG` next to it."""
+    x, z = np.asarray(profile.x, dtype=float), np.asarray(profile.z, dtype=float)
+    dx, dz = np.diff(x), np.diff(z)
+    ang = np.degrees(np.arctan2(-dz, dx))
+    i = int(np.argmax(ang))
+    lo, hi = i, i
+    while lo > 0 and ang[lo - 1] >= CUT_FACE_MIN_DEG:          # the face continues up ...
+        lo -= 1
+    while hi < ang.size - 1 and ang[hi + 1] >= CUT_FACE_MIN_DEG:   # ... and down
+        hi += 1
+    height = float(z[lo] - z[hi + 1])
+    return float(x[hi + 1]), height, float(np.degrees(np.arctan2(height, x[hi + 1] - x[lo])))
+
+
+def catchment_retention(scenario, *, n: int = 2000, seed=1, toe_x_m: float | None = None, chart=None,
+                        chart_source: str = "", max_width_m: float | None = None) -> CatchmentStudy:
+    """Re-simulate ``scenario`` and measure how far beyond the toe of its cut the blocks stop.
+
+    Parameters
+    ----------
+    scenario : simulation.Scenario (or path): a cut above a catchment (e.g. ``odot_catchment_cut.toml``)
+    n, seed : blocks simulated and seed
+    toe_x_m : toe of the cut [m] (default: the lower end of the profile's steepest segment)
+    chart : optional table or sequence of (width [m], percent retained) read from a published chart
+    chart_source : where the chart values come from (figure and page), required with ``chart``
+    max_width_m : widest catchment of the curve [m] (default: to the end of the profile)
+    """
+    import simulation
+    sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 100:
+        raise ValueError(f"n = {n!r}: simulate at least 100 blocks")
+    toe, height, angle = cut_geometry(sc.profile)
+    if toe_x_m is not None:
+        toe = float(toe_x_m)
+    res = simulation.run(sc, n=int(n), seed=seed)
+    study = retention_from_result(res, toe_x_m=toe, max_width_m=max_width_m)
+    if chart is not None:
+        study = with_chart(study, chart, chart_source)
+    return study
+
+
+#: The geometry the ODOT charts cover (Pierson et al. 2001): cut heights 40-80 ft, faces vertical to 1H:1V.
+ODOT_HEIGHTS_M = (12.19, 24.38)
+ODOT_FACE_DEG = (45.0, 90.0)
+
+
+def odot_chart_applies(cut_height_m: float, face_angle_deg: float) -> str:
+    """'' when a cut lies within the ODOT charts' geometry, else why not (in words)."""
+    why = []
+    if not ODOT_HEIGHTS_M[0] - 0.5 <= cut_height_m <= ODOT_HEIGHTS_M[1] + 0.5:
+        why.append(f"cut height {cut_height_m:.1f} m outside the charts' 40-80 ft (12.2-24.4 m)")
+    if not ODOT_FACE_DEG[0] - 1 <= face_angle_deg <= ODOT_FACE_DEG[1]:
+        why.append(f"face angle {face_angle_deg:.0f} deg outside the charts' 1H:1V to vertical (45-90 deg)")
+    return "; ".join(why)
+
+
+def with_chart(study, chart, chart_source: str):
+    """``study`` with chart values (width [m], percent retained) and the simulated percent at the same widths."""
+    if not chart_source:
+        raise ValueError("chart values need chart_source (the chart's report, figure and page)")
+    c = pd.DataFrame(chart, columns=["width_m", "retained_percent"]) if not isinstance(chart, pd.DataFrame) \
+        else chart[["width_m", "retained_percent"]].copy()
+    c["simulated_percent"] = 100.0 * study.retained_at(c["width_m"])
+    c["difference_points"] = c["simulated_percent"] - c["retained_percent"]
+    from dataclasses import replace
+    return replace(study, chart=c, chart_source=chart_source)
+
+
+def retention_from_result(res, *, toe_x_m: float | None = None, max_width_m: float | None = None) -> CatchmentStudy:
+    """:class:`CatchmentStudy` from a simulation already run (its blocks' stop points beyond the toe)."""
+    sc = res.scenario
+    toe, height, angle = cut_geometry(sc.profile)
+    if toe_x_m is not None:
+        toe = float(toe_x_m)
+    ro = res.runout
+    beyond = ro["x_stop_m"].to_numpy(dtype=float) - toe
+    left = (ro["reason"].astype(str) == "left profile").to_numpy()
+    beyond[left | ~np.isfinite(beyond)] = np.inf          # never retained within the profile
+    top = float(sc.profile.x[-1] - toe) if max_width_m is None else float(max_width_m)
+    w = np.linspace(0.0, top, 401)
+    s = np.sort(beyond)
+    retained = np.searchsorted(s, w, side="right") / s.size
+    widths = {}
+    for q in RETENTION_LEVELS:
+        k = int(np.ceil(q / 100.0 * s.size)) - 1
+        widths[q] = float(max(s[k], 0.0)) if np.isfinite(s[k]) else float("nan")
+    return CatchmentStudy(title=f"{sc.name}: {height:.1f} m cut at {angle:.0f} deg, catchment retention",
+                          toe_x_m=toe, cut_height_m=height, face_angle_deg=angle, n=int(res.n),
+                          curve=pd.DataFrame({"width_m": w, "retained": retained}), widths=widths)
+
+
+__all__ = ["CatchmentStudy", "ODOT_FACE_DEG", "ODOT_HEIGHTS_M", "RETENTION_LEVELS", "catchment_retention", "cut_geometry",
+           "odot_chart_applies", "retention_from_result", "with_chart"]

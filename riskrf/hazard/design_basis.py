@@ -1,0 +1,574 @@
+"""The design basis of a flexible rock fall barrier: one standard governs, and it gives REQUIRED values.
+
+A checking engineer needs one stated basis, the design energy and height it gives, the checks it asks for
+and the barrier it requires, not pass/fail on a few candidates.  Three bases are offered; the site file
+chooses one (``[design] basis``, default ``"UNI 11211-4"``, the one whose partial factors are seen in a
+public source) and every output names it.
+
+``"UNI 11211-4"`` (UNI 11211-4:2012, rev. 2018; Peila & Ronco 2009, NHESS 9:1291-1298)
+    E_d = 1/2 m_d v_d^2 with m_d = Vol rho gamma_VolF gamma_gamma and v_d = v_t gamma_Tr gamma_Dp, v_t the
+    95th-percentile speed of the design block at the line; check E_d <= MEL / gamma_E (gamma_E = 1.2 against
+    MEL).  Design height h_d = h_t gamma_Tr gamma_Dp (h_t the 95th-percentile passing height); design
+    elongation D_d = D_MEL gamma_d (gamma_d = 1.3 at MEL) against the distance available to the road D_A; the net
+    height H_tot >= h_d + f_min, the free border f_min at least 0.5 m and at most half the block size (the larger
+    is taken).
+    Factor values: gamma_Tr, gamma_Dp, gamma_VolF in {1.02, 1.10}, gamma_gamma 1.0 [V: the RocFall UNI 11211
+    design page citing UNI 11211-4:2012]; gamma_E, gamma_d and the height factor [R].
+``"ONR 24810"`` (ONR 24810:2021)
+    The design block (the 95th-98th percentile of the block sizes by event frequency [V]) at the
+    characteristic (95th or 99th [V]) percentile speed at the line, each with a partial factor:
+    E_d = 1/2 (m_k gamma_m) (v_k gamma_v)^2.  The kit's MEL is used for rare design events, its
+    SEL = MEL/3 for frequent ones (the design block's return period at the line below ``frequent_T_years``).
+    The factor values are riskrf defaults [R], NOT checked against the standard's tables: every output says so
+    until the site file states them (``[design] gamma_m``, ``gamma_v``).
+``"return period"``
+    E_d is the T-year impact energy at the line (``hazard.design_period_years``), checked against MEL without
+    a factor.
+
+Every basis adds the serviceability check the standards ask for frequent events: the ``frequent_T_years``
+impact energy (default 30 years: the Swiss "high probability" class 1-30 years, BUWAL 1997 [R]) against
+SEL = MEL/3, so that frequent impacts need no repair.  The residual-height category after a MEL impact
+(EAD 340059-00-0106 / ETAG 027: A >= 50 %, B 30-50 %, C < 30 % of the nominal height [R]) is required as
+``[design] residual_category`` (default "A").
+
+:func:`design_requirement` gives the required MEL (and the smallest product class that meets it), the required
+net height, the elongation the road clearance permits and the checks of candidate fences;
+:func:`position_search` repeats the requirement along the profile from one simulation with collectors at
+several x.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pandas as pd
+
+from ..core.units import SEL_PER_MEL, kinetic_energy_kj
+
+BASES = ("ONR 24810", "UNI 11211-4", "return period")
+DEFAULT_BASIS = "UNI 11211-4"
+
+#: MEL classes [kJ] of certified kits: EAD 340059 / ETAG 027 classes 0-7 (100-4,500 kJ) and, in class 8
+#: (> 4,500 kJ), kits certified at 5,000, 8,000 and 8,500 kJ [R: product catalogues].  ``[design]
+#: mel_classes_kj`` replaces the list with the classes of the products the owner accepts.
+MEL_PRODUCT_CLASSES_KJ = (100.0, 250.0, 500.0, 1000.0, 1500.0, 2000.0, 3000.0, 4500.0, 5000.0, 8000.0, 8500.0)
+#: Residual height after the MEL test as a share of the nominal height: category A >= 0.5, B 0.3-0.5, C < 0.3
+#: (EAD 340059-00-0106, ETAG 027) [R].
+RESIDUAL_CATEGORIES = {"A": 0.5, "B": 0.3, "C": 0.0}
+#: Net heights are chosen in steps of this [m] (kits come in 0.5 m or 1 m steps).
+HEIGHT_STEP_M = 0.5
+
+#: Default partial factors per basis; [V] seen in a source, [R] recalled (see the module notes).
+DEFAULT_FACTORS = {
+    "UNI 11211-4": {"gamma_Tr": 1.10, "gamma_Dp": 1.10, "gamma_VolF": 1.10, "gamma_gamma": 1.0,
+                    "gamma_E": 1.2, "gamma_d": 1.3, "velocity_percentile": 95.0, "height_percentile": 95.0},
+    "ONR 24810": {"gamma_m": 1.0, "gamma_v": 1.0, "gamma_d": 1.0, "velocity_percentile": 95.0,
+                  "height_percentile": 95.0},
+    "return period": {"gamma_d": 1.0, "height_percentile": 95.0},
+}
+FACTOR_SOURCES = {
+    "UNI 11211-4": ("gamma_Tr, gamma_Dp, gamma_VolF (1.02 / 1.10) and gamma_gamma (1.0): UNI 11211-4:2012 as quoted "
+                    "by the RocFall UNI 11211 design page and Peila & Ronco (2009) [V]; gamma_E = 1.2 against MEL, "
+                    "gamma_d = 1.3 at MEL and h_d = h_t gamma_Tr gamma_Dp [R: confirm against the standard]"),
+    "ONR 24810": ("design block 95th-98th percentile and characteristic percentiles 95/99 [V: Natural Hazards 2024, "
+                  "doi 10.1007/s11069-024-06432-4; Marchelli 2022]; gamma_m and gamma_v are riskrf defaults, NOT "
+                  "checked against the ONR 24810 tables: state them in [design] for a signed design"),
+    "return period": "the T-year impact energy at the line against MEL, no partial factor",
+}
+
+
+def check_basis(basis, where: str = "design.basis") -> str:
+    """The basis name if it is one of :data:`BASES`, else a ValueError naming the field and the choices."""
+    if basis not in BASES:
+        raise ValueError(f"{where} = {basis!r} is not one of {', '.join(map(repr, BASES))}")
+    return basis
+
+
+def residual_height_category(residual_share: float) -> str:
+    """EAD 340059 / ETAG 027 residual-height category of a kit from its residual height after the MEL test as a
+    share of the nominal height [-]: "A" (>= 0.5), "B" (0.3-0.5) or "C" (< 0.3)."""
+    r = float(residual_share)
+    if not (np.isfinite(r) and 0.0 <= r <= 1.0):
+        raise ValueError(f"residual_share = {residual_share!r} must lie between 0 and 1 (residual / nominal height)")
+    for cat, lo in RESIDUAL_CATEGORIES.items():
+        if r >= lo:
+            return cat
+    return "C"  # pragma: no cover - lo of C is 0
+
+
+def required_product_class(energy_kj: float, classes_kj=MEL_PRODUCT_CLASSES_KJ) -> float:
+    """The smallest MEL class [kJ] at or above ``energy_kj``; NaN when the largest class is too small."""
+    c = np.sort(np.asarray(classes_kj, dtype=float))
+    above = c[c >= float(energy_kj) * (1 - 1e-12)]
+    return float(above[0]) if above.size else float("nan")
+
+
+def round_up(value: float, step: float = HEIGHT_STEP_M) -> float:
+    """``value`` rounded up to a multiple of ``step`` (a kit's nominal height) [m]."""
+    return float(math.ceil(float(value) / step - 1e-9) * step)
+
+
+def uni11211_energy(volume_m3, density_kg_m3, velocity_ms, *, gamma_Tr, gamma_Dp, gamma_VolF, gamma_gamma=1.0):
+    """UNI 11211-4 design energy [kJ]: E_d = 1/2 (Vol rho gamma_VolF gamma_gamma) (v_t gamma_Tr gamma_Dp)^2."""
+    return kinetic_energy_kj(volume_m3 * density_kg_m3 * gamma_VolF * gamma_gamma, velocity_ms * gamma_Tr * gamma_Dp)
+
+
+def onr24810_energy(mass_kg, velocity_ms, *, gamma_m, gamma_v):
+    """ONR 24810 design energy [kJ]: E_d = 1/2 (m_k gamma_m) (v_k gamma_v)^2."""
+    return kinetic_energy_kj(mass_kg * gamma_m, velocity_ms * gamma_v)
+
+
+@dataclass(frozen=True)
+class DesignBasis:
+    """The chosen standard with its factors and limits (site file ``[design]``).
+
+    basis : one of :data:`BASES`; factors : the partial factors in force (defaults of the basis, replaced by those
+    the site states); stated : names of the factors the site file stated; frequent_T_years : return period [yr] of
+    the frequent event checked against SEL; residual_category : the required residual-height category;
+    clearance_m : distance [m] from the barrier to the road available for the net's elongation (None: from the
+    scenario, barrier line to road line); free_board_m : free board [m] above the design block's top;
+    mel_classes_kj : the product classes [kJ]; elongation_m : {fence name: maximum elongation at MEL [m]} of
+    candidate kits; design_T : return period [yr] of the return-period basis.
+    """
+
+    basis: str = DEFAULT_BASIS
+    factors: dict = field(default_factory=dict)
+    stated: tuple = ()
+    frequent_T_years: float = 30.0
+    residual_category: str = "A"
+    clearance_m: float | None = None
+    free_board_m: float = 0.5
+    mel_classes_kj: tuple = MEL_PRODUCT_CLASSES_KJ
+    elongation_m: dict = field(default_factory=dict)
+    design_T: float = 100.0
+
+    def __post_init__(self):
+        check_basis(self.basis)
+        merged = dict(DEFAULT_FACTORS[self.basis])
+        for k, v in self.factors.items():
+            if k not in merged:
+                raise ValueError(f"design.{k}: not a factor of {self.basis} (its factors: {', '.join(merged)})")
+            merged[k] = v
+        for k, v in merged.items():
+            if k.endswith("percentile"):
+                if not 50.0 <= float(v) < 100.0:
+                    raise ValueError(f"design.{k} = {v!r} must lie between 50 and 100 (exclusive) [%]")
+            elif not (np.isfinite(float(v)) and 1.0 <= float(v) <= 2.0):
+                raise ValueError(f"design.{k} = {v!r}: a partial factor lies between 1.0 and 2.0")
+        object.__setattr__(self, "factors", {k: float(v) for k, v in merged.items()})
+        if self.residual_category not in RESIDUAL_CATEGORIES:
+            raise ValueError(f"design.residual_category = {self.residual_category!r} is not one of 'A', 'B', 'C'")
+        if not (np.isfinite(self.frequent_T_years) and self.frequent_T_years > 1):
+            raise ValueError(f"design.frequent_T_years = {self.frequent_T_years!r} must be a number > 1 year")
+        if self.clearance_m is not None and not (np.isfinite(self.clearance_m) and self.clearance_m > 0):
+            raise ValueError(f"design.clearance_m = {self.clearance_m!r} must be a number > 0 m")
+        if not (np.isfinite(self.free_board_m) and self.free_board_m >= 0):
+            raise ValueError(f"design.free_board_m = {self.free_board_m!r} must be a number >= 0 m")
+        c = np.asarray(self.mel_classes_kj, dtype=float)
+        if c.size == 0 or np.any(~np.isfinite(c) | (c <= 0)):
+            raise ValueError(f"design.mel_classes_kj = {list(self.mel_classes_kj)!r} must be positive energies [kJ]")
+        object.__setattr__(self, "mel_classes_kj", tuple(sorted(float(x) for x in c)))
+        for name, d in self.elongation_m.items():
+            if not (np.isfinite(float(d)) and float(d) > 0):
+                raise ValueError(f"design.elongation_m[{name!r}] = {d!r} must be a number > 0 m")
+
+    @property
+    def unverified(self) -> list:
+        """Factors in force that are riskrf defaults of [R] status and were not stated by the site file."""
+        recalled = {"UNI 11211-4": ("gamma_E", "gamma_d"), "ONR 24810": ("gamma_m", "gamma_v", "gamma_d"),
+                    "return period": ()}[self.basis]
+        return [k for k in recalled if k not in self.stated]
+
+    def text(self) -> str:
+        """The basis in one sentence, for every output."""
+        f = ", ".join(f"{k} {v:g}" for k, v in self.factors.items())
+        s = f"design basis {self.basis} ({f}); {FACTOR_SOURCES[self.basis]}"
+        if self.unverified:
+            s += (f"; NOT STATED in the site file, riskrf defaults in force: {', '.join(self.unverified)} "
+                  "(confirm against the standard before signing)")
+        return s
+
+
+def design_basis_from_site(cfg: dict | None, *, design_T: float = 100.0, free_board_m: float = 0.5) -> DesignBasis:
+    """A :class:`DesignBasis` from a site file's ``[design]`` table (already checked for unknown keys)."""
+    cfg = dict(cfg or {})
+    basis = cfg.pop("basis", DEFAULT_BASIS)
+    check_basis(basis)
+    factor_names = set(DEFAULT_FACTORS[basis])
+    all_factors = set().union(*DEFAULT_FACTORS.values())
+    factors = {}
+    for k in list(cfg):
+        if k in all_factors:
+            v = cfg.pop(k)
+            if v is None:
+                continue
+            if k not in factor_names:
+                raise ValueError(f"design.{k} is not a factor of the basis {basis!r} (its factors: "
+                                 f"{', '.join(sorted(factor_names))})")
+            factors[k] = v
+    keep = {k: v for k, v in cfg.items() if v is not None}
+    if "mel_classes_kj" in keep:
+        keep["mel_classes_kj"] = tuple(keep["mel_classes_kj"])
+    if "elongation_m" in keep and not isinstance(keep["elongation_m"], dict):
+        raise ValueError(f"design.elongation_m = {keep['elongation_m']!r} must be a table {{fence name = metres}}")
+    keep.setdefault("free_board_m", free_board_m)
+    return DesignBasis(basis=basis, factors=factors, stated=tuple(factors), design_T=float(design_T), **keep)
+
+
+# ---- the requirement at one line ------------------------------------------------------------------------
+@dataclass(frozen=True)
+class DesignRequirement:
+    """What the chosen basis requires of a fence at one line, and the checks of candidate fences.
+
+    Fields (energies kJ, lengths m): ``basis`` (:class:`DesignBasis`), ``x_m`` of the line, the governing
+    ``block_mass_kg`` and its ``block_diameter_m``, characteristic speed ``v_k_ms`` and design speed ``v_d_ms``,
+    characteristic ``E_k_kj`` and design energy ``E_d_kj``, ``frequent_energy_kj`` (the frequent-event energy,
+    NaN when fewer than one fall reaches the line in that time), ``design_event`` ("rare": MEL, "frequent": SEL),
+    ``required_mel_kj`` (exact), ``required_class_kj`` (smallest product class; NaN above the largest),
+    ``h_k_m`` and ``h_d_m`` (characteristic and design passing heights of the block centre), ``required_height_m``
+    (exact) and ``required_net_height_m`` (rounded up to 0.5 m), ``clearance_m`` and ``permitted_elongation_m``
+    (= clearance / gamma_d), ``residual_category``, ``governs`` (which check sets the MEL) and ``candidates``
+    (one row per candidate check).
+    """
+
+    basis: DesignBasis
+    x_m: float
+    block_mass_kg: float
+    block_diameter_m: float
+    block_rule: str
+    v_k_ms: float
+    v_d_ms: float
+    E_k_kj: float
+    E_d_kj: float
+    frequent_energy_kj: float
+    design_event: str
+    required_mel_kj: float
+    required_class_kj: float
+    governs: str
+    h_k_m: float
+    h_d_m: float
+    required_height_m: float
+    required_net_height_m: float
+    clearance_m: float | None
+    permitted_elongation_m: float | None
+    residual_category: str
+    shares: dict = field(default_factory=dict)
+    candidates: pd.DataFrame = field(default_factory=pd.DataFrame, repr=False)
+
+    def summary(self) -> pd.DataFrame:
+        """The requirement as a one-column table with plain-language row names and units."""
+        rows = {
+            "design basis (governs)": self.basis.basis,
+            "barrier line x [m]": self.x_m,
+            "governing block": f"{self.block_rule}: {self.block_mass_kg:.4g} kg, diameter {self.block_diameter_m:.3g} m",
+            "characteristic speed v_k [m/s]": self.v_k_ms,
+            "design speed v_d [m/s]": self.v_d_ms,
+            "characteristic energy E_k [kJ]": self.E_k_kj,
+            "design energy E_d [kJ]": self.E_d_kj,
+            "design event (kit level used)": "rare: MEL" if self.design_event == "rare" else "frequent: SEL = MEL/3",
+            f"{self.basis.frequent_T_years:g}-year energy (frequent event, against SEL) [kJ]": self.frequent_energy_kj,
+            "required MEL [kJ]": self.required_mel_kj,
+            "required product class MEL [kJ]": self.required_class_kj,
+            "MEL set by": self.governs,
+            "characteristic passing height h_k [m]": self.h_k_m,
+            "design passing height h_d [m]": self.h_d_m,
+            "required height: design passing height + free border [m]": self.required_height_m,
+            "required net height (0.5 m steps) [m]": self.required_net_height_m,
+            "clearance to the road D_A [m]": self.clearance_m,
+            "permitted maximum elongation D_A / gamma_d [m]": self.permitted_elongation_m,
+            "required residual-height category": self.residual_category,
+        }
+        return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
+
+    def text(self) -> str:
+        """The requirement in one sentence."""
+        cls = (f"{self.required_class_kj:,.0f} kJ class" if np.isfinite(self.required_class_kj)
+               else f"above the largest product class ({max(self.basis.mel_classes_kj):,.0f} kJ): no single kit")
+        return (f"{self.basis.basis} governs: E_d = {self.E_d_kj:,.0f} kJ; required MEL {self.required_mel_kj:,.0f} kJ "
+                f"({cls}), required net height {self.required_net_height_m:g} m at x = {self.x_m:g} m"
+                + (f", maximum elongation {self.permitted_elongation_m:.2f} m" if self.permitted_elongation_m else "")
+                + f", residual-height category {self.residual_category}")
+
+    def to_dict(self) -> dict:
+        """JSON-ready: every field, the basis with its factors, the candidate checks as records."""
+        out = {k: getattr(self, k) for k in (
+            "x_m", "block_mass_kg", "block_diameter_m", "block_rule", "v_k_ms", "v_d_ms", "E_k_kj", "E_d_kj",
+            "frequent_energy_kj", "design_event", "required_mel_kj", "required_class_kj", "governs", "h_k_m",
+            "h_d_m", "required_height_m", "required_net_height_m", "clearance_m", "permitted_elongation_m",
+            "residual_category")}
+        out = {k: (None if isinstance(v, float) and not np.isfinite(v) else v) for k, v in out.items()}
+        out["basis"] = self.basis.basis
+        out["basis_text"] = self.basis.text()
+        out["factors"] = dict(self.basis.factors)
+        out["factors_not_stated"] = self.basis.unverified
+        out["frequent_T_years"] = self.basis.frequent_T_years
+        out["required_barrier_shares"] = dict(self.shares)
+        out["candidates"] = self.candidates.to_dict(orient="records")
+        return out
+
+
+def _block_for_basis(hazard, basis: DesignBasis, block, density_kg_m3: float):
+    """(mass [kg], rule text) of the block the basis designs for: the design block for ONR/UNI, the T-year block
+    reaching the line for the return-period basis (the one whose class gives the height)."""
+    if basis.basis != "return period" and block is not None:
+        return float(block.mass_kg), f"design block ({block.rule})"
+    from .design_block import line_return_period_mass
+    m = float(line_return_period_mass(hazard, [basis.design_T])[0])
+    if not np.isfinite(m):
+        if block is None:
+            raise ValueError(f"no design block and no {basis.design_T:g}-year block at the line (fewer than one fall "
+                             f"reaches it in {basis.design_T:g} years): the {basis.basis} basis needs one")
+        return float(block.mass_kg), f"design block ({block.rule})"
+    return m, f"{basis.design_T:g}-year block reaching the line"
+
+
+def _class_value(hazard, what: str, q: float, mass_kg: float) -> float:
+    """The q-th percentile speed [m/s] or height [m] of the simulated blocks of ``mass_kg``'s class (mass-coupled),
+    else of all arriving blocks."""
+    if what == "speed":
+        return float(hazard.velocity_percentile(q, mass_kg=mass_kg))
+    if hazard.mass_coupled:
+        return float(hazard.velocity.height_percentile(q, mass_kg))
+    if hazard.heights_m is None:
+        return float("nan")
+    return float(hazard.height_percentile(q))
+
+
+def frequent_energy(hazard, T: float) -> float:
+    """The T-year impact energy at the line [kJ]; NaN when fewer than one fall reaches it in T years."""
+    return float(hazard.energy_at_return_period(T)) if T * hazard.arrival_rate > 1 else float("nan")
+
+
+def barrier_shares(hazard, mel_kj: float, height_m: float, *, block_top_m: float = 0.0) -> dict:
+    """Shares [-] of the falls reaching the line that a fence of MEL [kJ] and height [m] stops, that pass over
+    it (centre + ``block_top_m`` above the height) and that break through it (energy above MEL, not over; height and
+    energy taken as independent).  NaN shares without simulated heights."""
+    p_e = float(hazard.exceedance_probability(mel_kj))
+    over = float(hazard.height_exceedance(height_m - block_top_m)) if hazard.heights_m is not None else float("nan")
+    through = (1.0 - over) * p_e if np.isfinite(over) else p_e
+    return {"stopped": 1.0 - over - through if np.isfinite(over) else float("nan"), "over": over,
+            "through": through}
+
+
+def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3: float = 2650.0,
+                       x_m: float = float("nan"), clearance_m: float | None = None,
+                       candidates=()) -> DesignRequirement:
+    """The barrier the chosen basis requires at one line (see the module notes), with candidate checks.
+
+    Parameters
+    ----------
+    hazard : EnergyHazard at the line (mass-coupled: speeds and heights of the design block's own mass class)
+    basis : DesignBasis
+    block : DesignBlock or None (needed by ONR 24810 and UNI 11211-4; the return-period basis uses the T-year block)
+    density_kg_m3 : rock density [kg/m3]
+    x_m : position of the line [m] (for the outputs)
+    clearance_m : distance [m] from the line to the road (``basis.clearance_m`` replaces it when stated)
+    candidates : sequence of (name, MEL [kJ], height [m]) fences to check against the requirement
+    """
+    f = basis.factors
+    m, rule = _block_for_basis(hazard, basis, block, density_kg_m3)
+    d = float((6.0 * m / density_kg_m3 / np.pi) ** (1.0 / 3.0))
+    qv = f.get("velocity_percentile", 95.0)
+    v_k = _class_value(hazard, "speed", qv, m)
+    e_freq = frequent_energy(hazard, basis.frequent_T_years)
+    if basis.basis == "UNI 11211-4":
+        v_d = v_k * f["gamma_Tr"] * f["gamma_Dp"]
+        E_k = kinetic_energy_kj(m, v_k)
+        E_d = uni11211_energy(m / density_kg_m3, density_kg_m3, v_k, gamma_Tr=f["gamma_Tr"], gamma_Dp=f["gamma_Dp"],
+                              gamma_VolF=f["gamma_VolF"], gamma_gamma=f["gamma_gamma"])
+        event, need = "rare", E_d * f["gamma_E"]
+        what = f"E_d x gamma_E ({f['gamma_E']:g}) <= MEL"
+        h_factor = f["gamma_Tr"] * f["gamma_Dp"]
+    elif basis.basis == "ONR 24810":
+        v_d = v_k * f["gamma_v"]
+        E_k = kinetic_energy_kj(m, v_k)
+        E_d = onr24810_energy(m, v_k, gamma_m=f["gamma_m"], gamma_v=f["gamma_v"])
+        rate_block = float(hazard.rate_per_year * (hazard.velocity.arrival_sf(m, _mass_model(hazard))
+                                                     if hazard.mass_coupled else
+                                                     hazard.reach_probability * _mass_model(hazard).sf(m)))
+        T_block = 1.0 / rate_block if rate_block > 0 else float("inf")
+        event = "frequent" if T_block < basis.frequent_T_years else "rare"
+        need = E_d / SEL_PER_MEL if event == "frequent" else E_d
+        what = (f"E_d <= SEL = MEL/3 (design block arrives every {T_block:.3g} yr, frequent)" if event == "frequent"
+                else f"E_d <= MEL (design block arrives every {T_block:.3g} yr, rare)")
+        h_factor = 1.0
+    else:
+        T = basis.design_T
+        E_d = float(hazard.energy_at_return_period(T)) if T * hazard.arrival_rate > 1 else float("nan")
+        if not np.isfinite(E_d):
+            raise ValueError(f"the {T:g}-year energy at x = {x_m:g} m is not defined: fewer than one fall reaches the "
+                             f"line in {T:g} years; choose another basis or return period")
+        E_k, v_k, v_d = E_d, float("nan"), float("nan")
+        event, need = "rare", E_d
+        what = f"{T:g}-year energy <= MEL"
+        h_factor = 1.0
+    governs = what
+    if np.isfinite(e_freq) and e_freq / SEL_PER_MEL > need:
+        need, governs = e_freq / SEL_PER_MEL, f"{basis.frequent_T_years:g}-year energy <= SEL = MEL/3 (frequent events)"
+    cls = required_product_class(need, basis.mel_classes_kj)
+    qh = f.get("height_percentile", 95.0)
+    h_k = _class_value(hazard, "height", qh, m)
+    h_d = h_k * h_factor
+    if basis.basis == "UNI 11211-4":
+        # H_tot >= H_d + f_min, the free border at least 0.5 m and at most half the block size (the radius):
+        # the larger of the two (RocFall UNI 11211 design page quoting UNI 11211-4:2012 [V])
+        border = max(basis.free_board_m, d / 2.0)
+        border_text = f"h_d + free border f_min = max({basis.free_board_m:g} m, radius)"
+    else:
+        border = d / 2.0 + basis.free_board_m      # the block's top and a free board above it
+        border_text = f"h_d + radius + free board ({basis.free_board_m:g} m)"
+    H = h_d + border
+    clear = basis.clearance_m if basis.clearance_m is not None else clearance_m
+    permitted = clear / f["gamma_d"] if clear is not None else None
+    shares = barrier_shares(hazard, cls if np.isfinite(cls) else need, round_up(H), block_top_m=0.0) \
+        if np.isfinite(H) else {}
+    rows = []
+    for name, mel, height in candidates:
+        sel = mel * SEL_PER_MEL
+        rows.append({"fence": name, "check": f"energy: {governs}", "demand": need, "capacity": mel, "unit": "kJ",
+                     "adequate": bool(need <= mel * (1 + 1e-12))})
+        if np.isfinite(e_freq):
+            rows.append({"fence": name, "check": f"frequent events: {basis.frequent_T_years:g}-year energy vs SEL",
+                         "demand": e_freq, "capacity": sel, "unit": "kJ", "adequate": bool(e_freq <= sel)})
+        rows.append({"fence": name, "check": f"height: {border_text}",
+                     "demand": H, "capacity": height, "unit": "m",
+                     "adequate": bool(H <= height) if np.isfinite(H) else None})   # no simulated heights
+        elong = basis.elongation_m.get(name)
+        if elong is not None and clear is not None:
+            rows.append({"fence": name, "check": f"elongation: D_MEL x gamma_d ({f['gamma_d']:g}) vs clearance",
+                         "demand": float(elong) * f["gamma_d"], "capacity": clear, "unit": "m",
+                         "adequate": bool(float(elong) * f["gamma_d"] <= clear)})
+        elif clear is not None:
+            rows.append({"fence": name, "check": "elongation: the kit's maximum elongation at MEL must not exceed",
+                         "demand": float("nan"), "capacity": permitted, "unit": "m", "adequate": None})
+    return DesignRequirement(
+        basis=basis, x_m=float(x_m), block_mass_kg=m, block_diameter_m=d, block_rule=rule, v_k_ms=v_k, v_d_ms=v_d,
+        E_k_kj=float(E_k), E_d_kj=float(E_d), frequent_energy_kj=e_freq, design_event=event,
+        required_mel_kj=float(need), required_class_kj=cls, governs=governs, h_k_m=h_k, h_d_m=h_d,
+        required_height_m=float(H), required_net_height_m=round_up(H) if np.isfinite(H) else float("nan"),
+        clearance_m=clear, permitted_elongation_m=permitted, residual_category=basis.residual_category,
+        shares=shares, candidates=pd.DataFrame(rows))
+
+
+def _mass_model(hazard):
+    from .impact_energy import mass_model
+    return mass_model(hazard.mass)
+
+
+# ---- position search ---------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PositionSearch:
+    """The requirement at several barrier positions along the profile (one simulation, collectors at each x).
+
+    ``table``: one row per position: x [m], ground z [m], share of released blocks reaching it, arrivals per year,
+    E_d [kJ], required MEL [kJ] and product class [kJ], required net height [m], clearance [m]; ``profile``:
+    (x, z) of the slope; ``basis``: the :class:`DesignBasis`; ``n``: blocks simulated.  Its figure is
+    :func:`riskrf.report.design_figures.position_search_figure` (the science draws nothing).
+    """
+
+    table: pd.DataFrame
+    profile: tuple
+    basis: DesignBasis
+    n: int
+    road_x_m: float | None = None
+
+    def summary(self) -> pd.DataFrame:
+        """The per-position table."""
+        return self.table
+
+    def cheapest(self) -> pd.Series | None:
+        """The position with the smallest required class, then the lowest net height (None when no position has a
+        class)."""
+        t = self.table.dropna(subset=["required_class_kj"])
+        if t.empty:
+            return None
+        return t.sort_values(["required_class_kj", "required_net_height_m", "x_m"]).iloc[0]
+
+
+def default_positions(scenario, barrier_x: float, road_x: float | None, k: int = 9) -> list:
+    """``k`` positions [m] between a quarter of the way from the release zone to the road and 2 m before the road,
+    with the barrier line among them."""
+    start = float(scenario.seeder.x_high)
+    end = (road_x if road_x is not None else float(scenario.profile.x[-1])) - 2.0
+    lo = start + 0.25 * (end - start)
+    xs = set(np.round(np.linspace(lo, end, k), 1).tolist()) | {float(barrier_x)}
+    return sorted(x for x in xs if start < x < end + 2.0)
+
+
+def position_search(hazard, scenario, basis: DesignBasis, *, block=None, density_kg_m3: float = 2650.0,
+                    positions_m=None, road_collector: str | None = "road", barrier_x: float | None = None,
+                    n: int = 10_000, seed=1) -> PositionSearch:
+    """:func:`design_requirement` at several positions along the profile from one simulation.
+
+    The blocks are simulated over the hazard's own mass range (log-uniform, stratified, as the mass-coupled
+    hazard) with a collector at each position; each position's reach, speeds and heights by mass class give its
+    hazard under the site's mass law and rate, and the chosen basis gives the required MEL and height there.
+    """
+    import simulation
+
+    from .annual_hazard import EnergyHazard, inertia_factors
+    from .mass_coupling import MassCoupledSamples, stratified_log_uniform
+
+    if not hazard.mass_coupled:
+        raise ValueError("the position search needs a mass-coupled hazard (hazard.mass_coupling = 'simulated')")
+    names = [c.name for c in scenario.collectors]
+    road_x = scenario.collectors[names.index(road_collector)].x if road_collector in names else None
+    if barrier_x is None:
+        barrier_x = scenario.collectors[scenario.collector_index(hazard.collector)].x
+    xs = list(positions_m) if positions_m is not None else default_positions(scenario, barrier_x, road_x)
+    if not xs:
+        raise ValueError("design.positions_x_m: no position to search")
+    px = np.asarray(scenario.profile.x, dtype=float)
+    for x in xs:
+        if not px[0] < float(x) < px[-1]:
+            raise ValueError(f"design.positions_x_m: x = {x!r} m lies outside the profile ({px[0]:g} - {px[-1]:g} m)")
+    cols = tuple(simulation.scenario.Collector(name=f"position_{i}", x=float(x)) for i, x in enumerate(xs))
+    sc = replace(scenario, collectors=cols)
+    edges = hazard.velocity.edges_kg
+    rng = np.random.default_rng(np.random.SeedSequence([0 if seed is None else int(seed), 11]))
+    masses = stratified_log_uniform(float(edges[0]), float(edges[-1]), int(n), rng)
+    result = simulation.run(sc, seed=seed, masses_kg=masses)
+    mm = _mass_model(hazard)
+    pz = np.asarray(scenario.profile.z, dtype=float)
+    rows = []
+    for i, x in enumerate(xs):
+        df = result.collector(f"position_{i}", first_only=True)
+        row = {"x_m": float(x), "ground_z_m": float(np.interp(x, px, pz)), "reach_share": len(df) / result.n}
+        if df.empty:
+            rows.append(row | {"arrivals_per_year": 0.0, "E_d_kj": np.nan, "required_mel_kj": np.nan,
+                               "required_class_kj": np.nan, "required_net_height_m": np.nan,
+                               "clearance_m": (road_x - x) if road_x is not None else np.nan,
+                               "note": "no simulated block reaches this line"})
+            continue
+        speed = np.full(result.n, np.nan)
+        height = np.full(result.n, np.nan)
+        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
+        blk = df["block"].to_numpy()
+        speed[blk] = np.sqrt(df["velocity_ms"].to_numpy() ** 2 + inertia_factors(df) * spin ** 2)
+        height[blk] = df["height_m"].to_numpy()
+        samples = MassCoupledSamples(masses, speed, height, edges, f"position_{i}").with_representative(mm)
+        reach = samples.reach_probability(mm)
+        hz = EnergyHazard(mass=hazard.mass, velocity=samples, rate_per_year=hazard.rate_per_year,
+                          reach_probability=max(reach, 1e-300), n_released=result.n, heights_m=samples.heights_m,
+                          collector=f"position_{i}")
+        clear = (road_x - x) if road_x is not None else None
+        try:
+            req = design_requirement(hz, basis, block=block, density_kg_m3=density_kg_m3, x_m=x, clearance_m=clear)
+        except ValueError as exc:
+            rows.append(row | {"arrivals_per_year": hz.arrival_rate, "E_d_kj": np.nan, "required_mel_kj": np.nan,
+                               "required_class_kj": np.nan, "required_net_height_m": np.nan,
+                               "clearance_m": clear if clear is not None else np.nan, "note": str(exc)})
+            continue
+        rows.append(row | {"arrivals_per_year": hz.arrival_rate, "E_d_kj": req.E_d_kj,
+                           "required_mel_kj": req.required_mel_kj, "required_class_kj": req.required_class_kj,
+                           "required_net_height_m": req.required_net_height_m,
+                           "clearance_m": clear if clear is not None else np.nan,
+                           "note": "barrier line of the hazard" if abs(x - barrier_x) < 1e-9 else ""})
+    return PositionSearch(table=pd.DataFrame(rows), profile=(px, pz), basis=basis, n=int(n), road_x_m=road_x)
+
+
+__all__ = ["BASES", "DEFAULT_BASIS", "DEFAULT_FACTORS", "DesignBasis", "DesignRequirement", "MEL_PRODUCT_CLASSES_KJ",
+           "PositionSearch", "RESIDUAL_CATEGORIES", "barrier_shares", "check_basis", "default_positions",
+           "design_basis_from_site", "design_requirement", "frequent_energy", "onr24810_energy", "position_search",
+           "required_product_class", "residual_height_category", "round_up", "uni11211_energy"]
