@@ -396,8 +396,8 @@ def test_committed_file_format_reference_is_up_to_date():
     from riskrf.core.schema import render_markdown
     committed = (ROOT / "docs" / "reference" / "file-formats-generated.md").read_text(encoding="utf-8")
     assert committed == render_markdown(ALL_SCHEMAS), ("docs/reference/file-formats-generated.md is stale: run "
-                                                       "python -c 'from riskrf.core.schema import write_reference; "
-                                                       "write_reference()'")
+                                                       "python -c 'from riskrf.core.file_schemas import "
+                                                       "write_reference; write_reference()'")
 
 
 def test_options_file_and_corridor_use_the_schema(tmp_path, capsys, no_work):

@@ -314,5 +314,19 @@ def check_scenario_file(path, *, error=ValueError) -> None:
     check(data, SCENARIO_SCHEMA, path, error=error)
 
 
+def write_reference(path=None) -> str:
+    """Write the file-format reference (:func:`riskrf.core.schema.render_markdown` of :data:`ALL_SCHEMAS`) to
+    ``path`` (default ``docs/reference/file-formats-generated.md`` of the source tree) and return its text."""
+    from pathlib import Path
+
+    from .schema import render_markdown
+    text = render_markdown(ALL_SCHEMAS)
+    if path is None:
+        path = Path(__file__).resolve().parents[2] / "docs" / "reference" / "file-formats-generated.md"
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    Path(path).write_text(text, encoding="utf-8")
+    return text
+
+
 __all__ = ["ALL_SCHEMAS", "CORRIDOR_SCHEMA", "OPTIONS_SCHEMA", "SCENARIO_SCHEMA", "SITE_SCHEMA",
-           "check_scenario_file"]
+           "check_scenario_file", "write_reference"]

@@ -203,8 +203,8 @@ def render_markdown(schemas) -> str:
     """The file-format reference: one section per file, one table per TOML table (field, type, unit, allowed
     values, default, meaning), generated from the declarations so that the documentation cannot drift."""
     lines = ["# Input file formats (generated)", "",
-             "Generated from the declarations in `riskrf/core/schema.py` by `riskrf.core.schema.write_reference()`;",
-             "do not edit by hand.  Every field below is checked before any work starts; an error names the file,",
+             "Generated from the declarations in `riskrf/core/file_schemas.py` by",
+             "`riskrf.core.file_schemas.write_reference()`; do not edit by hand.  Every field below is checked before any work starts; an error names the file,",
              "the table, the field and the value.  Paths are relative to the file that names them.", ""]
     for s in schemas:
         lines += [f"## {s.name}", "", s.doc, ""]
@@ -221,18 +221,4 @@ def render_markdown(schemas) -> str:
     return "\n".join(lines).rstrip() + "\n"
 
 
-def write_reference(path=None) -> str:
-    """Write :func:`render_markdown` of every declared file to ``path`` (default
-    ``docs/reference/file-formats-generated.md`` of the source tree) and return the text."""
-    from pathlib import Path
-
-    from .file_schemas import ALL_SCHEMAS
-    text = render_markdown(ALL_SCHEMAS)
-    if path is None:
-        path = Path(__file__).resolve().parents[2] / "docs" / "reference" / "file-formats-generated.md"
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    Path(path).write_text(text, encoding="utf-8")
-    return text
-
-
-__all__ = ["REQUIRED", "Field", "FileSchema", "Table", "check", "problems", "render_markdown", "write_reference"]
+__all__ = ["REQUIRED", "Field", "FileSchema", "Table", "check", "problems", "render_markdown"]
