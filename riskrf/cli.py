@@ -1052,7 +1052,7 @@ def _terminate_as_interrupt():
     Yields a list that holds the signal number once one arrived; the previous handler is restored after."""
     import signal
     got: list = []
-    if threading_main():
+    if _on_main_thread():
         def handler(signum, frame):
             got.append(signum)
             raise KeyboardInterrupt
@@ -1066,7 +1066,8 @@ def _terminate_as_interrupt():
             signal.signal(signal.SIGTERM, previous)
 
 
-def threading_main() -> bool:
+def _on_main_thread() -> bool:
+    """True in the main thread (the only one where a signal handler can be installed)."""
     import threading
     return threading.current_thread() is threading.main_thread()
 

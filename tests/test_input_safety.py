@@ -444,7 +444,8 @@ def test_lognormal_max_far_below_its_median_refused(tmp_path, capsys):
     assert "seeder.mass_kg.max = 10 lies below the median = 3000" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("argv", [["fit", "BIN.csv"], ["simulate", "BIN.toml", "--out", "OUT.csv"], ["assess", "BIN.toml"],
+@pytest.mark.parametrize("argv", [["fit", "BIN.csv"], ["simulate", "BIN.toml", "--out", "OUT.csv"],
+                                  ["assess", "BIN.toml"],
                                   ["decide", "BIN.json"], ["corridor", "BIN.toml"]])
 def test_binary_files_are_named(tmp_path, capsys, argv):
     data = bytes(range(256)) * 8

@@ -204,8 +204,8 @@ def render_markdown(schemas) -> str:
     values, default, meaning), generated from the declarations so that the documentation cannot drift."""
     lines = ["# Input file formats (generated)", "",
              "Generated from the declarations in `riskrf/core/file_schemas.py` by",
-             "`riskrf.core.file_schemas.write_reference()`; do not edit by hand.  Every field below is checked before any work starts; an error names the file,",
-             "the table, the field and the value.  Paths are relative to the file that names them.", ""]
+             "`riskrf.core.file_schemas.write_reference()`; do not edit by hand.  Every field below is checked",
+             "before any work starts; an error names the file, the table, the field and the value.  Paths are relative to the file that names them.", ""]
     for s in schemas:
         lines += [f"## {s.name}", "", s.doc, ""]
         for t in s.tables:

@@ -86,7 +86,8 @@ def check_output_spares_inputs(out, inputs, *, option: str = "--out") -> Path:
         raise ValueError(f"{option} = {text!r}: an empty name is not an output folder; name a new folder")
     here = _real(os.curdir)
     if _real(text) == here or _real(text) in here.parents:
-        raise ValueError(f"{option} = {text!r}: the working folder{'' if _real(text) == here else ' (or a folder above it)'} "
+        above = "" if _real(text) == here else " (or a folder above it)"
+        raise ValueError(f"{option} = {text!r}: the working folder{above} "
                          "would be replaced whole, with everything in it; name a new folder for the outputs")
     target = _real(text)
     for label, path in inputs.items():

@@ -159,7 +159,8 @@ def cases() -> list:
                      command=command)
             inv_case(f"sidecar density {density}", "volume_m3\n1.5\n2.5\n3.5\n", "density_kg_m3",
                      sidecar=f"[record]\nduration_years = 5\ndensity_kg_m3 = {density}\n", command=command)
-    thousands_ok = 'mass_kg\n"1,234,567"\n"146,402"\n"12"\n"2,500"\n"7,300"\n"1,100"\n"45"\n"860"\n"3,300"\n"15"\n"2,100"\n"640"\n"9,900"\n'
+    thousands_ok = "mass_kg\n" + "\n".join(f'"{v}"' for v in ("1,234,567", "146,402", "12", "2,500", "7,300", "1,100",
+                                                                "45", "860", "3,300", "15", "2,100", "640", "9,900"))
 
     us12 = "mass_kg\n" + "\n".join(f'"{v}"' for v in ("146,402", "2,500", "1,250", "3,000", "12,750", "5,125",
                                                          "1,010", "2,020", "4,400", "8,800", "16,500", "33,100"))
@@ -334,7 +335,8 @@ def cases() -> list:
     for old, new, needle in (("vehicles_per_day = 3000", "vehicles_per_day = 0", "vehicles_per_day"),
                              ("speed_kmh = 80", "speed_kmh = -1", "speed_kmh"),
                              ("n_blocks = 400", "n_blocks = 5", "n_blocks"),
-                             ("b = 0.7", "b = -0.7", "b"), ("discount_rate = 0.03", "discount_rate = 3", "discount_rate"),
+                             ("b = 0.7", "b = -0.7", "b"),
+                             ("discount_rate = 0.03", "discount_rate = 3", "discount_rate"),
                              ("face_angle_deg = 60", "face_angle_deg = 120", "face_angle_deg"),
                              ('sections = "small_sections.csv"', 'sections = "missing.csv"', "missing.csv")):
         out.append(Case("corridor", f"{new}", ["corridor", "c.toml"], {"c.toml": ctext.replace(old, new, 1),
