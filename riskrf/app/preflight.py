@@ -34,6 +34,7 @@ def check_number(value, option, *, low=None, high=None, low_open=False, high_ope
 
 def check_inventory_args(args) -> None:
     """Options shared by fit, energy and decide."""
+    check_number(_num(args, "density"), "--density", low=0, low_open=True, what=" kg/m3")
     if _num(args, "density") is not None:
         from ..core.validation import check_density
         check_density(args.density, "--density")

@@ -72,12 +72,9 @@ def check_density(value, name: str = "density_kg_m3") -> float:
     TypeError, ValueError
         Naming ``name`` and the value; a value below 500 suggests g/cm³ (2.65 → 2650 kg/m³).
     """
-    try:
-        v = float(value)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(f"{name} = {value!r}: a rock density must be a number in kg/m3") from exc
+    v = check_positive(value, name)
     lo, hi = DENSITY_RANGE_KG_M3
-    if not lo <= v <= hi:           # NaN fails too
+    if not lo <= v <= hi:
         hint = (f"; {v:g} looks like g/cm3 or t/m3: {v:g} g/cm3 is {v * 1000:g} kg/m3" if 0.5 <= v <= 6 else
                 f"; {v:g} looks like g/m3: that is {v / 1000:g} kg/m3" if lo * 1000 <= v <= hi * 1000 else "")
         raise ValueError(f"{name} = {value!r}: a rock density must lie between {lo:,.0f} and {hi:,.0f} kg/m3 "
