@@ -167,7 +167,8 @@ def check_common(args) -> None:
         check_number(seed, "--seed", low=0, what=" (a whole number; NumPy seeds are >= 0)")
     n = getattr(args, "n", None)
     if n is not None:
-        check_number(n, "-n", low=1, what=" blocks")
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise ValueError(f"-n = {n}: n must be a positive whole number of blocks")
         memory = physical_memory_bytes()
         if memory is not None and n * BYTES_PER_BLOCK > memory:
             raise ValueError(f"-n = {n:,}: simulating that many blocks needs about {n * BYTES_PER_BLOCK / 1e9:,.0f} GB "
