@@ -572,6 +572,9 @@ def cmd_corridor(args) -> int:
     from .app.corridor import load_corridor, run_corridor, write_corridor
     from .app.preflight import check_number, check_out
     check_number(args.workers, "--workers", low=1, what=" (whole workers of the local cluster)")
+    if args.n is not None and args.n < 100:
+        raise ValueError(f"-n = {args.n} (n_blocks = {args.n} blocks per section) must be a whole number >= 100 (the "
+                         "mass-coupled hazard needs at least 20 blocks in each of at least 4 mass classes)")
     out = check_out(args, f"{Path(args.corridor).stem}-corridor")
 
     corridor = load_corridor(args.corridor, keep_going=args.keep_going, sheet=args.sheet,   # every row checked
