@@ -175,14 +175,19 @@ def cmd_simulate(args) -> int:
 
     import simulation
 
-    from .io.outputs import atomic_outputs, check_output
-    out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-crossings.parquet")
+    from .io.outputs import atomic_outputs, check_output, check_output_spares_inputs
+    from .app.preflight import command_inputs
+    out = Path(f"{Path(args.scenario).stem}-crossings.parquet") if args.out is None else \
+        check_output_spares_inputs(args.out, command_inputs(args))
     check_output(out, overwrite=args.overwrite, kind="file")
     if out.suffix.lower() not in (".parquet", ".csv"):
         raise ValueError(f"--out {out}: use a .parquet or .csv file name")
-    figures = Path(args.figures) if args.figures else out.with_name(f"{out.stem}-figures")
+    figures = out.with_name(f"{out.stem}-figures") if args.figures is None else Path(args.figures)
+    check_output_spares_inputs(figures, command_inputs(args), option="--figures")
     check_output(figures, overwrite=args.overwrite, kind="dir", option="--figures")
     scenario = simulation.load_scenario(args.scenario)
+    from .core.file_schemas import check_scenario_file
+    check_scenario_file(args.scenario)          # every declared field's type and range
     progress = None if args.progress is None else args.progress
     result = simulation.run(scenario, n=args.n, seed=args.seed, progress=progress)
     print(f"Scenario {scenario.name} ({scenario.source}): {args.n:,} blocks, seed {args.seed}")
@@ -354,14 +359,22 @@ def cmd_decide(args) -> int:
         tornado = tree.tornado() if tree.parameters else None
         with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
             ranking.to_csv(tmp / "ranking.csv", index=False)
-            tree.risk_profile().to_csv(tmp / "risk_profiles.csv", index=False)
+            profiles = tree.risk_profile()
+            profiles.to_csv(tmp / "risk_profiles.csv", index=False)
             write_json({"objective": tree.objective, "value": rb.value, "options": rb.option_values,
                         "policy": rb.policy, "evpi": evpi},
                        tmp / "decision.json")
-            ax = plot_tree(tree)
-            save_figure(ax.figure, tmp / "tree.png")
-            ax = plot_risk_profiles(tree.risk_profile())
-            save_figure(ax.figure, tmp / "risk_profiles.png")
+            n_leaves = _count_leaves(tree.root)
+            if n_leaves <= MAX_DRAWN_LEAVES:
+                save_figure(plot_tree(tree).figure, tmp / "tree.png")
+            else:           # a diagram of thousands of branches is unreadable and takes minutes to draw
+                print(f"note: tree.png not drawn: {n_leaves:,} end branches (more than {MAX_DRAWN_LEAVES}); "
+                      "ranking.csv and risk_profiles.csv hold every option")
+            if profiles["option"].nunique() <= MAX_DRAWN_PROFILES:
+                save_figure(plot_risk_profiles(profiles).figure, tmp / "risk_profiles.png")
+            else:
+                print(f"note: risk_profiles.png not drawn: {profiles['option'].nunique():,} options (more than "
+                      f"{MAX_DRAWN_PROFILES}); risk_profiles.csv holds them")
             if tornado is not None and len(tornado):
                 tornado.to_csv(tmp / "tornado.csv", index=False)
                 ax = plot_tornado(tornado)
@@ -369,6 +382,8 @@ def cmd_decide(args) -> int:
         print(f"\nWrote ranking.csv, decision.json and figures to {out}/")
         return 0
 
+    from .risk.mitigation import check_mitigation_file
+    check_mitigation_file(args.options)          # every option and table checked before the inventory is read
     inv = _read(args, args.inventory)
     gr, hazard, result = build_energy_hazard(args, inv)
     from .app.assess import road_share, study_context
@@ -382,6 +397,23 @@ def cmd_decide(args) -> int:
         write_mitigation_outputs(study, report, tmp)
     print(f"\nWrote ranking.csv, tornado.csv, break_even.csv, decision.json and figures to {out}/")
     return 0
+
+
+#: Decision-tree figures are drawn up to these sizes (end branches; options with a risk profile).
+MAX_DRAWN_LEAVES = 400
+MAX_DRAWN_PROFILES = 40
+
+
+def _count_leaves(node) -> int:
+    """End branches below ``node`` (iteratively: a tree may be deeper than Python's recursion limit)."""
+    count, stack = 0, [node]
+    while stack:
+        n = stack.pop()
+        if n.branches:
+            stack.extend(b.child for b in n.branches)
+        else:
+            count += 1
+    return count
 
 
 def _add_energy_arguments(p):
@@ -491,7 +523,9 @@ def cmd_calibrate(args) -> int:
             raise ValueError(f"--select {item!r}: use COLUMN=VALUE, e.g. profile=P1")
         select[key] = value
     from .app.preflight import check_out
-    check_out(args, f"{Path(args.scenario).stem}-calibration")
+    out = check_out(args, f"{Path(args.scenario).stem}-calibration")
+    from .core.file_schemas import check_scenario_file
+    check_scenario_file(args.scenario)
     table = None
     if Path(args.observed).is_file():
         from .io.tables import read_numeric_table       # separators, decimal commas, encodings, sheets as for inventories
@@ -514,7 +548,6 @@ def cmd_calibrate(args) -> int:
     print(cal.comparison().to_string(float_format=lambda v: f"{v:.4g}"))
     for note in cal.notes:
         print(f"note: {note}")
-    out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-calibration")
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         (tmp / f"{Path(args.scenario).stem}_calibrated.toml").write_text(cal.to_toml())
         cal.summary().to_csv(tmp / "parameters.csv")
@@ -537,13 +570,17 @@ def cmd_corridor(args) -> int:
     section and write the tables, figures and report to ``--out``.  Returns the exit code (0 on success).
     """
     from .app.corridor import load_corridor, run_corridor, write_corridor
+    from .app.preflight import check_number, check_out
+    check_number(args.workers, "--workers", low=1, what=" (whole workers of the local cluster)")
+    if args.n is not None and args.n < 100:
+        raise ValueError(f"-n = {args.n} (n_blocks = {args.n} blocks per section) must be a whole number >= 100 (the "
+                         "mass-coupled hazard needs at least 20 blocks in each of at least 4 mass classes)")
+    out = check_out(args, f"{Path(args.corridor).stem}-corridor")
 
     corridor = load_corridor(args.corridor, keep_going=args.keep_going, sheet=args.sheet,   # every row checked
                              header_row=args.header_row, decimal=args.decimal, encoding=args.encoding)
     for e in corridor.errors:
         print(f"skipped (--keep-going): {e}")
-    from .app.preflight import check_out
-    out = check_out(args, f"{Path(args.corridor).stem}-corridor")
     parts = out.parent / f".{out.name}.sections"
     n = args.n or corridor.n_blocks
     where = args.scheduler or os.environ.get("DASK_SCHEDULER_ADDRESS") or \
@@ -930,7 +967,10 @@ def _readable_numbers():
     import pandas as pd
 
     from .report.format import sig
-    with pd.option_context("display.float_format", lambda v: sig(v, 4), "display.width", 200):
+
+    def shown(v):          # whole numbers exactly (19,999 stays 19,999), others to 4 significant figures
+        return f"{v:,.0f}".replace("-", "−") if float(v).is_integer() and abs(v) < 1e15 else sig(v, 4)
+    with pd.option_context("display.float_format", shown, "display.width", 200):
         yield
 
 
@@ -947,12 +987,15 @@ def main(argv=None) -> int:
     logger.setLevel(logging.INFO)
     parser = build_parser()
     args = parser.parse_args(argv)
+    terminated: list = []
     try:
-        with warnings.catch_warnings(), _readable_numbers():
+        with warnings.catch_warnings(), _readable_numbers(), _terminate_as_interrupt() as terminated:
             warnings.simplefilter("ignore")  # every warning is reported in the printed summary instead
+            from .app.preflight import check_common
+            check_common(args)               # --seed and -n, before anything is read
             return args.func(args)
     except KeyboardInterrupt:
-        return _interrupted(args)
+        return _interrupted(args, terminated)
     except (ValueError, TypeError, FileNotFoundError, KeyError) as exc:   # includes SiteError, ScenarioError
         if args.debug:
             traceback.print_exc()
@@ -960,12 +1003,37 @@ def main(argv=None) -> int:
         return 2
     except Exception as exc:     # OSError, RecursionError, ...: one line, the traceback only with --debug
         if _caused_by_interrupt(exc):       # Ctrl-C inside compiled code surfaces as SystemError
-            return _interrupted(args)
+            return _interrupted(args, terminated)
         if args.debug:
             traceback.print_exc()
-        print(f"riskrf {args.command}: error: {type(exc).__name__}: {exc} (run with --debug for the traceback)",
-              file=sys.stderr)
-        return 2
+        if isinstance(exc, OSError):           # a file system refusal names its file itself
+            print(f"riskrf {args.command}: error: {type(exc).__name__}: {exc} (run with --debug for the "
+                  "traceback)", file=sys.stderr)
+            return 2
+        print(f"riskrf {args.command}: internal error (a fault of riskrf, not of the inputs) in stage "
+              f"{_failing_stage(exc)} with {_inputs_text(args)}: {type(exc).__name__}: {exc}.  Please report it "
+              "with the output of --debug", file=sys.stderr)
+        return 3
+
+
+def _failing_stage(exc) -> str:
+    """The innermost riskrf or simulation function on the traceback of ``exc`` (module.function)."""
+    tb, stage = exc.__traceback__, "?"
+    while tb is not None:
+        module = tb.tb_frame.f_globals.get("__name__", "")
+        if module.split(".")[0] in ("riskrf", "simulation") and module != "riskrf.cli":
+            stage = f"{module}.{tb.tb_frame.f_code.co_name}"
+        tb = tb.tb_next
+    return stage
+
+
+def _inputs_text(args) -> str:
+    from .app.preflight import command_inputs
+    try:
+        found = command_inputs(args)
+    except Exception:                      # noqa: BLE001 (the message must not fail in turn)
+        found = {}
+    return ("inputs " + ", ".join(f"{k} {v}" for k, v in found.items())) if found else "no input files"
 
 
 def _caused_by_interrupt(exc) -> bool:
@@ -978,10 +1046,38 @@ def _caused_by_interrupt(exc) -> bool:
     return False
 
 
-def _interrupted(args) -> int:
-    print(f"riskrf {args.command}: interrupted; nothing was written (outputs appear only when complete)",
+@contextlib.contextmanager
+def _terminate_as_interrupt():
+    """SIGTERM (what ``timeout``, batch schedulers and CI send) handled like Ctrl-C: it raises KeyboardInterrupt
+    in the main thread, so the temporary outputs are removed and the cluster is shut down on the way out.
+    Yields a list that holds the signal number once one arrived; the previous handler is restored after."""
+    import signal
+    got: list = []
+    if _on_main_thread():
+        def handler(signum, frame):
+            got.append(signum)
+            raise KeyboardInterrupt
+        previous = signal.signal(signal.SIGTERM, handler)
+    else:
+        previous = None
+    try:
+        yield got
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _on_main_thread() -> bool:
+    """True in the main thread (the only one where a signal handler can be installed)."""
+    import threading
+    return threading.current_thread() is threading.main_thread()
+
+
+def _interrupted(args, terminated=()) -> int:
+    why = "terminated (SIGTERM)" if terminated else "interrupted"
+    print(f"riskrf {args.command}: {why}; nothing was written (outputs appear only when complete)",
           file=sys.stderr)
-    return 130
+    return 143 if terminated else 130
 
 
 def _compile_early(argv) -> None:

@@ -74,7 +74,7 @@ def scenario_dict(scenario) -> tuple[dict, str]:
         with open(path, "rb") as fh:
             try:
                 return tomllib.load(fh), str(path)
-            except tomllib.TOMLDecodeError as exc:
+            except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:   # a binary file: named, not a bare codec error
                 raise ScenarioError(f"{path}: not valid TOML: {exc}") from exc
     if isinstance(scenario, dict):
         return copy.deepcopy(scenario), "<dict>"

@@ -81,6 +81,13 @@ class Distribution:
             raise ScenarioError(f"{source}: {where} needs low <= mode <= high; got {spec}")
         if "min" in p and "max" in p and not p["min"] < p["max"]:
             raise ScenarioError(f"{source}: {where} needs min < max; got min = {p['min']:g}, max = {p['max']:g}")
+        if kind == "lognormal" and not p["median"] > 0:
+            raise ScenarioError(f"{source}: {where}.median = {p['median']:g} must be > 0 (a lognormal law's median; "
+                                "its logarithm is the law's centre)")
+        if kind == "lognormal" and "max" in p and p["max"] < p["median"]:
+            raise ScenarioError(f"{source}: {where}.max = {p['max']:g} lies below the median = {p['median']:g}: the "
+                                "truncation would leave only the law's lower tail (every draw near max); check both "
+                                "values and their units")
         if p.get("std", 0) < 0 or p.get("sigma", 0) < 0:
             raise ScenarioError(f"{source}: {where} spread must be >= 0; got {spec}")
         dist = cls(kind, p)
@@ -432,6 +439,6 @@ def load_scenario(path) -> Scenario:
     try:
         with open(path, "rb") as fh:
             data = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:   # a binary file: named, not a bare codec error
         raise ScenarioError(f"{path}: not valid TOML: {exc}") from exc
     return scenario_from_dict(data, source=str(path), base_dir=path.parent)

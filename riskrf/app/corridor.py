@@ -57,6 +57,10 @@ TEXT_COLUMNS = ("id", "scenario", "face_material", "ditch_material", "road_mater
                 "notes")
 RHRS_COLUMNS = tuple("rhrs_" + f for f in rhrs.RATE_FIELDS)
 ALL_COLUMNS = TEXT_COLUMNS + NUMBER_COLUMNS + RHRS_COLUMNS
+#: Most falls a year one section may be given.  A deliberately loose bound against unit and typing mistakes
+#: (per m2 read as per km, 10^6 for 10^-6): 10,000 a year is 27 falls a day reaching one road section, a
+#: slope that closes its road rather than one a corridor screening ranks.
+MAX_SECTION_FALLS_PER_YEAR = 10_000.0
 #: Per-metre cost fields of corridor options, multiplied by the section length.
 PER_M_FIELDS = ("capital_cost_per_m", "annual_maintenance_per_m", "replacement_cost_per_m")
 #: Crest plateau [m] behind the cut and verge [m] beyond the road of a generated profile (room for
@@ -350,7 +354,7 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
         raise CorridorError(f"corridor file not found: {path}")
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:   # a binary file: named, not a bare codec error
         raise CorridorError(f"{path}: not valid TOML: {exc}") from exc
     src = str(path)
     _unknown(data, {"corridor", "defaults", "mass", "materials", "traffic", "consequences", "economics", "criteria",
@@ -387,6 +391,9 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     _unknown(defaults, [c for c in ALL_COLUMNS if c not in ("id", "chainage_from", "chainage_to", "inventory")]
              + ["seeder_mass_kg"],
              "defaults.", src)
+    from ..core.file_schemas import CORRIDOR_SCHEMA
+    from ..core.schema import check as check_schema
+    check_schema(data, CORRIDOR_SCHEMA, src, error=CorridorError)      # every declared type and range
     gr, mass_note = _mass_law(data.get("mass", {}), path.parent, src)
     shared = _shared_rate(data.get("rates"), path.parent, float(gr.m_min), src)
 
@@ -531,6 +538,12 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
             if rate_source != "shared" and not rate > 0:
                 raise CorridorError(f"{where}: the section's rate of falls is {rate:g} per year; a section without "
                                     "falls needs no assessment (remove it or give a rate > 0)")
+            if rate_source != "shared" and rate > MAX_SECTION_FALLS_PER_YEAR:
+                raise CorridorError(f"{where}: column {rate_source!r} gives {rate:,.4g} falls a year on this section, "
+                                    f"more than {MAX_SECTION_FALLS_PER_YEAR:,.0f} "
+                                    f"({MAX_SECTION_FALLS_PER_YEAR / 365.25:.0f} a day): a slope that active closes "
+                                    "its road rather than being screened; check the value and its unit (per year, "
+                                    "per km of road, per m2 of face)")
             # geometry
             if vals["scenario"]:
                 sp = (path.parent / str(vals["scenario"])).resolve()
@@ -812,8 +825,42 @@ def connect(scheduler: str | None = None, n_workers: int | None = None, *, timeo
             raise ConnectionError(f"cannot reach the dask scheduler at {address!r} within {timeout_s:g} s: {exc}") \
                 from None
     n = int(n_workers or os.cpu_count() or 1)
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=processes, dashboard_address=":0")
+    import logging
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=processes, dashboard_address=":0",
+                           silence_logs=logging.ERROR)
     return Client(cluster), cluster
+
+
+#: Loggers of dask.distributed that report a cluster's shutdown ("Worker process still alive ... killing",
+#: cancelled futures): silenced while riskrf closes its own cluster, on success, error or Ctrl-C alike.
+_DASK_LOGGERS = ("distributed", "distributed.nanny", "distributed.worker", "distributed.scheduler",
+                 "distributed.core", "distributed.comm", "distributed.batched", "distributed.client", "tornado",
+                 "asyncio")
+
+
+def _shutdown(client, cluster, timeout_s: float = 10.0) -> None:
+    """Close the client and (when riskrf started it) the local cluster without tracebacks or shutdown noise.
+
+    Runs in a ``finally``: errors while closing (a cancelled future, a worker that will not stop) are not the
+    user's concern and must not hide the run's own outcome, so they are dropped; the workers are killed by
+    the cluster when they do not stop within ``timeout_s``."""
+    import asyncio
+    import logging
+    loggers = [logging.getLogger(n) for n in _DASK_LOGGERS]
+    levels = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL + 1)
+    try:
+        for thing in (client, cluster):
+            if thing is None:
+                continue
+            try:
+                thing.close(timeout=timeout_s)
+            except (Exception, asyncio.CancelledError):     # noqa: BLE001 (see above)
+                pass
+    finally:
+        for lg, level in zip(loggers, levels):
+            lg.setLevel(level)
 
 
 def _task(section, corridor, n_blocks):
@@ -971,9 +1018,7 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
         workers = len(client.scheduler_info().get("workers", {}))
     finally:
         if own:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+            _shutdown(client, cluster)
     if not done_rows:
         raise RuntimeError("no section finished: " + "; ".join(failures))
     table = pd.DataFrame(done_rows).sort_values("chainage_from_m").reset_index(drop=True)

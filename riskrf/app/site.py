@@ -14,45 +14,21 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..core import file_schemas as _fs
+from ..core.schema import check as _check_schema
 from ..core.validation import RiskrfError
 from ..risk.mitigation import MitigationError, study_inputs
-from ..risk.site_rates import INVENTORY_RATE_FIELDS, check_closure_options, check_rates
+from ..risk.site_rates import check_closure_options, check_rates
 
 
 class SiteError(RiskrfError, ValueError):
     """A site file is invalid; the message names the file and the field."""
 
 
-SITE_FIELDS = {
-    "site": {"name": None, "description": ""},
-    "inventory": {"path": None, "start": None, "end": None, "duration_years": None, "density_kg_m3": None,
-                  "m_min_kg": None, "m_max_kg": None, "rate_scale": 1.0, "annual_maxima": None,
-                  "rate_basis": "release",   # "release": falls released; "road": falls recorded on the road
-                  "sizes": None,          # None: the inventory sidecar's sizes, else event_volumes
-                  # reader options (README "Input formats"); None = the reader's rule or the sidecar's value
-                  "sheet": None, "header_row": None, "encoding": None, "decimal": None, "date_format": None,
-                  "volume_unit": None, "mass_unit": None, "duplicates": None, "volume_column": None,
-                  "mass_column": None, "date_column": None, "location_column": None,
-                  # where the hazard's rate comes from (docs: File formats, "Site files"; riskrf.risk.site_rates)
-                  **INVENTORY_RATE_FIELDS},
-    "hazard": {"scenario": None, "velocities": None, "collector": None, "road_collector": "road",
-               "n_blocks": 50_000, "reach_probability": 1.0, "fences_kj": [2000.0, 5000.0], "fence_height_m": 5.0,
-               "free_board_m": 0.5, "design_period_years": 100.0, "bootstrap": 300, "seed": 1,
-               "option_blocks": 20_000, "mass_coupling": "simulated", "velocity_unit": None,
-               "drop_height_m": None},
-    "design_block": {"rule": "return_period", "percentile": 97.0, "survey": None, "fractal_dimension": None,
-                     "iterations": None},
-    # the standard that governs the barrier design (riskrf.hazard.design_basis); factors left out take the basis's
-    # defaults, named in every output
-    "design": {"basis": "UNI 11211-4", "frequent_T_years": 30.0, "residual_category": "A", "clearance_m": None,
-               "mel_classes_kj": None, "elongation_m": None, "positions_x_m": None, "position_blocks": None,
-               "gamma_Tr": None, "gamma_Dp": None, "gamma_VolF": None, "gamma_gamma": None, "gamma_E": None,
-               "gamma_d": None, "gamma_m": None, "gamma_v": None, "velocity_percentile": None,
-               "height_percentile": None},
-    # the report's title block (report.pdf, report.html)
-    "report": {"project": None, "location": None, "revision": "A", "date": None, "author": "not stated",
-               "checker": "not stated", "client": None},
-}
+#: Fields of the site file's own tables and their defaults, from the one declaration of the file
+#: (:data:`riskrf.core.file_schemas.SITE_SCHEMA`: type, unit, range, default of every field).
+SITE_FIELDS = {t.name: t.defaults() for t in (_fs.SITE, _fs.INVENTORY, _fs.HAZARD, _fs.DESIGN_BLOCK, _fs.DESIGN,
+                                              _fs.REPORT)}
 MITIGATION_TABLES = ("traffic", "consequences", "economics", "options", "uncertainty", "criteria")
 #: Optional tables checked by their own modules: [rates] (riskrf.risk.site_rates).
 OTHER_TABLES = ("rates",)
@@ -100,7 +76,7 @@ def load_site(path) -> Site:
     try:
         with open(path, "rb") as fh:
             data = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:   # a binary file: named, not a bare codec error
         raise SiteError(f"{path}: not valid TOML: {exc}") from exc
     allowed = set(SITE_FIELDS) | set(MITIGATION_TABLES) | set(OTHER_TABLES)
     for key in data:
@@ -188,6 +164,7 @@ def load_site(path) -> Site:
             hz["collector"] = "barrier"
             used.append("hazard.collector = 'barrier'")
         scenario = simulation.load_scenario(path.parent / hz["scenario"])
+        _fs.check_scenario_file(path.parent / hz["scenario"], error=SiteError)
         names = [c.name for c in scenario.collectors]
         if hz["collector"] not in names:
             raise SiteError(f"{path}: hazard.collector = {hz['collector']!r}: scenario {hz['scenario']!r} has no "
@@ -211,6 +188,9 @@ def load_site(path) -> Site:
     check_closure_options(mitigation["options"], rates, path, error=SiteError)
     if hz["scenario"] is not None:
         _check_option_geometry(mitigation["options"], scenario, hz, path, mitigation["uncertainty"])
+    # every declared field against its type and range (shares and probabilities in [0, 1], rates, speeds,
+    # lengths and traffic > 0): the checks above keep their own messages, this catches the rest
+    _check_schema(data, _fs.SITE_SCHEMA, path, error=SiteError)
     return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
                 description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
                 mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"], rates=rates,

@@ -50,6 +50,38 @@ def check_positive(value, name: str) -> float:
     return v
 
 
+#: Bulk densities of rock [kg/m³] riskrf accepts.  Rocks span about 1,000 (pumice, porous tuff) to 3,300
+#: (peridotite), massive ores up to about 5,200 (magnetite) (Schön 2015, Physical Properties of Rocks, 2nd ed.,
+#: chapter 2, tables 2.1-2.4); the bounds leave a margin on both sides.  A value such as 2.65 is g/cm³ typed
+#: for kg/m³, and 2,650,000 is g/m³: both would make every mass 1,000 times wrong.
+DENSITY_RANGE_KG_M3 = (500.0, 6000.0)
+
+
+def check_density(value, name: str = "density_kg_m3") -> float:
+    """Return a rock density [kg/m³] as a float, refusing one outside :data:`DENSITY_RANGE_KG_M3`.
+
+    Parameters
+    ----------
+    value : float
+        The density as given [kg/m³].
+    name : str
+        The argument or field, for the message (e.g. ``"--density"`` or ``"site.toml: inventory.density_kg_m3"``).
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming ``name`` and the value; a value below 500 suggests g/cm³ (2.65 → 2650 kg/m³).
+    """
+    v = check_positive(value, name)
+    lo, hi = DENSITY_RANGE_KG_M3
+    if not lo <= v <= hi:
+        hint = (f"; {v:g} looks like g/cm3 or t/m3: {v:g} g/cm3 is {v * 1000:g} kg/m3" if 0.5 <= v <= 6 else
+                f"; {v:g} looks like g/m3: that is {v / 1000:g} kg/m3" if lo * 1000 <= v <= hi * 1000 else "")
+        raise ValueError(f"{name} = {value!r}: a rock density must lie between {lo:,.0f} and {hi:,.0f} kg/m3 "
+                         f"(pumice to magnetite ore; granite 2,650, limestone 2,700){hint}")
+    return v
+
+
 def check_probability_level(level, name: str = "level") -> float:
     """Return a confidence level in (0, 1)."""
     v = float(level)

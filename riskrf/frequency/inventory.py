@@ -38,7 +38,7 @@ import pandas as pd
 from ..io.tables import is_blank, parse_dates, parse_numbers, read_table, sniff_delimiter  # noqa: F401 (re-exported)
 from ..core.format import sig
 from ..core.units import DEFAULT_DENSITY_KG_M3, KG_PER_TONNE
-from ..core.validation import check_positive, warn
+from ..core.validation import check_density, check_positive, warn
 
 #: Rock density used when none is given [kg/m³] (a typical value for granite
 #: and limestone; Wyllie 2014 uses 2.6-2.7 t/m³).
@@ -184,6 +184,25 @@ class Inventory:
         """True when every event has at least a year."""
         return bool(self.events["year"].notna().all()) and self.n_events > 0
 
+    @property
+    def has_dates(self) -> bool:
+        """True when at least one event has a date or year (annual maxima can be formed from the dated ones)."""
+        return bool(self.events["year"].notna().any())
+
+    @property
+    def undated_rows(self) -> list[int]:
+        """File rows of the events that have no date or year (left out of the annual maxima)."""
+        return [int(r) for r in self.events.loc[self.events["year"].isna(), "source_row"]]
+
+    @property
+    def n_undated(self) -> int:
+        """Number of events without a date or year."""
+        return int(self.events["year"].isna().sum())
+
+    def undated_note(self) -> str:
+        """The sentence every output carries for a partly dated inventory ("" when all or none are dated)."""
+        return _undated_note(self.source, self.events)
+
     def record_years(self) -> list[int]:
         """Calendar years covered (wholly or partly) by the record period."""
         if self.start is None or self.end is None:
@@ -205,17 +224,20 @@ class Inventory:
         censored or missing size) has NaN (not zero, not dropped), and a
         warning says how many such years there are.  Partly covered first and
         last years are kept and named in a warning.  Raises ``ValueError`` for
-        an undated inventory.
+        an inventory without any date; events without a date are left out with a warning listing their rows.
         """
-        if not self.is_dated:
+        if not self.has_dates:
             raise ValueError(
-                f"{self.source}: annual maxima need a date or year for every event; "
-                f"{int(self.events['year'].isna().sum())} of {self.n_events} events have none")
+                f"{self.source}: annual maxima need a date or year for at least one event; none of the {self.n_events} "
+                "events has one")
         col = {"kg": "mass_kg", "m3": "volume_m3"}.get(unit)
         if col is None:
             raise ValueError(f"unit = {unit!r} is not one of 'kg', 'm3'")
+        if self.n_undated and self.undated_note() not in self.notes:
+            warn(self.undated_note())
         years = self.record_years()
-        maxima = self.events.groupby(self.events["year"].astype(int))[col].max()
+        dated = self.events[self.events["year"].notna()]
+        maxima = dated.groupby(dated["year"].astype(int))[col].max()
         series = maxima.reindex(years)
         series.index.name = "year"
         series.name = f"annual_max_{col}"
@@ -311,6 +333,7 @@ class Inventory:
             "volume min / median / max [m3]": " / ".join(sig(x) for x in (v.min(), np.median(v), v.max())),
             "mass min / median / max [kg]": " / ".join(sig(x) for x in (m.min(), np.median(m), m.max())),
             "dated": self.is_dated,
+            "events without a date (not in the annual maxima)": self.n_undated,
             "censored or no size (not in the size fits)": self.n_censored,
         }
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
@@ -332,7 +355,7 @@ def _sidecar(path: Path) -> tuple[dict, Path | None, str | None]:
     try:
         with open(side, "rb") as fh:
             data = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:   # a binary file: named, not a bare codec error
         raise ValueError(f"{side}: not valid TOML: {exc}") from exc
     if "record" not in data and any(k in data for k in ("inventory", "hazard", "site", "options")):
         return {}, None, (f"{side} is a site file, not a [record] sidecar of {path.name}; it is not read as "
@@ -521,10 +544,12 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
     lcol = location_column or _find_column(columns, _LOCATION_NAMES)[0]
     ncol = _find_column(columns, _NOTES_NAMES)[0]
 
+    density_from_argument = density_kg_m3 is not None
     if density_kg_m3 is None and "density_kg_m3" in sidecar:
         density_kg_m3 = sidecar["density_kg_m3"]
     density_is_default = density_kg_m3 is None
-    density = DEFAULT_DENSITY_KG_M3 if density_is_default else check_positive(density_kg_m3, "density_kg_m3")
+    density = DEFAULT_DENSITY_KG_M3 if density_is_default else check_density(
+        density_kg_m3, "density_kg_m3" if density_from_argument else f"{side_path}: [record] density_kg_m3")
 
     if vcol is not None:
         unit = volume_unit or vunit or "m3"
@@ -637,6 +662,8 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         raise ValueError(f"{path}: no usable events (every row lacked an exact size or lay outside the record "
                          "period)")
     events = events.reset_index(drop=True)
+    if _undated_note(str(path), events):
+        note(_undated_note(str(path), events))
     _check_plausible_sizes(events, path, vcol if vcol is not None else mcol, vcol is not None,
                            # a unit in the column name counts as declared unless it is the default one:
                            # litres typed into a 'volume_m3' column are exactly the mistake to catch
@@ -647,6 +674,17 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
                      period_source=period_source, size_column=size_column,
                      site=str(sidecar.get("site", "")), notes=tuple(notes), censored=censored,
                      sizes=sidecar.get("sizes"))
+
+
+def _undated_note(source: str, events: pd.DataFrame) -> str:
+    """"k of n events have no date (rows ...)" for a partly dated inventory; "" when all or none are dated."""
+    undated = events["year"].isna()
+    k, n = int(undated.sum()), len(events)
+    if k == 0 or k == n:
+        return ""
+    return (f"{source}: {k} of {n} events have no date (rows {_line_list(events.loc[undated, 'source_row'].tolist())}"
+            f"); they count in the power law (sizes and rate) but are left out of the annual maxima, which use the "
+            f"{n - k} dated events")
 
 
 def _line_list(lines, limit=12) -> str:
@@ -684,9 +722,31 @@ PLAUSIBLE_LARGE_M3 = 1e5
 PLAUSIBLE_LARGE_PER_YEAR = 0.1
 
 
+#: No single fall may exceed this volume [m³]: the largest known rock avalanches are Seymareh (Saidmarreh),
+#: Iran, about 4.4e10 m³ (Roberts & Evans 2013, Journal of the Geological Society 170, 685-700) and Flims,
+#: Switzerland, about 1e10 m³ (von Poschinger et al. 2006, Geomorphology 74, 17-31).  A larger value is a unit
+#: or typing mistake, whatever unit is declared.
+LARGEST_FALL_M3 = 1e11
+#: A median volume below this [m³] (1 litre, a 2.7 kg stone) is implausibly small for a rock fall inventory.
+SMALLEST_MEDIAN_M3 = 1e-3
+
+
 def _check_plausible_sizes(events, path, col, is_volume, declared_unit, duration_years, note):
-    """Refuse sizes that look like a unit mistake unless the unit was declared (see :func:`read_inventory`)."""
+    """Refuse sizes that look like a unit mistake unless the unit was declared (see :func:`read_inventory`);
+    refuse any single fall larger than every rock avalanche recorded (:data:`LARGEST_FALL_M3`), declared unit or
+    not; warn about sizes implausibly small for the stated unit."""
     v = events["volume_m3"].to_numpy(dtype=float)
+    huge = v > LARGEST_FALL_M3
+    if huge.any():
+        i = int(np.argmax(huge))
+        row = int(events["source_row"].iloc[i])
+        raise ValueError(f"{path}: row {row}, column {col!r}: a fall of "
+                         f"{v[i]:.3g} m3, larger than any rock fall or rock avalanche ever recorded (Seymareh, Iran, "
+                         f"about 4.4e10 m3; Flims, Switzerland, about 1e10 m3); check the value and its unit")
+    if is_volume and float(np.median(v)) < SMALLEST_MEDIAN_M3:
+        note(f"{path}: column {col!r}: median volume {float(np.median(v)):.3g} m3 is below one litre, implausibly "
+             f"small for a rock fall inventory; if the column holds m3 but a smaller unit was declared, fix "
+             "volume_unit (CLI --volume-unit, sidecar volume_unit)")
     med = float(np.median(v))
     large = int((v >= PLAUSIBLE_LARGE_M3).sum())
     rate = large / duration_years
@@ -711,6 +771,7 @@ def _check_plausible_sizes(events, path, col, is_volume, declared_unit, duration
         raise ValueError(
             f"{path}: column {col!r}: median mass {np.median(m):.3g} kg ({med:.3g} m3) looks like grams entered "
             "as kg.  Declare the unit: mass_unit='kg' if the masses are right (CLI --mass-unit, sidecar mass_unit)")
-    if declared_unit is None and np.median(m) < 1.0:
-        note(f"{path}: column {col!r}: median mass {np.median(m):.3g} kg is below 1 kg; if the masses are in "
-             "tonnes, declare mass_unit='t' (CLI --mass-unit)")
+    if np.median(m) < 1.0:
+        note(f"{path}: column {col!r}: median mass {np.median(m):.3g} kg is below 1 kg, implausibly small for a "
+             "rock fall inventory; if the masses are in tonnes, declare mass_unit='t' (CLI --mass-unit, sidecar "
+             "mass_unit)")

@@ -293,7 +293,7 @@ def analyse_inventory(inventory: Inventory, *, m_min=None, method: str = "mle", 
         comparison = gr.compare()
         maxima = gumbel = gev = deviance = None
         skipped = {}
-        if not inventory.is_dated:
+        if not inventory.has_dates:
             skipped["Gumbel/GEV"] = "the inventory has no dates, so there are no annual maxima"
         else:
             maxima = inventory.annual_maxima()

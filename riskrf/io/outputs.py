@@ -50,6 +50,101 @@ def check_output(path, *, overwrite: bool = False, kind: str = "dir", option: st
     return path
 
 
+def _real(path) -> Path:
+    return Path(os.path.realpath(os.path.abspath(os.fspath(path))))
+
+
+def check_output_spares_inputs(out, inputs, *, option: str = "--out") -> Path:
+    """Refuse an output that would replace, contain or sit inside one of the command's inputs, before any work.
+
+    An output directory is replaced whole with ``--overwrite``: an ``--out`` that is an input file, the folder
+    holding one (or any folder above it), or a path inside an input would delete or shadow the data the run
+    reads.  ``""`` and ``"."`` (the working folder) are refused as well.
+
+    Parameters
+    ----------
+    out : str or Path
+        The output path as given (a directory, or a file for ``riskrf simulate``).
+    inputs : mapping of str to path
+        What each input is (e.g. ``"inventory"``, ``"sidecar of the inventory"``) and its path; ``None`` values
+        and paths that do not exist are skipped.
+    option : str
+        The argument that named ``out``, for the message.
+
+    Returns
+    -------
+    Path
+        ``out`` as a :class:`~pathlib.Path`.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument, its value and the input it would endanger.
+    """
+    text = os.fspath(out)
+    if text.strip() == "":
+        raise ValueError(f"{option} = {text!r}: an empty name is not an output folder; name a new folder")
+    here = _real(os.curdir)
+    if _real(text) == here or _real(text) in here.parents:
+        above = "" if _real(text) == here else " (or a folder above it)"
+        raise ValueError(f"{option} = {text!r}: the working folder{above} "
+                         "would be replaced whole, with everything in it; name a new folder for the outputs")
+    target = _real(text)
+    for label, path in inputs.items():
+        if path is None or os.fspath(path) == "":
+            continue
+        src = _real(path)
+        if not src.exists():
+            continue
+        where = f"{label} {os.fspath(path)}"
+        if target == src:
+            raise ValueError(f"{option} = {text!r} is the {where}: the output would replace it; name a new "
+                             f"{'file' if src.is_file() else 'folder'} for the outputs")
+        if target in src.parents:
+            raise ValueError(f"{option} = {text!r} holds the {where}: writing the outputs there would delete it "
+                             "(an output folder is replaced whole); name a new folder for the outputs")
+        if src in target.parents:
+            raise ValueError(f"{option} = {text!r} lies inside the {where}, which is a "
+                             f"{'file' if src.is_file() else 'folder'}; name a folder outside the inputs")
+    return Path(text)
+
+
+def files_named_in_toml(path, *, label: str = "") -> dict:
+    """Every existing file a TOML input names (relative to its folder), with the TOML itself and each named
+    file's sidecar ``<stem>.toml``: ``{"what it is": path}`` for :func:`check_output_spares_inputs`.
+
+    Unreadable TOML gives just the file itself (its own reader reports the error)."""
+    import tomllib
+    path = Path(path)
+    label = label or "input file"
+    found = {label: path}
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except (OSError, ValueError):
+        return found
+
+    def walk(value, key):
+        if isinstance(value, dict):
+            for k, v in value.items():
+                walk(v, f"{key}.{k}" if key else str(k))
+        elif isinstance(value, list):
+            for i, v in enumerate(value):
+                walk(v, f"{key}[{i}]")
+        elif isinstance(value, str) and value and len(value) < 1024 and "\n" not in value:
+            try:
+                candidate = (path.parent / value)
+                if candidate.is_file():
+                    found[f"{key} of {path.name}"] = candidate
+                    side = candidate.with_suffix(".toml")
+                    if side.is_file() and side != candidate:
+                        found[f"sidecar of {key} of {path.name}"] = side
+            except (OSError, ValueError):
+                pass
+    walk(data, "")
+    return found
+
+
 _FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 
 

@@ -12,7 +12,10 @@ The rules (also in the documentation, File formats, "Input formats"):
   holding both ``.`` and ``,`` decides (the last one is the decimal mark, the other the
   thousands separator); otherwise a column whose values use only commas has decimal commas
   and one whose values use only dots has decimal points; a column mixing ``1,5`` and
-  ``1.192`` is refused (pass ``decimal``).  Apostrophes and spaces as thousands
+  ``1.192`` is refused (pass ``decimal``).  Commas followed by exactly three digits are
+  ambiguous (``146,402``: US thousands or a European decimal): a column holding
+  ``1,234,567`` reads them as thousands; a column where every comma is one followed by
+  three digits is refused unless ``decimal`` says which.  Apostrophes and spaces as thousands
   separators (``1'192.5``, ``1 192,5``) are removed.
 * **Dates** (:func:`parse_dates`): ``YYYY-MM-DD`` (ISO), ``DD.MM.YYYY`` (dots are
   always day first), a four-digit year alone, and month names are unambiguous.
@@ -45,7 +48,7 @@ def _header_line(text: str, header_row: int | None) -> str:
 
 def sniff_delimiter(path, *, encoding: str | None = None, header_row: int | None = None) -> str:
     """The most frequent of ``;``, tab, ``|`` and ``,`` on the header line (outside quotes); ``,`` when none."""
-    return _sniff_text(_decode(Path(path).read_bytes()[:65536], encoding)[0], header_row)
+    return _sniff_text(_decode(Path(path).read_bytes()[:65536], encoding, path)[0], header_row)
 
 
 def _sniff_text(text: str, header_row: int | None) -> str:
@@ -55,9 +58,16 @@ def _sniff_text(text: str, header_row: int | None) -> str:
     return best if counts[best] else ","
 
 
-def _decode(data: bytes, encoding: str | None) -> tuple[str, str]:
+def _decode(data: bytes, encoding: str | None, path=None) -> tuple[str, str]:
+    if b"\x00" in data[:65536] and not data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise ValueError(f"{path or 'the file'}: holds NUL bytes: a binary file, not a text table (an Excel "
+                         "workbook needs the .xlsx suffix, a Parquet file .parquet)")
     if encoding:
-        return data.decode(encoding), encoding
+        try:
+            return data.decode(encoding), encoding
+        except (UnicodeDecodeError, LookupError) as exc:
+            raise ValueError(f"{path or 'the file'}: cannot read as {encoding} text ({exc}); pass the file's "
+                             "encoding (CLI --encoding)") from None
     try:
         return data.decode("utf-8-sig"), "utf-8"
     except UnicodeDecodeError as exc:
@@ -97,7 +107,7 @@ def read_table(path, *, sheet=None, header_row: int | None = None, encoding: str
         if sheet is not None:
             raise ValueError(f"{path}: sheet = {sheet!r} applies to Excel workbooks only")
         raw = path.read_bytes()
-        text, used = _decode(raw, encoding)
+        text, used = _decode(raw, encoding, path)
         if comment:
             lines = text.splitlines()
             lines = ["" if ln.lstrip().startswith(comment) else ln for ln in lines]
@@ -196,6 +206,40 @@ def _where(path, row, col):
     return f"{path}: row {row}, column {col!r}"
 
 
+#: A number written with thousands separators: 1-3 leading digits (not a lone 0) and groups of three after commas.
+_GROUPED_BY_COMMA = r"^[+-]?[1-9]\d{0,2}(,\d{3})+$"
+
+
+def _comma_meaning(text, raw, has_comma, path, col, rows) -> str:
+    """The decimal mark of a column whose numbers hold commas but no dots: ``","`` (decimal commas) or ``"."``
+    (the commas separate thousands).
+
+    ``146,402`` is 146.402 in a European export and 146402 in a US one; the file alone cannot tell when every
+    comma is followed by exactly three digits.  A column holding a number with two or more commas
+    (``1,234,567``) groups thousands, so all its commas do; a column where some comma is followed by other than
+    three digits (``1,5``, ``0,125``) has decimal commas.  A column where every value is one comma followed by
+    three digits is refused, naming the column and how to say which (never read silently as decimals: that
+    would make masses 1,000 times too small).
+    """
+    commas = text[has_comma]
+    grouped = commas.str.match(_GROUPED_BY_COMMA)
+    several = commas.str.count(",") > 1
+    fix = ("pass decimal='.' if the commas separate thousands (146,402 = 146402) or decimal=',' if they are "
+           "decimal commas (146,402 = 146.402) (CLI --decimal, or decimal = ... in the sidecar [record] or the "
+           "site file's [inventory])")
+    if grouped.all():
+        if several.any():
+            return "."
+        i = commas.index[0]
+        raise ValueError(f"{path}: column {col!r}: every number with a comma has exactly three digits after it "
+                         f"(such as {raw[i]!r}, row {rows[i]}): thousands separators or decimal commas?  {fix}")
+    if several.any():
+        i, j = several.idxmax(), (~grouped).idxmax()
+        raise ValueError(f"{_where(path, rows[i], col)}: {raw[i]!r} separates thousands with commas, but row "
+                         f"{rows[j]} ({raw[j]!r}) has a decimal comma; the column is ambiguous: {fix}")
+    return ","
+
+
 def parse_numbers(raw: pd.Series, path, col: str, rows, *, decimal: str | None = None,
                   errors: str = "raise") -> pd.Series:
     """Numbers from text cells with the decimal-mark rule of this module; ``""`` gives NaN.
@@ -239,8 +283,10 @@ def parse_numbers(raw: pd.Series, path, col: str, rows, *, decimal: str | None =
                              f"different from row {rows[min(first_comma, first_dot)]} "
                              f"({raw[min(first_comma, first_dot)]!r}); the column is ambiguous: pass "
                              "decimal='.' or ',' (CLI --decimal)")
+        elif has_comma.any():
+            decimal = _comma_meaning(text, raw, has_comma, path, col, rows)
         else:
-            decimal = "," if has_comma.any() else "."
+            decimal = "."
     if decimal == ",":
         text = text.str.replace(".", "", regex=False).str.replace(",", ".", regex=False)
     else:

@@ -173,7 +173,7 @@ class DecisionTree:
                     data = tomllib.load(fh)
             else:
                 data = json.loads(path.read_text(encoding="utf-8"))
-        except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
+        except (json.JSONDecodeError, tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
             raise TreeError(f"{path}: cannot parse: {exc}") from exc
         except RecursionError:
             raise TreeError(f"{path}: the tree is nested too deeply to read") from None
@@ -209,6 +209,10 @@ class DecisionTree:
         walk(self.root)
 
     # ---- rollback -------------------------------------------------------------------
+    def _whole_tree_name(self) -> str:
+        """The one course of a tree whose root is not a decision (its name, else "the tree")."""
+        return self.root.name or "the tree"
+
     def _net(self, branch) -> float:
         cost = _evaluate(branch.cost, self.parameters, branch.name)
         payoff = _evaluate(branch.payoff, self.parameters, branch.name)
@@ -269,7 +273,8 @@ class DecisionTree:
     def ranking(self, **kwargs) -> pd.DataFrame:
         """Options of the top decision, best first, with their expected value and rank."""
         rb = self.rollback(**kwargs)
-        df = pd.DataFrame({"option": list(rb.option_values), "expected_value": list(rb.option_values.values())})
+        values = dict(rb.option_values) or {self._whole_tree_name(): rb.value}   # no decision: the tree is one course
+        df = pd.DataFrame({"option": list(values), "expected_value": list(values.values())})
         df = df.sort_values("expected_value", ascending=self.objective == "min").reset_index(drop=True)
         best = df["expected_value"].iloc[0]
         df["difference_from_best"] = (df["expected_value"] - best).abs()
@@ -283,16 +288,20 @@ class DecisionTree:
         Columns: option, outcome value, probability, cumulative probability.
         """
         rb = self.rollback()
-        names = [b.name for b in self.root.branches] if self.root.type == "decision" else [""]
+        names = [b.name for b in self.root.branches] if self.root.type == "decision" else [self._whole_tree_name()]
         if option is not None and option not in names:
             raise TreeError(f"{self.source}: no option {option!r}; options are {names}")
         rows = []
+        if self.root.type != "decision":          # a tree without a first decision: the tree is the one course
+            rows = [{"option": self._whole_tree_name(), "value": val, "probability": p}
+                    for val, p in self._outcomes(self.root, 0.0, 1.0, rb.policy)]
         for b in (self.root.branches if self.root.type == "decision" else []):
             if option is not None and b.name != option:
                 continue
             for val, p in self._outcomes(b.child, self._net(b), 1.0, rb.policy):
                 rows.append({"option": b.name, "value": val, "probability": p})
-        df = pd.DataFrame(rows).groupby(["option", "value"], as_index=False)["probability"].sum()
+        df = pd.DataFrame(rows, columns=["option", "value", "probability"])
+        df = df.groupby(["option", "value"], as_index=False)["probability"].sum()
         df["cumulative"] = df.groupby("option")["probability"].cumsum()
         return df
 

@@ -1501,6 +1501,31 @@ def study_inputs(data: dict, source: str) -> dict:
             "defaults_used": used, "uncertainty": uncertainty, "criteria": criteria}
 
 
+def check_mitigation_file(path):
+    """Read and check a mitigation TOML file (a site file works too) before any work: every table and option
+    against its declaration and rules, and a closure rule's [rates] table.  Returns (study inputs, the parsed
+    TOML, the checked [rates] or None when no closure rule needs it)."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"mitigation file not found: {path}")
+    with open(path, "rb") as fh:
+        try:
+            raw = tomllib.load(fh)
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:   # a binary file: named, not a bare codec error
+            raise MitigationError(f"{path}: not valid TOML: {exc}") from exc
+    data = {k: v for k, v in raw.items() if k not in ("site", "inventory", "hazard", "design_block", "rates",
+                                                      "design", "report")}
+    inputs = study_inputs(data, str(path))         # a site file works too
+    rates = None
+    if any(o.kind == "closure" and o.has_closure_rule for o in inputs["options"]):
+        # closure rules: share and hours from the file's [rates] model (riskrf.site_rates)
+        from .site_rates import check_closure_options, check_rates
+        inv = dict(raw.get("inventory", {})) if isinstance(raw.get("inventory"), dict) else {}
+        rates = check_rates(raw.get("rates"), inv, path, error=MitigationError)
+        check_closure_options(inputs["options"], rates, path, error=MitigationError)
+    return inputs, raw, rates
+
+
 def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0, **kw) -> MitigationStudy:
     """Read a mitigation TOML file (a site file works too) and combine it with an energy hazard.
 
@@ -1508,23 +1533,10 @@ def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0, **kw
     pass to :class:`MitigationStudy`.
     """
     path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"mitigation file not found: {path}")
-    with open(path, "rb") as fh:
-        try:
-            data = tomllib.load(fh)
-        except tomllib.TOMLDecodeError as exc:
-            raise MitigationError(f"{path}: not valid TOML: {exc}") from exc
-    raw = data
-    data = {k: v for k, v in data.items() if k not in ("site", "inventory", "hazard", "design_block", "rates",
-                                                      "design", "report")}
-    inputs = study_inputs(data, str(path))         # a site file works too
-    if any(o.kind == "closure" and o.has_closure_rule for o in inputs["options"]):
-        # closure rules: share and hours from the file's [rates] model (riskrf.risk.site_rates)
-        from .site_rates import check_closure_options, check_rates, evaluate_rates, resolve_closures
+    inputs, raw, rates = check_mitigation_file(path)
+    if rates is not None:
+        from .site_rates import evaluate_rates, resolve_closures
         inv = dict(raw.get("inventory", {})) if isinstance(raw.get("inventory"), dict) else {}
-        rates = check_rates(raw.get("rates"), inv, path, error=MitigationError)
-        check_closure_options(inputs["options"], rates, path, error=MitigationError)
         inputs["options"] = resolve_closures(inputs["options"], evaluate_rates(rates, path.parent, inv,
                                                                                inputs["options"]))
     return MitigationStudy(hazard=hazard, road_share=road_share, source=str(path), **inputs, **kw)

@@ -733,6 +733,9 @@ def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
     if dup:
         raise MitigationError(f"{source}: duplicate option name(s) {sorted(dup)}")
     _check_combinations(options, source)
+    from ..core.file_schemas import OPTIONS_SCHEMA
+    from ..core.schema import check
+    check(data, OPTIONS_SCHEMA, source, error=MitigationError)     # every declared type and range
     return options, exposure, consequences, economics, tuple(used), uncertainty, criteria
 
 
