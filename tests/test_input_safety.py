@@ -364,7 +364,7 @@ def test_schema_defaults_are_the_readers_defaults():
     from riskrf.risk.mitigation_inputs import Consequences, Criteria, Economics, Exposure
     from riskrf.app.site import SITE_FIELDS
     assert SITE_FIELDS["inventory"]["rate_scale"] == 1.0 and SITE_FIELDS == {
-        t.name: t.defaults() for t in (fs.SITE, fs.INVENTORY, fs.HAZARD, fs.DESIGN_BLOCK)}
+        t.name: t.defaults() for t in (fs.SITE, fs.INVENTORY, fs.HAZARD, fs.DESIGN_BLOCK, fs.DESIGN, fs.REPORT)}
     for table, cls in ((fs.TRAFFIC, Exposure), (fs.CONSEQUENCES, Consequences), (fs.ECONOMICS, Economics),
                        (fs.CRITERIA, Criteria)):
         declared = table.defaults()

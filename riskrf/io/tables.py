@@ -58,9 +58,30 @@ def _sniff_text(text: str, header_row: int | None) -> str:
     return best if counts[best] else ","
 
 
+#: Openings of binary files a table reader may be handed by mistake: zip (xlsx), Parquet, PDF, PNG, ELF, gzip,
+#: OLE (xls), GIF, JPEG, TIFF.
+_BINARY_MAGIC = (b"PK\x03\x04", b"PAR1", b"%PDF", b"\x89PNG", b"\x7fELF", b"\x1f\x8b", b"\xd0\xcf\x11\xe0",
+                 b"GIF8", b"\xff\xd8\xff", b"II*\x00", b"MM\x00*")
+
+
+def _looks_binary(sample: bytes) -> bool:
+    """A binary file, not text: a known binary opening, or control characters (other than tab, line ends and
+    form feed) in more than 1 % of the bytes once NUL bytes are set aside.  NUL padding alone does not make a
+    file binary: the real Hong Kong CEDD register export pads rows with runs of NUL bytes."""
+    if sample.startswith(_BINARY_MAGIC):
+        return True
+    if sample.startswith((b"\xff\xfe", b"\xfe\xff")):        # UTF-16 text holds NUL bytes by design
+        return False
+    text = sample.replace(b"\x00", b"")
+    if not text.strip():
+        return bool(sample)
+    control = sum(text.count(bytes([c])) for c in range(32) if c not in (9, 10, 12, 13))
+    return control > 0.01 * len(text)
+
+
 def _decode(data: bytes, encoding: str | None, path=None) -> tuple[str, str]:
-    if b"\x00" in data[:65536] and not data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        raise ValueError(f"{path or 'the file'}: holds NUL bytes: a binary file, not a text table (an Excel "
+    if _looks_binary(data[:65536]):
+        raise ValueError(f"{path or 'the file'}: is a binary file, not a text table (an Excel "
                          "workbook needs the .xlsx suffix, a Parquet file .parquet)")
     if encoding:
         try:
