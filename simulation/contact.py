@@ -331,3 +331,64 @@ def steep_face_launch(v_along, v_sep):
     vn = min(v_sep, u)
     vt = math.sqrt(max(u * u - vn * vn, 0.0))
     return (vt if v_along >= 0.0 else -vt), vn
+
+
+# ---- ground contact with a velocity-squared drag: dv/dt = a - c v^2 along the motion ----------------------
+# A block rolling over asperities (talus boulders, tussocks) or ploughing soft ground loses at each asperity
+# a share of its kinetic energy, and meets more asperities per second the faster it goes: a resistance that
+# grows as v^2 (the "drag" of RAMMS::ROCKFALL's soft-ground contact, and the v^2 term of Voellmy's law; here
+# c = rolling_drag / r [1/m], so a block twice as large, stepping over the same asperities with half as
+# many contacts per metre, feels half the drag).  With c = 0 the motion is the constant-acceleration one.
+# Closed forms along the distance s: v^2(s) = a/c + (u^2 - a/c) exp(-2 c s); times from dv/dt = a - c v^2.
+
+@njit(cache=True)
+def contact_speed_at(u, a, c, s):
+    """Speed [m/s] after a distance s [m] in contact from speed u [m/s], acceleration a [m/s^2] along the
+    motion and drag coefficient c [1/m] (dv/dt = a - c v^2); 0 once the block has stopped."""
+    if c <= 1e-12:
+        return math.sqrt(max(u * u + 2.0 * a * s, 0.0))
+    ac = a / c
+    return math.sqrt(max(ac + (u * u - ac) * math.exp(-2.0 * c * s), 0.0))
+
+
+@njit(cache=True)
+def contact_stop_distance(u, a, c):
+    """Distance [m] at which a block in contact (speed u, acceleration a, drag c; see :func:`contact_speed_at`)
+    comes to rest; inf when it never does (a >= 0)."""
+    if a >= 0.0:
+        return math.inf
+    if c <= 1e-12:
+        return u * u / (-2.0 * a)
+    big_a = -a / c
+    return math.log((u * u + big_a) / big_a) / (2.0 * c)
+
+
+@njit(cache=True)
+def contact_time(u, v, a, c, s):
+    """Time [s] to go from speed u to speed v >= 0 [m/s] over the distance s [m] (dv/dt = a - c v^2); -1 when
+    the block does not move (u = 0 and no acceleration)."""
+    if c <= 1e-12:
+        if abs(a) > 1e-12:
+            return (v - u) / a
+        return s / u if u > 0.0 else -1.0
+    if a < 0.0:                                  # decelerating everywhere: dv/dt = -c (A + v^2)
+        ra = math.sqrt(-a / c)
+        return (math.atan(u / ra) - math.atan(v / ra)) / (c * ra)
+    if a == 0.0:                                 # dv/dt = -c v^2
+        return (1.0 / v - 1.0 / u) / c if u > 0.0 and v > 0.0 else -1.0
+    vt = math.sqrt(a / c)                        # terminal speed
+    if abs(u - vt) <= 1e-9 * vt and abs(v - vt) <= 1e-9 * vt:
+        return s / vt
+    t = 0.0
+    if u < vt and v < vt:
+        t = (math.atanh(v / vt) - math.atanh(u / vt)) / (c * vt)
+    elif u > vt and v > vt:
+        t = (_acoth(v / vt) - _acoth(u / vt)) / (c * vt)
+    else:                                        # rounding at the terminal speed: uniform motion
+        t = s / max(0.5 * (u + v), 1e-300)
+    return t
+
+
+@njit(cache=True)
+def _acoth(x):
+    return 0.5 * math.log((x + 1.0) / (x - 1.0))

@@ -20,8 +20,9 @@ import math
 import numpy as np
 from numba import njit
 
-from .contact import (EN_WYLLIE, contact_acceleration, contact_speed, rebound, roll_on_speed,  # noqa: F401
-                      roughness_tilt_max, steep_face_launch)
+from .contact import (EN_WYLLIE, contact_acceleration, contact_speed, contact_speed_at,  # noqa: F401
+                      contact_stop_distance, contact_time, rebound, roll_on_speed, roughness_tilt_max,
+                      steep_face_launch)
 from .units import J_PER_KJ
 
 # Stop reasons.
@@ -344,17 +345,14 @@ def _envelope_flight(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass,
 
 @njit(cache=True)
 def _envelope_contact(env_x, env_acc, xa, xb, x0, mass, inertia, r, contact_speed0, contact_a, contact_dir, cosb,
-                      roll):
-    """Envelope bins between xa and xb crossed in ground contact (constant acceleration contact_a along the
+                      roll, drag):
+    """Envelope bins between xa and xb crossed in ground contact (acceleration contact_a - drag v^2 along the
     slope from speed contact_speed0 at x0; spin v/r when rolling, none when sliding; height 0)."""
     i0 = _first_at_least(env_x, min(xa, xb))
     i1 = _first_at_least(env_x, max(xa, xb))
     for i in range(i0, i1):
         s = contact_dir * (env_x[i] - x0) / cosb
-        if abs(contact_a) < 1e-12:
-            sp = contact_speed0
-        else:
-            sp = math.sqrt(max(contact_speed0 * contact_speed0 + 2.0 * contact_a * s, 0.0))
+        sp = contact_speed_at(contact_speed0, contact_a, drag, s)
         _envelope_add(env_acc, i, sp, 0.0, _kinetic_kj(mass, sp * sp, inertia, sp / r if roll else 0.0))
 
 
@@ -362,7 +360,7 @@ def _envelope_contact(env_x, env_acc, xa, xb, x0, mass, inertia, r, contact_spee
 def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
              px, pz, tree, n_leaves, seg_mat, run_first, run_last,
              m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
-             m_roll, m_mu_ground, m_gain, m_en_v0, m_hop,
+             m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag,
              c_x, c_cap, c_h, c_order, env_x, env_acc,
              g, v_contact, v_stop, sin_max_roll, max_events, key, n_path_blocks,
              out_x, out_z, out_reason, out_impacts, out_t,
@@ -378,6 +376,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
     (sorted by the caller: a sort compiled here would add about 2 s to the first compilation).
     The contact laws are those of :mod:`simulation.contact`: ``m_en_v0`` the velocity scale of e_N [m/s] (inf:
     none), ``m_hop`` the hop height [m] below which a rebound is ground contact (:func:`contact_speed`), and
+    ``m_drag`` the rolling drag (the contact's v^2 resistance c = m_drag / r [1/m], :func:`contact_speed_at`),
     ``sin_max_roll`` the sine of the steepest slope a block may roll or slide on in contact (1: any slope);
     on steeper segments it leaves the face (:func:`steep_face_launch`) and meets it in impacts.
     """
@@ -576,6 +575,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             else:
                 direction = 1.0 if v_along > 0 else -1.0
             a_dir = contact_acceleration(g, sinb, cosb, direction, mu, k_in, roll)   # along the motion
+            drag = m_drag[mat] / r if r > 0.0 else 0.0
             u = abs(v_along)
             # Collinear segments of the same material are crossed in one step.
             if direction > 0:
@@ -584,18 +584,16 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             else:
                 k_far = run_first[k]
                 dist = (x - px[k_far]) / cosb
-            stops_here = a_dir < 0 and u * u < -2.0 * a_dir * dist
+            d_stop = contact_stop_distance(u, a_dir, drag)
+            stops_here = d_stop < dist
             if stops_here:
-                t_step = u / (-a_dir)
-                d_step = u * u / (-2.0 * a_dir)
+                d_step = d_stop
                 u_end = 0.0
+                t_step = contact_time(u, 0.0, a_dir, drag, d_step)
             else:
-                u_end = math.sqrt(max(u * u + 2.0 * a_dir * dist, 0.0))
-                if abs(a_dir) > 1e-12:
-                    t_step = (u_end - u) / a_dir
-                elif u > 0:
-                    t_step = dist / u
-                else:
+                u_end = contact_speed_at(u, a_dir, drag, dist)
+                t_step = contact_time(u, u_end, a_dir, drag, dist)
+                if t_step < 0.0:
                     reason = STOPPED
                     if record:
                         _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, 0.0, 0.0,
@@ -612,12 +610,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 s_c = cross_t[j]
                 if not (1e-12 < s_c <= d_step):
                     continue
-                if abs(a_dir) < 1e-12:
-                    tc = s_c / u
-                    uc = u
-                else:
-                    uc = math.sqrt(max(u * u + 2.0 * a_dir * s_c, 0.0))
-                    tc = (uc - u) / a_dir
+                uc = contact_speed_at(u, a_dir, drag, s_c)
+                tc = contact_time(u, uc, a_dir, drag, s_c)
                 wc = direction * uc / r if roll else 0.0
                 vxc, vzc = direction * uc * cosb, direction * uc * sinb
                 outcome, keep = _meet_collector(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
@@ -626,7 +620,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
                     if env_x.shape[0] > 0:
                         _envelope_contact(env_x, env_acc, x, c_x[j], x, mass, inertia, r, u, a_dir, direction,
-                                          cosb, roll)
+                                          cosb, roll, drag)
                     t_abs += tc
                     x = c_x[j]
                     z = _ground(px, pz, x)
@@ -645,7 +639,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             if cut:
                 continue
             if env_x.shape[0] > 0:
-                _envelope_contact(env_x, env_acc, x, x_new, x, mass, inertia, r, u, a_dir, direction, cosb, roll)
+                _envelope_contact(env_x, env_acc, x, x_new, x, mass, inertia, r, u, a_dir, direction, cosb, roll, drag)
             t_abs += t_step
             x = x_new
             z = pz[k] + (pz[k + 1] - pz[k]) * (x - px[k]) / (px[k + 1] - px[k])

@@ -142,7 +142,9 @@ class Material:
     ``en_velocity_scale_ms``: v0 of the Pfeiffer & Bowen (1989) scaling e_N / (1 + (v_n / v0)^2) (inf: none;
     ``normal_restitution.velocity_scale_ms`` in a file); ``hop_height_m``: a rebound that would rise less
     than this above the surface is ground contact (``contact_hop_height_m``; 0: the numerical
-    ``contact_velocity_ms`` alone decides, as before).  See :mod:`simulation.contact`.
+    ``contact_velocity_ms`` alone decides, as before); ``rolling_drag`` kappa [-]: in ground contact the block
+    also decelerates by (kappa / r) v^2 (rolling over asperities, ploughing; 0: none).
+    See :mod:`simulation.contact`.
     """
 
     name: str
@@ -160,6 +162,7 @@ class Material:
     allow_energy_gain: bool
     en_velocity_scale_ms: float = math.inf
     hop_height_m: float = 0.0
+    rolling_drag: float = 0.0
 
     @classmethod
     def parse(cls, name: str, spec: dict, source: str) -> "Material":
@@ -171,7 +174,7 @@ class Material:
             raise ScenarioError(f"{source}: materials.{name} must be a table of material fields; got {spec!r}")
         _check_keys(spec, {"preset", "normal_restitution", "tangential", "roughness_m", "ground_motion",
                            "ground_friction_angle_deg", "rolling_resistance", "allow_energy_gain",
-                           "contact_hop_height_m"}, where, source)
+                           "contact_hop_height_m", "rolling_drag"}, where, source)
         given = set(spec)
         if "preset" in spec:            # a named material from published ranges (simulation.materials)
             try:
@@ -253,7 +256,8 @@ class Material:
                                                lo=0.0, hi=89.0),
                    allow_energy_gain=gain, en_velocity_scale_ms=en_v0,
                    hop_height_m=_number(spec.get("contact_hop_height_m", 0.0), f"{where}contact_hop_height_m",
-                                        source, lo=0.0, hi=10.0))
+                                        source, lo=0.0, hi=10.0),
+                   rolling_drag=_number(spec.get("rolling_drag", 0.0), f"{where}rolling_drag", source, lo=0.0, hi=10.0))
 
 
 #: I / (m r^2) of the block shapes: a solid sphere, and a solid cylinder (disc, wheel) rolling on its rim.
