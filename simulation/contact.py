@@ -305,6 +305,22 @@ def contact_speed(v_floor, g, cos_beta, hop_height_m):
 
 
 @njit(cache=True)
+def rolling_resistance(mu_0, size_k, roughness_m, r):
+    """Rolling-resistance coefficient [-] of a block of radius r [m]: mu_0 + size_k * roughness_m / r.
+
+    ``mu_0`` = tan(phi_g) is the resistance of a block much larger than the asperities; the second term
+    makes smaller blocks, which sink between asperities of height ``roughness_m`` [m], stop sooner: the
+    friction of a stone moving over scree falls as its size grows relative to the surface stones
+    (Kirkby & Statham 1975, J. Geol. 83:349, mu = tan(phi) + K d/D, d and D the sizes of surface and moving
+    stones [R]; Statham 1976, Earth Surf. Process. 1:43, the resulting downslope size sorting of screes).
+    With ``size_k`` = 0 it is mu_0 (the former behaviour).
+    """
+    if size_k <= 0.0 or r <= 0.0:
+        return mu_0
+    return mu_0 + size_k * roughness_m / r
+
+
+@njit(cache=True)
 def contact_acceleration(g, sin_beta, cos_beta, direction, mu_r, k, roll):
     """Acceleration [m/s^2] along the motion of a block in ground contact on a straight slope.
 

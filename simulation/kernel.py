@@ -21,7 +21,8 @@ import numpy as np
 from numba import njit
 
 from .contact import (EN_WYLLIE, contact_acceleration, contact_speed, contact_speed_at,  # noqa: F401
-                      contact_stop_distance, contact_time, rebound, roll_on_speed, roughness_tilt_max,
+                      contact_stop_distance, contact_time, rebound, roll_on_speed, rolling_resistance,
+                      roughness_tilt_max,
                       steep_face_launch)
 from .units import J_PER_KJ
 
@@ -360,7 +361,7 @@ def _envelope_contact(env_x, env_acc, xa, xb, x0, mass, inertia, r, contact_spee
 def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
              px, pz, tree, n_leaves, seg_mat, run_first, run_last,
              m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
-             m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag,
+             m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k,
              c_x, c_cap, c_h, c_order, env_x, env_acc,
              g, v_contact, v_stop, sin_max_roll, max_events, key, n_path_blocks,
              out_x, out_z, out_reason, out_impacts, out_t,
@@ -376,7 +377,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
     (sorted by the caller: a sort compiled here would add about 2 s to the first compilation).
     The contact laws are those of :mod:`simulation.contact`: ``m_en_v0`` the velocity scale of e_N [m/s] (inf:
     none), ``m_hop`` the hop height [m] below which a rebound is ground contact (:func:`contact_speed`), and
-    ``m_drag`` the rolling drag (the contact's v^2 resistance c = m_drag / r [1/m], :func:`contact_speed_at`),
+    ``m_size_k`` the size term of the rolling resistance (:func:`rolling_resistance`), ``m_drag`` the rolling drag (the contact's v^2 resistance c = m_drag / r [1/m], :func:`contact_speed_at`),
     ``sin_max_roll`` the sine of the steepest slope a block may roll or slide on in contact (1: any slope);
     on steeper segments it leaves the face (:func:`steep_face_launch`) and meets it in impacts.
     """
@@ -548,7 +549,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             sinb_raw = pz[k + 1] - pz[k]
             ls = math.sqrt(cosb_raw * cosb_raw + sinb_raw * sinb_raw)
             cosb, sinb = cosb_raw / ls, sinb_raw / ls
-            mu = m_mu_ground[mat]
+            mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r)
             roll = m_roll[mat]
             if abs(sinb) > sin_max_roll:
                 # No rolling or sliding in contact on a face this steep: the block leaves it (speed kept).

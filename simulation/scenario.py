@@ -143,7 +143,9 @@ class Material:
     ``normal_restitution.velocity_scale_ms`` in a file); ``hop_height_m``: a rebound that would rise less
     than this above the surface is ground contact (``contact_hop_height_m``; 0: the numerical
     ``contact_velocity_ms`` alone decides, as before); ``rolling_drag`` kappa [-]: in ground contact the block
-    also decelerates by (kappa / r) v^2 (rolling over asperities, ploughing; 0: none).
+    also decelerates by (kappa / r) v^2 (rolling over asperities, ploughing; 0: none);
+    ``rolling_size_coefficient`` K [-]: the rolling resistance is tan(phi_g) + K roughness / r, so small blocks
+    stop sooner (0: tan(phi_g) alone).
     See :mod:`simulation.contact`.
     """
 
@@ -163,6 +165,7 @@ class Material:
     en_velocity_scale_ms: float = math.inf
     hop_height_m: float = 0.0
     rolling_drag: float = 0.0
+    rolling_size_coefficient: float = 0.0
 
     @classmethod
     def parse(cls, name: str, spec: dict, source: str) -> "Material":
@@ -174,7 +177,7 @@ class Material:
             raise ScenarioError(f"{source}: materials.{name} must be a table of material fields; got {spec!r}")
         _check_keys(spec, {"preset", "normal_restitution", "tangential", "roughness_m", "ground_motion",
                            "ground_friction_angle_deg", "rolling_resistance", "allow_energy_gain",
-                           "contact_hop_height_m", "rolling_drag"}, where, source)
+                           "contact_hop_height_m", "rolling_drag", "rolling_size_coefficient"}, where, source)
         given = set(spec)
         if "preset" in spec:            # a named material from published ranges (simulation.materials)
             try:
@@ -257,7 +260,9 @@ class Material:
                    allow_energy_gain=gain, en_velocity_scale_ms=en_v0,
                    hop_height_m=_number(spec.get("contact_hop_height_m", 0.0), f"{where}contact_hop_height_m",
                                         source, lo=0.0, hi=10.0),
-                   rolling_drag=_number(spec.get("rolling_drag", 0.0), f"{where}rolling_drag", source, lo=0.0, hi=10.0))
+                   rolling_drag=_number(spec.get("rolling_drag", 0.0), f"{where}rolling_drag", source, lo=0.0, hi=10.0),
+                   rolling_size_coefficient=_number(spec.get("rolling_size_coefficient", 0.0),
+                                                    f"{where}rolling_size_coefficient", source, lo=0.0, hi=10.0))
 
 
 #: I / (m r^2) of the block shapes: a solid sphere, and a solid cylinder (disc, wheel) rolling on its rim.
