@@ -23,14 +23,16 @@ Method
   Monte Carlo noise (Glasserman 2004, sec. 4.2).
 * **Where to simulate: adaptive importance sampling** (population Monte Carlo, Cappé et al. 2004, J. Comput.
   Graph. Stat. 13:907; deterministic-mixture weights of AMIS, Cornuet et al. 2012, Scand. J. Stat. 39:798):
-  a Sobol design over the prior box, then ``iterations`` rounds that draw from a Student-t (4 degrees of
-  freedom) fitted to the weighted evaluations so far, truncated to the box.  The prior is uniform within the
-  bounds.
-* **Posterior from a surrogate.**  The simulated log-likelihood of a chaotic simulator is noisy (a bounce more
-  or less moves a stop by metres), so importance weights on the evaluations alone collapse on a few lucky
-  points.  A Gaussian process with a noise term is fitted to all evaluations (:class:`_GaussianProcess`) and
-  the posterior sample is drawn from prior x exp(GP mean) by two-stage importance sampling on the box (Wilkinson
-  2014; Gutmann & Corander 2016, BOLFI); its effective sample size is reported (a warning below 100).
+  a Sobol design over the prior box (uniform prior within the bounds), then ``iterations`` rounds that draw
+  from a Student-t (4 degrees of freedom) fitted to the importance-weighted evaluations so far, truncated to
+  the box.
+* **Posterior from a surrogate.**  The simulated log-likelihood is noisy (a bounce more or less moves a stop
+  by metres), so importance weights on the evaluations alone collapse on a few lucky points.  A quadratic is
+  fitted to the log-likelihood of the evaluations near its top (a Gaussian surrogate; the fit region widens
+  until the quadratic is concave) and the posterior sample is drawn from that Gaussian truncated to the box
+  (Wood 2010, Nature 466:1102, for the Gaussian synthetic-likelihood idea; Wilkinson 2014, AISTATS, for
+  surrogates of ABC likelihoods).  When no concave quadratic fits, ABC rejection: the evaluations within
+  chi2_d(0.99) / 2 of the best log-likelihood, weighted by prior / proposal.  ``notes`` says which was used.
 * **Posterior-predictive coverage.**  For ``n_predictive`` posterior draws every release is simulated again
   (another seed); the share of observed stops inside each release's central 90 % and 99 % predictive intervals
   should be near 0.90 and 0.99 when the model and its fitted parameters describe the data.
@@ -347,8 +349,8 @@ class PooledCalibration:
     ``posterior``: a sample (one row per draw, one column per dotted parameter); ``parameters``: its median;
     ``bounds``: the uniform prior; ``evaluations``: every parameter set simulated with its log-likelihood and
     importance weight; ``coverage_table``: per release, its observed stops and the share inside the 90 % and
-    99 % posterior-predictive intervals; ``ess``: effective sample size of the importance weights that draw the
-    posterior sample from the surrogate.
+    99 % posterior-predictive intervals; ``ess``: effective sample size of the posterior sample (its size when
+    drawn from the Gaussian surrogate; of the ABC-rejection weights otherwise).
     """
 
     parameters: dict
@@ -595,17 +597,41 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
     theta_all = lo + u_all * (hi - lo)
     evaluations = pd.DataFrame(theta_all, columns=names).assign(log_likelihood=ll_all, weight=w)
     notes = []
-    gp = _GaussianProcess.fit(u_all, ll_all)
-    post_u, post_ess = gp.posterior_sample(n_posterior, rng_resample)
-    posterior = pd.DataFrame(lo + post_u * (hi - lo), columns=names)
-    notes.append(f"posterior: Gaussian-process surrogate of the simulated log-likelihood over {len(ll_all)} "
-                 f"parameter sets (noise sd {gp.noise_sd:.2g} in log-likelihood units), sampled by importance "
-                 f"sampling (effective sample size {post_ess:.0f})")
-    if post_ess < 100:
-        msg = (f"effective sample size of the surrogate posterior is {post_ess:.0f} (< 100): the posterior is poorly "
-               "resolved; raise n_per_iteration or iterations")
-        notes.append(msg)
-        warnings.warn(msg, PooledCalibrationWarning, stacklevel=2)
+    surrogate = _quadratic_surrogate(u_all, ll_all)
+    if surrogate is not None:
+        # the log-likelihood near its top is quadratic (smooth under common random numbers): the posterior is the
+        # Gaussian it defines, truncated to the prior box; sampling it averages out the Monte Carlo noise that
+        # makes a few evaluated points dominate the importance weights
+        mean, cov, r2 = surrogate
+        draws = []
+        while len(draws) < n_posterior:
+            cand = rng_resample.multivariate_normal(mean, cov, size=4 * n_posterior)
+            draws.extend(cand[np.all((cand >= 0) & (cand <= 1), axis=1)].tolist())
+            if len(draws) == 0 and len(cand) > 0:
+                surrogate = None
+                break
+        if surrogate is not None:
+            posterior = pd.DataFrame(lo + np.array(draws[:n_posterior]) * (hi - lo), columns=names)
+            ess = float(n_posterior)
+            notes.append(f"posterior: Gaussian surrogate of the log-likelihood (R^2 {r2:.3f} over the evaluations "
+                         "near its top), truncated to the prior box")
+    if surrogate is None:
+        # ABC rejection: the evaluated parameter sets whose log-likelihood is within chi2_d(0.99) / 2 of the best
+        # (the approximate 99 % likelihood region, Wilks), weighted by prior / proposal mixture
+        band = ll_all >= ll_all.max() - 0.5 * stats.chi2.ppf(0.99, d)
+        wb = np.where(band, np.exp(-log_mix(u_all)), 0.0)
+        wb /= wb.sum()
+        ess = float(1.0 / np.sum(wb * wb))
+        pos = (rng_resample.random() + np.arange(n_posterior)) / n_posterior     # systematic resampling
+        idx = np.minimum(np.searchsorted(np.cumsum(wb), pos), wb.size - 1)
+        posterior = pd.DataFrame(theta_all[idx], columns=names)
+        notes.append(f"posterior: ABC rejection of the {int(band.sum())} evaluations within chi2_d(0.99)/2 of the "
+                     "best log-likelihood (no concave quadratic fits it near its top)")
+        if ess < 20:
+            msg = (f"effective sample size of the posterior sample is {ess:.0f} (< 20): the posterior is poorly "
+                   "resolved; raise n_per_iteration or iterations")
+            notes.append(msg)
+            warnings.warn(msg, PooledCalibrationWarning, stacklevel=2)
     for k in names:
         b_lo, b_hi = pool.bounds[k]
         at = np.mean(np.minimum(posterior[k] - b_lo, b_hi - posterior[k]) < 0.01 * (b_hi - b_lo))
@@ -616,100 +642,40 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
             warnings.warn(msg, PooledCalibrationWarning, stacklevel=2)
     coverage = _coverage(pool, releases, posterior, n_predictive, rng_pred)
     return PooledCalibration(parameters={k: float(posterior[k].median()) for k in names}, bounds=dict(pool.bounds),
-                             posterior=posterior, evaluations=evaluations, coverage_table=coverage, ess=post_ess,
+                             posterior=posterior, evaluations=evaluations, coverage_table=coverage, ess=ess,
                              n_per_release=int(n_per_release), seed=seed, releases=tuple(releases),
                              notes=tuple(notes))
 
 
-class _GaussianProcess:
-    """Gaussian-process regression of the simulated log-likelihood on the unit cube (a surrogate).
-
-    Squared-exponential kernel with one length scale per parameter plus a noise term (the Monte Carlo noise of a
-    simulated likelihood), hyperparameters by maximum marginal likelihood (Rasmussen & Williams 2006, ch. 2 and
-    5); the log-likelihood is clipped from below at ``max - 4 chi2_d(0.999)`` so that the far, uninformative
-    region does not decide the fit (as in BOLFI, Gutmann & Corander 2016, JMLR 17:1, and Wilkinson 2014,
-    AISTATS, who model the ABC log-likelihood with a GP).
-    """
-
-    def __init__(self, x, alpha, length, sf2, noise2, y_mean, y_sd):
-        self.x, self.alpha, self.length, self.sf2 = x, alpha, length, sf2
-        self.noise_sd = math.sqrt(noise2) * y_sd
-        self.y_mean, self.y_sd = y_mean, y_sd
-
-    @staticmethod
-    def _kernel(a, b, length, sf2):
-        d2 = np.sum(((a[:, None, :] - b[None, :, :]) / length) ** 2, axis=2)
-        return sf2 * np.exp(-0.5 * d2)
-
-    @classmethod
-    def fit(cls, u, ll):
-        from scipy import optimize
-        d = u.shape[1]
-        y = np.maximum(ll, ll.max() - 4.0 * stats.chi2.ppf(0.999, d))
-        y_mean, y_sd = float(y.mean()), float(max(y.std(), 1e-12))
-        yt = (y - y_mean) / y_sd
-        n = len(yt)
-
-        def nlml(p):
-            length, sf2, noise2 = np.exp(p[:d]), math.exp(2 * p[d]), math.exp(2 * p[d + 1])
-            k = cls._kernel(u, u, length, sf2) + (noise2 + 1e-8) * np.eye(n)
-            try:
-                chol = np.linalg.cholesky(k)
-            except np.linalg.LinAlgError:
-                return 1e10
-            a = np.linalg.solve(chol.T, np.linalg.solve(chol, yt))
-            return 0.5 * yt @ a + np.sum(np.log(np.diag(chol)))
-
-        bounds = [(math.log(0.01), math.log(3.0))] * d + [(math.log(0.1), math.log(10.0)),
-                                                          (math.log(1e-3), math.log(1.0))]
-        best = None
-        for start in (0.2, 0.05):
-            p0 = np.array([math.log(start)] * d + [0.0, math.log(0.05)])
-            res = optimize.minimize(nlml, p0, method="L-BFGS-B", bounds=bounds)
-            if best is None or res.fun < best.fun:
-                best = res
-        p = best.x
-        length, sf2, noise2 = np.exp(p[:d]), math.exp(2 * p[d]), math.exp(2 * p[d + 1])
-        k = cls._kernel(u, u, length, sf2) + (noise2 + 1e-8) * np.eye(n)
-        alpha = np.linalg.solve(k, yt)
-        return cls(u, alpha, length, sf2, noise2, y_mean, y_sd)
-
-    def mean(self, u):
-        """Surrogate log-likelihood at the points u (rows, unit cube)."""
-        out = np.empty(len(u))
-        for i in range(0, len(u), 4096):
-            out[i:i + 4096] = self._kernel(u[i:i + 4096], self.x, self.length, self.sf2) @ self.alpha
-        return out * self.y_sd + self.y_mean
-
-    def posterior_sample(self, n, rng):
-        """n draws (unit cube) from uniform prior x exp(surrogate), and the effective sample size of the final
-        importance weights: a Sobol stage over the box, then a stage from a Gaussian fitted to it (widened)."""
-        d = self.x.shape[1]
-        c1 = stats.qmc.Sobol(d, scramble=True, seed=rng).random(8192)
-        m1 = self.mean(c1)
-        w1 = np.exp(m1 - m1.max())
-        w1 /= w1.sum()
-        mean = w1 @ c1
-        diff = c1 - mean
-        cov = 2.0 * (w1[:, None] * diff).T @ diff + np.eye(d) * (0.5 / 8192 ** (1.0 / d)) ** 2
-        draws = []
-        for _ in range(20):
-            cand = rng.multivariate_normal(mean, cov, size=16384)
-            draws.extend(cand[np.all((cand >= 0) & (cand <= 1), axis=1)].tolist())
-            if len(draws) >= 8192:
-                break
-        if len(draws) < 8192:            # the fitted Gaussian lies mostly outside the box: stay with the Sobol stage
-            pos = (rng.random() + np.arange(n)) / n
-            idx = np.minimum(np.searchsorted(np.cumsum(w1), pos), w1.size - 1)
-            return c1[idx], float(1.0 / np.sum(w1 * w1))
-        c2 = np.array(draws[:8192])
-        lq = stats.multivariate_normal(mean, cov, allow_singular=True).logpdf(c2)
-        lw = self.mean(c2) - lq
-        w2 = np.exp(lw - lw.max())
-        w2 /= w2.sum()
-        pos = (rng.random() + np.arange(n)) / n                    # systematic resampling
-        idx = np.minimum(np.searchsorted(np.cumsum(w2), pos), w2.size - 1)
-        return c2[idx], float(1.0 / np.sum(w2 * w2))
+def _quadratic_surrogate(u, ll):
+    """Gaussian (mean, covariance, R^2) from a quadratic fitted to the log-likelihood ``ll`` at the points ``u``
+    (unit cube) within k chi2_d(0.999) of its maximum, k = 1, 2, 4, 8: the first concave fit (a jagged
+    likelihood gets a wider, smoother fit); None when no fit is concave or there are too few points."""
+    d = u.shape[1]
+    n_coef = 1 + d + d * (d + 1) // 2
+    drop = stats.chi2.ppf(0.999, d)
+    iu = np.triu_indices(d)
+    for widen in (1.0, 2.0, 4.0, 8.0):
+        sel = ll >= ll.max() - widen * drop
+        if sel.sum() < 3 * n_coef:
+            continue
+        us, ys = u[sel], ll[sel]
+        quad = np.einsum("ni,nj->nij", us, us)[:, iu[0], iu[1]]
+        design = np.hstack([np.ones((us.shape[0], 1)), us, quad])
+        coef, *_ = np.linalg.lstsq(design, ys, rcond=None)
+        b = coef[1:1 + d]
+        a = np.zeros((d, d))
+        a[iu] = coef[1 + d:]
+        prec = -(a + a.T)                         # ll = c + b.u + 1/2 u' A u, A = a + a' (diagonal doubled)
+        try:
+            np.linalg.cholesky(prec)
+        except np.linalg.LinAlgError:
+            continue
+        cov = np.linalg.inv(prec)
+        resid = ys - design @ coef
+        r2 = 1.0 - float(np.sum(resid ** 2) / max(np.sum((ys - ys.mean()) ** 2), 1e-300))
+        return cov @ b, cov, r2
+    return None
 
 
 def _coverage(pool, releases, posterior, n_predictive, rng) -> pd.DataFrame:
