@@ -32,7 +32,7 @@ Method
   until the quadratic is concave) and the posterior sample is drawn from that Gaussian truncated to the box
   (Wood 2010, Nature 466:1102, for the Gaussian synthetic-likelihood idea; Wilkinson 2014, AISTATS, for
   surrogates of ABC likelihoods).  When no concave quadratic fits, ABC rejection: the evaluations within
-  chi2_d(0.99) / 2 of the best log-likelihood, weighted by prior / proposal.  ``notes`` says which was used.
+  chi2_d(0.999) of the best log-likelihood, weighted by prior / proposal.  ``notes`` says which was used.
 * **Posterior-predictive coverage.**  For ``n_predictive`` posterior draws every release is simulated again
   (another seed); the share of observed stops inside each release's central 90 % and 99 % predictive intervals
   should be near 0.90 and 0.99 when the model and its fitted parameters describe the data.
@@ -616,16 +616,17 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
             notes.append(f"posterior: Gaussian surrogate of the log-likelihood (R^2 {r2:.3f} over the evaluations "
                          "near its top), truncated to the prior box")
     if surrogate is None:
-        # ABC rejection: the evaluated parameter sets whose log-likelihood is within chi2_d(0.99) / 2 of the best
-        # (the approximate 99 % likelihood region, Wilks), weighted by prior / proposal mixture
-        band = ll_all >= ll_all.max() - 0.5 * stats.chi2.ppf(0.99, d)
+        # ABC rejection: the evaluated parameter sets whose log-likelihood is within chi2_d(0.999) of the best
+        # (twice the drop of the approximate 99.9 % likelihood region, Wilks: the best value of a noisy simulated
+        # likelihood is itself inflated by the noise), weighted by prior / proposal mixture
+        band = ll_all >= ll_all.max() - stats.chi2.ppf(0.999, d)
         wb = np.where(band, np.exp(-log_mix(u_all)), 0.0)
         wb /= wb.sum()
         ess = float(1.0 / np.sum(wb * wb))
         pos = (rng_resample.random() + np.arange(n_posterior)) / n_posterior     # systematic resampling
         idx = np.minimum(np.searchsorted(np.cumsum(wb), pos), wb.size - 1)
         posterior = pd.DataFrame(theta_all[idx], columns=names)
-        notes.append(f"posterior: ABC rejection of the {int(band.sum())} evaluations within chi2_d(0.99)/2 of the "
+        notes.append(f"posterior: ABC rejection of the {int(band.sum())} evaluations within chi2_d(0.999) of the "
                      "best log-likelihood (no concave quadratic fits it near its top)")
         if ess < 20:
             msg = (f"effective sample size of the posterior sample is {ess:.0f} (< 20): the posterior is poorly "

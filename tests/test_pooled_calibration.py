@@ -179,10 +179,15 @@ def authume_releases(half):
 
 
 def test_the_two_halves_of_the_authume_releases_give_overlapping_posteriors():
+    """Each half (44 and 45 releases on both profiles, the a-priori materials of authume_p1/p2.toml, 3 shared
+    parameters) is fitted on its own; their 95 % posterior intervals overlap for every parameter, and at most
+    10 % of each half's observed stops lie beyond their release's predictive p99.  The kernel width floor is 2 m:
+    the observed stops lie up to 10 m to the side of the 2-D section they are projected on (column offset_m)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", simulation.PooledCalibrationWarning)
         fits = [calibrate_pooled(authume_releases(h), PARAMETERS, seed=1, n_per_release=50, n_initial=128,
-                                 n_per_iteration=48, iterations=3, n_predictive=20) for h in (0, 1)]
+                                 n_per_iteration=48, iterations=3, n_predictive=20, obs_error_m=2.0)
+                for h in (0, 1)]
     for k in PARAMETERS:
         (a_lo, a_hi), (b_lo, b_hi) = fits[0].interval(k, 0.95), fits[1].interval(k, 0.95)
         assert a_lo <= b_hi and b_lo <= a_hi, (k, (a_lo, a_hi), (b_lo, b_hi))
