@@ -481,15 +481,22 @@ def _current_value(data: dict, name: str):
 
 
 # ---- the fit ----------------------------------------------------------------------------------------------
-def calibrate(scenario, observed, parameters: dict, *, n: int = 1000, seed=1, distance: str = "wasserstein",
-              collector: str | None = None, maxiter: int = 20, popsize: int = 8, n_bootstrap: int = 200,
-              tol: float = 1e-3) -> Calibration:
+def calibrate(scenario, observed=None, parameters: dict | None = None, *, n: int = 1000, seed=1,
+              distance: str = "wasserstein", collector: str | None = None, maxiter: int = 20, popsize: int = 8,
+              n_bootstrap: int = 200, tol: float = 1e-3, **pooled):
     """Fit scenario parameters to observed stop positions (runout) by minimising a distance between distributions.
+
+    With a list of :class:`simulation.Release` in place of the scenario, the fit is pooled over the releases
+    (each with its own profile, mass, radius, shape and release state) and returns a posterior:
+    ``calibrate(releases, parameters=...)`` is :func:`simulation.pooled.calibrate_pooled` (its keyword
+    arguments ``n_per_release``, ``iterations``, ``n_posterior``, ``n_predictive``, ``obs_error_m``,
+    ``n_initial``, ``n_per_iteration`` are accepted here; ``seed`` is passed on).
 
     Parameters
     ----------
-    scenario : path, dict or Scenario
-        The scenario to calibrate (a Scenario must have been loaded from its TOML file).
+    scenario : path, dict, Scenario or list of Release
+        The scenario to calibrate (a Scenario must have been loaded from its TOML file), or the releases of a
+        pooled calibration.
     observed : array, DataFrame or path
         Observed horizontal stop positions x [m] in the profile's coordinates (an
         array, a DataFrame with ``x_stop_m`` and optionally ``velocity_ms`` /
@@ -514,8 +521,21 @@ def calibrate(scenario, observed, parameters: dict, *, n: int = 1000, seed=1, di
 
     Returns
     -------
-    Calibration
+    Calibration (one scenario) or PooledCalibration (releases)
     """
+    from .pooled import Release, calibrate_pooled
+    if isinstance(scenario, (list, tuple)) and scenario and all(isinstance(r, Release) for r in scenario):
+        if parameters is None and isinstance(observed, dict):
+            observed, parameters = None, observed
+        if observed is not None:
+            raise TypeError("a pooled calibration takes the observed stops from each Release (x_stop_m); "
+                            "pass observed=None and the parameters as parameters=")
+        return calibrate_pooled(scenario, parameters, seed=seed, **pooled)
+    if pooled:
+        raise TypeError(f"calibrate() got keyword arguments {sorted(pooled)} that only a pooled calibration "
+                        "(a list of simulation.Release) takes")
+    if observed is None or parameters is None:
+        raise TypeError("calibrate(scenario, observed, parameters): observed stops and parameters are required")
     if distance not in _DISTANCES:
         raise ValueError(f"distance = {distance!r} is not one of {sorted(_DISTANCES)}")
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 10:

@@ -31,7 +31,9 @@ def _material_arrays(scenario: Scenario):
         m_phi=f("friction_deg"), m_phi_std=f("friction_std_deg"), m_rough=f("roughness_m"),
         m_roll=np.array([m.ground_motion == "roll" for m in mats]),
         m_mu_ground=np.tan(np.radians(f("ground_friction_deg"))),
-        m_gain=np.array([m.allow_energy_gain for m in mats]))
+        m_gain=np.array([m.allow_energy_gain for m in mats]),
+        m_en_v0=f("en_velocity_scale_ms"), m_hop=f("hop_height_m"),
+        m_drag=f("rolling_drag"), m_size_k=f("rolling_size_coefficient"))
 
 
 def check_masses(masses_kg, n=None) -> np.ndarray:
@@ -59,8 +61,15 @@ def seed_blocks(scenario: Scenario, n: int, seed, masses_kg=None) -> dict:
     x = g_x.uniform(sd.x_low, sd.x_high, n) if sd.x_high > sd.x_low else np.full(n, sd.x_low)
     h = sd.height_m.sample(g_h, n)
     mass = sd.mass_kg.sample(g_m, n) if masses_kg is None else check_masses(masses_kg, n).copy()
-    return {"x": x, "z": scenario.profile.ground(x) + h, "vx": sd.vx_ms.sample(g_vx, n),
-            "vz": sd.vz_ms.sample(g_vz, n), "w": sd.angular_velocity_rads.sample(g_w, n),
+    vx, vz = sd.vx_ms.sample(g_vx, n), sd.vz_ms.sample(g_vz, n)
+    if sd.downslope_speed_ms is not None:
+        # a push along the ground under the release point, in its falling sense (+x on flat ground): a block
+        # released on ground flatter than its rolling-resistance angle then still starts (its own stream)
+        u = sd.downslope_speed_ms.sample(np.random.default_rng(ss.spawn(1)[0]), n)
+        cos_b, sin_b = scenario.profile.downslope_direction(x)
+        vx, vz = vx + u * cos_b, vz + u * sin_b
+    return {"x": x, "z": scenario.profile.ground(x) + h, "vx": vx,
+            "vz": vz, "w": sd.angular_velocity_rads.sample(g_w, n),
             "mass": mass, "radius": sd.radius(mass), "inertia_factor": np.full(n, sd.inertia_factor)}
 
 
@@ -165,6 +174,8 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
                 prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.material_index, prof.run_first, prof.run_last,
                 **mats, c_x=c_x, c_cap=c_cap, c_h=c_h, c_order=c_order, env_x=env_x, env_acc=env_chunk,
                 g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
+                sin_max_roll=float(np.sin(np.radians(st.max_rolling_slope_deg))) if st.max_rolling_slope_deg < 90
+                else 1.0,
                 max_events=st.max_events, key=key, n_path_blocks=n_paths,
                 out_x=per_block["x"][lo:hi], out_z=per_block["z"][lo:hi], out_reason=per_block["reason"][lo:hi],
                 out_impacts=per_block["impacts"][lo:hi], out_t=per_block["t"][lo:hi],

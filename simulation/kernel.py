@@ -20,7 +20,10 @@ import math
 import numpy as np
 from numba import njit
 
-from .impact import EN_WYLLIE, impact_body
+from .contact import (EN_WYLLIE, contact_acceleration, contact_speed, contact_speed_at,  # noqa: F401
+                      contact_stop_distance, contact_time, rebound, roll_on_speed, rolling_resistance,
+                      roughness_tilt_max,
+                      steep_face_launch)
 from .units import J_PER_KJ
 
 # Stop reasons.
@@ -263,18 +266,6 @@ def _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, block, t, x
 
 
 @njit(cache=True)
-def roll_on_speed(v_along, w, r, k):
-    """Speed [m/s] along the surface of a round body that starts rolling without slip.
-
-    Angular momentum about the contact point is conserved through the (slip-killing) transition:
-    m v r + k m r^2 w = (m r + k m r^2 / r) v'  =>  v' = (v + k r w) / (1 + k), w' = v' / r,
-    with I = k m r^2 (k = 2/5 sphere, 1/2 cylinder) and w > 0 meaning rolling in the +v direction.
-    Kinetic energy never increases through it (it falls by 1/2 m k (v - r w)^2 / (1 + k)).
-    """
-    return (v_along + k * r * w) / (1.0 + k)
-
-
-@njit(cache=True)
 def barrier_outcome(energy_kj, centre_height_m, radius_m, capacity_kj, height_m):
     """Outcome of a block meeting a flexible barrier, and the share of its kinetic energy kept.
 
@@ -355,17 +346,14 @@ def _envelope_flight(env_x, env_acc, xa, xb, x0, z0, vx, vz, w, g, px, pz, mass,
 
 @njit(cache=True)
 def _envelope_contact(env_x, env_acc, xa, xb, x0, mass, inertia, r, contact_speed0, contact_a, contact_dir, cosb,
-                      roll):
-    """Envelope bins between xa and xb crossed in ground contact (constant acceleration contact_a along the
+                      roll, drag):
+    """Envelope bins between xa and xb crossed in ground contact (acceleration contact_a - drag v^2 along the
     slope from speed contact_speed0 at x0; spin v/r when rolling, none when sliding; height 0)."""
     i0 = _first_at_least(env_x, min(xa, xb))
     i1 = _first_at_least(env_x, max(xa, xb))
     for i in range(i0, i1):
         s = contact_dir * (env_x[i] - x0) / cosb
-        if abs(contact_a) < 1e-12:
-            sp = contact_speed0
-        else:
-            sp = math.sqrt(max(contact_speed0 * contact_speed0 + 2.0 * contact_a * s, 0.0))
+        sp = contact_speed_at(contact_speed0, contact_a, drag, s)
         _envelope_add(env_acc, i, sp, 0.0, _kinetic_kj(mass, sp * sp, inertia, sp / r if roll else 0.0))
 
 
@@ -373,9 +361,9 @@ def _envelope_contact(env_x, env_acc, xa, xb, x0, mass, inertia, r, contact_spee
 def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
              px, pz, tree, n_leaves, seg_mat, run_first, run_last,
              m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
-             m_roll, m_mu_ground, m_gain,
+             m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k,
              c_x, c_cap, c_h, c_order, env_x, env_acc,
-             g, v_contact, v_stop, max_events, key, n_path_blocks,
+             g, v_contact, v_stop, sin_max_roll, max_events, key, n_path_blocks,
              out_x, out_z, out_reason, out_impacts, out_t,
              r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
              pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount):
@@ -387,6 +375,11 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
     only remove energy, unless a material sets ``allow_energy_gain``.
     ``c_order`` lists the collectors by increasing x, the order in which a block moving downslope crosses them
     (sorted by the caller: a sort compiled here would add about 2 s to the first compilation).
+    The contact laws are those of :mod:`simulation.contact`: ``m_en_v0`` the velocity scale of e_N [m/s] (inf:
+    none), ``m_hop`` the hop height [m] below which a rebound is ground contact (:func:`contact_speed`), and
+    ``m_size_k`` the size term of the rolling resistance (:func:`rolling_resistance`), ``m_drag`` the rolling drag (the contact's v^2 resistance c = m_drag / r [1/m], :func:`contact_speed_at`),
+    ``sin_max_roll`` the sine of the steepest slope a block may roll or slide on in contact (1: any slope);
+    on steeper segments it leaves the face (:func:`steep_face_launch`) and meets it in impacts.
     """
     n_coll = c_x.shape[0]
     n_seg = px.shape[0] - 1
@@ -493,7 +486,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 impacts += 1
                 mat = seg_mat[k]
                 beta = math.atan2(pz[k + 1] - pz[k], px[k + 1] - px[k])
-                theta_max = math.atan(m_rough[mat] / r) if r > 0 else 0.0
+                theta_max = roughness_tilt_max(m_rough[mat], r)
                 delta = (2.0 * _uniform(state) - 1.0) * theta_max
                 bp = beta + delta
                 vn = -vx * math.sin(bp) + vz * math.cos(bp)
@@ -513,16 +506,27 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 phi = m_phi[mat] + (m_phi_std[mat] * _normal(state) if m_phi_std[mat] > 0 else 0.0)
                 mu = math.tan(math.radians(min(max(phi, 0.0), 89.0)))
                 if vn < 0.0:
-                    vn2, vt2, w, _ = impact_body(vn, vt, w, r, m_en_law[mat], en, m_et_law[mat], et, mu, gain, k_in)
+                    vn2, vt2, w, _ = rebound(vn, vt, w, r, k_in, m_en_law[mat], en, m_en_v0[mat], m_et_law[mat], et,
+                                             mu, gain)
                 else:
                     vn2, vt2 = 0.0, vt
                 vx = vt2 * math.cos(bp) - vn2 * math.sin(bp)
                 vz = vt2 * math.sin(bp) + vn2 * math.cos(bp)
                 vn_true = -vx * math.sin(beta) + vz * math.cos(beta)
+                v_thr = contact_speed(v_contact, g, math.cos(beta), m_hop[mat])
+                if vn_true < v_thr and abs(math.sin(beta)) > sin_max_roll:
+                    # A face too steep to roll on: the block leaves it again (speed kept), no ground contact.
+                    vt_true = vx * math.cos(beta) + vz * math.sin(beta)
+                    vt_new, vn_new = steep_face_launch(vt_true, v_thr)
+                    vx = vt_new * math.cos(beta) - vn_new * math.sin(beta)
+                    vz = vt_new * math.sin(beta) + vn_new * math.cos(beta)
+                    vn_true = vn_new
+                    if vn_new <= 0.0:            # at rest against the face: step off it horizontally
+                        x = _step_off(px, k, x, math.sin(beta))
                 if record:
                     _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
                                  MODE_FLIGHT, EV_IMPACT)
-                if vn_true < v_contact:
+                if vn_true < v_thr and not abs(math.sin(beta)) > sin_max_roll:
                     # Ground contact: the normal component is lost; a rolling material makes the block roll
                     # without slip, conserving angular momentum about the contact point.
                     contact = True
@@ -545,9 +549,20 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             sinb_raw = pz[k + 1] - pz[k]
             ls = math.sqrt(cosb_raw * cosb_raw + sinb_raw * sinb_raw)
             cosb, sinb = cosb_raw / ls, sinb_raw / ls
-            mu = m_mu_ground[mat]
+            mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r)
             roll = m_roll[mat]
-            factor = 1.0 / (1.0 + k_in) if roll else 1.0     # rolling sphere: 5/7
+            if abs(sinb) > sin_max_roll:
+                # No rolling or sliding in contact on a face this steep: the block leaves it (speed kept).
+                vt_new, vn_new = steep_face_launch(v_along, contact_speed(v_contact, g, cosb, m_hop[mat]))
+                vx = vt_new * cosb - vn_new * sinb
+                vz = vt_new * sinb + vn_new * cosb
+                if vn_new <= 0.0:
+                    x = _step_off(px, k, x, sinb)
+                contact = False
+                if record:
+                    _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
+                                 MODE_FLIGHT, EV_TAKEOFF)
+                continue
             if abs(v_along) < v_stop or v_along == 0.0:
                 if abs(sinb) <= mu * cosb or _at_trough(px, pz, k, x):
                     reason = STOPPED
@@ -560,7 +575,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 v_along = 0.0
             else:
                 direction = 1.0 if v_along > 0 else -1.0
-            a_dir = factor * (-g * sinb * direction - mu * g * cosb)   # acceleration along the motion
+            a_dir = contact_acceleration(g, sinb, cosb, direction, mu, k_in, roll)   # along the motion
+            drag = m_drag[mat] / r if r > 0.0 else 0.0
             u = abs(v_along)
             # Collinear segments of the same material are crossed in one step.
             if direction > 0:
@@ -569,18 +585,16 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             else:
                 k_far = run_first[k]
                 dist = (x - px[k_far]) / cosb
-            stops_here = a_dir < 0 and u * u < -2.0 * a_dir * dist
+            d_stop = contact_stop_distance(u, a_dir, drag)
+            stops_here = d_stop < dist
             if stops_here:
-                t_step = u / (-a_dir)
-                d_step = u * u / (-2.0 * a_dir)
+                d_step = d_stop
                 u_end = 0.0
+                t_step = contact_time(u, 0.0, a_dir, drag, d_step)
             else:
-                u_end = math.sqrt(max(u * u + 2.0 * a_dir * dist, 0.0))
-                if abs(a_dir) > 1e-12:
-                    t_step = (u_end - u) / a_dir
-                elif u > 0:
-                    t_step = dist / u
-                else:
+                u_end = contact_speed_at(u, a_dir, drag, dist)
+                t_step = contact_time(u, u_end, a_dir, drag, dist)
+                if t_step < 0.0:
                     reason = STOPPED
                     if record:
                         _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, 0.0, 0.0,
@@ -597,12 +611,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 s_c = cross_t[j]
                 if not (1e-12 < s_c <= d_step):
                     continue
-                if abs(a_dir) < 1e-12:
-                    tc = s_c / u
-                    uc = u
-                else:
-                    uc = math.sqrt(max(u * u + 2.0 * a_dir * s_c, 0.0))
-                    tc = (uc - u) / a_dir
+                uc = contact_speed_at(u, a_dir, drag, s_c)
+                tc = contact_time(u, uc, a_dir, drag, s_c)
                 wc = direction * uc / r if roll else 0.0
                 vxc, vzc = direction * uc * cosb, direction * uc * sinb
                 outcome, keep = _meet_collector(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
@@ -611,7 +621,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
                     if env_x.shape[0] > 0:
                         _envelope_contact(env_x, env_acc, x, c_x[j], x, mass, inertia, r, u, a_dir, direction,
-                                          cosb, roll)
+                                          cosb, roll, drag)
                     t_abs += tc
                     x = c_x[j]
                     z = _ground(px, pz, x)
@@ -630,7 +640,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             if cut:
                 continue
             if env_x.shape[0] > 0:
-                _envelope_contact(env_x, env_acc, x, x_new, x, mass, inertia, r, u, a_dir, direction, cosb, roll)
+                _envelope_contact(env_x, env_acc, x, x_new, x, mass, inertia, r, u, a_dir, direction, cosb, roll, drag)
             t_abs += t_step
             x = x_new
             z = pz[k] + (pz[k + 1] - pz[k]) * (x - px[k]) / (px[k + 1] - px[k])
@@ -659,7 +669,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             # A convex edge launches the block when its speed away from the next segment reaches the
             # contact velocity; below it the block stays in contact (as a landing below it would), so a
             # finely kinked terrain profile is not turned into thousands of micro-flights and impacts.
-            if -vxe * sin2 + vze * cos2 >= v_contact:
+            if -vxe * sin2 + vze * cos2 >= contact_speed(v_contact, g, cos2, m_hop[seg_mat[k2]]):
                 contact = False            # convex edge: the block takes off
                 vx, vz = vxe, vze
                 seg = k2
@@ -682,6 +692,15 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z,
                                  v_along * cos2, v_along * sin2, w, MODE_CONTACT, EV_VERTEX)
         out_x[b], out_z[b], out_reason[b], out_impacts[b], out_t[b] = x, z, reason, impacts, t_abs
+
+
+@njit(cache=True)
+def _step_off(px, k, x, sin_beta):
+    """x moved off a steep face horizontally, away from the rock (by 1e-6 of a metre, within segment k), so a
+    block at rest against the face falls onto it from just above (no energy is created: z is unchanged)."""
+    dx = 1e-6 * (1.0 + abs(x))
+    x2 = x + dx if sin_beta < 0.0 else x - dx
+    return min(max(x2, px[k]), px[k + 1])
 
 
 @njit(cache=True)

@@ -15,7 +15,7 @@ import numpy as np
 from scipy import stats
 
 from .materials import PresetError, resolve_material
-from .impact import EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_FRICTION
+from .contact import CRSP_VELOCITY_SCALE_MS, EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_COULOMB, ET_FRICTION
 from .slope import Profile
 from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2
 
@@ -144,7 +144,16 @@ class Material:
     ``roughness_m``: asperity amplitude; the slope angle at an impact is perturbed
     uniformly within +-atan(roughness / block radius);
     ``ground_motion``: ``"roll"`` (sphere rolling, a = 5/7 g (sin psi - tan(phi_g) cos psi))
-    or ``"slide"`` (a = g (sin psi - tan(phi_g) cos psi)), phi_g = ``ground_friction_angle_deg``.
+    or ``"slide"`` (a = g (sin psi - tan(phi_g) cos psi)), phi_g = ``ground_friction_angle_deg``: tan(phi_g)
+    is the rolling-resistance coefficient mu_r (resisting torque mu_r N r);
+    ``en_velocity_scale_ms``: v0 of the Pfeiffer & Bowen (1989) scaling e_N / (1 + (v_n / v0)^2) (inf: none;
+    ``normal_restitution.velocity_scale_ms`` in a file); ``hop_height_m``: a rebound that would rise less
+    than this above the surface is ground contact (``contact_hop_height_m``; 0: the numerical
+    ``contact_velocity_ms`` alone decides, as before); ``rolling_drag`` kappa [-]: in ground contact the block
+    also decelerates by (kappa / r) v^2 (rolling over asperities, ploughing; 0: none);
+    ``rolling_size_coefficient`` K [-]: the rolling resistance is tan(phi_g) + K roughness / r, so small blocks
+    stop sooner (0: tan(phi_g) alone).
+    See :mod:`simulation.contact`.
     """
 
     name: str
@@ -160,6 +169,10 @@ class Material:
     ground_motion: str
     ground_friction_deg: float
     allow_energy_gain: bool
+    en_velocity_scale_ms: float = math.inf
+    hop_height_m: float = 0.0
+    rolling_drag: float = 0.0
+    rolling_size_coefficient: float = 0.0
 
     @classmethod
     def parse(cls, name: str, spec: dict, source: str) -> "Material":
@@ -170,7 +183,9 @@ class Material:
         if not isinstance(spec, dict):
             raise ScenarioError(f"{source}: materials.{name} must be a table of material fields; got {spec!r}")
         _check_keys(spec, {"preset", "normal_restitution", "tangential", "roughness_m", "ground_motion",
-                           "ground_friction_angle_deg", "allow_energy_gain"}, where, source)
+                           "ground_friction_angle_deg", "rolling_resistance", "allow_energy_gain",
+                           "contact_hop_height_m", "rolling_drag", "rolling_size_coefficient"}, where, source)
+        given = set(spec)
         if "preset" in spec:            # a named material from published ranges (simulation.materials)
             try:
                 spec = resolve_material(spec, f"materials.{name}", source)
@@ -185,7 +200,7 @@ class Material:
             en = {"law": "constant", "mean": en}
         if not isinstance(en, dict):
             raise ScenarioError(f"{source}: {where}normal_restitution must be a number, a law name or a table")
-        _check_keys(en, {"law", "mean", "std"}, f"{where}normal_restitution.", source)
+        _check_keys(en, {"law", "mean", "std", "velocity_scale_ms"}, f"{where}normal_restitution.", source)
         laws = {"constant": EN_CONSTANT, "wyllie": EN_WYLLIE, "velocity": EN_VELOCITY}
         if en.get("law", "constant") not in laws:
             raise ScenarioError(f"{source}: {where}normal_restitution.law = {en.get('law')!r} is not one of "
@@ -198,6 +213,14 @@ class Material:
         en_mean = 0.0 if en_law == EN_WYLLIE else _number(en.get("mean"), f"{where}normal_restitution.mean",
                                                            source, lo=0.0, hi=en_max)
         en_std = _number(en.get("std", 0.0), f"{where}normal_restitution.std", source, lo=0.0, hi=1.0)
+        en_v0 = math.inf
+        if "velocity_scale_ms" in en:
+            if en_law == EN_VELOCITY:
+                raise ScenarioError(f"{source}: {where}normal_restitution.velocity_scale_ms is not used with law "
+                                    f"'velocity' (which scales by {CRSP_VELOCITY_SCALE_MS} m/s itself); use law "
+                                    "'constant' with velocity_scale_ms to choose the scale")
+            en_v0 = _number(en["velocity_scale_ms"], f"{where}normal_restitution.velocity_scale_ms", source,
+                            lo=0.0, hi=1e6, lo_open=True)
 
         et = spec.get("tangential", {"law": "friction", "friction_angle_deg": 30.0})
         if not isinstance(et, dict):
@@ -210,13 +233,30 @@ class Material:
             phi_std = _number(et.get("std_deg", 0.0), f"{where}tangential.std_deg", source, lo=0.0, hi=30.0)
         elif et["law"] == "constant":
             et_law, phi, phi_std = ET_CONSTANT, 0.0, 0.0
+            if "friction_angle_deg" in et:
+                raise ScenarioError(f"{source}: {where}tangential.friction_angle_deg is not used by law 'constant'; "
+                                    "law 'coulomb' bounds e_T by friction")
             et_mean = _number(et.get("mean"), f"{where}tangential.mean", source, lo=0.0, hi=en_max)
             et_std = _number(et.get("std", 0.0), f"{where}tangential.std", source, lo=0.0, hi=1.0)
+        elif et["law"] == "coulomb":
+            et_law = ET_COULOMB
+            et_mean = _number(et.get("mean"), f"{where}tangential.mean", source, lo=0.0, hi=1.0)
+            et_std = _number(et.get("std", 0.0), f"{where}tangential.std", source, lo=0.0, hi=1.0)
+            phi = _number(et.get("friction_angle_deg", 30.0), f"{where}tangential.friction_angle_deg", source,
+                          lo=0.0, hi=89.0)
+            phi_std = _number(et.get("std_deg", 0.0), f"{where}tangential.std_deg", source, lo=0.0, hi=30.0)
         else:
-            raise ScenarioError(f"{source}: {where}tangential.law = {et['law']!r} is not 'friction' or 'constant'")
+            raise ScenarioError(f"{source}: {where}tangential.law = {et['law']!r} is not 'friction', 'constant' "
+                                "or 'coulomb'")
         motion = spec.get("ground_motion", "roll")
         if motion not in ("roll", "slide"):
             raise ScenarioError(f"{source}: {where}ground_motion = {motion!r} is not 'roll' or 'slide'")
+        if "rolling_resistance" in spec:
+            if "ground_friction_angle_deg" in given:
+                raise ScenarioError(f"{source}: {where}rolling_resistance and ground_friction_angle_deg both given; "
+                                    "they are one quantity (rolling_resistance = tan(ground_friction_angle_deg))")
+            mu_r = _number(spec["rolling_resistance"], f"{where}rolling_resistance", source, lo=0.0, hi=50.0)
+            spec = dict(spec, ground_friction_angle_deg=math.degrees(math.atan(mu_r)))
         return cls(name=name, en_law=en_law, en_mean=en_mean, en_std=en_std, et_law=et_law, et_mean=et_mean,
                    et_std=et_std, friction_deg=phi, friction_std_deg=phi_std,
                    roughness_m=_number(spec.get("roughness_m", 0.0), f"{where}roughness_m", source, lo=0.0, hi=10.0),
@@ -224,7 +264,12 @@ class Material:
                    ground_friction_deg=_number(spec.get("ground_friction_angle_deg", 30.0 if motion == "slide"
                                                         else 15.0), f"{where}ground_friction_angle_deg", source,
                                                lo=0.0, hi=89.0),
-                   allow_energy_gain=gain)
+                   allow_energy_gain=gain, en_velocity_scale_ms=en_v0,
+                   hop_height_m=_number(spec.get("contact_hop_height_m", 0.0), f"{where}contact_hop_height_m",
+                                        source, lo=0.0, hi=10.0),
+                   rolling_drag=_number(spec.get("rolling_drag", 0.0), f"{where}rolling_drag", source, lo=0.0, hi=10.0),
+                   rolling_size_coefficient=_number(spec.get("rolling_size_coefficient", 0.0),
+                                                    f"{where}rolling_size_coefficient", source, lo=0.0, hi=10.0))
 
 
 #: I / (m r^2) of the block shapes: a solid sphere, and a solid cylinder (disc, wheel) rolling on its rim.
@@ -234,8 +279,15 @@ class Material:
 class Seeder:
     """Where blocks start: a point or a line (uniform in x) at ``height_m`` above the ground.
 
-    ``shape`` "sphere" (radius from mass and density) or "cylinder" (a disc or
-    wheel rolling on its rim, length = ``aspect_ratio`` x diameter).
+    ``shape`` "sphere" (radius from mass and density), "cylinder" (a wheel rolling on its rim, length =
+    ``aspect_ratio`` x diameter) or "disc" (a plate rolling on its rim, thickness = ``aspect_ratio`` x
+    diameter, default 0.3); the shape sets the inertia factor I / (m r^2) (2/5, 1/2, 1/2), which sets how
+    a block shares its energy between translation and spin at impacts and in rolling (a rolling sphere
+    accelerates at 5/7 g sin psi, a cylinder or disc at 2/3), and, with the mass and density, the radius
+    (a flat disc of a given mass has a larger radius than a sphere, so it sees a smoother slope).
+    ``downslope_speed_ms`` [m/s]: a release speed along the ground under the release point, in its falling
+    sense (a push, so blocks released on ground flatter than their rolling-resistance angle still start;
+    None: no push).
     """
 
     x_low: float
@@ -248,10 +300,11 @@ class Seeder:
     angular_velocity_rads: Distribution
     shape: str = "sphere"
     aspect_ratio: float = 1.0
+    downslope_speed_ms: Distribution | None = None
 
     def radius(self, mass):
         """Radius [m] of blocks of the given masses [kg]."""
-        if self.shape == "cylinder":          # m = rho pi r^2 (2 r aspect)
+        if self.shape in ("cylinder", "disc"):          # m = rho pi r^2 (2 r aspect)
             return (mass / (2.0 * np.pi * self.density_kg_m3 * self.aspect_ratio)) ** (1.0 / 3.0)
         return (3.0 * mass / (4.0 * np.pi * self.density_kg_m3)) ** (1.0 / 3.0)
 
@@ -283,13 +336,18 @@ class Settings:
     ``gravity_ms2`` [m/s^2] (default 9.81); ``contact_velocity_ms`` [m/s]: rebounds slower than this, normal to
     the slope, turn into rolling or sliding; ``stop_velocity_ms`` [m/s]: slower than this with static friction
     holding, the block stops; ``max_events``: per block (reaching it is reported); ``envelope_bins``: bins along
-    x for the envelopes (0 = off).
+    x for the envelopes (0 = off); ``max_rolling_slope_deg`` [deg]: no rolling or sliding in ground contact on
+    segments steeper than this -- a block there leaves the face and meets it in impacts (90, the default: any
+    slope; :func:`simulation.contact.steep_face_launch`).  With a material's ``contact_hop_height_m`` > 0 the
+    contact velocity is only a numerical floor under the hop speed sqrt(2 g cos(beta) h)
+    (:func:`simulation.contact.contact_speed`).
     """
     gravity_ms2: float = STANDARD_GRAVITY_MS2
     contact_velocity_ms: float = 0.5
     stop_velocity_ms: float = 0.05
     max_events: int = 5000
     envelope_bins: int = 50
+    max_rolling_slope_deg: float = 90.0
 
 
 @dataclass(frozen=True)
@@ -362,7 +420,7 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
 
     sd = data["seeder"]
     _check_keys(sd, {"type", "x", "height_m", "mass_kg", "density_kg_m3", "vx_ms", "vz_ms",
-                     "angular_velocity_rads", "shape", "aspect_ratio"}, "seeder.", source)
+                     "angular_velocity_rads", "shape", "aspect_ratio", "downslope_speed_ms"}, "seeder.", source)
     shape = sd.get("shape", "sphere")
     if shape not in INERTIA_FACTORS:
         raise ScenarioError(f"{source}: seeder.shape = {shape!r} is not one of {sorted(INERTIA_FACTORS)}")
@@ -393,8 +451,10 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
         vz_ms=Distribution.parse(sd.get("vz_ms", 0.0), "seeder.vz_ms", source, lo=-200, hi=200),
         angular_velocity_rads=Distribution.parse(sd.get("angular_velocity_rads", 0.0),
                                                  "seeder.angular_velocity_rads", source, lo=-1e3, hi=1e3),
-        shape=shape, aspect_ratio=_number(sd.get("aspect_ratio", 1.0), "seeder.aspect_ratio", source, lo=0.01,
-                                          hi=100.0))
+        shape=shape, aspect_ratio=_number(sd.get("aspect_ratio", 0.3 if shape == "disc" else 1.0),
+                                          "seeder.aspect_ratio", source, lo=0.01, hi=100.0),
+        downslope_speed_ms=(Distribution.parse(sd["downslope_speed_ms"], "seeder.downslope_speed_ms", source, lo=0.0,
+                                               hi=200.0) if "downslope_speed_ms" in sd else None))
 
     collectors = []
     for i, c in enumerate(data.get("collectors", [])):
@@ -425,7 +485,9 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
                                     lo=0.0, lo_open=True),
         stop_velocity_ms=_number(st.get("stop_velocity_ms", 0.05), "settings.stop_velocity_ms", source, lo=0.0),
         max_events=int(_number(st.get("max_events", 5000), "settings.max_events", source, lo=1)),
-        envelope_bins=int(_number(st.get("envelope_bins", 50), "settings.envelope_bins", source, lo=0, hi=10000)))
+        envelope_bins=int(_number(st.get("envelope_bins", 50), "settings.envelope_bins", source, lo=0, hi=10000)),
+        max_rolling_slope_deg=_number(st.get("max_rolling_slope_deg", 90.0), "settings.max_rolling_slope_deg",
+                                      source, lo=0.0, hi=90.0, lo_open=True))
     return Scenario(name=str(data.get("name", Path(source).stem)), description=str(data.get("description", "")),
                     profile=profile, materials=materials, seeder=seeder, collectors=tuple(collectors),
                     settings=settings, source=source)

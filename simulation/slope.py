@@ -93,6 +93,17 @@ class Profile:
         """Index of the segment below x (the left one at a vertex)."""
         return np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, self.n_segments - 1)
 
+    def downslope_direction(self, x):
+        """(cos, sin) of the unit vector along the ground at x [m] pointing down the slope (+x on flat ground).
+
+        The segment under x decides (the left one at a vertex).  Arrays in, arrays out.
+        """
+        k = self.segment_at(np.asarray(x, dtype=float))
+        dx, dz = self.x[k + 1] - self.x[k], self.z[k + 1] - self.z[k]
+        length = np.hypot(dx, dz)
+        sign = np.where(dz > 0.0, -1.0, 1.0)          # rising in +x: downhill is -x
+        return sign * dx / length, sign * dz / length
+
     def contains(self, x) -> bool:
         """Whether abscissa ``x`` [m] lies within the profile."""
         return bool(self.x[0] <= x <= self.x[-1])

@@ -24,8 +24,8 @@ SPHERE_INERTIA = 0.4
 CYLINDER_INERTIA = 0.5
 """I / (m r^2) of a solid cylinder or disc rolling on its curved face, 1/2."""
 
-INERTIA_FACTORS = {"sphere": SPHERE_INERTIA, "cylinder": CYLINDER_INERTIA}
-"""I / (m r^2) by block shape."""
+INERTIA_FACTORS = {"sphere": SPHERE_INERTIA, "cylinder": CYLINDER_INERTIA, "disc": CYLINDER_INERTIA}
+"""I / (m r^2) by block shape (a disc or plate rolls on its rim like a short cylinder: 1/2)."""
 
 
 def kinetic_energy_kj(mass_kg, speed_ms, angular_velocity_rads=0.0, radius_m=0.0, inertia_factor=SPHERE_INERTIA):

@@ -1,0 +1,410 @@
+"""Contact laws of a block with the ground, shared by the 2-D kernel and any other kernel.
+
+Every function here is a numba ``njit`` function of scalars (no arrays, no objects), so a kernel in
+another geometry (a 3-D kernel working in the local frame of the impacted facet) calls the same laws:
+pass the velocity decomposed in the local frame of the (possibly roughness-tilted) surface and the
+block's radius and inertia factor, get the outgoing state back.  Units: m, s, rad; velocities in m/s.
+
+Conventions: ``vn`` is the velocity component along the outward normal (negative when approaching),
+``vt`` the component along the surface tangent, ``w`` the angular velocity [rad/s] with the sign
+convention that rolling without slip means ``vt = r w``, so the slip velocity of the contact point is
+``vt - r w``; ``k`` is the inertia factor I / (m r^2) (2/5 solid sphere, 1/2 cylinder or disc).
+
+What the module holds
+---------------------
+* the impact (rebound) laws: normal restitution by law, optionally scaled by the impact velocity, and the
+  tangential laws below (:func:`rebound`, and its older form :func:`impact_body`);
+* the roughness tilt amplitude relative to the block radius (:func:`roughness_tilt_max`);
+* the switch between flight and ground contact (:func:`contact_speed`): a physical hop height, with the
+  scenario's ``contact_velocity_ms`` only a numerical floor under it;
+* rolling and sliding in contact (:func:`contact_acceleration`, :func:`roll_on_speed`);
+* the steep-face rule (:func:`steep_face_launch`): on faces steeper than a stated angle a block does not
+  roll in contact; it leaves the face and meets it again in impacts.
+
+Impact of a rotating body on a slope surface (Wyllie 2014, chapters 4 and 5)
+-----------------------------------------------------------------------------
+
+Normal restitution laws (``EN_*`` codes)
+---------------------------------------
+* ``EN_CONSTANT``: e_N given (sampled per impact when a spread is given).
+* ``EN_WYLLIE``: e_N = 19.5 theta_i^-1.03 with theta_i the impact angle in degrees between the
+  incoming velocity and the surface (Wyllie 2014, "Calibration of rock fall modeling parameters",
+  IJRMMS 67:170-180: field impacts at five sites; and the "Coefficient of restitution" part of
+  Wyllie's 2014 UBC PhD thesis, "Rock fall engineering: development and calibration of an improved
+  model ...", on which his book Rock Fall Engineering draws; the book's equation number is not cited
+  because no copy was at hand to check it).  It exceeds 1 below theta_i = 17.9 deg: Wyllie's
+  definition is kinematic (normal speeds), and at shallow angles the normal rebound is fed by the
+  tangential velocity lost to friction and rotation.  It is capped at ``EN_WYLLIE_MAX`` = 2.5, the
+  largest value Wyllie measured.
+* ``EN_VELOCITY``: e_N / (1 + (|v_n| / 9.144 m/s)^2), the CRSP "scale by
+  velocity" form (Pfeiffer & Bowen 1989; RocFall "scale Rn by velocity").
+
+Spread of Wyllie's law: the scenario's ``std`` is added to the law's value at each
+impact (``e_n`` passed to :func:`normal_restitution` is then that deviation).
+
+Energy guard (unless ``allow_energy_gain``): no impact creates kinetic energy, and a
+shallow impact is never lossless.  Wyllie's e_N is kinematic (a ratio of normal speeds
+measured in the field, Wyllie 2014 section 5.3; Wyllie, IJRMMS 67: 170-180): it exceeds 1
+at shallow angles because the rebound is fed by the tangential motion (block shape and
+rotation).  So with Wyllie's law (or a typed e_N > 1) the normal impact itself returns only
+the share sin^2(theta_i) of its elastic part, min(e_N, 1)^2 v_n^2, where theta_i is the
+impact angle; the rest of the rebound e_N^2 v_n^2 is drawn from the tangential and rotational
+energy that the tangential law leaves, and if that is not enough the rebound is reduced.
+The rebound speed is Wyllie's e_N |v_n| whenever the tangential energy suffices (at 90 deg
+e_N = 0.19 exactly); what the normal impact does not return is paid by the tangential motion,
+e_N^2 v_n^2 cos^2(theta_i) per unit mass, so at intermediate angles an impact also costs some
+tangential energy (a rolling block at 30 deg with e_T = 1 keeps 82 % of its energy, not the 87 % a
+purely normal loss would give), while a grazing impact loses nearly all of 1/2 m v_n^2: a rolling block
+hopping at 17.9 deg (e_N = 1) loses sin^2 cos^2 = 8.6 % of its translational energy at every
+impact, and
+the loss is continuous in the angle.  This split is a modelling choice, stated as one.
+With a constant or velocity-scaled e_N <= 1 the laws dissipate by themselves (Stronge 2000)
+and the guard acts only on a tangential coefficient e_T > 1.  The energy out never exceeds
+the energy in.
+
+Tangential laws (``ET_*`` codes)
+--------------------------------
+* ``ET_FRICTION``: the rough rotating sphere of Stronge (2000) as set out by
+  Wyllie (2014, ch. 5): the normal impulse is m (1 + e_N)|v_n|; the tangential
+  impulse needed to stop slip is (2/7) m |slip| for a solid sphere (I = 2/5 m r^2),
+  |slip| / (1 + 1/k) m for a round body with I = k m r^2 (k = 1/2: cylinder, disc).
+  If that is within mu (1 + e_N)|v_n| the contact sticks and the sphere leaves
+  rolling with v_t' = 5/7 v_t + 2/7 r w, w' = v_t'/r; otherwise it slips
+  throughout and friction mu (1 + e_N)|v_n| acts against the slip.
+* ``ET_CONSTANT``: v_t' = e_T v_t (the lumped-mass tangential coefficient of
+  RocFall/CRSP); the spin decays by the same factor.
+* ``ET_COULOMB``: Wyllie's e_T bounded by Coulomb's law.  The tangential impulse per unit mass
+  that e_T asks for, (1 - e_T)|v_t|, cannot exceed mu times the normal impulse, mu (1 + e_N)|v_n|
+  (Coulomb friction during the impact; Stronge 2000, ch. 4; the same bound that decides stick or
+  slip in the Stronge law above and in the "Bourrier" rebound model of PlatRock).  So
+  e_T,eff = 1 - min(1 - e_T, mu (1 + e_N) |v_n| / |v_t|):
+  a steep impact loses what Wyllie measured (e_T 0.3-0.8 at his five sites, where impacts were
+  mostly steeper than 20 deg), a grazing one only what friction can take, and in the limit of a
+  grazing touch nothing.  With e_T = 0.55, mu = tan 30 deg and e_N = 0.3 the bound acts below an
+  impact angle of 31 deg; at 5 deg the block keeps 87 % of its tangential speed (the constant law:
+  55 %), so results no longer depend on how many micro-bounces the kinks of a profile produce.
+  The spin decays by the same factor as v_t.  Wang et al. (2018, NHESS 18:3045) measured the same
+  trend in the laboratory (R_t grows as the impact angle falls).
+
+Velocity scaling of e_N (any law)
+---------------------------------
+With a finite ``v0`` (``normal_restitution.velocity_scale_ms`` in a scenario), e_N is divided by
+1 + (|v_n| / v0)^2: the CRSP "scale by velocity" form of Pfeiffer & Bowen (1989), v0 = 9.144 m/s
+(30 ft/s) in CRSP, applied on top of the constant or Wyllie law so that fast impacts on soft ground
+rebound less (plastic indentation; Bourrier et al. 2009 measured R_n falling with V_n on soil).
+"""
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from .units import SPHERE_INERTIA
+
+EN_CONSTANT, EN_WYLLIE, EN_VELOCITY = 0, 1, 2
+ET_FRICTION, ET_CONSTANT, ET_COULOMB = 0, 1, 2
+EN_WYLLIE_MAX = 2.5
+CRSP_VELOCITY_SCALE_MS = 9.144    # 30 ft/s (Pfeiffer & Bowen 1989)
+
+
+@njit(cache=True)
+def wyllie_normal_restitution(impact_angle_deg):
+    """e_N = 19.5 theta^-1.03 (theta in degrees), capped at 2.5 (Wyllie 2014)."""
+    theta = max(impact_angle_deg, 1e-6)
+    return min(19.5 * theta ** -1.03, EN_WYLLIE_MAX)
+
+
+@njit(cache=True)
+def normal_restitution(law, e_n, vn, vt):
+    """Coefficient e_N for an impact with normal velocity vn (< 0) and tangential vt."""
+    if law == EN_WYLLIE:
+        angle = math.degrees(math.atan2(-vn, abs(vt)))
+        return min(max(wyllie_normal_restitution(angle) + e_n, 0.0), EN_WYLLIE_MAX)   # e_n: this impact's deviation
+    if law == EN_VELOCITY:
+        return e_n / (1.0 + (vn / CRSP_VELOCITY_SCALE_MS) ** 2)
+    return e_n
+
+
+@njit(cache=True)
+def stronge_sphere(vn, vt, w, r, e_n, mu):
+    """Tangential velocity and spin after a rough impact of a solid sphere (I = 0.4 m r^2).
+
+    Returns (vt_out, w_out, stuck).  ``vn`` < 0 is the incoming normal velocity.
+    """
+    return stronge_body(vn, vt, w, r, e_n, mu, SPHERE_INERTIA)
+
+
+@njit(cache=True)
+def stronge_body(vn, vt, w, r, e_n, mu, k):
+    """Rough impact of a round body with inertia I = k m r^2 (k = 0.4 sphere, 0.5 cylinder or disc)."""
+    pn = (1.0 + e_n) * (-vn)              # normal impulse per unit mass
+    slip = vt - r * w
+    # Impulse per unit mass that brings the slip to zero: slip / (1 + 1/k) = 2/7 slip for a solid sphere.
+    p_stick = slip / (1.0 + 1.0 / k)
+    if abs(p_stick) <= mu * pn:
+        vt_out = vt - p_stick             # sphere: 5/7 vt + 2/7 r w
+        return vt_out, vt_out / r, True
+    pt = mu * pn if slip > 0 else -mu * pn
+    return vt - pt, w + pt / (k * r), False
+
+
+@njit(cache=True)
+def impact(vn, vt, w, r, en_law, e_n, et_law, e_t, mu, allow_energy_gain):
+    """Outgoing (vn', vt', w', e_N used) of a solid sphere; see :func:`impact_body`."""
+    return impact_body(vn, vt, w, r, en_law, e_n, et_law, e_t, mu, allow_energy_gain, SPHERE_INERTIA)
+
+
+@njit(cache=True)
+def impact_body(vn, vt, w, r, en_law, e_n, et_law, e_t, mu, allow_energy_gain, k_inertia):
+    """Outgoing (vn', vt', w', e_N used) for an incoming (vn < 0, vt, w) on a surface, without velocity scaling.
+
+    The same as :func:`rebound` with ``v0`` = inf (kept with this argument order for callers that use it).
+    """
+    return rebound(vn, vt, w, r, k_inertia, en_law, e_n, math.inf, et_law, e_t, mu, allow_energy_gain)
+
+
+@njit(cache=True)
+def velocity_scaled(e_n, vn, v0):
+    """e_N / (1 + (vn / v0)^2): the Pfeiffer & Bowen (1989) velocity scaling; ``v0`` [m/s] inf = none."""
+    if v0 == math.inf or v0 <= 0.0:
+        return e_n
+    return e_n / (1.0 + (vn / v0) ** 2)
+
+
+@njit(cache=True)
+def coulomb_tangential(vn, vt, w, e_t, e_n, mu):
+    """Tangential law ``ET_COULOMB``: (vt', w') with e_T bounded by Coulomb friction (module docstring).
+
+    Parameters
+    ----------
+    vn : float
+        Incoming normal velocity [m/s] (< 0).
+    vt, w : float
+        Incoming tangential velocity [m/s] and spin [rad/s].
+    e_t : float
+        Wyllie's tangential coefficient for a steep impact (0-1).
+    e_n : float
+        The normal coefficient of this impact (kinematic, as used for the normal rebound).
+    mu : float
+        Friction coefficient tan(phi) of the impact.
+
+    Returns
+    -------
+    (vt', w') : the tangential velocity [m/s] and spin [rad/s] after the impact, both scaled by the same
+    factor e_T,eff in [e_T, 1] (e_t is clipped to [0, 1]); unchanged when vt = 0.
+    """
+    e = min(max(e_t, 0.0), 1.0)
+    avt = abs(vt)
+    if avt <= 0.0:
+        return vt, w
+    loss = min(1.0 - e, mu * (1.0 + e_n) * (-vn) / avt) if vn < 0.0 else 0.0
+    f = 1.0 - max(loss, 0.0)
+    return f * vt, f * w
+
+
+@njit(cache=True)
+def rebound(vn, vt, w, r, k, en_law, e_n, v0, et_law, e_t, mu, allow_energy_gain):
+    """Outgoing state of a round block after an impact on a surface: (vn', vt', w', e_N used).
+
+    Parameters
+    ----------
+    vn, vt, w : float
+        Incoming normal velocity [m/s] (< 0 when approaching), tangential velocity [m/s] and spin [rad/s],
+        in the frame of the (roughness-tilted) surface.
+    r : float
+        Block radius [m].
+    k : float
+        Inertia factor I / (m r^2) (0.4 sphere, 0.5 cylinder or disc).
+    en_law : int
+        ``EN_CONSTANT``, ``EN_WYLLIE`` or ``EN_VELOCITY``.
+    e_n : float
+        e_N for the constant and velocity laws; the deviation added to the law's value for Wyllie's law.
+    v0 : float
+        Velocity scale [m/s] of the Pfeiffer & Bowen scaling applied after the law (inf: none).
+    et_law : int
+        ``ET_FRICTION`` (Stronge rough body), ``ET_CONSTANT`` or ``ET_COULOMB``.
+    e_t : float
+        Tangential coefficient (constant and Coulomb laws).
+    mu : float
+        Friction coefficient tan(phi) (Stronge and Coulomb laws).
+    allow_energy_gain : bool
+        When False the kinetic energy per unit mass (translational + rotational) never increases.
+
+    Returns
+    -------
+    (vn', vt', w', e_N) with vn' >= 0.
+    """
+    en = velocity_scaled(normal_restitution(en_law, e_n, vn, vt), vn, v0)
+    if et_law == ET_FRICTION:
+        vt2, w2, stuck = stronge_body(vn, vt, w, r, en, mu, k)
+    elif et_law == ET_COULOMB:
+        vt2, w2 = coulomb_tangential(vn, vt, w, e_t, min(en, EN_WYLLIE_MAX), mu)
+    else:
+        vt2 = e_t * vt
+        w2 = e_t * w
+    vn2 = -en * vn
+    if not allow_energy_gain:
+        kr2 = k * r * r
+        e_in = vn * vn + vt * vt + kr2 * w * w                 # twice the kinetic energy per unit mass
+        e_tan = vt2 * vt2 + kr2 * w2 * w2
+        # Kinematic e_N (Wyllie's law, or a typed e_N > 1): the normal impact returns the share
+        # sin^2(theta_i) of its elastic part, the rest of the rebound comes from the tangential motion.
+        # Otherwise the laws themselves dissipate.
+        budget = e_in
+        if en_law == EN_WYLLIE or en > 1.0:
+            sin2 = vn * vn / max(vn * vn + vt * vt, 1e-300)
+            budget = e_in - vn * vn * (1.0 - min(en, 1.0) ** 2 * sin2)
+        room = budget - vn2 * vn2                             # energy left for the tangential state
+        if room < 0.0:
+            vn2 = math.sqrt(max(budget, 0.0))
+            en = vn2 / -vn if vn < 0 else 0.0
+            room = 0.0
+        if e_tan > room:
+            s = math.sqrt(room / e_tan)
+            vt2 *= s
+            w2 *= s
+    return vn2, vt2, w2, en
+
+
+@njit(cache=True)
+def roll_on_speed(v_along, w, r, k):
+    """Speed [m/s] along the surface of a round body that starts rolling without slip.
+
+    Angular momentum about the contact point is conserved through the (slip-killing) transition:
+    m v r + k m r^2 w = (m r + k m r^2 / r) v'  =>  v' = (v + k r w) / (1 + k), w' = v' / r,
+    with I = k m r^2 (k = 2/5 sphere, 1/2 cylinder) and w > 0 meaning rolling in the +v direction.
+    Kinetic energy never increases through it (it falls by 1/2 m k (v - r w)^2 / (1 + k)).
+    """
+    return (v_along + k * r * w) / (1.0 + k)
+
+
+@njit(cache=True)
+def roughness_tilt_max(roughness_m, r):
+    """Largest tilt [rad] of the surface normal at an impact: atan(roughness / r).
+
+    The asperity amplitude seen by a block depends on its size: a block of radius r resting on asperities
+    of height h tilts by up to atan(h / r) (the CRSP "random impact angle variation limited by rock size
+    and slope irregularity", Pfeiffer & Bowen 1989; PlatRock and Rockyfor3D use the same ratio; Dorren
+    2016).  The kernel draws the tilt uniformly within +- this angle, so larger blocks see a smoother slope.
+    """
+    return math.atan(roughness_m / r) if r > 0.0 else 0.0
+
+
+@njit(cache=True)
+def contact_speed(v_floor, g, cos_beta, hop_height_m):
+    """Normal speed [m/s] below which a rebound (or the take-off at a convex edge) is ground contact.
+
+    A block whose rebound would rise less than ``hop_height_m`` [m] above the surface (normal to it,
+    under the normal gravity g cos(beta)) does not fly: it rolls or slides over the asperities, and the
+    rolling resistance stands for what those asperities take.  The speed is sqrt(2 g cos(beta) h),
+    never below ``v_floor`` (the scenario's ``contact_velocity_ms``, a purely numerical threshold that
+    only ends trains of ever smaller hops).  With h = 0 it is the floor (the former behaviour).
+    """
+    hop = math.sqrt(2.0 * g * max(cos_beta, 0.0) * hop_height_m) if hop_height_m > 0.0 else 0.0
+    return max(v_floor, hop)
+
+
+@njit(cache=True)
+def rolling_resistance(mu_0, size_k, roughness_m, r):
+    """Rolling-resistance coefficient [-] of a block of radius r [m]: mu_0 + size_k * roughness_m / r.
+
+    ``mu_0`` = tan(phi_g) is the resistance of a block much larger than the asperities; the second term
+    makes smaller blocks, which sink between asperities of height ``roughness_m`` [m], stop sooner: the
+    friction of a stone moving over scree falls as its size grows relative to the surface stones
+    (Kirkby & Statham 1975, J. Geol. 83:349, mu = tan(phi) + K d/D, d and D the sizes of surface and moving
+    stones [R]; Statham 1976, Earth Surf. Process. 1:43, the resulting downslope size sorting of screes).
+    With ``size_k`` = 0 it is mu_0 (the former behaviour).
+    """
+    if size_k <= 0.0 or r <= 0.0:
+        return mu_0
+    return mu_0 + size_k * roughness_m / r
+
+
+@njit(cache=True)
+def contact_acceleration(g, sin_beta, cos_beta, direction, mu_r, k, roll):
+    """Acceleration [m/s^2] along the motion of a block in ground contact on a straight slope.
+
+    ``sin_beta``, ``cos_beta``: of the slope angle (beta > 0 rising in +x); ``direction`` +1 / -1 the
+    sense of motion along +x; ``mu_r`` the rolling-resistance (or sliding friction) coefficient tan(phi_g).
+    Rolling (``roll``): a = (-g sin(beta) direction - mu_r g cos(beta)) / (1 + k), the resisting torque
+    being mu_r N r (a round body of inertia k m r^2 rolling without slip; 5/7 for a sphere, 2/3 for a
+    cylinder); sliding: the same without the 1 / (1 + k).
+    """
+    a = -g * sin_beta * direction - mu_r * g * cos_beta
+    return a / (1.0 + k) if roll else a
+
+
+@njit(cache=True)
+def steep_face_launch(v_along, v_sep):
+    """Velocity (vt, vn) [m/s] in the frame of a face too steep to roll on, for a block that leaves it.
+
+    The speed |v_along| is kept (no energy is created): the velocity is turned away from the face until
+    its outward normal component is ``v_sep`` (the contact speed), or straight out when the block is
+    slower than that.  The block then flies and meets the face again in impacts, so on a cliff it bounces
+    down the face instead of rolling on it.
+    """
+    u = abs(v_along)
+    vn = min(v_sep, u)
+    vt = math.sqrt(max(u * u - vn * vn, 0.0))
+    return (vt if v_along >= 0.0 else -vt), vn
+
+
+# ---- ground contact with a velocity-squared drag: dv/dt = a - c v^2 along the motion ----------------------
+# A block rolling over asperities (talus boulders, tussocks) or ploughing soft ground loses at each asperity
+# a share of its kinetic energy, and meets more asperities per second the faster it goes: a resistance that
+# grows as v^2 (the "drag" of RAMMS::ROCKFALL's soft-ground contact, and the v^2 term of Voellmy's law; here
+# c = rolling_drag / r [1/m], so a block twice as large, stepping over the same asperities with half as
+# many contacts per metre, feels half the drag).  With c = 0 the motion is the constant-acceleration one.
+# Closed forms along the distance s: v^2(s) = a/c + (u^2 - a/c) exp(-2 c s); times from dv/dt = a - c v^2.
+
+@njit(cache=True)
+def contact_speed_at(u, a, c, s):
+    """Speed [m/s] after a distance s [m] in contact from speed u [m/s], acceleration a [m/s^2] along the
+    motion and drag coefficient c [1/m] (dv/dt = a - c v^2); 0 once the block has stopped."""
+    if c <= 1e-12:
+        return math.sqrt(max(u * u + 2.0 * a * s, 0.0))
+    ac = a / c
+    return math.sqrt(max(ac + (u * u - ac) * math.exp(-2.0 * c * s), 0.0))
+
+
+@njit(cache=True)
+def contact_stop_distance(u, a, c):
+    """Distance [m] at which a block in contact (speed u, acceleration a, drag c; see :func:`contact_speed_at`)
+    comes to rest; inf when it never does (a >= 0)."""
+    if a >= 0.0:
+        return math.inf
+    if c <= 1e-12:
+        return u * u / (-2.0 * a)
+    big_a = -a / c
+    return math.log((u * u + big_a) / big_a) / (2.0 * c)
+
+
+@njit(cache=True)
+def contact_time(u, v, a, c, s):
+    """Time [s] to go from speed u to speed v >= 0 [m/s] over the distance s [m] (dv/dt = a - c v^2); -1 when
+    the block does not move (u = 0 and no acceleration)."""
+    if c <= 1e-12:
+        if abs(a) > 1e-12:
+            return (v - u) / a
+        return s / u if u > 0.0 else -1.0
+    if a < 0.0:                                  # decelerating everywhere: dv/dt = -c (A + v^2)
+        ra = math.sqrt(-a / c)
+        return (math.atan(u / ra) - math.atan(v / ra)) / (c * ra)
+    if a == 0.0:                                 # dv/dt = -c v^2
+        return (1.0 / v - 1.0 / u) / c if u > 0.0 and v > 0.0 else -1.0
+    vt = math.sqrt(a / c)                        # terminal speed
+    if abs(u - vt) <= 1e-9 * vt and abs(v - vt) <= 1e-9 * vt:
+        return s / vt
+    t = 0.0
+    if u < vt and v < vt:
+        t = (math.atanh(v / vt) - math.atanh(u / vt)) / (c * vt)
+    elif u > vt and v > vt:
+        t = (_acoth(v / vt) - _acoth(u / vt)) / (c * vt)
+    else:                                        # rounding at the terminal speed: uniform motion
+        t = s / max(0.5 * (u + v), 1e-300)
+    return t
+
+
+@njit(cache=True)
+def _acoth(x):
+    return 0.5 * math.log((x + 1.0) / (x - 1.0))
