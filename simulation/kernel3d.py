@@ -58,8 +58,9 @@ import math
 import numpy as np
 from numba import njit
 
-from .impact import EN_WYLLIE, impact_body
-from .kernel import _GOLDEN, _normal, _uniform, roll_on_speed
+from .contact import EN_WYLLIE, impact_body, roll_on_speed
+from .kernel import _GOLDEN, _normal, _uniform
+
 
 RUNNING, STOPPED, LEFT_TERRAIN, NODATA, MAX_EVENTS = 0, 1, 2, 3, 4
 STOP_REASONS = {STOPPED: "stopped", LEFT_TERRAIN: "left terrain (edge)", NODATA: "left terrain (nodata)",
