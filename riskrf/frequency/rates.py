@@ -359,8 +359,7 @@ def _fit_negbin(y, X, offset, pois, GLM, families, NegativeBinomial):
 
     At a fixed alpha the NB2 model is a generalised linear model fitted by IRLS, which is stable;
     the profile log-likelihood is maximised over log(alpha) in [1e-8, 1e3] (bounded Brent search),
-    then a few Newton steps from that optimum polish coefficients and alpha jointly and give the
-    usual standard errors.  Started instead from the Poisson fit with a fixed alpha guess,
+    and statsmodels' NB2 model evaluated at that optimum gives the usual standard errors.  Started instead from the Poisson fit with a fixed alpha guess,
     quasi-Newton search diverged to NaN on short records (statsmodels 0.15).
 
     Returns
@@ -383,17 +382,14 @@ def _fit_negbin(y, X, offset, pois, GLM, families, NegativeBinomial):
     beta = np.asarray(GLM(y, X, family=families.NegativeBinomial(alpha=alpha), offset=offset).fit(
         start_params=start).params)
     model = NegativeBinomial(y, X, offset=offset, loglike_method="nb2")
-    at_bound = opt.x < np.log(_NB_ALPHA_MIN) + 0.5
-    if not at_bound:
-        nb = model.fit(start_params=np.r_[beta, alpha], disp=0, maxiter=100, method="newton")
-        if np.all(np.isfinite(nb.params)) and np.all(np.isfinite(nb.bse)) and nb.llf >= -opt.fun - 1e-6:
-            return nb
-    # alpha at its lower bound (no overdispersion: NB2 reduces to the Poisson model) or Newton left the
-    # profile optimum: the profile optimum itself, evaluated without further iterations
+    # The profile optimum is the maximum-likelihood estimate (coefficients exact at that alpha, alpha to a
+    # relative 1e-4): statsmodels evaluates it without further iterations, the Hessian once for the standard
+    # errors.  (Newton iterations on top cost minutes on long daily records: each Hessian evaluates polygamma
+    # terms per day.)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         nb = model.fit(start_params=np.r_[beta, alpha], disp=0, maxiter=0, method="nm")
-    nb.mle_retvals["converged"] = bool(np.isfinite(nb.llf))
+    nb.mle_retvals["converged"] = bool(np.isfinite(nb.llf) and np.isfinite(-opt.fun))
     if not np.all(np.isfinite(nb.params)):
         raise ValueError("no finite negative binomial estimate")
     return nb
