@@ -73,6 +73,17 @@ CLASSES = {
                           "freezing periods"),
     "rockfall_history": ("few falls", "occasional falls", "many falls", "constant falls"),
 }
+#: Rating systems :func:`rate` implements, by the name a corridor file gives (``corridor.rhrs_variant``).
+VARIANTS = {"fhwa": "FHWA RHRS (Pierson & Van Vickle 1993, FHWA-SA-93-057; summary sheet, exponential 3-81 scores)"}
+#: Agency variants that are known but not implemented, with the reason (said when a corridor file asks for one).
+UNAVAILABLE_VARIANTS = {
+    "odot": "the ODOT revision's category tables could not be read from any copy in reach, so they are not encoded "
+            "rather than guessed; rate with 'fhwa'",
+    "colorado": "the Colorado-modified RHRS (Santi et al. 2009, Eng. Geol. 104: 55-65; Russell et al. 2008, "
+                "CDOT-2008-7) tables could not be read from any copy in reach, so they are not encoded rather than "
+                "guessed; rate with 'fhwa'",
+}
+
 #: Short names accepted for the classes: the first word of a class when no other class of the category shares it
 #: (e.g. "good", "limited", "occasional").
 def _short_names(names):
