@@ -273,8 +273,9 @@ def render_corridor_html(res, figure_png: Path, *, figures: dict | None = None, 
     if len(disagree):
         doc.section("Where the RHRS and the risk ranking disagree")
         doc.add(f"<p>Sections whose RHRS rank and risk rank differ by at least {max(3, len(s) // 5)} places.</p>",
-                doc.table(disagree[["id", "rank_risk", "rank_rhrs", "rhrs_score", "deaths_per_year",
-                                    "individual_risk"]].head(HTML_ROWS), "RHRS and risk ranks that disagree"))
+                doc.table(disagree[["id", "rank_risk", "rank_rhrs", "rhrs_total" if "rhrs_total" in disagree else
+                                    "rhrs_score", "deaths_per_year", "individual_risk"]].head(HTML_ROWS),
+                          "RHRS and risk ranks that disagree"))
     if c.errors or res.failures:
         doc.section("Rejected rows and failed sections")
         doc.add("<div class='warn'><ul>" + "".join(f"<li>{escape(e)}</li>" for e in list(c.errors) + list(res.failures))

@@ -7,11 +7,14 @@ The problem is a multiple-choice knapsack.  With a binary ``x[s, o]`` for "secti
                 sum_o x[s, o] <= 1              for every section s   (at most one option; none = do nothing)
                 x[s, o] in {0, 1}
 
-solved by branch and bound (``scipy.optimize.milp``, HiGHS) with a zero optimality gap, so the programme is
-the best one, not a greedy ranking by benefit per cost (which can miss it: a greedy order fills the budget
-with small efficient items and leaves no room for a large one that buys more in total).  Among programmes
-of equal benefit the cheapest is returned (a second solve that minimises cost with the benefit held at its
-optimum), so the answer does not depend on the solver's path.
+solved by branch and bound (``scipy.optimize.milp``, HiGHS) asking for a zero optimality gap, so the programme
+is the best one, not a greedy ranking by benefit per cost (which can miss it: a greedy order fills the budget
+with small efficient items and leaves no room for a large one that buys more in total).  The solver proves
+optimality against its bound; if it stops at ``time_limit_s`` first, the programme is the best found and
+:attr:`Programme.gap` states the proven relative gap to the optimum (0: proven optimal).  For problems up to
+:data:`TIE_BREAK_MAX` options, among programmes of equal benefit the cheapest is returned (a second solve that
+minimises cost with the benefit held at its optimum); above that the first optimum found is kept (HiGHS is
+deterministic: the same table gives the same programme).
 
 ``benefit`` is what the asset manager buys: deaths avoided per year (objective ``"risk"``) or the saving
 in expected total cost against doing nothing (objective ``"cost"``: maximising the saving is minimising the
@@ -29,6 +32,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
+
+#: Largest number of candidate options for which ties in benefit are broken by the least cost (a second solve).
+TIE_BREAK_MAX = 3000
 
 #: What a programme can maximise: deaths avoided per year, or the saving in expected total cost.
 OBJECTIVES = {"risk": "deaths_avoided_per_year", "cost": "expected_total_cost_saving"}
@@ -49,6 +55,7 @@ class Programme:
     cost_column: str
     benefit_column: str
     n_sections: int
+    gap: float = 0.0
 
     def summary(self) -> pd.DataFrame:
         """The chosen sections and options, with their cost and benefit (one row per funded section)."""
@@ -102,34 +109,39 @@ def _check(options: pd.DataFrame, cost: str, benefit: str, section: str) -> pd.D
     return t
 
 
-def _solve(cost: np.ndarray, benefit: np.ndarray, group: np.ndarray, n_groups: int, budget: float) -> np.ndarray:
-    """0/1 choice maximising benefit within budget, at most one per group; ties broken by the least cost."""
+def _solve(cost: np.ndarray, benefit: np.ndarray, group: np.ndarray, n_groups: int, budget: float,
+           time_limit_s: float = 120.0) -> tuple[np.ndarray, float]:
+    """0/1 choice maximising benefit within budget, at most one per group (ties broken by the least cost up to
+    :data:`TIE_BREAK_MAX` options); returns (choice, proven relative gap)."""
     from scipy.optimize import Bounds, LinearConstraint, milp
     from scipy.sparse import csr_matrix
     n = cost.size
     if n == 0:
-        return np.zeros(0, bool)
+        return np.zeros(0, bool), 0.0
     # scale to order one: HiGHS tolerances are absolute (deaths per year are ~1e-4)
     bscale = float(np.max(np.abs(benefit))) or 1.0
     cscale = float(max(np.max(cost), budget, 1e-300))
     b, c = benefit / bscale, cost / cscale
     one = csr_matrix((np.ones(n), (group, np.arange(n))), shape=(n_groups, n))
     cons = [LinearConstraint(c.reshape(1, -1), -np.inf, budget / cscale), LinearConstraint(one, -np.inf, 1.0)]
-    opts = {"mip_rel_gap": 0.0, "presolve": True}
+    opts = {"mip_rel_gap": 0.0, "presolve": True, "time_limit": float(time_limit_s)}
     first = milp(-b, integrality=np.ones(n), bounds=Bounds(0, 1), constraints=cons, options=opts)
-    if first.status != 0:
-        raise RuntimeError(f"the programme optimiser did not finish: {first.message}")
+    if first.x is None:
+        raise RuntimeError(f"the programme optimiser found no programme: {first.message}")
     best = -float(first.fun)
+    gap = float(getattr(first, "mip_gap", 0.0) or 0.0) if first.status != 0 else 0.0
+    if n > TIE_BREAK_MAX or first.status != 0:
+        return np.round(first.x).astype(bool), gap
     # second stage: the cheapest programme whose benefit is the optimum (to the solver's feasibility tolerance)
     tol = 1e-9 * max(abs(best), 1.0)
     cons2 = cons + [LinearConstraint(b.reshape(1, -1), best - tol, np.inf)]
     second = milp(c, integrality=np.ones(n), bounds=Bounds(0, 1), constraints=cons2, options=opts)
     x = second.x if second.status == 0 else first.x
-    return np.round(x).astype(bool)
+    return np.round(x).astype(bool), gap
 
 
 def optimise_programme(options: pd.DataFrame, budget: float, *, objective: str = "risk", cost_column: str = "capital",
-                       section_column: str = "id") -> Programme:
+                       section_column: str = "id", time_limit_s: float = 120.0) -> Programme:
     """The best programme within ``budget``: at most one option per section (MILP, exact).
 
     Parameters
@@ -143,6 +155,8 @@ def optimise_programme(options: pd.DataFrame, budget: float, *, objective: str =
         Upper limit of the summed ``cost_column`` of the chosen options (>= 0).
     objective : {"risk", "cost"}
         Maximise deaths avoided per year, or minimise the expected total cost (maximise its saving).
+    time_limit_s : float
+        Wall time the solver may take [s]; if it stops there, :attr:`Programme.gap` is the proven gap.
 
     Returns
     -------
@@ -158,20 +172,22 @@ def optimise_programme(options: pd.DataFrame, budget: float, *, objective: str =
     sections = pd.unique(t[section_column])
     cand = t[t[benefit] > 0].reset_index(drop=True)
     codes = pd.Categorical(cand[section_column], categories=sections).codes
-    pick = _solve(cand[cost_column].to_numpy(), cand[benefit].to_numpy(), np.asarray(codes), len(sections),
-                  float(budget))
+    pick, gap = _solve(cand[cost_column].to_numpy(), cand[benefit].to_numpy(), np.asarray(codes), len(sections),
+                       float(budget), time_limit_s)
     chosen = options.merge(cand.loc[pick, [section_column, "option"]], on=[section_column, "option"])
     return Programme(chosen=chosen, budget=float(budget), cost=float(cand.loc[pick, cost_column].sum()),
                      benefit=float(cand.loc[pick, benefit].sum()), objective=objective, cost_column=cost_column,
-                     benefit_column=benefit, n_sections=len(sections))
+                     benefit_column=benefit, n_sections=len(sections), gap=gap)
 
 
 def efficient_frontier(options: pd.DataFrame, budgets=None, *, objective: str = "risk", cost_column: str = "capital",
-                       section_column: str = "id", points: int = 25) -> Frontier:
+                       section_column: str = "id", points: int = 25, time_limit_s: float = 20.0) -> Frontier:
     """The best benefit at each budget (each point an exact programme of :func:`optimise_programme`).
 
-    ``budgets``: the budgets to solve at; default ``points`` budgets evenly spaced from 0 to the cost of the
-    programme that takes the best option of every section (beyond it more money buys nothing).
+    ``budgets``: the budgets to solve at; default 0 and ``points`` - 1 budgets in geometric steps from the cheapest
+    option to the cost of the programme that takes the best option of every section (beyond it more money buys
+    nothing).  Between two budgets the best benefit is at least that of the lower one (a step curve).  Each point may
+    take ``time_limit_s``; its proven gap is in the ``gap`` column (0: proven optimal).
     """
     benefit = OBJECTIVES.get(objective)
     if benefit is None:
@@ -181,10 +197,13 @@ def efficient_frontier(options: pd.DataFrame, budgets=None, *, objective: str = 
         top = t[t[benefit] > 0]
         full = top.sort_values([benefit, cost_column], ascending=[False, True]).groupby(section_column).head(1)
         hi = float(full[cost_column].sum())
-        budgets = np.linspace(0.0, hi, int(points)) if hi > 0 else np.zeros(1)
+        lo = float(top.loc[top[cost_column] > 0, cost_column].min()) if (top[cost_column] > 0).any() else hi
+        # 0, then geometric steps from the cheapest option to everything: the frontier rises fastest at small budgets
+        budgets = np.r_[0.0, np.geomspace(lo, hi, int(points) - 1)] if hi > 0 and lo < hi else np.array([0.0, hi])
     rows = []
     for b in np.asarray(budgets, dtype=float):
         p = optimise_programme(t, float(b), objective=objective, cost_column=cost_column,
-                               section_column=section_column)
-        rows.append({"budget": float(b), "cost": p.cost, "benefit": p.benefit, "sections": len(p.chosen)})
+                               section_column=section_column, time_limit_s=time_limit_s)
+        rows.append({"budget": float(b), "cost": p.cost, "benefit": p.benefit, "sections": len(p.chosen),
+                     "gap": p.gap})
     return Frontier(table=pd.DataFrame(rows), objective=objective, cost_column=cost_column, benefit_column=benefit)
