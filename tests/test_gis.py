@@ -60,6 +60,10 @@ def test_cut_gives_the_section_line():
     assert np.hypot(*np.diff(seg, axis=0).T).sum() == pytest.approx(300.0)
     with pytest.raises(gis.GISError, match="outside the centreline"):
         line.cut(600.0, 800.0)
+    # many at once: the same lines
+    many = line.cuts([0.0, 200.0, 650.0], [200.0, 500.0, 700.0])
+    for got, (a, b) in zip(many, [(0.0, 200.0), (200.0, 500.0), (650.0, 700.0)]):
+        np.testing.assert_array_equal(got, line.cut(a, b))
 
 
 def test_gpkg_round_trip_and_geographic_crs_refused(tmp_path):

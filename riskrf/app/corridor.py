@@ -1053,8 +1053,10 @@ class CorridorResult:
 
     def sections_table(self, programme=None) -> pd.DataFrame:
         """The result rows by chainage as written to sections.csv and sections.gpkg (same columns): everything
-        but the per-option list, with the programme's choice when one is given."""
-        t = self.table.drop(columns=[c for c in ("options_json",) if c in self.table]).copy()
+        but the per-option list (the text ``geometry`` of the cut renamed ``cut_geometry``), with the programme's
+        choice when one is given."""
+        t = self.table.drop(columns=[c for c in ("options_json",) if c in self.table]).rename(
+            columns={"geometry": "cut_geometry"})          # text: a GIS reserves "geometry" for the line itself
         if programme is not None:
             p = self.programme_table(programme)
             t = t.merge(p[["id"] + [c for c in p.columns if c.startswith("programme_")]], on="id", how="left")
@@ -1065,8 +1067,7 @@ class CorridorResult:
         when the corridor has no centreline."""
         if self.corridor.centreline is None:
             return None
-        return [self.corridor.centreline.cut(a, b) for a, b in zip(self.table["chainage_from_m"],
-                                                                   self.table["chainage_to_m"])]
+        return self.corridor.centreline.cuts(self.table["chainage_from_m"], self.table["chainage_to_m"])
 
     def to_json(self) -> dict:
         """The run as a JSON-ready dict (``corridor_summary.json``): counts, failures, rejected rows, seed, blocks,
@@ -1084,6 +1085,9 @@ class CorridorResult:
                 "top": s.head(10).replace({np.nan: None}).to_dict(orient="records"),
                 "defaults_used": list(self.corridor.defaults_used)}
 
+
+#: Points of the efficient frontier written with a programme: (up to the section count given, above it).
+FRONTIER_POINTS = (25, 10, 500)
 
 #: What a budget caps, by ``--budget-basis``: capital paid now, or the equivalent annual cost.
 BUDGET_BASES = {"total": "capital", "year": "equivalent_annual_cost"}
@@ -1210,8 +1214,9 @@ def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False, b
     programme = frontier = None
     if budget is not None:
         programme = res.programme(budget, basis=budget_basis, objective=objective)
+        # every frontier point is a full programme solve: fewer points for a long corridor (see FRONTIER_POINTS)
         frontier = res.frontier(basis=budget_basis, objective=objective,
-                                budgets=None)
+                                points=FRONTIER_POINTS[0] if len(res.table) <= FRONTIER_POINTS[2] else FRONTIER_POINTS[1])
     with atomic_output_dir(out, overwrite=overwrite) as tmp:
         res.summary().to_csv(tmp / "corridor.csv", index=False)
         sections = res.sections_table(programme)

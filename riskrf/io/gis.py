@@ -121,11 +121,11 @@ class Centreline:
     crs: str
     calibration: tuple = field(repr=False, default=((0.0,), (0.0,)))
     source: str = ""
+    distance_m: np.ndarray = field(init=False, repr=False, compare=False)
 
-    @property
-    def distance_m(self) -> np.ndarray:
-        """Distance along the line at each vertex [m] (0 at the first vertex)."""
-        return np.r_[0.0, np.cumsum(np.hypot(*np.diff(self.xy, axis=0).T))]
+    def __post_init__(self):
+        # distance along the line at each vertex [m] (0 at the first vertex), computed once
+        object.__setattr__(self, "distance_m", np.r_[0.0, np.cumsum(np.hypot(*np.diff(self.xy, axis=0).T))])
 
     @property
     def length_m(self) -> float:
@@ -189,8 +189,24 @@ class Centreline:
         x0, y0 = self.point_at(np.array([chainage_from_m, chainage_to_m]))
         s0, s1 = self._distance(np.array([chainage_from_m, chainage_to_m]))
         d = self.distance_m
-        inner = (d > s0) & (d < s1)
-        return np.vstack([[x0[0], y0[0]], self.xy[inner], [x0[1], y0[1]]])
+        i0, i1 = np.searchsorted(d, s0, side="right"), np.searchsorted(d, s1, side="left")   # vertices inside
+        return np.vstack([[x0[0], y0[0]], self.xy[i0:i1], [x0[1], y0[1]]])
+
+    def cuts(self, chainage_from_m, chainage_to_m) -> list:
+        """:meth:`cut` for many intervals at once (arrays of equal length): a list of vertex arrays, O(intervals
+        x log vertices) plus the vertices returned."""
+        c0, c1 = (np.atleast_1d(np.asarray(a, dtype=float)) for a in (chainage_from_m, chainage_to_m))
+        if c0.shape != c1.shape:
+            raise ValueError(f"{c0.size} start chainages for {c1.size} end chainages")
+        if np.any(~(c1 > c0)):
+            i = int(np.flatnonzero(~(c1 > c0))[0])
+            raise GISError(f"chainage_to = {c1[i]:g} must exceed chainage_from = {c0[i]:g}")
+        x0, y0 = self.point_at(c0)
+        x1, y1 = self.point_at(c1)
+        d = self.distance_m
+        i0 = np.searchsorted(d, self._distance(c0), side="right")
+        i1 = np.searchsorted(d, self._distance(c1), side="left")
+        return [np.vstack([[a, b], self.xy[j:k], [e, f]]) for a, b, j, k, e, f in zip(x0, y0, i0, i1, x1, y1)]
 
     def summary(self) -> pd.DataFrame:
         """One row: CRS, vertices, drawn length [m], chainage range [m], calibration points, source."""

@@ -169,10 +169,10 @@ def render_rating_sheets(res) -> str:
     for sec in c.sections:
         if sec.rating is None:
             continue
-        rows = "".join(f"<tr><td>{escape(r.category)}</td><td>{escape(r.rated_value)}</td>"
-                       f"<td class='n'>{'' if r.category == 'total' else f'{r.x:.3f}'}</td>"
-                       f"<td class='n'>{r.score:.2f}</td><td class='n'><b>{r.points}</b></td></tr>"
-                       for r in sec.rating.sheet().itertuples(index=False))
+        rows = "".join(f"<tr><td>{escape(r['category'])}</td><td>{escape(r['rated_value'])}</td>"
+                       f"<td class='n'>{'' if r['category'] == 'total' else format(r['x'], '.3f')}</td>"
+                       f"<td class='n'>{r['score']:.2f}</td><td class='n'><b>{r['points']}</b></td></tr>"
+                       for r in sec.rating.sheet_rows())
         parts.append(f"<section id='{escape(sec.id)}'><h2>{escape(sec.id)}: chainage {sec.chainage_from_m:,.0f}-"
                      f"{sec.chainage_to_m:,.0f} m</h2><table><thead><tr><th>category</th><th>rated value (SI)</th>"
                      f"<th>x</th><th>score 3<sup>x</sup></th><th>points</th></tr></thead><tbody>{rows}</tbody>"

@@ -211,6 +211,10 @@ class RHRSRating:
     def sheet(self) -> pd.DataFrame:
         """The rating sheet: one row per category with the rated value (SI, as given or derived), level x, score
         and the whole-point score; last row the totals."""
+        return pd.DataFrame(self.sheet_rows())
+
+    def sheet_rows(self) -> list:
+        """The rows of :meth:`sheet` as plain dicts (category, rated_value, x, score, points)."""
         value_of = {"slope_height": "slope_height_m", "ditch_effectiveness": "ditch_effectiveness",
                     "average_vehicle_risk": "avr_percent", "percent_decision_sight_distance": "percent_dsd",
                     "roadway_width": "roadway_width_m", "structural_condition": ("structural_condition_case1",
@@ -218,17 +222,17 @@ class RHRSRating:
                     "rock_friction": "rock_friction", "difference_in_erosion_rates": "difference_in_erosion_rates",
                     "block_size_or_volume": ("block_size_m", "volume_m3"), "climate_and_water": "climate_and_water",
                     "rockfall_history": "rockfall_history"}
-        rows = []
+        rows, scores, points = [], self.scores, self.integer_scores
         for cat, x in self.x.items():
             keys = value_of.get(cat, cat)
             keys = keys if isinstance(keys, tuple) else (keys,)
             given = [f"{k} = {self.inputs[k]:.4g}" if isinstance(self.inputs[k], float) else
                      f"{k} = {self.inputs[k]}" for k in keys if k in self.inputs]
-            rows.append({"category": cat, "rated_value": "; ".join(given), "x": x, "score": self.scores[cat],
-                         "points": self.integer_scores[cat]})
+            rows.append({"category": cat, "rated_value": "; ".join(given), "x": x, "score": scores[cat],
+                         "points": points[cat]})
         rows.append({"category": "total", "rated_value": "", "x": float("nan"), "score": self.total,
                      "points": self.integer_total})
-        return pd.DataFrame(rows)
+        return rows
 
     def summary(self) -> pd.DataFrame:
         """One row per category: x, score (points); last row the total."""
