@@ -76,13 +76,9 @@ class Frontier:
     benefit_column: str
 
     def summary(self) -> pd.DataFrame:
-        """One row per budget: budget, cost of the best programme, its benefit and the sections it funds."""
+        """One row per budget: budget, cost of the best programme, its benefit, the sections it funds and the
+        proven gap (the figure: :func:`riskrf.report.corridor_report.plot_frontier`)."""
         return self.table.copy()
-
-    def plot(self, ax=None, *, currency: str = "", chosen_budget: float | None = None):
-        """Benefit of the best programme against the budget (a step curve: the frontier is piecewise flat)."""
-        from ..report.corridor_report import plot_frontier
-        return plot_frontier(self, ax=ax, currency=currency, chosen_budget=chosen_budget)
 
 
 def _check(options: pd.DataFrame, cost: str, benefit: str, section: str) -> pd.DataFrame:
