@@ -1196,7 +1196,7 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
 
 
 def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False, budget: float | None = None,
-                   budget_basis: str = "total", objective: str = "risk") -> None:
+                   budget_basis: str = "total", objective: str = "risk", programme=None, frontier=None) -> None:
     """Write the corridor's outputs into ``out`` (a directory that appears only when everything is written; an
     existing non-empty ``out`` is replaced whole only with ``overwrite``):
 
@@ -1204,6 +1204,8 @@ def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False, b
     columns on each section's line in the centreline's CRS, and map.png), budget_curve.csv, chainage.png,
     rating_sheets.html (one RHRS sheet per rated section), summary.json; with ``budget`` also programme.csv (every
     section with the option the exact programme gives it, or none), frontier.csv and frontier.png.
+    ``programme`` and ``frontier``: already solved (:meth:`CorridorResult.programme` and ``frontier`` of the same
+    budget, basis and objective), written as they are instead of solved again.
     """
     from ..io.gis import write_lines_gpkg
     from ..io.outputs import atomic_output_dir, write_json
@@ -1211,9 +1213,11 @@ def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False, b
     from ..report.files import save_figure
     if budget_basis not in BUDGET_BASES:
         _bad_basis(budget_basis)
-    programme = frontier = None
-    if budget is not None:
+    if budget is None and programme is not None:
+        budget = programme.budget
+    if budget is not None and programme is None:
         programme = res.programme(budget, basis=budget_basis, objective=objective)
+    if budget is not None and frontier is None:
         # every frontier point is a full programme solve: fewer points for a long corridor (see FRONTIER_POINTS)
         frontier = res.frontier(basis=budget_basis, objective=objective,
                                 points=FRONTIER_POINTS[0] if len(res.table) <= FRONTIER_POINTS[2] else FRONTIER_POINTS[1])
