@@ -12,7 +12,7 @@ import pytest
 
 pyogrio = pytest.importorskip("pyogrio")
 
-from riskrf import corridor as cr  # noqa: E402
+from riskrf.app import corridor as cr  # noqa: E402
 from riskrf.io import gis  # noqa: E402
 from riskrf.risk.programme import optimise_programme  # noqa: E402
 

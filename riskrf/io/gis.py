@@ -26,12 +26,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..core.validation import RiskrfError
+
 #: CRS names that are geographic (degrees): refused for chainage work.
 GEOGRAPHIC_CRS = {"EPSG:4326", "EPSG:4258", "EPSG:4269", "EPSG:4230", "EPSG:4283", "EPSG:4167", "OGC:CRS84",
                   "CRS84"}
 
 
-class GISError(ValueError):
+class GISError(RiskrfError, ValueError):
     """A centreline or calibration file is unusable; the message names the file, layer, feature and value."""
 
 
