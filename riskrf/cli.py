@@ -872,7 +872,9 @@ def build_parser() -> argparse.ArgumentParser:
                        "(simulation, energy hazard, road-user risk, option ranking) as a task on dask.distributed: "
                        "a local cluster sized to the machine by default, or an existing scheduler unchanged.  "
                        "Writes report.html, corridor.csv (ranked by risk beside the RHRS rank), sections.csv, "
-                       "budget_curve.csv, chainage.png and summary.json (see the docs: Corridor).", epilog=EPILOG)
+                       "budget_curve.csv, chainage.png, rating_sheets.html and summary.json; with a centreline "
+                       "sections.gpkg and map.png; with --budget programme.csv, frontier.csv and frontier.png (see "
+                       "the docs: Corridor, and Corridor programmes).", epilog=EPILOG)
     p.add_argument("corridor", help="corridor file (.toml); paths in it are relative to it")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <corridor>-corridor)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",

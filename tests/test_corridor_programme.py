@@ -153,3 +153,10 @@ def test_variant_and_centreline_errors_named(tmp_path):
     (tmp_path / "c.toml").write_text(toml.replace("seed = 7", f'seed = 7\ncentreline = "{short}"'))
     with pytest.raises(cr.CorridorError, match=r"section 'C'\): chainage 400-700 m lies beyond the centreline"):
         cr.load_corridor(tmp_path / "c.toml")
+
+
+def test_cli_refuses_a_bad_budget_before_any_work(tmp_path, capsys):
+    from riskrf.cli import main
+    out = tmp_path / "out"
+    assert main(["corridor", str(DATA / "small.toml"), "--budget", "-5", "--out", str(out)]) == 2
+    assert "--budget = -5 must be a finite amount >= 0" in capsys.readouterr().err and not out.exists()
