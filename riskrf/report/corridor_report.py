@@ -242,9 +242,14 @@ def render_corridor_html(res, figure_png: Path, *, figures: dict | None = None, 
         doc.section("Programme within the budget")
         doc.add(f"<div class='box'><p>Budget {cell(programme.budget, money_columns=True, currency=cur)} caps "
                 f"{caps}. The programme gives each section at most one option and maximises "
-                f"{buys[programme.benefit_column]}; it is solved exactly (mixed-integer programme, zero gap), not by a "
-                f"greedy order. It funds {len(programme.chosen)} of {programme.n_sections} sections for "
-                f"{cell(programme.cost, money_columns=True, currency=cur)} and buys {cell(programme.benefit)}.</p>"
+                f"{buys[programme.benefit_column]}; it is solved as a mixed-integer programme, not by a greedy order, "
+                + ("and proven optimal. " if programme.gap == 0 else
+                   f"which stopped at its time limit: the programme is within {programme.gap:.2g} (relative) of the "
+                   "optimum. ")
+                + f"It funds {len(programme.chosen)} of {programme.n_sections} sections for "
+                f"{cell(programme.cost, money_columns=True, currency=cur)} and buys {cell(programme.benefit)}"
+                + (" deaths avoided per year" if programme.benefit_column == "deaths_avoided_per_year" else
+                   f" {escape(cur)} of expected total cost saved") + ".</p>"
                 f"<p><b>Capital</b> is what the works cost when built. <b>Present value</b> adds renewals at the end "
                 f"of each option's life and yearly maintenance over {e.horizon_years:g} years, discounted at "
                 f"{e.discount_rate:.1%}. Per-metre costs are paid on each section's cut length.</p></div>")
