@@ -963,8 +963,8 @@ class CorridorResult:
         t["rank_rhrs"] = _sig12(t["rhrs_score"]).rank(ascending=False, method="min").astype("Int64")
         t["rank_difference"] = t["rank_rhrs"] - t["rank_risk"]
         t["expected_annual_cost_per_km"] = t["expected_annual_loss_pv"] / _pv(self.corridor) / (t["length_m"] / M_PER_KM)
-        cols = ["rank_risk", "rank_rhrs", "rank_difference", "id", "chainage_from_m", "chainage_to_m",
-                "rhrs_total" if "rhrs_total" in t else "rhrs_score",
+        cols = ["rank_risk", "rank_rhrs", "rank_difference", "id", "chainage_from_m", "chainage_to_m", "rhrs_score",
+                "rhrs_total",
                 "road_falls_per_year", "deaths_per_year", "individual_risk", "expected_annual_cost_per_km",
                 "best_option", "best_option_capital", "best_option_total_cost", "best_individual_risk",
                 "deaths_avoided_per_million", "meets_criteria", "note"]

@@ -201,7 +201,7 @@ def render_corridor_html(res, figure_png: Path, *, figures: dict | None = None, 
                   "cumulative_spend")
     disagree = s[(s["rank_difference"].abs() >= max(3, len(s) // 5)).fillna(False).astype(bool)] \
         if s["rank_rhrs"].notna().any() else s.iloc[0:0]
-    s = s.copy()
+    s = s.drop(columns=["rhrs_score"]) if "rhrs_total" in s and "rhrs_score" in s else s.copy()   # whole points
     for col in ("rank_rhrs", "rank_difference"):           # integer ranks; a section without RHRS attributes: blank
         s[col] = s[col].astype(object).where(s[col].notna(), "")
     disagree = disagree.astype({"rank_rhrs": object, "rank_difference": object})
