@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
+import math
 import os
 import shutil
 import sys
@@ -577,6 +578,10 @@ def cmd_corridor(args) -> int:
                          "mass-coupled hazard needs at least 20 blocks in each of at least 4 mass classes)")
     out = check_out(args, f"{Path(args.corridor).stem}-corridor")
 
+    if args.budget is not None and not (args.budget >= 0 and math.isfinite(args.budget)):
+        print(f"riskrf corridor: error: --budget = {args.budget:g} must be a finite amount >= 0 (in the corridor's "
+              "currency)", file=sys.stderr)
+        return 2
     corridor = load_corridor(args.corridor, keep_going=args.keep_going, sheet=args.sheet,   # every row checked
                              header_row=args.header_row, decimal=args.decimal, encoding=args.encoding)
     for e in corridor.errors:
@@ -602,7 +607,8 @@ def cmd_corridor(args) -> int:
         if parts.exists():
             print(f"finished sections are kept in {parts}; rerun with --resume to skip them", file=sys.stderr)
         return 2
-    write_corridor(res, out, overwrite=args.overwrite)
+    write_corridor(res, out, overwrite=args.overwrite, budget=args.budget, budget_basis=args.budget_basis,
+                   objective=args.objective)
     shutil.rmtree(parts, ignore_errors=True)        # the run is complete: its partitions are in sections.csv
     for f in res.failures:
         print(f"failed: {f}")
@@ -610,10 +616,18 @@ def cmd_corridor(args) -> int:
     print(f"{len(res.table)} sections in {res.seconds:.1f} s on {res.workers} workers "
           f"({len(res.table) / max(res.seconds, 1e-9) * 60:.1f} sections per minute).  Highest risk first:")
     for _, r in top.iterrows():
-        print(f"  {r['id']}: RHRS {r['rhrs_score']:.0f} (rank {r['rank_rhrs']:.0f}), {probability(r['deaths_per_year'])} deaths/yr, "
+        print(f"  {r['id']}: RHRS {r.get('rhrs_total', r.get('rhrs_score')):.0f} (rank {r['rank_rhrs']:.0f}), {probability(r['deaths_per_year'])} deaths/yr, "
               f"best: {r['best_option']} ({r['best_option_capital']:,.0f} {corridor.currency})")
-    print(f"Report: {(out / 'report.html').resolve()} (also corridor.csv, sections.csv, budget_curve.csv, "
-          "chainage.png, summary.json)")
+    if args.budget is not None:
+        import json
+        p = json.loads((out / "summary.json").read_text(encoding="utf-8"))["programme"]
+        caps = "capital" if args.budget_basis == "total" else "equivalent annual cost"
+        print(f"Programme within {args.budget:,.0f} {corridor.currency} of {caps}: {p['sections_funded']} sections "
+              f"funded for {p['cost']:,.0f} {corridor.currency}, {p['maximised'].replace('_', ' ')} "
+              f"{p['benefit']:.4g} (programme.csv, frontier.png)")
+    extra = ", sections.gpkg, map.png" if corridor.centreline is not None else ""
+    print(f"Report: {(out / 'report.html').resolve()} (also corridor.csv, sections.csv{extra}, budget_curve.csv, "
+          "chainage.png, rating_sheets.html, summary.json)")
     return 0
 
 
@@ -858,7 +872,9 @@ def build_parser() -> argparse.ArgumentParser:
                        "(simulation, energy hazard, road-user risk, option ranking) as a task on dask.distributed: "
                        "a local cluster sized to the machine by default, or an existing scheduler unchanged.  "
                        "Writes report.html, corridor.csv (ranked by risk beside the RHRS rank), sections.csv, "
-                       "budget_curve.csv, chainage.png and summary.json (see the docs: Corridor).", epilog=EPILOG)
+                       "budget_curve.csv, chainage.png, rating_sheets.html and summary.json; with a centreline "
+                       "sections.gpkg and map.png; with --budget programme.csv, frontier.csv and frontier.png (see "
+                       "the docs: Corridor, and Corridor programmes).", epilog=EPILOG)
     p.add_argument("corridor", help="corridor file (.toml); paths in it are relative to it")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <corridor>-corridor)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
@@ -867,6 +883,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-n", type=int, default=None, help="simulated blocks per section (default: the corridor file's)")
     p.add_argument("--keep-going", action="store_true", help="skip bad rows and failed sections, listing them")
     p.add_argument("--resume", action="store_true", help="skip sections already finished by an earlier run")
+    p.add_argument("--budget", type=float, default=None, metavar="AMOUNT",
+                   help="choose one option (or none) per section to get the most within AMOUNT (corridor currency), "
+                        "exactly (mixed-integer programme); writes programme.csv, frontier.csv and frontier.png")
+    p.add_argument("--budget-basis", choices=("total", "year"), default="total",
+                   help="what --budget caps: 'total' the capital paid now (default), 'year' the equivalent annual "
+                        "cost (present value of capital, renewals and maintenance as a level cost per year)")
+    p.add_argument("--objective", choices=("risk", "cost"), default="risk",
+                   help="'risk': maximise deaths avoided per year (default); 'cost': minimise the expected total cost")
     _add_reader_arguments(p, "the sections table", "corridor.sections_")
     p.set_defaults(func=cmd_corridor)
     p = sub.add_parser("hazard-map", help="3-D rock fall hazard rasters on a DEM (GeoTIFF, GeoPackage)",

@@ -321,6 +321,28 @@ def test_e6_builder_reproduces_the_shipped_tables(tmp_path):
     assert mod.main([str(gml)]) == 0
     for f in ("e6_sections.csv", "e6_rockfalls.csv", "e6_volumes.csv"):
         assert (tmp_path / f).read_text() == (E6 / f).read_text()
+    # the centreline: the same vertices and calibration (a GeoPackage is not byte-stable: compare its content)
+    from riskrf.io.gis import read_centreline
+    a, b = (read_centreline(d / "e6_centreline.gpkg", layer="centreline", calibration_layer="nvdb_metres")
+            for d in (tmp_path, E6))
+    np.testing.assert_array_equal(a.xy, b.xy)
+    assert a.calibration == b.calibration and a.crs == b.crs == "EPSG:25833"
+
+
+def test_e6_centreline_keeps_register_metres():
+    """The register's own road points (Skred_E6_Trondelag_2000_2014.gml, EPSG:25833) are where their NVDB metre
+    says: feature 'veglenkeMeterFra' 9394 of main section 1 starts at (221642.786354518, 6923218.28523806)."""
+    c = cr.load_corridor(E6 / "e6_drivdalen.toml")
+    line = c.centreline
+    assert line.crs == "EPSG:25833" and line.chainage_range_m == (0.0, 19000.0)
+    assert line.point_at(9394.0) == pytest.approx((221642.786354518, 6923218.28523806), abs=1e-6)
+    assert line.chainage_at(221642.786354518, 6923218.28523806)[0] == pytest.approx(9394.0, abs=1e-6)
+    # every section carries its line, end to end along the road
+    ends = [(s.line[0], s.line[-1]) for s in c.sections]
+    for (_, end), (start, _) in zip(ends[:-1], ends[1:]):
+        assert end == pytest.approx(start)
+    # per-metre option costs are paid on the 200 m cut length (rhrs_slope_length_m), not the 1 km section
+    assert all(s.works_length_m == 200.0 and s.length_m == 1000.0 for s in c.sections)
 
 
 # ---- rates from inventories (issue 14, Build 1) ----------------------------------------------------------------

@@ -89,3 +89,22 @@ def test_table9_si_criteria_are_the_summary_sheet_benchmarks():
     for dsd, pts in zip(t.loc["percent_decision_sight_distance", cols], (3, 9, 27, 81)):
         assert rhrs.score(rhrs.dsd_x(dsd)) == pytest.approx(pts, rel=1e-12)
     assert not any(math.isnan(v) for v in t[cols].to_numpy().ravel())
+
+
+def test_lashotor_whole_point_scores_are_table10_rows(table10):
+    # the sheet's whole points are the printed rows (Taherynia et al. 2014, Table 10, p. 9), total their sum 453
+    r = rhrs.rate(cap_points=100, **LASHOTOR)
+    printed = table10["printed_rating"].drop("total")
+    assert r.integer_scores == {k: int(v) for k, v in printed.items()}
+    assert r.integer_total == 453
+    sheet = r.sheet().set_index("category")
+    assert list(sheet["points"].drop("total")) == [r.integer_scores[c] for c in r.x]
+    assert sheet.loc["total", "points"] == 453 and sheet.loc["total", "score"] == pytest.approx(r.total)
+    assert "slope_height_m = 34" in sheet.loc["slope_height", "rated_value"]
+
+
+def test_whole_points_round_halves_up():
+    # a score of exactly 82.5 (a category capped at 82.5 points) prints 83 (half up), not 82 (half to even)
+    r = rhrs.RHRSRating(x={"a": 5.0, "b": 1.0}, cap_points=82.5)
+    assert r.scores["a"] == 82.5
+    assert r.integer_scores == {"a": 83, "b": 3} and r.integer_total == 86

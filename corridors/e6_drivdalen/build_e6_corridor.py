@@ -15,6 +15,16 @@ Writes:
   at zero) -- a stated estimator choice.  Geometry (cut height from the record's height-difference class:
   "0 - 50 m" -> 25 m, "50 - 200 m" -> 60 m; face angle, ditch, road width) and the RHRS descriptive classes
   are ILLUSTRATIVE, not surveyed.
+* ``e6_centreline.gpkg``: the road centreline of main section 1 (EPSG:25833, ETRS89 / UTM 33N) from the register's
+  own geometry: every feature of the extract on E6 main section 1 (any slide type) carries a ``senterlinje``
+  LineString "generated from linear references to the NVDB road network" between its ``veglenkeMeterFra`` and
+  ``veglenkeMeterTil``.  Its vertices, with their metre values (interpolated along the feature's line between the
+  two), are the centreline's vertices in metre order (layer ``centreline``) and its calibration points (layer
+  ``nvdb_metres``, field ``chainage_m``), so a chainage is the NVDB metre exactly at those points and linear in
+  the distance along the drawn line between them.  Between far-apart points (e.g. metres 1,245-9,394) the drawn
+  line is a straight chord of the real, winding road: positions there are interpolated, not surveyed.  Before the
+  first point (metre 52) the line is extended back to metre 0 along its first segment, and it ends at metre
+  19,000 on the chord towards the next point (metre 29,820): both ASSUMPTIONS, stated in PROVENANCE.md.
 """
 from __future__ import annotations
 
@@ -33,6 +43,60 @@ MAIN_SECTION = "1"
 SECTION_M = 1000.0
 END_M = 19000.0
 HEIGHT_CLASS_M = {"0 - 50 m": 25.0, "50 - 200 m": 60.0}     # ILLUSTRATIVE cut height per recorded class
+CRS = "EPSG:25833"           # the extract's srsName (ETRS89 / UTM zone 33N)
+
+
+def road_points(gml: Path, main_section: str = MAIN_SECTION) -> pd.DataFrame:
+    """(metre, x, y) of every vertex of the register's road geometry on E6 ``main_section``, in metre order.
+
+    Each feature's ``senterlinje`` runs from ``veglenkeMeterFra`` to ``veglenkeMeterTil``; its vertices get metre
+    values linear in the distance along it.  Repeated metres and repeated positions keep their first occurrence."""
+    import numpy as np
+    rows = []
+    for el in ET.parse(gml).getroot().iter():
+        if not el.tag.endswith("}Skred"):
+            continue
+        d, pos = {}, None
+        for c in el.iter():
+            if c.tag.endswith("}posList"):
+                pos = c.text
+            elif c.text and c.text.strip() and len(list(c)) == 0:
+                d.setdefault(c.tag.split("}")[1], c.text.strip())
+        if d.get("vegnummer") != "6" or d.get("hovedParsell") != main_section or not pos:
+            continue
+        xy = np.array(pos.split(), dtype=float).reshape(-1, 2)
+        m0, m1 = float(d["veglenkeMeterFra"]), float(d.get("veglenkeMeterTil", d["veglenkeMeterFra"]))
+        s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(xy, axis=0).T))]
+        m = m0 + (m1 - m0) * (s / s[-1] if s[-1] > 0 else 0.0)
+        rows += [(float(a), float(x), float(y)) for a, (x, y) in zip(m, xy)]
+    pts = pd.DataFrame(rows, columns=["metre", "x", "y"]).sort_values(["metre", "x", "y"], kind="stable")
+    pts = pts.drop_duplicates("metre").drop_duplicates(["x", "y"]).reset_index(drop=True)
+    return pts
+
+
+def write_centreline(gml: Path, path: Path, end_m: float = END_M) -> None:
+    """``e6_centreline.gpkg``: the register's road points of main section 1 as a calibrated centreline from metre 0
+    (extended back along the first segment) to ``end_m`` (on the chord towards the next point)."""
+    import numpy as np
+
+    from riskrf.io.gis import centreline_from_vertices, write_centreline as write_line
+    pts = road_points(gml)
+    first, second = pts.iloc[0], pts.iloc[1]
+    u = np.array([second.x - first.x, second.y - first.y])
+    u /= np.hypot(*u)
+    start = np.array([first.x, first.y]) - u * first.metre          # metre 0: back along the first segment
+    after = pts[pts["metre"] > end_m].iloc[0]
+    before = pts[pts["metre"] <= end_m].iloc[-1]
+    f = (end_m - before.metre) / (after.metre - before.metre)
+    end = np.array([before.x + f * (after.x - before.x), before.y + f * (after.y - before.y)])
+    inner = pts[pts["metre"] <= end_m]
+    xy = np.vstack([start, inner[["x", "y"]].to_numpy(), end])
+    metres = np.r_[0.0, inner["metre"].to_numpy(), end_m]
+    cal = np.column_stack([metres, xy])
+    line = centreline_from_vertices(xy, crs=CRS, calibration=cal, source=path.name)
+    if path.exists():
+        path.unlink()
+    write_line(line, path, layer="centreline", calibration_layer="nvdb_metres", calibration_chainage_m=metres)
 
 
 def read_rockfalls(gml: Path) -> pd.DataFrame:
@@ -58,6 +122,7 @@ def main(argv=None) -> int:
     gml = Path(argv[0]) if argv else DEFAULT_GML
     falls = read_rockfalls(gml)
     falls.to_csv(HERE / "e6_rockfalls.csv", index=False)
+    write_centreline(gml, HERE / "e6_centreline.gpkg")
     vols = falls[falls["volume_m3"] != ""][["date", "volume_m3", "nvdb_id"]]
     vols.to_csv(HERE / "e6_volumes.csv", index=False)
     (HERE / "e6_volumes.toml").write_text(
@@ -85,6 +150,7 @@ def main(argv=None) -> int:
         fh.write("# E6 hovedParsell 1, 1-km sections.  falls_per_year: (recorded NVDB rock falls 2000-2014 + 0.5) / 15 yr"
                  " (real record; +0.5 = Jeffreys-prior mean).  cut_height_m and RHRS classes ILLUSTRATIVE.\n")
         sec.drop(columns=["recorded_falls"]).to_csv(fh, index=False)
+    print(f"e6_centreline.gpkg: {len(road_points(gml))} register road points on main section {MAIN_SECTION}")
     print(f"{len(falls)} rock falls ({len(vols)} with a volume); {len(sec)} sections on main section {MAIN_SECTION}, "
           f"{int(sec['recorded_falls'].sum())} falls in them")
     return 0

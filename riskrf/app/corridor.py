@@ -49,7 +49,8 @@ GEOMETRY_COLUMNS = ("cut_height_m", "face_angle_deg", "ditch_width_m", "ditch_de
 #: Optional geometry of a generated cut: a horizontal catch bench in the face (width 0: no bench).
 BENCH_COLUMNS = ("bench_width_m", "bench_height_m")
 NUMBER_COLUMNS = GEOMETRY_COLUMNS + BENCH_COLUMNS + ("chainage_from", "chainage_to", "falls_per_year", "falls_per_km_year",
-                                     "falls_per_m2_year", "vehicles_per_day", "speed_kmh", "release_zone_share")
+                                     "falls_per_m2_year", "vehicles_per_day", "speed_kmh", "release_zone_share",
+                                     "cut_length_m")
 RATE_COLUMNS = ("falls_per_year", "falls_per_km_year", "falls_per_m2_year")
 #: Ways to give a section's rate: one of the rate columns, or ``inventory`` (the section's own inventory file).
 RATE_SOURCES = RATE_COLUMNS + ("inventory",)
@@ -61,7 +62,8 @@ ALL_COLUMNS = TEXT_COLUMNS + NUMBER_COLUMNS + RHRS_COLUMNS
 #: (per m2 read as per km, 10^6 for 10^-6): 10,000 a year is 27 falls a day reaching one road section, a
 #: slope that closes its road rather than one a corridor screening ranks.
 MAX_SECTION_FALLS_PER_YEAR = 10_000.0
-#: Per-metre cost fields of corridor options, multiplied by the section length.
+#: Per-metre cost fields of corridor options, multiplied by the section's cut length (``cut_length_m``: the length
+#: of rock cut along the road that the works treat; default ``rhrs_slope_length_m``, else the section length).
 PER_M_FIELDS = ("capital_cost_per_m", "annual_maintenance_per_m", "replacement_cost_per_m")
 #: Crest plateau [m] behind the cut and verge [m] beyond the road of a generated profile (room for
 #: the seeder and for blocks crossing the road to come to rest).
@@ -90,6 +92,13 @@ class Section:
     rating: rhrs.RHRSRating | None = None
     notes: str = ""
     rate_source: str = ""
+    cut_length_m: float | None = None
+    line: tuple | None = field(default=None, repr=False)
+
+    @property
+    def works_length_m(self) -> float:
+        """Length [m] that per-metre option costs are paid on: the cut length, else the section length."""
+        return self.length_m if self.cut_length_m is None else self.cut_length_m
 
     @property
     def length_m(self) -> float:
@@ -115,6 +124,9 @@ class Corridor:
     currency: str = "CHF"
     errors: tuple = ()
     defaults_used: tuple = ()
+    crs: str | None = None
+    centreline: object = field(default=None, repr=False)
+    rhrs_variant: str = "fhwa"
 
     def section(self, sid: str) -> Section:
         """The section with id ``sid`` (StopIteration when there is none)."""
@@ -362,7 +374,27 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     cor = data.get("corridor", {})
     _unknown(cor, {"name", "description", "sections", "seed", "n_blocks", "option_blocks", "chainage_unit",
                    "rate_basis", "rhrs_cap_points", "sections_sheet", "sections_header_row", "sections_decimal",
-                   "sections_encoding"}, "corridor.", src)
+                   "sections_encoding", "rhrs_variant", "centreline", "centreline_layer",
+                   "centreline_calibration_layer", "centreline_calibration_field", "centreline_chainage_start_m"},
+             "corridor.", src)
+    variant = cor.get("rhrs_variant", "fhwa")
+    if variant not in rhrs.VARIANTS:
+        raise CorridorError(f"{src}: corridor.rhrs_variant = {variant!r} must be one of {sorted(rhrs.VARIANTS)}"
+                            + (f" ({rhrs.UNAVAILABLE_VARIANTS[variant]})" if variant in rhrs.UNAVAILABLE_VARIANTS
+                               else ""))
+    centreline = None
+    if "centreline" in cor:
+        from ..io.gis import GISError, read_centreline
+        try:
+            centreline = read_centreline(
+                (path.parent / str(cor["centreline"])).resolve(), layer=cor.get("centreline_layer"),
+                calibration_layer=cor.get("centreline_calibration_layer"),
+                calibration_field=cor.get("centreline_calibration_field", "chainage_m"),
+                chainage_start_m=float(cor.get("centreline_chainage_start_m", 0.0)))
+        except GISError as exc:
+            raise CorridorError(f"{src}: corridor.centreline = {cor['centreline']!r}: {exc}") from None
+    elif any(k.startswith("centreline_") for k in cor):
+        raise CorridorError(f"{src}: centreline_* fields need corridor.centreline = \"road.gpkg\" (the road's line)")
     reader = {"sheet": sheet if sheet is not None else cor.get("sections_sheet"),
               "header_row": header_row if header_row is not None else cor.get("sections_header_row"),
               "decimal": decimal if decimal is not None else cor.get("sections_decimal"),
@@ -622,19 +654,32 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                 # what the section's own columns already say; rhrs_* columns override
                 derived = {"slope_height_m": num.get("cut_height_m"), "roadway_width_m": num.get("road_width_m")}
                 if "avr_percent" not in given:
-                    derived.update(slope_length_m=c1 - c0, adt_vehicles_per_day=vpd, speed_kmh=speed)
+                    derived.update(slope_length_m=num.get("cut_length_m", c1 - c0), adt_vehicles_per_day=vpd,
+                                   speed_kmh=speed)
                 attrs = {k: v for k, v in derived.items() if v is not None}
                 attrs.update(given)
                 try:
                     rating = rhrs.rate(cap_points=rhrs_cap, **attrs)
                 except (ValueError, TypeError) as exc:
                     raise CorridorError(f"{where}: RHRS: {exc}") from exc
+            cut_len = num.get("cut_length_m", num.get("rhrs_slope_length_m"))
+            if cut_len is not None and not 0 < cut_len <= (c1 - c0) * (1 + 1e-12):
+                raise CorridorError(f"{where}: column 'cut_length_m' (or rhrs_slope_length_m) = {cut_len:g} m must lie "
+                                    f"in (0, {c1 - c0:g}] (the section's length along the chainage)")
+            line = None
+            if centreline is not None:
+                lo, hi = centreline.chainage_range_m
+                if c0 < lo - 1e-6 or c1 > hi + 1e-6:
+                    raise CorridorError(f"{where}: chainage {c0:g}-{c1:g} m lies beyond the centreline "
+                                        f"{centreline.source} ({lo:g} to {hi:g} m)")
+                line = tuple(map(tuple, centreline.cut(c0, c1)))
             if rate_source == "shared":
                 weights[sid] = weight
             sections.append(Section(id=sid, row=row, chainage_from_m=c0, chainage_to_m=c1, scenario=sc,
                                     geometry=geometry, falls_per_year=float(rate), vehicles_per_day=float(vpd),
                                     speed_kmh=float(speed), options=opts, rating=rating,
-                                    notes=str(vals["notes"] or ""), rate_source=rate_source))
+                                    notes=str(vals["notes"] or ""), rate_source=rate_source,
+                                    cut_length_m=None if cut_len is None else float(cut_len), line=line))
         except CorridorError as exc:
             errors.append(str(exc))
             bad_rows.add(row)
@@ -684,12 +729,40 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                     mass_note=mass_note, rate_basis=basis, study=study, options=options,
                     n_blocks=int(cor.get("n_blocks", 2000)), option_blocks=int(cor.get("option_blocks", 1000)),
                     seed=int(cor.get("seed", 1)), currency=consequences.currency, errors=tuple(errors),
-                    defaults_used=tuple(used))
+                    defaults_used=tuple(used), crs=None if centreline is None else centreline.crs,
+                    centreline=centreline, rhrs_variant=variant)
 
 
 # ---------------------------------------------------------------------------------------------------------
 # one section (a task)
 # ---------------------------------------------------------------------------------------------------------
+def rhrs_columns(rating) -> dict:
+    """RHRS columns of a section's result row: ``rhrs_<category>`` whole-point score of every category and
+    ``rhrs_total`` (their sum, as a rating sheet prints it); empty (NaN) without a rating.  The category set is
+    the union of both geologic cases, so every section's row has the same columns."""
+    cats = ("slope_height", "ditch_effectiveness", "average_vehicle_risk", "percent_decision_sight_distance",
+            "roadway_width", "structural_condition", "rock_friction", "difference_in_erosion_rates",
+            "block_size_or_volume", "climate_and_water", "rockfall_history")
+    if rating is None:
+        return {**{f"rhrs_{c}": np.nan for c in cats}, "rhrs_total": np.nan}
+    pts = rating.integer_scores
+    return {**{f"rhrs_{c}": float(pts[c]) if c in pts else np.nan for c in cats},
+            "rhrs_total": float(rating.integer_total)}
+
+
+#: Per-option fields kept in a result row (``options_json``) for the budget programme.
+OPTION_FIELDS = ("option", "kind", "capital", "pv_renewals", "pv_maintenance", "deaths_per_year", "individual_risk",
+                 "expected_total_cost", "meets_criteria")
+
+
+def _options_json(rk: pd.DataFrame, base) -> str:
+    """Every option of a section's ranking as a JSON list (plain numbers): what the programme chooses among."""
+    import json
+    recs = []
+    for _, r in rk.iterrows():
+        recs.append({k: (bool(r[k]) if k == "meets_criteria" else str(r[k]) if k in ("option", "kind")
+                         else float(r[k])) for k in OPTION_FIELDS})
+    return json.dumps(recs, sort_keys=True)
 def _road_reach(hazard, result, mm) -> float:
     """P(a fall of mass model ``mm`` reaches the road line) from the mass-coupled run ``result`` behind ``hazard``
     (the same blocks and mass classes as the hazard's barrier samples, reach counted per class)."""
@@ -724,8 +797,9 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
     t0 = time.perf_counter()
     mm = mass_model(corridor.mass)
     row = {"id": section.id, "chainage_from_m": section.chainage_from_m, "chainage_to_m": section.chainage_to_m,
-           "length_m": section.length_m, "geometry": section.geometry,
+           "length_m": section.length_m, "cut_length_m": section.works_length_m, "geometry": section.geometry,
            "rhrs_score": section.rating.total if section.rating is not None else np.nan,
+           **rhrs_columns(section.rating),
            "rate_given_per_year": section.falls_per_year, "rate_source": section.rate_source,
            "rate_basis": corridor.rate_basis, "n_blocks": n,
            "seed": s_seed}
@@ -744,6 +818,7 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
                     "expected_annual_loss": 0.0, "best_option": "do nothing (no block reaches the barrier line)",
                     "best_option_capital": 0.0, "best_option_total_cost": 0.0, "best_deaths_per_year": 0.0,
                     "best_individual_risk": 0.0, "meets_criteria": True, "note": "no simulated block reached the line",
+                    "options_json": "[]",
                     "seconds": time.perf_counter() - t0})
         return row
     reach_barrier = float(hazard.reach_probability)
@@ -760,17 +835,17 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
     hazard = replace(hazard, rate_per_year=release)
     row.update({"reach_barrier": reach_barrier, "reach_road": reach_road, "release_falls_per_year": release})
     result = simulation.run(section.scenario, n=n, seed=s_seed, record_paths=0)    # the seeder's run: option effects
-    length = section.length_m
+    works = section.works_length_m           # per-metre costs are paid on the cut, not on the whole section
     opts = []
     for o, pm in corridor.options:
         if o.name not in section.options:
             continue
-        upd = {k: v * length for k, v in pm.items()}
+        upd = {k: v * works for k, v in pm.items()}
         if o.kind == "shed":
-            upd["covered_length_m"] = length
+            upd["covered_length_m"] = works
         opts.append(replace(o, **upd))
     exposure = replace(corridor.study["exposure"], vehicles_per_day=section.vehicles_per_day,
-                       speed_kmh=section.speed_kmh, exposed_length_m=length)
+                       speed_kmh=section.speed_kmh, exposed_length_m=section.length_m)
     unc = replace(corridor.study["uncertainty"], seed=s_seed % (2 ** 32))
     study = MitigationStudy(hazard=hazard, options=tuple(opts), exposure=exposure,
                             consequences=corridor.study["consequences"], economics=corridor.study["economics"],
@@ -800,6 +875,7 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
         "deaths_avoided_per_million": avoided * years / spend * 1e6 if spend > 0 else np.nan,
         "meets_criteria": bool(best["meets_criteria"]),
         "cheapest_option": str(rk.iloc[0]["option"]),
+        "options_json": _options_json(rk, base),
         "note": "" if len(ok) else f"no option meets the criteria (individual risk <= {lim:g}/yr and F-N); "
                                    "cheapest shown",
         "seconds": time.perf_counter() - t0})
@@ -888,6 +964,7 @@ class CorridorResult:
         t["rank_difference"] = t["rank_rhrs"] - t["rank_risk"]
         t["expected_annual_cost_per_km"] = t["expected_annual_loss_pv"] / _pv(self.corridor) / (t["length_m"] / M_PER_KM)
         cols = ["rank_risk", "rank_rhrs", "rank_difference", "id", "chainage_from_m", "chainage_to_m", "rhrs_score",
+                "rhrs_total",
                 "road_falls_per_year", "deaths_per_year", "individual_risk", "expected_annual_cost_per_km",
                 "best_option", "best_option_capital", "best_option_total_cost", "best_individual_risk",
                 "deaths_avoided_per_million", "meets_criteria", "note"]
@@ -912,6 +989,86 @@ class CorridorResult:
         from ..report.corridor_report import plot_corridor
         return plot_corridor(self)
 
+    def options_table(self) -> pd.DataFrame:
+        """Every option that could be built on every section (one row each; "do nothing" left out: not funding a
+        section is doing nothing there), with what it costs and what it buys against doing nothing.
+
+        Money in the corridor currency: ``capital`` (paid now), ``present_value`` (capital + renewals +
+        maintenance discounted at the corridor's rate over its horizon), ``equivalent_annual_cost``
+        (present_value / annuity factor (1 - (1 + r)^-n) / r: the same money as a level cost per year);
+        ``deaths_avoided_per_year`` and ``expected_total_cost_saving`` against the section's do-nothing option.
+        """
+        import json
+        pv = _pv(self.corridor)
+        rows = []
+        for _, r in self.table.iterrows():
+            for o in json.loads(r.get("options_json", "[]") or "[]"):
+                if o["kind"] == "none":
+                    continue
+                present = o["capital"] + o["pv_renewals"] + o["pv_maintenance"]
+                rows.append({"id": r["id"], "option": o["option"], "kind": o["kind"], "capital": o["capital"],
+                             "present_value": present, "equivalent_annual_cost": present / pv,
+                             "deaths_per_year": o["deaths_per_year"],
+                             "deaths_avoided_per_year": r["deaths_per_year"] - o["deaths_per_year"],
+                             "expected_total_cost": o["expected_total_cost"],
+                             "expected_total_cost_saving": r["do_nothing_total_cost"] - o["expected_total_cost"],
+                             "individual_risk": o["individual_risk"], "meets_criteria": o["meets_criteria"]})
+        cols = ["id", "option", "kind", "capital", "present_value", "equivalent_annual_cost", "deaths_per_year",
+                "deaths_avoided_per_year", "expected_total_cost", "expected_total_cost_saving", "individual_risk",
+                "meets_criteria"]
+        return pd.DataFrame(rows, columns=cols)
+
+    def programme(self, budget: float, *, basis: str = "total", objective: str = "risk"):
+        """The best programme within ``budget`` (:func:`riskrf.risk.programme.optimise_programme`, exact MILP).
+
+        ``basis``: ``"total"`` -- the budget caps the summed capital of the chosen options (money paid now);
+        ``"year"`` -- it caps their summed equivalent annual cost (present value of capital, renewals and
+        maintenance spread as a level yearly cost at the discount rate).  ``objective``: ``"risk"`` maximises
+        deaths avoided per year, ``"cost"`` minimises the corridor's expected total cost.
+        """
+        from ..risk.programme import optimise_programme
+        return optimise_programme(self.options_table(), budget, objective=objective,
+                                  cost_column=BUDGET_BASES[basis] if basis in BUDGET_BASES else _bad_basis(basis))
+
+    def frontier(self, *, basis: str = "total", objective: str = "risk", points: int = 25, budgets=None):
+        """Efficient frontier: the best programme's benefit at each budget (exact at every point)."""
+        from ..risk.programme import efficient_frontier
+        return efficient_frontier(self.options_table(), budgets, objective=objective, points=points,
+                                  cost_column=BUDGET_BASES[basis] if basis in BUDGET_BASES else _bad_basis(basis))
+
+    def programme_table(self, programme) -> pd.DataFrame:
+        """Every section with the programme's choice: ``programme_option`` ("" = not funded: do nothing), its
+        capital, present value and equivalent annual cost, deaths per year before and after."""
+        t = self.table[["id", "chainage_from_m", "chainage_to_m", "rhrs_total", "deaths_per_year",
+                        "do_nothing_total_cost"]].copy()
+        ch = programme.chosen.set_index("id")
+        t["programme_option"] = [ch.loc[i, "option"] if i in ch.index else "" for i in t["id"]]
+        for c in ("capital", "present_value", "equivalent_annual_cost"):
+            t[f"programme_{c}"] = [float(ch.loc[i, c]) if i in ch.index else 0.0 for i in t["id"]]
+        t["programme_deaths_per_year"] = [float(ch.loc[i, "deaths_per_year"]) if i in ch.index else d
+                                          for i, d in zip(t["id"], t["deaths_per_year"])]
+        t["programme_expected_total_cost"] = [float(ch.loc[i, "expected_total_cost"]) if i in ch.index else d
+                                              for i, d in zip(t["id"], t["do_nothing_total_cost"])]
+        return t
+
+    def sections_table(self, programme=None) -> pd.DataFrame:
+        """The result rows by chainage as written to sections.csv and sections.gpkg (same columns): everything
+        but the per-option list (the text ``geometry`` of the cut renamed ``cut_geometry``), with the programme's
+        choice when one is given."""
+        t = self.table.drop(columns=[c for c in ("options_json",) if c in self.table]).rename(
+            columns={"geometry": "cut_geometry"})          # text: a GIS reserves "geometry" for the line itself
+        if programme is not None:
+            p = self.programme_table(programme)
+            t = t.merge(p[["id"] + [c for c in p.columns if c.startswith("programme_")]], on="id", how="left")
+        return t
+
+    def lines(self) -> list | None:
+        """Line geometry (k x 2 vertices, metres in :attr:`Corridor.crs`) of every row of :attr:`table`, or None
+        when the corridor has no centreline."""
+        if self.corridor.centreline is None:
+            return None
+        return self.corridor.centreline.cuts(self.table["chainage_from_m"], self.table["chainage_to_m"])
+
     def to_json(self) -> dict:
         """The run as a JSON-ready dict (``corridor_summary.json``): counts, failures, rejected rows, seed, blocks,
         workers, seconds, units (chainage m, rates 1/yr, money in the corridor's currency) and totals.
@@ -927,6 +1084,18 @@ class CorridorResult:
                 "total_capital_best_options": float(self.table["best_option_capital"].sum()),
                 "top": s.head(10).replace({np.nan: None}).to_dict(orient="records"),
                 "defaults_used": list(self.corridor.defaults_used)}
+
+
+#: Points of the efficient frontier written with a programme: (up to the section count given, above it).
+FRONTIER_POINTS = (25, 10, 500)
+
+#: What a budget caps, by ``--budget-basis``: capital paid now, or the equivalent annual cost.
+BUDGET_BASES = {"total": "capital", "year": "equivalent_annual_cost"}
+
+
+def _bad_basis(basis):
+    raise ValueError(f"budget basis = {basis!r} must be 'total' (capital paid now) or 'year' (equivalent annual "
+                     "cost: present value of capital, renewals and maintenance as a level yearly cost)")
 
 
 def _sig12(values: pd.Series) -> pd.Series:
@@ -1026,17 +1195,55 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
                           seconds=time.perf_counter() - t0, n_blocks=int(n_blocks or corridor.n_blocks))
 
 
-def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False) -> None:
-    """Write report.html, corridor.csv (ranked), sections.csv (by chainage), budget_curve.csv, chainage.png and
-    summary.json into ``out`` (a directory that appears only when everything is written; an existing non-empty
-    ``out`` is replaced whole only with ``overwrite``)."""
+def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False, budget: float | None = None,
+                   budget_basis: str = "total", objective: str = "risk", programme=None, frontier=None) -> None:
+    """Write the corridor's outputs into ``out`` (a directory that appears only when everything is written; an
+    existing non-empty ``out`` is replaced whole only with ``overwrite``):
+
+    report.html, corridor.csv (ranked), sections.csv (by chainage; with a centreline also sections.gpkg, the same
+    columns on each section's line in the centreline's CRS, and map.png), budget_curve.csv, chainage.png,
+    rating_sheets.html (one RHRS sheet per rated section), summary.json; with ``budget`` also programme.csv (every
+    section with the option the exact programme gives it, or none), frontier.csv and frontier.png.
+    ``programme`` and ``frontier``: already solved (:meth:`CorridorResult.programme` and ``frontier`` of the same
+    budget, basis and objective), written as they are instead of solved again.
+    """
+    from ..io.gis import write_lines_gpkg
     from ..io.outputs import atomic_output_dir, write_json
-    from ..report.corridor_report import render_corridor_html
+    from ..report.corridor_report import plot_frontier, plot_map, render_corridor_html, render_rating_sheets
     from ..report.files import save_figure
+    if budget_basis not in BUDGET_BASES:
+        _bad_basis(budget_basis)
+    if budget is None and programme is not None:
+        budget = programme.budget
+    if budget is not None and programme is None:
+        programme = res.programme(budget, basis=budget_basis, objective=objective)
+    if budget is not None and frontier is None:
+        # every frontier point is a full programme solve: fewer points for a long corridor (see FRONTIER_POINTS)
+        frontier = res.frontier(basis=budget_basis, objective=objective,
+                                points=FRONTIER_POINTS[0] if len(res.table) <= FRONTIER_POINTS[2] else FRONTIER_POINTS[1])
     with atomic_output_dir(out, overwrite=overwrite) as tmp:
         res.summary().to_csv(tmp / "corridor.csv", index=False)
-        res.table.to_csv(tmp / "sections.csv", index=False)
+        sections = res.sections_table(programme)
+        sections.to_csv(tmp / "sections.csv", index=False)
         res.budget_curve().to_csv(tmp / "budget_curve.csv", index=False)
-        save_figure(res.figure(), tmp / "chainage.png")
-        (tmp / "report.html").write_text(render_corridor_html(res, tmp / "chainage.png"), encoding="utf-8")
-        write_json(res.to_json(), tmp / "summary.json")
+        figures = {"chainage": save_figure(res.figure(), tmp / "chainage.png")}
+        lines = res.lines()
+        if lines is not None:
+            write_lines_gpkg(tmp / "sections.gpkg", sections, lines, crs=res.corridor.crs)
+            figures["map"] = save_figure(plot_map(res, lines, programme), tmp / "map.png")
+        if programme is not None:
+            res.programme_table(programme).to_csv(tmp / "programme.csv", index=False)
+            frontier.summary().to_csv(tmp / "frontier.csv", index=False)
+            figures["frontier"] = save_figure(plot_frontier(frontier, currency=res.corridor.currency,
+                                                            chosen_budget=budget), tmp / "frontier.png")
+        (tmp / "rating_sheets.html").write_text(render_rating_sheets(res), encoding="utf-8")
+        (tmp / "report.html").write_text(render_corridor_html(res, figures["chainage"], figures=figures,
+                                                              programme=programme, frontier=frontier,
+                                                              budget_basis=budget_basis), encoding="utf-8")
+        summary = res.to_json()
+        if programme is not None:
+            summary["programme"] = {"budget": programme.budget, "basis": budget_basis,
+                                    "budget_caps": BUDGET_BASES[budget_basis], "objective": objective,
+                                    "maximised": programme.benefit_column, "cost": programme.cost,
+                                    "benefit": programme.benefit, "sections_funded": int(len(programme.chosen))}
+        write_json(summary, tmp / "summary.json")

@@ -8,44 +8,190 @@ from ..core.units import M_PER_KM
 from .format import Document, cell, escape
 
 
+#: Above this many sections the chainage figure draws binned step curves (one artist per curve, no labels), so
+#: that it costs O(sections) with a small constant; at or below it, one bar and one label per section.
+AGGREGATE_ABOVE = 300
+#: Number of chainage bins of the aggregated figure.
+CHAINAGE_BINS = 300
+#: Rows of the ranked and budget tables shown in the HTML report (all rows are in the CSV files).
+HTML_ROWS = 100
+
+
+def _binned(t, bins):
+    """Per chainage bin (sections assigned by their start): max RHRS, max individual risk now and with the best
+    option, and deaths per year per km now and after (sums over the bin's section length)."""
+    import numpy as np
+    x0 = t["chainage_from_m"].to_numpy() / M_PER_KM
+    edges = np.linspace(x0.min(), (t["chainage_to_m"].to_numpy() / M_PER_KM).max(), bins + 1)
+    k = np.clip(np.searchsorted(edges, x0, side="right") - 1, 0, bins - 1)
+    out = {}
+    for name, col, how in (("rhrs", "rhrs_score", "max"), ("ir", "individual_risk", "max"),
+                           ("ir_best", "best_individual_risk", "max"), ("d", "deaths_per_year", "sum"),
+                           ("d_best", "best_deaths_per_year", "sum"), ("km", "length_m", "sum")):
+        v = t[col].to_numpy(dtype=float)
+        acc = np.full(bins, -np.inf if how == "max" else 0.0)
+        (np.maximum if how == "max" else np.add).at(acc, k, np.nan_to_num(v, nan=-np.inf if how == "max" else 0.0))
+        out[name] = np.where(np.isfinite(acc), acc, np.nan)
+    out["km"] = out["km"] / M_PER_KM
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out["d"], out["d_best"] = out["d"] / out["km"], out["d_best"] / out["km"]
+    return edges, out
+
+
 def plot_corridor(res):
     """Along chainage: RHRS score, individual risk (criterion line), deaths per year per km now and with the
-    best option."""
+    best option.  Above :data:`AGGREGATE_ABOVE` sections the curves are binned (:data:`CHAINAGE_BINS` bins; RHRS
+    and individual risk the bin's maximum, deaths per km the bin's total over its length)."""
     import matplotlib.pyplot as plt
     t = res.table.sort_values("chainage_from_m")
-    x0, w = t["chainage_from_m"].to_numpy() / M_PER_KM, t["length_m"].to_numpy() / M_PER_KM
     fig, ax = plt.subplots(3, 1, figsize=(10, 7.5), sharex=True)
-    ax[0].bar(x0, t["rhrs_score"], width=w, align="edge", color="#8c6d31", edgecolor="k", lw=0.3)
-    ax[0].set_ylabel("RHRS score")
-    ax[1].bar(x0, t["individual_risk"], width=w, align="edge", color="#d62728", alpha=0.7, edgecolor="k", lw=0.3,
-              label="do nothing")
-    ax[1].bar(x0, t["best_individual_risk"], width=w, align="edge", color="#2ca02c", alpha=0.8, edgecolor="k",
-              lw=0.3, label="best option")
-    ax[1].axhline(res.corridor.study["criteria"].individual_risk_per_year, color="k", ls="--", lw=1,
-                  label="tolerable")
+    crit = res.corridor.study["criteria"].individual_risk_per_year
+    if len(t) > AGGREGATE_ABOVE:
+        edges, b = _binned(t, CHAINAGE_BINS)
+        ax[0].stairs(b["rhrs"], edges, color="#8c6d31", fill=True, alpha=0.8)
+        ax[0].set_ylabel("RHRS score (bin max)")
+        ax[1].stairs(b["ir"], edges, color="#d62728", label="do nothing")
+        ax[1].stairs(b["ir_best"], edges, color="#2ca02c", label="best option")
+        ax[1].set_ylabel("individual risk [1/yr]\n(bin max)")
+        ax[2].stairs(b["d"], edges, color="#d62728", label="do nothing")
+        ax[2].stairs(b["d_best"], edges, color="#2ca02c", label="best option")
+        title = f"{res.corridor.name}: {len(t):,} sections in {CHAINAGE_BINS} chainage bins"
+    else:
+        x0, w = t["chainage_from_m"].to_numpy() / M_PER_KM, t["length_m"].to_numpy() / M_PER_KM
+        ax[0].bar(x0, t["rhrs_score"], width=w, align="edge", color="#8c6d31", edgecolor="k", lw=0.3)
+        ax[0].set_ylabel("RHRS score")
+        ax[1].bar(x0, t["individual_risk"], width=w, align="edge", color="#d62728", alpha=0.7, edgecolor="k",
+                  lw=0.3, label="do nothing")
+        ax[1].bar(x0, t["best_individual_risk"], width=w, align="edge", color="#2ca02c", alpha=0.8, edgecolor="k",
+                  lw=0.3, label="best option")
+        ax[1].set_ylabel("individual risk [1/yr]")
+        km = t["length_m"].to_numpy() / M_PER_KM
+        ax[2].bar(x0, t["deaths_per_year"] / km, width=w, align="edge", color="#d62728", alpha=0.7, edgecolor="k",
+                  lw=0.3, label="do nothing")
+        ax[2].bar(x0, t["best_deaths_per_year"] / km, width=w, align="edge", color="#2ca02c", alpha=0.8,
+                  edgecolor="k", lw=0.3, label="best option")
+        if len(t) <= 60:
+            for a, b_, sid in zip(x0, w, t["id"]):
+                ax[0].annotate(str(sid), (a + b_ / 2, 0), xytext=(0, 2), textcoords="offset points", ha="center",
+                               fontsize=6, rotation=90)
+        title = f"{res.corridor.name}: {len(t)} sections"
+    ax[1].axhline(crit, color="k", ls="--", lw=1, label="tolerable")
     ax[1].set_yscale("log")
-    ax[1].set_ylabel("individual risk [1/yr]")
     ax[1].legend(fontsize=8, loc="upper right")
-    km = t["length_m"].to_numpy() / M_PER_KM
-    ax[2].bar(x0, t["deaths_per_year"] / km, width=w, align="edge", color="#d62728", alpha=0.7, edgecolor="k",
-              lw=0.3, label="do nothing")
-    ax[2].bar(x0, t["best_deaths_per_year"] / km, width=w, align="edge", color="#2ca02c", alpha=0.8,
-              edgecolor="k", lw=0.3, label="best option")
     ax[2].set_yscale("log")
     ax[2].set_ylabel("deaths per year per km")
     ax[2].set_xlabel("chainage [km]")
     ax[2].legend(fontsize=8, loc="upper right")
-    for i, (a, b, sid) in enumerate(zip(x0, w, t["id"])):
-        ax[0].annotate(str(sid), (a + b / 2, 0), xytext=(0, 2), textcoords="offset points", ha="center",
-                       fontsize=6, rotation=90)
-    fig.suptitle(f"{res.corridor.name}: {len(t)} sections")
+    fig.suptitle(title)
     fig.subplots_adjust(left=0.09, right=0.98, bottom=0.07, top=0.93, hspace=0.12)   # tight_layout: seconds
     return fig
 
 
-def render_corridor_html(res, figure_png: Path) -> str:
-    """Self-contained HTML corridor report: key figures, chainage figure, ranked table, budget curve, where the
-    RHRS and the quantitative ranking disagree, rejected rows, failures and assumptions."""
+def plot_map(res, lines, programme=None):
+    """Map of the sections on the road (projected CRS, metres): each section's line coloured by deaths per year
+    per km of doing nothing (log scale); sections the programme funds drawn wide with a black casing."""
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import LogNorm
+    t = res.table
+    km = t["length_m"].to_numpy() / M_PER_KM
+    dens = t["deaths_per_year"].to_numpy(dtype=float) / km
+    pos = dens[dens > 0]
+    norm = LogNorm(vmin=pos.min(), vmax=max(pos.max(), pos.min() * 10)) if pos.size else None
+    fig, ax = plt.subplots(figsize=(8, 8))
+    funded = set(programme.chosen["id"]) if programme is not None else set()
+    if funded:
+        sel = [ln for ln, i in zip(lines, t["id"]) if i in funded]
+        ax.add_collection(LineCollection(sel, colors="k", linewidths=7, zorder=1, label="funded by the programme"))
+    lc = LineCollection(lines, array=np.where(dens > 0, dens, np.nan), cmap="inferno_r", norm=norm, linewidths=3.5,
+                        zorder=2)
+    ax.add_collection(lc)
+    allxy = np.vstack(lines)
+    pad = 0.05 * max(np.ptp(allxy[:, 0]), np.ptp(allxy[:, 1]), 100.0)
+    ax.set_xlim(allxy[:, 0].min() - pad, allxy[:, 0].max() + pad)
+    ax.set_ylim(allxy[:, 1].min() - pad, allxy[:, 1].max() + pad)
+    ax.set_aspect("equal")
+    ax.ticklabel_format(useOffset=False, style="plain")
+    ax.set_xlabel(f"easting [m] ({res.corridor.crs})")
+    ax.set_ylabel(f"northing [m] ({res.corridor.crs})")
+    if norm is not None:
+        fig.colorbar(lc, ax=ax, shrink=0.7, label="deaths per year per km, doing nothing")
+    if len(t) <= 60:
+        for ln, sid in zip(lines, t["id"]):
+            mid = ln[len(ln) // 2]
+            ax.annotate(str(sid), tuple(mid), xytext=(4, 0), textcoords="offset points", fontsize=6)
+    if funded:
+        ax.legend(loc="lower right", fontsize=8)
+    ax.set_title(f"{res.corridor.name}: sections on the road" + (f", {len(funded)} funded" if funded else ""))
+    return fig
+
+
+def plot_frontier(frontier, ax=None, *, currency: str = "", chosen_budget: float | None = None):
+    """The efficient frontier: benefit of the best programme against the budget (steps: each point exact)."""
+    import matplotlib.pyplot as plt
+    t = frontier.table
+    own = ax is None
+    if own:
+        fig, ax = plt.subplots(figsize=(8, 5))
+    else:
+        fig = ax.figure
+    scale = 1e6 if t["budget"].max() >= 1e6 else 1.0
+    unit = f"million {currency}" if scale == 1e6 else currency
+    ax.step(t["budget"] / scale, t["benefit"], where="post", color="#1f77b4", lw=1.5)
+    ax.plot(t["budget"] / scale, t["benefit"], "o", color="#1f77b4", ms=3)
+    if chosen_budget is not None:
+        ax.axvline(chosen_budget / scale, color="k", ls="--", lw=1, label=f"budget {chosen_budget / scale:,.3g} {unit}")
+        ax.legend(fontsize=8, loc="lower right")
+    what = {"capital": "capital paid now", "equivalent_annual_cost": "equivalent annual cost per year"}
+    ax.set_xlabel(f"budget: {what.get(frontier.cost_column, frontier.cost_column)} [{unit}]")
+    ax.set_ylabel({"deaths_avoided_per_year": "deaths avoided per year",
+                   "expected_total_cost_saving": f"expected total cost saved [{currency}]"}[frontier.benefit_column])
+    ax.set_title("Efficient frontier: the best programme at each budget (exact, one option per section)")
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def render_rating_sheets(res) -> str:
+    """One RHRS rating sheet per rated section (HTML): category, rated value, level x, score and whole points,
+    the total as a sheet prints it; built as plain strings so that it costs O(sections)."""
+    c = res.corridor
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>RHRS rating sheets: "
+             f"{escape(c.name)}</title><style>body{{font-family:Georgia,serif;max-width:900px;margin:2em auto}}"
+             "table{border-collapse:collapse;margin-bottom:1.5em}td,th{border:1px solid #999;padding:2px 6px}"
+             "td.n{text-align:right}section{page-break-inside:avoid}</style></head><body>",
+             f"<h1>RHRS rating sheets: {escape(c.name)}</h1><p>Variant: {escape(c.rhrs_variant)} "
+             f"({escape(_variant_text(c.rhrs_variant))})"
+             + (f"; each category capped at {c.sections[0].rating.cap_points:g} points"
+                if c.sections and c.sections[0].rating is not None and c.sections[0].rating.cap_points else "")
+             + ". Points are the category scores 3<sup>x</sup> to the nearest whole point (halves up), the total "
+               "their sum, as a rating sheet prints them.</p>"]
+    for sec in c.sections:
+        if sec.rating is None:
+            continue
+        rows = "".join(f"<tr><td>{escape(r['category'])}</td><td>{escape(r['rated_value'])}</td>"
+                       f"<td class='n'>{'' if r['category'] == 'total' else format(r['x'], '.3f')}</td>"
+                       f"<td class='n'>{r['score']:.2f}</td><td class='n'><b>{r['points']}</b></td></tr>"
+                       for r in sec.rating.sheet_rows())
+        parts.append(f"<section id='{escape(sec.id)}'><h2>{escape(sec.id)}: chainage {sec.chainage_from_m:,.0f}-"
+                     f"{sec.chainage_to_m:,.0f} m</h2><table><thead><tr><th>category</th><th>rated value (SI)</th>"
+                     f"<th>x</th><th>score 3<sup>x</sup></th><th>points</th></tr></thead><tbody>{rows}</tbody>"
+                     "</table></section>")
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def _variant_text(name):
+    from ..risk.rhrs import VARIANTS
+    return VARIANTS.get(name, name)
+
+
+def render_corridor_html(res, figure_png: Path, *, figures: dict | None = None, programme=None, frontier=None,
+                         budget_basis: str = "total") -> str:
+    """Self-contained HTML corridor report: key figures, chainage figure, map, the budget programme and its
+    efficient frontier, ranked table (first :data:`HTML_ROWS` rows), budget curve, where the RHRS and the
+    quantitative ranking disagree, rejected rows, failures and assumptions."""
+    figures = figures or {}
     c = res.corridor
     cur = c.currency
     s = res.summary()
@@ -55,7 +201,7 @@ def render_corridor_html(res, figure_png: Path) -> str:
                   "cumulative_spend")
     disagree = s[(s["rank_difference"].abs() >= max(3, len(s) // 5)).fillna(False).astype(bool)] \
         if s["rank_rhrs"].notna().any() else s.iloc[0:0]
-    s = s.copy()
+    s = s.drop(columns=["rhrs_score"]) if "rhrs_total" in s and "rhrs_score" in s else s.copy()   # whole points
     for col in ("rank_rhrs", "rank_difference"):           # integer ranks; a section without RHRS attributes: blank
         s[col] = s[col].astype(object).where(s[col].notna(), "")
     disagree = disagree.astype({"rank_rhrs": object, "rank_difference": object})
@@ -75,18 +221,66 @@ def render_corridor_html(res, figure_png: Path) -> str:
               + f"</li><li>{escape(c.mass_note)}</li></ul></div>")
     doc.section("Along the chainage")
     doc.add(doc.figure(figure_png, "RHRS score, individual risk and deaths per year per km of each section, doing "
-                                   "nothing and with its best option"))
+                                   "nothing and with its best option"
+                       + (f" (binned: {len(t):,} sections in {CHAINAGE_BINS} bins of chainage)"
+                          if len(t) > AGGREGATE_ABOVE else "")))
+    if "map" in figures:
+        doc.section("On the road")
+        doc.add(f"<p>Each section's line on the road centreline ({escape(c.centreline.source)}, {escape(c.crs)}); "
+                "the same lines with every column of sections.csv are in <code>sections.gpkg</code> for a GIS.</p>",
+                doc.figure(figures["map"], "Sections on the road, coloured by deaths per year per km of doing "
+                                           "nothing" + ("; wide black casing: funded by the programme"
+                                                        if programme is not None else "")))
+    if programme is not None:
+        caps = {"total": "the capital of the chosen options (money paid now)",
+                "year": "the equivalent annual cost of the chosen options (present value of capital, renewals and "
+                        "maintenance, spread as a level cost per year at the discount rate)"}[budget_basis]
+        buys = {"deaths_avoided_per_year": "the deaths avoided per year",
+                "expected_total_cost_saving": "the saving in expected total cost (capital + discounted "
+                                              "maintenance, renewals and expected losses) against doing nothing"}
+        e = c.study["economics"]
+        doc.section("Programme within the budget")
+        doc.add(f"<div class='box'><p>Budget {cell(programme.budget, money_columns=True, currency=cur)} caps "
+                f"{caps}. The programme gives each section at most one option and maximises "
+                f"{buys[programme.benefit_column]}; it is solved as a mixed-integer programme, not by a greedy order, "
+                + ("and proven optimal. " if programme.gap == 0 else
+                   f"which stopped at its time limit: the programme is within {programme.gap:.2g} (relative) of the "
+                   "optimum. ")
+                + f"It funds {len(programme.chosen)} of {programme.n_sections} sections for "
+                f"{cell(programme.cost, money_columns=True, currency=cur)} and buys {cell(programme.benefit)}"
+                + (" deaths avoided per year" if programme.benefit_column == "deaths_avoided_per_year" else
+                   f" {escape(cur)} of expected total cost saved") + ".</p>"
+                f"<p><b>Capital</b> is what the works cost when built. <b>Present value</b> adds renewals at the end "
+                f"of each option's life and yearly maintenance over {e.horizon_years:g} years, discounted at "
+                f"{e.discount_rate:.1%}. Per-metre costs are paid on each section's cut length.</p></div>")
+        pt = res.programme_table(programme)
+        funded = pt[pt["programme_option"] != ""]
+        doc.add(doc.table(funded.head(HTML_ROWS), "Sections the programme funds" + (
+            f" (first {HTML_ROWS} of {len(funded)}; all in programme.csv)" if len(funded) > HTML_ROWS else ""),
+            money_columns=("do_nothing_total_cost", "programme_capital", "programme_present_value",
+                           "programme_equivalent_annual_cost", "programme_expected_total_cost"), currency=cur))
+        if "frontier" in figures:
+            doc.add(doc.figure(figures["frontier"], "Efficient frontier: what the best programme buys at each "
+                                                    "budget (each point an exact programme; frontier.csv)"))
     doc.section("Sections ranked by quantitative risk (RHRS rank beside)")
-    doc.add(doc.table(s, "Sections ranked by risk", money_columns=money_cols, currency=cur))
+    doc.add("<p>Whole-point RHRS category scores and totals of every section are in sections.csv; one rating sheet "
+            "per section is in <code>rating_sheets.html</code>.</p>",
+            doc.table(s.head(HTML_ROWS), "Sections ranked by risk" + (
+                f" (first {HTML_ROWS} of {len(s)}; all in corridor.csv)" if len(s) > HTML_ROWS else ""),
+                money_columns=money_cols, currency=cur))
     doc.section("Budget curve")
     doc.add("<p>Sections in order of deaths avoided per unit spent with their best option: what a budget buys when "
-            "sections are done in this order.</p>",
-            doc.table(b, "Budget curve", money_columns=money_cols, currency=cur))
+            "sections are done in this order (a greedy order; the programme above is the exact choice). Spend is "
+            "the present value (capital + renewals + maintenance) above doing nothing.</p>",
+            doc.table(b.head(HTML_ROWS), "Budget curve" + (f" (first {HTML_ROWS} of {len(b)}; all in "
+                                                           "budget_curve.csv)" if len(b) > HTML_ROWS else ""),
+                      money_columns=money_cols, currency=cur))
     if len(disagree):
         doc.section("Where the RHRS and the risk ranking disagree")
         doc.add(f"<p>Sections whose RHRS rank and risk rank differ by at least {max(3, len(s) // 5)} places.</p>",
-                doc.table(disagree[["id", "rank_risk", "rank_rhrs", "rhrs_score", "deaths_per_year",
-                                    "individual_risk"]], "RHRS and risk ranks that disagree"))
+                doc.table(disagree[["id", "rank_risk", "rank_rhrs", "rhrs_total" if "rhrs_total" in disagree else
+                                    "rhrs_score", "deaths_per_year", "individual_risk"]].head(HTML_ROWS),
+                          "RHRS and risk ranks that disagree"))
     if c.errors or res.failures:
         doc.section("Rejected rows and failed sections")
         doc.add("<div class='warn'><ul>" + "".join(f"<li>{escape(e)}</li>" for e in list(c.errors) + list(res.failures))

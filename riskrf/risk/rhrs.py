@@ -73,6 +73,17 @@ CLASSES = {
                           "freezing periods"),
     "rockfall_history": ("few falls", "occasional falls", "many falls", "constant falls"),
 }
+#: Rating systems :func:`rate` implements, by the name a corridor file gives (``corridor.rhrs_variant``).
+VARIANTS = {"fhwa": "FHWA RHRS (Pierson & Van Vickle 1993, FHWA-SA-93-057; summary sheet, exponential 3-81 scores)"}
+#: Agency variants that are known but not implemented, with the reason (said when a corridor file asks for one).
+UNAVAILABLE_VARIANTS = {
+    "odot": "the ODOT revision's category tables could not be read from any copy in reach, so they are not encoded "
+            "rather than guessed; rate with 'fhwa'",
+    "colorado": "the Colorado-modified RHRS (Santi et al. 2009, Eng. Geol. 104: 55-65; Russell et al. 2008, "
+                "CDOT-2008-7) tables could not be read from any copy in reach, so they are not encoded rather than "
+                "guessed; rate with 'fhwa'",
+}
+
 #: Short names accepted for the classes: the first word of a class when no other class of the category shares it
 #: (e.g. "good", "limited", "occasional").
 def _short_names(names):
@@ -185,6 +196,43 @@ class RHRSRating:
     def total(self) -> float:
         """The RHRS rating: sum of the category scores."""
         return float(sum(self.scores.values()))
+
+    @property
+    def integer_scores(self) -> dict:
+        """Score of each category as a rating sheet prints it: the nearest whole point (halves up), e.g. 5.67 -> 6
+        (Taherynia et al. 2014, Table 10 prints the roadway score 5.67 as 6 and the block score 36.76 as 37)."""
+        return {k: int(math.floor(v + 0.5)) for k, v in self.scores.items()}
+
+    @property
+    def integer_total(self) -> int:
+        """The rating as a sheet prints it: the sum of the whole-point category scores (453 for Table 10's rows)."""
+        return int(sum(self.integer_scores.values()))
+
+    def sheet(self) -> pd.DataFrame:
+        """The rating sheet: one row per category with the rated value (SI, as given or derived), level x, score
+        and the whole-point score; last row the totals."""
+        return pd.DataFrame(self.sheet_rows())
+
+    def sheet_rows(self) -> list:
+        """The rows of :meth:`sheet` as plain dicts (category, rated_value, x, score, points)."""
+        value_of = {"slope_height": "slope_height_m", "ditch_effectiveness": "ditch_effectiveness",
+                    "average_vehicle_risk": "avr_percent", "percent_decision_sight_distance": "percent_dsd",
+                    "roadway_width": "roadway_width_m", "structural_condition": ("structural_condition_case1",
+                                                                                 "structural_condition_case2"),
+                    "rock_friction": "rock_friction", "difference_in_erosion_rates": "difference_in_erosion_rates",
+                    "block_size_or_volume": ("block_size_m", "volume_m3"), "climate_and_water": "climate_and_water",
+                    "rockfall_history": "rockfall_history"}
+        rows, scores, points = [], self.scores, self.integer_scores
+        for cat, x in self.x.items():
+            keys = value_of.get(cat, cat)
+            keys = keys if isinstance(keys, tuple) else (keys,)
+            given = [f"{k} = {self.inputs[k]:.4g}" if isinstance(self.inputs[k], float) else
+                     f"{k} = {self.inputs[k]}" for k in keys if k in self.inputs]
+            rows.append({"category": cat, "rated_value": "; ".join(given), "x": x, "score": scores[cat],
+                         "points": points[cat]})
+        rows.append({"category": "total", "rated_value": "", "x": float("nan"), "score": self.total,
+                     "points": self.integer_total})
+        return rows
 
     def summary(self) -> pd.DataFrame:
         """One row per category: x, score (points); last row the total."""
