@@ -1,4 +1,4 @@
-"""End to end: `riskrf assess` and `riskrf demo` (issue 6)."""
+"""End to end: `riskrf assess` and `riskrf demo`."""
 import json
 import shutil
 

@@ -1,4 +1,4 @@
-"""Inputs as practitioners export them, outputs that never clobber, impossible values refused first (issue 11).
+"""Inputs as practitioners export them, outputs that never clobber, impossible values refused first.
 
 A table-driven sweep: every case names what it feeds riskrf and what must come back.  Refused
 cases assert that the message names the place (file, row, column or argument) and the value, that
@@ -385,7 +385,7 @@ CLI_REFUSALS = [
     ("zero density", ["--density", "0"], r"--density = 0"),
     ("m_min above m_max", ["--m-min", "1e5", "--m-max", "10"], r"--m-min = 100000.*--m-max = 10"),
     ("unknown collector in a scenario", ["--collector", "nope"], r"collector.*'nope'.*barrier"),
-    # issue 10 audit d: the design block's percentile and fragmentation parameters, before the simulation
+    # the design block's percentile and fragmentation parameters, before the simulation
     ("design percentile 0", ["--design-percentile", "0"], r"--design-percentile = 0\b.*> 0 and < 100"),
     ("design percentile 100", ["--design-percentile", "100"], r"--design-percentile = 100\b"),
     ("design percentile NaN", ["--design-percentile", "nan"], r"--design-percentile = nan"),

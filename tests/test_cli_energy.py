@@ -1,4 +1,4 @@
-"""`riskrf energy` (issue 4, item 5)."""
+"""`riskrf energy`."""
 import json
 
 import numpy as np
@@ -26,7 +26,7 @@ def test_energy_from_scenario_on_real_inventory(tmp_path, capsys):
     assert (table["ci_low_kj"] <= table["energy_kj"]).all() and (table["energy_kj"] <= table["ci_high_kj"]).all()
     for name in ("energy_exceedance.png", "mass_velocity.png", "fence_checks.csv", "design_energy_tornado.png"):
         assert (out / name).stat().st_size > 0
-    # issue 10 item 4: the tornado of the design energy, printed and written, its base the 100-year energy
+    # the tornado of the design energy, printed and written, its base the 100-year energy
     assert "One-way sensitivity (tornado)" in text and "dominant for the 100-year energy" in text
     tornado = pd.read_csv(out / "design_energy_tornado.csv")
     t100 = tornado[tornado["design_energy"] == "100-year energy at the barrier line"]
@@ -47,7 +47,7 @@ def test_energy_from_velocity_file(tmp_path, capsys):
     assert rc == 0
     text = capsys.readouterr().out
     assert "reach probability 0.3 as given" in text and "Fence 1000 kJ" in text
-    # issue 10 audit g: the "Wrote ..." line names every file the command wrote
+    # the "Wrote ..." line names every file the command wrote
     wrote = [line for line in text.splitlines() if line.startswith("Wrote ")]
     assert len(wrote) == 1
     files = sorted(p.name for p in (tmp_path / "o").iterdir())
@@ -58,7 +58,7 @@ def test_energy_from_velocity_file(tmp_path, capsys):
 
 
 def test_energy_design_percentile_zero_is_refused_not_replaced(tmp_path, capsys):
-    """issue 10 audit d: --design-percentile 0 once ran with p97 in its place."""
+    """--design-percentile 0 once ran with p97 in its place."""
     vel = tmp_path / "v.csv"
     pd.DataFrame({"velocity_ms": np.linspace(10, 20, 200)}).to_csv(vel, index=False)
     rc = main(["energy", "--inventory", str(LAUTER), "--velocities", str(vel), "--design-percentile", "0",

@@ -1,4 +1,4 @@
-"""The `riskrf fit` and `riskrf demo` commands (issue 2, item 6)."""
+"""The `riskrf fit` and `riskrf demo` commands."""
 import json
 
 import pandas as pd

@@ -1,4 +1,4 @@
-"""`riskrf simulate` (issue 3, item 6)."""
+"""`riskrf simulate`."""
 import pandas as pd
 
 from riskrf.cli import main

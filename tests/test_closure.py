@@ -1,4 +1,4 @@
-"""Rain-triggered closure as a mitigation option (issue 12, item 4): effectiveness from the rate model and the
+"""Rain-triggered closure as a mitigation option: effectiveness from the rate model and the
 rainfall record, cost from closure hours, and the option in the decision analysis."""
 import warnings
 

@@ -345,7 +345,7 @@ def test_e6_centreline_keeps_register_metres():
     assert all(s.works_length_m == 200.0 and s.length_m == 1000.0 for s in c.sections)
 
 
-# ---- rates from inventories (issue 14, Build 1) ----------------------------------------------------------------
+# ---- rates from inventories -----------------------------------------------------------------
 REPO = Path(__file__).resolve().parents[1]
 E6_VOLUMES = REPO / "corridors" / "e6_drivdalen" / "e6_volumes.csv"       # 34 real NVDB volumes, 1-30 m3, 15 yr
 LAUTER_2015 = REPO / "inventories" / "lauterbrunnen" / "lauterbrunnen_tls_2015.csv"   # 122 real TLS falls, 1.5 yr
@@ -404,7 +404,7 @@ def test_corridor_wide_inventory_shared_by_km_and_by_face_area(tmp_path):
         cr.load_corridor(path)
 
 
-# ---- load-only checks of further columns (issue 14, Build 1) ---------------------------------------------------
+# ---- load-only checks of further columns ----------------------------------------------------
 def test_chainage_in_km(tmp_path):
     rows = HEAD.replace(",scenario", ",falls_per_km_year,scenario").replace("falls_per_year,", "") + \
         "A,0,0.2,25,3,1,2.5,\nB,0.2,0.35,12,3,1,2.5,\n"

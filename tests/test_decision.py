@@ -1,4 +1,4 @@
-"""Decision trees, road-user risk and discounting (issue 5)."""
+"""Decision trees, road-user risk and discounting."""
 import json
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""One-way sensitivity (tornado) of the design energies (issue 10, item 4).
+"""One-way sensitivity (tornado) of the design energies.
 
 Small synthetic hazards, no simulation: a constant speed makes the T-year energy exact
 (E_T = 1/2 m_T v0^2 with m_T from the truncated power law's closed-form inverse), and velocity samples

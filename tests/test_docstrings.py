@@ -1,4 +1,4 @@
-"""Every public function, class and method of riskrf and simulation has a docstring (issue 15).
+"""Every public function, class and method of riskrf and simulation has a docstring.
 
 Public: module-level functions and classes, and methods of public classes, whose names do not start
 with an underscore, in modules whose path has no part starting with an underscore (``__init__``

@@ -1,4 +1,4 @@
-"""Impact-energy probability, hazard and design standards (issue 4)."""
+"""Impact-energy probability, hazard and design standards."""
 import numpy as np
 import pandas as pd
 import pytest

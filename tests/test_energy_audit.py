@@ -1,4 +1,4 @@
-"""Energy-exact contact mechanics and lossless-free bookkeeping (issue 9, "Must show").
+"""Energy-exact contact mechanics and lossless-free bookkeeping.
 
 Every number here is an exact analytic case or a property of the mechanics:
 angular momentum about the contact point is conserved when a sphere starts rolling

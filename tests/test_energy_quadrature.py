@@ -1,4 +1,4 @@
-"""Accuracy of the energy quadrature with a truncated power-law mass model (issue 10).
+"""Accuracy of the energy quadrature with a truncated power-law mass model.
 
 Exact case: mass M ~ power law with cumulative exponent b on [m0, m1] (Corominas et al. 2018
 truncation, riskrf.frequency.power_law), speed V ~ lognormal(mu, s), E = 1/2 M V^2 / 1000 kJ.  With

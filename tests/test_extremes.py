@@ -1,4 +1,4 @@
-"""Gumbel and GEV fits of annual maxima against published values (issue 2, item 4)."""
+"""Gumbel and GEV fits of annual maxima against published values."""
 from pathlib import Path
 
 import numpy as np
@@ -155,7 +155,7 @@ def test_return_levels_monotone_in_T(seed):
         assert np.all(np.diff(fit.return_level(T)) > 0)
 
 
-# ---------------------------------------------------------------- issue 10: profile interval, degenerate samples
+# ---------------------------------------------------------------- profile interval, degenerate samples
 SYNTHETIC = Path(__file__).resolve().parents[1] / "riskrf" / "data" / "synthetic_corridor_1985_2024.csv"
 
 
@@ -200,7 +200,7 @@ def _brute_gev_profile_loglik(x, z, q):
 
 def test_gev_profile_interval_heavy_tail_matches_independent_profile():
     # The shipped SYNTHETIC corridor record (riskrf/data, xi-hat = 1.94): before the fix the 100-year
-    # interval was [2.63e6, 6.58e7] kg while the profile crosses the 95 % cut near 1.77e9 kg (issue 10).
+    # interval was [2.63e6, 6.58e7] kg while the profile crosses the 95 % cut near 1.77e9 kg.
     from riskrf import read_inventory
     with pytest.warns(Warning):
         maxima = read_inventory(SYNTHETIC).annual_maxima()
@@ -217,7 +217,7 @@ def test_gev_profile_interval_heavy_tail_matches_independent_profile():
 
 
 def test_gev_profile_interval_coverage_seeded():
-    # xi = 0.5, n = 40, 100-year level: the cut-off interval covered 0.59 of 0.95 (issue 10).
+    # xi = 0.5, n = 40, 100-year level: the cut-off interval covered 0.59 of 0.95.
     true = stats.genextreme(-0.5, loc=100.0, scale=20.0)
     z100 = true.isf(0.01)
     rng = np.random.default_rng(2026)

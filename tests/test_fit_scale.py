@@ -1,4 +1,4 @@
-"""Scale of the power-law fits (issue 11, item 5): parallel, seeded, gridded and interruptible bootstrap."""
+"""Scale of the power-law fits: parallel, seeded, gridded and interruptible bootstrap."""
 import signal
 import subprocess
 import sys

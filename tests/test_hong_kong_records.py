@@ -1,4 +1,4 @@
-"""Real multi-decade records (issue 12, item 1): the Hong Kong rock-cut register, the Observatory's
+"""Real multi-decade records: the Hong Kong rock-cut register, the Observatory's
 rainfall and the NVDB E6 record; censored sizes in read_inventory.
 
 Reference numbers are the facts measured in ../shared/inventories-raw/*/PROVENANCE.md.

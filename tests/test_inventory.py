@@ -1,4 +1,4 @@
-"""Reading, validating and summarising inventories (issue 2, item 2)."""
+"""Reading, validating and summarising inventories."""
 import hashlib
 import warnings
 from pathlib import Path

@@ -1,4 +1,4 @@
-"""Power-law (Gutenberg-Richter) fits against published values (issue 2, item 3)."""
+"""Power-law (Gutenberg-Richter) fits against published values."""
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -247,7 +247,7 @@ def test_clauset_cities_threshold_both_statistics():
     # Clauset et al. (2009) Table 6.1, populations of US cities (2000 census; data in thousands there):
     # x_min = 52.46 +- 11.88 (thousand), alpha = 2.37 +- 0.08, n_tail = 580 +- 177.  Clauset's statistic
     # (their published code) reproduces it; the supremum statistic's exhaustive minimum is at 52.65
-    # thousand, D = 0.019423 (independent re-computation quoted in issue 10).
+    # thousand, D = 0.019423 (an independent re-computation).
     x = np.loadtxt(DATA / "clauset2009" / "cities.txt")
     fit = fit_gutenberg_richter(x, 1.0)
     assert fit.ks_statistic == "clauset" and not fit.discrete

@@ -1,4 +1,4 @@
-"""Mass-coupled energy hazard, design block, site design masses and sensitivity (issue 10, items 1-4)."""
+"""Mass-coupled energy hazard, design block, site design masses and sensitivity."""
 import numpy as np
 import pytest
 from scipy import integrate, stats

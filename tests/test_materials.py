@@ -134,7 +134,7 @@ def test_cliff_talus_runout_shadow_angles_match_evans_and_hungr(cliff_run):
 
 def test_stronge_law_on_talus_runs_far_beyond_the_shadow_line():
     """The check can fail: the rough-sphere (Stronge) tangential law on talus and run-out, which keeps a rolling
-    block's speed at shallow impacts, puts most blocks beyond the 22 deg line (the issue-9 finding)."""
+    block's speed at shallow impacts, puts most blocks beyond the 22 deg line."""
     import tomllib
     with open(CLIFF, "rb") as fh:
         d = tomllib.load(fh)

@@ -1,4 +1,4 @@
-"""Mitigation options as transformations of the site, one loss engine, uncertainty and recommendation (issue 13)."""
+"""Mitigation options as transformations of the site, one loss engine, uncertainty and recommendation."""
 import numpy as np
 import pytest
 from scipy import stats
@@ -54,7 +54,7 @@ def test_expected_annual_loss_by_hand_with_strikes_in_individual_risk():
            + road * (co.closure_days_per_fall * co.closure_cost_per_day + co.cleanup_cost_per_fall))
     assert r.road_falls_per_year == pytest.approx(1.0, rel=1e-6)
     assert r.expected_annual_loss == pytest.approx(eal, rel=1e-6)
-    # individual risk: direct hit and striking a rock on the road (issue 13: strikes were left out)
+    # individual risk: direct hit and striking a rock on the road
     ir = road * (commuter_passage_probability(2, 5, 80) * 0.5 + ex.share_stopping_on_road
                  * commuter_strike_probability(2, ex.hours_rock_on_road, ex.p_cannot_stop) * 0.1)
     assert r.individual_risk == pytest.approx(ir, rel=1e-6)
@@ -63,7 +63,7 @@ def test_expected_annual_loss_by_hand_with_strikes_in_individual_risk():
 
 
 def test_fn_curve_counts_hits_and_strikes_and_sums_to_deaths():
-    """sum_N F(N) = E[deaths per year]: occupants as a distribution, nothing rounded (issue 13)."""
+    """sum_N F(N) = E[deaths per year]: occupants as a distribution, nothing rounded."""
     s = study()
     fn = s.fn_curve("nothing")
     assert len(fn) == 9 and fn["F"].is_monotonic_decreasing
@@ -97,7 +97,7 @@ def test_fence_residual_from_paired_heights_and_energies_with_damage_states():
     assert r.replacements_per_year == pytest.approx(lam_d * (1 - down), rel=1e-9)
     assert r.repairs_per_year > 0
     # the engine's PV of maintenance: pv factor x (maintenance + repairs x repair cost + replacements x replacement
-    # cost; the replacement cost defaults to the capital cost), issue 13 audit k
+    # cost; the replacement cost defaults to the capital cost)
     row = s.ranking().set_index("option").loc["fence"]
     opt = s.option("fence")
     assert opt.replacement_cost is None
@@ -392,7 +392,7 @@ def test_material_parameters_are_resimulated_jointly_and_at_the_ends_of_their_ra
     tornado = s.tornado()
     assert "material:gravel.ground_friction_angle_deg" in set(tornado["parameter"])
     assert s.ranking()["probability_best"].sum() == pytest.approx(1.0)
-    # issue 13 audit h: the break-even table has a row per material parameter, from the low / base / high models
+    # the break-even table has a row per material parameter, from the low / base / high models
     be = s.break_even_table().set_index("parameter")
     row = be.loc["material:gravel.ground_friction_angle_deg"]
     assert (row["range_low"], row["range_high"]) == (20.0, 45.0)

@@ -1,4 +1,4 @@
-"""Rate models (issue 12, item 3): Poisson / negative-binomial regression of event counts on rainfall,
+"""Rate models: Poisson / negative-binomial regression of event counts on rainfall,
 season and trend.  Known-answer checks on simulated counts (seeded), bad input, and the real Hong Kong
 record."""
 import warnings

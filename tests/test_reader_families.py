@@ -1,4 +1,4 @@
-"""The same reading rules for every table riskrf reads (issue 11, item 1): one European export per reader family.
+"""The same reading rules for every table riskrf reads: one European export per reader family.
 
 Inventories and velocity files are covered in test_bad_input.py; here the readers moved onto
 riskrf.io.tables: corridor sections, generic rainfall, block surveys and observed stops.  Each gets a

@@ -1,4 +1,4 @@
-"""Numbers and tables as a reader sees them in the report (issue 15)."""
+"""Numbers and tables as a reader sees them in the report."""
 import pandas as pd
 import pytest
 

@@ -1,4 +1,4 @@
-"""Analytic checks of the trajectory simulator (issue 3, "Must show")."""
+"""Analytic checks of the trajectory simulator."""
 import math
 
 import numpy as np

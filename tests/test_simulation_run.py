@@ -1,4 +1,4 @@
-"""Scenario validation, reproducibility, chunking and convergence of the simulator (issue 3)."""
+"""Scenario validation, reproducibility, chunking and convergence of the simulator."""
 import numpy as np
 import pandas as pd
 import pytest

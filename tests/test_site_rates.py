@@ -1,4 +1,4 @@
-"""The site file's [rates] table (issue 12, item 4): the hazard's rate from the rate model and closure options
+"""The site file's [rates] table: the hazard's rate from the rate model and closure options
 given as rules, computed from it.  Small simulated records (seeded) keep these fast."""
 import json
 import warnings

@@ -1,4 +1,4 @@
-"""Velocities above what a free fall from the profile could give are warned about (issue 11, item 2)."""
+"""Velocities above what a free fall from the profile could give are warned about."""
 import numpy as np
 import pandas as pd
 import pytest

@@ -584,7 +584,7 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     return relative_paths(summary, a.site.path.parent)
 
 
-#: What the inventory fit's design-mass table is, in the outputs of an assessment (issue 10).
+#: What the inventory fit's design-mass table is, in the outputs of an assessment.
 WHOLE_WALL_BASIS = ("whole monitored wall (inventory fit), untruncated power law, rate not scaled: reference only, "
                     "not the site's design masses (site_design_masses.csv)")
 

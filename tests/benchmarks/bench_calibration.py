@@ -1,4 +1,4 @@
-"""Benchmark: calibration of two parameters on 50 observed stop points (issue 9).
+"""Benchmark: calibration of two parameters on 50 observed stop points.
 
 Run: python tests/benchmarks/bench_calibration.py [--authume]
 

@@ -1,4 +1,4 @@
-"""Benchmark: first compilation of the numba kernels (issue 15, the demo's first run).
+"""Benchmark: first compilation of the numba kernels (the demo's first run).
 
 Run: python tests/benchmarks/bench_compile.py [--repeat N]
 Each group of kernels is compiled in a fresh interpreter with an empty ``NUMBA_CACHE_DIR``, after numba's own

@@ -1,4 +1,4 @@
-"""Benchmark: reading (and optionally fitting) a European-style export of 10^6 rock falls (issue 11).
+"""Benchmark: reading (and optionally fitting) a European-style export of 10^6 rock falls.
 
 Run: python tests/benchmarks/bench_inventory.py [--n 1000000] [--fit] [--bootstrap 20] [--cli]
 

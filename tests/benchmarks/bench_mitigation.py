@@ -1,4 +1,4 @@
-"""Benchmark: the uncertainty ranking of the demo's mitigation options (issue 13).
+"""Benchmark: the uncertainty ranking of the demo's mitigation options.
 
 Run: python tests/benchmarks/bench_mitigation.py [samples]
 Builds the demo site's hazard (50,000 simulated blocks, as ``riskrf demo``), then times

@@ -1,4 +1,4 @@
-"""Optional side-by-side benchmark against PyRockfall on the same profile (issue 3).
+"""Optional side-by-side benchmark against PyRockfall on the same profile.
 
 The profile, release and materials are those of simulation/scenarios/peer_benchmark_profile.toml
 (shared/research/rockfall-simulation.md, section 3.1).  Each engine is timed in the interpreter

@@ -1,4 +1,4 @@
-"""Benchmark: KS threshold search and bootstrap p-value (issue 2).
+"""Benchmark: KS threshold search and bootstrap p-value.
 
 Run: python tests/benchmarks/bench_powerlaw_fit.py
 Prints the time of the (exact) KS threshold search on 100,000 masses, checked against the

@@ -1,8 +1,8 @@
-"""Benchmark: simulator throughput (issues 3 and 9).
+"""Benchmark: simulator throughput.
 
 Run: python tests/benchmarks/bench_simulator.py [--million]
 
-Prints each issue-9 target beside its figure with PASS/FAIL:
+Prints each target beside its figure with PASS/FAIL:
 
 * cost flat in the number of segments (ratio 200 / 5 segments >= 0.7), measured two ways:
   - per kernel event on the peer profile with a real slope change at every vertex (a random 0.05-0.1 deg
@@ -10,7 +10,7 @@ Prints each issue-9 target beside its figure with PASS/FAIL:
     and the contact phase see all 5 or 200 segments.  Per impact this profile is NOT flat, and the script
     says so: a block rolling in contact crosses every vertex as an exact constant-acceleration step, so the
     events per impact grow with the vertices crossed;
-  - per impact on the issue-3 benchmark, the peer profile cut into collinear pieces (they merge back into
+  - per impact on the peer-profile benchmark, the peer profile cut into collinear pieces (they merge back into
     the 5 original runs, so it mostly tests that merging).
 * the shipped barrier scenario (road_cut_barrier.toml) >= 200,000 trajectories per CPU-second on one core.
 
@@ -69,8 +69,8 @@ def bent(scenario, n_segments, seed=0):
 
 
 REPEAT = 3
-TARGET_RATIO = 0.7                 # issue 9: cost at 200 segments / at 5 segments (per event; per impact on the issue-3 profile)
-TARGET_BARRIER = 200_000           # issue 9: trajectories/s on the shipped barrier scenario, one core
+TARGET_RATIO = 0.7                 # cost at 200 segments / at 5 segments (per event; per impact on the analytic-check profile)
+TARGET_BARRIER = 200_000           # trajectories/s on the shipped barrier scenario, one core
 
 
 def timed(scenario, n, seed=1):
@@ -133,7 +133,7 @@ def main():
         print(f"peer profile, {sc.profile.n_segments:>4} collinear pieces (merged into 5 runs): "
               f"{rates[segs] / 1e6:.2f} M impacts/s, {args.n / dt:,.0f} trajectories/s")
     ratio = rates[200] / rates[5]
-    print(f"TARGET cost per impact flat in the segments on the issue-3 benchmark (peer profile cut into collinear "
+    print(f"TARGET cost per impact flat in the segments on the peer-profile benchmark (peer profile cut into collinear "
           f"pieces, which merge back into its 5 runs): impacts/s at 200 / 5 = {ratio:.2f} (must be >= {TARGET_RATIO}): "
           f"{verdict(ratio >= TARGET_RATIO)}; 1,000 / 10 = {rates[1000] / rates[10]:.2f}")
     # The same vertices moved by up to 2 cm: every vertex a slope change big enough to launch rolling blocks.
