@@ -44,6 +44,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pandas as pd
 
+from ..core.format import sig
 from ..core.units import SEL_PER_MEL, kinetic_energy_kj
 
 BASES = ("ONR 24810", "UNI 11211-4", "return period")
@@ -261,7 +262,7 @@ class DesignRequirement:
         rows = {
             "design basis (governs)": self.basis.basis,
             "barrier line x [m]": self.x_m,
-            "governing block": f"{self.block_rule}: {self.block_mass_kg:.4g} kg, diameter {self.block_diameter_m:.3g} m",
+            "governing block": f"{self.block_rule}: {sig(self.block_mass_kg)} kg, diameter {sig(self.block_diameter_m)} m",
             "characteristic speed v_k [m/s]": self.v_k_ms,
             "design speed v_d [m/s]": self.v_d_ms,
             "characteristic energy E_k [kJ]": self.E_k_kj,
@@ -390,8 +391,8 @@ def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3:
         T_block = 1.0 / rate_block if rate_block > 0 else float("inf")
         event = "frequent" if T_block < basis.frequent_T_years else "rare"
         need = E_d / SEL_PER_MEL if event == "frequent" else E_d
-        what = (f"E_d <= SEL = MEL/3 (design block arrives every {T_block:.3g} yr, frequent)" if event == "frequent"
-                else f"E_d <= MEL (design block arrives every {T_block:.3g} yr, rare)")
+        what = (f"E_d <= SEL = MEL/3 (design block arrives every {sig(T_block)} yr, frequent)" if event == "frequent"
+                else f"E_d <= MEL (design block arrives every {sig(T_block)} yr, rare)")
         h_factor = 1.0
     else:
         T = basis.design_T

@@ -13,7 +13,7 @@ import pandas as pd
 
 from ..core.validation import RiskrfError
 from .measures import Ditch, MeasureError
-from ..core.format import money
+from ..core.format import money, sig
 from .road_users import DEFAULT_VULNERABILITY
 from .tolerability import CRITERIA_SETS, CriteriaSet, user_criteria
 from .road_risk import occupancy_distribution
@@ -698,10 +698,9 @@ def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
     consequences = Consequences(**cq)
     for key in ("vulnerability_moving_vehicle", "vulnerability_striking_rock"):
         if key not in cq:
-            used[-1:] = used[-1:]
-            used.append(f"consequences.{key}: size-dependent curve {getattr(consequences, key)} "
-                        "(mass_kg, probability of death), chosen to match the Hong Kong CEDD/GEO register "
-                        "(riskrf.risk.road_users.DEFAULT_VULNERABILITY)")
+            curve = ", ".join(f"{sig(p)} at {sig(m)} kg" for m, p in getattr(consequences, key))
+            used.append(f"consequences.{key}: probability of death by block mass {curve}, chosen to match the "
+                        "Hong Kong CEDD/GEO register (the road-user model's default vulnerability)")
     economics = Economics(**_table(data.get("economics", {}), Economics, "economics", source, used))
     if not economics.horizon_years > 0:
         raise MitigationError(f"{source}: economics.horizon_years = {economics.horizon_years!r} must be > 0 years "
