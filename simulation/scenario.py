@@ -17,7 +17,7 @@ from scipy import stats
 from .materials import PresetError, resolve_material
 from .contact import CRSP_VELOCITY_SCALE_MS, EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_COULOMB, ET_FRICTION
 from .slope import Profile
-from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2
+from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2, block_radius
 
 
 class ScenarioError(ValueError):
@@ -304,9 +304,7 @@ class Seeder:
 
     def radius(self, mass):
         """Radius [m] of blocks of the given masses [kg]."""
-        if self.shape in ("cylinder", "disc"):          # m = rho pi r^2 (2 r aspect)
-            return (mass / (2.0 * np.pi * self.density_kg_m3 * self.aspect_ratio)) ** (1.0 / 3.0)
-        return (3.0 * mass / (4.0 * np.pi * self.density_kg_m3)) ** (1.0 / 3.0)
+        return block_radius(mass, self.density_kg_m3, self.shape, self.aspect_ratio)
 
     @property
     def inertia_factor(self) -> float:

@@ -43,7 +43,7 @@ import numpy as np
 
 from .scenario import Distribution, Material, ScenarioError, Settings, _check_keys, _number
 from .terrain import MaterialGrid, Terrain, TerrainError, read_dem, read_material_raster
-from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2
+from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2, block_radius
 
 #: Contact steps are events in 3-D (one per half cell rolled), so the default limit is higher than in 2-D.
 DEFAULT_MAX_EVENTS_3D = 200_000
@@ -65,9 +65,7 @@ class Sources:
 
     def radius(self, mass):
         """Radius [m] of spheres (or cylinders of aspect ratio 1) of the given masses [kg]."""
-        if self.shape == "cylinder":
-            return (mass / (2.0 * np.pi * self.density_kg_m3)) ** (1.0 / 3.0)
-        return (3.0 * mass / (4.0 * np.pi * self.density_kg_m3)) ** (1.0 / 3.0)
+        return block_radius(mass, self.density_kg_m3, self.shape)
 
     @property
     def inertia_factor(self) -> float:

@@ -127,8 +127,8 @@ class Terrain:
         """True where plan points lie in the domain and on a bilinear cell without a nodata corner."""
         return np.isfinite(self.elevation(x, y))
 
-    def elevation(self, x, y) -> np.ndarray:
-        """Bilinear elevation [m] at plan points; NaN outside the domain or on a cell touching nodata."""
+    def _cell(self, x, y):
+        """(inside, row i, column j, fraction along x, fraction along y) of the bilinear cell under plan points."""
         x = np.asarray(x, dtype=float)
         y = np.asarray(y, dtype=float)
         ny, nx = self.z.shape
@@ -138,6 +138,11 @@ class Terrain:
         j = np.clip(np.floor(np.where(inside, u, 0)).astype(np.int64), 0, nx - 2)
         i = np.clip(np.floor(np.where(inside, v, 0)).astype(np.int64), 0, ny - 2)
         fu, fv = np.where(inside, u, 0) - j, np.where(inside, v, 0) - i
+        return inside, i, j, fu, fv
+
+    def elevation(self, x, y) -> np.ndarray:
+        """Bilinear elevation [m] at plan points; NaN outside the domain or on a cell touching nodata."""
+        inside, i, j, fu, fv = self._cell(x, y)
         z = self.z
         out = (z[i, j] * (1 - fu) * (1 - fv) + z[i, j + 1] * fu * (1 - fv) + z[i + 1, j] * (1 - fu) * fv
                + z[i + 1, j + 1] * fu * fv)
@@ -145,15 +150,7 @@ class Terrain:
 
     def gradient(self, x, y) -> tuple[np.ndarray, np.ndarray]:
         """(dz/dx, dz/dy) of the bilinear surface at plan points [-]; NaN outside."""
-        x = np.asarray(x, dtype=float)
-        y = np.asarray(y, dtype=float)
-        ny, nx = self.z.shape
-        u = (x - self.x0) / self.dx
-        v = (y - self.y0) / self.dy
-        inside = (u >= 0) & (u <= nx - 1) & (v >= 0) & (v <= ny - 1)
-        j = np.clip(np.floor(np.where(inside, u, 0)).astype(np.int64), 0, nx - 2)
-        i = np.clip(np.floor(np.where(inside, v, 0)).astype(np.int64), 0, ny - 2)
-        fu, fv = np.where(inside, u, 0) - j, np.where(inside, v, 0) - i
+        inside, i, j, fu, fv = self._cell(x, y)
         z = self.z
         gx = ((z[i, j + 1] - z[i, j]) * (1 - fv) + (z[i + 1, j + 1] - z[i + 1, j]) * fv) / self.dx
         gy = ((z[i + 1, j] - z[i, j]) * (1 - fu) + (z[i + 1, j + 1] - z[i, j + 1]) * fu) / self.dy

@@ -25,6 +25,17 @@ CYLINDER_INERTIA = 0.5
 """I / (m r^2) of a solid cylinder or disc rolling on its curved face, 1/2."""
 
 INERTIA_FACTORS = {"sphere": SPHERE_INERTIA, "cylinder": CYLINDER_INERTIA, "disc": CYLINDER_INERTIA}
+
+
+def block_radius(mass, density_kg_m3, shape="sphere", aspect_ratio=1.0):
+    """Radius [m] of blocks of the given masses [kg] and density [kg/m3].
+
+    A sphere: m = 4/3 pi rho r^3.  A cylinder or disc of length 2 r x aspect_ratio: m = 2 pi rho r^3 aspect_ratio.
+    """
+    import numpy as np
+    if shape in ("cylinder", "disc"):
+        return (np.asarray(mass) / (2.0 * np.pi * density_kg_m3 * aspect_ratio)) ** (1.0 / 3.0)
+    return (3.0 * np.asarray(mass) / (4.0 * np.pi * density_kg_m3)) ** (1.0 / 3.0)
 """I / (m r^2) by block shape (a disc or plate rolls on its rim like a short cylinder: 1/2)."""
 
 
