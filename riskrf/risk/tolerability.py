@@ -14,11 +14,15 @@ reproduction; "R": recalled from the literature, not re-read here):
   slopes) and 1e-5 /yr (new) [R, the pair GEO shares with AGS 2007].
 * **AGS (2007)** - Australian Geomechanics Society, "Practice note guidelines for landslide risk management",
   Australian Geomechanics 42(1), section 7, Table 1: tolerable loss-of-life individual risk for the person
-  most at risk 1e-4 /yr for existing slopes, 1e-5 /yr for new slopes [R, high confidence]; for societal risk
-  the commentary (AGS 2007d) points to the GEO (1998) diagram, used here [R].
+  most at risk 1e-4 /yr for existing slopes, 1e-5 /yr for new slopes [V: AGS's own landslide-risk teaching
+  site, regulators module question 10, citing AGS 2007c p. 68, states that AGS recommends tolerable
+  loss-of-life values for the person most at risk; the 1e-4 / 1e-5 pair is R, high confidence]; for societal
+  risk the commentary (AGS 2007d) points to the GEO (1998) diagram, used here [R].
 * **UK HSE, R2P2 (2001)** - "Reducing risks, protecting people", HSE Books, ISBN 0 7176 2151 0, "Tolerability
   limits" pp. 44-47: individual risk of death 1 in 10,000 a year for members of the public as the limit of
-  tolerability (para 130), 1 in 1,000,000 a year broadly acceptable (para 130); societal: 50 or more deaths in
+  tolerability (para 130), 1 in 1,000,000 a year broadly acceptable (para 130) [V: the R2P2 text on
+  tolerability limits reproduced in a third-party copy read on 2026-11-25 gives "1 in 10,000 per annum" for
+  members of the public and 1 in 1,000,000 at the broadly acceptable end]; societal: 50 or more deaths in
   one event more often than 1 in 5,000 years intolerable (para 136) [R; contents page V,
   studylib.net/doc/8689343].  The point (N = 50, F = 2e-4) is drawn as a line of slope -1 (F = 1e-2 / N), the
   usual extension; R2P2 itself gives the point only.  No distinction between existing and new.
