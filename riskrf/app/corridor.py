@@ -57,6 +57,12 @@ RATE_SOURCES = RATE_COLUMNS + ("inventory",)
 TEXT_COLUMNS = ("id", "scenario", "face_material", "ditch_material", "road_material", "options", "inventory",
                 "notes")
 RHRS_COLUMNS = tuple("rhrs_" + f for f in rhrs.RATE_FIELDS)
+#: Sections-table columns that give an RHRS attribute when its ``rhrs_*`` column is empty (named in errors).
+_RHRS_SOURCE_COLUMNS = {"slope_height_m": "'rhrs_slope_height_m' (or 'cut_height_m')",
+                        "roadway_width_m": "'rhrs_roadway_width_m' (or 'road_width_m')",
+                        "sight_distance_m": "'rhrs_sight_distance_m' (or 'rhrs_percent_dsd')",
+                        "decision_sight_distance_m": "'rhrs_decision_sight_distance_m' (or 'rhrs_percent_dsd')",
+                        "block_size_m or volume_m3": "'rhrs_block_size_m' or 'rhrs_volume_m3'"}
 ALL_COLUMNS = TEXT_COLUMNS + NUMBER_COLUMNS + RHRS_COLUMNS
 #: Most falls a year one section may be given.  A deliberately loose bound against unit and typing mistakes
 #: (per m2 read as per km, 10^6 for 10^-6): 10,000 a year is 27 falls a day reaching one road section, a
@@ -371,17 +377,19 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     src = str(path)
     _unknown(data, {"corridor", "defaults", "mass", "materials", "traffic", "consequences", "economics", "criteria",
                     "uncertainty", "options", "rates"}, "", src)
+    from ..core.file_schemas import CORRIDOR_SCHEMA
+    from ..core.schema import check as check_schema
     cor = data.get("corridor", {})
-    _unknown(cor, {"name", "description", "sections", "seed", "n_blocks", "option_blocks", "chainage_unit",
-                   "rate_basis", "rhrs_cap_points", "sections_sheet", "sections_header_row", "sections_decimal",
-                   "sections_encoding", "rhrs_variant", "centreline", "centreline_layer",
-                   "centreline_calibration_layer", "centreline_calibration_field", "centreline_chainage_start_m"},
-             "corridor.", src)
+    cor_table = CORRIDOR_SCHEMA.table("corridor")          # one declaration of the [corridor] fields
+    _unknown(cor, {f.name for f in cor_table.fields}, "corridor.", src)
     variant = cor.get("rhrs_variant", "fhwa")
-    if variant not in rhrs.VARIANTS:
-        raise CorridorError(f"{src}: corridor.rhrs_variant = {variant!r} must be one of {sorted(rhrs.VARIANTS)}"
-                            + (f" ({rhrs.UNAVAILABLE_VARIANTS[variant]})" if variant in rhrs.UNAVAILABLE_VARIANTS
-                               else ""))
+    why = rhrs.variant_problem(variant)
+    if why:
+        raise CorridorError(f"{src}: corridor.rhrs_variant = {variant!r} {why}")
+    for k in [k for k in cor if k.startswith("centreline")]:     # checked before the line is read
+        why = cor_table.field(k).problem(cor[k])
+        if why:
+            raise CorridorError(f"{src}: corridor.{k} = {cor[k]!r} {why}")
     centreline = None
     if "centreline" in cor:
         from ..io.gis import GISError, read_centreline
@@ -423,8 +431,6 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     _unknown(defaults, [c for c in ALL_COLUMNS if c not in ("id", "chainage_from", "chainage_to", "inventory")]
              + ["seeder_mass_kg"],
              "defaults.", src)
-    from ..core.file_schemas import CORRIDOR_SCHEMA
-    from ..core.schema import check as check_schema
     check_schema(data, CORRIDOR_SCHEMA, src, error=CorridorError)      # every declared type and range
     gr, mass_note = _mass_law(data.get("mass", {}), path.parent, src)
     shared = _shared_rate(data.get("rates"), path.parent, float(gr.m_min), src)
@@ -659,8 +665,14 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                 attrs = {k: v for k, v in derived.items() if v is not None}
                 attrs.update(given)
                 try:
-                    rating = rhrs.rate(cap_points=rhrs_cap, **attrs)
-                except (ValueError, TypeError) as exc:
+                    rating = rhrs.rate(variant=variant, cap_points=rhrs_cap, **attrs)
+                except rhrs.RHRSError as exc:
+                    if exc.missing:        # name the columns that would give what is missing
+                        cols = [_RHRS_SOURCE_COLUMNS.get(m, f"'rhrs_{m}'") for m in exc.missing]
+                        raise CorridorError(f"{where}: RHRS ({variant}) needs column(s) {', '.join(cols)}, empty "
+                                            "in this row and in [defaults]") from exc
+                    raise CorridorError(f"{where}: RHRS: {exc}") from exc
+                except TypeError as exc:
                     raise CorridorError(f"{where}: RHRS: {exc}") from exc
             cut_len = num.get("cut_length_m", num.get("rhrs_slope_length_m"))
             if cut_len is not None and not 0 < cut_len <= (c1 - c0) * (1 + 1e-12):

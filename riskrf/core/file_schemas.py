@@ -277,10 +277,20 @@ CORRIDOR_SCHEMA = FileSchema("Corridor file (riskrf corridor CORRIDOR.toml)", (
         _text("chainage_unit", "unit of the chainage columns", default="m", choices=("m", "km")),
         _text("rate_basis", "what the rate columns count", default="road", choices=("road", "release")),
         _num("rhrs_cap_points", "points", "cap of an RHRS category score", low=81),
+        # choices = riskrf.risk.rhrs.VARIANTS (core imports nothing of riskrf; a test holds them equal)
+        _text("rhrs_variant", "RHRS rating system: 'fhwa' (Pierson & Van Vickle 1993). 'odot' and 'colorado' are "
+              "refused with what is missing: their published tables were not found", default="fhwa",
+              choices=("fhwa",)),
         Field("sections_sheet", "any", "", "Excel sheet of the sections table"),
         _count("sections_header_row", "1-based header row of the sections table"),
         _text("sections_decimal", "decimal mark of the sections table", choices=(".", ",")),
         _text("sections_encoding", "text encoding of the sections table"),
+        _path("centreline", "the road centreline (GeoPackage, GeoJSON or shapefile; projected CRS in metres)"),
+        _text("centreline_layer", "layer of the centreline file holding the line"),
+        _text("centreline_calibration_layer", "point layer of known chainage (same file)"),
+        _text("centreline_calibration_field", "chainage field [m] of the calibration points", default="chainage_m"),
+        _num("centreline_chainage_start_m", "m", "chainage of the line's first vertex (without calibration points)",
+             default=0.0),
     ), "The corridor and its sections table."),
     Table("defaults", (
         _pos("cut_height_m", "m", "height of a generated cut"),

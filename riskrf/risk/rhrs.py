@@ -40,6 +40,11 @@ Checked against a published rated slope: Taherynia, Mohammadi & Ajalloeian (2014
 2014:763598, Table 10. With ``cap_points=100`` and scores rounded to integers, as that paper prints
 them, all ten category ratings are reproduced (tests/test_rhrs_published.py;
 tests/data/taherynia2014/README.md).
+
+Variants: :func:`rate` implements the FHWA RHRS only (``variant="fhwa"``, :data:`VARIANTS`).  The ODOT and the
+Colorado-modified RHRS (Santi et al. 2009; Russell et al. 2008, CDOT-2008-7) change and add categories; their
+published tables were searched for and not found in any copy in reach, so they are refused with what is missing
+(:data:`UNAVAILABLE_VARIANTS`) rather than guessed.
 """
 from __future__ import annotations
 
@@ -49,6 +54,7 @@ from dataclasses import dataclass, field
 import pandas as pd
 
 from ..core.units import HOURS_PER_DAY, M_PER_KM
+from ..core.validation import RiskrfError
 
 FT_M = 0.3048                       # exact (international foot)
 MILE_M = 1609.344                   # exact
@@ -75,14 +81,43 @@ CLASSES = {
 }
 #: Rating systems :func:`rate` implements, by the name a corridor file gives (``corridor.rhrs_variant``).
 VARIANTS = {"fhwa": "FHWA RHRS (Pierson & Van Vickle 1993, FHWA-SA-93-057; summary sheet, exponential 3-81 scores)"}
-#: Agency variants that are known but not implemented, with the reason (said when a corridor file asks for one).
+#: Agency variants that are known but not implemented, with what is missing (said when a corridor file or
+#: :func:`rate` asks for one).  They stay refused until their published tables can be read and checked; the
+#: documents searched for, and what the project's reference library returned, are listed in
+#: docs/validation/corridor-programme.md.
 UNAVAILABLE_VARIANTS = {
-    "odot": "the ODOT revision's category tables could not be read from any copy in reach, so they are not encoded "
-            "rather than guessed; rate with 'fhwa'",
-    "colorado": "the Colorado-modified RHRS (Santi et al. 2009, Eng. Geol. 104: 55-65; Russell et al. 2008, "
-                "CDOT-2008-7) tables could not be read from any copy in reach, so they are not encoded rather than "
+    "odot": "not implemented: ODOT's own rating tables (the Oregon DOT revisions after FHWA-OR-GI-92-05, i.e. "
+            "its rockfall and unstable-slope rating forms) were not found in any copy in reach: the stored "
+            "copies of Pierson (1991) FHWA-OR-GI-92-05 and Pierson & Van Vickle (1993) FHWA-SA-93-057 hold only "
+            "their first pages, and ODOT's Unstable Slopes page publishes no table; no ODOT category table or "
+            "ODOT-rated slope could be read, so nothing is encoded rather than guessed; rate with 'fhwa'",
+    "colorado": "not implemented: the Colorado-modified RHRS category table and a slope rated with it (Santi, "
+                "Russell, Higgins & Spriet 2009, Eng. Geol. 104: 55-65; Russell, Santi & Higgins 2008, "
+                "CDOT-2008-7) were not found in any copy in reach: the stored copies of both hold only the title "
+                "page and abstract, and the 2007 GSA abstract names factors (launching features, rockfall "
+                "frequency, discontinuity sets, ...) but no criteria or points; nothing is encoded rather than "
                 "guessed; rate with 'fhwa'",
 }
+
+
+class RHRSError(RiskrfError, ValueError):
+    """An RHRS input is invalid or missing, or the rating system asked for is not implemented.  ``missing``
+    lists the attributes (names of :data:`RATE_FIELDS`) that a rating needed and did not get."""
+
+    def __init__(self, message: str, missing: tuple = ()):
+        super().__init__(message)
+        self.missing = tuple(missing)
+
+
+def variant_problem(variant) -> str | None:
+    """``None`` when :func:`rate` implements ``variant``, else what is wrong, as the end of an error message:
+    ``"must be one of ['fhwa'] (<why the variant asked for is not implemented>)"``."""
+    if isinstance(variant, str) and variant in VARIANTS:
+        return None
+    why = UNAVAILABLE_VARIANTS.get(variant) if isinstance(variant, str) else None
+    return (f"must be one of {sorted(VARIANTS)} ("
+            + (why if why else f"known but not implemented: {sorted(UNAVAILABLE_VARIANTS)}") + ")")
+
 
 #: Short names accepted for the classes: the first word of a class when no other class of the category shares it
 #: (e.g. "good", "limited", "occasional").
@@ -100,7 +135,7 @@ def _finite(value, name: str, *, lo: float | None = None, lo_open: bool = False)
     v = float(value)
     if not math.isfinite(v) or (lo is not None and (v < lo or (lo_open and v == lo))):
         bound = "" if lo is None else f" {'>' if lo_open else '>='} {lo:g}"
-        raise ValueError(f"{name} must be a finite number{bound}; got {value!r}")
+        raise RHRSError(f"{name} must be a finite number{bound}; got {value!r}")
     return v
 
 
@@ -159,7 +194,7 @@ def class_x(category: str, value) -> float:
     """Level x of a descriptive category: a class name of :data:`CLASSES` (or its first word), or a number in
     [1, 4] (fractional allowed: between two classes)."""
     if category not in CLASSES:
-        raise ValueError(f"unknown RHRS category {category!r}; categories: {sorted(CLASSES)}")
+        raise RHRSError(f"unknown RHRS category {category!r}; categories: {sorted(CLASSES)}")
     if isinstance(value, str):
         key = value.strip().lower()
         for i, name in enumerate(CLASSES[category]):
@@ -167,11 +202,11 @@ def class_x(category: str, value) -> float:
                 return float(i + 1)
         if key in _SHORT[category]:
             return float(_SHORT[category][key])
-        raise ValueError(f"{category} = {value!r} is not one of {list(CLASSES[category])} "
+        raise RHRSError(f"{category} = {value!r} is not one of {list(CLASSES[category])} "
                          f"(or {sorted(_SHORT[category])})")
     x = _finite(value, category)
     if not 1.0 <= x <= 4.0:
-        raise ValueError(f"{category} = {value!r}: a class level must lie in [1, 4] (3 to 81 points)")
+        raise RHRSError(f"{category} = {value!r}: a class level must lie in [1, 4] (3 to 81 points)")
     return x
 
 
@@ -179,12 +214,14 @@ def class_x(category: str, value) -> float:
 class RHRSRating:
     """RHRS rating of one slope: level x and score 3**x of each category, and the total.
 
-    ``inputs`` keeps what was given (SI units) and derived quantities (AVR %, %DSD).
+    ``inputs`` keeps what was given (SI units) and derived quantities (AVR %, %DSD); ``variant`` names the
+    rating system (a key of :data:`VARIANTS`).
     """
 
     x: dict
     inputs: dict = field(default_factory=dict)
     cap_points: float | None = None
+    variant: str = "fhwa"
 
     @property
     def scores(self) -> dict:
@@ -250,29 +287,56 @@ RATE_FIELDS = ("slope_height_m", "ditch_effectiveness", "adt_vehicles_per_day", 
                "difference_in_erosion_rates", "block_size_m", "volume_m3", "climate_and_water", "rockfall_history")
 
 
-def rate(*, cap_points: float | None = None, **attrs) -> RHRSRating:
+def rate(*, variant: str = "fhwa", cap_points: float | None = None, **attrs) -> RHRSRating:
     """Rate one slope from its attributes (names in :data:`RATE_FIELDS`, SI units).
 
-    Needed: slope_height_m; ditch_effectiveness; the AVR (``avr_percent``, or ``adt_vehicles_per_day``,
-    ``slope_length_m`` and ``speed_kmh``); the %DSD (``percent_dsd``, or ``sight_distance_m`` and
-    ``decision_sight_distance_m``); roadway_width_m; the geologic character (case 1 or case 2 pair);
-    block_size_m or volume_m3 (the larger score counts when both are given, as the manual rates the
-    greater of the two); climate_and_water; rockfall_history.
+    Parameters
+    ----------
+    variant : str
+        The rating system, a key of :data:`VARIANTS`: only ``"fhwa"`` (Pierson & Van Vickle 1993).  ``"odot"``
+        and ``"colorado"`` are refused with what is missing (:data:`UNAVAILABLE_VARIANTS`).
+    cap_points : float, optional
+        Upper limit of each category score [points], >= 81 (a user's choice, e.g. 100, so that one continuous
+        category far beyond the 81-point class cannot dominate the total); default uncapped.
+    **attrs
+        slope_height_m [m]; ditch_effectiveness (class); the AVR (``avr_percent`` [%], or
+        ``adt_vehicles_per_day`` [vehicles/day], ``slope_length_m`` [m] and ``speed_kmh`` [km/h]); the %DSD
+        (``percent_dsd`` [%], or ``sight_distance_m`` and ``decision_sight_distance_m`` [m]);
+        roadway_width_m [m]; the geologic character (case 1 or case 2 pair, classes); block_size_m [m] or
+        volume_m3 [m3] (the larger score counts when both are given, as the manual rates the greater of the
+        two); climate_and_water and rockfall_history (classes).  A class is a name of :data:`CLASSES` (or its
+        first word) or a level x in [1, 4].
 
-    ``cap_points``: optional upper limit of each category score (a user's choice, e.g. 100, so that one
-    continuous category far beyond the 81-point class cannot dominate the total); default uncapped.
+    Returns
+    -------
+    RHRSRating
+        Level x and score 3**x of every category, the total, whole points and the rating sheet.
+
+    Raises
+    ------
+    RHRSError
+        An unknown or unimplemented variant, an unknown attribute, a missing one (listed in ``.missing``) or a
+        value out of range.
+
+    References
+    ----------
+    Pierson, L.A. & Van Vickle, R. (1993). Rockfall Hazard Rating System - Participant's Manual. FHWA-SA-93-057
+    (summary sheet, as listed in shared/research/domain-methods.md section 4.3 [R]).
     """
+    why = variant_problem(variant)
+    if why:
+        raise RHRSError(f"RHRS variant = {variant!r} {why}")
     if cap_points is not None:
         cap_points = _finite(cap_points, "cap_points", lo=81)
     unknown = sorted(set(attrs) - set(RATE_FIELDS))
     if unknown:
-        raise ValueError(f"unknown RHRS attribute(s) {unknown}; allowed: {list(RATE_FIELDS)}")
+        raise RHRSError(f"unknown RHRS attribute(s) {unknown}; allowed: {list(RATE_FIELDS)}")
     a = {k: v for k, v in attrs.items() if v is not None and not (isinstance(v, float) and math.isnan(v))}
 
     def need(*names):
         missing = [n for n in names if n not in a]
         if missing:
-            raise ValueError(f"RHRS rating needs {', '.join(missing)}")
+            raise RHRSError(f"{variant.upper()} RHRS rating needs {', '.join(missing)}", missing=missing)
 
     x, inputs = {}, dict(a)
     need("slope_height_m")
@@ -298,7 +362,7 @@ def rate(*, cap_points: float | None = None, **attrs) -> RHRSRating:
     case1 = "structural_condition_case1" in a or "rock_friction" in a
     case2 = "structural_condition_case2" in a or "difference_in_erosion_rates" in a
     if case1 == case2:
-        raise ValueError("RHRS geologic character: give case 1 (structural_condition_case1 and rock_friction) or "
+        raise RHRSError("RHRS geologic character: give case 1 (structural_condition_case1 and rock_friction) or "
                          "case 2 (structural_condition_case2 and difference_in_erosion_rates), not both or neither")
     if case1:
         need("structural_condition_case1", "rock_friction")
@@ -309,10 +373,11 @@ def rate(*, cap_points: float | None = None, **attrs) -> RHRSRating:
         x["structural_condition"] = class_x("structural_condition_case2", a["structural_condition_case2"])
         x["difference_in_erosion_rates"] = class_x("difference_in_erosion_rates", a["difference_in_erosion_rates"])
     if "block_size_m" not in a and "volume_m3" not in a:
-        raise ValueError("RHRS rating needs block_size_m or volume_m3")
+        raise RHRSError(f"{variant.upper()} RHRS rating needs block_size_m or volume_m3",
+                        missing=("block_size_m or volume_m3",))
     xs = [f(a[k]) for k, f in (("block_size_m", block_size_x), ("volume_m3", volume_x)) if k in a]
     x["block_size_or_volume"] = max(xs)
     need("climate_and_water", "rockfall_history")
     x["climate_and_water"] = class_x("climate_and_water", a["climate_and_water"])
     x["rockfall_history"] = class_x("rockfall_history", a["rockfall_history"])
-    return RHRSRating(x=x, inputs=inputs, cap_points=cap_points)
+    return RHRSRating(x=x, inputs=inputs, cap_points=cap_points, variant=variant)
