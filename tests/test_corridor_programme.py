@@ -145,6 +145,23 @@ def test_variant_and_centreline_errors_named(tmp_path):
     (tmp_path / "a.toml").write_text(toml.replace("seed = 7", 'seed = 7\nrhrs_variant = "colorado"'))
     with pytest.raises(cr.CorridorError, match="rhrs_variant = 'colorado' must be one of \\['fhwa'\\] .*Santi"):
         cr.load_corridor(tmp_path / "a.toml")
+    (tmp_path / "a2.toml").write_text(toml.replace("seed = 7", 'seed = 7\nrhrs_variant = "odot"'))
+    with pytest.raises(cr.CorridorError, match=r"a2.toml: corridor.rhrs_variant = 'odot' must be one of \['fhwa'\] "
+                                               r"\(not implemented: .*FHWA-OR-GI-92-05"):
+        cr.load_corridor(tmp_path / "a2.toml")
+    (tmp_path / "a3.toml").write_text(toml.replace("seed = 7", 'seed = 7\nrhrs_varient = "fhwa"'))
+    with pytest.raises(cr.CorridorError, match=r"unknown field corridor.'rhrs_varient'; did you mean 'rhrs_variant'"):
+        cr.load_corridor(tmp_path / "a3.toml")
+    (tmp_path / "a4.toml").write_text(toml.replace("seed = 7", 'seed = 7\ncentreline = "r.gpkg"\n'
+                                                               'centreline_chainage_start_m = "zero"'))
+    with pytest.raises(cr.CorridorError, match=r"corridor.centreline_chainage_start_m = 'zero' must be a number m"):
+        cr.load_corridor(tmp_path / "a4.toml")
+    # a field the variant needs, empty in the row and in [defaults]: the column is named, with the row and section
+    (tmp_path / "a5.toml").write_text(toml.replace('rhrs_rockfall_history = "occasional"\n', ""))
+    with pytest.raises(cr.CorridorError, match=r"small_sections.csv: row 2 \(section 'A'\): RHRS \(fhwa\) needs "
+                                               r"column\(s\) 'rhrs_rockfall_history', empty in this row and in "
+                                               r"\[defaults\]"):
+        cr.load_corridor(tmp_path / "a5.toml")
     (tmp_path / "b.toml").write_text(toml.replace("seed = 7", 'seed = 7\ncentreline = "nowhere.gpkg"'))
     with pytest.raises(cr.CorridorError, match="corridor.centreline = 'nowhere.gpkg': centreline not found"):
         cr.load_corridor(tmp_path / "b.toml")

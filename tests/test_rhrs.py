@@ -139,3 +139,36 @@ def test_cap_points_limits_each_category():
     assert capped.scores["slope_height"] == 100 and capped.total == pytest.approx(9 * 81 + 100)
     with pytest.raises(ValueError, match="cap_points"):
         rhrs.rate(cap_points=10, **a)
+
+
+def test_only_the_fhwa_variant_is_rated_and_the_others_say_what_is_missing():
+    """ODOT and Colorado-modified RHRS: their published tables were not found, so they are refused (not guessed),
+    and the refusal names the documents that are missing."""
+    from riskrf import RiskrfError
+    r = rhrs.rate(variant="fhwa", **_worst_case())
+    assert r.variant == "fhwa" and r.total == pytest.approx(810.0)
+    assert sorted(rhrs.VARIANTS) == ["fhwa"] and sorted(rhrs.UNAVAILABLE_VARIANTS) == ["colorado", "odot"]
+    with pytest.raises(RiskrfError, match=r"variant = 'colorado' must be one of \['fhwa'\] \(not implemented: .*"
+                                          r"Santi, Russell, Higgins & Spriet 2009, Eng. Geol. 104: 55-65.*CDOT-2008-7"):
+        rhrs.rate(variant="colorado", **_worst_case())
+    with pytest.raises(ValueError, match=r"variant = 'odot' .*FHWA-OR-GI-92-05.*not found"):
+        rhrs.rate(variant="odot", **_worst_case())
+    with pytest.raises(ValueError, match=r"variant = 'nz' must be one of \['fhwa'\] \(known but not implemented: "
+                                         r"\['colorado', 'odot'\]\)"):
+        rhrs.rate(variant="nz", **_worst_case())
+    assert rhrs.variant_problem("fhwa") is None and rhrs.variant_problem(3) is not None
+
+
+def test_missing_attributes_are_listed():
+    a = _worst_case()
+    del a["climate_and_water"], a["rockfall_history"]
+    with pytest.raises(rhrs.RHRSError, match="FHWA RHRS rating needs climate_and_water, rockfall_history") as e:
+        rhrs.rate(**a)
+    assert e.value.missing == ("climate_and_water", "rockfall_history")
+
+
+def test_schema_declares_the_implemented_variants():
+    """riskrf.core.file_schemas cannot import riskrf.risk; the declared choices must be rhrs.VARIANTS."""
+    from riskrf.core.file_schemas import CORRIDOR_SCHEMA
+    field = CORRIDOR_SCHEMA.table("corridor").field("rhrs_variant")
+    assert set(field.choices) == set(rhrs.VARIANTS) and field.default == "fhwa"
