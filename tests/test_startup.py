@@ -187,8 +187,9 @@ def test_every_input_error_is_a_riskrf_error():
     from riskrf.risk.decision_tree import TreeError
     from riskrf.risk.measures import MeasureError
     from riskrf.risk.mitigation_inputs import MitigationError
+    from riskrf.risk.rhrs import RHRSError
     assert "RiskrfError" in riskrf.__all__
-    for cls in (CorridorError, SiteError, NoArrivalsError, TreeError, MeasureError, MitigationError):
+    for cls in (CorridorError, SiteError, NoArrivalsError, TreeError, MeasureError, MitigationError, RHRSError):
         assert issubclass(cls, riskrf.RiskrfError) and issubclass(cls, ValueError), cls
     with pytest.raises(riskrf.RiskrfError, match="node type 'nonsense'"):
         riskrf.DecisionTree.from_dict({"name": "tree", "type": "nonsense"})
