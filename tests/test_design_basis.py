@@ -65,7 +65,8 @@ def test_onr24810_rare_and_frequent_design_events():
     assert rare.E_d_kj == pytest.approx(1437.48, rel=1e-9)
     assert rare.design_event == "rare" and rare.required_mel_kj == pytest.approx(1437.48)
     assert rare.required_class_kj == 1500.0
-    assert basis.unverified == ["gamma_d"]          # stated factors are not flagged; the recalled gamma_d is
+    assert basis.unverified == []                   # stated factors are not flagged; gamma_d = 1.2 has a source
+    assert DesignBasis("ONR 24810").unverified == ["gamma_m", "gamma_v"]
     # the same block arriving several times a year: frequent -> designed against SEL = MEL/3
     freq = design_requirement(_hazard(rate=20.0), basis, block=_block(), density_kg_m3=RHO)
     assert freq.design_event == "frequent"

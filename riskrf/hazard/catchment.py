@@ -4,9 +4,27 @@ The Oregon DOT / FHWA Rockfall Catchment Area Design Guide (Pierson, Gullixson &
 FHWA-OR-RD-02-04) rolled about 11,250 rocks off cuts 40, 60 and 80 ft high (vertical to 1H:1V) into flat,
 6H:1V and 4H:1V catchments and plots the cumulative percentage of rocks retained against the catchment width
 measured from the toe.  :func:`catchment_retention` computes the same curve for a scenario by simulation: a
-block is retained within width w when it stops no farther than w beyond the toe of the cut.  The widths that
-retain 90, 95 and 99 % are read off it; chart values (width, percent retained), when the user gives them
-with their source, are set beside the simulated percentages at the same widths.
+block is retained within width w when it stops no farther than w beyond the toe of the cut.  As in the ODOT
+tests, where every rock was rolled off the top of the cut, the shares are of the blocks that went over the
+cut face (a block that stops on the crest above the face never tested the catchment; how many did is
+recorded).  The widths that retain 90, 95 and 99 % are read off it; chart values (width, percent retained),
+when the user gives them with their source, are set beside the simulated percentages at the same widths.
+
+The published width rule set beside every study is the Modified Ritchie Criterion (Ryan & Pryor 2000, from
+Ritchie's 1963 highway ditch tests): catchment width W = 0.2 H + 4.5 m for a face H metres high, quoted in
+Warren et al. (2025), whose regressions on the ODOT data set use 90 % retention as the performance level
+(:func:`modified_ritchie_width_m`).  The ODOT chart values themselves could not be retrieved for riskrf
+(docs/validation/design-standards.md).
+
+References
+----------
+Pierson, L.A., Gullixson, C.F. & Chassie, R.G. (2001) Rockfall Catchment Area Design Guide. Oregon DOT / FHWA,
+FHWA-OR-RD-02-04.
+Ritchie, A.M. (1963) Evaluation of rockfall and its control. Highway Research Record 17: 13-28.
+Ryan, T.M. & Pryor, P.R. (2000) Designing catch benches and interramp slopes. In Slope Stability in Surface
+Mining, SME, 27-38.
+Warren, S., McNabb, J.C., Meyer, B.J., Potter, J.J., Sbai, S., Reasoner, A.E. & Ryan, T. (2025) Preliminary
+expansion of the Modified Ritchie Criterion. SSIM 2025, ACG Perth, doi 10.36487/ACG_repo/2535_04 (abstract).
 """
 from __future__ import annotations
 
@@ -16,6 +34,8 @@ import numpy as np
 import pandas as pd
 
 RETENTION_LEVELS = (90.0, 95.0, 99.0)
+#: Modified Ritchie Criterion (Ryan & Pryor 2000, quoted in Warren et al. 2025 abstract): W = a H + b [m].
+MRC_SLOPE, MRC_INTERCEPT_M = 0.2, 4.5
 #: Segments at least this steep [deg] next to the steepest one belong to the cut face (1H:1V, the flattest
 #: face of the ODOT tests).
 CUT_FACE_MIN_DEG = 45.0
@@ -28,7 +48,9 @@ class CatchmentStudy:
     ``title``; ``toe_x_m`` of the cut; ``cut_height_m`` and ``face_angle_deg``; ``n`` blocks simulated;
     ``curve`` (width_m, retained share); ``widths`` {percent: width [m]} (NaN when the simulated catchment never
     retains that share, e.g. blocks leave the profile); ``chart`` (width_m, retained_percent, simulated_percent,
-    difference_points) or None; ``chart_source``.  Its figure is :func:`riskrf.report.design_figures.catchment_figure`.
+    difference_points) or None; ``chart_source``; ``n_over_face``: blocks that went over the cut face (the shares
+    are of these; the others stopped on the crest).  Its figure: :meth:`plot`
+    (:func:`riskrf.report.design_figures.plot_catchment`).
     """
 
     title: str
@@ -40,20 +62,53 @@ class CatchmentStudy:
     widths: dict
     chart: pd.DataFrame | None = None
     chart_source: str = ""
+    n_over_face: int | None = None
 
     def retained_at(self, width_m) -> np.ndarray:
         """Share [-] of the released blocks retained within ``width_m`` of the toe."""
         return np.interp(np.asarray(width_m, dtype=float), self.curve["width_m"], self.curve["retained"])
 
     def summary(self) -> pd.DataFrame:
-        """Width [m] for each retention level, the geometry and (when given) the chart comparison rows."""
-        rows = [{"retention_percent": q, "width_m": w} for q, w in self.widths.items()]
-        return pd.DataFrame(rows)
+        """One row per compared width: the re-simulated widths for 90/95/99 % retention, the Modified Ritchie
+        Criterion width and (when given) the chart values, each with the simulated retention at that width.
+
+        Columns: ``source``, ``width_m``, ``retained_percent`` (what the source says is retained at that width;
+        NaN for the Ritchie rule, which states no level), ``simulated_percent`` (re-simulated share at the width).
+        """
+        rows = [{"source": f"re-simulated ({self.blocks_counted} blocks over the face)", "width_m": w,
+                 "retained_percent": q,
+                 "simulated_percent": 100.0 * float(self.retained_at(w)) if np.isfinite(w) else np.nan}
+                for q, w in self.widths.items()]
+        w_mrc = modified_ritchie_width_m(self.cut_height_m)
+        rows.append({"source": "Modified Ritchie Criterion W = 0.2 H + 4.5 m (Ryan & Pryor 2000)", "width_m": w_mrc,
+                     "retained_percent": np.nan, "simulated_percent": 100.0 * float(self.retained_at(w_mrc))})
+        if self.chart is not None:
+            for r in self.chart.itertuples():
+                rows.append({"source": f"chart: {self.chart_source}", "width_m": r.width_m,
+                             "retained_percent": r.retained_percent, "simulated_percent": r.simulated_percent})
+        return pd.DataFrame(rows, columns=["source", "width_m", "retained_percent", "simulated_percent"])
+
+    @property
+    def blocks_counted(self) -> int:
+        """Blocks the shares are of: those that went over the cut face (all released blocks for older studies)."""
+        return int(self.n if self.n_over_face is None else self.n_over_face)
+
+    def plot(self, ax=None):
+        """Retention against catchment width with the Ritchie width and chart values; returns the matplotlib axes
+        (drawn by :func:`riskrf.report.design_figures.plot_catchment`)."""
+        from ..core.figures import draw
+        return draw("catchment", self, ax=ax)
 
     def to_dict(self) -> dict:
         """JSON-ready summary: geometry, widths for 90/95/99 %, chart comparison (or why there is none)."""
+        w_mrc = modified_ritchie_width_m(self.cut_height_m)
         return {"title": self.title, "toe_x_m": self.toe_x_m, "cut_height_m": self.cut_height_m,
                 "face_angle_deg": self.face_angle_deg, "blocks_simulated": self.n,
+                "blocks_over_face": self.blocks_counted,
+                "modified_ritchie_criterion": {
+                    "source": "W = 0.2 H + 4.5 m, Ryan & Pryor (2000) after Ritchie (1963), quoted by Warren et al. "
+                              "(2025, SSIM, doi 10.36487/ACG_repo/2535_04)",
+                    "width_m": w_mrc, "simulated_retained_percent": 100.0 * float(self.retained_at(w_mrc))},
                 "width_for_retention_m": {f"{q:g}": (None if not np.isfinite(w) else w)
                                           for q, w in self.widths.items()},
                 "chart_source": self.chart_source or None,
@@ -64,18 +119,37 @@ class CatchmentStudy:
                                      "available to riskrf; pass them as chart= with their source")}
 
 
-def cut_geometry(profile) -> tuple:
-    """(toe x [m], cut height [m], overall face angle [deg]) of the cut face: the steepest segment of a profile with
-    the segments of at least :data:`CUT_FACE_MIN_DEG` next to it."""
+def modified_ritchie_width_m(height_m: float) -> float:
+    """Catchment width [m] of the Modified Ritchie Criterion for a face ``height_m`` metres high.
+
+    W = 0.2 H + 4.5 m (Ryan & Pryor 2000, the mining form of Ritchie's 1963 highway ditch rule, as quoted in the
+    abstract of Warren et al. 2025, who measure catch benches against 90 % retention).  A single linear rule: it
+    takes no account of rock size, face angle or catchment material, which Warren et al. found also govern rollout.
+    """
+    h = float(height_m)
+    if not (np.isfinite(h) and h > 0):
+        raise ValueError(f"height_m = {height_m!r} must be a number > 0 m")
+    return MRC_SLOPE * h + MRC_INTERCEPT_M
+
+
+def _face_span(profile) -> tuple:
+    """(index of the first, index of the last) segment of the cut face (see :func:`cut_geometry`)."""
     x, z = np.asarray(profile.x, dtype=float), np.asarray(profile.z, dtype=float)
-    dx, dz = np.diff(x), np.diff(z)
-    ang = np.degrees(np.arctan2(-dz, dx))
+    ang = np.degrees(np.arctan2(-np.diff(z), np.diff(x)))
     i = int(np.argmax(ang))
     lo, hi = i, i
     while lo > 0 and ang[lo - 1] >= CUT_FACE_MIN_DEG:          # the face continues up ...
         lo -= 1
     while hi < ang.size - 1 and ang[hi + 1] >= CUT_FACE_MIN_DEG:   # ... and down
         hi += 1
+    return lo, hi
+
+
+def cut_geometry(profile) -> tuple:
+    """(toe x [m], cut height [m], overall face angle [deg]) of the cut face: the steepest segment of a profile with
+    the segments of at least :data:`CUT_FACE_MIN_DEG` next to it."""
+    x, z = np.asarray(profile.x, dtype=float), np.asarray(profile.z, dtype=float)
+    lo, hi = _face_span(profile)
     height = float(z[lo] - z[hi + 1])
     return float(x[hi + 1]), height, float(np.degrees(np.arctan2(height, x[hi + 1] - x[lo])))
 
@@ -141,9 +215,16 @@ def retention_from_result(res, *, toe_x_m: float | None = None, max_width_m: flo
     if toe_x_m is not None:
         toe = float(toe_x_m)
     ro = res.runout
-    beyond = ro["x_stop_m"].to_numpy(dtype=float) - toe
+    x_stop = ro["x_stop_m"].to_numpy(dtype=float)
     left = (ro["reason"].astype(str) == "left profile").to_numpy()
-    beyond[left | ~np.isfinite(beyond)] = np.inf          # never retained within the profile
+    face_top = float(sc.profile.x[_face_span(sc.profile)[0]])
+    over = left | ~np.isfinite(x_stop) | (x_stop > face_top)     # went over the face (or left the profile)
+    beyond = x_stop[over] - toe
+    gone = left[over] | ~np.isfinite(beyond)
+    beyond[gone] = np.inf                                   # never retained within the profile
+    if beyond.size == 0:
+        raise ValueError(f"{sc.name}: no simulated block went over the cut face (top at x = {face_top:g} m); "
+                         "the catchment is not tested")
     top = float(sc.profile.x[-1] - toe) if max_width_m is None else float(max_width_m)
     w = np.linspace(0.0, top, 401)
     s = np.sort(beyond)
@@ -154,8 +235,10 @@ def retention_from_result(res, *, toe_x_m: float | None = None, max_width_m: flo
         widths[q] = float(max(s[k], 0.0)) if np.isfinite(s[k]) else float("nan")
     return CatchmentStudy(title=f"{sc.name}: {height:.1f} m cut at {angle:.0f} deg, catchment retention",
                           toe_x_m=toe, cut_height_m=height, face_angle_deg=angle, n=int(res.n),
-                          curve=pd.DataFrame({"width_m": w, "retained": retained}), widths=widths)
+                          curve=pd.DataFrame({"width_m": w, "retained": retained}), widths=widths,
+                          n_over_face=int(beyond.size))
 
 
-__all__ = ["CatchmentStudy", "ODOT_FACE_DEG", "ODOT_HEIGHTS_M", "RETENTION_LEVELS", "catchment_retention", "cut_geometry",
-           "odot_chart_applies", "retention_from_result", "with_chart"]
+__all__ = ["CatchmentStudy", "MRC_INTERCEPT_M", "MRC_SLOPE", "ODOT_FACE_DEG", "ODOT_HEIGHTS_M", "RETENTION_LEVELS",
+           "catchment_retention", "cut_geometry", "modified_ritchie_width_m", "odot_chart_applies",
+           "retention_from_result", "with_chart"]

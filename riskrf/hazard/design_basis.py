@@ -19,8 +19,12 @@ public source) and every output names it.
     characteristic (95th or 99th [V]) percentile speed at the line, each with a partial factor:
     E_d = 1/2 (m_k gamma_m) (v_k gamma_v)^2.  The kit's MEL is used for rare design events, its
     SEL = MEL/3 for frequent ones (the design block's return period at the line below ``frequent_T_years``).
-    The factor values are riskrf defaults [R], NOT checked against the standard's tables: every output says so
-    until the site file states them (``[design] gamma_m``, ``gamma_v``).
+    The factor values gamma_m, gamma_v are riskrf defaults [R], NOT checked against the standard's tables: every
+    output says so until the site file states them (``[design] gamma_m``, ``gamma_v``).  The distance to the
+    element at risk is at least 1.2 times the kit's maximum elongation in the MEL test and at least that
+    elongation + 1 m, D_min = max(1.2 D_MEL, D_MEL + 1 m) [V: Trumer Schutzbauten's summary of ONR 24810,
+    "Constructive Rules", trumerschutzbauten.com/standards/rockfall-standards/onr-24810/constructive/]
+    (:func:`onr24810_min_distance_m`).
 ``"return period"``
     E_d is the T-year impact energy at the line (``hazard.design_period_years``), checked against MEL without
     a factor.
@@ -64,7 +68,7 @@ HEIGHT_STEP_M = 0.5
 DEFAULT_FACTORS = {
     "UNI 11211-4": {"gamma_Tr": 1.10, "gamma_Dp": 1.10, "gamma_VolF": 1.10, "gamma_gamma": 1.0,
                     "gamma_E": 1.2, "gamma_d": 1.3, "velocity_percentile": 95.0, "height_percentile": 95.0},
-    "ONR 24810": {"gamma_m": 1.0, "gamma_v": 1.0, "gamma_d": 1.0, "velocity_percentile": 95.0,
+    "ONR 24810": {"gamma_m": 1.0, "gamma_v": 1.0, "gamma_d": 1.2, "velocity_percentile": 95.0,
                   "height_percentile": 95.0},
     "return period": {"gamma_d": 1.0, "height_percentile": 95.0},
 }
@@ -73,8 +77,10 @@ FACTOR_SOURCES = {
                     "by the RocFall UNI 11211 design page and Peila & Ronco (2009) [V]; gamma_E = 1.2 against MEL, "
                     "gamma_d = 1.3 at MEL and h_d = h_t gamma_Tr gamma_Dp [R: confirm against the standard]"),
     "ONR 24810": ("design block 95th-98th percentile and characteristic percentiles 95/99 [V: Natural Hazards 2024, "
-                  "doi 10.1007/s11069-024-06432-4; Marchelli 2022]; gamma_m and gamma_v are riskrf defaults, NOT "
-                  "checked against the ONR 24810 tables: state them in [design] for a signed design"),
+                  "doi 10.1007/s11069-024-06432-4; Marchelli 2022]; distance to the element at risk >= max(1.2 D_MEL, "
+                  "D_MEL + 1 m) [V: ONR 24810 constructive rules as summarised by Trumer Schutzbauten]; gamma_m and "
+                  "gamma_v are riskrf defaults, NOT checked against the ONR 24810 tables: state them in [design] for "
+                  "a signed design"),
     "return period": "the T-year impact energy at the line against MEL, no partial factor",
 }
 
@@ -113,6 +119,47 @@ def round_up(value: float, step: float = HEIGHT_STEP_M) -> float:
 def uni11211_energy(volume_m3, density_kg_m3, velocity_ms, *, gamma_Tr, gamma_Dp, gamma_VolF, gamma_gamma=1.0):
     """UNI 11211-4 design energy [kJ]: E_d = 1/2 (Vol rho gamma_VolF gamma_gamma) (v_t gamma_Tr gamma_Dp)^2."""
     return kinetic_energy_kj(volume_m3 * density_kg_m3 * gamma_VolF * gamma_gamma, velocity_ms * gamma_Tr * gamma_Dp)
+
+
+#: ONR 24810 constructive rule: the distance to the element at risk is at least this many times the MEL elongation
+#: and at least the elongation plus :data:`ONR_MIN_EXTRA_DISTANCE_M` (Trumer Schutzbauten's ONR 24810 summary [V]).
+ONR_DISTANCE_FACTOR = 1.2
+ONR_MIN_EXTRA_DISTANCE_M = 1.0
+
+
+def onr24810_min_distance_m(elongation_m, factor: float = ONR_DISTANCE_FACTOR) -> float:
+    """Least distance [m] from an ONR 24810 fence to the element at risk for a kit whose maximum elongation in the
+    MEL test is ``elongation_m`` [m]: D_min = max(factor x D_MEL, D_MEL + 1 m), factor 1.2 (so D_MEL + 1 m governs
+    below 5 m of elongation and 1.2 D_MEL above).
+
+    References
+    ----------
+    ONR 24810:2013/2021, constructive rules for rock fall catchment fences, as summarised at
+    trumerschutzbauten.com/standards/rockfall-standards/onr-24810/constructive/ ("1.2 times the maximum
+    elongation ... and shall not be less than one meter greater than the maximum elongation").
+    """
+    d = float(elongation_m)
+    if not (np.isfinite(d) and d > 0):
+        raise ValueError(f"elongation_m = {elongation_m!r} must be a number > 0 m")
+    return max(float(factor) * d, d + ONR_MIN_EXTRA_DISTANCE_M)
+
+
+def permitted_elongation_m(basis: "DesignBasis", clearance_m: float) -> float:
+    """The largest maximum elongation [m] of a kit that the clearance to the road [m] permits under ``basis``:
+    clearance / gamma_d (UNI 11211-4, return period), and for ONR 24810 also clearance - 1 m
+    (:func:`onr24810_min_distance_m` inverted)."""
+    g = basis.factors["gamma_d"]
+    if basis.basis == "ONR 24810":
+        return min(clearance_m / g, clearance_m - ONR_MIN_EXTRA_DISTANCE_M)
+    return clearance_m / g
+
+
+def required_distance_m(basis: "DesignBasis", elongation_m: float) -> float:
+    """Distance [m] a kit of maximum elongation ``elongation_m`` needs to the road under ``basis``: D_MEL x gamma_d,
+    and for ONR 24810 :func:`onr24810_min_distance_m` (gamma_d as the factor)."""
+    if basis.basis == "ONR 24810":
+        return onr24810_min_distance_m(elongation_m, basis.factors["gamma_d"])
+    return float(elongation_m) * basis.factors["gamma_d"]
 
 
 def onr24810_energy(mass_kg, velocity_ms, *, gamma_m, gamma_v):
@@ -177,7 +224,7 @@ class DesignBasis:
     @property
     def unverified(self) -> list:
         """Factors in force that are riskrf defaults of [R] status and were not stated by the site file."""
-        recalled = {"UNI 11211-4": ("gamma_E", "gamma_d"), "ONR 24810": ("gamma_m", "gamma_v", "gamma_d"),
+        recalled = {"UNI 11211-4": ("gamma_E", "gamma_d"), "ONR 24810": ("gamma_m", "gamma_v"),
                     "return period": ()}[self.basis]
         return [k for k in recalled if k not in self.stated]
 
@@ -277,7 +324,7 @@ class DesignRequirement:
             "required height: design passing height + free border [m]": self.required_height_m,
             "required net height (0.5 m steps) [m]": self.required_net_height_m,
             "clearance to the road D_A [m]": self.clearance_m,
-            "permitted maximum elongation D_A / gamma_d [m]": self.permitted_elongation_m,
+            "permitted maximum elongation [m] (D_A / gamma_d; ONR 24810 also D_A - 1 m)": self.permitted_elongation_m,
             "required residual-height category": self.residual_category,
         }
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
@@ -421,7 +468,7 @@ def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3:
         border_text = f"h_d + radius + free board ({basis.free_board_m:g} m)"
     H = h_d + border
     clear = basis.clearance_m if basis.clearance_m is not None else clearance_m
-    permitted = clear / f["gamma_d"] if clear is not None else None
+    permitted = permitted_elongation_m(basis, clear) if clear is not None else None
     shares = barrier_shares(hazard, cls if np.isfinite(cls) else need, round_up(H), block_top_m=0.0) \
         if np.isfinite(H) else {}
     rows = []
@@ -437,9 +484,11 @@ def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3:
                      "adequate": bool(H <= height) if np.isfinite(H) else None})   # no simulated heights
         elong = basis.elongation_m.get(name)
         if elong is not None and clear is not None:
-            rows.append({"fence": name, "check": f"elongation: D_MEL x gamma_d ({f['gamma_d']:g}) vs clearance",
-                         "demand": float(elong) * f["gamma_d"], "capacity": clear, "unit": "m",
-                         "adequate": bool(float(elong) * f["gamma_d"] <= clear)})
+            need_d = required_distance_m(basis, elong)
+            rule = (f"max({f['gamma_d']:g} D_MEL, D_MEL + 1 m)" if basis.basis == "ONR 24810"
+                    else f"D_MEL x gamma_d ({f['gamma_d']:g})")
+            rows.append({"fence": name, "check": f"elongation: {rule} vs clearance",
+                         "demand": need_d, "capacity": clear, "unit": "m", "adequate": bool(need_d <= clear)})
         elif clear is not None:
             rows.append({"fence": name, "check": "elongation: the kit's maximum elongation at MEL must not exceed",
                          "demand": float("nan"), "capacity": permitted, "unit": "m", "adequate": None})
@@ -464,8 +513,8 @@ class PositionSearch:
 
     ``table``: one row per position: x [m], ground z [m], share of released blocks reaching it, arrivals per year,
     E_d [kJ], required MEL [kJ] and product class [kJ], required net height [m], clearance [m]; ``profile``:
-    (x, z) of the slope; ``basis``: the :class:`DesignBasis`; ``n``: blocks simulated.  Its figure is
-    :func:`riskrf.report.design_figures.position_search_figure` (the science draws nothing).
+    (x, z) of the slope; ``basis``: the :class:`DesignBasis`; ``n``: blocks simulated.  Its figure: :meth:`plot`
+    (drawn by :func:`riskrf.report.design_figures.plot_position_search`; the science draws nothing).
     """
 
     table: pd.DataFrame
@@ -475,8 +524,23 @@ class PositionSearch:
     road_x_m: float | None = None
 
     def summary(self) -> pd.DataFrame:
-        """The per-position table."""
-        return self.table
+        """The per-position table with plain-language headers and units, one row per position, the cheapest
+        position marked (column "cheapest")."""
+        names = {"x_m": "position x [m]", "ground_z_m": "ground z [m]", "reach_share": "share of blocks reaching",
+                 "arrivals_per_year": "arrivals per year", "E_d_kj": "design energy E_d [kJ]",
+                 "required_mel_kj": "required MEL [kJ]", "required_class_kj": "product class MEL [kJ]",
+                 "required_net_height_m": "required net height [m]", "clearance_m": "clearance to the road [m]",
+                 "note": "note"}
+        t = self.table.rename(columns=names)
+        best = self.cheapest()
+        t["cheapest"] = (self.table["x_m"] == best["x_m"]).to_numpy() if best is not None else False
+        return t
+
+    def plot(self, ax=None):
+        """Required MEL, product class and net height per position; returns the matplotlib axes (drawn by
+        :func:`riskrf.report.design_figures.plot_position_search`)."""
+        from ..core.figures import draw
+        return draw("position_search", self, ax=ax)
 
     def cheapest(self) -> pd.Series | None:
         """The position with the smallest required class, then the lowest net height (None when no position has a
@@ -508,8 +572,9 @@ def position_search(hazard, scenario, basis: DesignBasis, *, block=None, density
     """
     import simulation
 
-    from .annual_hazard import EnergyHazard, inertia_factors
-    from .mass_coupling import MassCoupledSamples, stratified_log_uniform
+    from .annual_hazard import EnergyHazard
+    from .mass_coupling import stratified_log_uniform
+    from .simulated import coupled_samples
 
     if not hazard.mass_coupled:
         raise ValueError("the position search needs a mass-coupled hazard (hazard.mass_coupling = 'simulated')")
@@ -534,21 +599,15 @@ def position_search(hazard, scenario, basis: DesignBasis, *, block=None, density
     pz = np.asarray(scenario.profile.z, dtype=float)
     rows = []
     for i, x in enumerate(xs):
-        df = result.collector(f"position_{i}", first_only=True)
-        row = {"x_m": float(x), "ground_z_m": float(np.interp(x, px, pz)), "reach_share": len(df) / result.n}
-        if df.empty:
+        row = {"x_m": float(x), "ground_z_m": float(np.interp(x, px, pz)),
+               "reach_share": float(result.reach_probability(f"position_{i}")[0])}
+        samples = coupled_samples(result, f"position_{i}", masses, edges, mm)
+        if samples is None:
             rows.append(row | {"arrivals_per_year": 0.0, "E_d_kj": np.nan, "required_mel_kj": np.nan,
                                "required_class_kj": np.nan, "required_net_height_m": np.nan,
                                "clearance_m": (road_x - x) if road_x is not None else np.nan,
                                "note": "no simulated block reaches this line"})
             continue
-        speed = np.full(result.n, np.nan)
-        height = np.full(result.n, np.nan)
-        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
-        blk = df["block"].to_numpy()
-        speed[blk] = np.sqrt(df["velocity_ms"].to_numpy() ** 2 + inertia_factors(df) * spin ** 2)
-        height[blk] = df["height_m"].to_numpy()
-        samples = MassCoupledSamples(masses, speed, height, edges, f"position_{i}").with_representative(mm)
         reach = samples.reach_probability(mm)
         hz = EnergyHazard(mass=hazard.mass, velocity=samples, rate_per_year=hazard.rate_per_year,
                           reach_probability=max(reach, 1e-300), n_released=result.n, heights_m=samples.heights_m,
@@ -571,5 +630,6 @@ def position_search(hazard, scenario, basis: DesignBasis, *, block=None, density
 
 __all__ = ["BASES", "DEFAULT_BASIS", "DEFAULT_FACTORS", "DesignBasis", "DesignRequirement", "MEL_PRODUCT_CLASSES_KJ",
            "PositionSearch", "RESIDUAL_CATEGORIES", "barrier_shares", "check_basis", "default_positions",
-           "design_basis_from_site", "design_requirement", "frequent_energy", "onr24810_energy", "position_search",
+           "design_basis_from_site", "design_requirement", "frequent_energy", "onr24810_energy", "onr24810_min_distance_m",
+           "permitted_elongation_m", "position_search", "required_distance_m",
            "required_product_class", "residual_height_category", "round_up", "uni11211_energy"]

@@ -62,6 +62,32 @@ def energy_hazard(mass, scenario, collector: str = "barrier", *, rate_per_year=N
                                   rotational=rotational, return_periods=return_periods)[0]
 
 
+def coupled_samples(result, collector: str, masses_kg, edges_kg, mass_model, *, rotational: bool = True):
+    """The :class:`MassCoupledSamples` of one collector of a run of blocks of given masses, or None when no block
+    reached it.
+
+    Each released block (``masses_kg``, in the order simulated) keeps its speed [m/s] and passing height [m] at its
+    first crossing of ``collector`` (NaN when it never crossed); with ``rotational`` the speed is the effective one,
+    v_eff^2 = v^2 + k (omega r)^2 (:func:`~riskrf.hazard.annual_hazard.inertia_factors`), so that 1/2 m v_eff^2 is
+    the translational plus rotational energy.  ``edges_kg`` are the mass-class edges [kg]; the classes take their
+    representative mass from ``mass_model``.
+    """
+    df = result.collector(collector, first_only=True)
+    if df.empty:
+        return None
+    speed = np.full(result.n, np.nan)
+    height = np.full(result.n, np.nan)
+    v = df["velocity_ms"].to_numpy()
+    if rotational:
+        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
+        v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
+    blk = df["block"].to_numpy()
+    speed[blk] = v
+    height[blk] = df["height_m"].to_numpy()
+    return MassCoupledSamples(np.asarray(masses_kg, dtype=float), speed, height, np.asarray(edges_kg, dtype=float),
+                              collector).with_representative(mass_model)
+
+
 def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_per_year=None, n: int = 20_000,
                            seed=1, mass_range_kg=None, design_masses_kg=(), n_bins: int | None = None,
                            rotational: bool = True, return_periods=DESIGN_RETURN_PERIODS):
@@ -105,22 +131,12 @@ def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_p
     rng = np.random.default_rng(np.random.SeedSequence([0 if seed is None else int(seed), 10]))
     masses = stratified_log_uniform(lo, hi, int(n), rng)
     result = simulation.run(sc, seed=seed, masses_kg=masses)
-    df = result.collector(collector, first_only=True)
-    if df.empty:
-        raise NoArrivalsError(f"no simulated block reached collector {collector!r}: the hazard there is nil for the "
-                         "simulated release; check the scenario")
-    speed = np.full(result.n, np.nan)
-    height = np.full(result.n, np.nan)
-    v = df["velocity_ms"].to_numpy()
-    if rotational:
-        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
-        v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
-    blk = df["block"].to_numpy()
-    speed[blk] = v
-    height[blk] = df["height_m"].to_numpy()
     edges = np.exp(np.linspace(np.log(lo), np.log(hi), n_bins + 1))
     edges[0], edges[-1] = lo, hi
-    samples = MassCoupledSamples(masses, speed, height, edges, collector).with_representative(mm)
+    samples = coupled_samples(result, collector, masses, edges, mm, rotational=rotational)
+    if samples is None:
+        raise NoArrivalsError(f"no simulated block reached collector {collector!r}: the hazard there is nil for "
+                              "the simulated release; check the scenario")
     reach = samples.reach_probability(mm)
     below, above = samples.outside_range(mm)
     notes = [samples.description + "; the seeder's own mass distribution is not used"
@@ -136,4 +152,4 @@ def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_p
     return hz, result
 
 
-__all__ = ["energy_hazard", "simulate_energy_hazard"]
+__all__ = ["coupled_samples", "energy_hazard", "simulate_energy_hazard"]

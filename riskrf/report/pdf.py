@@ -346,7 +346,7 @@ def write_pdf_report(a, path, figs) -> Path:
                        for _, r in req.candidates.iterrows()], widths=[2, 4, 1.2, 1.2, 0.7, 1])
             rep.text("Elongation: state the kit's maximum elongation at MEL (from its European Technical "
                      "Assessment) in [design] elongation_m to check it; the permitted value is the clearance to the "
-                     "road divided by gamma_d.", size=8)
+                     "road divided by gamma_d (ONR 24810: also at most the clearance less 1 m).", size=8)
 
         if d.positions is not None:
             rep.section("Barrier position along the profile")
