@@ -187,6 +187,8 @@ def test_assess_writes_the_pdf_and_the_design_entries(tmp_path):
     assert rb["required_net_height_m"] >= rb["required_height_m"]
     assert s["deflection_check"]["permitted_max_elongation_m"] == pytest.approx(20.0 / 1.3)   # road 120, line 100
     assert "width_for_retention_m" in s["ditch_chart_comparison"]
+    ditch = s["ditch_chart_comparison"]          # the Modified Ritchie width W = 0.2 H + 4.5 m beside the retention
+    assert ditch["modified_ritchie_criterion"]["width_m"] == pytest.approx(0.2 * ditch["cut_height_m"] + 4.5)
     assert len(s["position_search"]) >= 5
     reader = PdfReader(out / "report.pdf")
     assert len(reader.pages) >= 10
