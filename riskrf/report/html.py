@@ -466,7 +466,7 @@ def render_report(a, figs: Path) -> str:
                 doc.table(d.requirement.candidates if d.requirement is not None else None,
                           "Checks of the candidate fences against the design basis"))
         if d.positions is not None:
-            doc.add(doc.table(d.positions.table, "Required MEL and net height by barrier position"),
+            doc.add(doc.table(d.positions.summary(), "Required MEL and net height by barrier position"),
                     doc.figure(figs / "barrier_positions.png", "Barrier position search"))
         doc.add(doc.figure(figs / "options_profile.png", "Every option's geometry on the slope profile"),
                 doc.figure(figs / "stop_points.png", "Stop points of the simulated blocks"))
