@@ -11,32 +11,24 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..core.validation import RiskrfError
 from .measures import Ditch, MeasureError
-from ..core.format import money, sig
+from ..core.format import sig
 from .road_users import DEFAULT_VULNERABILITY
 from .tolerability import CRITERIA_SETS, CriteriaSet, user_criteria
 from .road_risk import occupancy_distribution
-
-OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "closure", "combined",
-                "bench", "bund", "drape")
-#: Options that change the slope's geometry or surface; their effect is derived by re-simulation (like a ditch).
-SLOPE_KINDS = ("bench", "bund", "drape")
-BARRIER_KINDS = ("fence", "attenuator", "shed")
-#: Days a destroyed structure stays out of service (ASSUMPTION; override with ``repair_days``).
-DEFAULT_REPAIR_DAYS = {"fence": 30.0, "attenuator": 30.0, "shed": 180.0}
-MASS_BINS = 120
-#: Scaling and bolting by zone and mass: share of the targeted releases removed when the work is new, its range,
-#: and the cycle over which the effect is averaged without a life_years.  ASSUMPTIONS (no published effectiveness
-#: of scaling was found): labelled "assumed" in every output; override with effectiveness, effectiveness_range and
-#: effectiveness_half_life_years.
-SCALING_EFFECTIVENESS = 0.8
-SCALING_EFFECTIVENESS_RANGE = (0.6, 0.95)
-SCALING_DEFAULT_CYCLE_YEARS = 10.0
-
-
-class MitigationError(RiskrfError, ValueError):
-    """A mitigation file or option is invalid; the message names the option and field."""
+from .loss_engine import MASS_BINS, closure_cost_per_fall  # noqa: F401  (public names of this module)
+from .options import (  # noqa: F401  (public names of this module)
+    BARRIER_KINDS,
+    DEFAULT_REPAIR_DAYS,
+    OPTION_KINDS,
+    SCALING_DEFAULT_CYCLE_YEARS,
+    SCALING_EFFECTIVENESS,
+    SCALING_EFFECTIVENESS_RANGE,
+    SLOPE_KINDS,
+    MitigationError,
+    effect_of,
+    scaling_effect,
+)
 
 
 @dataclass(frozen=True)
@@ -84,15 +76,6 @@ class Consequences:
     value_of_time_per_hour: float = 0.0
     cleanup_cost_per_fall: float = 3000.0
     currency: str = "CHF"
-
-
-def closure_cost_per_fall(co: "Consequences", vehicles_per_day):
-    """Cost of one fall reaching the road besides injuries and vehicle damage [currency]: the agency's closure
-    cost per day and the road users' delay (each of the vehicles_per_day x closure days detours for
-    ``detour_hours`` at ``value_of_time_per_hour``), plus clean-up."""
-    days = co.closure_days_per_fall
-    return days * co.closure_cost_per_day + days * np.asarray(vehicles_per_day, dtype=float) * co.detour_hours \
-        * co.value_of_time_per_hour + co.cleanup_cost_per_fall
 
 
 @dataclass(frozen=True)
@@ -251,17 +234,8 @@ class Option:
 
     def scaling_effect(self) -> tuple:
         """Scaling and bolting by zone and mass: (initial effectiveness, its range, half-life [yr], mean over a
-        renewal cycle, mean at the range's ends).  ASSUMED defaults: 0.8 of the targeted releases removed when new
-        (range 0.6-0.95), halving every ``life_years`` (10 years without one): loosening, new joints opening and
-        missed blocks make scaling neither complete nor lasting.  Mean over a cycle of length L of e0 2^(-t/h):
-        e0 h (1 - 2^(-L/h)) / (L ln 2)."""
-        e0 = SCALING_EFFECTIVENESS if self.effectiveness is None else self.effectiveness
-        rng = self.effectiveness_range or ((SCALING_EFFECTIVENESS_RANGE if self.effectiveness is None
-                                            else (self.effectiveness, self.effectiveness)))
-        life = self.life_years or SCALING_DEFAULT_CYCLE_YEARS
-        h = self.effectiveness_half_life_years or life
-        k = h * -np.expm1(-np.log(2.0) * life / h) / (life * np.log(2.0))
-        return e0, tuple(rng), h, e0 * k, (rng[0] * k, rng[1] * k)
+        renewal cycle, mean at the range's ends); see :meth:`riskrf.risk.options.Scaling.effect`."""
+        return scaling_effect(self)
 
     @property
     def has_closure_rule(self) -> bool:
@@ -271,68 +245,12 @@ class Option:
     @property
     def typed(self) -> bool:
         """Does a typed effectiveness (an assumption) replace the derived one?"""
-        return self.retention is not None or self.rate_reduction is not None or (
-            self.kind == "closure" and not self.has_closure_rule)
+        return effect_of(self).typed
 
     def describe(self, currency: str = "") -> str:
-        """What the option is and assumes, in words (money in ``currency``)."""
-        k = self.kind
-        if k == "none":
-            text = "the site as it is"
-        elif k == "scaling":
-            if self.rate_reduction is not None:
-                text = f"scaling and bolting; ASSUMED to prevent {self.rate_reduction:.0%} of falls (typed)"
-            else:
-                size = (f"{self.min_mass_kg or 0:,.0f}-{self.max_mass_kg:,.0f} kg" if self.max_mass_kg
-                        else f"above {self.min_mass_kg:,.0f} kg" if self.min_mass_kg else "of every size")
-                zone = f" from x = {self.zone_x_m[0]:g}-{self.zone_x_m[1]:g} m" if self.zone_x_m else ""
-                e0, rng, h, mean, _ = self.scaling_effect()
-                text = (f"scaling and bolting: removes {e0:.0%} (ASSUMED, {rng[0]:.0%}-{rng[1]:.0%}) of the release of "
-                        f"blocks {size}{zone} when new, halving every {h:g} years (ASSUMED): {mean:.0%} on average")
-        elif k == "ditch":
-            if self.retention is not None:
-                text = f"catchment ditch; ASSUMED to retain {self.retention:.0%} of falls (typed)"
-            else:
-                text = (f"catchment ditch {self.width_m:g} m wide and {self.depth_m:g} m deep from x = {self.x_m:g} m; "
-                        "retention derived by simulation")
-        elif k in ("fence", "attenuator"):
-            text = (f"{k} of {self.capacity_kj:,.0f} kJ (MEL), {self.height_m:g} m high"
-                    + (f" at x = {self.x_m:g} m" if self.x_m is not None else " at the barrier line")
-                    + (f"; ASSUMED to retain {self.retention:.0%} (typed)" if self.retention is not None
-                       else "; passing falls from simulated heights and energies")
-                    + f"; out of service {self.repair_days:g} days after an impact above MEL (assumption)")
-        elif k == "shed":
-            text = (f"rock shed of {self.capacity_kj:,.0f} kJ over "
-                    + (f"{self.covered_length_m:g} m of road" if self.covered_length_m else "the exposed road")
-                    + f"; out of service {self.repair_days:g} days after an impact above capacity (assumption)")
-        elif k in SLOPE_KINDS and self.retention is not None:
-            text = f"{k}; ASSUMED to retain {self.retention:.0%} of falls (typed)"
-        elif k == "bench":
-            text = f"catch bench {self.width_m:g} m wide cut into the slope from x = {self.x_m:g} m; retention derived by " \
-                   "simulation"
-        elif k == "bund":
-            text = (f"bund {self.height_m:g} m high on the ground from x = {self.x_m:g} m over {self.width_m:g} m; "
-                    "retention derived by simulation")
-        elif k == "drape":
-            text = (f"drape (secured mesh) over x = {self.zone_x_m[0]:g}-{self.zone_x_m[1]:g} m: the surface takes "
-                    "an ASSUMED low-bounce, high-friction material; retention derived by simulation")
-        elif k == "realignment":
-            text = (f"road moved to x = {self.road_x_m:g} m" if self.road_x_m is not None
-                    else "road moved away from the slope (no exposure)")
-        elif k == "closure" and self.share_while_closed is None:
-            text = f"{self.rule_text()}; share and hours not yet computed (needs the site's rate model, [rates])"
-        elif k == "closure":
-            how = "computed from the rate model" if self.has_closure_rule else "ASSUMED (typed)"
-            cur = f" {currency}" if currency else ""
-            text = ((f"{self.closure_rule}: " if self.closure_rule else "")
-                    + f"road closed {self.closure_hours_per_year:,.1f} h per year ({how}) at "
-                    f"{self.cost_per_closure_hour:,.0f}{cur} per hour "
-                    f"({money(self.closure_hours_per_year * self.cost_per_closure_hour, sig=3)}{cur} per year, in the "
-                    f"annual maintenance); {self.share_while_closed:.1%} of falls occur while closed "
-                    f"({how}); protects road users, falls still reach the road")
-        else:
-            text = "combination of " + " + ".join(self.options)
-        return (self.description + ": " if self.description else "") + text
+        """What the option is and assumes, in words (money in ``currency``); each kind's text is its class's in
+        :mod:`riskrf.risk.options`."""
+        return (self.description + ": " if self.description else "") + effect_of(self).describe(currency)
 
     def rule_text(self) -> str:
         """A closure rule in words (rainfall or warning rule)."""

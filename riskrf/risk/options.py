@@ -1,0 +1,499 @@
+"""Mitigation options as transformations of the site: one small class per option kind.
+
+Each option of a study (a :class:`riskrf.risk.mitigation_inputs.Option` read from the ``[[options]]`` tables) is
+wrapped by the class of its kind (:func:`effect_of`), which says what it does to the falls and what it costs
+(CLIMADA's measures: a measure changes the hazard, the exposure or the vulnerability; one engine,
+:mod:`riskrf.risk.loss_engine`, computes the losses):
+
+* ``none`` (:class:`DoNothing`): the site as it is;
+* ``scaling`` (:class:`Scaling`, scaling and bolting): removes the release of blocks between ``min_mass_kg`` and
+  ``max_mass_kg`` from the source zone ``zone_x_m`` (the share of the release line it covers follows from the
+  scenario's seeder), with an ASSUMED effectiveness decaying over its life;
+* ``ditch`` (:class:`CatchDitch`): a catchment dug into the profile (``x_m``, ``width_m``, ``depth_m``); its
+  retention is derived by re-simulating the scenario with the new profile; ``bench``, ``bund``, ``drape``
+  (:class:`Bench`, :class:`Bund`, :class:`Drape`) change the slope likewise
+  (:mod:`riskrf.risk.geometry_measures`);
+* ``fence`` / ``attenuator`` (:class:`Barrier`): a barrier line (``capacity_kj`` = MEL, ``height_m``) at the
+  barrier collector or at its own ``x_m``; falls pass over (the block's underside, simulated centre height minus
+  the radius of a block of that mass, above the fence: the simulator's own barrier rule,
+  ``simulation.kernel.barrier_outcome``) or through (energy above MEL, block by block);
+* ``shed`` (:class:`Shed`): covers ``covered_length_m`` of the exposed road with a capacity ``capacity_kj``;
+* ``realignment`` (:class:`Realignment`): moves the road to ``road_x_m`` on the profile (share of falls still
+  reaching it from the simulated run-out), or away from the slope altogether;
+* ``closure`` (:class:`Closure`): closes the road while a rainfall or warning rule holds; falls still reach the
+  road but meet no road user;
+* ``combined`` (:class:`Combined`): several of the above in series, each acting on the falls the previous ones let
+  through, costs added: no double counting.
+
+A typed ``retention`` (ditch, slope measures, barriers) or ``rate_reduction`` (scaling) replaces the derived effect;
+it is then an assumption and says so in every output.
+
+The protocol of a kind: :meth:`OptionEffect.parameters` (its costs and effect parameters, named as in the tornado),
+:meth:`OptionEffect.stages` (its typed stages for the engine, derived from the slope models of
+:class:`riskrf.risk.slope_models.SlopeModels`), :meth:`OptionEffect.describe` and the effect basis
+(derived / ASSUMED / typed) of :func:`effect_basis`.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.format import money
+from ..core.validation import RiskrfError
+from .geometry_measures import SlopeMeasure
+from .loss_engine import BarrierStage, ClosureStage, ExposureStage, OptionChain, ReleaseStage, RetentionStage
+from .measures import Ditch, MeasureError, runout_beyond, seeder_share
+
+OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "closure", "combined",
+                "bench", "bund", "drape")
+#: Options that change the slope's geometry or surface; their effect is derived by re-simulation (like a ditch).
+SLOPE_KINDS = ("bench", "bund", "drape")
+BARRIER_KINDS = ("fence", "attenuator", "shed")
+#: Days a destroyed structure stays out of service (ASSUMPTION; override with ``repair_days``).
+DEFAULT_REPAIR_DAYS = {"fence": 30.0, "attenuator": 30.0, "shed": 180.0}
+#: Scaling and bolting by zone and mass: share of the targeted releases removed when the work is new, its range,
+#: and the cycle over which the effect is averaged without a life_years.  ASSUMPTIONS (no published effectiveness
+#: of scaling was found): labelled "assumed" in every output; override with effectiveness, effectiveness_range and
+#: effectiveness_half_life_years.
+SCALING_EFFECTIVENESS = 0.8
+SCALING_EFFECTIVENESS_RANGE = (0.6, 0.95)
+SCALING_DEFAULT_CYCLE_YEARS = 10.0
+
+# the order in which the elements of an option act on the falls, in series
+RELEASE, TYPED_RETENTION, GEOMETRY, BARRIER, SHED, CLOSURE, EXPOSURE = range(7)
+
+
+class MitigationError(RiskrfError, ValueError):
+    """A mitigation file or option is invalid; the message names the option and field."""
+
+
+def _typed_retention(o, what: str) -> str:
+    return f"{what}; ASSUMED to retain {o.retention:.0%} of falls (typed)"
+
+
+class OptionEffect:
+    """The behaviour of one option kind; wraps the option record ``option``.
+
+    ``order``: where its stages act in the series of a combined option (releases, typed retentions, the
+    re-simulated slope geometry, barriers, sheds, closures, realignments).
+    """
+
+    order = EXPOSURE
+    needs_design_check = False
+
+    def __init__(self, option):
+        self.option = option
+
+    # ---- what it is and assumes --------------------------------------------------------------------------
+    @property
+    def typed(self) -> bool:
+        """Does a typed effectiveness (an assumption) replace the derived one?"""
+        return self.option.retention is not None or self.option.rate_reduction is not None
+
+    def describe(self, currency: str = "") -> str:
+        """What the option does, in words (money in ``currency``)."""
+        raise NotImplementedError
+
+    #: the effect basis when every component of an option is of this kind (else None)
+    @property
+    def sole_basis(self) -> str | None:
+        return None
+
+    def assumed_basis(self, n_components: int) -> tuple | None:
+        """(priority, text): the effect basis of an option with an assumed part of this kind, lower first."""
+        return None
+
+    def check(self, source: str) -> None:
+        """Raise a MitigationError if the option cannot enter the engine yet."""
+
+    # ---- costs and effect parameters -----------------------------------------------------------------------
+    def parameters(self) -> list:
+        """(name, central value) of every input of this option the engine varies: capital cost, annual
+        maintenance, typed effects, and the kind's own (scaling effectiveness, closure share, repair days)."""
+        o = self.option
+        p = [(f"capital_cost:{o.name}", o.capital_cost), (f"annual_maintenance:{o.name}", o.annual_maintenance)]
+        if o.rate_reduction is not None:
+            p.append((f"rate_reduction:{o.name}", o.rate_reduction))
+        p += self._release_parameters()
+        if o.retention is not None:
+            p.append((f"retention:{o.name}", o.retention))
+        return p + self._own_parameters()
+
+    def _release_parameters(self) -> list:
+        return []
+
+    def _own_parameters(self) -> list:
+        return []
+
+    def stated_ranges(self, central: dict) -> dict:
+        """name -> (low, high, how) of the option's stated ranges (costs and typed effects)."""
+        o = self.option
+        out = {}
+        for fld in ("capital_cost", "annual_maintenance", "retention", "rate_reduction"):
+            rng = getattr(o, f"{fld}_range")
+            if rng is not None and f"{fld}:{o.name}" in central:
+                out[f"{fld}:{o.name}"] = (*rng, "uniform, stated" + (" (typed effectiveness: assumption)"
+                                                                     if fld in ("retention", "rate_reduction")
+                                                                     else ""))
+        return out
+
+    def assumed_ranges(self) -> dict:
+        """name -> (low, high, how) of the option's assumed (not stated) ranges."""
+        return {}
+
+    # ---- effect on the falls -------------------------------------------------------------------------------
+    def stages(self, site, space, index: int) -> list:
+        """The option's typed stages (:mod:`riskrf.risk.loss_engine`), derived with the slope models ``site``
+        (:class:`riskrf.risk.slope_models.SlopeModels`); effect parameters get their columns from ``space``;
+        ``index``: the option's position in the study."""
+        return []
+
+    def geometry_measure(self):
+        """The profile or surface change to re-simulate (a derived ditch, bench, bund or drape), else None."""
+        return None
+
+
+class DoNothing(OptionEffect):
+    """``none``: the site as it is."""
+
+    def describe(self, currency=""):
+        return "the site as it is"
+
+    @property
+    def sole_basis(self):
+        return "-"
+
+
+class Scaling(OptionEffect):
+    """``scaling``: scaling and bolting removes releases (of its zone and mass range, or a typed share)."""
+
+    order = RELEASE
+
+    def effect(self) -> tuple:
+        """Scaling and bolting by zone and mass: (initial effectiveness, its range, half-life [yr], mean over a
+        renewal cycle, mean at the range's ends).  ASSUMED defaults: 0.8 of the targeted releases removed when new
+        (range 0.6-0.95), halving every ``life_years`` (10 years without one): loosening, new joints opening and
+        missed blocks make scaling neither complete nor lasting.  Mean over a cycle of length L of e0 2^(-t/h):
+        e0 h (1 - 2^(-L/h)) / (L ln 2)."""
+        o = self.option
+        e0 = SCALING_EFFECTIVENESS if o.effectiveness is None else o.effectiveness
+        rng = o.effectiveness_range or ((SCALING_EFFECTIVENESS_RANGE if o.effectiveness is None
+                                         else (o.effectiveness, o.effectiveness)))
+        life = o.life_years or SCALING_DEFAULT_CYCLE_YEARS
+        h = o.effectiveness_half_life_years or life
+        k = h * -np.expm1(-np.log(2.0) * life / h) / (life * np.log(2.0))
+        return e0, tuple(rng), h, e0 * k, (rng[0] * k, rng[1] * k)
+
+    def describe(self, currency=""):
+        o = self.option
+        if o.rate_reduction is not None:
+            return f"scaling and bolting; ASSUMED to prevent {o.rate_reduction:.0%} of falls (typed)"
+        size = (f"{o.min_mass_kg or 0:,.0f}-{o.max_mass_kg:,.0f} kg" if o.max_mass_kg
+                else f"above {o.min_mass_kg:,.0f} kg" if o.min_mass_kg else "of every size")
+        zone = f" from x = {o.zone_x_m[0]:g}-{o.zone_x_m[1]:g} m" if o.zone_x_m else ""
+        e0, rng, h, mean, _ = self.effect()
+        return (f"scaling and bolting: removes {e0:.0%} (ASSUMED, {rng[0]:.0%}-{rng[1]:.0%}) of the release of "
+                f"blocks {size}{zone} when new, halving every {h:g} years (ASSUMED): {mean:.0%} on average")
+
+    def assumed_basis(self, n_components):
+        e0, _, h, mean, _ = self.effect()
+        return 1, (f"derived zone and mass range, ASSUMED effectiveness ({self.option.name}: {e0:.0%} when new, "
+                   f"halving every {h:g} yr, {mean:.0%} on average)"
+                   + ("; others derived (simulation and site geometry)" if n_components > 1 else ""))
+
+    def _release_parameters(self):
+        if self.option.rate_reduction is not None:
+            return []
+        return [(f"scaling_effectiveness:{self.option.name}", self.effect()[3])]
+
+    def assumed_ranges(self):
+        o = self.option
+        if o.rate_reduction is not None:
+            return {}
+        e0, (a, b), h, _, (lo, hi) = self.effect()
+        if not hi > lo:
+            return {}
+        return {f"scaling_effectiveness:{o.name}": (
+            lo, hi, f"uniform, ASSUMED (removes {a:.0%}-{b:.0%} of the targeted releases when new, "
+            f"halving every {h:g} years; mean over the cycle)")}
+
+    def stages(self, site, space, index):
+        o = self.option
+        if o.rate_reduction is not None:
+            return [ReleaseStage(o.name, space.column(f"rate_reduction:{o.name}"))]
+        share = 1.0
+        if o.zone_x_m is not None:
+            ctx = site.need_context(o, "zone_x_m")
+            try:
+                share = seeder_share(ctx.scenario, o.zone_x_m, f"{site.source}: option {o.name!r}")
+            except MeasureError as exc:
+                raise MitigationError(str(exc)) from exc
+        mid = site.grid.mid
+        lo, hi = o.min_mass_kg or 0.0, o.max_mass_kg or np.inf
+        inside = (mid >= lo) & (mid <= hi)
+        # the targeted releases (derived: zone and mass range) times the ASSUMED mean effectiveness
+        return [ReleaseStage(o.name, space.column(f"scaling_effectiveness:{o.name}"),
+                             target=share * inside.astype(float))]
+
+
+class _SlopeGeometry(OptionEffect):
+    """A change of the slope (ditch, bench, bund, drape): a typed retention, or re-simulated with the changed
+    profile or surface (every such component of an option at once; see :func:`option_chain`)."""
+
+    @property
+    def order(self):
+        return TYPED_RETENTION if self.option.retention is not None else GEOMETRY
+
+    def stages(self, site, space, index):
+        if self.option.retention is None:
+            return []               # derived: simulated with the option's other geometry changes
+        return [RetentionStage(self.option.name, space.column(f"retention:{self.option.name}"))]
+
+    def geometry_measure(self):
+        if self.option.retention is not None:
+            return None
+        o = self.option
+        return SlopeMeasure(o.kind, o.name, o.x_m, o.width_m, o.height_m, o.zone_x_m, o.inner_slope_hv,
+                            o.outer_slope_hv, o.material)
+
+
+class CatchDitch(_SlopeGeometry):
+    """``ditch``: a catchment ditch dug into the profile."""
+
+    def describe(self, currency=""):
+        o = self.option
+        if o.retention is not None:
+            return _typed_retention(o, "catchment ditch")
+        return (f"catchment ditch {o.width_m:g} m wide and {o.depth_m:g} m deep from x = {o.x_m:g} m; "
+                "retention derived by simulation")
+
+    def geometry_measure(self):
+        if self.option.retention is not None:
+            return None
+        o = self.option
+        return Ditch(o.x_m, o.width_m, o.depth_m, o.inner_slope_hv or 0.25,
+                     1.0 if o.outer_slope_hv is None else o.outer_slope_hv, o.material, o.name)
+
+
+class Bench(_SlopeGeometry):
+    """``bench``: a catch bench cut into the slope."""
+
+    def describe(self, currency=""):
+        o = self.option
+        if o.retention is not None:
+            return _typed_retention(o, "bench")
+        return f"catch bench {o.width_m:g} m wide cut into the slope from x = {o.x_m:g} m; retention derived by " \
+               "simulation"
+
+
+class Bund(_SlopeGeometry):
+    """``bund``: an embankment on the ground."""
+
+    def describe(self, currency=""):
+        o = self.option
+        if o.retention is not None:
+            return _typed_retention(o, "bund")
+        return (f"bund {o.height_m:g} m high on the ground from x = {o.x_m:g} m over {o.width_m:g} m; "
+                "retention derived by simulation")
+
+
+class Drape(_SlopeGeometry):
+    """``drape``: a secured mesh; the surface of its zone takes an ASSUMED material."""
+
+    def describe(self, currency=""):
+        o = self.option
+        if o.retention is not None:
+            return _typed_retention(o, "drape")
+        return (f"drape (secured mesh) over x = {o.zone_x_m[0]:g}-{o.zone_x_m[1]:g} m: the surface takes "
+                "an ASSUMED low-bounce, high-friction material; retention derived by simulation")
+
+    def assumed_basis(self, n_components):
+        return 0, ("derived by re-simulation of the draped surface, whose material is ASSUMED "
+                   "(riskrf.risk.geometry_measures.DRAPE_MATERIAL)")
+
+
+class _Structure(OptionEffect):
+    """A structure with damage states: out of service ``repair_days`` after a destructive impact."""
+
+    def _own_parameters(self):
+        o = self.option
+        return [(f"repair_days:{o.name}", DEFAULT_REPAIR_DAYS[o.kind] if o.repair_days is None else o.repair_days)]
+
+    def _stage(self, site, space, index, *, shed: bool, coverage: float) -> BarrierStage:
+        o = self.option
+        passing, held_sel, destroy = site.barrier_damage(o, shed=shed)
+        return BarrierStage(o.name, index, passing, held_sel, destroy, coverage=coverage, after_road=shed,
+                            param=space.column(f"retention:{o.name}") if o.retention is not None else None,
+                            repair_cost_per_impact=o.repair_cost_per_impact, replacement_cost=o.replacement_cost)
+
+
+class Barrier(_Structure):
+    """``fence`` / ``attenuator``: a barrier line of capacity ``capacity_kj`` (MEL) and height ``height_m``."""
+
+    order = BARRIER
+    needs_design_check = True
+
+    def describe(self, currency=""):
+        o = self.option
+        return (f"{o.kind} of {o.capacity_kj:,.0f} kJ (MEL), {o.height_m:g} m high"
+                + (f" at x = {o.x_m:g} m" if o.x_m is not None else " at the barrier line")
+                + (f"; ASSUMED to retain {o.retention:.0%} (typed)" if o.retention is not None
+                   else "; passing falls from simulated heights and energies")
+                + f"; out of service {o.repair_days:g} days after an impact above MEL (assumption)")
+
+    def stages(self, site, space, index):
+        return [self._stage(site, space, index, shed=False, coverage=1.0)]
+
+
+class Shed(_Structure):
+    """``shed``: a rock shed over ``covered_length_m`` of the exposed road, capacity ``capacity_kj``."""
+
+    order = SHED
+
+    def describe(self, currency=""):
+        o = self.option
+        return (f"rock shed of {o.capacity_kj:,.0f} kJ over "
+                + (f"{o.covered_length_m:g} m of road" if o.covered_length_m else "the exposed road")
+                + f"; out of service {o.repair_days:g} days after an impact above capacity (assumption)")
+
+    def stages(self, site, space, index):
+        o = self.option
+        coverage = min(o.covered_length_m / site.exposed_length_m, 1.0) if o.covered_length_m else 1.0
+        return [self._stage(site, space, index, shed=True, coverage=coverage)]
+
+
+class Realignment(OptionEffect):
+    """``realignment``: the road moved to ``road_x_m`` on the profile, or away from the slope."""
+
+    order = EXPOSURE
+
+    def describe(self, currency=""):
+        o = self.option
+        return (f"road moved to x = {o.road_x_m:g} m" if o.road_x_m is not None
+                else "road moved away from the slope (no exposure)")
+
+    @property
+    def sole_basis(self):
+        return "geometry: the road leaves the slope" if self.option.road_x_m is None else None
+
+    def stages(self, site, space, index):
+        o = self.option
+        if o.road_x_m is None:
+            return [ExposureStage(o.name, np.zeros(len(site.models)))]
+        ctx = site.need_context(o, "road_x_m")
+        prof = ctx.scenario.profile
+        if not prof.x[0] < o.road_x_m < prof.x[-1]:
+            raise MitigationError(f"{site.source}: option {o.name!r}: road_x_m = {o.road_x_m:g} m is "
+                                  f"outside the profile ({prof.x[0]:g}, {prof.x[-1]:g}) m")
+        factor = []
+        for m in site.models:
+            ref = m.result if m.result is not None else site.reference_run
+            road_x = ref.scenario.collectors[ref.scenario.collector_index(ctx.road_collector)].x
+            now = runout_beyond(ref, road_x).sum()
+            factor.append(min(float(runout_beyond(ref, o.road_x_m).sum() / now), 1.0) if now else 0.0)
+        return [ExposureStage(o.name, np.array(factor))]
+
+
+class Closure(OptionEffect):
+    """``closure``: the road closed under a rainfall or warning rule (or a typed share of falls while closed)."""
+
+    order = CLOSURE
+
+    @property
+    def typed(self):
+        return super().typed or not self.option.has_closure_rule
+
+    def describe(self, currency=""):
+        o = self.option
+        if o.share_while_closed is None:
+            return f"{o.rule_text()}; share and hours not yet computed (needs the site's rate model, [rates])"
+        how = "computed from the rate model" if o.has_closure_rule else "ASSUMED (typed)"
+        cur = f" {currency}" if currency else ""
+        return ((f"{o.closure_rule}: " if o.closure_rule else "")
+                + f"road closed {o.closure_hours_per_year:,.1f} h per year ({how}) at "
+                f"{o.cost_per_closure_hour:,.0f}{cur} per hour "
+                f"({money(o.closure_hours_per_year * o.cost_per_closure_hour, sig=3)}{cur} per year, in the "
+                f"annual maintenance); {o.share_while_closed:.1%} of falls occur while closed "
+                f"({how}); protects road users, falls still reach the road")
+
+    @property
+    def sole_basis(self):
+        return "computed: closure rule on the rate model and rainfall record"
+
+    def check(self, source):
+        o = self.option
+        if o.share_while_closed is None:
+            raise MitigationError(
+                f"{source}: option {o.name!r}: its closure rule ({o.rule_text()}) has not been evaluated: "
+                "the share of falls while closed and the closure hours are computed from a daily rate model "
+                "(a site file's [rates] table, riskrf assess; or riskrf.risk.site_rates.resolve_closures)")
+
+    def _own_parameters(self):
+        return [(f"closure_share:{self.option.name}", self.option.share_while_closed)]
+
+    def stages(self, site, space, index):
+        return [ClosureStage(self.option.name, space.column(f"closure_share:{self.option.name}"))]
+
+
+class Combined(OptionEffect):
+    """``combined``: its components in series; costs and effects are theirs."""
+
+    def describe(self, currency=""):
+        return "combination of " + " + ".join(self.option.options)
+
+    def parameters(self):
+        return []
+
+
+#: The class of each option kind.
+KIND_CLASSES = {"none": DoNothing, "scaling": Scaling, "ditch": CatchDitch, "fence": Barrier, "attenuator": Barrier,
+                "shed": Shed, "realignment": Realignment, "closure": Closure, "combined": Combined, "bench": Bench,
+                "bund": Bund, "drape": Drape}
+assert tuple(KIND_CLASSES) == OPTION_KINDS
+
+
+def effect_of(option) -> OptionEffect:
+    """The behaviour of ``option`` (its kind's class, wrapping it)."""
+    return KIND_CLASSES[option.kind](option)
+
+
+def scaling_effect(option) -> tuple:
+    """:meth:`Scaling.effect` of a scaling option."""
+    return Scaling(option).effect()
+
+
+def effect_basis(option, components) -> str:
+    """How the effect of ``option`` (made of ``components``) is known: typed (an ASSUMPTION), computed, derived,
+    or derived with an ASSUMED part, in words."""
+    effects = [effect_of(c) for c in components]
+    typed = [e.option.name for e in effects if e.typed]
+    if typed:
+        return "ASSUMPTION: typed effectiveness (" + ", ".join(typed) + ")"
+    sole = {e.sole_basis for e in effects}
+    if len(sole) == 1 and None not in sole:
+        return sole.pop()
+    assumed = [b for b in (e.assumed_basis(len(components)) for e in effects) if b is not None]
+    if assumed:
+        return min(assumed, key=lambda b: b[0])[1]
+    return "derived (simulation and site geometry)"
+
+
+def option_chain(option, components, site, space, index_of: dict) -> OptionChain:
+    """The engine's view of ``option``: the stages of its ``components`` in series (releases, typed retentions, the
+    slope geometry changes re-simulated together, barriers, sheds, closures, realignments) and their costs.
+    ``index_of``: option name -> position in the study."""
+    effects = [effect_of(c) for c in components]
+    stages = []
+    for order in range(EXPOSURE + 1):
+        for e in effects:
+            if e.order == order:
+                stages += e.stages(site, space, index_of[e.option.name])
+        if order == GEOMETRY:
+            geo = [e for e in effects if e.order == GEOMETRY]
+            if geo:
+                site.need_context(geo[0].option, "x_m")
+                key = "+".join(e.option.name for e in geo)
+                ret0, _, _, by_mass = site.geometry_retention(key, [e.geometry_measure() for e in geo])
+                # retention by mass bin and slope model, as a shift from the overall reference retention (the
+                # parameter)
+                stages.append(RetentionStage(key, space.column(f"retention:{key}"), shift=by_mass - ret0))
+    return OptionChain(option.name, tuple(stages), tuple((index_of[c.name], c.life_years) for c in components))
