@@ -413,7 +413,7 @@ def test_material_parameters_are_resimulated_jointly_and_at_the_ends_of_their_ra
     s2 = MitigationStudy(hazard=HAZ, options=(opts[0], replace(opts[1], capital_cost=1e5)), consequences=CONSTANT_V,
                          uncertainty=s.uncertainty,
                          context=s.context)
-    s2.__dict__["_models"] = s._models                     # the same slope models, not simulated again
+    s2.__dict__["_slopes"] = s._slopes                     # the same slope models, not simulated again
     row2 = s2.break_even_table().set_index("parameter").loc["material:gravel.ground_friction_angle_deg"]
     assert np.isnan(row2["break_even"]) and not row2["within_stated_range"]
     assert "no tie within [20, 45]" in row2["note"]
@@ -561,9 +561,9 @@ def test_material_variant_with_the_central_materials_reproduces_a_mass_coupled_r
                                                 materials={name: (central, central + 5.0)}),
                         context=SimulationContext(sc, barrier_collector="barrier", road_collector="road",
                                                   n_blocks=1000, seed=3))
-    labels = [m["label"] for m in s._models]
+    labels = [m.label for m in s._models]
     low = labels.index(f"{name} low")
-    assert s._models[low]["values"][name] == central
+    assert s._models[low].values[name] == central
     reach = s._model_arrays[0]
     assert reach[low] == pytest.approx(reach[0], rel=1e-12)
     st = s._barrier_stage(fence)

@@ -200,7 +200,7 @@ class MitigationStudy:
     # ---- option effects (derived once per slope model) ----------------------------------------------
     def _components(self, opt: Option) -> list:
         """The options acting for ``opt``: its components for a combined option, else itself."""
-        return [self.option(n) for n in opt.options] if opt.kind == "combined" else [opt]
+        return effect_of(opt).components(self.option)
 
     @cached_property
     def _space(self) -> ParameterSpace:
@@ -461,7 +461,7 @@ class MitigationStudy:
         """The verdict of an option's design checks (``design_checks``, e.g. a fence's 100-year energy against its
         MEL): "-" when it has none to pass, "not checked" for a barrier without one."""
         comps = self._components(opt)
-        combined = len(opt.options) > 0
+        combined = comps != [opt]
         verdicts = [f"{c.name}: {self.design_checks[c.name]}" if combined else self.design_checks[c.name]
                     for c in comps if c.name in self.design_checks]
         if verdicts:

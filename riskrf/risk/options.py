@@ -105,6 +105,11 @@ class OptionEffect:
     def check(self, source: str) -> None:
         """Raise a MitigationError if the option cannot enter the engine yet."""
 
+    def components(self, option_named) -> list:
+        """The options acting for this one (itself; a combined option's components), ``option_named`` giving the
+        study's option of a name."""
+        return [self.option]
+
     # ---- costs and effect parameters -----------------------------------------------------------------------
     def parameters(self) -> list:
         """(name, central value) of every input of this option the engine varies: capital cost, annual
@@ -439,6 +444,9 @@ class Combined(OptionEffect):
 
     def describe(self, currency=""):
         return "combination of " + " + ".join(self.option.options)
+
+    def components(self, option_named):
+        return [option_named(n) for n in self.option.options]
 
     def parameters(self):
         return []
