@@ -68,8 +68,8 @@ def study_report(study) -> dict:
               "Uncertain inputs sampled jointly: " + "; ".join(f"{k} {lo:.4g}-{hi:.4g} ({how})"
                                                                 for k, (lo, hi, how) in ranges.items())]
     r0 = study._central_result
-    order = np.argsort(r0["total"][0], kind="stable")
-    ca, cb = r0["names"][order[0]], r0["names"][order[1]]
+    order = np.argsort(r0.total[0], kind="stable")
+    ca, cb = r0.names[order[0]], r0.names[order[1]]
     lines += ["", f"Break-even (at central values {ca!r} is cheapest, then {cb!r}; value at which they tie, "
                   "other inputs unchanged):"]
     for r in be.itertuples():
