@@ -456,7 +456,6 @@ class Combined(OptionEffect):
 KIND_CLASSES = {"none": DoNothing, "scaling": Scaling, "ditch": CatchDitch, "fence": Barrier, "attenuator": Barrier,
                 "shed": Shed, "realignment": Realignment, "closure": Closure, "combined": Combined, "bench": Bench,
                 "bund": Bund, "drape": Drape}
-assert tuple(KIND_CLASSES) == OPTION_KINDS
 
 
 def effect_of(option) -> OptionEffect:
