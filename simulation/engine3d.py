@@ -44,18 +44,23 @@ def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> d
 
 
 def _collector_segments(scenario: TerrainScenario):
-    ax, ay, bx, by, cid, s0 = [], [], [], [], [], []
+    """The plan segments of every collector for the kernel; a barrier's segments carry its net height [m] and
+    capacity [kJ] (NaN height: a plain collector; infinite capacity: a net that holds every block below its top)."""
+    ax, ay, bx, by, cid, s0, cap, net = [], [], [], [], [], [], [], []
     for j, c in enumerate(scenario.collectors):
         cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(c.line, axis=0).T))])
         for k in range(len(c.line) - 1):
             ax.append(c.line[k, 0]), ay.append(c.line[k, 1]), bx.append(c.line[k + 1, 0]), by.append(c.line[k + 1, 1])
             cid.append(j), s0.append(cum[k])
+            net.append(np.nan if c.height_m is None else c.height_m)
+            cap.append(np.inf if c.capacity_kj is None else c.capacity_kj)
     f = lambda v: np.asarray(v, dtype=float)  # noqa: E731
-    return dict(c_ax=f(ax), c_ay=f(ay), c_bx=f(bx), c_by=f(by), c_id=np.asarray(cid, dtype=np.int64), c_s0=f(s0))
+    return dict(c_ax=f(ax), c_ay=f(ay), c_bx=f(bx), c_by=f(by), c_id=np.asarray(cid, dtype=np.int64), c_s0=f(s0),
+                c_cap=f(cap), c_net=f(net))
 
 
 _CROSS = (("block", np.int64), ("coll", np.int64), ("s", float), ("t", float), ("x", float), ("y", float),
-          ("vx", float), ("vy", float), ("vz", float), ("w", float), ("h", float))
+          ("vx", float), ("vy", float), ("vz", float), ("w", float), ("h", float), ("out", np.int64))
 _PASS = (("block", np.int32), ("cell", np.int32), ("e", np.float32), ("h", np.float32))   # 16 bytes a passage
 _PATH = (("block", np.int64), ("t", float), ("x", float), ("y", float), ("z", float), ("v", float),
          ("mode", np.int64))
@@ -86,7 +91,7 @@ def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_
             out_x=out["x"], out_y=out["y"], out_z=out["z"], out_reason=out["reason"], out_impacts=out["impacts"],
             out_t=out["t"], out_excess=out["excess"], out_events=out["events"],
             r_block=r["block"], r_coll=r["coll"], r_s=r["s"], r_t=r["t"], r_x=r["x"], r_y=r["y"], r_vx=r["vx"],
-            r_vy=r["vy"], r_vz=r["vz"], r_w=r["w"], r_h=r["h"], r_count=r_count,
+            r_vy=r["vy"], r_vz=r["vz"], r_w=r["w"], r_h=r["h"], r_out=r["out"], r_count=r_count,
             p_block=p["block"], p_cell=p["cell"], p_e=p["e"], p_h=p["h"], p_count=p_count,
             pb=pth["block"], pt=pth["t"], ppx=pth["x"], ppy=pth["y"], ppz=pth["z"], ppv=pth["v"],
             pmode=pth["mode"], pcount=pcount)
@@ -254,6 +259,32 @@ class TerrainResult:
             "reason": pd.Categorical.from_codes(pb["reason"] - 1, reasons), "impacts": pb["impacts"],
             "time_s": pb["t"], "mass_kg": b["mass"]})
 
+    def reach_probability(self, name: str) -> float:
+        """Share of the released blocks that reached the line ``name`` (crossed it or met it, at a barrier)."""
+        j = self.scenario.collector_index(name)
+        return np.unique(self.crossings["block"][self.crossings["coll"] == j]).size / self.n
+
+    def barrier(self, name: str) -> pd.DataFrame:
+        """Blocks meeting the barrier ``name`` (first meeting each): :meth:`collector` rows, with ``outcome``
+        "caught", "through" or "over"; the summary of shares is :meth:`barrier_summary`."""
+        c = self.scenario.collectors[self.scenario.collector_index(name)]
+        if c.height_m is None:
+            raise KeyError(f"{self.scenario.source}: collector {name!r} is not a barrier (it has no height_m)")
+        return self.collector(name, first_only=True)
+
+    def barrier_summary(self, name: str) -> pd.DataFrame:
+        """Per outcome at barrier ``name``: blocks, share of the blocks meeting it, share of the blocks
+        released, and the largest energy [kJ] and centre height [m] among them."""
+        df = self.barrier(name)
+        rows = []
+        for o in ("caught", "through", "over"):
+            s = df[df["outcome"] == o]
+            rows.append({"outcome": o, "blocks": len(s), "share_of_arrivals": len(s) / max(len(df), 1),
+                         "share_of_released": len(s) / self.n,
+                         "max_energy_kj": float(s["energy_kj"].max()) if len(s) else float("nan"),
+                         "max_height_m": float(s["height_m"].max()) if len(s) else float("nan")})
+        return pd.DataFrame(rows).set_index("outcome")
+
     def energy_excess_j(self) -> np.ndarray:
         """Per block, the largest rise [J] of its total energy (kinetic + m g z) from one impact or contact step
         to the next (the energy audit: 0 or rounding-small unless a material allows energy gain)."""
@@ -262,7 +293,9 @@ class TerrainResult:
     def collector(self, name: str, *, first_only: bool = False) -> pd.DataFrame:
         """One row per crossing of the plan collector ``name``: ``block``, ``position_m`` (distance along the
         line), ``x_m``, ``y_m``, ``time_s``, ``velocity_ms``, ``vx_ms``, ``vy_ms``, ``vz_ms``,
-        ``angular_velocity_rads``, ``height_m`` (centre above the ground), ``mass_kg``, ``energy_kj``."""
+        ``angular_velocity_rads``, ``height_m`` (centre above the ground), ``mass_kg``, ``radius_m``,
+        ``inertia_factor``, ``energy_kj`` and ``outcome`` ("crossed" at a plain collector; at a barrier
+        "caught", "through" or "over", :func:`simulation.kernel.barrier_outcome`)."""
         j = self.scenario.collector_index(name)
         c = self.crossings
         sel = c["coll"] == j
@@ -272,8 +305,9 @@ class TerrainResult:
         df = pd.DataFrame({"block": blk, "position_m": c["s"][sel], "x_m": c["x"][sel], "y_m": c["y"][sel],
                            "time_s": c["t"][sel], "velocity_ms": v, "vx_ms": c["vx"][sel], "vy_ms": c["vy"][sel],
                            "vz_ms": c["vz"][sel], "angular_velocity_rads": c["w"][sel], "height_m": c["h"][sel],
-                           "mass_kg": mass,
-                           "energy_kj": kinetic_energy_kj(mass, v, c["w"][sel], radius, k)})
+                           "mass_kg": mass, "radius_m": radius, "inertia_factor": k,
+                           "energy_kj": kinetic_energy_kj(mass, v, c["w"][sel], radius, k),
+                           "outcome": pd.Categorical.from_codes(c["out"][sel], list(kernel3d.OUTCOMES.values()))})
         df = df.sort_values(["block", "time_s"])
         if first_only:
             df = df.drop_duplicates("block", keep="first")

@@ -42,6 +42,14 @@ Physics (shared with the 2-D kernel :mod:`simulation.kernel`)
   momentary rest on a steeper slope restarts down the fall line, and one that comes to rest a second
   time within half a cell of its previous rest is held there (a pit or trough between flanks).
 * A block that reaches the DEM's edge or a nodata hole leaves the simulation there.
+* Collectors and barriers are polylines in plan.  Every crossing of a plan segment is recorded (position
+  along the line, velocity, spin, height of the centre above the ground).  A barrier is a collector with a
+  net height above the ground (and a capacity, infinite when none is given): the outcome of a crossing is
+  decided by the 2-D kernel's :func:`simulation.kernel.barrier_outcome` (over when the block's underside,
+  centre height minus radius, is above the net; else caught within the capacity, or through with the
+  energy above it); a caught block stops at the line ("caught by barrier"), one that goes through continues
+  from the crossing point with the kinetic energy share (E - capacity) / E.  Crossings within one flight or
+  contact step are met in the order of the motion.
 
 Energy audit: each block's total energy E = 1/2 m v^2 + 1/2 I w^2 + m g z is evaluated after every impact
 and contact step; ``out_excess`` returns the largest rise of E from one such event to the next [J] (0 when
@@ -59,12 +67,13 @@ import numpy as np
 from numba import njit
 
 from .contact import EN_WYLLIE, impact_body, roll_on_speed
-from .kernel import _GOLDEN, _normal, _uniform
+from .kernel import (BARRIER_CAUGHT, BARRIER_THROUGH, CROSSED, OUTCOMES, _GOLDEN, _normal, _uniform,  # noqa: F401
+                     barrier_outcome)
 
 
-RUNNING, STOPPED, LEFT_TERRAIN, NODATA, MAX_EVENTS = 0, 1, 2, 3, 4
+RUNNING, STOPPED, LEFT_TERRAIN, NODATA, MAX_EVENTS, CAUGHT = 0, 1, 2, 3, 4, 5
 STOP_REASONS = {STOPPED: "stopped", LEFT_TERRAIN: "left terrain (edge)", NODATA: "left terrain (nodata)",
-                MAX_EVENTS: "event limit reached"}
+                MAX_EVENTS: "event limit reached", CAUGHT: "caught by barrier"}
 MODE_FLIGHT, MODE_CONTACT, MODE_STOP = 0, 1, 2
 
 
@@ -197,9 +206,12 @@ def _flight_passages(zg, x0, y0, dx, dy, xa, ya, za, vx, vy, vz, w, t_end, g, ma
 @njit(cache=True)
 def _collector_hits(c_ax, c_ay, c_bx, c_by, c_id, c_s0, xa, ya, xb, yb, s_hit, j_hit, lam_hit):
     """Collector segments crossed by the plan segment (xa, ya) -> (xb, yb): fills s_hit (fraction along the
-    motion, in (0, 1]), j_hit (segment) and lam_hit (fraction along the collector segment); returns the count."""
+    motion, in (0, 1]), j_hit (segment) and lam_hit (fraction along the collector segment), sorted by s_hit
+    (the order of the motion); returns the count.  A crossing within 1e-9 m of the start is not counted (the
+    block starts on the line it has just crossed, after a barrier let it through)."""
     n = 0
     ex, ey = xb - xa, yb - ya
+    s_min = 1e-9 / max(math.sqrt(ex * ex + ey * ey), 1e-300)
     for k in range(c_ax.shape[0]):
         fx, fy = c_bx[k] - c_ax[k], c_by[k] - c_ay[k]
         den = ex * fy - ey * fx
@@ -208,22 +220,35 @@ def _collector_hits(c_ax, c_ay, c_bx, c_by, c_id, c_s0, xa, ya, xb, yb, s_hit, j
         gx, gy = c_ax[k] - xa, c_ay[k] - ya
         s = (gx * fy - gy * fx) / den
         lam = (gx * ey - gy * ex) / den
-        if 0.0 < s <= 1.0 and 0.0 <= lam <= 1.0:
-            s_hit[n], j_hit[n], lam_hit[n] = s, k, lam
+        if s_min < s <= 1.0 and 0.0 <= lam <= 1.0:
+            # insertion in order of s (a handful of hits at most)
+            q = n
+            while q > 0 and s_hit[q - 1] > s:
+                s_hit[q], j_hit[q], lam_hit[q] = s_hit[q - 1], j_hit[q - 1], lam_hit[q - 1]
+                q -= 1
+            s_hit[q], j_hit[q], lam_hit[q] = s, k, lam
             n += 1
     return n
 
 
 @njit(cache=True)
-def _record_cross(r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_count,
-                  bid, coll, s_along, t, x, y, vx, vy, vz, w, h):
+def _record_cross(r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_out, r_count,
+                  bid, coll, s_along, t, x, y, vx, vy, vz, w, h, mass, inertia, r, cap_kj, net_m):
+    """Record a crossing; at a barrier (``net_m`` not NaN) decide its outcome first with
+    :func:`simulation.kernel.barrier_outcome`.  Returns (outcome, share of kinetic energy kept)."""
+    outcome = CROSSED
+    keep = 1.0
+    if net_m == net_m:
+        e = (0.5 * mass * (vx * vx + vy * vy + vz * vz) + 0.5 * inertia * w * w) / 1000.0
+        outcome, keep = barrier_outcome(e, h, r, cap_kj, net_m)
     i = r_count[0]
     if i < r_block.shape[0]:
         r_block[i], r_coll[i], r_s[i], r_t[i], r_x[i], r_y[i] = bid, coll, s_along, t, x, y
-        r_vx[i], r_vy[i], r_vz[i], r_w[i], r_h[i] = vx, vy, vz, w, h
+        r_vx[i], r_vy[i], r_vz[i], r_w[i], r_h[i], r_out[i] = vx, vy, vz, w, h, outcome
         r_count[0] = i + 1
     else:
         r_count[1] += 1
+    return outcome, keep
 
 
 @njit(cache=True, inline="always")
@@ -344,10 +369,10 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                zg, x0, y0, dx, dy, lip, mat_grid,
                m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
                m_roll, m_mu_ground, m_gain,
-               c_ax, c_ay, c_bx, c_by, c_id, c_s0,
+               c_ax, c_ay, c_bx, c_by, c_id, c_s0, c_cap, c_net,
                g, v_contact, v_stop, max_events, key, n_path_blocks, rec_pass,
                out_x, out_y, out_z, out_reason, out_impacts, out_t, out_excess, out_events,
-               r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_count,
+               r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_out, r_count,
                p_block, p_cell, p_e, p_h, p_count,
                pb, pt, ppx, ppy, ppz, ppv, pmode, pcount):
     """Run every block of a chunk on the DEM surface; fill the output arrays in place.
@@ -355,7 +380,8 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
     Grid: ``zg`` (ny, nx) elevations [m] (NaN holes), centre of cell (0, 0) at (x0, y0), cell size dx, dy [m];
     ``lip`` an upper bound of the surface slope (|grad z|) used to step flights safely; ``mat_grid`` material
     index per cell.  Collectors: plan segments (c_ax, c_ay)-(c_bx, c_by) of collector ``c_id``, starting at
-    distance ``c_s0`` [m] along their polyline.  With ``rec_pass`` every pixel a block crosses is recorded once
+    distance ``c_s0`` [m] along their polyline; a barrier segment has a net height ``c_net`` [m] above the
+    ground and capacity ``c_cap`` [kJ] (``c_net`` NaN: a plain collector).  With ``rec_pass`` every pixel a block crosses is recorded once
     per visit with the block's largest kinetic energy [kJ] and height above ground [m] there (hazard maps).
     Buffers that fill up count the rows that did not fit (``r_count[1]``, ``p_count[1]``): the caller reruns
     the chunk with larger ones (results depend only on the seed and block index).
@@ -418,6 +444,7 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
             if not contact:
                 t_hit, status = _find_impact(zg, x0, y0, dx, dy, lip, x, y, z, vx, vy, vz, g)
                 # collectors and hazard pixels along the flight (its plan path is a straight line)
+                cut = False
                 if n_cseg > 0 and t_hit > 0:
                     n_h = _collector_hits(c_ax, c_ay, c_bx, c_by, c_id, c_s0, x, y, x + vx * t_hit,
                                           y + vy * t_hit, s_hit, j_hit, lam_hit)
@@ -427,10 +454,31 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                         xc, yc = x + vx * tc, y + vy * tc
                         zc = z + vz * tc - 0.5 * g * tc * tc
                         hc = _height(zg, x0, y0, dx, dy, xc, yc, zc)
+                        hc = hc if hc == hc else 0.0
                         seg_len = math.sqrt((c_bx[k] - c_ax[k]) ** 2 + (c_by[k] - c_ay[k]) ** 2)
-                        _record_cross(r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_count,
-                                      bid, c_id[k], c_s0[k] + lam_hit[q] * seg_len, t_abs + tc, xc, yc,
-                                      vx, vy, vz - g * tc, w, hc if hc == hc else 0.0)
+                        outcome, keep = _record_cross(
+                            r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_out, r_count,
+                            bid, c_id[k], c_s0[k] + lam_hit[q] * seg_len, t_abs + tc, xc, yc, vx, vy, vz - g * tc, w,
+                            hc, mass, inertia, r, c_cap[k], c_net[k])
+                        if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
+                            # the barrier cuts the flight at the line
+                            if rec_pass:
+                                _flight_passages(zg, x0, y0, dx, dy, x, y, z, vx, vy, vz, w, tc, g, mass, inertia,
+                                                 acc, p_block, p_cell, p_e, p_h, p_count, bid)
+                            f = math.sqrt(keep)
+                            x, y, z = xc, yc, zc
+                            vx, vy, vz, w = vx * f, vy * f, (vz - g * tc) * f, w * f
+                            t_abs += tc
+                            if outcome == BARRIER_CAUGHT:
+                                z = zc - hc
+                                reason = CAUGHT
+                            if record:
+                                _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, t_abs, x, y, z,
+                                             math.sqrt(vx * vx + vy * vy + vz * vz), MODE_FLIGHT)
+                            cut = True
+                            break
+                if cut:
+                    continue
                 if rec_pass and t_hit > 0:
                     _flight_passages(zg, x0, y0, dx, dy, x, y, z, vx, vy, vz, w, t_hit, g, mass, inertia,
                                      acc, p_block, p_cell, p_e, p_h, p_count, bid)
@@ -572,19 +620,72 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
             nz_avg = 0.5 * (nz0 + 1.0 / nln)
             # work-energy balance over the step (per unit mass, rolling share f = 1/(1+k))
             u2sq = u * u + 2.0 * factor * (g * (z - zn) - mu * g * nz_avg * ds)
-            # collectors crossed on this step (speed interpolated, height 0: in contact)
+            # collectors crossed on this step (height 0: in contact), up to where the block comes to rest
             if n_cseg > 0:
                 n_h = _collector_hits(c_ax, c_ay, c_bx, c_by, c_id, c_s0, x, y, xn, yn, s_hit, j_hit, lam_hit)
+                f_end = 1.0 if u2sq > 0.0 else (u * u / (u * u - u2sq) if u * u - u2sq > 0 else 0.0)
+                cut = False
                 for q in range(n_h):
                     fq = s_hit[q]
+                    if fq > f_end:
+                        break
                     k = j_hit[q]
                     seg_len = math.sqrt((c_bx[k] - c_ax[k]) ** 2 + (c_by[k] - c_ay[k]) ** 2)
-                    uq = math.sqrt(max(u * u + fq * (u2sq - u * u), 0.0))
+                    xq, yq = x + fq * (xn - x), y + fq * (yn - y)
+                    if c_net[k] == c_net[k]:
+                        # a barrier: the speed from the work-energy balance up to the line itself
+                        zq, _, _ = _surface(zg, x0, y0, dx, dy, xq, yq)
+                        dsq = math.sqrt((xq - x) ** 2 + (yq - y) ** 2 + (zq - z) ** 2)
+                        uq = math.sqrt(max(u * u + 2.0 * factor * (g * (z - zq) - mu * g * nz_avg * dsq), 0.0))
+                    else:
+                        zq = z
+                        uq = math.sqrt(max(u * u + fq * (u2sq - u * u), 0.0))
                     ul = max(math.sqrt(vx1 * vx1 + vy1 * vy1 + vz1 * vz1), 1e-300)
-                    _record_cross(r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_count,
-                                  bid, c_id[k], c_s0[k] + lam_hit[q] * seg_len, t_abs + fq * dt,
-                                  x + fq * (xn - x), y + fq * (yn - y), vx1 / ul * uq, vy1 / ul * uq, vz1 / ul * uq,
-                                  uq / r if roll else 0.0, 0.0)
+                    wq = uq / r if roll else 0.0
+                    outcome, keep = _record_cross(
+                        r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_out, r_count,
+                        bid, c_id[k], c_s0[k] + lam_hit[q] * seg_len, t_abs + fq * dt, xq, yq,
+                        vx1 / ul * uq, vy1 / ul * uq, vz1 / ul * uq, wq, 0.0, mass, inertia, r, c_cap[k], c_net[k])
+                    if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
+                        t_abs += fq * dt
+                        x, y, z = xq, yq, zq
+                        have_s = False
+                        if outcome == BARRIER_CAUGHT:
+                            vx, vy, vz, w = 0.0, 0.0, 0.0, 0.0
+                            reason = CAUGHT
+                        else:
+                            # on with the energy share kept, along the tangent plane at the line
+                            u3 = uq * math.sqrt(keep)
+                            _, gxq, gyq = _surface(zg, x0, y0, dx, dy, xq, yq)
+                            nlq = math.sqrt(gxq * gxq + gyq * gyq + 1.0)
+                            nxq, nyq, nzq = -gxq / nlq, -gyq / nlq, 1.0 / nlq
+                            dxv, dyv, dzv = vx1 / ul, vy1 / ul, vz1 / ul
+                            dn = dxv * nxq + dyv * nyq + dzv * nzq
+                            dxv, dyv, dzv = dxv - dn * nxq, dyv - dn * nyq, dzv - dn * nzq
+                            dl = math.sqrt(dxv * dxv + dyv * dyv + dzv * dzv)
+                            if dl > 1e-12:
+                                vx, vy, vz = u3 * dxv / dl, u3 * dyv / dl, u3 * dzv / dl
+                                sx, sy, sz = dxv / dl, dyv / dl, dzv / dl
+                            else:
+                                vx, vy, vz, u3 = 0.0, 0.0, 0.0, 0.0
+                            w = u3 / r if roll else 0.0
+                        if rec_pass:
+                            sp = math.sqrt(vx * vx + vy * vy + vz * vz)
+                            _pass_add(acc, p_block, p_cell, p_e, p_h, p_count, bid,
+                                      _cell_of(x0, y0, dx, dy, nx, ny, x, y),
+                                      (0.5 * mass * sp * sp + 0.5 * inertia * w * w) / 1000.0, 0.0)
+                        e = 0.5 * mass * (vx * vx + vy * vy + vz * vz) + 0.5 * inertia * w * w + mass * g * z
+                        excess = max(excess, e - e_prev)
+                        e_prev = e
+                        if record:
+                            _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, t_abs, x, y, z,
+                                         math.sqrt(vx * vx + vy * vy + vz * vz), MODE_CONTACT)
+                        cut = True
+                        break
+                if cut:
+                    if reason != RUNNING:
+                        break
+                    continue
             if u2sq <= 0.0:
                 # the block comes to rest within the step: where the balance reaches zero, if that point is
                 # not above what the energy allows; else it stays (a momentary rest decides next)

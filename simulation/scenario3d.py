@@ -27,6 +27,12 @@ collectors, read from TOML.
     name = "road"                    # velocity, height above ground, mass)
     line = [[x, y], [x, y], ...]
 
+    [[collectors]]                   # a barrier: a net height_m above the ground along the line; blocks
+    name = "fence"                   # below its top are caught up to capacity_kj (left out: every one,
+    line = [[x, y], [x, y]]          # stated as an assumption) and go through with the excess above it
+    height_m = 4.0
+    capacity_kj = 2000
+
     [settings]                       # gravity_ms2, contact_velocity_ms, stop_velocity_ms, max_events
 
 Every error names the file and the field; sources or collector vertices off the DEM (or on a nodata
@@ -75,10 +81,29 @@ class Sources:
 
 @dataclass(frozen=True)
 class PlanCollector:
-    """A polyline in plan [m, the DEM's CRS]; crossings are recorded with their distance along it."""
+    """A polyline in plan [m, the DEM's CRS]; crossings are recorded with their distance along it.
+
+    With ``height_m`` it is a barrier: a net of that height [m] above the ground along the line, holding
+    blocks whose underside is below its top up to ``capacity_kj`` [kJ] (None: every such block, an infinite
+    capacity, stated in :meth:`description`); see :mod:`simulation.kernel3d`."""
 
     name: str
     line: np.ndarray = field(repr=False)
+    height_m: float | None = None
+    capacity_kj: float | None = None
+
+    @property
+    def is_barrier(self) -> bool:
+        """True when the line is a barrier (it has a net height)."""
+        return self.height_m is not None
+
+    def description(self) -> str:
+        """One line: what the line is (collector, or barrier with its height and capacity)."""
+        if not self.is_barrier:
+            return f"collector {self.name!r} ({self.length_m:.1f} m)"
+        cap = ("capacity not given: ASSUMED to hold every block below the net's top" if self.capacity_kj is None
+               else f"capacity {self.capacity_kj:g} kJ")
+        return f"barrier {self.name!r} ({self.length_m:.1f} m, net {self.height_m:g} m above ground, {cap})"
 
     @property
     def length_m(self) -> float:
@@ -208,13 +233,19 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
         where = f"collectors[{i}]"
         if not isinstance(c, dict):
             raise ScenarioError(f"{source}: {where} must be a table with name and line")
-        _check_keys(c, {"name", "line"}, f"{where}.", source)
+        _check_keys(c, {"name", "line", "height_m", "capacity_kj"}, f"{where}.", source)
         if "name" not in c or "line" not in c:
             raise ScenarioError(f"{source}: {where} needs a name and a line = [[x, y], ...]")
         line = _plan_points(c["line"], f"{where}.line", source, min_points=2)
         if np.any(np.hypot(*np.diff(line, axis=0).T) == 0):
             raise ScenarioError(f"{source}: {where}.line ({c['name']!r}) has two coinciding vertices")
-        collectors.append(PlanCollector(str(c["name"]), line))
+        h = None if c.get("height_m") is None else _number(c["height_m"], f"{where}.height_m", source, lo=0.0,
+                                                           lo_open=True, hi=100.0)
+        cap = None if c.get("capacity_kj") is None else _number(c["capacity_kj"], f"{where}.capacity_kj", source,
+                                                                lo=0.0, lo_open=True)
+        if cap is not None and h is None:
+            raise ScenarioError(f"{source}: {where}.height_m is required for a barrier (capacity_kj given)")
+        collectors.append(PlanCollector(str(c["name"]), line, h, cap))
     cnames = [c.name for c in collectors]
     if len(set(cnames)) != len(cnames):
         raise ScenarioError(f"{source}: collector names must be unique; got {cnames}")
