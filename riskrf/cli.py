@@ -463,6 +463,8 @@ def cmd_assess(args) -> int:
     check_number(args.n, "-n", low=1)
     out = check_out(args, f"{Path(args.site).stem}-assessment")
     site = load_site(args.site)          # every input is checked before anything is computed
+    if site.three_d:
+        return _assess_terrain(site, args, out)
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         # figures of each stage are drawn into the temporary output beside the later stages
         assessment = run_assessment(site, seed=args.seed, n_blocks=args.n, figures_dir=tmp / "figures")
@@ -480,6 +482,28 @@ def cmd_assess(args) -> int:
     if "resolution" in s["recommendation"]:
         print(f"Resolution: {s['recommendation']['resolution']['text']}")
     print(f"Report: {(out / 'report.html').resolve()}")
+    return 0
+
+
+def _assess_terrain(site, args, out) -> int:
+    """``riskrf assess`` for a site on 3-D terrain (:mod:`riskrf.app.assess3d`)."""
+    from .app.assess3d import run_terrain_assessment
+    from .io.outputs import atomic_output_dir
+    with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
+        a = run_terrain_assessment(site, seed=args.seed, n_blocks=args.n)
+        s = a.write(tmp)
+    print(f"\nStage times: {', '.join(f'{k} {v:.1f} s' for k, v in a.timings.items())}.")
+    hz = s["hazard"]
+    print(f"3-D terrain: {hz['line']}; reach {hz['reach_probability']:.3g}, "
+          f"{hz['arrival_rate_per_year']:.3g} falls/yr at the line.")
+    if s["road"] is not None:
+        r = s["road"]
+        print(f"Road {r['road']!r}: {r['falls_per_year']:.3g} falls/yr over {r['length_m']:.0f} m, "
+              f"{r['deaths_per_year']:.3g} deaths/yr; worst metre at {r['worst_metre_start_m']:.0f} m.")
+    for w in a.warnings:
+        print(f"  - {w}")
+    print("Not done on 3-D terrain: " + "; ".join(s["not_done_on_3d_terrain"]) + ".")
+    print(f"Outputs: {out.resolve()}")
     return 0
 
 

@@ -23,7 +23,8 @@ _EXPORTS = {
     **dict.fromkeys(["TerrainProfile", "profile_from_points", "read_stl"], "profile_extraction"),
     # 3-D terrain: DEM rasters, profiles cut from them, 3-D scenarios and the 3-D kernel's runs.
     **dict.fromkeys(["Terrain", "TerrainError", "read_dem", "read_material_raster", "profile_from_grid"], "terrain"),
-    **dict.fromkeys(["TerrainScenario", "load_terrain_scenario", "terrain_scenario_from_dict"], "scenario3d"),
+    **dict.fromkeys(["TerrainScenario", "is_terrain_scenario_file", "load_terrain_scenario",
+                     "terrain_scenario_from_dict"], "scenario3d"),
     **dict.fromkeys(["run_terrain", "TerrainResult"], "engine3d"),
 }
 

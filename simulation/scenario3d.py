@@ -265,6 +265,16 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
                            collectors=tuple(collectors), settings=settings, source=source)
 
 
+def is_terrain_scenario_file(path) -> bool:
+    """True when the scenario TOML file has a ``[terrain]`` table (a 3-D scenario); False for any other file
+    (a 2-D scenario, or a file :func:`simulation.load_scenario` will report on)."""
+    try:
+        with open(path, "rb") as fh:
+            return isinstance(tomllib.load(fh).get("terrain"), dict)
+    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError):
+        return False
+
+
 def load_terrain_scenario(path, crs=None) -> TerrainScenario:
     """Read a 3-D scenario TOML file (a ``[terrain]`` table; see this module's docstring)."""
     path = Path(path)

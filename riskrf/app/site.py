@@ -54,6 +54,9 @@ class Site:
     rates: dict | None = None
     design: dict = field(default_factory=lambda: dict(SITE_FIELDS["design"]))
     report: dict = field(default_factory=lambda: dict(SITE_FIELDS["report"]))
+    #: True when hazard.scenario is a 3-D terrain scenario (a ``[terrain]`` table): ``riskrf assess`` then runs
+    #: :func:`riskrf.app.assess3d.run_terrain_assessment` (hazard, energy and road outputs; no option ranking).
+    three_d: bool = False
 
     def resolve(self, relative) -> Path:
         """A path given in the site file, resolved against the site file's folder."""
@@ -158,13 +161,19 @@ def load_site(path) -> Site:
     rates = check_rates(data.get("rates"), inv, path, error=SiteError)
     if rates is not None:
         used += rates.pop("defaults_used")
+    three_d = False
     if hz["scenario"] is not None:
         import simulation
         if hz["collector"] is None:
             hz["collector"] = "barrier"
             used.append("hazard.collector = 'barrier'")
-        scenario = simulation.load_scenario(path.parent / hz["scenario"])
-        _fs.check_scenario_file(path.parent / hz["scenario"], error=SiteError)
+        three_d = simulation.is_terrain_scenario_file(path.parent / hz["scenario"])
+        if three_d:
+            scenario = simulation.load_terrain_scenario(path.parent / hz["scenario"])
+            _check_terrain_site(data, hz, path)
+        else:
+            scenario = simulation.load_scenario(path.parent / hz["scenario"])
+            _fs.check_scenario_file(path.parent / hz["scenario"], error=SiteError)
         names = [c.name for c in scenario.collectors]
         if hz["collector"] not in names:
             raise SiteError(f"{path}: hazard.collector = {hz['collector']!r}: scenario {hz['scenario']!r} has no "
@@ -181,12 +190,13 @@ def load_site(path) -> Site:
             raise SiteError(f"{path}: hazard.velocities = {hz['velocities']!r}: {exc}") from exc
     mit = {k: data[k] for k in MITIGATION_TABLES if k in data}
     try:
-        mitigation = study_inputs(mit, str(path))
+        mitigation = study_inputs(mit, str(path), require_options=not three_d)
     except MitigationError as exc:
         raise SiteError(str(exc)) from exc
     used += list(mitigation.pop("defaults_used"))
-    check_closure_options(mitigation["options"], rates, path, error=SiteError)
-    if hz["scenario"] is not None:
+    if not three_d:
+        check_closure_options(mitigation["options"], rates, path, error=SiteError)
+    if hz["scenario"] is not None and not three_d:
         _check_option_geometry(mitigation["options"], scenario, hz, path, mitigation["uncertainty"])
     # every declared field against its type and range (shares and probabilities in [0, 1], rates, speeds,
     # lengths and traffic > 0): the checks above keep their own messages, this catches the rest
@@ -194,7 +204,23 @@ def load_site(path) -> Site:
     return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
                 description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
                 mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"], rates=rates,
-                design=tables["design"], report=tables["report"])
+                design=tables["design"], report=tables["report"], three_d=three_d)
+
+
+def _check_terrain_site(data, hz, path):
+    """A site on 3-D terrain: what ``riskrf assess`` does with it (hazard, energy at the barrier line, road per
+    metre) and what it does not do yet, refused before any work rather than ignored."""
+    for table in ("options", "rates", "uncertainty"):
+        if data.get(table):
+            raise SiteError(f"{path}: [{table}] is given, but hazard.scenario {hz['scenario']!r} is a 3-D terrain "
+                            "scenario: on 3-D terrain riskrf assess writes the hazard, energy and road outputs and "
+                            f"does not rank mitigation options yet; remove [{table}] or give a 2-D profile scenario")
+    if hz["mass_coupling"] != "simulated":
+        raise SiteError(f"{path}: hazard.mass_coupling = {hz['mass_coupling']!r}: a 3-D terrain site is assessed "
+                        "with the mass-coupled hazard only ('simulated')")
+    if data.get("inventory", {}).get("rate_basis", "release") != "release":
+        raise SiteError(f"{path}: inventory.rate_basis = 'road' is not supported on 3-D terrain yet (the inventory "
+                        "must count falls released from the slope)")
 
 
 def _check_design(tables, path):

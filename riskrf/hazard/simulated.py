@@ -21,6 +21,25 @@ from .impact_energy import mass_model
 from .mass_coupling import MassCoupledSamples, NoArrivalsError, default_mass_range, stratified_log_uniform
 
 
+def load_any_scenario(scenario):
+    """A 2-D :class:`simulation.Scenario` or a 3-D :class:`simulation.TerrainScenario` as given, or read from a
+    TOML file (a ``[terrain]`` table makes it 3-D, a ``[profile]`` table 2-D)."""
+    if isinstance(scenario, (simulation.Scenario, simulation.TerrainScenario)):
+        return scenario
+    if simulation.is_terrain_scenario_file(scenario):
+        return simulation.load_terrain_scenario(scenario)
+    return simulation.load_scenario(scenario)
+
+
+def run_any(scenario, *, seed, masses_kg, workers: int = 1):
+    """Run a 2-D scenario (:func:`simulation.run`) or a 3-D one (:func:`simulation.run_terrain`, ``workers``
+    threads) with the given block masses [kg]; both results give ``collector(name, first_only=True)`` rows with
+    ``block``, ``velocity_ms``, ``angular_velocity_rads``, ``radius_m``, ``height_m``."""
+    if isinstance(scenario, simulation.TerrainScenario):
+        return simulation.run_terrain(scenario, seed=seed, masses_kg=masses_kg, workers=workers)
+    return simulation.run(scenario, seed=seed, masses_kg=masses_kg)
+
+
 def energy_hazard(mass, scenario, collector: str = "barrier", *, rate_per_year=None, n: int = 20_000, seed=1,
                   mass_range_kg=None, design_masses_kg=(), n_bins: int | None = None, rotational: bool = True,
                   return_periods=DESIGN_RETURN_PERIODS):
@@ -30,8 +49,9 @@ def energy_hazard(mass, scenario, collector: str = "barrier", *, rate_per_year=N
     ----------
     mass : GutenbergRichterFit (usually truncated at m_max), Gumbel/GEV fit or scipy distribution
         Mass model [kg] of the falls at the source.
-    scenario : simulation.Scenario or path to a scenario TOML
-        The slope; its seeder's mass distribution is replaced by the simulated mass range.
+    scenario : simulation.Scenario, simulation.TerrainScenario or path to a scenario TOML
+        The slope, a 2-D profile or 3-D terrain (a ``[terrain]`` table: the 3-D kernel runs and the line is a
+        plan polyline); its seeder's (sources') mass distribution is replaced by the simulated mass range.
     collector : str
         The line (a collector of the scenario).
     rate_per_year : float, optional
@@ -90,8 +110,9 @@ def coupled_samples(result, collector: str, masses_kg, edges_kg, mass_model, *, 
 
 def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_per_year=None, n: int = 20_000,
                            seed=1, mass_range_kg=None, design_masses_kg=(), n_bins: int | None = None,
-                           rotational: bool = True, return_periods=DESIGN_RETURN_PERIODS):
-    """:func:`energy_hazard` that also returns the :class:`simulation.SimulationResult`: (hazard, result)."""
+                           rotational: bool = True, return_periods=DESIGN_RETURN_PERIODS, workers: int = 1):
+    """:func:`energy_hazard` that also returns the run (a :class:`simulation.SimulationResult`, or a
+    :class:`simulation.TerrainResult` on 3-D terrain, run on ``workers`` threads): (hazard, result)."""
     mm = mass_model(mass)
     if rate_per_year is None:
         if not isinstance(mass, GutenbergRichterFit):
@@ -126,11 +147,11 @@ def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_p
         n_bins = int(np.clip(n // 400, 4, 24))
     if isinstance(n_bins, bool) or not isinstance(n_bins, (int, np.integer)) or not 1 <= n_bins <= n // 20:
         raise ValueError(f"n_bins = {n_bins!r} must be a whole number between 1 and n / 20 = {n // 20}")
-    sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
+    sc = load_any_scenario(scenario)
     sc.collector_index(collector)
     rng = np.random.default_rng(np.random.SeedSequence([0 if seed is None else int(seed), 10]))
     masses = stratified_log_uniform(lo, hi, int(n), rng)
-    result = simulation.run(sc, seed=seed, masses_kg=masses)
+    result = run_any(sc, seed=seed, masses_kg=masses, workers=workers)
     edges = np.exp(np.linspace(np.log(lo), np.log(hi), n_bins + 1))
     edges[0], edges[-1] = lo, hi
     samples = coupled_samples(result, collector, masses, edges, mm, rotational=rotational)
@@ -152,4 +173,4 @@ def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_p
     return hz, result
 
 
-__all__ = ["coupled_samples", "energy_hazard", "simulate_energy_hazard"]
+__all__ = ["coupled_samples", "energy_hazard", "load_any_scenario", "run_any", "simulate_energy_hazard"]

@@ -846,9 +846,11 @@ class MitigationStudy:
 
 
 
-def study_inputs(data: dict, source: str) -> dict:
-    """Keyword arguments of :class:`MitigationStudy` from a parsed mitigation (or site) table."""
-    options, exposure, consequences, economics, used, uncertainty, criteria = parse_mitigation(data, source)
+def study_inputs(data: dict, source: str, *, require_options: bool = True) -> dict:
+    """Keyword arguments of :class:`MitigationStudy` from a parsed mitigation (or site) table
+    (``require_options=False``: none needed, :func:`parse_mitigation`)."""
+    options, exposure, consequences, economics, used, uncertainty, criteria = parse_mitigation(
+        data, source, require_options=require_options)
     return {"options": options, "exposure": exposure, "consequences": consequences, "economics": economics,
             "defaults_used": used, "uncertainty": uncertainty, "criteria": criteria}
 

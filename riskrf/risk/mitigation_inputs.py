@@ -573,9 +573,10 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
     return Uncertainty(**vals)
 
 
-def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
+def parse_mitigation(data: dict, source: str = "<dict>", *, require_options: bool = True) -> tuple:
     """Validate a mitigation table: returns (options, exposure, consequences, economics, defaults_used,
-    uncertainty, criteria)."""
+    uncertainty, criteria).  ``require_options=False``: no [[options]] is accepted (a site on 3-D terrain,
+    whose traffic and consequences are used without ranking options)."""
     allowed = {"options", "traffic", "consequences", "economics", "uncertainty", "criteria"}
     for key in data:
         if key not in allowed:
@@ -642,7 +643,7 @@ def parse_mitigation(data: dict, source: str = "<dict>") -> tuple:
         raise MitigationError(f"{source}: {exc}") from None
     uncertainty = _uncertainty(data.get("uncertainty", {}), source, used)
     specs = data.get("options", [])
-    if not isinstance(specs, list) or len(specs) < 2:
+    if not isinstance(specs, list) or (len(specs) < 2 and (require_options or specs)):
         raise MitigationError(f"{source}: [[options]] needs at least two options to compare")
     options = tuple(parse_option(s, i, source) for i, s in enumerate(specs))
     names = [o.name for o in options]

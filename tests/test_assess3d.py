@@ -1,0 +1,123 @@
+"""``riskrf assess`` on a 3-D terrain site: mass-coupled energy hazard at a barrier line, road per metre."""
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+rasterio = pytest.importorskip("rasterio")
+from affine import Affine  # noqa: E402
+
+from riskrf.app.site import SiteError, load_site  # noqa: E402
+from riskrf.cli import main  # noqa: E402
+
+DATA = Path(__file__).resolve().parents[1] / "riskrf" / "data"
+
+
+def _dem(path):
+    """A 38 deg slope down +x to x = 60 m, then a 6 deg runout to x = 160 m; 2 m cells, 100 m wide."""
+    nx, ny, cell = 80, 50, 2.0
+    xs = cell * (np.arange(nx) + 0.5)
+    ys = cell * (np.arange(ny) + 0.5)
+    X, Y = np.meshgrid(xs, ys[::-1])
+    z = 200 - np.where(X < 60, np.tan(np.radians(38)) * X,
+                       np.tan(np.radians(38)) * 60 + np.tan(np.radians(6)) * (X - 60))
+    with rasterio.open(path, "w", driver="GTiff", height=ny, width=nx, count=1, dtype="float32", crs="EPSG:2056",
+                       transform=Affine(cell, 0, 0, 0, -cell, ny * cell), nodata=-9999.0) as dst:
+        dst.write(z.astype("float32"), 1)
+
+
+SCENARIO = """
+name = "plane_3d"
+[terrain]
+dem = "dem.tif"
+material = "talus"
+[materials.talus]
+preset = "talus"
+[sources]
+polygon = [[4, 20], [12, 20], [12, 80], [4, 80]]
+height_m = 1.0
+mass_kg = 1000
+speed_ms = 1.0
+[[collectors]]
+name = "barrier"
+line = [[50, 1.5], [50, 98.5]]
+[[collectors]]
+name = "road"
+line = [[64, 1.5], [64, 98.5]]
+"""
+
+SITE = f"""
+[site]
+name = "3-D plane test"
+[inventory]
+path = "{(DATA / 'lauterbrunnen_tls_2018.csv').as_posix()}"
+m_max_kg = 2.0e6
+rate_scale = 0.05
+[hazard]
+scenario = "slope3d.toml"
+collector = "barrier"
+road_collector = "road"
+n_blocks = 1200
+fences_kj = [2000]
+fence_height_m = 5.0
+bootstrap = 30
+seed = 3
+[traffic]
+vehicles_per_day = 6000
+"""
+
+
+@pytest.fixture(scope="module")
+def site3d(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("site3d")
+    _dem(tmp / "dem.tif")
+    (tmp / "slope3d.toml").write_text(SCENARIO)
+    (tmp / "site.toml").write_text(SITE)
+    return tmp
+
+
+@pytest.fixture(scope="module")
+def assessed3d(site3d):
+    out = site3d / "out"
+    assert main(["assess", str(site3d / "site.toml"), "--out", str(out)]) == 0
+    return out
+
+
+def test_a_terrain_site_is_recognised_and_checked(site3d):
+    site = load_site(site3d / "site.toml")
+    assert site.three_d
+    text = SITE + '\n[[options]]\nname = "fence"\nkind = "fence"\ncost = 1000\ncapacity_kj = 2000\nheight_m = 5\n'
+    (site3d / "bad.toml").write_text(text)
+    with pytest.raises(SiteError, match=r"\[options\] is given, but hazard.scenario 'slope3d.toml' is a 3-D "
+                                        "terrain scenario"):
+        load_site(site3d / "bad.toml")
+    (site3d / "bad2.toml").write_text(SITE.replace('collector = "barrier"', 'collector = "fence"'))
+    with pytest.raises(SiteError, match="no collector named 'fence'"):
+        load_site(site3d / "bad2.toml")
+
+
+def test_assess_on_terrain_writes_hazard_energy_and_road_outputs(assessed3d):
+    out = assessed3d
+    for name in ("summary.json", "design_energies.csv", "fence_checks.csv", "barrier_crossings.csv",
+                 "road_per_metre.csv", "road_per_metre.png", "plan.png", "stops.csv"):
+        assert (out / name).exists(), name
+    s = json.loads((out / "summary.json").read_text())
+    assert s["terrain"] is True and 0 < s["hazard"]["reach_probability"] <= 1
+    bc = pd.read_csv(out / "barrier_crossings.csv")
+    # crossings lie on the barrier line x = 50 m, positions measured from its first vertex (y = 1.5 m)
+    np.testing.assert_allclose(bc["x_m"], 50.0, atol=1e-6)
+    np.testing.assert_allclose(bc["position_m"], bc["y_m"] - 1.5, atol=1e-6)
+    road = pd.read_csv(out / "road_per_metre.csv")
+    assert len(road) == 97 and (road["end_m"] - road["start_m"]).max() <= 1.0 + 1e-9
+    # the per-metre falls add up to the whole-road total, and deaths follow the falls
+    assert (road["falls_per_year_per_m"] * (road["end_m"] - road["start_m"])).sum() == pytest.approx(
+        s["road"]["falls_per_year"], rel=1e-9)
+    assert s["road"]["falls_per_year"] <= s["hazard"]["arrival_rate_per_year"] * (1 + 1e-9)
+    assert s["road"]["deaths_per_year"] > 0
+    # the sources span y 20-80 m on a plane: blocks reach the road there, hardly at its ends
+    mid = road[(road["start_m"] > 25) & (road["end_m"] < 75)]["falls_per_year_per_m"].mean()
+    ends = road[(road["end_m"] < 10) | (road["start_m"] > 87)]["falls_per_year_per_m"].mean()
+    assert mid > 5 * ends
+    assert "ranking of mitigation options" in s["not_done_on_3d_terrain"]
