@@ -7,15 +7,22 @@ collectors, read from TOML.
     [terrain]
     dem = "authume_dem.tif"          # GeoTIFF or ESRI ASCII grid, path relative to this file
     crs = "EPSG:2154"                # only when the DEM has no CRS of its own
-    material = "soil"                # one material everywhere, or:
+    material = "soil"                # one material everywhere (or the default where no polygon lies), or:
     # material_raster = "materials.tif"        # integer codes on the DEM's grid
     # material_codes = { 1 = "soil", 2 = "bedrock" }
+    # material_polygons = "zones.gpkg"         # or polygons (GeoPackage, shapefile), rasterised on the grid
+    # material_field = "zone"                  # the attribute naming each polygon's class
+    # material_values = { scree = "soil", cliff = "bedrock" }   # class -> material (default: same names)
+    # material_layer = "zones"                 # optional
 
     [materials.soil]                 # as in 2-D scenarios (presets, laws, roughness, ground friction)
     preset = "soil"
 
     [sources]                        # release points (chosen uniformly) or a polygon (uniform inside)
-    points = [[x, y], ...]           # or polygon = [[x, y], ...]
+    points = [[x, y], ...]           # or polygon = [[x, y], ...], or line = [[x, y], ...] (uniform along), or
+                                     # file = "sources.gpkg" (points, lines or polygons; layer = "...")
+    # slope_above_deg = 55.0         # or "loye2009": sources in the cells steeper than this (inside the
+    # slope_units = 4                # polygon(s) if given); Loye et al. 2009 threshold (simulation.sources)
     height_m = 1.0                   # above the ground [m]; numbers or distribution tables as in 2-D
     mass_kg = { dist = "lognormal", median = 800, sigma = 0.5 }
     density_kg_m3 = 2650
@@ -57,7 +64,10 @@ DEFAULT_MAX_EVENTS_3D = 200_000
 
 @dataclass(frozen=True)
 class Sources:
-    """Where blocks start: ``points`` (n, 2) chosen uniformly, or inside ``polygon`` (k, 2) uniformly."""
+    """Where blocks start: ``points`` (n, 2) chosen uniformly, or inside ``polygon`` (k, 2) uniformly, or along
+    ``lines`` (a list of (k, 2) polylines, uniformly by length), or in ``cells`` (flat indices of DEM cells in
+    internal order, a cell chosen uniformly and a point uniformly in it: source polygons from a file, or the
+    cells steeper than ``threshold``).  ``basis`` says which, in words, for outputs."""
 
     points: np.ndarray | None = field(repr=False)
     polygon: np.ndarray | None = field(repr=False)
@@ -68,6 +78,10 @@ class Sources:
     vz_ms: Distribution
     angular_velocity_rads: Distribution
     shape: str = "sphere"
+    lines: tuple | None = field(repr=False, default=None)
+    cells: np.ndarray | None = field(repr=False, default=None)
+    threshold: object = None
+    basis: str = ""
 
     def radius(self, mass):
         """Radius [m] of spheres (or cylinders of aspect ratio 1) of the given masses [kg]."""
@@ -164,7 +178,10 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
     names = [m.name for m in materials]
 
     tt = data["terrain"]
-    _check_keys(tt, {"dem", "crs", "material", "material_raster", "material_codes"}, "terrain.", source)
+    _check_keys(tt, {"dem", "crs", "material", "material_raster", "material_codes", "material_polygons",
+                     "material_field", "material_layer", "material_values"}, "terrain.", source)
+    if "material_raster" in tt and "material_polygons" in tt:
+        raise ScenarioError(f"{source}: give terrain.material_raster or terrain.material_polygons, not both")
     base = Path(base_dir) if base_dir is not None else Path(".")
     try:
         if terrain is None:
@@ -186,6 +203,24 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
                     raise ScenarioError(f"{source}: terrain.material_codes key {k!r} is not an integer code") \
                         from None
             grid = read_material_raster(base / str(tt["material_raster"]), terrain, codes, names)
+        elif "material_polygons" in tt:
+            from .sources import read_material_polygons
+            if "material_field" not in tt:
+                raise ScenarioError(f"{source}: terrain.material_polygons needs terrain.material_field (the attribute "
+                                    "naming each polygon's material)")
+            mv = tt.get("material_values")
+            if mv is not None and not isinstance(mv, dict):
+                raise ScenarioError(f"{source}: terrain.material_values must be a table {{ value = \"material\" }}")
+            if "material" in tt and tt["material"] not in names:
+                raise ScenarioError(f"{source}: terrain.material = {tt['material']!r} is not a defined material "
+                                    f"({', '.join(names)})")
+            poly_path = base / str(tt["material_polygons"])
+            if not poly_path.exists():
+                raise ScenarioError(f"{source}: terrain.material_polygons = {tt['material_polygons']!r}: file not "
+                                    f"found ({poly_path})")
+            grid = read_material_polygons(poly_path, terrain, names, field_name=str(tt["material_field"]),
+                                          values=None if mv is None else {str(k): str(v) for k, v in mv.items()},
+                                          default=tt.get("material"), layer=tt.get("material_layer"))
         else:
             mname = tt.get("material", names[0])
             if mname not in names:
@@ -196,19 +231,17 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
         raise ScenarioError(f"{source}: [terrain]: {exc}") from None
 
     sd = data["sources"]
-    _check_keys(sd, {"points", "polygon", "height_m", "mass_kg", "density_kg_m3", "speed_ms", "vz_ms",
-                     "angular_velocity_rads", "shape"}, "sources.", source)
-    if ("points" in sd) == ("polygon" in sd):
-        raise ScenarioError(f"{source}: [sources] needs exactly one of points = [[x, y], ...] or "
-                            "polygon = [[x, y], ...]")
-    points = polygon = None
+    _check_keys(sd, {"points", "polygon", "line", "file", "layer", "slope_above_deg", "slope_units", "height_m",
+                     "mass_kg", "density_kg_m3", "speed_ms", "vz_ms", "angular_velocity_rads", "shape"}, "sources.",
+                source)
+    geometry = [k for k in ("points", "polygon", "line", "file") if k in sd]
+    slope_rule = "slope_above_deg" in sd
+    if len(geometry) > 1 or (not geometry and not slope_rule):
+        raise ScenarioError(f"{source}: [sources] needs exactly one of points = [[x, y], ...], polygon = [[x, y], ...],"
+                            " line = [[x, y], ...] or file = \"sources.gpkg\" (points, lines or polygons), and/or "
+                            f"slope_above_deg = <angle> or \"loye2009\"; got {geometry}")
     try:
-        if "points" in sd:
-            points = terrain.check_points(_plan_points(sd["points"], "sources.points", source),
-                                          f"{source}: sources.points")
-        else:
-            polygon = _plan_points(sd["polygon"], "sources.polygon", source, min_points=3)
-            terrain.check_points(polygon, f"{source}: sources.polygon")
+        places = _source_places(sd, terrain, base, source, slope_rule)
     except TerrainError as exc:
         raise ScenarioError(str(exc)) from None
     if "mass_kg" not in sd:
@@ -217,7 +250,7 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
     if shape not in INERTIA_FACTORS:
         raise ScenarioError(f"{source}: sources.shape = {shape!r} is not one of {sorted(INERTIA_FACTORS)}")
     sources = Sources(
-        points=points, polygon=polygon,
+        **places,
         height_m=Distribution.parse(sd.get("height_m", 1.0), "sources.height_m", source, lo=0.0, hi=1e4),
         mass_kg=Distribution.parse(sd["mass_kg"], "sources.mass_kg", source, lo=0.0, hi=1e9, lo_open=True),
         density_kg_m3=_number(sd.get("density_kg_m3", DEFAULT_DENSITY_KG_M3), "sources.density_kg_m3", source,
@@ -275,6 +308,83 @@ def is_terrain_scenario_file(path) -> bool:
         return False
 
 
+def _source_places(sd, terrain, base, source, slope_rule) -> dict:
+    """Where the [sources] table releases blocks: points, polygon, lines or DEM cells (see :class:`Sources`), each
+    checked on the DEM before any work."""
+    from .sources import SlopeThreshold, loye_threshold, rasterise, read_vector_layer, source_cells
+    out = {"points": None, "polygon": None, "lines": None, "cells": None, "threshold": None, "basis": ""}
+    within = None
+    if "points" in sd:
+        out["points"] = terrain.check_points(_plan_points(sd["points"], "sources.points", source),
+                                             f"{source}: sources.points")
+        out["basis"] = f"{len(out['points'])} release points"
+    elif "polygon" in sd:
+        poly = _plan_points(sd["polygon"], "sources.polygon", source, min_points=3)
+        terrain.check_points(poly, f"{source}: sources.polygon")
+        out["polygon"] = poly
+        out["basis"] = "uniform in the source polygon"
+        if slope_rule:
+            xc, yc = terrain.cell_centres()
+            within = _in_polygon(poly, xc, yc)
+    elif "line" in sd:
+        line = _plan_points(sd["line"], "sources.line", source, min_points=2)
+        terrain.check_points(line, f"{source}: sources.line")
+        out["lines"] = (line,)
+        out["basis"] = "uniform along the source line"
+    elif "file" in sd:
+        path = base / str(sd["file"])
+        if not path.exists():
+            raise ScenarioError(f"{source}: sources.file = {sd['file']!r}: file not found ({path})")
+        vl = read_vector_layer(path, sd.get("layer"), terrain)
+        kind = vl.kind
+        where = f"{source}: sources.file {vl.source}"
+        if kind == "point":
+            pts = []
+            for g in vl.geometries:
+                pts += [g["coordinates"]] if g["type"] == "Point" else list(g["coordinates"])
+            out["points"] = terrain.check_points(np.asarray(pts, dtype=float), where)
+            out["basis"] = f"{len(pts)} release points from {vl.source}"
+        elif kind == "line":
+            lines = []
+            for g in vl.geometries:
+                parts = [g["coordinates"]] if g["type"] == "LineString" else g["coordinates"]
+                for part in parts:
+                    ln = np.asarray(part, dtype=float)
+                    terrain.check_points(ln, where)
+                    lines.append(ln)
+            out["lines"] = tuple(lines)
+            out["basis"] = f"uniform along {len(lines)} source lines from {vl.source}"
+        else:
+            within = rasterise(terrain, [(g, 1) for g in vl.geometries]).astype(bool) & np.isfinite(terrain.z)
+            if not within.any():
+                raise ScenarioError(f"{where}: no DEM cell centre lies inside the source polygons (are they outside "
+                                    f"the DEM {terrain.source}, or smaller than a cell?)")
+            if not slope_rule:
+                out["cells"] = np.flatnonzero(within)
+                out["basis"] = f"uniform in the {int(within.sum())} DEM cells inside the source polygons of {vl.source}"
+    if slope_rule:
+        rule = sd["slope_above_deg"]
+        if rule == "loye2009":
+            units = sd.get("slope_units", 4)
+            th = loye_threshold(terrain, units)
+        elif isinstance(rule, (int, float)) and not isinstance(rule, bool) and 0 < rule < 90:
+            th = SlopeThreshold(float(rule), "given")
+        else:
+            raise ScenarioError(f"{source}: sources.slope_above_deg = {rule!r} must be an angle in (0, 90) deg or "
+                                "\"loye2009\" (the Loye et al. 2009 rule)")
+        if out["points"] is not None or out["lines"] is not None:
+            raise ScenarioError(f"{source}: sources.slope_above_deg selects DEM cells: combine it with a polygon (or "
+                                "polygons in sources.file), not with points or lines")
+        cells = source_cells(terrain, th, within)
+        if cells.size == 0:
+            raise ScenarioError(f"{source}: no DEM cell is steeper than {th.angle_deg:.1f} deg"
+                                + (" inside the source polygon(s)" if within is not None else ""))
+        out.update(cells=cells, threshold=th, polygon=None,
+                   basis=th.label() + (" inside the source polygon(s)" if within is not None else "")
+                   + f"; {cells.size} cells")
+    return out
+
+
 def load_terrain_scenario(path, crs=None) -> TerrainScenario:
     """Read a 3-D scenario TOML file (a ``[terrain]`` table; see this module's docstring)."""
     path = Path(path)
@@ -306,6 +416,28 @@ def sample_sources(sources: Sources, terrain: Terrain, rng: np.random.Generator,
     sampling in its bounding box; points on nodata holes are rejected too)."""
     if sources.points is not None:
         return sources.points[rng.integers(0, len(sources.points), n)]
+    if sources.lines is not None:
+        segs = np.concatenate([np.stack([ln[:-1], ln[1:]], axis=1) for ln in sources.lines])
+        length = np.hypot(*(segs[:, 1] - segs[:, 0]).T)
+        k = np.searchsorted(np.cumsum(length), rng.uniform(0, length.sum(), n), side="right").clip(0, len(segs) - 1)
+        f = rng.uniform(size=n)[:, None]
+        return segs[k, 0] + f * (segs[k, 1] - segs[k, 0])
+    if sources.cells is not None:
+        ny, nx = terrain.shape
+        x0, y0, x1, y1 = terrain.bounds
+        out = np.empty((0, 2))
+        for _ in range(1000):
+            m = max(2 * (n - len(out)), 64)
+            c = sources.cells[rng.integers(0, sources.cells.size, m)]
+            i, j = np.divmod(c, nx)
+            cand = np.column_stack([terrain.x0 + (j + rng.uniform(-0.5, 0.5, m)) * terrain.dx,
+                                    terrain.y0 + (i + rng.uniform(-0.5, 0.5, m)) * terrain.dy])
+            cand[:, 0] = cand[:, 0].clip(x0, x1)     # edge cells: the domain ends at their centres
+            cand[:, 1] = cand[:, 1].clip(y0, y1)
+            out = np.vstack([out, cand[terrain.contains(cand[:, 0], cand[:, 1])]])
+            if len(out) >= n:
+                return out[:n]
+        raise ScenarioError("sources: could not place release points in the source cells (all on nodata?)")
     poly = sources.polygon
     lo, hi = poly.min(axis=0), poly.max(axis=0)
     out = np.empty((0, 2))
