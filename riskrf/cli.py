@@ -662,7 +662,10 @@ def cmd_hazard_map(args) -> int:
     from .io.outputs import check_output
     out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-hazard-map")
     check_output(out, overwrite=args.overwrite, kind="dir")
-    hm = hazard_map(args.scenario, n=args.n, seed=args.seed, crs=args.crs, workers=args.workers)
+    if args.tile_m <= 0:
+        raise ValueError(f"--tile-m {args.tile_m!r} must be a tile size > 0 m")
+    hm = hazard_map(args.scenario, n=args.n, seed=args.seed, crs=args.crs, workers=args.workers,
+                    dask=args.dask or args.scheduler is not None, scheduler=args.scheduler, tile_m=args.tile_m)
     print(f"Scenario {hm.scenario.name} ({hm.scenario.source}): {hm.result.n:,} blocks, seed {args.seed}")
     print(hm.result.summary().to_string(index=False, header=False))
     hm.write(out, overwrite=args.overwrite)
@@ -927,7 +930,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-n", type=int, default=10_000, help="number of blocks to release (default 10,000)")
     p.add_argument("--seed", type=int, default=1, help="random seed; the same seed gives identical results")
     p.add_argument("--crs", default=None, help="the DEM's CRS when its file has none, e.g. EPSG:2154")
-    p.add_argument("--workers", type=int, default=1, help="threads running the kernel (results do not depend on it)")
+    p.add_argument("--workers", type=int, default=1, help="threads running the kernel, or with --dask the local "
+                   "cluster's worker processes (results do not depend on it)")
+    p.add_argument("--dask", action="store_true", help="tile the sources and run the tiles on dask.distributed "
+                   "(a LocalCluster of --workers, or --scheduler / DASK_SCHEDULER_ADDRESS); same rasters")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="a dask scheduler to run the tiles on "
+                   "(implies --dask)")
+    p.add_argument("--tile-m", type=float, default=250.0, help="tile size: squares of release points [m] "
+                   "(default 250; results do not depend on it)")
     p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <scenario>-hazard-map)")
     p.set_defaults(func=cmd_hazard_map)
 

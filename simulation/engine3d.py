@@ -66,8 +66,15 @@ _PATH = (("block", np.int64), ("t", float), ("x", float), ("y", float), ("z", fl
          ("mode", np.int64))
 
 
-def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap, hint=None):
-    m = hi - lo
+def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap, hint=None, ids=None):
+    """Run blocks lo..hi-1 (or, with ``ids``, the blocks of those indices: ``blocks`` then holds only theirs)."""
+    if ids is None:
+        ids = np.arange(lo, hi, dtype=np.int64)
+        sub = {k: v[lo:hi] for k, v in blocks.items()}
+    else:
+        ids = np.asarray(ids, dtype=np.int64)
+        sub = blocks
+    m = ids.size
     out = {k: np.empty(m, dtype=dt) for k, dt in (("x", float), ("y", float), ("z", float), ("reason", np.int64),
                                                    ("impacts", np.int64), ("t", float), ("excess", float),
                                                    ("events", np.int64))}
@@ -75,7 +82,7 @@ def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_
     # pixel passages per block: a guess, then what the chunks run so far needed (a rerun when short)
     per_block = hint.get("passages", 300.0) if hint is not None else 300.0
     cap_p = max(int(per_block * m), 16) if hazard else 1
-    pth_cap = path_cap if lo < n_paths else 1
+    pth_cap = path_cap if m > 0 and ids.min() < n_paths else 1
     while True:
         r = {k: np.empty(cap_r, dtype=dt) for k, dt in _CROSS}
         big = grid[0].size >= 2 ** 31          # pixel indices beyond int32: a DEM of more than 2.1e9 cells
@@ -83,7 +90,7 @@ def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_
         pth = {k: np.empty(pth_cap, dtype=dt) for k, dt in _PATH}
         r_count, p_count, pcount = np.zeros(2, np.int64), np.zeros(2, np.int64), np.zeros(1, np.int64)
         kernel3d.simulate3d(
-            np.arange(lo, hi, dtype=np.int64), *(blocks[k][lo:hi] for k in
+            ids, *(sub[k] for k in
                                                   ("x", "y", "z", "vx", "vy", "vz", "w", "mass", "radius",
                                                    "inertia_factor")),
             *grid, **mats, **cols, g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
@@ -172,6 +179,104 @@ def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, m
     cat = lambda i: {k: np.concatenate([p[i][k] for p in parts]) for k in parts[0][i]}  # noqa: E731
     return TerrainResult(scenario=scenario, n=n, seed=seed, blocks=blocks, per_block=cat(0), crossings=cat(1),
                          passages=cat(2) if hazard else None, paths=cat(3), elapsed_s=elapsed, workers=workers)
+
+
+# ---- tiles: the same run split by source, for a distributed engine ----------------------------------------------
+@dataclass(frozen=True)
+class TerrainRunPlan:
+    """A run of ``n`` blocks prepared once (initial states, kernel inputs) and split into tiles of block indices
+    grouped by where they start (:func:`plan_terrain_run`); each tile runs alone (:meth:`run_tile`, e.g. as a task
+    of a dask.distributed cluster) and :meth:`merge` puts the tiles' outputs together in block order, so the result
+    is the one :func:`run_terrain` gives, whatever the tiles and the order they finish in."""
+
+    scenario: TerrainScenario
+    n: int
+    seed: object
+    blocks: dict = field(repr=False)
+    tiles: tuple = field(repr=False)
+    key: int = 0
+    hazard: bool = True
+    record_paths: int = 20
+
+    def tile_blocks(self, i: int) -> dict:
+        """The initial states of tile ``i``'s blocks (what its task needs), with their indices under ``ids``."""
+        ids = self.tiles[i]
+        return {"ids": ids, **{k: v[ids] for k, v in self.blocks.items()}}
+
+    def run_tile(self, part: dict, chunk_size: int = DEFAULT_CHUNK_3D):
+        """Run one tile (``part`` from :meth:`tile_blocks`); returns its outputs for :meth:`merge`."""
+        return run_tile(self.scenario, part, self.key, hazard=self.hazard, n_paths=min(self.record_paths, self.n),
+                        chunk_size=chunk_size)
+
+    def merge(self, outputs, elapsed_s: float = 0.0, workers: int = 1) -> "TerrainResult":
+        """The :class:`TerrainResult` of the whole run from every tile's output (any order)."""
+        outputs = list(outputs)
+        ids = np.concatenate([o["ids"] for o in outputs]) if outputs else np.empty(0, np.int64)
+        if ids.size != self.n or np.unique(ids).size != self.n:
+            raise ValueError(f"the tiles' outputs cover {np.unique(ids).size} of the {self.n} blocks; every tile must "
+                             "be run once")
+        per_block = {}
+        for k in outputs[0]["per_block"]:
+            vals = np.concatenate([o["per_block"][k] for o in outputs])
+            arr = np.empty(self.n, dtype=vals.dtype)
+            arr[ids] = vals
+            per_block[k] = arr
+
+        def in_block_order(name):
+            cat = {k: np.concatenate([o[name][k] for o in outputs]) for k in outputs[0][name]}
+            order = np.argsort(cat["block"], kind="stable")      # a block's rows stay in the kernel's order
+            return {k: v[order] for k, v in cat.items()}
+        return TerrainResult(scenario=self.scenario, n=self.n, seed=self.seed, blocks=self.blocks,
+                             per_block=per_block, crossings=in_block_order("crossings"),
+                             passages=in_block_order("passages") if self.hazard else None,
+                             paths=in_block_order("paths"), elapsed_s=elapsed_s, workers=workers)
+
+
+def plan_terrain_run(scenario: TerrainScenario, n: int, seed=None, *, tile_m: float = 250.0, max_tile_blocks: int =
+                     50_000, masses_kg=None, hazard: bool = True, record_paths: int = 20) -> TerrainRunPlan:
+    """Seed ``n`` blocks as :func:`run_terrain` does and split them into tiles by source: squares of ``tile_m``
+    metres of the release points (in plan, from the DEM's corner), each cut into pieces of at most
+    ``max_tile_blocks`` blocks.  Tiles hold block indices in increasing order; their order is by square."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
+        raise ValueError(f"n must be a positive whole number of blocks; got {n!r}")
+    if not (np.isfinite(tile_m) and tile_m > 0) or int(max_tile_blocks) < 1:
+        raise ValueError(f"tile_m = {tile_m!r} must be > 0 m and max_tile_blocks = {max_tile_blocks!r} >= 1")
+    n = int(n)
+    blocks = seed_blocks_3d(scenario, n, seed, masses_kg)
+    ter = scenario.terrain
+    ti = np.floor((blocks["x"] - ter.x0) / tile_m).astype(np.int64)
+    tj = np.floor((blocks["y"] - ter.y0) / tile_m).astype(np.int64)
+    square = ti * (int(np.ceil(ter.shape[0] * ter.dy / tile_m)) + 1) + tj
+    order = np.lexsort((np.arange(n), square))
+    tiles = []
+    for sq in np.unique(square):
+        ids = order[square[order] == sq]
+        for lo in range(0, ids.size, int(max_tile_blocks)):
+            tiles.append(np.sort(ids[lo:lo + int(max_tile_blocks)]))
+    key = int(np.random.SeedSequence(seed).generate_state(1, dtype=np.uint64)[0])
+    return TerrainRunPlan(scenario=scenario, n=n, seed=seed, blocks=blocks, tiles=tuple(tiles), key=key,
+                          hazard=hazard, record_paths=int(record_paths))
+
+
+def run_tile(scenario: TerrainScenario, part: dict, key: int, *, hazard: bool = True, n_paths: int = 20,
+             chunk_size: int = DEFAULT_CHUNK_3D) -> dict:
+    """Run the blocks of one tile (``part``: their indices ``ids`` and initial states, from
+    :meth:`TerrainRunPlan.tile_blocks`) with the run's ``key``; the kernel's outputs for the tile."""
+    ter = scenario.terrain
+    grid = (ter.z, ter.x0, ter.y0, ter.dx, ter.dy, _lipschitz(ter.z, ter.dx, ter.dy), scenario.material_grid.index)
+    mats = {k: v for k, v in _material_arrays(scenario).items() if k in _KERNEL3D_MATERIALS}
+    cols = _collector_segments(scenario)
+    st = scenario.settings
+    ids = np.asarray(part["ids"], dtype=np.int64)
+    hint = {}
+    outs = []
+    for lo in range(0, ids.size, int(chunk_size)):
+        sel = slice(lo, lo + int(chunk_size))
+        sub = {k: np.ascontiguousarray(part[k][sel]) for k in part if k != "ids"}
+        outs.append(_run_chunk(0, 0, sub, grid, mats, cols, st, np.uint64(key), n_paths, hazard,
+                               max(n_paths * 4000, 16), hint, ids=ids[sel]))
+    cat = lambda i: {k: np.concatenate([o[i][k] for o in outs]) for k in outs[0][i]}  # noqa: E731
+    return {"ids": ids, "per_block": cat(0), "crossings": cat(1), "passages": cat(2), "paths": cat(3)}
 
 
 @njit(cache=True)

@@ -138,3 +138,32 @@ def test_cli_profile_cuts_a_section_from_the_dem(tmp_path, capsys):
     assert main(["profile", str(tmp_path / "dem.tif"), "--path", "900002,6600040", "900300,6600040",
                  "--out", str(tmp_path / "far.toml")]) == 2
     assert "leaves the DEM" in capsys.readouterr().err
+
+
+def test_tiled_by_source_on_dask_gives_the_same_rasters_for_one_and_two_workers(tmp_path):
+    """Tiles by source on dask.distributed (threads: the kernel releases the GIL) give the rasters of the
+    one-machine run exactly, for 1 and 2 workers and any tile size."""
+    distributed = pytest.importorskip("distributed")
+    import simulation
+    from riskrf.app.hazard_map import run_tiled
+    _dem(tmp_path / "dem.tif")
+    (tmp_path / "slope.toml").write_text(SCENARIO.replace('points = [[900005.0, 6600041.0]]',
+                                                          'polygon = [[900003, 6600005], [900030, 6600005], '
+                                                          '[900030, 6600075], [900003, 6600075]]'))
+    sc = simulation.load_terrain_scenario(tmp_path / "slope.toml")
+    ref = simulation.run_terrain(sc, 300, seed=5, hazard=True, record_paths=10)
+    ga = ref.hazard_grids()
+    for n_workers, tile_m in ((1, 20.0), (2, 12.0)):
+        with distributed.Client(n_workers=n_workers, threads_per_worker=1, processes=False,
+                                dashboard_address=":0") as client:
+            res = run_tiled(sc, 300, seed=5, client=client, tile_m=tile_m, max_tile_blocks=40, record_paths=10)
+        assert res.workers == n_workers
+        for k in ref.per_block:
+            np.testing.assert_array_equal(ref.per_block[k], res.per_block[k])
+        for k in ref.crossings:
+            np.testing.assert_array_equal(ref.crossings[k], res.crossings[k])
+        gb = res.hazard_grids()
+        for k in ga:
+            np.testing.assert_array_equal(ga[k], gb[k])
+        for k in ref.paths:
+            np.testing.assert_array_equal(ref.paths[k], res.paths[k])

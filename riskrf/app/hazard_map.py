@@ -16,6 +16,14 @@ crosses and returns a :class:`HazardMap`; :meth:`HazardMap.write` writes, all or
 
 The percentiles are those of the blocks that reached the pixel (conditional on reaching it); combine them
 with ``reach_probability`` for unconditional figures.
+
+Large source sets: ``hazard_map(..., dask=True)`` (``riskrf hazard-map --dask``) splits the blocks into tiles by
+source (squares of ``tile_m`` metres of release points, :func:`simulation.engine3d.plan_terrain_run`) and runs
+each tile as a task on the same dask.distributed engine as the corridor (:func:`riskrf.app.corridor.connect`: a
+scheduler address, or a LocalCluster).  Every block's initial state and random numbers depend only on the seed
+and its index, and the tiles' outputs are merged in block order, so the rasters are identical to a one-machine
+run and for any number of workers.  The client gathers every pixel passage (16 bytes per pixel a block
+crosses) to compute the exact percentiles: its memory bounds the run, not the workers'.
 """
 from __future__ import annotations
 
@@ -132,7 +140,8 @@ def write_geopackage(result, path) -> Path:
 
 
 def hazard_map(scenario, n: int = 10_000, seed=1, *, crs=None, workers: int = 1, record_paths: int = 50,
-               masses_kg=None, chunk_size: int = 5_000) -> HazardMap:
+               masses_kg=None, chunk_size: int = 5_000, dask: bool = False, client=None, scheduler: str | None = None,
+               tile_m: float = 250.0, max_tile_blocks: int = 50_000, log=None) -> HazardMap:
     """Run a 3-D scenario for hazard rasters.
 
     Parameters
@@ -153,10 +162,66 @@ def hazard_map(scenario, n: int = 10_000, seed=1, *, crs=None, workers: int = 1,
         Block masses [kg] instead of the sources' distribution.
     chunk_size : int
         Blocks per kernel call (the unit of work of a thread; results do not depend on it).
+    dask : bool
+        Run tiles by source on a dask.distributed cluster (see the module docstring): ``client`` (used as is),
+        else ``scheduler`` (an address, or DASK_SCHEDULER_ADDRESS), else a LocalCluster of ``workers`` processes.
+    tile_m, max_tile_blocks : float, int
+        Tile size: squares of release points [m], at most this many blocks a tile.
+    log : callable, optional
+        Receives progress lines (tiles done).
     """
     import simulation
     if isinstance(scenario, (str, Path)):
         scenario = simulation.load_terrain_scenario(scenario, crs=crs)
+    if dask or client is not None or scheduler is not None:
+        result = run_tiled(scenario, n, seed, client=client, scheduler=scheduler, n_workers=workers, tile_m=tile_m,
+                           max_tile_blocks=max_tile_blocks, record_paths=record_paths, masses_kg=masses_kg,
+                           chunk_size=chunk_size, log=log)
+        return HazardMap(result=result, grids=result.hazard_grids())
     result = simulation.run_terrain(scenario, n, seed, workers=workers, hazard=True, record_paths=record_paths,
                                     masses_kg=masses_kg, chunk_size=chunk_size)
     return HazardMap(result=result, grids=result.hazard_grids())
+
+
+def _tile_task(scenario, part, key, n_paths, chunk_size):
+    from simulation.engine3d import run_tile
+    return run_tile(scenario, part, key, hazard=True, n_paths=n_paths, chunk_size=chunk_size)
+
+
+def run_tiled(scenario, n: int, seed=1, *, client=None, scheduler: str | None = None, n_workers: int | None = None,
+              tile_m: float = 250.0, max_tile_blocks: int = 50_000, record_paths: int = 50, masses_kg=None,
+              chunk_size: int = 5_000, log=None):
+    """A 3-D run recording hazard pixels, tiled by source on a dask.distributed client (see the module
+    docstring); the :class:`simulation.TerrainResult` equals :func:`simulation.run_terrain`'s with
+    ``hazard=True``.  ``client`` is used as is; else :func:`riskrf.app.corridor.connect` (``scheduler``, or a
+    LocalCluster of ``n_workers``), closed at the end."""
+    import time
+    import uuid
+
+    from distributed import as_completed
+
+    from simulation.engine3d import plan_terrain_run
+    from .corridor import _shutdown, connect
+    plan = plan_terrain_run(scenario, n, seed, tile_m=tile_m, max_tile_blocks=max_tile_blocks, masses_kg=masses_kg,
+                            hazard=True, record_paths=record_paths)
+    own = client is None
+    cluster = None
+    if own:
+        client, cluster = connect(scheduler, n_workers)
+    t0 = time.perf_counter()
+    try:
+        sc_future = client.scatter(scenario, broadcast=True)
+        run = uuid.uuid4().hex[:8]
+        n_paths = min(plan.record_paths, plan.n)
+        futures = [client.submit(_tile_task, sc_future, plan.tile_blocks(i), plan.key, n_paths, chunk_size,
+                                 key=f"riskrf-tile-{i}-{run}", retries=1) for i in range(len(plan.tiles))]
+        outputs = []
+        for k, fut in enumerate(as_completed(futures), start=1):
+            outputs.append(fut.result())
+            if log is not None:
+                log(f"tile {k}/{len(futures)} done")
+        workers = len(client.scheduler_info().get("workers", {}))
+    finally:
+        if own:
+            _shutdown(client, cluster)
+    return plan.merge(outputs, elapsed_s=time.perf_counter() - t0, workers=workers)
