@@ -140,8 +140,12 @@ def test_energy_audit_on_random_dems(seed):
                                    {"dist": "uniform", "low": 0, "high": 5}, "mass_kg":
                                    {"dist": "lognormal", "median": 1000, "sigma": 1.0, "max": 50000},
                                    "speed_ms": {"dist": "uniform", "low": 0, "high": 4},
-                                   "angular_velocity_rads": {"dist": "uniform", "low": -5, "high": 5}}, material=name)
+                                   "angular_velocity_rads": {"dist": "uniform", "low": -5, "high": 5}}, material=name,
+                        # a barrier that lets most blocks through (the energy above 50 kJ): no gain there either
+                        collectors=[{"name": "net", "line": [[34, 0], [34, 120]], "height_m": 2.0,
+                                     "capacity_kj": 20.0}])
         r = run_terrain(sc, 300, seed=seed)
+        assert (r.collector("net")["outcome"] == "through").sum() >= 10, name
         mass = r.blocks["mass"]
         # No energy gained: the total energy never rises from one impact or contact step to the next by more
         # than m g x 1e-6 m (the takeoff nudge of 1e-9 m above the ground, and rounding).
@@ -165,8 +169,10 @@ def test_results_do_not_depend_on_chunking_or_threads():
     mats = {"talus": {"preset": "talus"}}
     sc = _scenario(dem, mats, {"polygon": [[5, 10], [30, 10], [30, 110], [5, 110]], "height_m": 2.0,
                                "mass_kg": {"dist": "lognormal", "median": 1000, "sigma": 1.0, "max": 50000}},
-                   collectors=[{"name": "c", "line": [[60, 0], [60, 120]]}])
+                   collectors=[{"name": "c", "line": [[60, 0], [60, 120]]},
+                               {"name": "net", "line": [[34, 0], [34, 120]], "height_m": 1.5, "capacity_kj": 100.0}])
     a = run_terrain(sc, 500, seed=9, chunk_size=500, hazard=True)
+    assert set(a.collector("net")["outcome"]) >= {"caught", "through"}
     b = run_terrain(sc, 500, seed=9, chunk_size=37, workers=2, hazard=True)
     for k in a.per_block:
         np.testing.assert_array_equal(a.per_block[k], b.per_block[k])
