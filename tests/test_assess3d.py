@@ -121,3 +121,35 @@ def test_assess_on_terrain_writes_hazard_energy_and_road_outputs(assessed3d):
     ends = road[(road["end_m"] < 10) | (road["start_m"] > 87)]["falls_per_year_per_m"].mean()
     assert mid > 5 * ends
     assert "ranking of mitigation options" in s["not_done_on_3d_terrain"]
+
+
+def test_the_mass_coupled_hazard_on_a_plane_matches_the_2d_section():
+    """On a plane slope (nothing varies across it) the 3-D mass-coupled hazard at a line equals the 2-D one on
+    the section through the release point, within Monte Carlo error and the 3-D kernel's half-cell steps."""
+    from scipy import stats
+
+    import simulation
+    from riskrf.hazard.simulated import simulate_energy_hazard
+    from simulation import Terrain, profile_from_grid, terrain_scenario_from_dict
+    t40, t15 = np.tan(np.radians(40)), np.tan(np.radians(15))
+    dem = Terrain.from_function(lambda x, y: np.where(x < 60, 200 - t40 * x, 200 - t40 * 60 - t15 * (x - 60)),
+                                (0, 200), (0, 100), 1.0)
+    mats = {"soil": {"preset": "soil"}}
+    sc3 = terrain_scenario_from_dict({"terrain": {}, "materials": mats,
+                                      "sources": {"points": [[5.0, 50.0]], "mass_kg": 1000, "speed_ms": 1.0},
+                                      "collectors": [{"name": "line", "line": [[55.0, 0.0], [55.0, 100.0]]}]},
+                                     terrain=dem)
+    prof = profile_from_grid(dem, [(0.0, 50.0), (200.0, 50.0)], spacing=1.0)
+    sc2 = simulation.scenario_from_dict({"profile": prof.to_dict(), "materials": mats,
+                                         "seeder": {"x": 5.0, "height_m": 1.0, "mass_kg": 1000, "vx_ms": 1.0},
+                                         "collectors": [{"name": "line", "x": 55.0}]})
+    law = stats.truncpareto(b=0.7, c=1000.0, scale=10.0)        # 10 kg - 10 t
+    h3, _ = simulate_energy_hazard(law, sc3, "line", rate_per_year=2.0, n=1500, seed=1)
+    h2, _ = simulate_energy_hazard(law, sc2, "line", rate_per_year=2.0, n=1500, seed=2)
+    assert h3.reach_probability == pytest.approx(h2.reach_probability, abs=0.02)
+    for m in (30.0, 300.0, 3000.0):
+        for q in (0.5, 0.95):
+            assert h3.velocity_percentile(q, mass_kg=m) == pytest.approx(h2.velocity_percentile(q, mass_kg=m),
+                                                                          rel=0.03), (m, q)
+    for e in (20.0, 200.0):
+        assert h3.annual_frequency(e) == pytest.approx(h2.annual_frequency(e), rel=0.02), e
