@@ -431,8 +431,12 @@ class TerrainResult:
         rows.append(("mean events per block (impacts and contact steps)", float(self.per_block["events"].mean()), ""))
         rows.append(("largest energy rise between events", float(np.max(self.energy_excess_j())) / J_PER_KJ, "kJ"))
         for c in self.scenario.collectors:
-            k = self.collector(c.name, first_only=True).shape[0]
-            rows.append((f"reach {c.name}", k / self.n, ""))
+            first = self.collector(c.name, first_only=True)
+            rows.append((f"reach {c.name}", first.shape[0] / self.n, ""))
+            if c.is_barrier:
+                for o in ("caught", "through", "over"):
+                    rows.append((f"{o} at barrier {c.name} (share of released)",
+                                 float((first["outcome"] == o).sum()) / self.n, ""))
         return pd.DataFrame(rows, columns=["quantity", "value", "unit"])
 
     def __repr__(self) -> str:
