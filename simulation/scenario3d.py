@@ -7,6 +7,8 @@ collectors, read from TOML.
     [terrain]
     dem = "authume_dem.tif"          # GeoTIFF or ESRI ASCII grid, path relative to this file
     crs = "EPSG:2154"                # only when the DEM has no CRS of its own
+    # nodata = "leave"               # a block reaching a nodata hole leaves there (default), or "error": refuse
+                                     # a DEM whose fall lines from the sources meet a hole, before any work
     material = "soil"                # one material everywhere (or the default where no polygon lies), or:
     # material_raster = "materials.tif"        # integer codes on the DEM's grid
     # material_codes = { 1 = "soil", 2 = "bedrock" }
@@ -179,7 +181,12 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
 
     tt = data["terrain"]
     _check_keys(tt, {"dem", "crs", "material", "material_raster", "material_codes", "material_polygons",
-                     "material_field", "material_layer", "material_values"}, "terrain.", source)
+                     "material_field", "material_layer", "material_values", "nodata"}, "terrain.", source)
+    nodata_rule = tt.get("nodata", "leave")
+    if nodata_rule not in ("leave", "error"):
+        raise ScenarioError(f"{source}: terrain.nodata = {nodata_rule!r} must be \"leave\" (a block reaching a hole "
+                            "leaves the simulation there, counted) or \"error\" (refuse a DEM whose fall lines from "
+                            "the sources meet a hole)")
     if "material_raster" in tt and "material_polygons" in tt:
         raise ScenarioError(f"{source}: give terrain.material_raster or terrain.material_polygons, not both")
     base = Path(base_dir) if base_dir is not None else Path(".")
@@ -244,6 +251,8 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
         places = _source_places(sd, terrain, base, source, slope_rule)
     except TerrainError as exc:
         raise ScenarioError(str(exc)) from None
+    if nodata_rule == "error":
+        _check_fall_lines(terrain, places, source)
     if "mass_kg" not in sd:
         raise ScenarioError(f"{source}: sources.mass_kg is required (a number or a distribution table)")
     shape = sd.get("shape", "sphere")
@@ -306,6 +315,25 @@ def is_terrain_scenario_file(path) -> bool:
             return isinstance(tomllib.load(fh).get("terrain"), dict)
     except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError):
         return False
+
+
+def _check_fall_lines(terrain, places, source):
+    """``[terrain] nodata = "error"``: refuse, before any work, a DEM whose steepest-descent paths from the
+    sources (every point, or 500 points drawn with a fixed seed from a polygon, lines or cells) meet a hole."""
+    from .terrain import fall_line_to_nodata
+    if places["points"] is not None:
+        pts = places["points"]
+    else:
+        tmp = Sources(points=None, polygon=places["polygon"], height_m=None, mass_kg=None, density_kg_m3=0.0,
+                      speed_ms=None, vz_ms=None, angular_velocity_rads=None, lines=places["lines"],
+                      cells=places["cells"])
+        pts = sample_sources(tmp, terrain, np.random.default_rng(0), 500)
+    k, at = fall_line_to_nodata(terrain, pts)
+    if k >= 0:
+        raise ScenarioError(f"{source}: terrain.nodata = \"error\": the fall line from the source point "
+                            f"({pts[k, 0]:.2f}, {pts[k, 1]:.2f}) reaches a nodata hole of the DEM {terrain.source} "
+                            f"next to ({at[0]:.2f}, {at[1]:.2f}); fill the DEM there, or set terrain.nodata = "
+                            "\"leave\" (blocks reaching a hole leave the simulation, counted in the summary)")
 
 
 def _source_places(sd, terrain, base, source, slope_rule) -> dict:

@@ -216,6 +216,49 @@ class Terrain:
         return p
 
 
+def fall_line_to_nodata(terrain: Terrain, xy, max_steps: int | None = None):
+    """Follow the steepest descent on the DEM's cells (D8: to the lowest of the 8 neighbours) from each plan
+    point until a pit, the DEM's edge or a cell next to a nodata hole (where the bilinear surface ends).
+
+    Returns (index of the first point whose fall line meets a hole, or -1; the plan point [m] of the cell where
+    it does, or None).  A pre-flight check: bouncing blocks may leave the fall line, so it finds the holes
+    that the terrain leads blocks to, not every hole a block could reach."""
+    z = terrain.z
+    ny, nx = z.shape
+    hole = np.isnan(z)
+    if not hole.any():
+        return -1, None
+    near = hole.copy()                       # cells touching a hole (8-neighbourhood)
+    pad = np.pad(hole, 1, constant_values=False)
+    for di in (-1, 0, 1):
+        for dj in (-1, 0, 1):
+            near |= pad[1 + di:1 + di + ny, 1 + dj:1 + dj + nx]
+    zf = np.where(hole, np.inf, z)
+    zp = np.pad(zf, 1, constant_values=np.inf)
+    p = np.atleast_2d(np.asarray(xy, dtype=float))
+    i = np.clip(np.rint((p[:, 1] - terrain.y0) / terrain.dy).astype(np.int64), 0, ny - 1)
+    j = np.clip(np.rint((p[:, 0] - terrain.x0) / terrain.dx).astype(np.int64), 0, nx - 1)
+    alive = np.ones(len(p), dtype=bool)
+    offs = [(di, dj) for di in (-1, 0, 1) for dj in (-1, 0, 1) if di or dj]
+    dist = np.array([np.hypot(di * terrain.dy, dj * terrain.dx) for di, dj in offs])
+    for _ in range(max_steps or 4 * (nx + ny)):
+        hit = alive & near[i, j]
+        if hit.any():
+            k = int(np.argmax(hit))
+            return k, (float(terrain.x0 + j[k] * terrain.dx), float(terrain.y0 + i[k] * terrain.dy))
+        drops = np.stack([(zf[i, j] - zp[1 + i + di, 1 + j + dj]) / d for (di, dj), d in zip(offs, dist)])
+        best = np.argmax(drops, axis=0)
+        down = drops[best, np.arange(len(p))] > 0
+        edge = (i == 0) | (j == 0) | (i == ny - 1) | (j == nx - 1)
+        alive &= down & ~edge
+        if not alive.any():
+            break
+        step = np.array(offs)[best]
+        i = np.where(alive, i + step[:, 0], i)
+        j = np.where(alive, j + step[:, 1], j)
+    return -1, None
+
+
 def _crs_from(value, where: str):
     from rasterio.crs import CRS
     from rasterio.errors import CRSError

@@ -210,6 +210,15 @@ def test_nodata_holes_and_sources_outside_are_handled():
         _scenario(holed, mats, {"points": [[250.0, 50.0]], "mass_kg": 1000})
     with pytest.raises(ScenarioError, match="is on a nodata hole of the DEM holed.tif"):
         _scenario(holed, mats, {"points": [[105.0, 50.0]], "mass_kg": 1000})
+    # stated handling by default; refused before any work with terrain.nodata = "error" (the fall line from
+    # the source runs down +x into the hole at x 100-109 m)
+    with pytest.raises(ScenarioError, match=r"the fall line from the source point \(5.00, 50.00\) reaches a nodata "
+                                            r"hole of the DEM holed.tif next to \(99.00, 50.00\)"):
+        terrain_scenario_from_dict({"terrain": {"nodata": "error"}, "materials": mats,
+                                    "sources": {"points": [[5.0, 50.0]], "mass_kg": 1000}}, terrain=holed)
+    ok = terrain_scenario_from_dict({"terrain": {"nodata": "error"}, "materials": mats,
+                                     "sources": {"points": [[5.0, 20.0]], "mass_kg": 1000}}, terrain=holed)
+    assert ok.sources.points.shape == (1, 2)      # a fall line beside the hole is accepted
     r = run_terrain(_scenario(holed, mats, {"points": [[5.0, 50.0]], "mass_kg": 1000, "height_m": 1.0}), 200, seed=1)
     st = r.stops()
     holes = st["reason"] == "left terrain (nodata)"
