@@ -381,8 +381,9 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
     ``lip`` an upper bound of the surface slope (|grad z|) used to step flights safely; ``mat_grid`` material
     index per cell.  Collectors: plan segments (c_ax, c_ay)-(c_bx, c_by) of collector ``c_id``, starting at
     distance ``c_s0`` [m] along their polyline; a barrier segment has a net height ``c_net`` [m] above the
-    ground and capacity ``c_cap`` [kJ] (``c_net`` NaN: a plain collector).  With ``rec_pass`` every pixel a block crosses is recorded once
-    per visit with the block's largest kinetic energy [kJ] and height above ground [m] there (hazard maps).
+    ground and capacity ``c_cap`` [kJ] (``c_net`` NaN: a plain collector).  With ``rec_pass`` every pixel a
+    block crosses is recorded once per visit with the block's largest kinetic energy [kJ] and height above ground
+    [m] there (hazard maps).
     Buffers that fill up count the rows that did not fit (``r_count[1]``, ``p_count[1]``): the caller reruns
     the chunk with larger ones (results depend only on the seed and block index).
     """
