@@ -149,7 +149,9 @@ def test_tiled_by_source_on_dask_gives_the_same_rasters_for_one_and_two_workers(
     _dem(tmp_path / "dem.tif")
     (tmp_path / "slope.toml").write_text(SCENARIO.replace('points = [[900005.0, 6600041.0]]',
                                                           'polygon = [[900003, 6600005], [900030, 6600005], '
-                                                          '[900030, 6600075], [900003, 6600075]]'))
+                                                          '[900030, 6600075], [900003, 6600075]]')
+                                         + '[[collectors]]\nname = "net"\nline = [[900012, 6600001], '
+                                           '[900012, 6600079]]\nheight_m = 2.0\ncapacity_kj = 100\n')
     sc = simulation.load_terrain_scenario(tmp_path / "slope.toml")
     ref = simulation.run_terrain(sc, 300, seed=5, hazard=True, record_paths=10)
     ga = ref.hazard_grids()
@@ -167,3 +169,9 @@ def test_tiled_by_source_on_dask_gives_the_same_rasters_for_one_and_two_workers(
             np.testing.assert_array_equal(ga[k], gb[k])
         for k in ref.paths:
             np.testing.assert_array_equal(ref.paths[k], res.paths[k])
+    from riskrf.app.hazard_map import HazardMap
+    out = HazardMap(result=res, grids=gb).write(tmp_path / "maps")
+    import pandas as pd
+    bars = pd.read_csv(out / "barriers.csv")
+    assert list(bars["outcome"]) == ["caught", "through", "over"] and set(bars["barrier"]) == {"net"}
+    assert bars["blocks"].sum() == res.barrier("net").shape[0] > 0

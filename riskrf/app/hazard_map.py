@@ -12,7 +12,8 @@ crosses and returns a :class:`HazardMap`; :meth:`HazardMap.write` writes, all or
 * ``hazard_map.gpkg`` (GeoPackage, written with pyogrio) with layers ``stop_points`` (every block's final
   point, reason, mass, runout) and ``trajectories`` (the recorded sample of paths as 3-D lines);
 * ``hillshade.png``: the reach probability over a hillshade of the DEM with the stop points and paths;
-* ``summary.csv`` and ``crossings.csv`` (one row per crossing of each plan collector).
+* ``summary.csv`` and ``crossings.csv`` (one row per crossing of each plan collector, with its outcome at a
+  barrier); ``barriers.csv`` (per barrier: blocks caught, through and over, shares, largest energy and height).
 
 The percentiles are those of the blocks that reached the pixel (conditional on reaching it); combine them
 with ``reach_probability`` for unconditional figures.
@@ -94,6 +95,10 @@ class HazardMap:
             tables = [self.result.collector(c.name).assign(collector=c.name) for c in self.scenario.collectors]
             if tables:
                 pd.concat(tables, ignore_index=True).to_csv(tmp / "crossings.csv", index=False)
+            barriers = [self.result.barrier_summary(c.name).assign(barrier=c.name, line=c.description())
+                        for c in self.scenario.collectors if c.is_barrier]
+            if barriers:
+                pd.concat(barriers).reset_index().to_csv(tmp / "barriers.csv", index=False)
             import matplotlib.pyplot as plt
             ax = self.plot()
             ax.figure.savefig(tmp / "hillshade.png", dpi=130, bbox_inches="tight")
