@@ -285,6 +285,7 @@ class ReleaseStage:
     moves_road = False
 
     def apply(self, flow: _Flow, P: Parameters, d) -> None:
+        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place)."""
         if self.target is not None:
             m = 1.0 - np.clip(P.effect[:, self.param], 0.0, 1.0)[:, None] * self.target[None, :]
         else:
@@ -313,6 +314,7 @@ class RetentionStage:
     moves_road = False
 
     def apply(self, flow: _Flow, P: Parameters, d) -> None:
+        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place)."""
         ret = P.effect[:, self.param][:, None] + (self.shift[d] if self.shift is not None else 0.0)
         flow.x = flow.x * (1.0 - np.clip(ret, 0.0, 1.0))
 
@@ -340,6 +342,7 @@ class BarrierStage:
     moves_road = False
 
     def apply(self, flow: _Flow, P: Parameters, d) -> None:
+        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place)."""
         reach = flow.x * self.coverage
         lam_d = (reach * self.destroy[d]).sum(axis=1)
         down = out_of_service_share(lam_d, P.repair_days[:, self.component])
@@ -367,6 +370,7 @@ class ClosureStage:
     moves_road = False
 
     def apply(self, flow: _Flow, P: Parameters, d) -> None:
+        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place)."""
         flow.users = flow.users * (1.0 - P.effect[:, self.param])
 
 
@@ -382,6 +386,7 @@ class ExposureStage:
     moves_road = True
 
     def apply(self, flow: _Flow, P: Parameters, d) -> None:
+        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place)."""
         flow.x = flow.x * self.factor[d][:, None]
 
 

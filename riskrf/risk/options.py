@@ -93,9 +93,9 @@ class OptionEffect:
         """What the option does, in words (money in ``currency``)."""
         raise NotImplementedError
 
-    #: the effect basis when every component of an option is of this kind (else None)
     @property
     def sole_basis(self) -> str | None:
+        """The effect basis when every component of an option is of this kind (else None)."""
         return None
 
     def assumed_basis(self, n_components: int) -> tuple | None:
