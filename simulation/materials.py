@@ -171,7 +171,9 @@ def preset(name: str, basis: str = "published") -> dict:
         Preset name or alias.
     basis : {"published", "data"}
         ``"published"`` (default): the values of :data:`PRESETS` (published ranges, the table above).
-        ``"data"``: the same table with every field fitted to real data (:func:`preset_prior`) replaced by its
+        ``"data"``: the table the data-derived priors were fitted with -- the preset's table with the contact laws
+        of ``simulation.preset_priors.LAWS`` put over it (Coulomb-bounded e_T, hop heights, the size term of the
+        rolling resistance) -- and every field fitted to real data (:func:`preset_prior`) replaced by its
         posterior median; fields no data set constrains keep their published values.
 
     Returns
@@ -186,6 +188,9 @@ def preset(name: str, basis: str = "published") -> dict:
         raise PresetError(f"<preset()>: basis = {basis!r} must be 'published' or 'data'")
     out = copy.deepcopy(PRESETS[key])
     if basis == "data":
+        from . import preset_priors
+        for field, value in getattr(preset_priors, "LAWS", {}).get(key, {}).items():
+            out[field] = copy.deepcopy(value)
         for field, stat in _data_priors().get(key, {}).items():
             holder = out
             parts = field.split(".")

@@ -53,11 +53,30 @@ OBSERVED = REPO / "tests" / "data" / "authume" / "observed_runout.csv"
 ZONE_PRESET = {"vegetated_slope": "soil", "hard_ground": "bedrock", "rocky_slope": "talus"}
 SETTINGS = {"max_rolling_slope_deg": 55.0}
 
+#: The contact model the data-derived presets use (``--model contact``, the default): the laws of
+#: simulation/contact.py that make the contact velocity a numerical setting -- Wyllie's e_T bounded by Coulomb
+#: friction (mu = tan 35 deg on natural ground, tan 30 deg on rock: the presets' friction angles), hop heights
+#: equal to the preset's roughness, and the size term of the rolling resistance (K = 1: tan(phi_g) + roughness / r)
+#: -- put over each preset's own table.  ``--model presets`` uses the presets' own laws unchanged.
+CONTACT_LAWS = {
+    "soil": {"tangential": {"law": "coulomb", "mean": 0.55, "std": 0.12, "friction_angle_deg": 35.0, "std_deg": 3.0},
+             "contact_hop_height_m": 0.1, "rolling_size_coefficient": 1.0},
+    "bedrock": {"tangential": {"law": "coulomb", "mean": 0.55, "std": 0.12, "friction_angle_deg": 30.0,
+                               "std_deg": 3.0},
+                "contact_hop_height_m": 0.1, "rolling_size_coefficient": 1.0},
+    "talus": {"tangential": {"law": "coulomb", "mean": 0.55, "std": 0.12, "friction_angle_deg": 35.0,
+                             "std_deg": 3.0},
+              "contact_hop_height_m": 0.3, "rolling_size_coefficient": 1.0},
+}
+MODEL = {"laws": CONTACT_LAWS}
+
 #: The fitted preset fields and their uniform priors (wide: the published ranges sit inside them).
 PARAMETERS = {"materials.soil.ground_friction_angle_deg": (3.0, 45.0),
               "materials.soil.tangential.mean": (0.2, 1.0),
               "materials.bedrock.ground_friction_angle_deg": (3.0, 65.0),
               "materials.talus.ground_friction_angle_deg": (10.0, 50.0)}
+#: With the contact model the bedrock's e_T is fitted as well (with the presets' own law it is Stronge's).
+CONTACT_PARAMETERS = {**PARAMETERS, "materials.bedrock.tangential.mean": (0.2, 1.0)}
 
 #: Evans & Hungr (1993), Can. Geotech. J. 30:620-636, abstract: "An empirical minimum shadow angle of 27.5 deg
 #: ... is suggested"; "rockfall fragments impacted on homes at equivalent shadow angles of 30 deg or more".
@@ -72,7 +91,7 @@ def authume_scenario(profile: str) -> dict:
     data = copy.deepcopy(data)
     mats = data["profile"].get("materials")
     data["profile"]["materials"] = [ZONE_PRESET[m] for m in mats]
-    data["materials"] = {ZONE_PRESET[k]: {"preset": ZONE_PRESET[k]} for k in data["materials"]}
+    data["materials"] = {ZONE_PRESET[k]: _material(ZONE_PRESET[k]) for k in data["materials"]}
     data["name"] = f"authume_{profile.lower()}_presets"
     data.setdefault("settings", {}).update(SETTINGS)
     return data
@@ -83,7 +102,7 @@ def evans_hungr_scenario() -> dict:
     return {"name": "evans_hungr_talus_presets",
             "profile": {"x": [0.0, 10.0, EH_APEX[0], 128.072, 450.0], "z": [140.0, 140.0, EH_APEX[1], 0.0, 0.0],
                         "materials": ["bedrock", "bedrock", "talus", "soil"]},
-            "materials": {"bedrock": {"preset": "bedrock"}, "talus": {"preset": "talus"}, "soil": {"preset": "soil"}},
+            "materials": {k: _material(k) for k in ("bedrock", "talus", "soil")},
             "seeder": {"type": "line", "x": [10.2, 12.0], "height_m": 0.0,
                        "downslope_speed_ms": {"dist": "uniform", "low": 0.5, "high": 3.0},
                        "mass_kg": {"dist": "lognormal", "median": 2000, "sigma": 1.0, "max": 100000},
@@ -94,20 +113,26 @@ def evans_hungr_scenario() -> dict:
 _SCEN = {}
 
 
+def _material(name: str) -> dict:
+    return {"preset": name, **copy.deepcopy(MODEL["laws"].get(name, {}))}
+
+
 def releases(profile: str, rows=None) -> list:
     """Every observed block of ``profile`` (P1 or P2) as a release with its measured mass."""
-    if profile not in _SCEN:
-        _SCEN[profile] = authume_scenario(profile)
+    key = (profile, bool(MODEL["laws"]))
+    if key not in _SCEN:
+        _SCEN[key] = authume_scenario(profile)
     obs = pd.read_csv(OBSERVED) if rows is None else rows
-    return [Release(name=f"{r.profile}-{r.block}", scenario=_SCEN[profile], x_stop_m=[r.x_stop_m],
+    return [Release(name=f"{r.profile}-{r.block}", scenario=_SCEN[key], x_stop_m=[r.x_stop_m],
                     mass_kg=r.mass_kg, source=str(OBSERVED.relative_to(REPO)))
             for r in obs.itertuples() if r.profile == profile]
 
 
 def evans_hungr() -> ReachConstraint:
-    if "EH" not in _SCEN:
-        _SCEN["EH"] = evans_hungr_scenario()
-    return ReachConstraint(name="evans_hungr_1993", scenario=_SCEN["EH"], apex_x_m=EH_APEX[0],
+    key = ("EH", bool(MODEL["laws"]))
+    if key not in _SCEN:
+        _SCEN[key] = evans_hungr_scenario()
+    return ReachConstraint(name="evans_hungr_1993", scenario=_SCEN[key], apex_x_m=EH_APEX[0],
                            apex_z_m=EH_APEX[1], shadow_angle_deg=EH_SHADOW_ANGLE_DEG, sd_deg=EH_SD_DEG,
                            quantile=0.99, n_blocks=200, source="tests/data/evans_hungr1993/README.md")
 
@@ -122,7 +147,7 @@ def fit(datasets, n_per_release=50, seed=1, n_predictive=20):
             con.append(evans_hungr())
         else:
             rel.extend(releases(d.split("_")[1].upper()))
-    params = {k: v for k, v in PARAMETERS.items()
+    params = {k: v for k, v in _parameters().items()
               if any(k.split(".")[1] in r.scenario["materials"] for r in rel)
               or any(k.split(".")[1] in c.scenario["materials"] for c in con)}
     with warnings.catch_warnings():
@@ -132,13 +157,20 @@ def fit(datasets, n_per_release=50, seed=1, n_predictive=20):
                                 constraints=con)
 
 
+def _parameters() -> dict:
+    return CONTACT_PARAMETERS if MODEL["laws"] else PARAMETERS
+
+
 def write_priors(cal, path: Path, datasets, args):
     summ = cal.summary()
     sample = cal.posterior.sample(200, random_state=1).reset_index(drop=True)
     lines = ['"""Data-derived priors of the substrate presets -- GENERATED by',
-             f'simulation/scenarios/presets/derive_presets.py fit --n-per-release {args.n_per_release} --seed {args.seed}',
+             f'simulation/scenarios/presets/derive_presets.py fit --n-per-release {args.n_per_release} --seed {args.seed} '
+             f'--model {args.model}',
              f'(data sets: {", ".join(datasets)}; do not edit by hand)."""', "",
              f"DATASETS = {tuple(datasets)!r}",
+             "#: preset -> the contact laws put over the preset's table before the fitted fields (see derive_presets.py).",
+             f"LAWS = {MODEL['laws']!r}",
              f"NOTES = {tuple(cal.notes)!r}",
              "#: field -> posterior summary (mean, sd, median, q05, q95) and the uniform prior's bounds.",
              "SUMMARY = {"]
@@ -156,8 +188,8 @@ def write_priors(cal, path: Path, datasets, args):
 
 
 def predict_release_stops(rels, draws, n_each, seed0):
-    pool = _Pool(rels, {k: PARAMETERS[k] for k in PARAMETERS
-                        if k.split(".")[1] in rels[0].scenario["materials"]})
+    P = _parameters()
+    pool = _Pool(rels, {k: P[k] for k in P if k.split(".")[1] in rels[0].scenario["materials"]})
     per = [[] for _ in rels]
     for t, values in enumerate(draws):
         vals = {k: v for k, v in values.items() if k in pool.bounds}
@@ -198,7 +230,11 @@ def main():
     ap.add_argument("--n-per-release", type=int, default=50)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--draws", type=int, default=40)
+    ap.add_argument("--model", choices=["contact", "presets"], default="contact")
+    ap.add_argument("--out", default="presets_loo", help="name of the LOO table and figure (docs/validation)")
     args = ap.parse_args()
+    if args.model == "presets":
+        MODEL["laws"] = {}
     t0 = time.time()
     if args.mode == "fit":
         cal = fit(DATASETS, args.n_per_release, args.seed)
@@ -217,9 +253,13 @@ def main():
         draws = cal.posterior.sample(args.draws, random_state=args.seed).to_dict("records")
         label = "fitted on " + " + ".join(train)
         if held == "evans_hungr_1993":
-            c = evans_hungr()
-            cp = _ConstraintPool([c], PARAMETERS)
             for model, ds in ((label, draws), ("published presets", [{}])):
+                laws = MODEL["laws"]
+                if ds is not draws:
+                    MODEL["laws"] = {}
+                c = evans_hungr()
+                cp = _ConstraintPool([c], _parameters())
+                MODEL["laws"] = laws
                 angs = []
                 for t, v in enumerate(ds):
                     for rep in range(1 if ds is draws else args.draws):
@@ -228,15 +268,19 @@ def main():
                 rows.append(r)
                 curves[(held, model)] = a
         else:
-            rels = releases(held.split("_")[1].upper())
             for model, ds, n_each in ((label, draws, 10), ("published presets", [{}], 400)):
+                laws = MODEL["laws"]
+                if ds is not draws:
+                    MODEL["laws"] = {}
+                rels = releases(held.split("_")[1].upper())
+                MODEL["laws"] = laws
                 r, cv = release_row(held, model, predict_release_stops(rels, ds, n_each, 50_000), rels)
                 rows.append(r)
                 curves[(held, model)] = cv
         print(pd.DataFrame(rows).round(3).to_string())
     table = pd.DataFrame(rows)
     out = REPO / "docs" / "validation"
-    table.to_csv(out / "presets_loo.csv", index=False, float_format="%.4g")
+    table.to_csv(out / f"{args.out}.csv", index=False, float_format="%.4g")
     print(f"total {time.time() - t0:.0f} s")
     print(table.round(3).to_string())
     import matplotlib
@@ -268,7 +312,7 @@ def main():
         ax.set_title(f"{held} held out", fontsize="small")
         ax.legend(fontsize="x-small")
     fig.tight_layout()
-    fig.savefig(out / "figures" / "presets_loo.png", dpi=110)
+    fig.savefig(out / "figures" / f"{args.out}.png", dpi=110)
 
 
 if __name__ == "__main__":
