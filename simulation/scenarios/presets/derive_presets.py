@@ -157,7 +157,14 @@ def fit(datasets, n_per_release=50, seed=1, n_predictive=20):
                                 constraints=con)
 
 
+#: ``--model contact-drag``: the soil's velocity-squared rolling drag kappa fitted as well (RAMMS-like ploughing of
+#: soft ground; simulation.contact), a variant tried for the transfer between the two Authume profiles.
+DRAG_PARAMETERS = {**CONTACT_PARAMETERS, "materials.soil.rolling_drag": (0.0, 0.05)}
+
+
 def _parameters() -> dict:
+    if MODEL.get("drag"):
+        return DRAG_PARAMETERS
     return CONTACT_PARAMETERS if MODEL["laws"] else PARAMETERS
 
 
@@ -230,11 +237,12 @@ def main():
     ap.add_argument("--n-per-release", type=int, default=50)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--draws", type=int, default=40)
-    ap.add_argument("--model", choices=["contact", "presets"], default="contact")
+    ap.add_argument("--model", choices=["contact", "contact-drag", "presets"], default="contact")
     ap.add_argument("--out", default="presets_loo", help="name of the LOO table and figure (docs/validation)")
     args = ap.parse_args()
     if args.model == "presets":
         MODEL["laws"] = {}
+    MODEL["drag"] = args.model == "contact-drag"
     t0 = time.time()
     if args.mode == "fit":
         cal = fit(DATASETS, args.n_per_release, args.seed)
