@@ -162,12 +162,136 @@ def preset_names() -> list[str]:
     return sorted(PRESETS)
 
 
-def preset(name: str) -> dict:
-    """A deep copy of the material table of preset ``name`` (aliases accepted)."""
+def preset(name: str, basis: str = "published") -> dict:
+    """A deep copy of the material table of preset ``name`` (aliases accepted).
+
+    Parameters
+    ----------
+    name : str
+        Preset name or alias.
+    basis : {"published", "data"}
+        ``"published"`` (default): the values of :data:`PRESETS` (published ranges, the table above).
+        ``"data"``: the table the data-derived priors were fitted with -- the preset's table with the contact laws
+        of ``simulation.preset_priors.LAWS`` put over it (Coulomb-bounded e_T, hop heights, the size term of the
+        rolling resistance) -- and every field fitted to real data (:func:`preset_prior`) replaced by its
+        posterior median; fields no data set constrains keep their published values.
+
+    Returns
+    -------
+    dict
+        A scenario material table (point values).
+    """
     key = ALIASES.get(name, name)
     if key not in PRESETS:
         raise PresetError(_unknown(name, "preset", "<preset()>"))
-    return copy.deepcopy(PRESETS[key])
+    if basis not in ("published", "data"):
+        raise PresetError(f"<preset()>: basis = {basis!r} must be 'published' or 'data'")
+    out = copy.deepcopy(PRESETS[key])
+    if basis == "data":
+        from . import preset_priors
+        for field, value in getattr(preset_priors, "LAWS", {}).get(key, {}).items():
+            out[field] = copy.deepcopy(value)
+        for field, stat in _data_priors().get(key, {}).items():
+            holder = out
+            parts = field.split(".")
+            for p in parts[:-1]:
+                holder = holder[p]
+            holder[parts[-1]] = float(stat["median"])
+    return out
+
+
+def _data_priors() -> dict:
+    """preset -> {field (dotted, inside the material table): posterior summary} from simulation/preset_priors.py."""
+    from . import preset_priors
+    out: dict = {}
+    for path, stat in preset_priors.SUMMARY.items():
+        _, mat, *field = path.split(".")
+        out.setdefault(mat, {})[".".join(field)] = stat
+    return out
+
+
+def preset_prior(name: str):
+    """The spread of preset ``name``'s values: one row per field, data-derived where a data set constrains it.
+
+    Fields fitted jointly to real data (``simulation/scenarios/presets/derive_presets.py``: the Authume quarry
+    releases P1 and P2, Garcia et al. 2022, and the minimum shadow angle of talus slopes, Evans & Hungr 1993)
+    carry their posterior mean, sd, median and 90 % interval (``basis = "data"``); the other numeric fields carry
+    the published point value (``basis = "published"``) and, for e_N and e_T, the published spread as ``sd``
+    (that spread is the impact-to-impact variability of the law, not an uncertainty of the mean).
+
+    Parameters
+    ----------
+    name : str
+        Preset name or alias.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index ``field`` (dotted, inside the material table); columns ``basis``, ``published`` (the value of
+        :data:`PRESETS`), ``mean``, ``sd``, ``median``, ``q05``, ``q95``, ``datasets``.
+
+    References
+    ----------
+    Garcia, B. et al. (2022) Engineering Geology 310:106855. Evans, S.G. & Hungr, O. (1993) Can. Geotech. J.
+    30:620-636.
+    """
+    import pandas as pd
+    from . import preset_priors
+    key = ALIASES.get(name, name)
+    if key not in PRESETS:
+        raise PresetError(_unknown(name, "preset", "<preset_prior()>"))
+    p = PRESETS[key]
+    data = _data_priors().get(key, {})
+    rows = []
+    flat = {"ground_friction_angle_deg": p["ground_friction_angle_deg"], "roughness_m": p["roughness_m"]}
+    for tab in ("normal_restitution", "tangential"):
+        for k, v in p[tab].items():
+            if isinstance(v, (int, float)) and not k.startswith("std"):
+                flat[f"{tab}.{k}"] = v
+    for field, value in flat.items():
+        if field in data:
+            st = data[field]
+            rows.append({"field": field, "basis": "data", "published": value, "mean": st["mean"], "sd": st["sd"],
+                         "median": st["median"], "q05": st["q05"], "q95": st["q95"],
+                         "datasets": ", ".join(preset_priors.DATASETS)})
+        else:
+            tab = field.split(".")[0] if "." in field else None
+            sd = float("nan")
+            if tab and field.endswith(".mean") and "std" in p[tab]:
+                sd = float(p[tab]["std"])
+            elif tab and field.endswith("friction_angle_deg") and "std_deg" in p[tab]:
+                sd = float(p[tab]["std_deg"])
+            rows.append({"field": field, "basis": "published", "published": value, "mean": value, "sd": sd,
+                         "median": value, "q05": float("nan"), "q95": float("nan"), "datasets": ""})
+    return pd.DataFrame(rows).set_index("field")
+
+
+def preset_posterior(presets=None):
+    """The joint posterior sample of the data-derived preset fields (200 draws; rows are joint draws, keep them
+    together).  Columns are dotted scenario paths ``materials.<preset>.<field>``, usable as the parameters of
+    ``[uncertainty.materials]`` draws or of :func:`simulation.pooled.read_posterior`-style propagation.
+
+    Parameters
+    ----------
+    presets : list of str, optional
+        Keep only the columns of these presets (aliases accepted).
+
+    Returns
+    -------
+    pandas.DataFrame
+    """
+    import pandas as pd
+    from . import preset_priors
+    df = pd.DataFrame(preset_priors.SAMPLE)
+    if presets is not None:
+        keys = []
+        for n in presets:
+            k = ALIASES.get(n, n)
+            if k not in PRESETS:
+                raise PresetError(_unknown(n, "preset", "<preset_posterior()>"))
+            keys.append(k)
+        df = df[[c for c in df.columns if c.split(".")[1] in keys]]
+    return df
 
 
 def _unknown(name, where: str, source: str) -> str:

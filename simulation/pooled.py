@@ -103,6 +103,129 @@ class Release:
     source: str = "<releases>"
 
 
+@dataclass(frozen=True)
+class ReachConstraint:
+    """A published far limit of deposition, used as one more term of a pooled likelihood.
+
+    Some data sets give no stop positions but the **shadow angle** of the farthest deposits below a talus: the
+    angle, from the horizontal, of the line from the top of the talus (the apex) to the distal limit of the
+    boulders' shadow (Evans & Hungr 1993, Can. Geotech. J. 30:620, abstract: "an empirical minimum shadow
+    angle of 27.5 deg").  The term is a Gaussian log-density of the simulated shadow angle of the stop quantile
+    ``quantile`` (the far limit of ``n_blocks`` simulated blocks) about ``shadow_angle_deg`` with standard
+    deviation ``sd_deg``.
+
+    Parameters
+    ----------
+    name : str
+        Named in every message and table.
+    scenario : path, dict or Scenario
+        The slope (a cliff over a talus) whose materials share the calibrated parameters.
+    apex_x_m, apex_z_m : float
+        Top of the talus [m] in the scenario's profile coordinates.
+    shadow_angle_deg : float
+        Observed shadow angle of the far limit [deg].
+    sd_deg : float
+        Its standard deviation [deg] (the spread between sites and the reading of the limit; an assumption the
+        caller states).
+    quantile : float
+        Quantile of the simulated stops read as the far limit (default 0.99).
+    n_blocks : int
+        Simulated blocks per parameter set (default 200).
+    source : str
+        Where the numbers come from, named in errors.
+    """
+
+    name: str
+    scenario: object
+    apex_x_m: float
+    apex_z_m: float
+    shadow_angle_deg: float
+    sd_deg: float
+    quantile: float = 0.99
+    n_blocks: int = 200
+    source: str = "<constraint>"
+
+    def shadow_angle(self, x_stop_m, z_stop_m):
+        """Shadow angle [deg] of stops at (x, z) [m] seen from the apex (90 deg for stops above or behind it)."""
+        dx = np.asarray(x_stop_m, float) - self.apex_x_m
+        dz = self.apex_z_m - np.asarray(z_stop_m, float)
+        return np.degrees(np.arctan2(dz, np.maximum(dx, 1e-9)))
+
+    def _release(self):
+        return Release(name=self.name, scenario=self.scenario, x_stop_m=[self.apex_x_m], source=self.source)
+
+
+def _check_constraints(constraints) -> list:
+    constraints = list(constraints or ())
+    for c in constraints:
+        if not isinstance(c, ReachConstraint):
+            raise TypeError(f"constraints must be simulation.pooled.ReachConstraint objects; got {type(c).__name__}")
+        where = f"{c.source}: constraint {c.name!r}"
+        if not (np.isfinite(c.shadow_angle_deg) and 0.0 < c.shadow_angle_deg < 90.0):
+            raise ValueError(f"{where}: shadow_angle_deg = {c.shadow_angle_deg!r} must lie in (0, 90) deg")
+        if not (np.isfinite(c.sd_deg) and c.sd_deg > 0.0):
+            raise ValueError(f"{where}: sd_deg = {c.sd_deg!r} must be a finite number > 0 deg")
+        if not 0.5 <= c.quantile < 1.0:
+            raise ValueError(f"{where}: quantile = {c.quantile!r} must lie in [0.5, 1)")
+        if isinstance(c.n_blocks, bool) or not isinstance(c.n_blocks, (int, np.integer)) or c.n_blocks < 20:
+            raise ValueError(f"{where}: n_blocks = {c.n_blocks!r} must be a whole number >= 20")
+    return constraints
+
+
+class _ConstraintPool:
+    """The reach constraints' scenarios, with the parameters each defines swapped in per parameter set."""
+
+    def __init__(self, constraints, parameters: dict):
+        self.constraints = constraints
+        self.pools = []
+        for c in constraints:
+            from .calibration import scenario_dict
+            data, _ = scenario_dict(c.scenario)
+            mats = data.get("materials", {})
+            own = {k: b for k, b in parameters.items() if str(k).split(".")[1:2] and str(k).split(".")[1] in mats}
+            self.pools.append((_Pool([c._release()], own) if own else None, own))
+
+    def simulate(self, values: dict, seed) -> list:
+        """(x, z) of the simulated stops [m] per constraint."""
+        from .engine import run
+        out = []
+        for g, (c, (pool, own)) in enumerate(zip(self.constraints, self.pools)):
+            if pool is not None:
+                sc = pool.scenarios({k: v for k, v in values.items() if k in own})[pool.rel_key[0]]
+            else:
+                from .calibration import scenario_dict
+                data, src = scenario_dict(c.scenario)
+                sc = scenario_from_dict(data, source=src)
+            res = run(sc, n=int(c.n_blocks), seed=[int(seed), 7919, g], record_paths=0)
+            out.append((np.asarray(res.per_block["x"], float), np.asarray(sc.profile.x, float),
+                        np.asarray(sc.profile.z, float)))
+        return out
+
+    def far_angles(self, sims) -> list:
+        """Shadow angle [deg] of each constraint's simulated far limit (its ``quantile`` of the stops)."""
+        out = []
+        for c, (x, px, pz) in zip(self.constraints, sims):
+            far = float(np.quantile(x, c.quantile))
+            out.append(float(c.shadow_angle(far, np.interp(far, px, pz))))
+        return out
+
+    def log_likelihood(self, sims) -> float:
+        """Sum of the Gaussian log-densities of the simulated far-limit shadow angles about the observed ones."""
+        return float(sum(stats.norm.logpdf(a, c.shadow_angle_deg, c.sd_deg)
+                         for c, a in zip(self.constraints, self.far_angles(sims))))
+
+    def table(self, angles_per_draw) -> pd.DataFrame:
+        """Per constraint: the observed angle and the posterior-predictive shadow angle of the far limit [deg]."""
+        cols = ["constraint", "observed_deg", "sd_deg", "predicted_median_deg", "predicted_q05_deg",
+                "predicted_q95_deg"]
+        rows = []
+        for i, c in enumerate(self.constraints):
+            a = np.asarray([d[i] for d in angles_per_draw], float)
+            q = np.quantile(a, [0.5, 0.05, 0.95]) if a.size else [np.nan] * 3
+            rows.append(dict(zip(cols, [c.name, c.shadow_angle_deg, c.sd_deg, *map(float, q)])))
+        return pd.DataFrame(rows, columns=cols).set_index("constraint")
+
+
 # ---- reading and checking releases ----------------------------------------------------------------------------------
 def read_releases(path, scenarios: dict, *, release_column: str = "release") -> list[Release]:
     """Releases from a CSV file: one row per observed block.
@@ -188,7 +311,7 @@ def check_releases(releases) -> list[Release]:
 class _Pool:
     """Every release's scenario parsed once; new material values swapped in per parameter set."""
 
-    def __init__(self, releases, parameters: dict):
+    def __init__(self, releases, parameters: dict, extra_materials=()):
         from .calibration import scenario_dict
         self.releases = releases
         self.bases = {}          # key -> (data, source, Scenario)
@@ -208,7 +331,8 @@ class _Pool:
             if len(parts) < 3 or parts[0] != "materials":
                 raise ValueError(f"parameter {name!r}: a pooled calibration fits material fields shared by the "
                                  "releases: 'materials.NAME.FIELD' (e.g. 'materials.talus.ground_friction_angle_deg')")
-            if not any(parts[1] in data.get("materials", {}) for data, _, _ in self.bases.values()):
+            if parts[1] not in extra_materials and not any(parts[1] in data.get("materials", {})
+                                                           for data, _, _ in self.bases.values()):
                 files = sorted({src for _, src, _ in self.bases.values()})
                 raise ValueError(f"parameter {name!r}: no release's scenario defines material {parts[1]!r} "
                                  f"(scenarios: {files})")
@@ -363,6 +487,7 @@ class PooledCalibration:
     seed: object
     releases: tuple = field(repr=False, default=())
     notes: tuple = ()
+    constraint_table: pd.DataFrame = field(repr=False, default_factory=pd.DataFrame)
 
     def summary(self) -> pd.DataFrame:
         """One row per parameter: posterior median, mean, sd, 5/95 % and 0.5/99.5 % quantiles, prior sd (uniform
@@ -498,7 +623,7 @@ def _t_draw(rng, mean, cov, n, dof=4.0):
 
 def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, seed=1, n_initial: int | None = None,
                      n_per_iteration: int | None = None, iterations: int = 3, n_posterior: int = 2000,
-                     n_predictive: int = 40, obs_error_m: float = 0.5) -> PooledCalibration:
+                     n_predictive: int = 40, obs_error_m: float = 0.5, constraints=()) -> PooledCalibration:
     """Fit material parameters shared by many releases to all their observed stops; a posterior sample.
 
     Parameters
@@ -524,6 +649,9 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
         Posterior draws simulated for the predictive coverage (0 to skip).
     obs_error_m : float
         Smallest kernel width [m]: the observation error of a stop position.
+    constraints : list of ReachConstraint, optional
+        Published far limits of deposition (shadow angles) added to the likelihood; each is simulated with its
+        own ``n_blocks`` per parameter set and reported in ``constraint_table``.
 
     Returns
     -------
@@ -539,7 +667,9 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
     if not isinstance(parameters, dict) or not parameters:
         raise TypeError(f"parameters must be a non-empty dict of dotted material path -> (low, high); got "
                         f"{parameters!r}")
-    pool = _Pool(releases, parameters)
+    constraints = _check_constraints(constraints)
+    cpool = _ConstraintPool(constraints, parameters)
+    pool = _Pool(releases, parameters, extra_materials={k.split(".")[1] for pl in cpool.pools for k in pl[1]})
     names = pool.names
     d = len(names)
     lo = np.array([pool.bounds[k][0] for k in names])
@@ -552,7 +682,8 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
 
     def loglik(u):
         values = dict(zip(names, lo + u * (hi - lo)))
-        return _log_likelihood(pool.simulate(values, n_per_release, sim_seed), releases, lengths, obs_error_m)
+        ll = _log_likelihood(pool.simulate(values, n_per_release, sim_seed), releases, lengths, obs_error_m)
+        return ll + (cpool.log_likelihood(cpool.simulate(values, sim_seed)) if constraints else 0.0)
 
     n0 = n_initial or 2 ** int(math.ceil(math.log2(64 * d)))
     n_it = n_per_iteration or 32 * d
@@ -642,10 +773,15 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
             notes.append(msg)
             warnings.warn(msg, PooledCalibrationWarning, stacklevel=2)
     coverage = _coverage(pool, releases, posterior, n_predictive, rng_pred)
+    ctable = pd.DataFrame()
+    if constraints and n_predictive:
+        draws = posterior.iloc[rng_pred.choice(len(posterior), size=n_predictive, replace=False)]
+        ctable = cpool.table([cpool.far_angles(cpool.simulate(row.to_dict(), 20_000 + t))
+                              for t, (_, row) in enumerate(draws.iterrows())])
     return PooledCalibration(parameters={k: float(posterior[k].median()) for k in names}, bounds=dict(pool.bounds),
                              posterior=posterior, evaluations=evaluations, coverage_table=coverage, ess=ess,
                              n_per_release=int(n_per_release), seed=seed, releases=tuple(releases),
-                             notes=tuple(notes))
+                             notes=tuple(notes), constraint_table=ctable)
 
 
 def _quadratic_surrogate(u, ll):

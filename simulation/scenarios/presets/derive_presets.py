@@ -1,0 +1,325 @@
+"""Substrate presets from real data: a joint pooled calibration, and leave-one-dataset-out validation.
+
+    python simulation/scenarios/presets/derive_presets.py fit   [--n-per-release 50] [--seed 1]
+    python simulation/scenarios/presets/derive_presets.py loo   [--n-per-release 50] [--seed 1]
+
+The data sets (each cited in tests/data/<source>/README.md):
+
+* ``authume_p1``, ``authume_p2`` -- the Authume quarry block releases (Garcia et al. 2022, Engineering Geology
+  310:106855; richefeu/AuthumeQuarryRockfalls_Data-in-Brief f695c933): 41 and 48 real blocks, each a release on
+  its profile's 2-D section with its measured mass (tests/data/authume/observed_runout.csv).  The zones of the
+  terrain are mapped to presets: Blue (vegetated slope) = ``soil``, Gray (hard rock walls and benches) =
+  ``bedrock``, Red (rocky slope) = ``talus``.
+* ``evans_hungr_1993`` -- the empirical minimum shadow angle of talus slopes, 27.5 deg (Evans & Hungr 1993,
+  Can. Geotech. J. 30:620, abstract; tests/data/evans_hungr1993/README.md), as a reach constraint
+  (:class:`simulation.pooled.ReachConstraint`) on an 80 m cliff at 70 deg over a 34 deg talus 60 m high (the
+  geometry of simulation/scenarios/cliff_talus_deposition.toml) with the presets ``bedrock``, ``talus`` and
+  ``soil``; standard deviation 2.0 deg [assumption: the spread of the far limit between sites, chosen so that
+  the fatal impacts at 30 deg or more of the same abstract lie within 1.25 sd].
+
+Every scenario uses the presets as they are (their own laws) with ``settings.max_rolling_slope_deg = 55``
+(no rolling in contact down faces steeper than 55 deg; simulation/contact.py).  The fitted fields are the
+four the data constrain: the rolling-resistance angles of soil, bedrock and talus and the tangential
+coefficient of soil.
+
+``fit`` fits all data sets jointly and writes simulation/preset_priors.py (posterior summary and a 200-draw
+sample per fitted field); ``loo`` fits every data set's complement and predicts the held-out one, writing
+docs/validation/presets_loo.csv and docs/validation/figures/presets_loo.png.
+"""
+from __future__ import annotations
+
+import argparse
+import copy
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parents[2]
+sys.path.insert(0, str(REPO))
+
+from simulation.calibration import scenario_dict  # noqa: E402
+from simulation.pooled import ReachConstraint, Release, _ConstraintPool, _Pool, calibrate_pooled  # noqa: E402
+
+AUTHUME = REPO / "simulation" / "scenarios" / "authume"
+OBSERVED = REPO / "tests" / "data" / "authume" / "observed_runout.csv"
+ZONE_PRESET = {"vegetated_slope": "soil", "hard_ground": "bedrock", "rocky_slope": "talus"}
+SETTINGS = {"max_rolling_slope_deg": 55.0}
+
+#: The contact model the data-derived presets use (``--model contact``, the default): the laws of
+#: simulation/contact.py that make the contact velocity a numerical setting -- Wyllie's e_T bounded by Coulomb
+#: friction (mu = tan 35 deg on natural ground, tan 30 deg on rock: the presets' friction angles), hop heights
+#: equal to the preset's roughness, and the size term of the rolling resistance (K = 1: tan(phi_g) + roughness / r)
+#: -- put over each preset's own table.  ``--model presets`` uses the presets' own laws unchanged.
+CONTACT_LAWS = {
+    "soil": {"tangential": {"law": "coulomb", "mean": 0.55, "std": 0.12, "friction_angle_deg": 35.0, "std_deg": 3.0},
+             "contact_hop_height_m": 0.1, "rolling_size_coefficient": 1.0},
+    "bedrock": {"tangential": {"law": "coulomb", "mean": 0.55, "std": 0.12, "friction_angle_deg": 30.0,
+                               "std_deg": 3.0},
+                "contact_hop_height_m": 0.1, "rolling_size_coefficient": 1.0},
+    "talus": {"tangential": {"law": "coulomb", "mean": 0.55, "std": 0.12, "friction_angle_deg": 35.0,
+                             "std_deg": 3.0},
+              "contact_hop_height_m": 0.3, "rolling_size_coefficient": 1.0},
+}
+MODEL = {"laws": CONTACT_LAWS}
+
+#: The fitted preset fields and their uniform priors (wide: the published ranges sit inside them).
+PARAMETERS = {"materials.soil.ground_friction_angle_deg": (3.0, 45.0),
+              "materials.soil.tangential.mean": (0.2, 1.0),
+              "materials.bedrock.ground_friction_angle_deg": (3.0, 65.0),
+              "materials.talus.ground_friction_angle_deg": (10.0, 50.0)}
+#: With the contact model the bedrock's e_T is fitted as well (with the presets' own law it is Stronge's).
+CONTACT_PARAMETERS = {**PARAMETERS, "materials.bedrock.tangential.mean": (0.2, 1.0)}
+
+#: Evans & Hungr (1993), Can. Geotech. J. 30:620-636, abstract: "An empirical minimum shadow angle of 27.5 deg
+#: ... is suggested"; "rockfall fragments impacted on homes at equivalent shadow angles of 30 deg or more".
+EH_SHADOW_ANGLE_DEG = 27.5
+EH_SD_DEG = 2.0                     # assumption (see the module docstring)
+EH_APEX = (39.118, 60.0)            # top of the talus [m] (x, z)
+
+
+def authume_scenario(profile: str) -> dict:
+    """The Authume section of ``profile`` with its zones named and valued by the presets."""
+    data, _ = scenario_dict(AUTHUME / f"authume_{profile.lower()}.toml")
+    data = copy.deepcopy(data)
+    mats = data["profile"].get("materials")
+    data["profile"]["materials"] = [ZONE_PRESET[m] for m in mats]
+    data["materials"] = {ZONE_PRESET[k]: _material(ZONE_PRESET[k]) for k in data["materials"]}
+    data["name"] = f"authume_{profile.lower()}_presets"
+    data.setdefault("settings", {}).update(SETTINGS)
+    return data
+
+
+def evans_hungr_scenario() -> dict:
+    """An 80 m cliff at 70 deg over a 34 deg talus 60 m high and a flat run-out, materials by preset."""
+    return {"name": "evans_hungr_talus_presets",
+            "profile": {"x": [0.0, 10.0, EH_APEX[0], 128.072, 450.0], "z": [140.0, 140.0, EH_APEX[1], 0.0, 0.0],
+                        "materials": ["bedrock", "bedrock", "talus", "soil"]},
+            "materials": {k: _material(k) for k in ("bedrock", "talus", "soil")},
+            "seeder": {"type": "line", "x": [10.2, 12.0], "height_m": 0.0,
+                       "downslope_speed_ms": {"dist": "uniform", "low": 0.5, "high": 3.0},
+                       "mass_kg": {"dist": "lognormal", "median": 2000, "sigma": 1.0, "max": 100000},
+                       "density_kg_m3": 2650},
+            "settings": {"envelope_bins": 0, **SETTINGS}}
+
+
+_SCEN = {}
+
+
+def _material(name: str) -> dict:
+    return {"preset": name, **copy.deepcopy(MODEL["laws"].get(name, {}))}
+
+
+def releases(profile: str, rows=None) -> list:
+    """Every observed block of ``profile`` (P1 or P2) as a release with its measured mass."""
+    key = (profile, bool(MODEL["laws"]))
+    if key not in _SCEN:
+        _SCEN[key] = authume_scenario(profile)
+    obs = pd.read_csv(OBSERVED) if rows is None else rows
+    return [Release(name=f"{r.profile}-{r.block}", scenario=_SCEN[key], x_stop_m=[r.x_stop_m],
+                    mass_kg=r.mass_kg, source=str(OBSERVED.relative_to(REPO)))
+            for r in obs.itertuples() if r.profile == profile]
+
+
+def evans_hungr() -> ReachConstraint:
+    key = ("EH", bool(MODEL["laws"]))
+    if key not in _SCEN:
+        _SCEN[key] = evans_hungr_scenario()
+    return ReachConstraint(name="evans_hungr_1993", scenario=_SCEN[key], apex_x_m=EH_APEX[0],
+                           apex_z_m=EH_APEX[1], shadow_angle_deg=EH_SHADOW_ANGLE_DEG, sd_deg=EH_SD_DEG,
+                           quantile=0.99, n_blocks=200, source="tests/data/evans_hungr1993/README.md")
+
+
+DATASETS = ("authume_p1", "authume_p2", "evans_hungr_1993")
+
+
+def fit(datasets, n_per_release=50, seed=1, n_predictive=20):
+    rel, con = [], []
+    for d in datasets:
+        if d == "evans_hungr_1993":
+            con.append(evans_hungr())
+        else:
+            rel.extend(releases(d.split("_")[1].upper()))
+    params = {k: v for k, v in _parameters().items()
+              if any(k.split(".")[1] in r.scenario["materials"] for r in rel)
+              or any(k.split(".")[1] in c.scenario["materials"] for c in con)}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return calibrate_pooled(rel, params, seed=seed, n_per_release=n_per_release, n_initial=1024,
+                                n_per_iteration=256, iterations=4, n_predictive=n_predictive, obs_error_m=2.0,
+                                constraints=con)
+
+
+#: ``--model contact-drag``: the soil's velocity-squared rolling drag kappa fitted as well (RAMMS-like ploughing of
+#: soft ground; simulation.contact), a variant tried for the transfer between the two Authume profiles.
+DRAG_PARAMETERS = {**CONTACT_PARAMETERS, "materials.soil.rolling_drag": (0.0, 0.05)}
+
+
+def _parameters() -> dict:
+    if MODEL.get("drag"):
+        return DRAG_PARAMETERS
+    return CONTACT_PARAMETERS if MODEL["laws"] else PARAMETERS
+
+
+def write_priors(cal, path: Path, datasets, args):
+    summ = cal.summary()
+    sample = cal.posterior.sample(200, random_state=1).reset_index(drop=True)
+    lines = ['"""Data-derived priors of the substrate presets -- GENERATED by',
+             f'simulation/scenarios/presets/derive_presets.py fit --n-per-release {args.n_per_release} --seed {args.seed} '
+             f'--model {args.model}',
+             f'(data sets: {", ".join(datasets)}; do not edit by hand)."""', "",
+             f"DATASETS = {tuple(datasets)!r}",
+             "#: preset -> the contact laws put over the preset's table before the fitted fields (see derive_presets.py).",
+             f"LAWS = {MODEL['laws']!r}",
+             f"NOTES = {tuple(cal.notes)!r}",
+             "#: field -> posterior summary (mean, sd, median, q05, q95) and the uniform prior's bounds.",
+             "SUMMARY = {"]
+    for k in summ.index:
+        r = summ.loc[k]
+        lines.append(f"    {k!r}: {{'mean': {r['mean']:.4g}, 'sd': {r['sd']:.4g}, 'median': {r['median']:.4g}, "
+                     f"'q05': {r['q05']:.4g}, 'q95': {r['q95']:.4g}, 'bounds': {tuple(cal.bounds[k])!r}}},")
+    lines.append("}")
+    lines.append("#: 200 posterior draws (joint: keep rows together), one list per field.")
+    lines.append("SAMPLE = {")
+    for k in sample.columns:
+        lines.append(f"    {k!r}: [" + ", ".join(f"{v:.4g}" for v in sample[k]) + "],")
+    lines.append("}")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def predict_release_stops(rels, draws, n_each, seed0):
+    P = _parameters()
+    pool = _Pool(rels, {k: P[k] for k in P if k.split(".")[1] in rels[0].scenario["materials"]})
+    per = [[] for _ in rels]
+    for t, values in enumerate(draws):
+        vals = {k: v for k, v in values.items() if k in pool.bounds}
+        for i, s in enumerate(pool.simulate(vals, n_each, seed0 + t)):
+            per[i].append(s)
+    return [np.concatenate(p) for p in per]
+
+
+def release_row(dataset, model, per_release, rels):
+    obs = np.array([r.x_stop_m[0] for r in rels])
+    pred = np.concatenate(per_release)
+    p95 = np.array([np.quantile(s, 0.95) for s in per_release])
+    p99 = np.array([np.quantile(s, 0.99) for s in per_release])
+    qo, qp = np.quantile(obs, [0.1, 0.5, 0.9]), np.quantile(pred, [0.1, 0.5, 0.9])
+    return {"held_out": dataset, "model": model, "observations": obs.size,
+            "obs_p10": qo[0], "obs_p50": qo[1], "obs_p90": qo[2], "pred_p10": qp[0], "pred_p50": qp[1],
+            "pred_p90": qp[2], "median_error_pct": 100.0 * (qp[1] / qo[1] - 1.0),
+            "ks_d": stats.ks_2samp(pred, obs).statistic, "w1": stats.wasserstein_distance(pred, obs),
+            "beyond_p95": float(np.mean(obs > p95)), "beyond_p99": float(np.mean(obs > p99)),
+            "unit": "m (stop x)"}, (obs, pred)
+
+
+def constraint_row(model, cons, angles):
+    a = np.asarray(angles)
+    q = np.quantile(a, [0.1, 0.5, 0.9])
+    return {"held_out": "evans_hungr_1993", "model": model, "observations": 1, "obs_p10": np.nan,
+            "obs_p50": cons.shadow_angle_deg, "obs_p90": np.nan, "pred_p10": q[0], "pred_p50": q[1],
+            "pred_p90": q[2], "median_error_pct": 100.0 * (q[1] / cons.shadow_angle_deg - 1.0),
+            "ks_d": np.nan, "w1": float(np.mean(np.abs(a - cons.shadow_angle_deg))),
+            "beyond_p95": float(cons.shadow_angle_deg < np.quantile(a, 0.05)),
+            "beyond_p99": float(cons.shadow_angle_deg < np.quantile(a, 0.01)),
+            "unit": "deg (shadow angle of the p99 stop)"}, a
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("mode", choices=["fit", "loo"])
+    ap.add_argument("--n-per-release", type=int, default=50)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--draws", type=int, default=40)
+    ap.add_argument("--model", choices=["contact", "contact-drag", "presets"], default="contact")
+    ap.add_argument("--out", default="presets_loo", help="name of the LOO table and figure (docs/validation)")
+    args = ap.parse_args()
+    if args.model == "presets":
+        MODEL["laws"] = {}
+    MODEL["drag"] = args.model == "contact-drag"
+    t0 = time.time()
+    if args.mode == "fit":
+        cal = fit(DATASETS, args.n_per_release, args.seed)
+        print(f"fit {time.time() - t0:.0f} s")
+        print(cal.summary()[["median", "mean", "sd", "q05", "q95", "sd_ratio"]].round(3).to_string())
+        print(cal.correlations().round(2).to_string())
+        print(cal.coverage().to_dict(), cal.constraint_table.round(2).to_string(), cal.notes)
+        write_priors(cal, REPO / "simulation" / "preset_priors.py", DATASETS, args)
+        return
+    rows, curves = [], {}
+    for held in DATASETS:
+        train = [d for d in DATASETS if d != held]
+        cal = fit(train, args.n_per_release, args.seed, n_predictive=0)
+        print(held, f"fitted on {train} {time.time() - t0:.0f} s")
+        print(cal.summary()[["median", "q05", "q95", "sd_ratio"]].round(3).to_string(), cal.notes)
+        draws = cal.posterior.sample(args.draws, random_state=args.seed).to_dict("records")
+        label = "fitted on " + " + ".join(train)
+        if held == "evans_hungr_1993":
+            for model, ds in ((label, draws), ("published presets", [{}])):
+                laws = MODEL["laws"]
+                if ds is not draws:
+                    MODEL["laws"] = {}
+                c = evans_hungr()
+                cp = _ConstraintPool([c], _parameters())
+                MODEL["laws"] = laws
+                angs = []
+                for t, v in enumerate(ds):
+                    for rep in range(1 if ds is draws else args.draws):
+                        angs.append(cp.far_angles(cp.simulate(v, 30_000 + 100 * t + rep))[0])
+                r, a = constraint_row(model, c, angs)
+                rows.append(r)
+                curves[(held, model)] = a
+        else:
+            for model, ds, n_each in ((label, draws, 10), ("published presets", [{}], 400)):
+                laws = MODEL["laws"]
+                if ds is not draws:
+                    MODEL["laws"] = {}
+                rels = releases(held.split("_")[1].upper())
+                MODEL["laws"] = laws
+                r, cv = release_row(held, model, predict_release_stops(rels, ds, n_each, 50_000), rels)
+                rows.append(r)
+                curves[(held, model)] = cv
+        print(pd.DataFrame(rows).round(3).to_string())
+    table = pd.DataFrame(rows)
+    out = REPO / "docs" / "validation"
+    table.to_csv(out / f"{args.out}.csv", index=False, float_format="%.4g")
+    print(f"total {time.time() - t0:.0f} s")
+    print(table.round(3).to_string())
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
+    for ax, held in zip(axes, DATASETS):
+        for (h, model), c in curves.items():
+            if h != held:
+                continue
+            style = "C0" if model == "published presets" else "C3"
+            if held == "evans_hungr_1993":
+                ax.hist(c, bins=15, alpha=0.5, color=style, label=model, density=True)
+            else:
+                obs, pred = c
+                if model != "published presets":
+                    o = np.sort(obs)
+                    ax.step(o, np.arange(1, o.size + 1) / o.size, where="post", color="k", lw=2,
+                            label=f"observed ({o.size})")
+                p = np.sort(pred)
+                ax.plot(p, np.arange(1, p.size + 1) / p.size, color=style, label=model)
+        if held == "evans_hungr_1993":
+            ax.axvline(EH_SHADOW_ANGLE_DEG, color="k", lw=2, label="Evans & Hungr 27.5 deg")
+            ax.set_xlabel("shadow angle of the p99 stop [deg]")
+            ax.set_ylabel("density over posterior draws")
+        else:
+            ax.set_xlabel("stop position x [m]")
+            ax.set_ylabel("fraction of blocks stopped before x")
+        ax.set_title(f"{held} held out", fontsize="small")
+        ax.legend(fontsize="x-small")
+    fig.tight_layout()
+    fig.savefig(out / "figures" / f"{args.out}.png", dpi=110)
+
+
+if __name__ == "__main__":
+    main()
