@@ -19,7 +19,9 @@ _EXPORTS = {
     **dict.fromkeys(["Calibration", "CalibrationWarning", "calibrate", "read_observed"], "calibration"),
     # Calibration pooled over many releases, with a posterior sample.
     **dict.fromkeys(["Release", "PooledCalibration", "PooledCalibrationWarning", "calibrate_pooled",
-                     "read_releases", "read_posterior", "ReachConstraint"], "pooled"),
+                     "read_releases", "read_posterior", "ReachConstraint", "stop_density"], "pooled"),
+    # The trajectory model's uncertainty as material draws: a posterior's rows or the presets' spread.
+    **dict.fromkeys(["material_draws", "preset_spread", "scenario_with_values"], "material_uncertainty"),
     **dict.fromkeys(["TerrainProfile", "profile_from_points", "read_stl"], "profile_extraction"),
     # 3-D terrain: DEM rasters, profiles cut from them, 3-D scenarios and the 3-D kernel's runs.
     **dict.fromkeys(["Terrain", "TerrainError", "read_dem", "read_material_raster", "profile_from_grid"], "terrain"),

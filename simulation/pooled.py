@@ -465,6 +465,28 @@ def _predictive_density(s, x, ri, lengths, obs_error_m):
     return (1.0 - DEFENSIVE_SHARE) * dens + DEFENSIVE_SHARE / lengths[ri]
 
 
+def stop_density(simulated_x_m, x_m, length_m: float, obs_error_m: float = 0.5) -> np.ndarray:
+    """Predictive density [1/m] of stops at ``x_m`` given one release's simulated stops: the per-stop likelihood
+    of :func:`calibrate_pooled` (Gaussian kernel of Silverman's width, at least ``obs_error_m`` [m], mixed with a
+    uniform share ``DEFENSIVE_SHARE`` over the profile length ``length_m`` [m]).  Exact inference for the
+    simulator plus a Gaussian observation error of the kernel's width (Wilkinson 2013)."""
+    s = np.asarray(simulated_x_m, dtype=float).ravel()
+    x = np.asarray(x_m, dtype=float)
+    if s.size < 2 or not np.isfinite(s).all():
+        raise ValueError(f"simulated_x_m must hold at least 2 finite stops [m]; got {s.size}")
+    if not (np.isfinite(length_m) and length_m > 0):
+        raise ValueError(f"length_m = {length_m!r} must be a profile length > 0 m")
+    flat = x.ravel()
+    out = _predictive_density(s[None, :], flat, np.zeros(flat.size, dtype=int), np.array([float(length_m)]),
+                              obs_error_m)
+    return out.reshape(x.shape)
+
+
+def stop_bandwidth(simulated_x_m, obs_error_m: float = 0.5) -> float:
+    """Kernel width [m] of :func:`stop_density` for one release's simulated stops."""
+    return float(_bandwidths(np.asarray(simulated_x_m, dtype=float).ravel()[None, :], obs_error_m)[0])
+
+
 # ---- the result ---------------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class PooledCalibration:
