@@ -227,13 +227,19 @@ class EnergyHazard:
         """
         T = check_return_periods(T)
         level = check_probability_level(level)
-        Tv = np.atleast_1d(T).astype(float)
-        sims = np.empty((int(n_bootstrap), Tv.size))
-        for i, (curve, scale) in enumerate(self._bootstrap_curves(int(n_bootstrap), seed)):
-            sims[i] = _interp_log_inverse(curve, 1.0 / (Tv * scale))
+        sims = self.energy_at_return_period_replicates(T, n_bootstrap, seed)
         q = (1 - level) / 2
         lo, hi = np.nanquantile(sims, q, axis=0), np.nanquantile(sims, 1 - q, axis=0)
         return lo.reshape(np.shape(T)), hi.reshape(np.shape(T))
+
+    def energy_at_return_period_replicates(self, T, n_bootstrap: int = 300, seed=None) -> np.ndarray:
+        """The bootstrap replicates behind :meth:`energy_at_return_period_ci`: T-year energies [kJ], an array
+        (n_bootstrap, number of T); NaN where a replicate has fewer than one arrival in T years."""
+        Tv = np.atleast_1d(check_return_periods(T)).astype(float)
+        sims = np.empty((int(n_bootstrap), Tv.size))
+        for i, (curve, scale) in enumerate(self._bootstrap_curves(int(n_bootstrap), seed)):
+            sims[i] = _interp_log_inverse(curve, 1.0 / (Tv * scale))
+        return sims
 
     def _bootstrap_curves(self, n_bootstrap: int, seed):
         """Replicates (P(E > e) on the energy grid, arrivals per year) of the parametric bootstrap.
