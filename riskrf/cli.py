@@ -481,6 +481,8 @@ def cmd_assess(args) -> int:
     print(f"Recommendation: {s['recommendation']['option']} ({s['recommendation']['basis']}).")
     if "resolution" in s["recommendation"]:
         print(f"Resolution: {s['recommendation']['resolution']['text']}")
+    if assessment.model_uncertainty is not None:
+        print("\n".join(assessment.model_uncertainty.text()))
     print(f"Report: {(out / 'report.html').resolve()}")
     return 0
 

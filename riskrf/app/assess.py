@@ -255,6 +255,9 @@ class Assessment:
     release_factor: float = 1.0     # rate_basis = "road": released falls per fall recorded on the road
     #: the governing design basis's requirement at the barrier line and along the profile (SiteDesign), or None
     design: object = None
+    #: the trajectory model's uncertainty carried to the design energies and the ranking
+    #: (:class:`~riskrf.app.model_uncertainty.ModelUncertaintyStudy`), None unless the site asks for it
+    model_uncertainty: object = None
     #: figures already being drawn beside the computation: {"dir": Path, "pending": [InBackground, ...]} (see
     #: ``run_assessment(figures_dir=...)``); empty when ``write_assessment`` draws them all.
     drawing: dict = field(default_factory=dict, repr=False)
@@ -333,6 +336,8 @@ class Assessment:
         }
         if self.rates is not None:
             out["rate_model"] = self.rates.summary()
+        if self.model_uncertainty is not None:
+            out["model_uncertainty"] = self.model_uncertainty.to_dict()
         if self.design is not None:
             out.update(self.design.to_dict())
         if fr.gumbel is not None or (self.maxima_frequency and self.maxima_frequency.gumbel is not None):
@@ -512,6 +517,17 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         decision = study_report(study)
         site_design = with_recommended_run(site_design, site, result, decision["recommendation"]["option"], seed)
         timings["decision"] = round(time.perf_counter() - t, 2)
+        model_uncertainty = None
+        if site.model_uncertainty is not None:
+            from .model_uncertainty import run_model_uncertainty
+            t = time.perf_counter()
+            log(f"      the trajectory model's uncertainty: {site.model_uncertainty['draws']} draws of the material "
+                "parameters re-simulated (design energies, ranking, value of a field calibration)")
+            model_uncertainty = run_model_uncertainty(
+                site, inventory, rate_scale=rate_scale / release_factor, rate_note=rate_note, mitigation=mitigation,
+                design_masses=design_masses, reference_hazard=hazard, design_T=hz_cfg["design_period_years"],
+                T=energy.design["T_years"].tolist(), log=log)
+            timings["model_uncertainty"] = round(time.perf_counter() - t, 2)
     notes = []
     for w in list(frequency.warnings) + [str(c.message) for c in caught] + list(site_rates.notes if site_rates
                                                                                 else ()):
@@ -528,7 +544,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
     return Assessment(site=site, inventory=inventory, frequency=frequency, maxima_frequency=maxima_frequency,
                       result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
                       warnings=notes, timings=timings, rates=site_rates, release_factor=release_factor,
-                      design=site_design,
+                      design=site_design, model_uncertainty=model_uncertainty,
                       drawing={"dir": figures, "pending": pending} if figures is not None else {})
 
 
@@ -571,6 +587,9 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
             shutil.move(str(figs / name), str(out / name))
     for name in ("ranking.csv", "tornado.csv", "break_even.csv", "decision.json"):
         shutil.move(str(figs / name), str(out / name))
+    if a.model_uncertainty is not None:
+        a.model_uncertainty.write(out)
+        a.model_uncertainty.figures(figs)
     a.timings["report"] = round(time.perf_counter() - t, 2)
     summary = a.summary()
     write_json(summary, out / "summary.json")

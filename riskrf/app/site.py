@@ -30,8 +30,9 @@ class SiteError(RiskrfError, ValueError):
 SITE_FIELDS = {t.name: t.defaults() for t in (_fs.SITE, _fs.INVENTORY, _fs.HAZARD, _fs.DESIGN_BLOCK, _fs.DESIGN,
                                               _fs.REPORT)}
 MITIGATION_TABLES = ("traffic", "consequences", "economics", "options", "uncertainty", "criteria")
-#: Optional tables checked by their own modules: [rates] (riskrf.risk.site_rates).
-OTHER_TABLES = ("rates",)
+#: Optional tables checked by their own modules: [rates] (riskrf.risk.site_rates), [model_uncertainty]
+#: (riskrf.app.model_uncertainty).
+OTHER_TABLES = ("rates", "model_uncertainty")
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,8 @@ class Site:
     #: True when hazard.scenario is a 3-D terrain scenario (a ``[terrain]`` table): ``riskrf assess`` then runs
     #: :func:`riskrf.app.assess3d.run_terrain_assessment` (hazard, energy and road outputs; no option ranking).
     three_d: bool = False
+    #: the checked [model_uncertainty] table (riskrf.app.model_uncertainty), None when absent (off)
+    model_uncertainty: dict | None = None
 
     def resolve(self, relative) -> Path:
         """A path given in the site file, resolved against the site file's folder."""
@@ -201,17 +204,21 @@ def load_site(path) -> Site:
     # every declared field against its type and range (shares and probabilities in [0, 1], rates, speeds,
     # lengths and traffic > 0): the checks above keep their own messages, this catches the rest
     _check_schema(data, _fs.SITE_SCHEMA, path, error=SiteError)
+    from .model_uncertainty import check_model_uncertainty
+    model_uncertainty, mu_used = check_model_uncertainty(data.get("model_uncertainty"), path, hz, error=SiteError)
+    used += mu_used
     return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
                 description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
                 mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"], rates=rates,
-                design=tables["design"], report=tables["report"], three_d=three_d)
+                design=tables["design"], report=tables["report"], three_d=three_d,
+                model_uncertainty=model_uncertainty)
 
 
 def _check_terrain_site(data, hz, path):
     """A site on 3-D terrain: what ``riskrf assess`` does with it (hazard, energy at the barrier line, road per
     metre) and what it does not do yet, refused before any work rather than ignored."""
-    for table in ("options", "rates", "uncertainty"):
-        if data.get(table):
+    for table in ("options", "rates", "uncertainty", "model_uncertainty"):
+        if table in data:
             raise SiteError(f"{path}: [{table}] is given, but hazard.scenario {hz['scenario']!r} is a 3-D terrain "
                             "scenario: on 3-D terrain riskrf assess writes the hazard, energy and road outputs and "
                             f"does not rank mitigation options yet; remove [{table}] or give a 2-D profile scenario")

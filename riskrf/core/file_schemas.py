@@ -260,8 +260,27 @@ UNCERTAINTY = Table("uncertainty", (
 
 MITIGATION_TABLES = (TRAFFIC, CONSEQUENCES, ECONOMICS, CRITERIA, OPTIONS, UNCERTAINTY)
 
+MODEL_UNCERTAINTY = Table("model_uncertainty", (
+    _path("posterior", "posterior sample of the scenario's material parameters (simulation.PooledCalibration.write); "
+          "without it, the presets' spread (ASSUMED ranges, simulation.material_uncertainty)"),
+    _count("draws", "draws of the material parameters, each re-simulated", default=8, low=2),
+    _count("n_blocks", "simulated blocks per draw (energy hazard and the seeder's run)", default=2000, low=100),
+    _count("option_blocks", "blocks per re-simulation of an option, per draw", default=1000, low=100),
+    _count("bootstrap", "bootstrap replicates of the design energies, per draw", default=100, low=10),
+    _count("seed", "random seed of the draws, their simulations and the synthetic calibrations (default: "
+           "hazard.seed)", low=0),
+    _count("calibration_releases", "blocks released and observed in the field calibration whose value is "
+           "computed", default=20, low=1),
+    _nonneg("calibration_cost", "currency", "cost of that calibration (default: an ASSUMED 100,000 in the "
+            "site's currency)"),
+    _count("synthetic_calibrations", "synthetic calibrations per draw in the preposterior analysis", default=200),
+    _pos("obs_error_m", "m", "observation error of a stop position (smallest kernel width)", default=0.5),
+), "The trajectory model's uncertainty carried to the design energies and the ranking, and the value of a "
+   "field calibration (off when the table is absent).")
+
 SITE_SCHEMA = FileSchema("Site file (riskrf assess SITE.toml)",
-                         (SITE, INVENTORY, HAZARD, DESIGN_BLOCK, DESIGN, REPORT, RATES) + MITIGATION_TABLES,
+                         (SITE, INVENTORY, HAZARD, DESIGN_BLOCK, DESIGN, REPORT, RATES) + MITIGATION_TABLES
+                         + (MODEL_UNCERTAINTY,),
                          "One assessment: inventory, slope, exposure, options and economics.")
 OPTIONS_SCHEMA = FileSchema("Mitigation options file (riskrf decide --options OPTIONS.toml)", MITIGATION_TABLES,
                             "The mitigation tables of a site file on their own.")

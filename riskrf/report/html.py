@@ -305,7 +305,13 @@ def render_report(a, figs: Path) -> str:
                    "GEO F-N lines.</li>")
     summary.append(f"<li>Lowest expected total cost: <b>{_e(best)}</b> "
                    f"({money_est(ranking['expected_total_cost'].iloc[0])}), then {_e(second)} "
-                   f"({money_est(ranking['expected_total_cost'].iloc[1])}).</li></ul></div>")
+                   f"({money_est(ranking['expected_total_cost'].iloc[1])}).</li>")
+    mu = getattr(a, "model_uncertainty", None)
+    if mu is not None:
+        summary += [f"<li>Trajectory model: {_e(t)}.</li>" for t in mu.energy.text(mu.design_T)]
+        summary.append(f"<li>Over {mu.ranking.n_draws} draws of the trajectory model the least expected cost is "
+                       f"<b>{_e(mu.ranking.best_now())}</b>; <b>{_e(mu.verdict())}</b>.</li>")
+    summary.append("</ul></div>")
     header += "".join(summary)
 
     # 1. Site and data
@@ -573,6 +579,9 @@ def render_report(a, figs: Path) -> str:
             f"sampled inputs at once: <b>{money_est(voi['evpi_all_sampled_inputs'])}</b> &mdash; the most that "
             "investigations settling them are worth.</p>")
 
+    if mu is not None:
+        _model_uncertainty_section(doc, mu, figs, cur)
+
     # 9. Assumptions
     doc.section("Assumptions, defaults and warnings")
     classed = isinstance(hz.velocity, PairedSamples)
@@ -598,3 +607,28 @@ def render_report(a, figs: Path) -> str:
         doc.add("<h3>Warnings</h3><div class='warn'><ul>"
                 + "".join(f"<li>{_e(w)}</li>" for w in a.warnings) + "</ul></div>")
     return _ABSOLUTE_DIRS.sub("", doc.render(header=header))
+
+
+def _model_uncertainty_section(doc, mu, figs: Path, cur: str) -> None:
+    """The trajectory model's uncertainty: the design energies' split, the ranking over the draws, the EVPI and
+    the EVSI of a field calibration (riskrf.app.model_uncertainty)."""
+    doc.section("Trajectory model uncertainty")
+    e = mu.energy.summary()
+    e = e[["T_years", "energy_kj_reference", "energy_kj_mean", "combined_low_kj", "combined_high_kj",
+           "model_low_kj", "model_high_kj", "statistical_low_kj", "statistical_high_kj",
+           "share_from_trajectory_model"]]
+    rank = mu.ranking.summary()
+    money_cols = [c for c in rank.columns if "cost" in c]
+    doc.add(f"<p>The slope was re-simulated for {mu.ranking.n_draws} draws of its material parameters "
+            f"({_e(mu.basis)}); for each draw the energy hazard, the design energies and the mitigation study were "
+            "computed again with the same seed and the same samples of the other inputs.  The interval of a design "
+            "energy is split by the law of total variance into the part from the trajectory model (the spread of "
+            "the draws) and the statistical part (b, the rate, the finite number of trajectories).</p>",
+            doc.table(e, f"Design energies over the draws [kJ] ({mu.energy.level:.0%} intervals)"),
+            doc.figure(figs / "design_energy_model_uncertainty.png",
+                       f"The {mu.design_T:g}-year energy of each draw with its bootstrap interval"),
+            doc.table(rank, f"Ranking over the draws of the trajectory model [{cur}]", money_columns=money_cols,
+                      currency=cur),
+            doc.figure(figs / "ranking_model_uncertainty.png", "Expected total cost of each option under each draw"),
+            f"<div class='box'><b>{_e(mu.verdict())}</b></div>",
+            "<div class='warn'><ul>" + "".join(f"<li>{_e(n)}</li>" for n in mu.notes) + "</ul></div>")
