@@ -683,9 +683,9 @@ def _copy_inputs(a: Assessment, dest: Path) -> None:
     text = site.path.read_text(encoding="utf-8")
     for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
                        ("hazard", "velocities"), ("design_block", "survey"), ("rates", "record"),
-                       ("rates", "rainfall"), ("rates", "warnings")):
+                       ("rates", "rainfall"), ("rates", "warnings"), ("model_uncertainty", "posterior")):
         rel = {"inventory": site.inventory, "hazard": site.hazard, "design_block": site.design_block,
-               "rates": site.rates or {}}[table].get(key)
+               "rates": site.rates or {}, "model_uncertainty": site.model_uncertainty or {}}[table].get(key)
         if rel:
             src = site.resolve(rel)
             shutil.copy2(src, dest / src.name)

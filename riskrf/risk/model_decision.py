@@ -335,7 +335,7 @@ class ModelUncertainRanking:
     def text(self) -> list[str]:
         """Plain-text lines: the ranking over the draws and the EVPI."""
         cur = f" {self.currency}" if self.currency else ""
-        lines = [f"Ranking over {self.n_draws} draws of the trajectory model ({self.basis}):"]
+        lines = [f"Ranking over {self.n_draws} draws of the trajectory model:"]
         for _, r in self.summary().iterrows():
             share = r.get("share_of_variance_from_trajectory_model", np.nan)
             lines.append(f"  {r['rank']}. {r['option']}: {money(r['expected_total_cost'], sig=3)}{cur} "

@@ -1,0 +1,283 @@
+"""The trajectory model's uncertainty carried to the decision: material draws, the design-energy split, the
+ranking over draws, EVPI and the EVSI of a field calibration, and `[model_uncertainty]` in `riskrf assess`."""
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import stats
+
+import simulation
+from riskrf.app.site import SiteError, load_site
+from riskrf.hazard.annual_hazard import EnergyHazard
+from riskrf.hazard.model_uncertainty import ModelUncertaintyError, design_energy_split
+from riskrf.risk.model_decision import DecisionValueError, ModelUncertainRanking
+
+from .conftest import ROOT
+
+SCENARIO = ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml"
+INVENTORY = ROOT / "riskrf" / "data" / "lauterbrunnen_tls_2018.csv"
+
+
+# ---- an exact decision: two options, a two-point prior, Gaussian observations -------------------------------------
+# Costs C[theta, option]: option A costs 10 if theta_1 and 20 if theta_2, option B 14 either way; prior 1/2 each.
+# Prior means A 15, B 14: choose B (14).  Perfect information: min(10, 14) = 10, min(20, 14) = 14, mean 12, so
+# EVPI = 2.  A calibration stop x ~ N(mu_theta, h) with mu = 40, 42 m and h = 1 m (every simulated stop of a draw at
+# mu: the kernel density is N(mu, h), h = obs_error_m).  After N stops with mean xbar, A is chosen when
+# P(theta_1 | x) > 0.6, i.e. L1/L2 > 1.5, i.e. N (mu2 - mu1)(mu1 + mu2 - 2 xbar) / (2 h^2) > ln 1.5, i.e.
+# xbar < 41 - ln(1.5) / (2 N); xbar ~ N(mu, h / sqrt N).  EVSI = 1/2 (14 - 10) P(A | theta_1) - 1/2 (20 - 14)
+# P(A | theta_2) (Raiffa & Schlaifer 1961, ch. 4: the preposterior value of a normal sample, two actions).
+COSTS = np.array([[10.0, 14.0], [20.0, 14.0]])
+STOPS = [np.full(40, 40.0), np.full(40, 42.0)]
+
+
+def _hand_evsi(n):
+    x_star = 41.0 - np.log(1.5) / (2 * n)
+    return 0.5 * 4 * stats.norm.cdf((x_star - 40) * np.sqrt(n)) - 0.5 * 6 * stats.norm.cdf((x_star - 42) * np.sqrt(n))
+
+
+def test_exact_two_option_two_point_prior():
+    r = ModelUncertainRanking(("A", "B"), COSTS, currency="CHF")
+    assert r.evpi() == pytest.approx(2.0, abs=1e-12)
+    assert r.best_now() == "B"
+    assert r.probability_best().tolist() == [0.5, 0.5]
+    for n, hand in ((1, 1.2311), (3, 1.7971)):
+        assert _hand_evsi(n) == pytest.approx(hand, abs=1e-4)
+        v = r.calibration_value(STOPS, n_releases=n, profile_range_m=(0, 100), obs_error_m=1.0, n_datasets=20_000,
+                                seed=1)
+        # the defensive uniform share (1e-3 of the density) moves the exact value by < 0.006
+        assert v.evsi_estimate == pytest.approx(hand, abs=4 * v.standard_error + 0.006), (n, v.evsi_estimate)
+        assert v.standard_error < 0.015
+    none = r.calibration_value(STOPS, n_releases=0, profile_range_m=(0, 100), obs_error_m=1.0, n_datasets=50)
+    assert none.evsi == 0.0 and none.probability_decision_changes == 0.0          # no data, no value
+    many = r.calibration_value(STOPS, n_releases=60, profile_range_m=(0, 100), obs_error_m=1.0, n_datasets=200)
+    assert many.evsi == pytest.approx(2.0, abs=1e-9)                                # identifying data: the EVPI
+
+
+def test_verdict_weighs_the_evsi_against_the_calibration_cost():
+    r = ModelUncertainRanking(("A", "B"), COSTS, currency="CHF")
+    kw = dict(n_releases=1, profile_range_m=(0, 100), obs_error_m=1.0, n_datasets=4000, seed=2)
+    cheap = r.calibration_value(STOPS, calibration_cost=0.5, **kw)
+    dear = r.calibration_value(STOPS, calibration_cost=1.9, cost_is_assumption=True, **kw)
+    assert cheap.calibrate_first and cheap.verdict().startswith("calibrate first, then decide")
+    assert not dear.calibrate_first and dear.verdict().startswith("decide now")
+    assert "ASSUMED default" in dear.verdict() and "(stated)" in cheap.verdict()
+    assert json.loads(json.dumps(cheap.to_dict()))["calibrate_first"] is True
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 10_000), J=st.integers(2, 5), K=st.integers(2, 4), n=st.integers(0, 6))
+def test_evsi_lies_between_zero_and_the_evpi(seed, J, K, n):
+    rng = np.random.default_rng(seed)
+    costs = rng.uniform(0, 10, (J, K))
+    weights = rng.uniform(0.1, 1, J)
+    stops = [rng.normal(rng.uniform(20, 80), rng.uniform(0.5, 8), 30) for _ in range(J)]
+    r = ModelUncertainRanking(tuple("ABCD"[:K]), costs, weights=weights)
+    v = r.calibration_value(stops, n_releases=n, profile_range_m=(0, 100), n_datasets=60, seed=seed)
+    evpi = r.evpi()
+    assert evpi == pytest.approx(float((r.weights @ costs).min() - r.weights @ costs.min(axis=1)))
+    assert 0.0 <= v.evsi <= evpi + 1e-9
+    assert v.evsi_estimate <= evpi + 1e-9                       # the paired estimator can never exceed the EVPI
+    if np.isfinite(v.standard_error) and v.standard_error > 0:
+        assert v.evsi_estimate >= -4 * v.standard_error          # the Bayes choice does not lose on average
+    assert sum(v.after_calibration.values()) == pytest.approx(1.0)
+
+
+def test_ranking_summary_splits_each_options_cost_variance():
+    rng = np.random.default_rng(3)
+    means = np.array([[1.0, 2.0], [3.0, 2.5], [2.0, 2.2]])
+    samples = means[:, None, :] + rng.normal(0, 0.3, (3, 400, 2))
+    r = ModelUncertainRanking(("A", "B"), samples.mean(axis=1), sample_costs=samples)
+    t = r.summary().set_index("option")
+    s = samples[:, :, 0]
+    between = np.var(s.mean(axis=1))
+    assert t.loc["A", "share_of_variance_from_trajectory_model"] == pytest.approx(between / s.var(), rel=1e-9)
+    assert t["probability_best_given_model"].sum() == pytest.approx(1.0)
+    assert t["probability_best_joint"].sum() == pytest.approx(1.0)
+    assert t.loc["A", "probability_best_given_model"] == pytest.approx(2 / 3)     # draws 0 and 2
+    per = r.per_draw()
+    assert per["best_option"].tolist() == ["A", "B", "A"]
+    with pytest.raises(DecisionValueError, match="costs must be a table"):
+        ModelUncertainRanking(("A", "B", "C"), means)
+    with pytest.raises(DecisionValueError, match="stops: give the simulated stops of each of the 3 draws"):
+        r.calibration_value(STOPS, n_releases=1, profile_range_m=(0, 100))
+
+
+# ---- the design-energy split --------------------------------------------------------------------------------------
+def _hazard(scale=1.0):
+    gr = pytest.importorskip("riskrf").fit_gutenberg_richter(
+        np.random.default_rng(1).pareto(0.8, 300) * 100 + 100, 10.0, m_min=100.0)
+    v = np.random.default_rng(2).gamma(9.0, 2.0, 400)
+    return EnergyHazard(mass=gr, velocity=v * scale, rate_per_year=gr.rate_min, reach_probability=0.4)
+
+
+def test_design_energy_split_by_the_law_of_total_variance():
+    """Two draws whose speeds differ by sqrt 2 have T-year energies (and bootstrap replicates, same seed) in the
+    ratio 2, so with one draw's replicate mean m and variance v: between = (2m - m)^2 / 4, within = (v + 4v) / 2."""
+    base = _hazard()
+    reps = base.energy_at_return_period_replicates([50.0], 60, seed=4)[:, 0]
+    m, v = reps.mean(), reps.var()
+    split = design_energy_split([base, _hazard(np.sqrt(2.0))], [50.0], n_bootstrap=60, seed=4, reference=base)
+    r = split.row(50.0)
+    assert r["variance_trajectory_model_kj2"] == pytest.approx(m ** 2 / 4, rel=0.02)
+    assert r["variance_statistical_kj2"] == pytest.approx(2.5 * v, rel=0.02)
+    assert r["share_from_trajectory_model"] == pytest.approx((m ** 2 / 4) / (m ** 2 / 4 + 2.5 * v), rel=0.02)
+    assert r["energy_kj_reference"] == pytest.approx(float(base.energy_at_return_period(50.0)))
+    assert r["combined_low_kj"] <= r["model_low_kj"] <= r["model_high_kj"] <= r["combined_high_kj"]
+    same = design_energy_split([base, base, base], [50.0], n_bootstrap=30, seed=4).row(50.0)
+    assert same["share_from_trajectory_model"] == pytest.approx(0.0, abs=1e-12)
+    assert same["model_low_kj"] == same["model_high_kj"]
+    assert any("trajectory model" in t for t in split.text())
+    with pytest.raises(ModelUncertaintyError, match="at least 2 draws"):
+        design_energy_split([base], [50.0])
+
+
+# ---- material draws -----------------------------------------------------------------------------------------------
+def test_preset_spread_is_labelled_and_latin_hypercube_draws_fill_every_slice():
+    spread = simulation.preset_spread(SCENARIO)
+    assert spread.loc["materials.talus.ground_friction_angle_deg", ["low", "high"]].tolist() == [34.0, 42.0]
+    assert "materials.talus.normal_restitution.mean" not in spread.index          # Wyllie's law has no mean
+    assert spread["assumption"].all() and spread["basis"].str.startswith("ASSUMPTION").all()
+    d = simulation.material_draws(SCENARIO, 7, seed=3)
+    assert "ASSUMPTIONS" in d.attrs["basis"]
+    for col in d:
+        lo, hi = spread.loc[col, ["low", "high"]]
+        slices = np.floor((d[col] - lo) / (hi - lo) * 7).astype(int)
+        assert sorted(slices) == list(range(7)), col                                 # one draw per slice
+    sc = simulation.scenario_with_values(SCENARIO, d.iloc[0].to_dict())
+    talus = next(m for m in sc.materials if m.name == "talus")
+    assert talus.ground_friction_deg == pytest.approx(d.iloc[0]["materials.talus.ground_friction_angle_deg"])
+
+
+def test_a_data_derived_spread_plugs_in_first(monkeypatch):
+    from simulation import material_uncertainty as mu
+
+    def data_source(preset, table):
+        return {"ground_friction_angle_deg": (30.0, 31.0, "data: a test source")} if preset == "talus" else {}
+    monkeypatch.setattr(mu, "PRESET_SPREAD_SOURCES", [data_source] + mu.PRESET_SPREAD_SOURCES)
+    spread = simulation.preset_spread(SCENARIO)
+    row = spread.loc["materials.talus.ground_friction_angle_deg"]
+    assert (row["low"], row["high"], row["assumption"]) == (30.0, 31.0, False)
+    assert spread.loc["materials.talus.tangential.mean", "assumption"]               # the rest stays assumed
+
+
+def test_posterior_draws_keep_rows_whole():
+    post = pd.DataFrame({"materials.talus.ground_friction_angle_deg": np.arange(10.0) + 30,
+                         "materials.talus.tangential.mean": np.arange(10.0) / 20 + 0.3})
+    d = simulation.material_draws(SCENARIO, 4, posterior=post, seed=1)
+    assert len(d) == 4 and "posterior" in d.attrs["basis"]
+    for _, row in d.iterrows():
+        i = int(row.iloc[0] - 30)
+        assert row.iloc[1] == pytest.approx(post.iloc[i, 1])
+
+
+# ---- the site file: bad input before any work, and the assessment ------------------------------------------------
+def _posterior_file(path, columns):
+    with open(path, "w") as fh:
+        fh.write("# simulation pooled posterior; bounds = "
+                 + json.dumps({c: [0.0, 60.0] for c in columns}) + "\n")
+        pd.DataFrame({c: np.linspace(0.4, 0.6, 6) if c.endswith("mean") else np.linspace(35, 40, 6)
+                      for c in columns}).to_csv(fh, index=False)
+    return path
+
+
+def _site(tmp_path, extra="", options=None):
+    opts = options or """
+[[options]]
+name = "do nothing"
+kind = "none"
+capital_cost = 0
+
+[[options]]
+name = "fence 2000 kJ"
+kind = "fence"
+capital_cost = 900000
+annual_maintenance = 10000
+life_years = 25
+repair_cost_per_impact = 40000
+replacement_cost = 250000
+capacity_kj = 2000
+height_m = 5.0
+"""
+    text = f"""
+[inventory]
+path = "{INVENTORY}"
+m_max_kg = 2.0e6
+rate_scale = 0.05
+
+[hazard]
+scenario = "{SCENARIO}"
+n_blocks = 1500
+option_blocks = 500
+bootstrap = 20
+fences_kj = [2000]
+
+[uncertainty]
+samples = 200
+{opts}
+{extra}
+"""
+    p = tmp_path / "site.toml"
+    p.write_text(text)
+    return p
+
+
+def test_bad_posterior_refused_before_any_work(tmp_path):
+    good = _posterior_file(tmp_path / "post.csv", ["materials.talus.ground_friction_angle_deg"])
+    assert load_site(_site(tmp_path, '[model_uncertainty]\nposterior = "post.csv"')).model_uncertainty is not None
+    _posterior_file(tmp_path / "clay.csv", ["materials.clay.ground_friction_angle_deg"])
+    with pytest.raises(SiteError, match=r"model_uncertainty.posterior = 'clay.csv'.*clay.csv.*"
+                                        r"'materials.clay.ground_friction_angle_deg'.*does not define"):
+        load_site(_site(tmp_path, '[model_uncertainty]\nposterior = "clay.csv"'))
+    (tmp_path / "plain.csv").write_text("a,b\n1,2\n")
+    with pytest.raises(SiteError, match="plain.csv: not a posterior written by PooledCalibration.write"):
+        load_site(_site(tmp_path, '[model_uncertainty]\nposterior = "plain.csv"'))
+    with pytest.raises(SiteError, match="model_uncertainty.posterior = 'none.csv': file not found"):
+        load_site(_site(tmp_path, '[model_uncertainty]\nposterior = "none.csv"'))
+    with pytest.raises(SiteError, match="unknown field model_uncertainty.'draw'; did you mean 'draws'"):
+        load_site(_site(tmp_path, "[model_uncertainty]\ndraw = 4"))
+    with pytest.raises(SiteError, match="model_uncertainty.draws = 1 must be a whole number >= 2"):
+        load_site(_site(tmp_path, "[model_uncertainty]\ndraws = 1"))
+    assert good.exists()
+
+
+def test_off_by_default(tmp_path):
+    site = load_site(_site(tmp_path))
+    assert site.model_uncertainty is None
+    assert not any(d.startswith("model_uncertainty") for d in site.defaults_used)
+
+
+@pytest.fixture(scope="module")
+def carried(tmp_path_factory):
+    from riskrf.app.assess import run_assessment
+    tmp = tmp_path_factory.mktemp("model_uncertainty")
+    site = load_site(_site(tmp, "[model_uncertainty]\ndraws = 3\nn_blocks = 600\noption_blocks = 300\n"
+                                "bootstrap = 20\nsynthetic_calibrations = 40\ncalibration_releases = 10"))
+    return run_assessment(site)
+
+
+def test_assess_carries_the_model_uncertainty_to_the_decision(carried, tmp_path):
+    mu = carried.model_uncertainty
+    s = carried.summary()["model_uncertainty"]
+    assert s["draws"] == 3 and len(s["parameters"]) == 9 and "ASSUMPTIONS" in s["basis"]
+    d = s["design_energy"]
+    assert 0.0 <= d["share_of_variance_from_trajectory_model"] <= 1.0
+    assert d["interval_kj"][0] <= d["trajectory_model_interval_kj"][0] <= d["trajectory_model_interval_kj"][1] \
+        <= d["interval_kj"][1]
+    assert d["energy_kj_reference"] == pytest.approx(
+        float(carried.energy.hazard.energy_at_return_period(100.0)))
+    assert {r["option"] for r in s["ranking"]} == {"do nothing", "fence 2000 kJ"}
+    assert sum(r["probability_best_given_model"] for r in s["ranking"]) == pytest.approx(1.0)
+    cal = s["calibration"]
+    assert 0.0 <= cal["evsi"] <= s["evpi_material_parameters"] + 1e-9
+    assert cal["calibration_cost"] == 100_000.0 and cal["calibration_cost_is_assumption"]
+    assert s["verdict"].startswith(("calibrate first, then decide", "decide now"))
+    assert any("calibration_cost" in u for u in carried.site.defaults_used)
+    # the draws differ: the materials move the reach of the barrier line
+    assert mu.per_draw["reach_probability"].nunique() == 3
+    files = mu.write(tmp_path)
+    draws = pd.read_csv(files[1])
+    assert len(draws) == 3 and "cost:do nothing" in draws and "materials.talus.ground_friction_angle_deg" in draws
+    json.dumps(carried.summary(), default=str)
