@@ -188,6 +188,33 @@ def release_factor_for_road_record(hazard, share: float, context: dict, source: 
     return recorded / road
 
 
+def draw_evaluator(site, inventory, scenario, n_blocks: int, option_blocks: int, seed, uncertainty, *,
+                   rate_scale: float, rate_note, mitigation: dict, design_masses) -> tuple:
+    """The assessment's chain for one draw of the trajectory model (``[model_uncertainty]``): the energy hazard
+    simulated on ``scenario`` with ``n_blocks`` blocks, the road-basis release factor recomputed when the record
+    counts road falls, and the mitigation study with ``option_blocks`` per option re-simulation and the study's
+    uncertainty ``uncertainty``.  ``rate_scale``, ``rate_note``, ``mitigation`` and ``design_masses``: as the
+    assessment used them (before its own release factor).  Returns (hazard, study, seeder run, road share)."""
+    hz_cfg, inv_cfg = site.hazard, site.inventory
+    collector, road = hz_cfg["collector"], hz_cfg["road_collector"]
+    _, hz, result, hits = energy_hazard_from_inputs(
+        inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=rate_scale, scenario=scenario,
+        collector=collector, n=n_blocks, seed=seed, mass_coupling=hz_cfg["mass_coupling"],
+        design_masses_kg=design_masses, rate_note=rate_note, road_collector=road)
+    share = road_share(result, collector, road)
+    if inv_cfg.get("rate_basis", "release") == "road":
+        factor = release_factor_for_road_record(
+            hz, share, study_context(result, collector, road, option_blocks, seed, inventory, hz, rate_scale, hits),
+            str(site.path), uncertainty=uncertainty)
+        hz = replace(hz, rate_per_year=hz.rate_per_year * factor)
+        rate_scale = rate_scale * factor
+    study = MitigationStudy(hazard=hz, road_share=share, source=str(site.path), defaults_used=site.defaults_used,
+                            **study_context(result, collector, road, option_blocks, seed, inventory, hz, rate_scale,
+                                            hits),
+                            **(dict(mitigation, uncertainty=uncertainty) if uncertainty is not None else mitigation))
+    return hz, study, result, share
+
+
 def fence_design_checks(options, energy) -> dict:
     """Option name -> verdict of its fence checks in ``energy`` (an EnergyAnalysis): "adequate" or "NOT ADEQUATE:
     <failed checks>", for the fence and attenuator options checked there; shown in the ranking itself."""
@@ -523,9 +550,10 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             t = time.perf_counter()
             log(f"      the trajectory model's uncertainty: {site.model_uncertainty['draws']} draws of the material "
                 "parameters re-simulated (design energies, ranking, value of a field calibration)")
+            evaluate = partial(draw_evaluator, site, inventory, rate_scale=rate_scale / release_factor,
+                               rate_note=rate_note, mitigation=mitigation, design_masses=design_masses)
             model_uncertainty = run_model_uncertainty(
-                site, inventory, rate_scale=rate_scale / release_factor, rate_note=rate_note, mitigation=mitigation,
-                design_masses=design_masses, reference_hazard=hazard, design_T=hz_cfg["design_period_years"],
+                site, evaluate, reference_hazard=hazard, design_T=hz_cfg["design_period_years"],
                 T=energy.design["T_years"].tolist(), log=log)
             timings["model_uncertainty"] = round(time.perf_counter() - t, 2)
     notes = []

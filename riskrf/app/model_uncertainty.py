@@ -191,24 +191,20 @@ def _without_material_draws(uncertainty):
     return replace(uncertainty, **kw)
 
 
-def run_model_uncertainty(site, inventory, *, rate_scale: float, rate_note, mitigation: dict, design_masses,
-                          reference_hazard=None, design_T: float = 100.0, T=None, log=None) -> ModelUncertaintyStudy:
+def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_T: float = 100.0, T=None,
+                          log=None) -> ModelUncertaintyStudy:
     """Re-simulate the site's slope for each draw of the trajectory model and carry it to the design energies,
     the ranking and the value of a field calibration (see the module docstring).
 
-    ``rate_scale`` and ``rate_note``: the hazard's rate factor as the assessment computed it (before a
-    road-basis release factor, which is recomputed per draw); ``mitigation``: the study's inputs as the
-    assessment used them (closure rules resolved); ``design_masses``: the masses [kg] (or the function of the law
-    and rate) the simulated range must include; ``reference_hazard``: the assessment's own hazard (reported beside
-    the draws); ``T``: return periods [yr] of the design energies (default the design period).
+    ``evaluate_draw(scenario, n_blocks, option_blocks, seed, uncertainty)`` runs the assessment's own chain for
+    one scenario and returns (EnergyHazard, MitigationStudy, SimulationResult of the scenario's seeder, road
+    share) (:func:`riskrf.app.assess.draw_evaluator`); ``uncertainty`` is the study's uncertainty to use (its
+    material draws switched off).  ``reference_hazard``: the assessment's own hazard (reported beside the
+    draws); ``T``: return periods [yr] of the design energies (default the design period).
     """
     import simulation
 
-    from ..risk.mitigation import MitigationStudy
-    from .assess import energy_hazard_from_inputs, release_factor_for_road_record, road_share, study_context
-
     cfg = site.model_uncertainty
-    hz_cfg, inv_cfg = site.hazard, site.inventory
     log = log or (lambda s: None)
     seed = int(cfg["seed"])
     scenario = cfg["scenario_path"]
@@ -218,29 +214,14 @@ def run_model_uncertainty(site, inventory, *, rate_scale: float, rate_note, miti
     basis = draws.attrs.get("basis", "")
     if cfg["posterior"]:
         basis = f"posterior {Path(cfg['posterior']).name}: " + basis
-    mitigation = dict(mitigation, uncertainty=_without_material_draws(mitigation.get("uncertainty")))
-    collector, road = hz_cfg["collector"], hz_cfg["road_collector"]
+    uncertainty = _without_material_draws(site.mitigation.get("uncertainty"))
     hazards, costs, samples, stops, rows = [], [], [], [], []
     names = None
     for j, (_, values) in enumerate(draws.iterrows()):
         log(f"      draw {j + 1}/{len(draws)} of the trajectory model")
         sc = simulation.scenario_with_values(scenario, values.to_dict())
-        gr, hz, result, hits = energy_hazard_from_inputs(
-            inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=rate_scale, scenario=sc,
-            collector=collector, n=int(cfg["n_blocks"]), seed=seed, mass_coupling=hz_cfg["mass_coupling"],
-            design_masses_kg=design_masses, rate_note=rate_note, road_collector=road)
-        scale = rate_scale
-        share = road_share(result, collector, road)
-        if inv_cfg.get("rate_basis", "release") == "road":
-            factor = release_factor_for_road_record(
-                hz, share, study_context(result, collector, road, int(cfg["option_blocks"]), seed, inventory, hz,
-                                         scale, hits), str(site.path), uncertainty=mitigation.get("uncertainty"))
-            hz = replace(hz, rate_per_year=hz.rate_per_year * factor)
-            scale *= factor
-        study = MitigationStudy(hazard=hz, road_share=share, source=str(site.path), defaults_used=site.defaults_used,
-                                **study_context(result, collector, road, int(cfg["option_blocks"]), seed, inventory,
-                                                hz, scale, hits),
-                                **mitigation)
+        hz, study, result, share = evaluate_draw(sc, int(cfg["n_blocks"]), int(cfg["option_blocks"]), seed,
+                                                 uncertainty)
         u = study.uncertain
         names = tuple(u["names"]) if names is None else names
         hazards.append(hz)
