@@ -25,6 +25,8 @@ _EXPORTS = {
     "exceedance_probability": "hazard.impact_energy", "fit_velocity": "hazard.impact_energy",
     "DEFAULT_DENSITY_KG_M3": "frequency.inventory", "Inventory": "frequency.inventory", "read_inventory": "frequency.inventory",
     "MassCoupledSamples": "hazard.mass_coupling", "energy_hazard": "hazard.simulated",
+    # the trajectory model's uncertainty: hazards over material draws, ranking and value of calibrating first
+    "energy_hazard_ensemble": "hazard.model_uncertainty", "ModelUncertainRanking": "risk.model_decision",
     "GutenbergRichterFit": "frequency.power_law", "find_m_min": "frequency.power_law", "fit_gutenberg_richter": "frequency.power_law",
     "Rainfall": "io.rainfall", "read_rainfall": "io.rainfall",
     "RateModel": "frequency.rates", "rate_model": "frequency.rates",

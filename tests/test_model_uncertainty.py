@@ -281,3 +281,13 @@ def test_assess_carries_the_model_uncertainty_to_the_decision(carried, tmp_path)
     draws = pd.read_csv(files[1])
     assert len(draws) == 3 and "cost:do nothing" in draws and "materials.talus.ground_friction_angle_deg" in draws
     json.dumps(carried.summary(), default=str)
+
+
+def test_stop_density_is_the_pooled_calibrations_per_stop_likelihood():
+    """Every simulated stop at 50 m: the kernel is N(50, obs_error) (Silverman's width of no spread is 0), mixed
+    with the uniform share 1e-3 over the profile length (simulation.pooled.DEFENSIVE_SHARE)."""
+    x = np.array([48.0, 50.0, 53.0])
+    got = simulation.stop_density(np.full(30, 50.0), x, 100.0, obs_error_m=2.0)
+    assert got == pytest.approx(0.999 * stats.norm.pdf(x, 50.0, 2.0) + 1e-3 / 100.0, rel=1e-12)
+    import riskrf
+    assert riskrf.ModelUncertainRanking is ModelUncertainRanking and callable(riskrf.energy_hazard_ensemble)
