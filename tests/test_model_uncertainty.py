@@ -291,3 +291,30 @@ def test_stop_density_is_the_pooled_calibrations_per_stop_likelihood():
     assert got == pytest.approx(0.999 * stats.norm.pdf(x, 50.0, 2.0) + 1e-3 / 100.0, rel=1e-12)
     import riskrf
     assert riskrf.ModelUncertainRanking is ModelUncertainRanking and callable(riskrf.energy_hazard_ensemble)
+
+
+def test_a_road_record_is_reproduced_in_every_draw(tmp_path):
+    """rate_basis = "road": each draw's release rate is recomputed so that doing nothing reproduces the falls
+    recorded on the road (the draws move the reach, not the record)."""
+    from functools import partial
+
+    from riskrf.app.assess import draw_evaluator
+    from riskrf.app.model_uncertainty import _without_material_draws
+    from riskrf.frequency.inventory import read_inventory
+    path = _site(tmp_path, "[model_uncertainty]\ndraws = 2")
+    path.write_text(path.read_text().replace("rate_scale = 0.05", 'rate_scale = 0.05\nrate_basis = "road"'))
+    site = load_site(path)
+    inv = read_inventory(site.resolve(site.inventory["path"]))
+    evaluate = partial(draw_evaluator, site, inv, rate_scale=0.05, rate_note=None, mitigation=site.mitigation,
+                       design_masses=())
+    draws = simulation.material_draws(SCENARIO, 2, seed=5)
+    recorded = []
+    gr = None
+    for _, row in draws.iterrows():
+        hz, study, result, share = evaluate(simulation.scenario_with_values(SCENARIO, row.to_dict()), 600, 300, 1,
+                                            _without_material_draws(site.mitigation["uncertainty"]))
+        gr = hz.mass
+        recorded.append(study.evaluate("do nothing").road_falls_per_year)
+    small = np.sum(inv.masses < gr.m_min)
+    expected = (len(inv.masses[inv.masses >= gr.m_min]) + small) / inv.duration_years * 0.05
+    assert recorded == pytest.approx([expected, expected], rel=1e-6)
