@@ -318,3 +318,16 @@ def test_a_road_record_is_reproduced_in_every_draw(tmp_path):
     small = np.sum(inv.masses < gr.m_min)
     expected = (len(inv.masses[inv.masses >= gr.m_min]) + small) / inv.duration_years * 0.05
     assert recorded == pytest.approx([expected, expected], rel=1e-6)
+
+
+def test_report_section_and_figures(carried, tmp_path):
+    from riskrf.report.format import Document
+    from riskrf.report.html import _model_uncertainty_section
+    mu = carried.model_uncertainty
+    figs = mu.figures(tmp_path)
+    assert all(f.exists() and f.stat().st_size > 1000 for f in figs)
+    doc = Document(title="t")
+    _model_uncertainty_section(doc, mu, tmp_path, "CHF")
+    html = doc.render()
+    assert "Trajectory model uncertainty" in html and "share of the variance from the trajectory model" in html
+    assert mu.verdict().split(":")[0] in html and html.count("data:image/png;base64,") == 2

@@ -624,7 +624,10 @@ def _model_uncertainty_section(doc, mu, figs: Path, cur: str) -> None:
             "computed again with the same seed and the same samples of the other inputs.  The interval of a design "
             "energy is split by the law of total variance into the part from the trajectory model (the spread of "
             "the draws) and the statistical part (b, the rate, the finite number of trajectories).</p>",
-            doc.table(e, f"Design energies over the draws [kJ] ({mu.energy.level:.0%} intervals)"),
+            doc.table(e, f"Design energies over the draws [kJ] ({mu.energy.level:.0%} intervals)",
+                      headers={"energy_kj_reference": "at the scenario's values [kJ]",
+                               "energy_kj_mean": "mean of the draws [kJ]",
+                               "share_from_trajectory_model": "share of the variance from the trajectory model"}),
             doc.figure(figs / "design_energy_model_uncertainty.png",
                        f"The {mu.design_T:g}-year energy of each draw with its bootstrap interval"),
             doc.table(rank, f"Ranking over the draws of the trajectory model [{cur}]", money_columns=money_cols,

@@ -463,6 +463,24 @@ def write_pdf_report(a, path, figs) -> Path:
     rep.text(f"Recommendation: {rec['reason']}", size=8.5)
     rep.figure(figs / "tornado.png", "One-way sensitivity of the expected total cost.", max_height=100)
 
+    mu = getattr(a, "model_uncertainty", None)
+    if mu is not None:
+        rep.section("Trajectory model uncertainty")
+        rep.text(f"The slope re-simulated for {mu.ranking.n_draws} draws of its material parameters ({mu.basis}).",
+                 size=8.5)
+        for line in mu.energy.text(mu.design_T):
+            rep.text(line, size=8.5)
+        rank_mu = mu.ranking.summary()
+        rep.table(["option", f"expected total cost [{cur}]", f"trajectory model 5-95 % [{cur}]", "P(best | model)",
+                   "cost variance from the model"],
+                  [[r["option"], fmt(r["expected_total_cost"]), f"{fmt(r['model_cost_p05'])} - "
+                    f"{fmt(r['model_cost_p95'])}", f"{r['probability_best_given_model']:.2f}",
+                    f"{r.get('share_of_variance_from_trajectory_model', float('nan')):.0%}"]
+                   for _, r in rank_mu.iterrows()], widths=[2.2, 1.3, 1.9, 1, 1.2], size=7.2)
+        rep.text(mu.verdict(), size=8.5, style="B")
+        rep.figure(figs / "design_energy_model_uncertainty.png",
+                   f"The {mu.design_T:g}-year energy of each draw with its bootstrap interval.", max_height=90)
+
     # ---- inventory -----------------------------------------------------------------------------
     rep.section("Inventory and magnitude-frequency law")
     gr = a.frequency.power_law
