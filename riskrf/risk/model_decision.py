@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ..core.format import money, sig
+from ..core.format import money
 from ..core.validation import RiskrfError
 
 
