@@ -331,3 +331,22 @@ def test_report_section_and_figures(carried, tmp_path):
     html = doc.render()
     assert "Trajectory model uncertainty" in html and "share of the variance from the trajectory model" in html
     assert mu.verdict().split(":")[0] in html and html.count("data:image/png;base64,") == 2
+
+
+def test_energy_hazard_ensemble_from_a_posterior_file(tmp_path):
+    import riskrf
+    from riskrf.hazard.model_uncertainty import energy_hazard_ensemble, read_model_posterior
+    path = _posterior_file(tmp_path / "post.csv", ["materials.talus.ground_friction_angle_deg"])
+    inv = riskrf.read_inventory(INVENTORY)
+    gr = riskrf.fit_gutenberg_richter(inv.masses, inv.duration_years, m_max=2e6)
+    ens = energy_hazard_ensemble(gr, SCENARIO, posterior=path, draws=3, n=300, seed=2, reference=False,
+                                 rate_per_year=0.05 * gr.rate_min)
+    post = read_model_posterior(path, SCENARIO)
+    assert len(ens.hazards) == 3 and "posterior" in ens.basis
+    assert set(ens.draws["materials.talus.ground_friction_angle_deg"]) <= set(post.iloc[:, 0])
+    # a steeper rolling-resistance angle on the talus stops more blocks before the barrier line
+    s = ens.summary().sort_values("materials.talus.ground_friction_angle_deg")
+    assert s["reach_probability"].iloc[0] >= s["reach_probability"].iloc[-1]
+    with pytest.raises(ModelUncertaintyError, match="post.csv.*materials.clay"):
+        _posterior_file(tmp_path / "post.csv", ["materials.clay.ground_friction_angle_deg"])
+        energy_hazard_ensemble(gr, SCENARIO, posterior=path, draws=2, n=300)
