@@ -218,7 +218,7 @@ def _check_terrain_site(data, hz, path):
     """A site on 3-D terrain: what ``riskrf assess`` does with it (hazard, energy at the barrier line, road per
     metre) and what it does not do yet, refused before any work rather than ignored."""
     for table in ("options", "rates", "uncertainty", "model_uncertainty"):
-        if table in data:
+        if data.get(table) or (table == "model_uncertainty" and table in data):     # an empty one switches it on
             raise SiteError(f"{path}: [{table}] is given, but hazard.scenario {hz['scenario']!r} is a 3-D terrain "
                             "scenario: on 3-D terrain riskrf assess writes the hazard, energy and road outputs and "
                             f"does not rank mitigation options yet; remove [{table}] or give a 2-D profile scenario")
