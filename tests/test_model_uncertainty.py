@@ -350,3 +350,13 @@ def test_energy_hazard_ensemble_from_a_posterior_file(tmp_path):
     with pytest.raises(ModelUncertaintyError, match="post.csv.*materials.clay"):
         _posterior_file(tmp_path / "post.csv", ["materials.clay.ground_friction_angle_deg"])
         energy_hazard_ensemble(gr, SCENARIO, posterior=path, draws=2, n=300)
+
+
+def test_a_posterior_table_is_checked_before_any_simulation():
+    from riskrf.hazard.model_uncertainty import energy_hazard_ensemble
+    bad = pd.DataFrame({"materials.clay.ground_friction_angle_deg": [20.0, 25.0]})
+    with pytest.raises(ModelUncertaintyError, match="posterior column 'materials.clay.ground_friction_angle_deg'"):
+        energy_hazard_ensemble(None, SCENARIO, posterior=bad, draws=2)
+    steep = pd.DataFrame({"materials.talus.ground_friction_angle_deg": [20.0, 95.0]})
+    with pytest.raises(ModelUncertaintyError, match="posterior draw 1: .*ground_friction_angle_deg"):
+        energy_hazard_ensemble(None, SCENARIO, posterior=steep, draws=2)

@@ -296,6 +296,17 @@ def energy_hazard_ensemble(mass, scenario, collector: str = "barrier", *, poster
         table = simulation.material_draws(path, draws, posterior=post, seed=seed)
     except ValueError as exc:
         raise ModelUncertaintyError(str(exc)) from None
+    materials = [m.name for m in simulation.load_scenario(path).materials]
+    for col in table.columns:                     # a posterior given as a table: checked before any simulation
+        parts = str(col).split(".")
+        if len(parts) < 3 or parts[0] != "materials" or parts[1] not in materials:
+            raise ModelUncertaintyError(f"posterior column {col!r}: not a parameter 'materials.NAME.FIELD' of a "
+                                        f"material of {path} (materials: {materials})")
+    for i, row in table.iterrows():
+        try:
+            simulation.scenario_with_values(path, row.to_dict())
+        except ValueError as exc:
+            raise ModelUncertaintyError(f"posterior draw {i}: {exc}") from None
     hazards = tuple(energy_hazard(mass, simulation.scenario_with_values(path, row.to_dict()), collector,
                                   rate_per_year=rate_per_year, n=n, seed=seed, **kwargs)
                     for _, row in table.iterrows())
