@@ -351,23 +351,26 @@ def inventory_rate(path: Path, m_min_kg: float, where: str) -> tuple[float, str]
                                  f"{inv.duration_years:.4g} yr (power law b = {fit.b:.3g}), {fit.rate_min:.4g}/yr")
 
 
-def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int | None = None,
-                  decimal: str | None = None, encoding: str | None = None) -> Corridor:
-    """Read and check a corridor file and its sections table before any work.
+def _read_corridor_toml(path: Path) -> tuple[dict, str]:
+    """Read a corridor file and check its top-level tables.
 
-    The sections table is read by the rules of :mod:`riskrf.io.tables` (separator, decimal comma,
-    UTF-8 or cp1252, Excel ``sheet`` and ``header_row``, Parquet); ``sheet``, ``header_row``,
-    ``decimal`` and ``encoding`` may also be given in the ``[corridor]`` table (``sections_sheet``,
-    ``sections_header_row``, ``sections_decimal``, ``sections_encoding``); arguments win.
-    Every bad row is reported (file, row, section id, column, value; rows are the file's lines
-    as an editor or spreadsheet numbers them, comment lines ``#`` of a CSV included).  With ``keep_going`` the bad rows
-    are left out and listed in :attr:`Corridor.errors`; otherwise any bad row raises :class:`CorridorError`
-    listing all of them.  Errors in the corridor file itself always raise.
+    Parameters
+    ----------
+    path : pathlib.Path
+        The corridor file (TOML).
+
+    Returns
+    -------
+    data : dict
+        The parsed TOML.
+    src : str
+        The file's name as errors give it.
+
+    Raises
+    ------
+    CorridorError
+        The file is missing, is not valid TOML or has an unknown top-level table.
     """
-    import simulation
-    from simulation.scenario import ScenarioError, scenario_from_dict
-
-    path = Path(path)
     if not path.exists():
         raise CorridorError(f"corridor file not found: {path}")
     try:
@@ -377,9 +380,36 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     src = str(path)
     _unknown(data, {"corridor", "defaults", "mass", "materials", "traffic", "consequences", "economics", "criteria",
                     "uncertainty", "options", "rates"}, "", src)
+    return data, src
+
+
+def _corridor_settings(cor: dict, path: Path, src: str, sheet, header_row, decimal, encoding) -> dict:
+    """Check the ``[corridor]`` table and read its centreline, in the order the errors are raised.
+
+    Parameters
+    ----------
+    cor : dict
+        The ``[corridor]`` table.
+    path : pathlib.Path
+        The corridor file (paths in it are relative to its folder).
+    src : str
+        The corridor file's name for messages.
+    sheet, header_row, decimal, encoding
+        Reader options of the sections table given as arguments (they win over ``sections_*`` fields).
+
+    Returns
+    -------
+    dict
+        ``variant`` (RHRS variant), ``centreline`` (:class:`riskrf.io.gis` centreline or None), ``reader``
+        (options of :func:`_read_table`), ``rhrs_cap`` (points or None), ``unit`` (chainage unit, 'm' or 'km')
+        and ``basis`` (rate basis, 'road' or 'release').
+
+    Raises
+    ------
+    CorridorError
+        An unknown or invalid field, or a centreline that cannot be read.
+    """
     from ..core.file_schemas import CORRIDOR_SCHEMA
-    from ..core.schema import check as check_schema
-    cor = data.get("corridor", {})
     cor_table = CORRIDOR_SCHEMA.table("corridor")          # one declaration of the [corridor] fields
     _unknown(cor, {f.name for f in cor_table.fields}, "corridor.", src)
     variant = cor.get("rhrs_variant", "fhwa")
@@ -427,23 +457,59 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     if basis not in ("road", "release"):
         raise CorridorError(f"{src}: corridor.rate_basis = {basis!r} must be 'road' (rates count falls reaching "
                             "the road, as a road maintenance record does) or 'release' (falls >= m_min released)")
-    defaults = data.get("defaults", {})
-    _unknown(defaults, [c for c in ALL_COLUMNS if c not in ("id", "chainage_from", "chainage_to", "inventory")]
-             + ["seeder_mass_kg"],
-             "defaults.", src)
-    check_schema(data, CORRIDOR_SCHEMA, src, error=CorridorError)      # every declared type and range
-    gr, mass_note = _mass_law(data.get("mass", {}), path.parent, src)
-    shared = _shared_rate(data.get("rates"), path.parent, float(gr.m_min), src)
+    return {"variant": variant, "centreline": centreline, "reader": reader, "rhrs_cap": rhrs_cap, "unit": unit,
+            "basis": basis}
 
-    mat = data.get("materials", {})
+
+def _materials_template(mat: dict, path: Path, src: str) -> tuple[dict, dict, Path]:
+    """The materials and settings that generated cuts use, from ``materials.scenario`` or the bundled file.
+
+    Parameters
+    ----------
+    mat : dict
+        The ``[materials]`` table (``scenario``: a scenario TOML relative to the corridor file).
+    path : pathlib.Path
+        The corridor file.
+    src : str
+        The corridor file's name for messages.
+
+    Returns
+    -------
+    materials : dict
+        The template's ``[materials]`` table.
+    settings : dict
+        The template's ``[settings]`` table (empty when it has none).
+    template_path : pathlib.Path
+        The template file read.
+    """
     _unknown(mat, {"scenario"}, "materials.", src)
     template_path = (path.parent / mat["scenario"]).resolve() if "scenario" in mat else BUNDLED_MATERIALS
     if not template_path.exists():
         raise CorridorError(f"{src}: materials.scenario = {mat.get('scenario')!r}: file not found ({template_path})")
     template = tomllib.loads(template_path.read_text(encoding="utf-8"))
-    materials, settings = template["materials"], template.get("settings", {})
+    return template["materials"], template.get("settings", {}), template_path
 
-    # study inputs: the mitigation tables, with per-metre costs set aside per option
+
+def _corridor_options(data: dict, src: str) -> tuple[tuple, dict, list]:
+    """Parse the corridor's ``[[options]]`` and study tables, setting per-metre costs aside per option.
+
+    Parameters
+    ----------
+    data : dict
+        The parsed corridor file.
+    src : str
+        The corridor file's name for messages.
+
+    Returns
+    -------
+    options : tuple
+        ``(option, per_m)`` pairs: the parsed option (costs per metre replaced by placeholders) and its
+        per-metre costs ``{capital_cost, annual_maintenance, replacement_cost}`` [money/m].
+    study : dict
+        ``exposure``, ``consequences``, ``economics``, ``uncertainty`` and ``criteria`` of the study.
+    used : list of str
+        The defaults the mitigation parser used (as :func:`riskrf.risk.mitigation_inputs.parse_mitigation`).
+    """
     opt_specs = data.get("options", [])
     if not isinstance(opt_specs, list):
         raise CorridorError(f"{src}: [[options]] must be an array of tables")
@@ -481,9 +547,28 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     options = tuple(zip(options, per_m))
     study = {"exposure": exposure, "consequences": consequences, "economics": economics,
              "uncertainty": uncertainty, "criteria": criteria}
-    option_names = [o.name for o, _ in options]
+    return options, study, used
 
-    table_path = (path.parent / cor["sections"]).resolve()
+
+def _read_sections_table(table_path: Path, reader: dict) -> tuple[pd.DataFrame, np.ndarray, str]:
+    """Read the sections table and check its columns and that it has rows.
+
+    Parameters
+    ----------
+    table_path : pathlib.Path
+        The sections table (CSV, Excel or Parquet).
+    reader : dict
+        Reader options of :func:`_read_table`.
+
+    Returns
+    -------
+    df : pandas.DataFrame
+        The table, as text.
+    file_rows : numpy.ndarray
+        The file line / spreadsheet row of each table row.
+    tsrc : str
+        The table's name as errors give it.
+    """
     df, file_rows = _read_table(table_path, reader)
     tsrc = str(table_path)
     bad_cols = [c for c in df.columns if c not in ALL_COLUMNS]
@@ -497,214 +582,396 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
             raise CorridorError(f"{tsrc}: missing column {c!r}")
     if df.empty:
         raise CorridorError(f"{tsrc}: the sections table has no rows")
-    scale = M_PER_KM if unit == "km" else 1.0
-    errors, sections, bad_rows = [], [], set()
-    fallback = set()          # corridor-wide fallbacks that at least one section used
-    inv_cache, weights = {}, {}
-    default_seeder = {"dist": "lognormal", "median": float(gr.m_min) * 2, "sigma": 1.0,
-                      "max": float(gr.m_max or gr.m_min * 1e4)}
-    seen = {}
-    for i, raw in df.iterrows():
-        row = int(file_rows[i])  # file line / spreadsheet row (header row 1 unless header_row says otherwise)
-        sid = str(raw["id"]).strip()
-        where = f"{tsrc}: row {row} (section {sid!r})"
+    return df, file_rows, tsrc
+
+
+@dataclass
+class _RowContext:
+    """What every row of a sections table is checked against (corridor-wide inputs and running state).
+
+    ``inv_cache`` (rate and note per inventory file) and ``fallback`` (corridor-wide fallbacks that at least one
+    section used) are filled as the rows are read.
+    """
+
+    path: Path
+    columns: object
+    defaults: dict
+    scale: float
+    unit: str
+    shared: dict | None
+    m_min_kg: float
+    materials: dict
+    settings: dict
+    template_path: Path
+    default_seeder: dict
+    option_names: list
+    exposure: object
+    variant: str
+    rhrs_cap: float | None
+    centreline: object
+    inv_cache: dict = field(default_factory=dict)
+    fallback: set = field(default_factory=set)
+
+
+def _row_values(ctx: _RowContext, raw, where: str) -> tuple[dict, dict]:
+    """A row's cells with ``[defaults]`` filled in, and its numbers checked.
+
+    Parameters
+    ----------
+    ctx : _RowContext
+        The corridor-wide inputs.
+    raw : pandas.Series
+        The row, as text.
+    where : str
+        File, row and section id for messages.
+
+    Returns
+    -------
+    vals : dict
+        Every column of :data:`ALL_COLUMNS`: the cell, else the default, else ``""``.
+    num : dict
+        The non-empty number columns as float (an RHRS class name stays text).
+    """
+    vals = {}
+    for c in ALL_COLUMNS:
+        v = str(raw[c]).strip() if c in ctx.columns else ""
+        if v == "" and c in ctx.defaults:
+            v = ctx.defaults[c]
+        vals[c] = v
+    num = {}
+    for c in NUMBER_COLUMNS + RHRS_COLUMNS:
+        v = vals[c]
+        if v == "" or v is None:
+            continue
+        if isinstance(v, bool):
+            raise CorridorError(f"{where}: column {c!r} = {v!r} must be a number, not true/false")
+        if isinstance(v, (int, float)):
+            num[c] = float(v)
+            continue
         try:
-            if not sid:
-                raise CorridorError(f"{tsrc}: row {row}: column 'id' is empty")
-            if sid in seen:
-                raise CorridorError(f"{where}: column 'id' = {sid!r} duplicates row {seen[sid]}")
-            seen[sid] = row
-            vals = {}
-            for c in ALL_COLUMNS:
-                v = str(raw[c]).strip() if c in df.columns else ""
-                if v == "" and c in defaults:
-                    v = defaults[c]
-                vals[c] = v
-            num = {}
-            for c in NUMBER_COLUMNS + RHRS_COLUMNS:
-                v = vals[c]
-                if v == "" or v is None:
-                    continue
-                if isinstance(v, bool):
-                    raise CorridorError(f"{where}: column {c!r} = {v!r} must be a number, not true/false")
-                if isinstance(v, (int, float)):
-                    num[c] = float(v)
-                    continue
-                try:
-                    num[c] = float(v)
-                except (TypeError, ValueError):
-                    if c in RHRS_COLUMNS and c.removeprefix("rhrs_") in rhrs.CLASSES:
-                        num[c] = v          # a class name
-                        continue
-                    raise CorridorError(f"{where}: column {c!r} = {v!r} is not a number") from None
-                if not math.isfinite(num[c]):
-                    raise CorridorError(f"{where}: column {c!r} = {v!r} must be finite")
-            for c in ("chainage_from", "chainage_to"):
-                if c not in num:
-                    raise CorridorError(f"{where}: column {c!r} is empty")
-            c0, c1 = num["chainage_from"] * scale, num["chainage_to"] * scale
-            if c1 <= c0:
-                raise CorridorError(f"{where}: chainage_to = {num['chainage_to']:g} must exceed chainage_from = "
-                                    f"{num['chainage_from']:g} ({unit})")
-            for c in RATE_COLUMNS + ("vehicles_per_day", "speed_kmh"):
-                if c in num and num[c] < 0 or (c == "speed_kmh" and c in num and num[c] == 0):
-                    raise CorridorError(f"{where}: column {c!r} = {num[c]:g} must be > 0" if c == "speed_kmh" else
-                                        f"{where}: column {c!r} = {num[c]:g} must be >= 0")
-            given_rates = [c for c in RATE_COLUMNS if c in num] + (["inventory"] if vals["inventory"] else [])
-            if len(given_rates) > 1 or (not given_rates and shared is None):
-                raise CorridorError(f"{where}: give exactly one of falls_per_year, falls_per_km_year, "
-                                    f"falls_per_m2_year or inventory (own rate or inventory, or a corridor rate per km "
-                                    f"of road or per m2 of rock face; or a corridor-wide [rates] inventory); got "
-                                    f"{given_rates or 'none'}")
-            rate_source = given_rates[0] if given_rates else "shared"
-            if "falls_per_year" in num:
-                rate = num["falls_per_year"]
-            elif "falls_per_km_year" in num:
-                rate = num["falls_per_km_year"] * (c1 - c0) / M_PER_KM
-            elif "falls_per_m2_year" in num:
-                rate = num["falls_per_m2_year"] * _face_area(num, c1 - c0, where, "falls_per_m2_year")
-            elif vals["inventory"]:
-                inv_path = (path.parent / str(vals["inventory"])).resolve()
-                if inv_path not in inv_cache:
-                    inv_cache[inv_path] = inventory_rate(inv_path, float(gr.m_min),
-                                                         f"{where}: column 'inventory' = {vals['inventory']!r}")
-                rate, rate_source = inv_cache[inv_path]
-            else:                                  # a share of the corridor-wide inventory, set once all rows are read
-                weight = _face_area(num, c1 - c0, where, "rates.share = 'm2'") if shared["share"] == "m2" \
-                    else (c1 - c0) / M_PER_KM
-                rate = math.nan
-            if rate_source != "shared" and not rate > 0:
-                raise CorridorError(f"{where}: the section's rate of falls is {rate:g} per year; a section without "
-                                    "falls needs no assessment (remove it or give a rate > 0)")
-            if rate_source != "shared" and rate > MAX_SECTION_FALLS_PER_YEAR:
-                raise CorridorError(f"{where}: column {rate_source!r} gives {rate:,.4g} falls a year on this section, "
-                                    f"more than {MAX_SECTION_FALLS_PER_YEAR:,.0f} "
-                                    f"({MAX_SECTION_FALLS_PER_YEAR / 365.25:.0f} a day): a slope that active closes "
-                                    "its road rather than being screened; check the value and its unit (per year, "
-                                    "per km of road, per m2 of face)")
-            # geometry
-            if vals["scenario"]:
-                sp = (path.parent / str(vals["scenario"])).resolve()
-                if not sp.exists():
-                    raise CorridorError(f"{where}: column 'scenario' = {vals['scenario']!r}: file not found ({sp})")
-                sc = simulation.load_scenario(sp)
-                for cname in ("barrier", "road"):
-                    if cname not in [c.name for c in sc.collectors]:
-                        raise CorridorError(f"{where}: scenario {sp.name} needs collectors named 'barrier' and 'road'")
-                geometry = f"scenario {sp.name}"
-            else:
-                missing = [c for c in GEOMETRY_COLUMNS if c not in num]
-                if missing:
-                    raise CorridorError(f"{where}: columns {missing} are empty (a generated cut needs "
-                                        f"{list(GEOMETRY_COLUMNS)}, or give a scenario file)")
-                g = {c: num[c] for c in GEOMETRY_COLUMNS}
-                if not 1 <= g["cut_height_m"] <= 500:
-                    raise CorridorError(f"{where}: column 'cut_height_m' = {g['cut_height_m']:g} must lie in [1, 500] m")
-                if not 20 <= g["face_angle_deg"] <= 89:
-                    raise CorridorError(f"{where}: column 'face_angle_deg' = {g['face_angle_deg']:g} must lie in "
-                                        "[20, 89] degrees (vertical faces are not supported)")
-                for c in ("ditch_width_m", "ditch_depth_m", "runout_to_road_m"):
-                    if g[c] < 0:
-                        raise CorridorError(f"{where}: column {c!r} = {g[c]:g} must be >= 0")
-                if g["road_width_m"] <= 0:
-                    raise CorridorError(f"{where}: column 'road_width_m' = {g['road_width_m']:g} must be > 0")
-                if g["ditch_depth_m"] > 0 and g["ditch_width_m"] <= 1.25 * g["ditch_depth_m"]:
-                    raise CorridorError(f"{where}: column 'ditch_width_m' = {g['ditch_width_m']:g} is too narrow for "
-                                        f"ditch_depth_m = {g['ditch_depth_m']:g} (walls 0.25H:1V and 1H:1V need more "
-                                        f"than {1.25 * g['ditch_depth_m']:g} m)")
-                bench = {c: num.get(c, 0.0) for c in BENCH_COLUMNS}
-                if bench["bench_width_m"] < 0:
-                    raise CorridorError(f"{where}: column 'bench_width_m' = {bench['bench_width_m']:g} must be >= 0")
-                if bench["bench_width_m"] > 0 and not 0 < bench["bench_height_m"] < g["cut_height_m"]:
-                    raise CorridorError(f"{where}: column 'bench_height_m' = {bench['bench_height_m']:g} must lie "
-                                        f"strictly between 0 and cut_height_m = {g['cut_height_m']:g} (a bench "
-                                        f"{bench['bench_width_m']:g} m wide is given)")
-                share = num.get("release_zone_share", 0.3)
-                if not 0 < share <= 1:
-                    raise CorridorError(f"{where}: column 'release_zone_share' = {share:g} must lie in (0, 1]")
-                mats = {c: str(vals[c] or d) for c, d in (("face_material", "bedrock"), ("ditch_material", "soil"),
-                                                         ("road_material", "asphalt"))}
-                for c, m in mats.items():
-                    if m not in materials:
-                        raise CorridorError(f"{where}: column {c!r} = {m!r} is not a material of {template_path.name} "
-                                            f"({', '.join(materials)})")
-                seeder_mass = defaults.get("seeder_mass_kg", default_seeder)
-                if "seeder_mass_kg" not in defaults:
-                    fallback.add("seeder_mass_kg")
-                try:
-                    sc = scenario_from_dict(cut_scenario_dict(materials, settings, **g, **mats, **bench,
-                                                              seeder_mass=seeder_mass, release_zone_share=share,
-                                                              name=f"section {sid}"), source=where)
-                except ScenarioError as exc:
-                    raise CorridorError(str(exc)) from exc
-                geometry = (f"generated cut {g['cut_height_m']:g} m at {g['face_angle_deg']:g} deg, ditch "
-                            f"{g['ditch_width_m']:g} x {g['ditch_depth_m']:g} m, {g['runout_to_road_m']:g} m to a "
-                            f"{g['road_width_m']:g} m road"
-                            + (f", bench {bench['bench_width_m']:g} m wide at {bench['bench_height_m']:g} m"
-                               if bench["bench_width_m"] > 0 else ""))
-            opts = tuple(option_names)
-            if vals["options"]:
-                opts = tuple(o.strip() for o in str(vals["options"]).split(";") if o.strip())
-                unknown = [o for o in opts if o not in option_names]
-                if unknown:
-                    raise CorridorError(f"{where}: column 'options' names {unknown}, not options of the corridor "
-                                        f"({option_names})")
-                if len(opts) < 2:
-                    raise CorridorError(f"{where}: column 'options' must name at least two options to compare")
-            vpd = num.get("vehicles_per_day", exposure.vehicles_per_day)
-            speed = num.get("speed_kmh", exposure.speed_kmh)
-            fallback.update(c for c in ("vehicles_per_day", "speed_kmh") if c not in num)
-            rating = None
-            given = {c.removeprefix("rhrs_"): num[c] for c in RHRS_COLUMNS if c in num}
-            if given:
-                # what the section's own columns already say; rhrs_* columns override
-                derived = {"slope_height_m": num.get("cut_height_m"), "roadway_width_m": num.get("road_width_m")}
-                if "avr_percent" not in given:
-                    derived.update(slope_length_m=num.get("cut_length_m", c1 - c0), adt_vehicles_per_day=vpd,
-                                   speed_kmh=speed)
-                attrs = {k: v for k, v in derived.items() if v is not None}
-                attrs.update(given)
-                try:
-                    rating = rhrs.rate(variant=variant, cap_points=rhrs_cap, **attrs)
-                except rhrs.RHRSError as exc:
-                    if exc.missing:        # name the columns that would give what is missing
-                        cols = [_RHRS_SOURCE_COLUMNS.get(m, f"'rhrs_{m}'") for m in exc.missing]
-                        raise CorridorError(f"{where}: RHRS ({variant}) needs column(s) {', '.join(cols)}, empty "
-                                            "in this row and in [defaults]") from exc
-                    raise CorridorError(f"{where}: RHRS: {exc}") from exc
-                except TypeError as exc:
-                    raise CorridorError(f"{where}: RHRS: {exc}") from exc
-            cut_len = num.get("cut_length_m", num.get("rhrs_slope_length_m"))
-            if cut_len is not None and not 0 < cut_len <= (c1 - c0) * (1 + 1e-12):
-                raise CorridorError(f"{where}: column 'cut_length_m' (or rhrs_slope_length_m) = {cut_len:g} m must lie "
-                                    f"in (0, {c1 - c0:g}] (the section's length along the chainage)")
-            line = None
-            if centreline is not None:
-                lo, hi = centreline.chainage_range_m
-                if c0 < lo - 1e-6 or c1 > hi + 1e-6:
-                    raise CorridorError(f"{where}: chainage {c0:g}-{c1:g} m lies beyond the centreline "
-                                        f"{centreline.source} ({lo:g} to {hi:g} m)")
-                line = tuple(map(tuple, centreline.cut(c0, c1)))
-            if rate_source == "shared":
-                weights[sid] = weight
-            sections.append(Section(id=sid, row=row, chainage_from_m=c0, chainage_to_m=c1, scenario=sc,
-                                    geometry=geometry, falls_per_year=float(rate), vehicles_per_day=float(vpd),
-                                    speed_kmh=float(speed), options=opts, rating=rating,
-                                    notes=str(vals["notes"] or ""), rate_source=rate_source,
-                                    cut_length_m=None if cut_len is None else float(cut_len), line=line))
-        except CorridorError as exc:
-            errors.append(str(exc))
-            bad_rows.add(row)
-    if weights:
-        unit = "km" if shared["share"] == "km" else "m2 of face"
-        covered = shared["covered"] if shared["covered"] is not None else sum(weights.values())
-        if covered < sum(weights.values()) * (1 - 1e-9):
-            raise CorridorError(f"{src}: rates.covered_{'length_km' if shared['share'] == 'km' else 'face_area_m2'} "
-                                f"= {covered:g} is less than the sharing sections' {sum(weights.values()):g} {unit}")
-        per = shared["rate"] / covered
-        sections = [replace(s, falls_per_year=per * weights[s.id],
-                            rate_source=f"share of the corridor {shared['note']}: {per:.4g}/yr per {unit} x "
-                                        f"{weights[s.id]:.4g} {unit}") if s.id in weights else s for s in sections]
+            num[c] = float(v)
+        except (TypeError, ValueError):
+            if c in RHRS_COLUMNS and c.removeprefix("rhrs_") in rhrs.CLASSES:
+                num[c] = v          # a class name
+                continue
+            raise CorridorError(f"{where}: column {c!r} = {v!r} is not a number") from None
+        if not math.isfinite(num[c]):
+            raise CorridorError(f"{where}: column {c!r} = {v!r} must be finite")
+    return vals, num
+
+
+def _row_rate(ctx: _RowContext, vals: dict, num: dict, c0: float, c1: float, where: str):
+    """A section's rate of falls [1/yr] from its own column or inventory, or its weight in the shared rate.
+
+    Parameters
+    ----------
+    ctx : _RowContext
+        The corridor-wide inputs (``inv_cache`` is filled).
+    vals, num : dict
+        The row's cells and numbers (:func:`_row_values`).
+    c0, c1 : float
+        The section's chainage [m].
+    where : str
+        File, row and section id for messages.
+
+    Returns
+    -------
+    rate : float
+        Falls per year (NaN for a share of the corridor-wide ``[rates]`` inventory, set once all rows are read).
+    rate_source : str
+        The column that gave the rate, the inventory's note, or ``"shared"``.
+    weight : float or None
+        The section's weight in the shared rate (km of road or m2 of face); None for its own rate.
+    """
+    given_rates = [c for c in RATE_COLUMNS if c in num] + (["inventory"] if vals["inventory"] else [])
+    if len(given_rates) > 1 or (not given_rates and ctx.shared is None):
+        raise CorridorError(f"{where}: give exactly one of falls_per_year, falls_per_km_year, "
+                            f"falls_per_m2_year or inventory (own rate or inventory, or a corridor rate per km "
+                            f"of road or per m2 of rock face; or a corridor-wide [rates] inventory); got "
+                            f"{given_rates or 'none'}")
+    rate_source = given_rates[0] if given_rates else "shared"
+    weight = None
+    if "falls_per_year" in num:
+        rate = num["falls_per_year"]
+    elif "falls_per_km_year" in num:
+        rate = num["falls_per_km_year"] * (c1 - c0) / M_PER_KM
+    elif "falls_per_m2_year" in num:
+        rate = num["falls_per_m2_year"] * _face_area(num, c1 - c0, where, "falls_per_m2_year")
+    elif vals["inventory"]:
+        inv_path = (ctx.path.parent / str(vals["inventory"])).resolve()
+        if inv_path not in ctx.inv_cache:
+            ctx.inv_cache[inv_path] = inventory_rate(inv_path, ctx.m_min_kg,
+                                                     f"{where}: column 'inventory' = {vals['inventory']!r}")
+        rate, rate_source = ctx.inv_cache[inv_path]
+    else:                                  # a share of the corridor-wide inventory, set once all rows are read
+        weight = _face_area(num, c1 - c0, where, "rates.share = 'm2'") if ctx.shared["share"] == "m2" \
+            else (c1 - c0) / M_PER_KM
+        rate = math.nan
+    if rate_source != "shared" and not rate > 0:
+        raise CorridorError(f"{where}: the section's rate of falls is {rate:g} per year; a section without "
+                            "falls needs no assessment (remove it or give a rate > 0)")
+    if rate_source != "shared" and rate > MAX_SECTION_FALLS_PER_YEAR:
+        raise CorridorError(f"{where}: column {rate_source!r} gives {rate:,.4g} falls a year on this section, "
+                            f"more than {MAX_SECTION_FALLS_PER_YEAR:,.0f} "
+                            f"({MAX_SECTION_FALLS_PER_YEAR / 365.25:.0f} a day): a slope that active closes "
+                            "its road rather than being screened; check the value and its unit (per year, "
+                            "per km of road, per m2 of face)")
+    return rate, rate_source, weight
+
+
+def _row_scenario(ctx: _RowContext, vals: dict, num: dict, sid: str, where: str):
+    """A section's scenario: its own scenario file, or a cut generated from its geometry columns.
+
+    Parameters
+    ----------
+    ctx : _RowContext
+        The corridor-wide inputs (``fallback`` is updated when the default seeder mass is used).
+    vals, num : dict
+        The row's cells and numbers (:func:`_row_values`).
+    sid : str
+        The section id.
+    where : str
+        File, row and section id for messages.
+
+    Returns
+    -------
+    scenario : simulation.Scenario
+        The checked scenario, with collectors ``barrier`` and ``road``.
+    geometry : str
+        A one-line description of the geometry for the outputs.
+    """
+    import simulation
+    from simulation.scenario import ScenarioError, scenario_from_dict
+
+    if vals["scenario"]:
+        sp = (ctx.path.parent / str(vals["scenario"])).resolve()
+        if not sp.exists():
+            raise CorridorError(f"{where}: column 'scenario' = {vals['scenario']!r}: file not found ({sp})")
+        sc = simulation.load_scenario(sp)
+        for cname in ("barrier", "road"):
+            if cname not in [c.name for c in sc.collectors]:
+                raise CorridorError(f"{where}: scenario {sp.name} needs collectors named 'barrier' and 'road'")
+        return sc, f"scenario {sp.name}"
+    missing = [c for c in GEOMETRY_COLUMNS if c not in num]
+    if missing:
+        raise CorridorError(f"{where}: columns {missing} are empty (a generated cut needs "
+                            f"{list(GEOMETRY_COLUMNS)}, or give a scenario file)")
+    g = {c: num[c] for c in GEOMETRY_COLUMNS}
+    if not 1 <= g["cut_height_m"] <= 500:
+        raise CorridorError(f"{where}: column 'cut_height_m' = {g['cut_height_m']:g} must lie in [1, 500] m")
+    if not 20 <= g["face_angle_deg"] <= 89:
+        raise CorridorError(f"{where}: column 'face_angle_deg' = {g['face_angle_deg']:g} must lie in "
+                            "[20, 89] degrees (vertical faces are not supported)")
+    for c in ("ditch_width_m", "ditch_depth_m", "runout_to_road_m"):
+        if g[c] < 0:
+            raise CorridorError(f"{where}: column {c!r} = {g[c]:g} must be >= 0")
+    if g["road_width_m"] <= 0:
+        raise CorridorError(f"{where}: column 'road_width_m' = {g['road_width_m']:g} must be > 0")
+    if g["ditch_depth_m"] > 0 and g["ditch_width_m"] <= 1.25 * g["ditch_depth_m"]:
+        raise CorridorError(f"{where}: column 'ditch_width_m' = {g['ditch_width_m']:g} is too narrow for "
+                            f"ditch_depth_m = {g['ditch_depth_m']:g} (walls 0.25H:1V and 1H:1V need more "
+                            f"than {1.25 * g['ditch_depth_m']:g} m)")
+    bench = {c: num.get(c, 0.0) for c in BENCH_COLUMNS}
+    if bench["bench_width_m"] < 0:
+        raise CorridorError(f"{where}: column 'bench_width_m' = {bench['bench_width_m']:g} must be >= 0")
+    if bench["bench_width_m"] > 0 and not 0 < bench["bench_height_m"] < g["cut_height_m"]:
+        raise CorridorError(f"{where}: column 'bench_height_m' = {bench['bench_height_m']:g} must lie "
+                            f"strictly between 0 and cut_height_m = {g['cut_height_m']:g} (a bench "
+                            f"{bench['bench_width_m']:g} m wide is given)")
+    share = num.get("release_zone_share", 0.3)
+    if not 0 < share <= 1:
+        raise CorridorError(f"{where}: column 'release_zone_share' = {share:g} must lie in (0, 1]")
+    mats = {c: str(vals[c] or d) for c, d in (("face_material", "bedrock"), ("ditch_material", "soil"),
+                                             ("road_material", "asphalt"))}
+    for c, m in mats.items():
+        if m not in ctx.materials:
+            raise CorridorError(f"{where}: column {c!r} = {m!r} is not a material of {ctx.template_path.name} "
+                                f"({', '.join(ctx.materials)})")
+    seeder_mass = ctx.defaults.get("seeder_mass_kg", ctx.default_seeder)
+    if "seeder_mass_kg" not in ctx.defaults:
+        ctx.fallback.add("seeder_mass_kg")
+    try:
+        sc = scenario_from_dict(cut_scenario_dict(ctx.materials, ctx.settings, **g, **mats, **bench,
+                                                  seeder_mass=seeder_mass, release_zone_share=share,
+                                                  name=f"section {sid}"), source=where)
+    except ScenarioError as exc:
+        raise CorridorError(str(exc)) from exc
+    geometry = (f"generated cut {g['cut_height_m']:g} m at {g['face_angle_deg']:g} deg, ditch "
+                f"{g['ditch_width_m']:g} x {g['ditch_depth_m']:g} m, {g['runout_to_road_m']:g} m to a "
+                f"{g['road_width_m']:g} m road"
+                + (f", bench {bench['bench_width_m']:g} m wide at {bench['bench_height_m']:g} m"
+                   if bench["bench_width_m"] > 0 else ""))
+    return sc, geometry
+
+
+def _row_rating(ctx: _RowContext, num: dict, c0: float, c1: float, vpd: float, speed: float, where: str):
+    """A section's RHRS rating from its ``rhrs_*`` columns (and what its other columns already say).
+
+    Parameters
+    ----------
+    ctx : _RowContext
+        The corridor-wide inputs (RHRS variant and cap).
+    num : dict
+        The row's numbers (:func:`_row_values`).
+    c0, c1 : float
+        The section's chainage [m].
+    vpd : float
+        Vehicles per day.
+    speed : float
+        Speed [km/h].
+    where : str
+        File, row and section id for messages.
+
+    Returns
+    -------
+    riskrf.risk.rhrs.RHRSRating or None
+        None when the row gives no ``rhrs_*`` column.
+    """
+    given = {c.removeprefix("rhrs_"): num[c] for c in RHRS_COLUMNS if c in num}
+    if not given:
+        return None
+    # what the section's own columns already say; rhrs_* columns override
+    derived = {"slope_height_m": num.get("cut_height_m"), "roadway_width_m": num.get("road_width_m")}
+    if "avr_percent" not in given:
+        derived.update(slope_length_m=num.get("cut_length_m", c1 - c0), adt_vehicles_per_day=vpd,
+                       speed_kmh=speed)
+    attrs = {k: v for k, v in derived.items() if v is not None}
+    attrs.update(given)
+    try:
+        return rhrs.rate(variant=ctx.variant, cap_points=ctx.rhrs_cap, **attrs)
+    except rhrs.RHRSError as exc:
+        if exc.missing:        # name the columns that would give what is missing
+            cols = [_RHRS_SOURCE_COLUMNS.get(m, f"'rhrs_{m}'") for m in exc.missing]
+            raise CorridorError(f"{where}: RHRS ({ctx.variant}) needs column(s) {', '.join(cols)}, empty "
+                                "in this row and in [defaults]") from exc
+        raise CorridorError(f"{where}: RHRS: {exc}") from exc
+    except TypeError as exc:
+        raise CorridorError(f"{where}: RHRS: {exc}") from exc
+
+
+def _read_section_row(ctx: _RowContext, raw, row: int, sid: str, where: str) -> tuple[Section, float | None]:
+    """Check one row of the sections table and build its :class:`Section`.
+
+    Parameters
+    ----------
+    ctx : _RowContext
+        The corridor-wide inputs and running state.
+    raw : pandas.Series
+        The row, as text.
+    row : int
+        The file line / spreadsheet row.
+    sid : str
+        The section id (checked non-empty and unique by the caller).
+    where : str
+        File, row and section id for messages.
+
+    Returns
+    -------
+    section : Section
+        The checked section (a shared rate is NaN until all rows are read).
+    weight : float or None
+        The section's weight in the corridor-wide ``[rates]`` inventory; None for its own rate.
+
+    Raises
+    ------
+    CorridorError
+        The first problem found in the row.
+    """
+    vals, num = _row_values(ctx, raw, where)
+    for c in ("chainage_from", "chainage_to"):
+        if c not in num:
+            raise CorridorError(f"{where}: column {c!r} is empty")
+    c0, c1 = num["chainage_from"] * ctx.scale, num["chainage_to"] * ctx.scale
+    if c1 <= c0:
+        raise CorridorError(f"{where}: chainage_to = {num['chainage_to']:g} must exceed chainage_from = "
+                            f"{num['chainage_from']:g} ({ctx.unit})")
+    for c in RATE_COLUMNS + ("vehicles_per_day", "speed_kmh"):
+        if c in num and num[c] < 0 or (c == "speed_kmh" and c in num and num[c] == 0):
+            raise CorridorError(f"{where}: column {c!r} = {num[c]:g} must be > 0" if c == "speed_kmh" else
+                                f"{where}: column {c!r} = {num[c]:g} must be >= 0")
+    rate, rate_source, weight = _row_rate(ctx, vals, num, c0, c1, where)
+    sc, geometry = _row_scenario(ctx, vals, num, sid, where)
+    opts = tuple(ctx.option_names)
+    if vals["options"]:
+        opts = tuple(o.strip() for o in str(vals["options"]).split(";") if o.strip())
+        unknown = [o for o in opts if o not in ctx.option_names]
+        if unknown:
+            raise CorridorError(f"{where}: column 'options' names {unknown}, not options of the corridor "
+                                f"({ctx.option_names})")
+        if len(opts) < 2:
+            raise CorridorError(f"{where}: column 'options' must name at least two options to compare")
+    vpd = num.get("vehicles_per_day", ctx.exposure.vehicles_per_day)
+    speed = num.get("speed_kmh", ctx.exposure.speed_kmh)
+    ctx.fallback.update(c for c in ("vehicles_per_day", "speed_kmh") if c not in num)
+    rating = _row_rating(ctx, num, c0, c1, vpd, speed, where)
+    cut_len = num.get("cut_length_m", num.get("rhrs_slope_length_m"))
+    if cut_len is not None and not 0 < cut_len <= (c1 - c0) * (1 + 1e-12):
+        raise CorridorError(f"{where}: column 'cut_length_m' (or rhrs_slope_length_m) = {cut_len:g} m must lie "
+                            f"in (0, {c1 - c0:g}] (the section's length along the chainage)")
+    line = None
+    if ctx.centreline is not None:
+        lo, hi = ctx.centreline.chainage_range_m
+        if c0 < lo - 1e-6 or c1 > hi + 1e-6:
+            raise CorridorError(f"{where}: chainage {c0:g}-{c1:g} m lies beyond the centreline "
+                                f"{ctx.centreline.source} ({lo:g} to {hi:g} m)")
+        line = tuple(map(tuple, ctx.centreline.cut(c0, c1)))
+    section = Section(id=sid, row=row, chainage_from_m=c0, chainage_to_m=c1, scenario=sc,
+                      geometry=geometry, falls_per_year=float(rate), vehicles_per_day=float(vpd),
+                      speed_kmh=float(speed), options=opts, rating=rating,
+                      notes=str(vals["notes"] or ""), rate_source=rate_source,
+                      cut_length_m=None if cut_len is None else float(cut_len), line=line)
+    return section, (weight if rate_source == "shared" else None)
+
+
+def _share_corridor_rate(sections: list, weights: dict, shared: dict, src: str) -> list:
+    """Give the sections without a rate of their own their share of the corridor-wide ``[rates]`` inventory.
+
+    Parameters
+    ----------
+    sections : list of Section
+        The sections read.
+    weights : dict
+        Section id -> weight (km of road or m2 of rock face) of the sharing sections.
+    shared : dict
+        The corridor-wide rate (:func:`_shared_rate`).
+    src : str
+        The corridor file's name for messages.
+
+    Returns
+    -------
+    list of Section
+        The sections, the sharing ones with ``falls_per_year`` = rate / covered x weight [1/yr].
+    """
+    unit = "km" if shared["share"] == "km" else "m2 of face"
+    covered = shared["covered"] if shared["covered"] is not None else sum(weights.values())
+    if covered < sum(weights.values()) * (1 - 1e-9):
+        raise CorridorError(f"{src}: rates.covered_{'length_km' if shared['share'] == 'km' else 'face_area_m2'} "
+                            f"= {covered:g} is less than the sharing sections' {sum(weights.values()):g} {unit}")
+    per = shared["rate"] / covered
+    return [replace(s, falls_per_year=per * weights[s.id],
+                    rate_source=f"share of the corridor {shared['note']}: {per:.4g}/yr per {unit} x "
+                                f"{weights[s.id]:.4g} {unit}") if s.id in weights else s for s in sections]
+
+
+def _cross_row_errors(sections: list, tsrc: str, errors: list, bad_rows: set) -> list:
+    """Check the sections against each other: overlapping chainages and ids sharing a crc32 checksum.
+
+    Parameters
+    ----------
+    sections : list of Section
+        The sections read.
+    tsrc : str
+        The sections table's name for messages.
+    errors : list of str
+        The errors found so far; extended in place.
+    bad_rows : set of int
+        The rows with errors; extended in place.
+
+    Returns
+    -------
+    list of Section
+        The sections ordered by chainage (bad ones included).
+    """
     ordered = sorted(sections, key=lambda s: s.chainage_from_m)
     for a, b in zip(ordered[:-1], ordered[1:]):
         if b.chainage_from_m < a.chainage_to_m:
@@ -723,6 +990,70 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
             bad_rows.add(sec.row)
         else:
             by_key[k] = sec
+    return ordered
+
+
+def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int | None = None,
+                  decimal: str | None = None, encoding: str | None = None) -> Corridor:
+    """Read and check a corridor file and its sections table before any work.
+
+    The sections table is read by the rules of :mod:`riskrf.io.tables` (separator, decimal comma,
+    UTF-8 or cp1252, Excel ``sheet`` and ``header_row``, Parquet); ``sheet``, ``header_row``,
+    ``decimal`` and ``encoding`` may also be given in the ``[corridor]`` table (``sections_sheet``,
+    ``sections_header_row``, ``sections_decimal``, ``sections_encoding``); arguments win.
+    Every bad row is reported (file, row, section id, column, value; rows are the file's lines
+    as an editor or spreadsheet numbers them, comment lines ``#`` of a CSV included).  With ``keep_going`` the bad rows
+    are left out and listed in :attr:`Corridor.errors`; otherwise any bad row raises :class:`CorridorError`
+    listing all of them.  Errors in the corridor file itself always raise.
+    """
+    path = Path(path)
+    data, src = _read_corridor_toml(path)
+    from ..core.file_schemas import CORRIDOR_SCHEMA
+    from ..core.schema import check as check_schema
+    cor = data.get("corridor", {})
+    cs = _corridor_settings(cor, path, src, sheet, header_row, decimal, encoding)
+    centreline, variant = cs["centreline"], cs["variant"]
+    defaults = data.get("defaults", {})
+    _unknown(defaults, [c for c in ALL_COLUMNS if c not in ("id", "chainage_from", "chainage_to", "inventory")]
+             + ["seeder_mass_kg"],
+             "defaults.", src)
+    check_schema(data, CORRIDOR_SCHEMA, src, error=CorridorError)      # every declared type and range
+    gr, mass_note = _mass_law(data.get("mass", {}), path.parent, src)
+    shared = _shared_rate(data.get("rates"), path.parent, float(gr.m_min), src)
+    materials, settings, template_path = _materials_template(data.get("materials", {}), path, src)
+    # study inputs: the mitigation tables, with per-metre costs set aside per option
+    options, study, used = _corridor_options(data, src)
+
+    df, file_rows, tsrc = _read_sections_table((path.parent / cor["sections"]).resolve(), cs["reader"])
+    default_seeder = {"dist": "lognormal", "median": float(gr.m_min) * 2, "sigma": 1.0,
+                      "max": float(gr.m_max or gr.m_min * 1e4)}
+    ctx = _RowContext(path=path, columns=df.columns, defaults=defaults,
+                      scale=M_PER_KM if cs["unit"] == "km" else 1.0, unit=cs["unit"], shared=shared,
+                      m_min_kg=float(gr.m_min), materials=materials, settings=settings, template_path=template_path,
+                      default_seeder=default_seeder, option_names=[o.name for o, _ in options],
+                      exposure=study["exposure"], variant=variant, rhrs_cap=cs["rhrs_cap"], centreline=centreline)
+    errors, sections, bad_rows = [], [], set()
+    weights, seen = {}, {}
+    for i, raw in df.iterrows():
+        row = int(file_rows[i])  # file line / spreadsheet row (header row 1 unless header_row says otherwise)
+        sid = str(raw["id"]).strip()
+        where = f"{tsrc}: row {row} (section {sid!r})"
+        try:
+            if not sid:
+                raise CorridorError(f"{tsrc}: row {row}: column 'id' is empty")
+            if sid in seen:
+                raise CorridorError(f"{where}: column 'id' = {sid!r} duplicates row {seen[sid]}")
+            seen[sid] = row
+            section, weight = _read_section_row(ctx, raw, row, sid, where)
+            if weight is not None:
+                weights[sid] = weight
+            sections.append(section)
+        except CorridorError as exc:
+            errors.append(str(exc))
+            bad_rows.add(row)
+    if weights:
+        sections = _share_corridor_rate(sections, weights, shared, src)
+    ordered = _cross_row_errors(sections, tsrc, errors, bad_rows)
     if errors and not keep_going:
         raise CorridorError(f"{len(errors)} bad section row(s) (use --keep-going to run the others):\n  "
                             + "\n  ".join(errors))
@@ -731,6 +1062,7 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
         raise CorridorError(f"{tsrc}: no valid section to assess:\n  " + "\n  ".join(errors))
     # a default is listed only where a section uses it: traffic per section falls back on [traffic] only when
     # neither the row nor [defaults] gives it; the exposed length is always the section's length
+    fallback = ctx.fallback
     used = [u for u in used if not u.startswith("traffic.exposed_length_m")
             and not any(u.startswith(f"traffic.{c} ") and c not in fallback for c in ("vehicles_per_day", "speed_kmh"))]
     if "seeder_mass_kg" in fallback:
@@ -738,9 +1070,9 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
                     "generated cuts' own seeder, used only for the option effects (the reference run of the "
                     "mitigation study); the hazard is mass-coupled over the mass law)")
     return Corridor(name=str(cor.get("name", path.stem)), path=path, sections=tuple(ordered), mass=gr,
-                    mass_note=mass_note, rate_basis=basis, study=study, options=options,
+                    mass_note=mass_note, rate_basis=cs["basis"], study=study, options=options,
                     n_blocks=int(cor.get("n_blocks", 2000)), option_blocks=int(cor.get("option_blocks", 1000)),
-                    seed=int(cor.get("seed", 1)), currency=consequences.currency, errors=tuple(errors),
+                    seed=int(cor.get("seed", 1)), currency=study["consequences"].currency, errors=tuple(errors),
                     defaults_used=tuple(used), crs=None if centreline is None else centreline.crs,
                     centreline=centreline, rhrs_variant=variant)
 
