@@ -489,13 +489,71 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
         outside the rainfall record, a rainfall gap inside the period (gaps are
         never filled), a covariate not covering the period.
     """
-    # the four model classes used, not statsmodels.api (which imports all of statsmodels: 0.7 s more)
-    from statsmodels.discrete.discrete_model import NegativeBinomial
-    from statsmodels.genmod import families
-    from statsmodels.genmod.generalized_linear_model import GLM
-    from statsmodels.regression.linear_model import OLS
-    from statsmodels.tools.sm_exceptions import ConvergenceWarning
+    _check_rate_arguments(inventory, period, season, level, rain_per_mm, rain_transform)
+    extra, rain, windows = _covariate_inputs(covariates, rainfall, windows_days)
+    src = inventory.source
+    if inventory.start is None or inventory.end is None:
+        raise ValueError(f"{src}: the record period (start, end) is unknown; a rate model needs it "
+                         "(give start/end to read_inventory or in the sidecar .toml)")
+    start, end = pd.Timestamp(inventory.start), pd.Timestamp(inventory.end)
+    notes: list[str] = []
+    events = _counted_events(inventory, period, notes)
+    days, starts, exposure, key = _record_periods(start, end, period, min_periods, src)
 
+    # Rainfall: every event date and every day of the period with its antecedent window must be covered.
+    design = pd.DataFrame({"period_start": starts, "exposure_days": exposure})
+    rain_cols: list[tuple[str, str]] = []
+    if rain is not None:
+        rain_cols = _add_rainfall_columns(design, rain, events, period, windows, start, end, days, key, starts, src)
+    elif extra is None:
+        _note(notes, f"{src}: no rainfall or other covariates given; the model has only season and trend terms")
+    extra_cols = []
+    if extra is not None:
+        extra_cols = _add_covariate_columns(design, extra, period, start, end, days, key, starts, src)
+    season_frame, season_used, year_ref = _add_season_trend_columns(design, period, season, trend, start, end, notes)
+    _add_counts(design, events, period, start, end, src)
+    terms = _term_table(design, rain_cols, season_frame, trend, extra_cols, rain_per_mm, rain_transform)
+
+    y = design["count"].to_numpy(float)
+    X = _exog(design, terms)
+    offset = np.log(design["exposure_days"].to_numpy(float))
+    pois, nb = _fit_count_models(y, X, offset, src, notes)
+    comparison, overdispersion, nb_glm = _compare_models(y, X, offset, pois, nb)
+
+    preferred, reason, res, glm_pref = _preferred_model(pois, nb, nb_glm, overdispersion)
+    rate_ratios = _rate_ratio_table(res, terms, level)
+    trend_info = _trend_test(y, X, offset, res, preferred, rate_ratios, year_ref) if trend else None
+
+    return RateModel(design=design, terms=terms, period=period, poisson=pois, negbin=nb, preferred=preferred,
+                     reason=reason, comparison=comparison, overdispersion=overdispersion, rate_ratios=rate_ratios,
+                     trend=trend_info, level=level, year_ref=year_ref, inventory_source=src,
+                     rainfall_source=rain.source if rain is not None else "", start=start, end=end,
+                     season=season_used, windows_days=windows if period == "day" else (),
+                     notes=tuple(list(inventory.notes) + notes), _glm_preferred=glm_pref, rainfall=rain)
+
+
+def _note(notes: list, msg: str) -> None:
+    """Keep ``msg`` among the model's notes and warn with it (:func:`riskrf.core.validation.warn`)."""
+    notes.append(msg)
+    warn(msg)
+
+
+def _check_rate_arguments(inventory, period: str, season, level: float, rain_per_mm: float,
+                          rain_transform: str) -> None:
+    """Check the arguments of :func:`rate_model` that need no data, before any work.
+
+    Parameters
+    ----------
+    inventory, period, season, level, rain_per_mm, rain_transform
+        As :func:`rate_model` (``rain_per_mm`` in mm).
+
+    Raises
+    ------
+    TypeError
+        ``inventory`` is not an :class:`~riskrf.frequency.inventory.Inventory`.
+    ValueError
+        Naming the argument and its value.
+    """
     if not isinstance(inventory, Inventory):
         raise TypeError(f"inventory must be a riskrf Inventory (read_inventory); got {type(inventory).__name__}")
     if period not in _PERIODS:
@@ -508,28 +566,26 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
         raise ValueError(f"rain_per_mm = {rain_per_mm!r} must be > 0")
     if rain_transform not in _TRANSFORMS:
         raise ValueError(f"rain_transform = {rain_transform!r} is not one of {list(_TRANSFORMS)}")
-    extra = None
-    if isinstance(covariates, pd.DataFrame):
-        extra = covariates
-    elif covariates is not None:
-        if rainfall is not None:
-            raise ValueError("give rainfall either as covariates= or as rainfall=, not both")
-        rainfall = covariates
-    rain = _as_rainfall(rainfall, "rainfall")
-    windows = tuple(int(w) for w in windows_days)
-    if not windows or any(w < 1 for w in windows) or list(windows) != sorted(set(windows)):
-        raise ValueError(f"windows_days = {windows_days!r} must be increasing whole numbers of days >= 1")
+
+
+def _counted_events(inventory: Inventory, period: str, notes: list) -> pd.DataFrame:
+    """The inventory's events that can be counted per ``period`` (a full date, or a year for yearly counts).
+
+    Parameters
+    ----------
+    inventory : Inventory
+        The dated inventory (all events, censored sizes included).
+    period : {"day", "month", "year"}
+        Counting period.
+    notes : list of str
+        The model's notes; extended (and warned) with the events left out and those with a censored size.
+
+    Returns
+    -------
+    pandas.DataFrame
+        :meth:`Inventory.all_events` without the undated events.
+    """
     src = inventory.source
-    if inventory.start is None or inventory.end is None:
-        raise ValueError(f"{src}: the record period (start, end) is unknown; a rate model needs it "
-                         "(give start/end to read_inventory or in the sidecar .toml)")
-    start, end = pd.Timestamp(inventory.start), pd.Timestamp(inventory.end)
-    notes: list[str] = []
-
-    def note(msg):
-        notes.append(msg)
-        warn(msg)
-
     events = inventory.all_events()
     if period == "year":
         undated = events["year"].isna()
@@ -537,15 +593,41 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
         undated = events["date"].isna()
     if undated.any():
         rows = events.loc[undated, "source_row"].tolist()
-        note(f"{src}: {len(rows)} event(s) without a {'year' if period == 'year' else 'full date'} are not counted "
-             f"(rows {', '.join(map(str, rows[:12]))}{' ...' if len(rows) > 12 else ''})")
+        _note(notes, f"{src}: {len(rows)} event(s) without a {'year' if period == 'year' else 'full date'} are not "
+                     f"counted (rows {', '.join(map(str, rows[:12]))}{' ...' if len(rows) > 12 else ''})")
         events = events.loc[~undated]
     n_cens = int((events["censoring"] != "").sum())
     if n_cens:
         notes.append(f"{src}: {n_cens} event(s) with a censored or missing size are counted (the rate model "
                      "counts events of any size)")
+    return events
 
-    # Periods of the record.
+
+def _record_periods(start: pd.Timestamp, end: pd.Timestamp, period: str, min_periods: int, src: str):
+    """The days and counting periods of the record, with each period's exposure [days].
+
+    Parameters
+    ----------
+    start, end : pandas.Timestamp
+        First and last day of the record period.
+    period : {"day", "month", "year"}
+        Counting period.
+    min_periods : int
+        Fewest periods allowed.
+    src : str
+        The inventory's source for messages.
+
+    Returns
+    -------
+    days : pandas.DatetimeIndex
+        Every day of the record.
+    starts : pandas.DatetimeIndex
+        First day of each period.
+    exposure : numpy.ndarray
+        Days of each period inside the record.
+    key : pandas.DatetimeIndex
+        Each day's period start.
+    """
     days = pd.date_range(start, end, freq="D")
     if period == "day":
         starts = days
@@ -558,64 +640,144 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
     if len(starts) < min_periods:
         raise ValueError(f"{src}: {len(starts)} {period} period(s) from {start.date()} to {end.date()}; a count model "
                          f"needs at least {min_periods} (count per month or per day instead)")
+    return days, starts, exposure, key
 
-    # Rainfall: every event date and every day of the period with its antecedent window must be covered.
-    design = pd.DataFrame({"period_start": starts, "exposure_days": exposure})
+
+def _add_rainfall_columns(design: pd.DataFrame, rain: Rainfall, events: pd.DataFrame, period: str, windows: tuple,
+                          start: pd.Timestamp, end: pd.Timestamp, days, key, starts, src: str) -> list:
+    """Check that the rainfall covers every event and day (with its antecedent window) and add its columns.
+
+    Parameters
+    ----------
+    design : pandas.DataFrame
+        The model frame, one row per period; rainfall columns [mm] are added in place.
+    rain : Rainfall
+        Daily rainfall.
+    events : pandas.DataFrame
+        The counted events (:func:`_counted_events`).
+    period : {"day", "month", "year"}
+        Counting period.
+    windows : tuple of int
+        Antecedent rainfall bands of daily counts [days].
+    start, end : pandas.Timestamp
+        The record period.
+    days, key, starts
+        As :func:`_record_periods`.
+    src : str
+        The inventory's source for messages.
+
+    Returns
+    -------
+    list of (str, str)
+        Name and label of each rainfall column added.
+    """
     rain_cols: list[tuple[str, str]] = []
-    if rain is not None:
-        lead = max(windows) - 1 if period == "day" else 0
-        first_needed = start - pd.Timedelta(days=lead)
-        for r in events.itertuples():
-            d = r.date if period != "year" or pd.notna(r.date) else pd.Timestamp(int(r.year), 1, 1)
-            if pd.isna(d):
-                continue
-            if d - pd.Timedelta(days=lead) < rain.first_day or d > rain.last_day:
-                raise ValueError(f"{src}: row {r.source_row}, date {d.date()}: outside the rainfall record "
-                                 f"{rain.source} ({rain.first_day.date()} to {rain.last_day.date()}"
-                                 + (f", and the {max(windows)}-day antecedent window needs rainfall from "
-                                    f"{(d - pd.Timedelta(days=lead)).date()}" if lead else "") + ")")
-        rain.check_covers(first_needed, end, f"{src}: the record period {start.date()} to {end.date()}"
-                          + (f" with its {max(windows)}-day antecedent window" if lead else ""))
-        if period == "day":
-            lo = 0
-            for w in windows:
-                name, label = _band_name(lo, w - 1)
-                total = rain.window_total(w - lo, lag=lo).reindex(days)
-                design[name] = total.to_numpy()
-                rain_cols.append((name, label))
-                lo = w
-        else:
-            total = rain.daily.reindex(days).groupby(key).sum(min_count=1).reindex(starts)
-            design[f"rain_{period}_mm"] = total.to_numpy()
-            rain_cols.append((f"rain_{period}_mm", f"rainfall in the {period}"))
-    elif extra is None:
-        note(f"{src}: no rainfall or other covariates given; the model has only season and trend terms")
+    lead = max(windows) - 1 if period == "day" else 0
+    first_needed = start - pd.Timedelta(days=lead)
+    for r in events.itertuples():
+        d = r.date if period != "year" or pd.notna(r.date) else pd.Timestamp(int(r.year), 1, 1)
+        if pd.isna(d):
+            continue
+        if d - pd.Timedelta(days=lead) < rain.first_day or d > rain.last_day:
+            raise ValueError(f"{src}: row {r.source_row}, date {d.date()}: outside the rainfall record "
+                             f"{rain.source} ({rain.first_day.date()} to {rain.last_day.date()}"
+                             + (f", and the {max(windows)}-day antecedent window needs rainfall from "
+                                f"{(d - pd.Timedelta(days=lead)).date()}" if lead else "") + ")")
+    rain.check_covers(first_needed, end, f"{src}: the record period {start.date()} to {end.date()}"
+                      + (f" with its {max(windows)}-day antecedent window" if lead else ""))
+    if period == "day":
+        lo = 0
+        for w in windows:
+            name, label = _band_name(lo, w - 1)
+            total = rain.window_total(w - lo, lag=lo).reindex(days)
+            design[name] = total.to_numpy()
+            rain_cols.append((name, label))
+            lo = w
+    else:
+        total = rain.daily.reindex(days).groupby(key).sum(min_count=1).reindex(starts)
+        design[f"rain_{period}_mm"] = total.to_numpy()
+        rain_cols.append((f"rain_{period}_mm", f"rainfall in the {period}"))
+    return rain_cols
 
+
+def _add_covariate_columns(design: pd.DataFrame, extra: pd.DataFrame, period: str, start: pd.Timestamp,
+                           end: pd.Timestamp, days, key, starts, src: str) -> list:
+    """Check the user's daily covariates and add them per period (summed or averaged) to the model frame.
+
+    Parameters
+    ----------
+    design : pandas.DataFrame
+        The model frame, one row per period; a column per covariate is added in place.
+    extra : pandas.DataFrame
+        Daily covariates indexed by date.  ``*_mm``, ``*_days`` and ``freeze_thaw`` are summed over a month or
+        year, the others averaged.
+    period : {"day", "month", "year"}
+        Counting period.
+    start, end : pandas.Timestamp
+        The record period.
+    days, key, starts
+        As :func:`_record_periods`.
+    src : str
+        The inventory's source for messages.
+
+    Returns
+    -------
+    list of str
+        The covariate columns added.
+    """
     extra_cols = []
-    if extra is not None:
-        if not isinstance(extra.index, pd.DatetimeIndex):
-            raise TypeError("covariates: a DataFrame of covariates must be indexed by date (DatetimeIndex)")
-        for col in extra.columns:
-            values = pd.to_numeric(extra[col], errors="coerce")
-            bad = values.isna() & extra[col].notna()
-            if bad.any():
-                d = extra.index[bad.to_numpy()][0]
-                raise ValueError(f"covariates: column {col!r}, date {d.date()}: {extra[col][d]!r} is not a number")
-            series = values.groupby(extra.index.normalize()).mean()
-            daily = series.reindex(days)
-            if daily.isna().any():
-                d = days[daily.isna().to_numpy()][0]
-                raise ValueError(f"covariates: column {col!r} has no value for {d.date()}, but the inventory "
-                                 f"{src} covers {start.date()} to {end.date()}: covariates must cover every day "
-                                 f"of the period (given {series.index.min().date()} to {series.index.max().date()})")
-            if period == "day":
-                design[col] = daily.to_numpy()
-            else:
-                how = "sum" if (col.endswith(("_mm", "_days")) or col == "freeze_thaw") else "mean"
-                design[col] = daily.groupby(key).agg(how).reindex(starts).to_numpy()
-            extra_cols.append(col)
+    if not isinstance(extra.index, pd.DatetimeIndex):
+        raise TypeError("covariates: a DataFrame of covariates must be indexed by date (DatetimeIndex)")
+    for col in extra.columns:
+        values = pd.to_numeric(extra[col], errors="coerce")
+        bad = values.isna() & extra[col].notna()
+        if bad.any():
+            d = extra.index[bad.to_numpy()][0]
+            raise ValueError(f"covariates: column {col!r}, date {d.date()}: {extra[col][d]!r} is not a number")
+        series = values.groupby(extra.index.normalize()).mean()
+        daily = series.reindex(days)
+        if daily.isna().any():
+            d = days[daily.isna().to_numpy()][0]
+            raise ValueError(f"covariates: column {col!r} has no value for {d.date()}, but the inventory "
+                             f"{src} covers {start.date()} to {end.date()}: covariates must cover every day "
+                             f"of the period (given {series.index.min().date()} to {series.index.max().date()})")
+        if period == "day":
+            design[col] = daily.to_numpy()
+        else:
+            how = "sum" if (col.endswith(("_mm", "_days")) or col == "freeze_thaw") else "mean"
+            design[col] = daily.groupby(key).agg(how).reindex(starts).to_numpy()
+        extra_cols.append(col)
+    return extra_cols
 
-    # Season and trend.
+
+def _add_season_trend_columns(design: pd.DataFrame, period: str, season, trend: bool, start: pd.Timestamp,
+                              end: pd.Timestamp, notes: list):
+    """Add the season terms and the centred year [yr] of the trend to the model frame.
+
+    Parameters
+    ----------
+    design : pandas.DataFrame
+        The model frame (``period_start``, ``exposure_days``); columns are added in place.
+    period : {"day", "month", "year"}
+        Counting period (the middle of a month or year dates it).
+    season : {"harmonic", "wet", "month", None}
+        Season terms (none for yearly counts; a note says so).
+    trend : bool
+        Add ``year_c``, the decimal year minus ``year_ref``.
+    start, end : pandas.Timestamp
+        The record period.
+    notes : list of str
+        The model's notes.
+
+    Returns
+    -------
+    season_frame : pandas.DataFrame
+        The season columns added.
+    season_used : str or None
+        The season terms used.
+    year_ref : float
+        Reference year of the trend [yr]: the middle of the record, to 0.1 yr.
+    """
     mid = design["period_start"] + pd.to_timedelta(design["exposure_days"] / 2, unit="D") \
         if period != "day" else design["period_start"]
     season_used = season if period != "year" else None
@@ -629,8 +791,12 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
     year_ref = float(np.round((start.year + end.year + 1) / 2, 1))
     if trend:
         design["year_c"] = decimal_year.to_numpy() - year_ref
+    return season_frame, season_used, year_ref
 
-    # Counts.
+
+def _add_counts(design: pd.DataFrame, events: pd.DataFrame, period: str, start: pd.Timestamp, end: pd.Timestamp,
+                src: str) -> None:
+    """Insert the count of events per period as the model frame's column ``count`` (raises when all are 0)."""
     ev_key = events["date"].dt.normalize() if period == "day" else (
         events["date"].dt.to_period("M").dt.to_timestamp() if period == "month"
         else pd.to_datetime(events["year"].astype(int).astype(str) + "-01-01"))
@@ -640,6 +806,33 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
     if n_counted == 0:
         raise ValueError(f"{src}: no event falls inside the record period {start.date()} to {end.date()}")
 
+
+def _term_table(design: pd.DataFrame, rain_cols: list, season_frame: pd.DataFrame, trend: bool, extra_cols: list,
+                rain_per_mm: float, rain_transform: str) -> pd.DataFrame:
+    """The model's terms: column, label, unit of the rate ratio, scale and transform; each must vary.
+
+    Parameters
+    ----------
+    design : pandas.DataFrame
+        The model frame.
+    rain_cols : list of (str, str)
+        Rainfall columns and labels.
+    season_frame : pandas.DataFrame
+        The season columns.
+    trend : bool
+        Whether ``year_c`` is a term.
+    extra_cols : list of str
+        The user's covariates.
+    rain_per_mm : float
+        Rainfall [mm] that a rainfall rate ratio refers to.
+    rain_transform : {"linear", "sqrt", "log1p"}
+        How rainfall enters the linear predictor.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``term``, ``label``, ``unit``, ``scale``, ``transform``.
+    """
     terms = []
     rain_unit = f"{rain_per_mm:g} mm" if rain_transform == "linear" else f"{rain_per_mm:g} mm vs none"
     for name, label in rain_cols:
@@ -659,36 +852,88 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
     const_like = [t for t in terms["term"] if np.ptp(design[t].to_numpy(float)) == 0]
     if const_like:
         raise ValueError(f"covariate(s) {const_like} do not vary over the record period; they cannot be estimated")
+    return terms
 
-    y = design["count"].to_numpy(float)
-    X = _exog(design, terms)
-    offset = np.log(design["exposure_days"].to_numpy(float))
 
-    def fit_pair(Xm):
+def _fit_count_models(y, X, offset, src: str, notes: list):
+    """Fit the Poisson and the negative binomial (NB2) regressions of the counts.
+
+    Parameters
+    ----------
+    y : numpy.ndarray
+        Counts per period.
+    X : pandas.DataFrame
+        Model matrix (:func:`_exog`).
+    offset : numpy.ndarray
+        log of the exposure [days].
+    src : str
+        The inventory's source for messages.
+    notes : list of str
+        The model's notes; a negative binomial fit that fails or does not converge is noted (and warned).
+
+    Returns
+    -------
+    pois : statsmodels GLMResults
+        The Poisson fit.
+    nb : statsmodels NegativeBinomialResults or None
+        The NB2 fit; None when it failed.
+    """
+    # the model classes used, not statsmodels.api (which imports all of statsmodels: 0.7 s more)
+    from statsmodels.discrete.discrete_model import NegativeBinomial
+    from statsmodels.genmod import families
+    from statsmodels.genmod.generalized_linear_model import GLM
+    from statsmodels.tools.sm_exceptions import ConvergenceWarning
+
+    try:
+        pois = GLM(y, X, family=families.Poisson(), offset=offset).fit()
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        raise ValueError(f"{src}: the Poisson rate model cannot be fitted to these counts and covariates "
+                         f"({exc}); check the rainfall record for impossible values") from None
+    if not np.all(np.isfinite(pois.params)):
+        raise ValueError(f"{src}: the Poisson rate model has no finite estimate for these counts and "
+                         f"covariates; check the rainfall record for impossible values")
+    trouble = []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ConvergenceWarning)
         try:
-            pois = GLM(y, Xm, family=families.Poisson(), offset=offset).fit()
-        except (ValueError, np.linalg.LinAlgError) as exc:
-            raise ValueError(f"{src}: the Poisson rate model cannot be fitted to these counts and covariates "
-                             f"({exc}); check the rainfall record for impossible values") from None
-        if not np.all(np.isfinite(pois.params)):
-            raise ValueError(f"{src}: the Poisson rate model has no finite estimate for these counts and "
-                             f"covariates; check the rainfall record for impossible values")
-        trouble = []
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", ConvergenceWarning)
-            try:
-                nb = _fit_negbin(y, Xm, offset, pois, GLM, families, NegativeBinomial)
-            except (np.linalg.LinAlgError, ValueError) as exc:
-                nb = None
-                trouble.append(str(exc))
-        trouble += [str(w.message) for w in caught if issubclass(w.category, (ConvergenceWarning, RuntimeWarning))]
-        return pois, nb, trouble
-
-    pois, nb, trouble = fit_pair(X)
+            nb = _fit_negbin(y, X, offset, pois, GLM, families, NegativeBinomial)
+        except (np.linalg.LinAlgError, ValueError) as exc:
+            nb = None
+            trouble.append(str(exc))
+    trouble += [str(w.message) for w in caught if issubclass(w.category, (ConvergenceWarning, RuntimeWarning))]
     if nb is None or not np.all(np.isfinite(nb.params)) or (trouble and not nb.mle_retvals.get("converged", False)):
-        note(f"negative binomial model did not converge ({'; '.join(trouble)[:200] or 'no finite estimate'}); "
-             f"the Poisson model is used")
+        _note(notes, f"negative binomial model did not converge ({'; '.join(trouble)[:200] or 'no finite estimate'}); "
+                     f"the Poisson model is used")
         nb = None
+    return pois, nb
+
+
+def _compare_models(y, X, offset, pois, nb):
+    """Goodness of fit of both models and the overdispersion tests.
+
+    The likelihood-ratio test of alpha = 0 lies on the boundary, so its p-value is half the chi-square(1)
+    tail (Cameron & Trivedi 2013, section 3.4); Cameron & Trivedi's (1990) auxiliary regression is the second test.
+
+    Parameters
+    ----------
+    y, X, offset
+        Counts, model matrix and log exposure [days].
+    pois, nb
+        The fits of :func:`_fit_count_models`.
+
+    Returns
+    -------
+    comparison : pandas.DataFrame
+        Per model: log-likelihood, AIC, deviance, residual df, Pearson chi2 per df, alpha, expected and
+        observed totals.
+    overdispersion : dict
+        alpha and both tests (empty without a negative binomial fit).
+    nb_glm : statsmodels GLMResults or None
+        The NB2 model at its fitted alpha as a GLM.
+    """
+    from statsmodels.genmod import families
+    from statsmodels.genmod.generalized_linear_model import GLM
+    from statsmodels.regression.linear_model import OLS
 
     comparison = {"Poisson": {"loglik": pois.llf, "aic": pois.aic, "deviance": pois.deviance,
                               "df_resid": pois.df_resid, "pearson_chi2_per_df": pois.pearson_chi2 / pois.df_resid,
@@ -715,7 +960,61 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
                           "ct_statistic": ct_t, "ct_p_value": float(stats.t.sf(ct_t, ct.df_resid))}
     comparison = pd.DataFrame(comparison).T
     comparison.index.name = "model"
+    return comparison, overdispersion, nb_glm
 
+
+def _covariate_inputs(covariates, rainfall, windows_days):
+    """Sort :func:`rate_model`'s ``covariates`` and ``rainfall`` into a covariate frame and daily rainfall.
+
+    Parameters
+    ----------
+    covariates, rainfall, windows_days
+        As :func:`rate_model`.
+
+    Returns
+    -------
+    extra : pandas.DataFrame or None
+        The user's daily covariates.
+    rain : Rainfall or None
+        Daily rainfall (a file is read).
+    windows : tuple of int
+        The antecedent rainfall bands [days], checked increasing and >= 1.
+    """
+    extra = None
+    if isinstance(covariates, pd.DataFrame):
+        extra = covariates
+    elif covariates is not None:
+        if rainfall is not None:
+            raise ValueError("give rainfall either as covariates= or as rainfall=, not both")
+        rainfall = covariates
+    rain = _as_rainfall(rainfall, "rainfall")
+    windows = tuple(int(w) for w in windows_days)
+    if not windows or any(w < 1 for w in windows) or list(windows) != sorted(set(windows)):
+        raise ValueError(f"windows_days = {windows_days!r} must be increasing whole numbers of days >= 1")
+    return extra, rain, windows
+
+
+def _preferred_model(pois, nb, nb_glm, overdispersion: dict):
+    """The preferred model: the negative binomial when the LR test rejects alpha = 0 at 5 %, else the Poisson.
+
+    Parameters
+    ----------
+    pois, nb, nb_glm
+        The fits (:func:`_fit_count_models`, :func:`_compare_models`); ``nb`` may be None.
+    overdispersion : dict
+        The overdispersion tests (:func:`_compare_models`).
+
+    Returns
+    -------
+    preferred : str
+        "negative binomial" or "Poisson".
+    reason : str
+        Why, with the test's p-value and the AICs.
+    res
+        The preferred fit.
+    glm_pref
+        The preferred model as a GLM (for predictions with intervals).
+    """
     if nb is not None and overdispersion["lr_p_value"] < 0.05:
         preferred = "negative binomial"
         reason = (f"overdispersion: LR test of alpha = 0 gives p = {overdispersion['lr_p_value']:.3g}; "
@@ -726,7 +1025,11 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
         reason = ("no significant overdispersion" + (f" (p = {overdispersion['lr_p_value']:.3g})" if overdispersion
                   else "") + f"; AIC {pois.aic:.1f}" + (f" vs {nb.aic:.1f}" if nb is not None else ""))
         res, glm_pref = pois, pois
+    return preferred, reason, res, glm_pref
 
+
+def _rate_ratio_table(res, terms: pd.DataFrame, level: float) -> pd.DataFrame:
+    """Coefficients, rate ratios exp(beta) with Wald intervals at ``level``, and p-values of every term."""
     z = stats.norm.isf((1 - level) / 2)
     rr = []
     for t in terms.itertuples():
@@ -734,32 +1037,50 @@ def rate_model(inventory: Inventory, covariates=None, *, rainfall=None, period: 
         rr.append({"term": t.term, "label": t.label, "unit": t.unit, "coefficient": b, "stderr": se,
                    "rate_ratio": np.exp(b), "ci_low": np.exp(b - z * se), "ci_high": np.exp(b + z * se),
                    "p_value": p})
-    rate_ratios = pd.DataFrame(rr)
+    return pd.DataFrame(rr)
 
-    trend_info = None
-    if trend:
-        X0 = X.drop(columns="year_c")
-        if preferred == "Poisson":
-            llf0 = GLM(y, X0, family=families.Poisson(), offset=offset).fit().llf
-        else:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                sp = np.r_[res.params.drop(["year_c"]).to_numpy()]
-                llf0 = NegativeBinomial(y, X0, offset=offset, loglike_method="nb2").fit(
-                    start_params=sp, disp=0, maxiter=300, method="bfgs").llf
-        lr_t = max(2 * (res.llf - llf0), 0.0)
-        row = rate_ratios.set_index("term").loc["year_c"]
-        p_t = float(stats.chi2.sf(lr_t, 1))
-        trend_info = {"rate_ratio_per_year": float(row["rate_ratio"]), "ci_low": float(row["ci_low"]),
-                      "ci_high": float(row["ci_high"]), "lr_statistic": lr_t, "p_value": p_t,
-                      "detected": bool(p_t < 0.05), "model": preferred, "year_ref": year_ref}
 
-    return RateModel(design=design, terms=terms, period=period, poisson=pois, negbin=nb, preferred=preferred,
-                     reason=reason, comparison=comparison, overdispersion=overdispersion, rate_ratios=rate_ratios,
-                     trend=trend_info, level=level, year_ref=year_ref, inventory_source=src,
-                     rainfall_source=rain.source if rain is not None else "", start=start, end=end,
-                     season=season_used, windows_days=windows if period == "day" else (),
-                     notes=tuple(list(inventory.notes) + notes), _glm_preferred=glm_pref, rainfall=rain)
+def _trend_test(y, X, offset, res, preferred: str, rate_ratios: pd.DataFrame, year_ref: float) -> dict:
+    """Likelihood-ratio test of the trend: the preferred model with and without ``year_c``.
+
+    Parameters
+    ----------
+    y, X, offset
+        Counts, model matrix and log exposure [days].
+    res
+        The preferred model's fit.
+    preferred : {"Poisson", "negative binomial"}
+        The preferred model.
+    rate_ratios : pandas.DataFrame
+        :func:`_rate_ratio_table` of the preferred model.
+    year_ref : float
+        Reference year of the trend [yr].
+
+    Returns
+    -------
+    dict
+        Rate ratio per year with its interval, LR statistic, p-value, ``detected`` (p < 0.05), model and
+        ``year_ref``.
+    """
+    from statsmodels.discrete.discrete_model import NegativeBinomial
+    from statsmodels.genmod import families
+    from statsmodels.genmod.generalized_linear_model import GLM
+
+    X0 = X.drop(columns="year_c")
+    if preferred == "Poisson":
+        llf0 = GLM(y, X0, family=families.Poisson(), offset=offset).fit().llf
+    else:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sp = np.r_[res.params.drop(["year_c"]).to_numpy()]
+            llf0 = NegativeBinomial(y, X0, offset=offset, loglike_method="nb2").fit(
+                start_params=sp, disp=0, maxiter=300, method="bfgs").llf
+    lr_t = max(2 * (res.llf - llf0), 0.0)
+    row = rate_ratios.set_index("term").loc["year_c"]
+    p_t = float(stats.chi2.sf(lr_t, 1))
+    return {"rate_ratio_per_year": float(row["rate_ratio"]), "ci_low": float(row["ci_low"]),
+            "ci_high": float(row["ci_high"]), "lr_statistic": lr_t, "p_value": p_t,
+            "detected": bool(p_t < 0.05), "model": preferred, "year_ref": year_ref}
 
 
 __all__ = ["RateModel", "rate_model", "MIN_PERIODS", "DEFAULT_WINDOWS_DAYS", "RiskrfWarning"]
