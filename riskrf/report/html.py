@@ -229,17 +229,30 @@ SOFTWARE_METRICS = ("run time [s]", "impacts per second", "blocks per second")
 
 def render_report(a, figs: Path) -> str:
     """HTML of the hazard and mitigation report for assessment ``a`` (figures read from ``figs``)."""
-    site, inv, fr, gr = a.site, a.inventory, a.frequency, a.frequency.power_law
-    en, hz = a.energy, a.energy.hazard
-    ranking, cur = a.decision["ranking"], a.study.currency
-    best, second = ranking["option"].iloc[0], ranking["option"].iloc[1]
-    design = en.design.set_index("T_years")
+    site = a.site
     doc = Document(title=f"{site.name} - rock fall hazard and mitigation")
     header = (f"<h1>Rock fall hazard and mitigation: {_e(site.name)}</h1><p>{_e(site.description)}</p>"
               f"<p><small>riskrf {__version__} &middot; seed {a.seed} &middot; {a.n_blocks:,} simulated blocks "
               f"&middot; generated {_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; method after Wyllie "
               f"(2014) <i>Rock Fall Engineering</i>, ch. 3-8</small></p>")
-    rate_scale = site.inventory["rate_scale"]
+    header += _summary_box(a)
+    _site_and_data_section(doc, a)
+    _magnitude_frequency_section(doc, a, figs)
+    _annual_maxima_section(doc, a, figs)
+    _simulation_section(doc, a, figs)
+    _energy_section(doc, a, figs)
+    _fence_sections(doc, a, figs)
+    _risk_section(doc, a, figs)
+    _decision_section(doc, a, figs)
+    mu = getattr(a, "model_uncertainty", None)
+    if mu is not None:
+        _model_uncertainty_section(doc, mu, figs, a.study.currency)
+    _assumptions_section(doc, a)
+    return _ABSOLUTE_DIRS.sub("", doc.render(header=header))
+
+
+def _money_formatters(cur: str):
+    """Formatters of amounts in currency ``cur``: typed amounts in full, computed ones to 3 significant figures."""
 
     def money_cur(v):
         """A typed amount (capital cost), in full."""
@@ -249,7 +262,18 @@ def render_report(a, figs: Path) -> str:
         """A computed, uncertain amount (means, intervals, expected losses): 3 significant figures."""
         return "" if v is None or pd.isna(v) else money(v, cur, sig=3)
 
-    # Summary
+    return money_cur, money_est
+
+
+def _summary_box(a) -> str:
+    """HTML of the report's summary box: inventory, law, hazard, design energies, fences, risk and ranking."""
+    inv, gr = a.inventory, a.frequency.power_law
+    en, hz = a.energy, a.energy.hazard
+    ranking, cur = a.decision["ranking"], a.study.currency
+    best, second = ranking["option"].iloc[0], ranking["option"].iloc[1]
+    design = en.design.set_index("T_years")
+    rate_scale = a.site.inventory["rate_scale"]
+    money_est = _money_formatters(cur)[1]
     verdicts = en.fence_verdicts()
     summary = ["<div class='box'><b>Summary.</b><ul>",
                (f"<li>{inv.n_events:,} recorded falls in {sig(inv.duration_years)} years; power law b = "
@@ -312,9 +336,12 @@ def render_report(a, figs: Path) -> str:
         summary.append(f"<li>Over {mu.ranking.n_draws} draws of the trajectory model the least expected cost is "
                        f"<b>{_e(mu.ranking.best_now())}</b>; <b>{_e(mu.verdict())}</b>.</li>")
     summary.append("</ul></div>")
-    header += "".join(summary)
+    return "".join(summary)
 
-    # 1. Site and data
+
+def _site_and_data_section(doc, a) -> None:
+    """Section 1: the inventory, its completeness and the rate model with its closure rules."""
+    inv, cur = a.inventory, a.study.currency
     doc.section("Site and data")
     doc.add(doc.table(_item_table(inv.summary()), f"The inventory ({_e(_name(inv.source))})"),
             "<h3>Completeness</h3><p>Falls per year and the smallest recorded size show whether recording "
@@ -343,7 +370,10 @@ def render_report(a, figs: Path) -> str:
         if len(closures):
             doc.add(doc.table(closures, "Closure rules computed from the rate model"))
 
-    # 2. Magnitude-frequency
+
+def _magnitude_frequency_section(doc, a, figs: Path) -> None:
+    """Section 2: the power law, its goodness of fit and the design masses of the site and of the whole wall."""
+    fr, gr, en = a.frequency, a.frequency.power_law, a.energy
     doc.section("Magnitude-frequency relation (Wyllie 2014, 8.4.1)")
     n_table = doc.next_table
     doc.add(f"<p>log<sub>10</sub> N(&ge;m) = a &minus; b log<sub>10</sub> m, N per year, m in kg; "
@@ -370,7 +400,10 @@ def render_report(a, figs: Path) -> str:
             "bound, so its long-return-period masses can exceed any credible block.</p>",
             doc.table(fr.design_masses(), "Design masses of the whole wall's law (reference only)"))
 
-    # 3. Annual maxima
+
+def _annual_maxima_section(doc, a, figs: Path) -> None:
+    """Section 3: Gumbel and GEV fits of the annual maxima (of the inventory or of a dated record)."""
+    fr = a.frequency
     mf = fr if fr.gumbel is not None else a.maxima_frequency
     doc.section("Extreme values of annual maxima (Wyllie 2014, 8.4.2)")
     if mf is None or mf.gumbel is None:
@@ -397,7 +430,10 @@ def render_report(a, figs: Path) -> str:
                 doc.figure(sub / "return_levels.png",
                            "Return levels of the annual maximum, with the law the power law implies"))
 
-    # 4. Simulation
+
+def _simulation_section(doc, a, figs: Path) -> None:
+    """Section 4: the scenario, the simulation summary and its figures (or where the velocities come from)."""
+    hz = a.energy.hazard
     doc.section("Trajectories at the barrier line (Wyllie 2014, ch. 3-7)")
     if a.result is not None:
         res = a.result
@@ -417,7 +453,10 @@ def render_report(a, figs: Path) -> str:
     else:
         doc.add(f"<p>{_e(hz.notes[0] if hz.notes else 'velocities from a file')}</p>")
 
-    # 5. Energy
+
+def _energy_section(doc, a, figs: Path) -> None:
+    """Section 5: the impact energy hazard, design energies, mass classes, sensitivity, design block and UNI."""
+    en, hz = a.energy, a.energy.hazard
     doc.section("Impact energy hazard (Wyllie 2014, 8.1-8.3)")
     doc.add("<p>&lambda;(E &gt; e) = rate of falls &times; P(reach) &times; P(E &gt; e), with the mass "
             "distribution of the fitted power law and the simulated velocities (rotation included). "
@@ -462,7 +501,10 @@ def render_report(a, figs: Path) -> str:
                 f"velocity{' of blocks of its mass' if hz.mass_coupled else ''}: E<sub>k</sub> = {sig(u.characteristic_energy_kj, 2)} kJ, E<sub>d</sub> = "
                 f"{sig(u.design_energy_kj, 2)} kJ with factors {_e(cell(u.factors))}.</p>")
 
-    # 6. Fences
+
+def _fence_sections(doc, a, figs: Path) -> None:
+    """Section 6: the design basis (when given) and the fence checks against MEL and SEL."""
+    en = a.energy
     if getattr(a, "design", None) is not None:
         d = a.design
         doc.section(f"Design basis: {d.basis.basis} governs")
@@ -482,7 +524,10 @@ def render_report(a, figs: Path) -> str:
     for name, table in en.fences.items():
         doc.add(f"<h3>{_e(name)}</h3>", doc.table(table, f"Checks of {name}"))
 
-    # 7. Risk
+
+def _risk_section(doc, a, figs: Path) -> None:
+    """Section 7: individual and societal risk to road users by option."""
+    ranking = a.decision["ranking"]
     ir_limit = a.study.criteria.individual_risk_per_year
     risk = ranking[["option", "road_falls_per_year", "deaths_per_year", "individual_risk"]].copy()
     risk[f"meets {probability(ir_limit)}/yr"] = risk["individual_risk"] <= ir_limit
@@ -504,7 +549,11 @@ def render_report(a, figs: Path) -> str:
             doc.table(risk, "Risk to road users by option", digits=2),
             doc.figure(figs / "fn_curve.png", "F-N curves with Hong Kong GEO criteria"))
 
-    # 8. Decision
+
+def _decision_section(doc, a, figs: Path) -> None:
+    """Section 8: recommendation, options, costs, uncertain inputs, break-even, tornado and value of information."""
+    ranking, cur = a.decision["ranking"], a.study.currency
+    money_cur, money_est = _money_formatters(cur)
     be = a.decision["break_even"]
     rec = a.decision["recommendation"]
     unc = a.decision["uncertainty"]
@@ -579,10 +628,11 @@ def render_report(a, figs: Path) -> str:
             f"sampled inputs at once: <b>{money_est(voi['evpi_all_sampled_inputs'])}</b> &mdash; the most that "
             "investigations settling them are worth.</p>")
 
-    if mu is not None:
-        _model_uncertainty_section(doc, mu, figs, cur)
 
-    # 9. Assumptions
+def _assumptions_section(doc, a) -> None:
+    """Section 9: assumptions, defaults and judgement inputs, and warnings."""
+    en, hz = a.energy, a.energy.hazard
+    rate_scale = a.site.inventory["rate_scale"]
     doc.section("Assumptions, defaults and warnings")
     classed = isinstance(hz.velocity, PairedSamples)
     items = [("Lumped-mass trajectories of round blocks; restitution and friction parameters are starting values "
@@ -606,7 +656,6 @@ def render_report(a, figs: Path) -> str:
     if a.warnings:
         doc.add("<h3>Warnings</h3><div class='warn'><ul>"
                 + "".join(f"<li>{_e(w)}</li>" for w in a.warnings) + "</ul></div>")
-    return _ABSOLUTE_DIRS.sub("", doc.render(header=header))
 
 
 def _model_uncertainty_section(doc, mu, figs: Path, cur: str) -> None:
