@@ -7,6 +7,13 @@ parameters=...)``) fits material parameters shared by every release to all obser
 a :class:`PooledCalibration`: a posterior sample, its correlations, the posterior width against the prior's,
 and posterior-predictive coverage per release.
 
+**3-D releases.**  A release whose scenario has a ``[terrain]`` table (a DEM; see
+:func:`simulation.terrain_scenario_from_dict`) is simulated with the 3-D kernel (:func:`simulation.run_terrain`)
+from the scenario's sources, and its ``x_stop_m`` are the observed **plan runouts**: the horizontal distance
+[m] of each stop from its release point (``TerrainResult.stops()["runout_m"]``).  The likelihood is the same
+kernel density on that one number; the defensive mixture spreads over the DEM's plan diagonal.  2-D and 3-D
+releases may be pooled; a 3-D release takes ``mass_kg`` and ``height_m`` only (the sources give the rest).
+
 Method
 ------
 * **Likelihood by kernel ABC.**  For a parameter set theta every release is simulated (``n_per_release``
@@ -57,6 +64,8 @@ from .scenario import Distribution, Material, Scenario, ScenarioError, scenario_
 #: Share of the predictive density spread uniformly over the profile (the defensive mixture).
 DEFENSIVE_SHARE = 1e-3
 _RELEASE_FIELDS = ("x_m", "height_m", "vx_ms", "vz_ms", "downslope_speed_ms", "shape")
+#: Release fields a 3-D release may not set (its scenario's [sources] table gives them).
+_PROFILE_ONLY_FIELDS = ("x_m", "vx_ms", "vz_ms", "downslope_speed_ms", "shape", "radius_m")
 
 
 class PooledCalibrationWarning(UserWarning):
@@ -74,7 +83,9 @@ class Release:
     scenario : path, dict or Scenario
         The release's profile and materials (a Scenario must have been loaded from its TOML file).
     x_stop_m : array
-        Observed horizontal stop positions [m] in the profile's coordinates (one per observed block).
+        Observed horizontal stop positions [m] in the profile's coordinates (one per observed block); for a
+        3-D release (a scenario with a ``[terrain]`` table), the plan runout [m] of each stop from the release
+        point.
     mass_kg : float, optional
         Block mass [kg]; the scenario's seeder mass distribution when None.
     radius_m : float, optional
@@ -321,7 +332,7 @@ class _Pool:
             key = str(key)
             if key not in self.bases:
                 data, src = scenario_dict(r.scenario)
-                self.bases[key] = (data, src, scenario_from_dict(data, source=src))
+                self.bases[key] = (data, src, _build_scenario(data, src, r))
             self.rel_key.append(key)
         self._check_geometry()
         self.names = list(parameters)
@@ -356,9 +367,29 @@ class _Pool:
                 None if r.radius_m is None else (r.radius_m, r.mass_kg),)
             self.groups.setdefault(gkey, []).append(i)
 
-    def _check_geometry(self):
-        for r, key in zip(self.releases, self.rel_key):
+    def is_terrain(self, i: int) -> bool:
+        """True when release ``i`` runs on a DEM (3-D kernel)."""
+        return not isinstance(self.bases[self.rel_key[i]][2], Scenario)
+
+    def support_lengths(self) -> list[float]:
+        """Per release, the length [m] the defensive mixture spreads over: the profile's length in 2-D, the DEM's
+        plan diagonal (the longest possible plan runout) in 3-D."""
+        out = []
+        for key in self.rel_key:
             sc = self.bases[key][2]
+            if isinstance(sc, Scenario):
+                out.append(float(sc.profile.x[-1] - sc.profile.x[0]))
+            else:
+                x0, y0, x1, y1 = sc.terrain.bounds
+                out.append(float(math.hypot(x1 - x0, y1 - y0)))
+        return out
+
+    def _check_geometry(self):
+        for i, (r, key) in enumerate(zip(self.releases, self.rel_key)):
+            sc = self.bases[key][2]
+            if self.is_terrain(i):
+                _check_terrain_release(r, sc)
+                continue
             lo, hi = sc.profile.x[0], sc.profile.x[-1]
             where = f"{r.source}: release {r.name!r}"
             x = np.asarray(r.x_stop_m, dtype=float).ravel()
@@ -404,6 +435,11 @@ class _Pool:
         out = [None] * len(self.releases)
         for g, (gkey, idx) in enumerate(self.groups.items()):
             r0 = self.releases[idx[0]]
+            if self.is_terrain(idx[0]):
+                runout = _simulate_terrain(scs[gkey[0]], [self.releases[i] for i in idx], n_per, [int(seed), g])
+                for j, i in enumerate(idx):
+                    out[i] = runout[j * n_per:(j + 1) * n_per]
+                continue
             sc = _with_release_state(scs[gkey[0]], r0)
             masses = None
             if r0.mass_kg is not None:
@@ -415,6 +451,53 @@ class _Pool:
             for j, i in enumerate(idx):
                 out[i] = x[j * n_per:(j + 1) * n_per]
         return out
+
+
+def _build_scenario(data: dict, src: str, r: Release):
+    """The checked scenario of release ``r``: a 2-D :class:`Scenario`, or a ``TerrainScenario`` when ``data`` has a
+    ``[terrain]`` table (its files relative to the scenario file).  A 3-D scenario's errors (a source outside
+    the DEM, ...) are raised naming the release."""
+    if "terrain" not in data:
+        return scenario_from_dict(data, source=src)
+    from .scenario3d import terrain_scenario_from_dict
+    base = Path(src).parent if Path(src).is_file() else None
+    try:
+        return terrain_scenario_from_dict(data, source=src, base_dir=base)
+    except ScenarioError as exc:
+        raise ValueError(f"{r.source}: release {r.name!r} (3-D scenario): {exc}") from None
+
+
+def _check_terrain_release(r: Release, sc) -> None:
+    """A 3-D release: plan runouts >= 0 and within the DEM's plan diagonal, and no 2-D-only release field."""
+    where = f"{r.source}: release {r.name!r}"
+    for fld in _PROFILE_ONLY_FIELDS:
+        if getattr(r, fld) is not None:
+            raise ValueError(f"{where}: field {fld} = {getattr(r, fld)!r} applies to a 2-D profile only; a 3-D "
+                             f"release ({sc.source}) takes its release state from the scenario's [sources] table "
+                             "(set mass_kg and height_m at most)")
+    x0, y0, x1, y1 = sc.terrain.bounds
+    diag = math.hypot(x1 - x0, y1 - y0)
+    x = np.asarray(r.x_stop_m, dtype=float).ravel()
+    bad = (x < 0) | (x > diag)
+    if bad.any():
+        raise ValueError(f"{where}: x_stop_m = {x[bad][0]:g} m is not a plan runout on the DEM of {sc.source} "
+                         f"([0, {diag:.1f}] m: from the release point to the DEM's plan diagonal)")
+    if r.height_m is not None and not (np.isfinite(r.height_m) and r.height_m >= 0):
+        raise ValueError(f"{where}: height_m = {r.height_m!r} must be a finite number >= 0 m")
+
+
+def _simulate_terrain(sc, rels: list, n_per: int, seed) -> np.ndarray:
+    """Plan runouts [m] of ``n_per`` blocks per release in ``rels`` (one 3-D scenario and release state)."""
+    from .engine3d import run_terrain
+    r0 = rels[0]
+    if r0.height_m is not None:
+        sc = replace(sc, sources=replace(sc.sources, height_m=Distribution("constant", {"value": float(r0.height_m)})))
+    if r0.mass_kg is not None:
+        res = run_terrain(sc, seed=seed, masses_kg=np.repeat([r.mass_kg for r in rels], n_per), record_paths=0)
+    else:
+        res = run_terrain(sc, n=n_per * len(rels), seed=seed, record_paths=0)
+    pb, b = res.per_block, res.blocks
+    return np.hypot(pb["x"] - b["x"], pb["y"] - b["y"])
 
 
 def _density(mass, radius, shape, aspect):
@@ -696,7 +779,7 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
     d = len(names)
     lo = np.array([pool.bounds[k][0] for k in names])
     hi = np.array([pool.bounds[k][1] for k in names])
-    lengths = [pool.bases[k][2].profile.x[-1] - pool.bases[k][2].profile.x[0] for k in pool.rel_key]
+    lengths = pool.support_lengths()
     seed = int(np.random.SeedSequence().entropy % (2 ** 31)) if seed is None else seed
     ss = np.random.SeedSequence(seed)
     rng_design, rng_prop, rng_resample, rng_pred = (np.random.default_rng(c) for c in ss.spawn(4))
