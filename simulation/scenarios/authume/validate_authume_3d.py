@@ -1,11 +1,14 @@
 """Observed vs simulated stop positions in plan at the Authume quarry, with the 3-D kernel.
 
-    python simulation/scenarios/authume/validate_authume_3d.py [RAW_DIR] [--n 2000]
+    python simulation/scenarios/authume/validate_authume_3d.py [RAW_DIR] [--n 2000] [--n-per-release 400]
 
-Runs the 3-D scenario (``authume_3d.tif`` DEM, zones as materials) from each release (P1, P2) with three
-material sets: the a-priori presets, and the parameters calibrated with the 2-D kernel on P1 and on P2
+Runs the 3-D scenario (``authume_3d.tif`` DEM, zones as materials) from each release (P1, P2) with five
+material sets: the a-priori presets; the parameters calibrated with the 2-D kernel on P1 and on P2
 (``authume_p1_calibrated.toml``, ``authume_p2_calibrated.toml``; the 2-D calibration applied unchanged to
-the 3-D kernel).  Compares, per release, the 41 / 48 surveyed stop points with the simulated ones:
+the 3-D kernel); and the same three parameters calibrated on the 3-D kernel on P1 and on P2
+(:func:`simulation.pooled.calibrate_pooled` with the release's 3-D scenario, likelihood on the observed plan
+runouts; written to ``results_3d_parameters.csv``), each applied in-sample and to the other release
+(transfer).  Compares, per release, the 41 / 48 surveyed stop points with the simulated ones:
 
 * plan runout (horizontal distance from the release point): quantiles, Wasserstein distance W1, KS test;
 * lateral offset: signed distance from the reference line of the 2-D profile (release -> medians of the
@@ -37,6 +40,9 @@ sys.path.insert(0, str(HERE))
 import simulation  # noqa: E402
 from simulation.profile_extraction import TerrainProfile, _polyline  # noqa: E402
 from build_authume_3d import _raw_dir, release_point  # noqa: E402
+from calibrate_authume import PARAMETERS  # noqa: E402  (the 2-D calibration's parameters and bounds)
+from simulation.calibration import apply_parameters  # noqa: E402
+from simulation.pooled import Release, calibrate_pooled  # noqa: E402
 
 DOCS = REPO / "docs" / "validation"
 APRIORI = {"vegetated_slope": {"preset": "soil"},
@@ -121,8 +127,9 @@ def materials_from(toml_path: Path | None) -> dict:
     return mats
 
 
-def scenario(profile: str, materials: dict, raw: Path):
-    """The 3-D Authume scenario for release ``profile`` with the given materials."""
+def scenario_data(profile: str, materials: dict, raw: Path) -> dict:
+    """The 3-D Authume scenario dictionary for release ``profile`` with the given materials (raster paths
+    absolute, so that it can be rebuilt anywhere, e.g. by the pooled calibration)."""
     with open(HERE / "authume_3d.toml", "rb") as f:
         data = tomllib.load(f)
     x, y, drop = release_point(raw, profile)
@@ -130,11 +137,40 @@ def scenario(profile: str, materials: dict, raw: Path):
     ends = np.loadtxt(raw / f"Endpoints_{profile}.txt", ndmin=2)
     ln = np.log(ends[:, 3])
     data["materials"] = materials
+    data["terrain"].update(dem=str(HERE / data["terrain"]["dem"]),
+                           material_raster=str(HERE / data["terrain"]["material_raster"]))
     data["sources"].update(points=[[x, y]], height_m=drop - float(dem.elevation(x, y)),
                            mass_kg={"dist": "lognormal", "median": float(np.exp(ln.mean())),
                                     "sigma": float(ln.std(ddof=1)), "max": float(ends[:, 3].max())})
     data["collectors"] = []
-    return simulation.terrain_scenario_from_dict(data, source=f"authume_3d ({profile})", base_dir=HERE, terrain=dem)
+    return data
+
+
+def scenario(profile: str, materials: dict, raw: Path):
+    """The 3-D Authume scenario for release ``profile`` with the given materials."""
+    return simulation.terrain_scenario_from_dict(scenario_data(profile, materials, raw),
+                                                 source=f"authume_3d ({profile})", base_dir=HERE)
+
+
+def observed_plan(profile: str, raw: Path):
+    """Observed stops in plan (n, 2) [m] and their plan runouts from the release point [m]."""
+    obs = np.loadtxt(raw / f"Endpoints_{profile}.txt", ndmin=2)[:, [0, 2]]
+    x, y, _ = release_point(raw, profile)
+    return obs, np.hypot(obs[:, 0] - x, obs[:, 1] - y)
+
+
+def calibrate_3d(profile: str, raw: Path, n_per_release: int = 400, seed: int = 1):
+    """The 2-D calibration's three parameters (``calibrate_authume.PARAMETERS``, same bounds) fitted on the 3-D
+    kernel to the observed plan runouts of ``profile``, from the a-priori presets (a PooledCalibration)."""
+    data = scenario_data(profile, {k: dict(v) for k, v in APRIORI.items()}, raw)
+    _, runout = observed_plan(profile, raw)
+    rel = Release(name=profile, scenario=data, x_stop_m=runout, source=f"{raw / f'Endpoints_{profile}.txt'}")
+    return calibrate_pooled([rel], PARAMETERS, n_per_release=n_per_release, seed=seed)
+
+
+def materials_3d(cal) -> dict:
+    """The a-priori materials with the 3-D calibration's posterior medians put in."""
+    return apply_parameters({"materials": {k: dict(v) for k, v in APRIORI.items()}}, cal.parameters)["materials"]
 
 
 def reference_line(profile: str, raw: Path) -> TerrainProfile:
@@ -175,26 +211,43 @@ def beyond_farthest(observed: np.ndarray, simulated: np.ndarray, k: int = 100, r
 
 
 def main(argv) -> None:
-    n = 2000
-    if "--n" in argv:
-        n = int(argv[argv.index("--n") + 1])
-        argv = [a for i, a in enumerate(argv) if a != "--n" and (i == 0 or argv[i - 1] != "--n")]
+    import time
+    opts = {"--n": 2000, "--n-per-release": 400}
+    for flag in opts:
+        if flag in argv:
+            opts[flag] = int(argv[argv.index(flag) + 1])
+            argv = [a for i, a in enumerate(argv) if a != flag and (i == 0 or argv[i - 1] != flag)]
+    n, n_per_release = opts["--n"], opts["--n-per-release"]
     raw = _raw_dir(argv)
-    sets = {"a priori": None, "calibrated on P1 (2-D)": HERE / "authume_p1_calibrated.toml",
-            "calibrated on P2 (2-D)": HERE / "authume_p2_calibrated.toml"}
-    rows, stops_for_fig = [], {}
+    sets = {"a priori": materials_from(None),
+            "calibrated on P1 (2-D)": materials_from(HERE / "authume_p1_calibrated.toml"),
+            "calibrated on P2 (2-D)": materials_from(HERE / "authume_p2_calibrated.toml")}
+    cal_rows, runtimes = [], {}
     for prof in ("P1", "P2"):
-        ends = np.loadtxt(raw / f"Endpoints_{prof}.txt", ndmin=2)
-        obs = ends[:, [0, 2]]
+        t0 = time.perf_counter()
+        cal = calibrate_3d(prof, raw, n_per_release=n_per_release)
+        runtimes[prof] = time.perf_counter() - t0
+        print(f"3-D calibration on {prof}: {runtimes[prof]:.1f} s, {len(cal.evaluations)} parameter sets x "
+              f"{n_per_release} blocks; {'; '.join(cal.notes)}")
+        sets[f"calibrated on {prof} (3-D)"] = materials_3d(cal)
+        summ = cal.summary()
+        cov = cal.coverage()
+        for k, r in summ.iterrows():
+            cal_rows.append({"calibrated on": prof, "parameter": k, "median": r["median"], "q05": r["q05"],
+                             "q95": r["q95"], "bounds": f"{r['bound_low']:g}-{r['bound_high']:g}",
+                             "sd / prior sd": r["sd_ratio"], "inside 90 % predictive": cov["inside_90"],
+                             "runtime [s]": runtimes[prof]})
+    rows, stops_for_fig, stops_3d = [], {}, {}
+    for prof in ("P1", "P2"):
+        obs, o_run = observed_plan(prof, raw)
         x, y, _ = release_point(raw, prof)
         line = reference_line(prof, raw)
-        o_run = np.hypot(obs[:, 0] - x, obs[:, 1] - y)
         o_off = line.project(obs)["offset_m"].to_numpy()
         rows.append({"release": prof, "materials": "observed", "n": len(obs),
                      **{f"runout p{q}": np.percentile(o_run, q) for q in (10, 50, 90)},
                      **{f"offset p{q}": np.percentile(o_off, q) for q in (10, 50, 90)}})
-        for name, path in sets.items():
-            r = simulation.run_terrain(scenario(prof, materials_from(path), raw), n, seed=1)
+        for name, mats in sets.items():
+            r = simulation.run_terrain(scenario(prof, mats, raw), n, seed=1)
             st = r.stops()
             sim = st[["x_m", "y_m"]].to_numpy()
             s_run = st["runout_m"].to_numpy()
@@ -218,14 +271,20 @@ def main(argv) -> None:
                 obs_x = pd.read_csv(REPO / "tests" / "data" / "authume" / "observed_runout.csv")
                 obs_x = obs_x.loc[obs_x["profile"] == prof, "x_stop_m"].to_numpy()
                 row["beyond farthest of 100, 2-D"] = beyond_farthest(obs_x, r2.per_block["x"])
+            if name == f"calibrated on {prof} (3-D)":
+                stops_3d[prof] = (r, obs, (x, y))
             rows.append(row)
     table = pd.DataFrame(rows)
     DOCS.mkdir(parents=True, exist_ok=True)
     (DOCS / "figures").mkdir(exist_ok=True)
+    params = pd.DataFrame(cal_rows)
     table.to_csv(HERE / "results_3d.csv", index=False)
-    _figure(stops_for_fig, DOCS / "figures" / "authume-3d.png")
-    (DOCS / "authume-3d.md").write_text(_document(table, n))
+    params.to_csv(HERE / "results_3d_parameters.csv", index=False)
+    _figure(stops_for_fig, DOCS / "figures" / "authume-3d.png", "2-D")
+    _figure(stops_3d, DOCS / "figures" / "authume-3d-calibrated.png", "3-D")
+    (DOCS / "authume-3d.md").write_text(_document(table, params, n, n_per_release))
     print(table.to_string())
+    print(params.to_string())
 
 
 def _md(df: pd.DataFrame) -> str:
@@ -243,15 +302,18 @@ def _md(df: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
-def _document(t: pd.DataFrame, n: int) -> str:
+def _document(t: pd.DataFrame, params: pd.DataFrame, n: int, n_per_release: int) -> str:
     q = ["release", "materials", "n", "runout p10", "runout p50", "runout p90", "offset p10", "offset p50",
          "offset p90"]
     m = ["release", "materials", "W1 runout [m]", "KS p runout", "W1 offset [m]", "KS p offset",
          "energy distance [m]", "energy p", "beyond farthest of 100", "beyond farthest of 100, 2-D"]
-    return DOC_TEXT.format(n=n, quantiles=_md(t[q]), metrics=_md(t[t["materials"] != "observed"][m]))
+    p = params.drop(columns="runtime [s]")
+    runtime = ", ".join(f"{r} {v:.0f} s" for r, v in params.groupby("calibrated on")["runtime [s]"].first().items())
+    return DOC_TEXT.format(n=n, quantiles=_md(t[q]), metrics=_md(t[t["materials"] != "observed"][m]),
+                           parameters=_md(p), n_per_release=n_per_release, runtime=runtime)
 
 
-def _figure(runs: dict, path: Path) -> None:
+def _figure(runs: dict, path: Path, kernel: str) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -260,7 +322,7 @@ def _figure(runs: dict, path: Path) -> None:
         r.plot(ax=ax, paths=False)
         ax.scatter(obs[:, 0], obs[:, 1], s=18, facecolor="none", edgecolor="black", label="observed stops")
         ax.plot(*rel, marker="*", color="yellow", markeredgecolor="black", markersize=14, label="release")
-        ax.set_title(f"{prof}: simulated (red, calibrated on {prof} in 2-D) vs observed stops")
+        ax.set_title(f"{prof}: simulated (red, calibrated on {prof} in {kernel}) vs observed stops")
         ax.legend(loc="lower right", fontsize=8)
         ax.set_xlabel("raw X [m]")
         ax.set_ylabel("raw Z [m]")
