@@ -491,7 +491,8 @@ def _simulate_terrain(sc, rels: list, n_per: int, seed) -> np.ndarray:
     from .engine3d import run_terrain
     r0 = rels[0]
     if r0.height_m is not None:
-        sc = replace(sc, sources=replace(sc.sources, height_m=Distribution("constant", {"value": float(r0.height_m)})))
+        height = Distribution("constant", {"value": float(r0.height_m)})
+        sc = replace(sc, sources=replace(sc.sources, height_m=height))
     if r0.mass_kg is not None:
         res = run_terrain(sc, seed=seed, masses_kg=np.repeat([r.mass_kg for r in rels], n_per), record_paths=0)
     else:
