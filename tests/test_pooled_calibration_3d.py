@@ -62,3 +62,17 @@ def test_a_3d_release_refuses_profile_fields_and_impossible_runouts(dem):
         _Pool([Release("A", _data(dem), [10.0], x_m=3.0)], {PHI: (10.0, 40.0)})
     with pytest.raises(ValueError, match=r"release 'B': x_stop_m = -1 m is not a plan runout"):
         _Pool([Release("B", _data(dem), [10.0, -1.0])], {PHI: (10.0, 40.0)})
+
+
+def test_a_3d_release_state_sets_the_drop_height_and_masses(dem):
+    """height_m and mass_kg of a 3-D release replace the scenario's [sources] values: the runouts equal those of
+    a scenario whose [sources] table states the same height and mass (same seed), and differ from the
+    scenario's own uniform 0-6 m drop."""
+    given = Release("given", _data(dem, 24.0), [10.0], height_m=30.0, mass_kg=800.0)
+    stated = _data(dem, 24.0)
+    stated["sources"].update(height_m=30.0, mass_kg=800.0)
+    a = _Pool([given], {PHI: (10.0, 40.0)}).simulate({}, 50, 1)[0]
+    b = _Pool([Release("stated", stated, [10.0])], {PHI: (10.0, 40.0)}).simulate({}, 50, 1)[0]
+    c = _Pool([Release("own", _data(dem, 24.0), [10.0])], {PHI: (10.0, 40.0)}).simulate({}, 50, 1)[0]
+    np.testing.assert_allclose(a, b, rtol=0, atol=1e-9)
+    assert not np.allclose(a, c)
