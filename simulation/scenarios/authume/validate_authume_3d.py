@@ -88,7 +88,7 @@ adaptive importance sampling, Gaussian surrogate of the log-likelihood for the p
 the 2-D calibration (`calibrate_authume.PARAMETERS`): rolling resistance of the vegetated slope and of the
 hard ground, and the tangential coefficient e_T of the vegetated slope; everything else keeps the a-priori
 preset.  The lateral offset is **not** in the likelihood: it is a check.  Runtime: 544 parameter sets per
-release; the script prints each calibration's time (9-19 s per release on one core of the development
+release; the script prints each calibration's time (6-19 s per release on one core of the development
 machine, after the kernel is compiled; the whole script about 1 minute).
 
 ## 3-D calibration: posterior
@@ -141,8 +141,8 @@ circles: observed stops; star: release point.*
   12 deg (90 % interval 11-13 deg, against 8 deg in 2-D); blocks stay in the corridor (offset p90 14 m
   instead of 79 m) and every distance falls: W1 of the runout 5.6 m (22 m with the 2-D parameters), energy
   distance 1.9 m (17 m), and a real stop lies beyond the farthest of 100 simulated blocks 3.5 % of the time.
-  The runout distribution is still distinguishable from the observed one (KS p 3e-7: the simulated median
-  is 3 m short and its spread narrower), and 83 % of the observed runouts lie inside the 90 %
+  The runout distribution is still distinguishable from the observed one (KS p 2.5e-7: the simulated
+  runouts lie short, median 53 m against 56 m observed), and 83 % of the observed runouts lie inside the 90 %
   posterior-predictive interval: the model with three fitted parameters does not fully describe this
   release.
 * **P1 calibrated in 3-D (in-sample):** the runout matches (KS p 0.47, W1 2.7 m), as with the 2-D parameters;
