@@ -19,11 +19,10 @@ from scipy import optimize
 from ..frequency.extremes import _AnnualMaximumFit
 from .impact_energy import (
     PairedSamples,
-    VelocityFit,
     exceedance_function,
     exceedance_probability,
-    is_mass_coupled,
     mass_model,
+    velocity_model,
 )
 from ..frequency.power_law import GutenbergRichterFit
 from ..core.format import sig
@@ -109,7 +108,7 @@ class EnergyHazard:
     @property
     def mass_coupled(self) -> bool:
         """Whether reach, speed and bounce height depend on block mass (:func:`riskrf.energy_hazard`)."""
-        return is_mass_coupled(self.velocity)
+        return velocity_model(self.velocity).mass_coupled
 
     def with_mass(self, mass, rate_per_year: float | None = None) -> "EnergyHazard":
         """The same slope with another mass model (and rate): a mass-coupled reach probability is recomputed."""
@@ -137,14 +136,7 @@ class EnergyHazard:
         """Velocity [m/s] not exceeded by q % of the falls reaching the line, whatever the velocity model.
 
         With a mass-coupled model and ``mass_kg``: of the simulated blocks of that mass (its mass class)."""
-        v = self.velocity
-        if is_mass_coupled(v) and mass_kg is not None:
-            return v.velocity_percentile(q, mass_kg)
-        if isinstance(v, VelocityFit):
-            v = v.dist
-        if hasattr(v, "ppf"):
-            return float(v.ppf(q / 100.0))
-        return float(np.percentile(np.asarray(getattr(v, "velocity_ms", v), dtype=float), q))
+        return velocity_model(self.velocity).percentile(q, mass_kg)
 
     def height_percentile(self, q):
         """Bounce height [m] not exceeded by q % of the falls reaching the line (from simulated heights)."""
@@ -253,7 +245,7 @@ class EnergyHazard:
             return cache[key]
         rng = np.random.default_rng(seed)
         out = []
-        v_nodes = self._velocity_nodes()
+        v_nodes = velocity_model(self.velocity).bootstrap_nodes()
         for _ in range(n_bootstrap):
             mass, rate = self._perturbed_mass(rng)
             if self.mass_coupled:       # blocks resampled within each mass class: reach and speed together
@@ -262,22 +254,11 @@ class EnergyHazard:
             reach = self.reach_probability
             if self.n_released:
                 reach = max(rng.binomial(self.n_released, self.reach_probability), 1) / self.n_released
-            vel = v_nodes[rng.integers(0, v_nodes.size, v_nodes.size)] if isinstance(v_nodes, np.ndarray) \
-                else v_nodes
+            vel = v_nodes.resample(rng)
             out.append((exceedance_probability(_E_GRID, mass, vel), rate * reach))
         if key is not None:
             cache[key] = out
         return out
-
-    def _velocity_nodes(self):
-        """Velocity samples compressed to at most 2048 equal-probability quantiles (for the bootstrap)."""
-        v = self.velocity
-        if isinstance(v, (VelocityFit, PairedSamples)) or is_mass_coupled(v) or hasattr(v, "pdf"):
-            return v
-        v = np.sort(np.asarray(v, dtype=float))
-        if v.size <= 2048:
-            return v
-        return np.quantile(v, (np.arange(2048) + 0.5) / 2048)
 
     def _perturbed_mass(self, rng):
         m = self.mass

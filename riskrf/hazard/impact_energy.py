@@ -28,6 +28,7 @@ a millisecond per energy.  ``method="mc"`` samples instead, for cross-checks.
 """
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 import numpy as np
@@ -225,6 +226,205 @@ def _check_energies(energy_kj):
     return e
 
 
+# ---------------------------------------------------------------- velocity model protocol
+class VelocityModel(ABC):
+    """What the energy and hazard calculations ask of a velocity model [m/s] at a barrier line.
+
+    Every accepted velocity description (a scipy frozen distribution, a :class:`VelocityFit`, an array of
+    samples with optional paired angular velocities, :class:`PairedSamples`, or a mass-coupled model such as
+    :class:`~riskrf.hazard.mass_coupling.MassCoupledSamples`) is wrapped once by :func:`velocity_model` at the
+    public entry points; the calculations then call these methods instead of testing the type of the input.
+
+    Attributes
+    ----------
+    mass_coupled : bool
+        Whether reach, speed and bounce height depend on block mass (the model then also answers
+        ``exceedance_function`` per arriving fall, with the reach averaged over the mass model).
+    """
+
+    mass_coupled: bool = False
+
+    @abstractmethod
+    def exceedance(self, energy_kj: np.ndarray, mass: _MassModel) -> np.ndarray:
+        """P(E > e) for one (arriving) fall at energies ``energy_kj`` [kJ] (checked, >= 0), by quadrature over
+        the mass model ``mass`` (from :func:`mass_model`)."""
+
+    @abstractmethod
+    def sample_energy_kj(self, mass_kg: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, int]:
+        """Monte Carlo: impact energies [kJ] of falls of masses ``mass_kg`` [kg] (one speed drawn per mass with
+        ``rng``; -inf for a fall that does not arrive) and the number of arriving falls."""
+
+    @abstractmethod
+    def percentile(self, q, mass_kg=None) -> float:
+        """Velocity [m/s] not exceeded by q % of the arriving falls (of blocks of ``mass_kg`` [kg] when the model
+        depends on mass; otherwise ``mass_kg`` is ignored)."""
+
+    def exceedance_function(self, mass: _MassModel):
+        """e [kJ] -> P(E > e) per arriving fall, with whatever does not depend on e prepared once."""
+        return lambda energy_kj: self.exceedance(_check_energies(energy_kj), mass)
+
+    def bootstrap_nodes(self) -> "VelocityModel":
+        """The model as resampled by the bootstrap (samples compressed to at most 2048 quantiles)."""
+        return self
+
+    def resample(self, rng: np.random.Generator) -> "VelocityModel":
+        """One bootstrap replicate of the model (samples drawn with replacement; parametric models unchanged)."""
+        return self
+
+
+class _DistributionVelocity(VelocityModel):
+    """A scipy frozen distribution of speed [m/s] (or the one chosen by a :class:`VelocityFit`)."""
+
+    def __init__(self, dist, angular_velocity=None):
+        self.dist, self.angular_velocity = dist, angular_velocity
+
+    def exceedance(self, energy_kj, mass):
+        if self.angular_velocity is not None:
+            raise ValueError("angular_velocity needs velocity samples paired with it, not a distribution")
+        return _integrate_velocity_dist(energy_kj, mass, self.dist)
+
+    def sample_energy_kj(self, mass_kg, rng):
+        v = np.abs(self.dist.rvs(size=mass_kg.size, random_state=rng))
+        return kinetic_energy_kj(mass_kg, v), mass_kg.size
+
+    def percentile(self, q, mass_kg=None):
+        return float(self.dist.ppf(q / 100.0))
+
+
+class _PairedVelocity(VelocityModel):
+    """:class:`PairedSamples`: speeds [m/s] classed by the mass [kg] of their blocks."""
+
+    def __init__(self, paired: PairedSamples):
+        self.paired = paired
+
+    def exceedance(self, energy_kj, mass):
+        return _conditional_on_mass(energy_kj, mass, self.paired)
+
+    def sample_energy_kj(self, mass_kg, rng):
+        edges_m, vel = self.paired.classes()
+        cls = np.searchsorted(edges_m, mass_kg)
+        v = np.empty(mass_kg.size)
+        for c, vs in enumerate(vel):
+            sel = cls == c
+            v[sel] = rng.choice(vs, size=int(sel.sum()))
+        return kinetic_energy_kj(mass_kg, v), mass_kg.size
+
+    def percentile(self, q, mass_kg=None):
+        return float(np.percentile(np.asarray(self.paired.velocity_ms, dtype=float), q))
+
+
+class _SampleVelocity(VelocityModel):
+    """Speed samples [m/s] (empirical law), optionally with paired angular velocities [rad/s] adding the rotational
+    energy 1/2 k m r^2 w^2 (r [m] of the sphere of the same mass and density [kg/m^3], k = ``inertia_factor``)."""
+
+    def __init__(self, samples, angular_velocity=None, density_kg_m3=DEFAULT_DENSITY_KG_M3,
+                 inertia_factor=SPHERE_INERTIA):
+        self.samples, self.angular_velocity = samples, angular_velocity
+        self.density_kg_m3, self.inertia_factor = density_kg_m3, inertia_factor
+
+    def exceedance(self, energy_kj, mass):
+        v = _positive_samples(self.samples, "velocity")
+        w = None
+        if self.angular_velocity is not None:
+            w = np.asarray(self.angular_velocity, dtype=float).ravel()
+            if w.size != v.size:
+                raise ValueError(f"angular_velocity has {w.size} values but velocity has {v.size}: they must be "
+                                 "paired")
+        out = np.empty(energy_kj.size)
+        for i, ei in enumerate(energy_kj.ravel()):
+            out[i] = np.mean(mass.sf(_threshold_mass(ei, v, w, self.density_kg_m3, self.inertia_factor)))
+        return out.reshape(energy_kj.shape)
+
+    def sample_energy_kj(self, mass_kg, rng):
+        samples = _positive_samples(self.samples, "velocity")
+        idx = rng.integers(0, samples.size, mass_kg.size)
+        v = samples[idx]
+        if self.angular_velocity is None:
+            return kinetic_energy_kj(mass_kg, v), mass_kg.size
+        w = np.asarray(self.angular_velocity, dtype=float)[idx]
+        r = (3.0 * mass_kg / (4.0 * np.pi * self.density_kg_m3)) ** (1.0 / 3.0)
+        return kinetic_energy_kj(mass_kg, v, w, r, self.inertia_factor), mass_kg.size
+
+    def percentile(self, q, mass_kg=None):
+        return float(np.percentile(np.asarray(self.samples, dtype=float), q))
+
+    def bootstrap_nodes(self):
+        v = np.sort(np.asarray(self.samples, dtype=float))
+        return _SampleVelocity(v if v.size <= 2048 else np.quantile(v, (np.arange(2048) + 0.5) / 2048))
+
+    def resample(self, rng):
+        v = self.samples
+        return _SampleVelocity(v[rng.integers(0, v.size, v.size)])
+
+
+class _MassCoupledVelocity(VelocityModel):
+    """A mass-coupled model (:func:`is_mass_coupled`): reach and speed by block mass class; P(E > e) per arriving
+    fall."""
+
+    mass_coupled = True
+
+    def __init__(self, coupled):
+        self.coupled = coupled
+
+    def exceedance(self, energy_kj, mass):
+        # per arriving fall: P(E > e, reach) / P(reach), both integrated over the mass model
+        return self.coupled.exceedance_function(mass)(energy_kj)
+
+    def exceedance_function(self, mass):
+        return self.coupled.exceedance_function(mass)
+
+    def sample_energy_kj(self, mass_kg, rng):
+        vel = self.coupled
+        cls = vel.class_of(mass_kg)
+        members = [np.flatnonzero(vel.class_of(vel.mass_kg) == c) for c in range(vel.n_bins)]
+        pick = np.empty(mass_kg.size, dtype=np.int64)
+        for c in range(vel.n_bins):
+            sel = cls == c
+            pick[sel] = members[c][rng.integers(0, members[c].size, int(sel.sum()))]
+        v = vel.speed_ms[pick]
+        arrived = np.isfinite(v)
+        energy = np.where(arrived, kinetic_energy_kj(mass_kg, np.where(arrived, v, 0.0)), -np.inf)
+        return energy, int(arrived.sum())
+
+    def percentile(self, q, mass_kg=None):
+        if mass_kg is not None:
+            return self.coupled.velocity_percentile(q, mass_kg)
+        return float(np.percentile(np.asarray(self.coupled.velocity_ms, dtype=float), q))
+
+
+def velocity_model(velocity, *, angular_velocity=None, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+                   inertia_factor: float = SPHERE_INERTIA) -> VelocityModel:
+    """Wrap any accepted velocity description in the :class:`VelocityModel` interface (the one place that
+    looks at its type).
+
+    Parameters
+    ----------
+    velocity : VelocityModel, VelocityFit, PairedSamples, mass-coupled model, scipy frozen distribution or array
+        Velocity model [m/s] at the barrier line (see module notes); a :class:`VelocityModel` is returned as is.
+    angular_velocity : array, optional
+        Angular velocities [rad/s] paired with velocity samples (refused by a distribution's quadrature).
+    density_kg_m3 : float
+        Rock density [kg/m^3] giving the radius from the mass (only with ``angular_velocity``).
+    inertia_factor : float
+        k = I / (m r^2) of the block shape (only with ``angular_velocity``).
+
+    Returns
+    -------
+    VelocityModel
+    """
+    if isinstance(velocity, VelocityModel):
+        return velocity
+    if isinstance(velocity, VelocityFit):
+        velocity = velocity.dist
+    if isinstance(velocity, PairedSamples):
+        return _PairedVelocity(velocity)
+    if is_mass_coupled(velocity):
+        return _MassCoupledVelocity(velocity)
+    if (hasattr(velocity, "pdf") and hasattr(velocity, "isf")) or hasattr(velocity, "rvs"):
+        return _DistributionVelocity(velocity, angular_velocity)
+    return _SampleVelocity(velocity, angular_velocity, density_kg_m3, inertia_factor)
+
+
 def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
                            inertia_factor: float = SPHERE_INERTIA, method: str = "quad", n_samples: int = 1_000_000,
                            seed=None):
@@ -259,28 +459,9 @@ def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, 
         return exceedance_probability_mc(e, mass, velocity, angular_velocity=angular_velocity,
                                          density_kg_m3=density_kg_m3, inertia_factor=inertia_factor,
                                          n_samples=n_samples, seed=seed)[0]
-    mm = mass_model(mass)
-    if isinstance(velocity, VelocityFit):
-        velocity = velocity.dist
-    if isinstance(velocity, PairedSamples):
-        return _conditional_on_mass(e, mm, velocity)
-    if is_mass_coupled(velocity):
-        # per arriving fall: P(E > e, reach) / P(reach), both integrated over the mass model
-        return velocity.exceedance_function(mm)(e)
-    if hasattr(velocity, "pdf") and hasattr(velocity, "isf"):
-        if angular_velocity is not None:
-            raise ValueError("angular_velocity needs velocity samples paired with it, not a distribution")
-        return _integrate_velocity_dist(e, mm, velocity)
-    v = _positive_samples(velocity, "velocity")
-    w = None
-    if angular_velocity is not None:
-        w = np.asarray(angular_velocity, dtype=float).ravel()
-        if w.size != v.size:
-            raise ValueError(f"angular_velocity has {w.size} values but velocity has {v.size}: they must be paired")
-    out = np.empty(e.size)
-    for i, ei in enumerate(e.ravel()):
-        out[i] = np.mean(mm.sf(_threshold_mass(ei, v, w, density_kg_m3, inertia_factor)))
-    return out.reshape(e.shape)
+    vm = velocity_model(velocity, angular_velocity=angular_velocity, density_kg_m3=density_kg_m3,
+                        inertia_factor=inertia_factor)
+    return vm.exceedance(e, mass_model(mass))
 
 
 def exceedance_function(mass, velocity):
@@ -289,9 +470,7 @@ def exceedance_function(mass, velocity):
     The same values as :func:`exceedance_probability` (default quadrature); use it where one
     curve is evaluated many times (root finding for design energies).
     """
-    if is_mass_coupled(velocity):
-        return velocity.exceedance_function(mass_model(mass))
-    return lambda energy_kj: exceedance_probability(energy_kj, mass, velocity)
+    return velocity_model(velocity).exceedance_function(mass_model(mass))
 
 
 def _integrate_velocity_dist(e, mm, vdist):
@@ -373,48 +552,13 @@ def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=Non
     rng = np.random.default_rng(seed)
     mm = mass_model(mass)
     m = mm.rvs(n_samples, rng)
-    w = None
-    if isinstance(velocity, VelocityFit):
-        velocity = velocity.dist
-    if is_mass_coupled(velocity):
-        cls = velocity.class_of(m)
-        members = [np.flatnonzero(velocity.class_of(velocity.mass_kg) == c) for c in range(velocity.n_bins)]
-        pick = np.empty(m.size, dtype=np.int64)
-        for c in range(velocity.n_bins):
-            sel = cls == c
-            pick[sel] = members[c][rng.integers(0, members[c].size, int(sel.sum()))]
-        v = velocity.speed_ms[pick]
-        arrived = np.isfinite(v)
-        energy = np.where(arrived, kinetic_energy_kj(m, np.where(arrived, v, 0.0)), -np.inf)
-        n_arr = int(arrived.sum())
-        energy.sort()
-        k = n_samples - np.searchsorted(energy, e.ravel(), side="right")
-        lo, hi = wilson_interval(k, max(n_arr, 1), level)
-        return (k / max(n_arr, 1)).reshape(e.shape), lo.reshape(e.shape), hi.reshape(e.shape)
-    if isinstance(velocity, PairedSamples):
-        edges_m, vel = velocity.classes()
-        cls = np.searchsorted(edges_m, m)
-        v = np.empty(n_samples)
-        for c, vs in enumerate(vel):
-            sel = cls == c
-            v[sel] = rng.choice(vs, size=int(sel.sum()))
-    elif hasattr(velocity, "rvs"):
-        v = np.abs(velocity.rvs(size=n_samples, random_state=rng))
-    else:
-        samples = _positive_samples(velocity, "velocity")
-        idx = rng.integers(0, samples.size, n_samples)
-        v = samples[idx]
-        if angular_velocity is not None:
-            w = np.asarray(angular_velocity, dtype=float)[idx]
-    if w is None:
-        energy = kinetic_energy_kj(m, v)
-    else:
-        r = (3.0 * m / (4.0 * np.pi * density_kg_m3)) ** (1.0 / 3.0)
-        energy = kinetic_energy_kj(m, v, w, r, inertia_factor)
+    vm = velocity_model(velocity, angular_velocity=angular_velocity, density_kg_m3=density_kg_m3,
+                        inertia_factor=inertia_factor)
+    energy, n_arrived = vm.sample_energy_kj(m, rng)
     energy.sort()
-    k = n_samples - np.searchsorted(energy, e.ravel(), side="right")
-    lo, hi = wilson_interval(k, n_samples, level)
-    return (k / n_samples).reshape(e.shape), lo.reshape(e.shape), hi.reshape(e.shape)
+    k = energy.size - np.searchsorted(energy, e.ravel(), side="right")
+    lo, hi = wilson_interval(k, max(n_arrived, 1), level)
+    return (k / max(n_arrived, 1)).reshape(e.shape), lo.reshape(e.shape), hi.reshape(e.shape)
 
 
 def energy_quantile(p, mass, velocity, **kwargs):
