@@ -259,6 +259,10 @@ class VelocityModel(ABC):
         """Velocity [m/s] not exceeded by q % of the arriving falls (of blocks of ``mass_kg`` [kg] when the model
         depends on mass; otherwise ``mass_kg`` is ignored)."""
 
+    def speed_samples_ms(self) -> np.ndarray:
+        """The speeds [m/s] of the arriving falls as samples (for consumers that resample them)."""
+        raise ValueError(f"velocity model {self!r} has no speed samples: give simulated or observed velocities")
+
     def exceedance_function(self, mass: _MassModel):
         """e [kJ] -> P(E > e) per arriving fall, with whatever does not depend on e prepared once."""
         return lambda energy_kj: self.exceedance(_check_energies(energy_kj), mass)
@@ -290,6 +294,9 @@ class _DistributionVelocity(VelocityModel):
     def percentile(self, q, mass_kg=None):
         return float(self.dist.ppf(q / 100.0))
 
+    def __repr__(self):
+        return f"scipy {getattr(getattr(self.dist, 'dist', None), 'name', 'distribution')}"
+
 
 class _PairedVelocity(VelocityModel):
     """:class:`PairedSamples`: speeds [m/s] classed by the mass [kg] of their blocks."""
@@ -310,7 +317,10 @@ class _PairedVelocity(VelocityModel):
         return kinetic_energy_kj(mass_kg, v), mass_kg.size
 
     def percentile(self, q, mass_kg=None):
-        return float(np.percentile(np.asarray(self.paired.velocity_ms, dtype=float), q))
+        return float(np.percentile(self.speed_samples_ms(), q))
+
+    def speed_samples_ms(self):
+        return np.asarray(self.paired.velocity_ms, dtype=float)
 
 
 class _SampleVelocity(VelocityModel):
@@ -346,7 +356,10 @@ class _SampleVelocity(VelocityModel):
         return kinetic_energy_kj(mass_kg, v, w, r, self.inertia_factor), mass_kg.size
 
     def percentile(self, q, mass_kg=None):
-        return float(np.percentile(np.asarray(self.samples, dtype=float), q))
+        return float(np.percentile(self.speed_samples_ms(), q))
+
+    def speed_samples_ms(self):
+        return np.asarray(self.samples, dtype=float)
 
     def bootstrap_nodes(self):
         v = np.sort(np.asarray(self.samples, dtype=float))
@@ -389,7 +402,10 @@ class _MassCoupledVelocity(VelocityModel):
     def percentile(self, q, mass_kg=None):
         if mass_kg is not None:
             return self.coupled.velocity_percentile(q, mass_kg)
-        return float(np.percentile(np.asarray(self.coupled.velocity_ms, dtype=float), q))
+        return float(np.percentile(self.speed_samples_ms(), q))
+
+    def speed_samples_ms(self):
+        return np.asarray(self.coupled.velocity_ms, dtype=float)
 
 
 def velocity_model(velocity, *, angular_velocity=None, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,

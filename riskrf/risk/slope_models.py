@@ -18,6 +18,7 @@ import pandas as pd
 
 from ..core.units import kinetic_energy_kj
 from ..hazard.barriers import damage_state_shares
+from ..hazard.impact_energy import velocity_model
 from .loss_engine import MassGrid
 from .measures import (
     Ditch,
@@ -144,8 +145,7 @@ class SlopeModels:
                 for k, (lo, hi) in u.materials.items()}
 
     def _reference_model(self) -> SlopeModel:
-        v = self.hazard.velocity
-        v = np.asarray(getattr(v, "velocity_ms", v), dtype=float)
+        v = velocity_model(self.hazard.velocity).speed_samples_ms()
         h = self.hazard.heights_m
         ctx = self.context
         road = None
