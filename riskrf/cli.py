@@ -731,7 +731,7 @@ def _add_release_arguments(p, n_default: int) -> None:
 
 
 def _add_fit_parser(sub) -> None:
-    """Add the sub-command fit: magnitude-frequency fits of an inventory, with the bootstrap options for large inventories.
+    """Add the sub-command fit: magnitude-frequency fits of an inventory, bootstrap options included.
 
     Parameters
     ----------
@@ -937,7 +937,7 @@ def _add_calibrate_parser(sub) -> None:
 
 
 def _add_rates_parser(sub) -> None:
-    """Add the sub-command rates: rate regressions of a dated inventory on rainfall, season and trend, and closure rules.
+    """Add the sub-command rates: rate regressions on rainfall, season and trend, and closure rules.
 
     Parameters
     ----------
