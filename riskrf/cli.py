@@ -703,18 +703,41 @@ def cmd_profile(args) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The ``riskrf`` argument parser with one sub-command per task."""
-    parser = argparse.ArgumentParser(
-        prog="riskrf", description="Rock fall hazard, risk and mitigation decisions (after Wyllie 2014, "
-        "Rock Fall Engineering, chapters 3-8).  Start with 'riskrf demo' (the whole chain on a bundled site, "
-        "report in ./riskrf-demo/report.html), then copy riskrf/data/demo_site.toml, point it at your inventory "
-        "and slope, and run 'riskrf assess your_site.toml'.  Each step also runs alone: fit -> simulate -> "
-        "energy -> decide.", epilog=EPILOG)
-    parser.add_argument("--version", action="version", version=f"riskrf {__version__}")
-    parser.add_argument("--debug", action="store_true", help="show the full traceback of an error")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+def _add_out_dir(p, default: str) -> None:
+    """Add ``--out DIR``, the output directory of a command.
 
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The sub-command's parser.
+    default : str
+        The default directory as the help text names it, e.g. ``<scenario>-calibration``.
+    """
+    p.add_argument("--out", default=None, metavar="DIR", help=f"output directory (default {default})")
+
+
+def _add_release_arguments(p, n_default: int) -> None:
+    """Add ``-n`` (blocks to release) and ``--seed`` of a simulating command.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The sub-command's parser.
+    n_default : int
+        Default number of blocks to release.
+    """
+    p.add_argument("-n", type=int, default=n_default, help=f"number of blocks to release (default {n_default:,})")
+    p.add_argument("--seed", type=int, default=1, help="random seed; the same seed gives identical results")
+
+
+def _add_fit_parser(sub) -> None:
+    """Add the sub-command fit: magnitude-frequency fits of an inventory, bootstrap options included.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
     p = sub.add_parser("fit", help="fit power-law, Gumbel and GEV models to a rock fall inventory",
                        description="Fit the magnitude-frequency models of Wyllie (2014) section 8.4 to an "
                        "inventory (CSV, XLSX or Parquet with a volume_m3 or mass_kg column and optionally a "
@@ -743,14 +766,22 @@ def build_parser() -> argparse.ArgumentParser:
                         "0 = every value")
     p.set_defaults(func=cmd_fit)
 
+
+def _add_simulate_parser(sub) -> None:
+    """Add the sub-command simulate: Monte Carlo trajectories of a 2-D scenario.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
     p = sub.add_parser("simulate", help="Monte Carlo rock fall trajectories on a slope scenario",
                        description="Simulate blocks released by a scenario's seeder (TOML; see the docs: File "
                        "formats, 'Scenario files') and write one row per collector crossing (velocity_ms, "
                        "angular_velocity_rads, height_m, energy_kj, ...) to a Parquet or CSV file, with figures: "
                        "the profile and trajectories, distributions at each collector, envelopes.", epilog=EPILOG)
     p.add_argument("scenario", help="scenario TOML file, e.g. simulation/scenarios/road_cut_barrier.toml")
-    p.add_argument("-n", type=int, default=100_000, help="number of blocks to release (default 100,000)")
-    p.add_argument("--seed", type=int, default=1, help="random seed; the same seed gives identical results")
+    _add_release_arguments(p, 100_000)
     p.add_argument("--out", default=None, metavar="FILE",
                    help="crossings table, .parquet or .csv (default <scenario>-crossings.parquet)")
     p.add_argument("--figures", default=None, metavar="DIR", help="figure directory (default <out>-figures)")
@@ -758,6 +789,15 @@ def build_parser() -> argparse.ArgumentParser:
                    help="show a progress bar (default: on for 200,000 blocks or more on a terminal)")
     p.set_defaults(func=cmd_simulate)
 
+
+def _add_energy_parser(sub) -> None:
+    """Add the sub-command energy: impact-energy hazard at a barrier line, fence checks and the design block.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
     p = sub.add_parser("energy", help="impact-energy hazard at a barrier line and fence checks",
                        description="Combine the power law fitted to an inventory with velocities at a barrier line "
                        "(simulated from a scenario, or read from a file) into the annual frequency of impacts above "
@@ -786,10 +826,19 @@ def build_parser() -> argparse.ArgumentParser:
                    help="fragmentation generations (1-12) with --fractal-dimension")
     p.add_argument("--inventory-sizes", choices=("event_volumes", "blocks"), default=None,
                    help="what the inventory's sizes are (default: the inventory sidecar's sizes, else event_volumes)")
-    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-energy)")
+    _add_out_dir(p, "<inventory>-energy")
     _add_reader_arguments(p, "the --block-survey table", "", prefix="survey")
     p.set_defaults(func=cmd_energy)
 
+
+def _add_decide_parser(sub) -> None:
+    """Add the sub-command decide: roll back a decision tree, or rank mitigation options.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
     p = sub.add_parser("decide", help="rank mitigation options, or roll back any decision tree",
                        description="Two uses.  (1) riskrf decide TREE.json|TREE.toml: roll back a decision tree "
                        "(format in the docs: Risk and mitigation decisions), print the ranking, optimal policy and "
@@ -809,9 +858,18 @@ def build_parser() -> argparse.ArgumentParser:
                    help="exponential-utility risk tolerance for tree rollback (default: expected values)")
     _add_inventory_arguments(p)
     _add_energy_arguments(p)
-    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default ./decision)")
+    _add_out_dir(p, "./decision")
     p.set_defaults(func=cmd_decide)
 
+
+def _add_assess_parser(sub) -> None:
+    """Add the sub-command assess: the whole chain for one site file.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
     p = sub.add_parser("assess", help="the whole chain for one site file: fits, simulation, energy, decision",
                        description="Run the whole assessment of one site described by a TOML file (see the docs: File "
                        "formats, 'Site files'): magnitude-frequency fits, trajectory simulation, impact-energy "
@@ -820,21 +878,39 @@ def build_parser() -> argparse.ArgumentParser:
                        "with the version and seed; the directory appears only when everything succeeded.",
                        epilog=EPILOG)
     p.add_argument("site", help="site file (.toml); paths in it are relative to it")
-    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <site>-assessment)")
+    _add_out_dir(p, "<site>-assessment")
     p.add_argument("--seed", type=int, default=None, help="random seed (default: the site file's, else 1)")
     p.add_argument("-n", type=int, default=None, help="simulated blocks (default: the site file's, else 50,000)")
     p.set_defaults(func=cmd_assess)
 
+
+def _add_demo_parser(sub) -> None:
+    """Add the sub-command demo: the whole chain on the bundled example site.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
     p = sub.add_parser("demo", help="run the whole chain on the bundled example site",
                        description="Run riskrf assess on the bundled example site: the real Lauterbrunnen "
                        "laser-scanning inventory (power law), the real Hong Kong rock-cut incident register 1984-2020 "
                        "(annual maxima), the shipped road-cut barrier scenario and illustrative traffic, costs and options. "
                        "Works from any directory; takes well under a minute.", epilog=EPILOG)
-    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default ./riskrf-demo)")
+    _add_out_dir(p, "./riskrf-demo")
     p.add_argument("--seed", type=int, default=None, help="random seed (default 1)")
     p.add_argument("-n", type=int, default=None, help="simulated blocks (default 50,000)")
     p.set_defaults(func=cmd_demo)
 
+
+def _add_calibrate_parser(sub) -> None:
+    """Add the sub-command calibrate: fit scenario material parameters to observed stop points.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
     p = sub.add_parser("calibrate", help="fit scenario material parameters to observed stop points",
                        description="Fit scenario values named by dotted paths (e.g. "
                        "materials.talus.ground_friction_angle_deg) within bounds so that simulated stop positions "
@@ -855,10 +931,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=1, help="random seed of every evaluation (default 1)")
     p.add_argument("--maxiter", type=int, default=20, help="differential-evolution generations (default 20)")
     p.add_argument("--bootstrap", type=int, default=200, help="bootstrap replicates (default 200; 0 to skip)")
-    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <scenario>-calibration)")
+    _add_out_dir(p, "<scenario>-calibration")
     _add_reader_arguments(p, "the observed stops", "")
     p.set_defaults(func=cmd_calibrate)
 
+
+def _add_rates_parser(sub) -> None:
+    """Add the sub-command rates: rate regressions on rainfall, season and trend, and closure rules.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
     p = sub.add_parser("rates", help="rock fall rates against rainfall, season and trend (Poisson / negative binomial)",
                        description="Count the events of a dated inventory per day, month or year and fit Poisson and "
                        "negative-binomial regressions on antecedent rainfall, season and a year trend (see the docs: "
@@ -891,10 +976,19 @@ def build_parser() -> argparse.ArgumentParser:
                    help="with --heavy-day-change: daily rainfall of a heavy-rain day")
     p.add_argument("--heavy-day-change", type=float, default=None, metavar="SHARE",
                    help="expected rate if heavy-rain days became this much more frequent (0.1 = +10%%; an assumption)")
-    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <inventory>-rates)")
+    _add_out_dir(p, "<inventory>-rates")
     _add_reader_arguments(p, "the --rainfall table (generic layout)", "", dates=True, prefix="rainfall")
     p.set_defaults(func=cmd_rates)
 
+
+def _add_corridor_parser(sub) -> None:
+    """Add the sub-command corridor: screen and assess the sections of a road corridor on dask.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
     p = sub.add_parser("corridor", help="screen and assess many sections along a road (RHRS + risk, on dask)",
                        description="Read a corridor file (TOML with defaults, mass law, traffic, costs and options, "
                        "naming a sections table) and check every row first; then run each section's chain "
@@ -905,7 +999,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "sections.gpkg and map.png; with --budget programme.csv, frontier.csv and frontier.png (see "
                        "the docs: Corridor, and Corridor programmes).", epilog=EPILOG)
     p.add_argument("corridor", help="corridor file (.toml); paths in it are relative to it")
-    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <corridor>-corridor)")
+    _add_out_dir(p, "<corridor>-corridor")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="address of an existing dask scheduler (default: DASK_SCHEDULER_ADDRESS, else a local cluster)")
     p.add_argument("--workers", type=int, default=None, help="workers of the local cluster (default: one per core)")
@@ -922,6 +1016,16 @@ def build_parser() -> argparse.ArgumentParser:
                    help="'risk': maximise deaths avoided per year (default); 'cost': minimise the expected total cost")
     _add_reader_arguments(p, "the sections table", "corridor.sections_")
     p.set_defaults(func=cmd_corridor)
+
+
+def _add_hazard_map_parser(sub) -> None:
+    """Add the sub-command hazard-map: 3-D hazard rasters of a scenario on a DEM.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
     p = sub.add_parser("hazard-map", help="3-D rock fall hazard rasters on a DEM (GeoTIFF, GeoPackage)",
                        description="Run a 3-D scenario (TOML with a [terrain] table: DEM raster, materials, "
                        "[sources] points or polygon, plan collectors) and write GeoTIFFs on the DEM's grid and CRS "
@@ -929,8 +1033,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "density), stop points and trajectories as GeoPackage layers and a hillshade figure.",
                        epilog=EPILOG)
     p.add_argument("scenario", help="3-D scenario TOML, e.g. simulation/scenarios/authume/authume_3d.toml")
-    p.add_argument("-n", type=int, default=10_000, help="number of blocks to release (default 10,000)")
-    p.add_argument("--seed", type=int, default=1, help="random seed; the same seed gives identical results")
+    _add_release_arguments(p, 10_000)
     p.add_argument("--crs", default=None, help="the DEM's CRS when its file has none, e.g. EPSG:2154")
     p.add_argument("--workers", type=int, default=1, help="threads running the kernel, or with --dask the local "
                    "cluster's worker processes (results do not depend on it)")
@@ -940,9 +1043,18 @@ def build_parser() -> argparse.ArgumentParser:
                    "(implies --dask)")
     p.add_argument("--tile-m", type=float, default=250.0, help="tile size: squares of release points [m] "
                    "(default 250; results do not depend on it)")
-    p.add_argument("--out", default=None, metavar="DIR", help="output directory (default <scenario>-hazard-map)")
+    _add_out_dir(p, "<scenario>-hazard-map")
     p.set_defaults(func=cmd_hazard_map)
 
+
+def _add_profile_parser(sub) -> None:
+    """Add the sub-command profile: cut a 2-D slope profile from a DEM along a plan polyline.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
     p = sub.add_parser("profile", help="cut a 2-D slope profile from a DEM raster along a plan polyline",
                        description="Sample a DEM (GeoTIFF, ESRI ASCII grid) every --spacing metres along a plan "
                        "polyline (bilinear, the surface the 3-D simulator uses) and write the [profile] table of a "
@@ -956,6 +1068,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--crs", default=None, help="the DEM's CRS when its file has none, e.g. EPSG:2154")
     p.add_argument("--out", default=None, metavar="FILE", help="output TOML (default <dem>-profile.toml)")
     p.set_defaults(func=cmd_profile)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``riskrf`` argument parser with one sub-command per task."""
+    parser = argparse.ArgumentParser(
+        prog="riskrf", description="Rock fall hazard, risk and mitigation decisions (after Wyllie 2014, "
+        "Rock Fall Engineering, chapters 3-8).  Start with 'riskrf demo' (the whole chain on a bundled site, "
+        "report in ./riskrf-demo/report.html), then copy riskrf/data/demo_site.toml, point it at your inventory "
+        "and slope, and run 'riskrf assess your_site.toml'.  Each step also runs alone: fit -> simulate -> "
+        "energy -> decide.", epilog=EPILOG)
+    parser.add_argument("--version", action="version", version=f"riskrf {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show the full traceback of an error")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    _add_fit_parser(sub)
+    _add_simulate_parser(sub)
+    _add_energy_parser(sub)
+    _add_decide_parser(sub)
+    _add_assess_parser(sub)
+    _add_demo_parser(sub)
+    _add_calibrate_parser(sub)
+    _add_rates_parser(sub)
+    _add_corridor_parser(sub)
+    _add_hazard_map_parser(sub)
+    _add_profile_parser(sub)
 
     for p in sub.choices.values():       # every command with outputs: never clobber without --overwrite
         if any("--out" in a.option_strings for a in p._actions):

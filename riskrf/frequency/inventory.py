@@ -502,20 +502,124 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
     sidecar, side_path, side_note = _sidecar(path)
     if side_note:
         note(side_note)
-    given = dict(volume_column=volume_column, mass_column=mass_column, date_column=date_column,
-                 location_column=location_column, mass_unit=mass_unit, volume_unit=volume_unit, sheet=sheet,
-                 header_row=header_row, encoding=encoding, decimal=decimal, date_format=date_format,
-                 duplicates=duplicates)
+    opts = _reader_options(sidecar, volume_column=volume_column, mass_column=mass_column, date_column=date_column,
+                           location_column=location_column, mass_unit=mass_unit, volume_unit=volume_unit,
+                           sheet=sheet, header_row=header_row, encoding=encoding, decimal=decimal,
+                           date_format=date_format, duplicates=duplicates)
+    events, density, density_is_default, size_column, size_spec = _read_events(path, opts, density_kg_m3, sidecar,
+                                                                               side_path, note)
+    start, end, duration_years, period_source = _inventory_period(path, events, sidecar, side_path, start, end,
+                                                                  duration_years, note)
+    if start is not None:
+        events = _drop_outside_period(path, events, start, end, note)
+    duration_years = check_positive(duration_years, "duration_years")
+    events, censored = _split_censored_events(path, events, note)
+    if _undated_note(str(path), events):
+        note(_undated_note(str(path), events))
+    _check_plausible_sizes(events, path, *size_spec, duration_years, note)
+    return Inventory(events=events, duration_years=duration_years, start=start, end=end, density_kg_m3=density,
+                     density_is_default=density_is_default, source=str(path), period_source=period_source,
+                     size_column=size_column, site=str(sidecar.get("site", "")), notes=tuple(notes),
+                     censored=censored, sizes=sidecar.get("sizes"))
+
+
+def _reader_options(sidecar: dict, **given) -> dict:
+    """The reader options: each argument, else the sidecar's ``[record]`` value; checks duplicates and decimal.
+
+    Parameters
+    ----------
+    sidecar : dict
+        The sidecar's ``[record]`` table.
+    **given
+        The options :data:`READER_OPTIONS` as passed to :func:`read_inventory` (None when not given).
+
+    Returns
+    -------
+    dict
+        The options, ``duplicates`` defaulting to ``"warn"``.
+
+    Raises
+    ------
+    ValueError
+        ``duplicates`` or ``decimal`` is not one of its values.
+    """
     for key in READER_OPTIONS:
         if given[key] is None and key in sidecar:
             given[key] = sidecar[key]
-    (volume_column, mass_column, date_column, location_column, mass_unit, volume_unit, sheet, header_row,
-     encoding, decimal, date_format, duplicates) = given.values()
-    duplicates = duplicates or "warn"
-    if duplicates not in ("warn", "drop", "keep", "error"):
-        raise ValueError(f"duplicates = {duplicates!r} is not one of 'warn', 'drop', 'keep', 'error'")
-    if decimal not in (None, ".", ","):
-        raise ValueError(f"decimal = {decimal!r} is not '.' or ','")
+    given["duplicates"] = given["duplicates"] or "warn"
+    if given["duplicates"] not in ("warn", "drop", "keep", "error"):
+        raise ValueError(f"duplicates = {given['duplicates']!r} is not one of 'warn', 'drop', 'keep', 'error'")
+    if given["decimal"] not in (None, ".", ","):
+        raise ValueError(f"decimal = {given['decimal']!r} is not '.' or ','")
+    return given
+
+
+def _read_events(path: Path, opts: dict, density_kg_m3, sidecar: dict, side_path, note) -> tuple:
+    """Read the inventory's rows into a table of events with volumes [m³] and masses [kg], duplicates handled.
+
+    Parameters
+    ----------
+    path : Path
+        The inventory file.
+    opts : dict
+        The reader options (:func:`_reader_options`).
+    density_kg_m3 : float or None
+        Rock density given as an argument [kg/m³].
+    sidecar : dict
+        The sidecar's ``[record]`` table.
+    side_path : Path or None
+        The sidecar file.
+    note : callable
+        Records and warns one note of the reading.
+
+    Returns
+    -------
+    tuple
+        ``(events, density, density_is_default, size_column, size_spec)``: every row as an event (censored
+        and unsized ones included), the density [kg/m³], whether it is the default, the column the sizes were
+        given in (``"volume"`` or ``"mass"``) and the arguments ``(column, is_volume, declared_unit)`` of
+        :func:`_check_plausible_sizes`.
+    """
+    table, rows = _read_inventory_table(path, opts["sheet"], opts["header_row"], opts["encoding"], note)
+    vcol, vunit, mcol, munit, dcol, lcol, ncol = _inventory_columns(
+        path, table, opts["volume_column"], opts["mass_column"], opts["date_column"], opts["location_column"])
+    density, density_is_default = _inventory_density(density_kg_m3, sidecar, side_path)
+    volume_unit, mass_unit = opts["volume_unit"], opts["mass_unit"]
+    volume, mass, size_column, censoring, size_raw = _inventory_sizes(
+        path, table, rows, vcol, vunit, mcol, munit, volume_unit, mass_unit, opts["decimal"], density)
+    if density_is_default:
+        note(f"{path}: density not given; the default {DEFAULT_DENSITY_KG_M3:g} kg/m3 converts "
+             f"{'volume to mass' if size_column == 'volume' else 'mass to volume'}")
+    events = _inventory_events(path, table, rows, volume, mass, censoring, size_raw, dcol, lcol, ncol,
+                               opts["date_format"], note)
+    events = _check_duplicates(events, table, path, opts["duplicates"], note)
+    # a unit in the column name counts as declared unless it is the default one:
+    # litres typed into a 'volume_m3' column are exactly the mistake to catch
+    declared = ((volume_unit or (vunit if vunit != "m3" else None)) if vcol is not None
+                else (mass_unit or (munit if munit != "kg" else None)))
+    size_spec = (vcol if vcol is not None else mcol, vcol is not None, declared)
+    return events, density, density_is_default, size_column, size_spec
+
+
+def _read_inventory_table(path: Path, sheet, header_row, encoding, note) -> tuple[pd.DataFrame, np.ndarray]:
+    """Read the inventory's table and drop its blank rows.
+
+    Parameters
+    ----------
+    path : Path
+        The inventory file.
+    sheet, header_row, encoding : optional
+        Reader options of :func:`riskrf.io.tables.read_table`.
+    note : callable
+        Records and warns one note of the reading.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        The non-blank rows, indexed from 0.
+    rows : numpy.ndarray
+        The 1-based file row of each row of ``table``.
+    """
     table, first_row, read_notes = read_table(path, sheet=sheet, header_row=header_row, encoding=encoding,
                                               what="inventory")
     for msg in read_notes:
@@ -525,8 +629,34 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
     table = table.loc[~blank]
     rows = rows[~blank.to_numpy()]
     table.index = range(len(table))
-    columns = [c for c in table.columns if not str(c).startswith("Unnamed")]
+    return table, rows
 
+
+def _inventory_columns(path: Path, table: pd.DataFrame, volume_column, mass_column, date_column,
+                       location_column) -> tuple:
+    """Find the size, date, location and notes columns of the inventory's table, checking the named ones.
+
+    Parameters
+    ----------
+    path : Path
+        The inventory file (named in errors).
+    table : pandas.DataFrame
+        The inventory's rows.
+    volume_column, mass_column, date_column, location_column : str or None
+        Column names given by the user or the sidecar; None to recognise them by name.
+
+    Returns
+    -------
+    tuple
+        ``(vcol, vunit, mcol, munit, dcol, lcol, ncol)``: the volume and mass columns with the units their
+        names state (None when absent or unstated), the date, location and notes columns (None when absent).
+
+    Raises
+    ------
+    ValueError
+        A named column that is not in the table, neither a volume nor a mass column, or no rows.
+    """
+    columns = [c for c in table.columns if not str(c).startswith("Unnamed")]
     vcol, vunit = (volume_column, None) if volume_column else _find_column(columns, _VOLUME_NAMES, _VOLUME_UNITS)
     mcol, munit = (mass_column, None) if mass_column else _find_column(columns, _MASS_NAMES, _MASS_UNITS)
     for given, what in ((volume_column, "volume_column"), (mass_column, "mass_column"),
@@ -543,14 +673,64 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
     dcol = date_column or _find_column(columns, _DATE_NAMES)[0]
     lcol = location_column or _find_column(columns, _LOCATION_NAMES)[0]
     ncol = _find_column(columns, _NOTES_NAMES)[0]
+    return vcol, vunit, mcol, munit, dcol, lcol, ncol
 
+
+def _inventory_density(density_kg_m3, sidecar: dict, side_path) -> tuple[float, bool]:
+    """The rock density converting volumes and masses: the argument, else the sidecar's, else the default.
+
+    Parameters
+    ----------
+    density_kg_m3 : float or None
+        Density given as an argument [kg/m³].
+    sidecar : dict
+        The sidecar's ``[record]`` table.
+    side_path : Path or None
+        The sidecar file (named in errors).
+
+    Returns
+    -------
+    density : float
+        Density [kg/m³].
+    density_is_default : bool
+        True when neither the argument nor the sidecar gave it.
+    """
     density_from_argument = density_kg_m3 is not None
     if density_kg_m3 is None and "density_kg_m3" in sidecar:
         density_kg_m3 = sidecar["density_kg_m3"]
     density_is_default = density_kg_m3 is None
     density = DEFAULT_DENSITY_KG_M3 if density_is_default else check_density(
         density_kg_m3, "density_kg_m3" if density_from_argument else f"{side_path}: [record] density_kg_m3")
+    return density, density_is_default
 
+
+def _inventory_sizes(path: Path, table: pd.DataFrame, rows: np.ndarray, vcol, vunit, mcol, munit, volume_unit,
+                     mass_unit, decimal, density: float) -> tuple:
+    """Parse the size columns into volumes [m³] and masses [kg], each completing the other through the density.
+
+    Parameters
+    ----------
+    path : Path
+        The inventory file (named in errors).
+    table : pandas.DataFrame
+        The inventory's rows.
+    rows : numpy.ndarray
+        The file row of each table row (named in errors).
+    vcol, vunit, mcol, munit : str or None
+        Volume and mass columns and the units their names state (:func:`_inventory_columns`).
+    volume_unit, mass_unit : str or None
+        Units declared by the user or the sidecar; they win over the names' units.
+    decimal : {".", ","} or None
+        Decimal mark.
+    density : float
+        Rock density [kg/m³].
+
+    Returns
+    -------
+    tuple
+        ``(volume, mass, size_column, censoring, size_raw)``: volumes [m³] and masses [kg] as Series, the
+        column the sizes were given in (``"volume"`` or ``"mass"``), the censoring of each size and its text.
+    """
     if vcol is not None:
         unit = volume_unit or vunit or "m3"
         if unit not in _VOLUME_UNITS:
@@ -576,10 +756,37 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         use_mass = mcens != "unknown"
         censoring = mcens.where(use_mass, vcens)
         size_raw = table[mcol].where(use_mass, table[vcol])
-    if density_is_default:
-        note(f"{path}: density not given; the default {DEFAULT_DENSITY_KG_M3:g} kg/m3 converts "
-             f"{'volume to mass' if size_column == 'volume' else 'mass to volume'}")
+    return volume, mass, size_column, censoring, size_raw
 
+
+def _inventory_events(path: Path, table: pd.DataFrame, rows: np.ndarray, volume, mass, censoring, size_raw,
+                      dcol, lcol, ncol, date_format, note) -> pd.DataFrame:
+    """The table of events: dates, sizes, location, notes, file row and censoring; notes rows without a size.
+
+    Parameters
+    ----------
+    path : Path
+        The inventory file (named in errors and notes).
+    table : pandas.DataFrame
+        The inventory's rows.
+    rows : numpy.ndarray
+        The file row of each table row.
+    volume, mass : pandas.Series
+        Volumes [m³] and masses [kg] (:func:`_inventory_sizes`).
+    censoring, size_raw : pandas.Series
+        Censoring of each size and the size as written.
+    dcol, lcol, ncol : str or None
+        Date, location and notes columns.
+    date_format : str or None
+        ``strftime`` pattern of the dates.
+    note : callable
+        Records and warns one note of the reading.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per table row, censored and unsized ones included.
+    """
     if dcol is not None:
         dates, years = parse_dates(table[dcol].astype(str), path, dcol, rows, date_format=date_format)
     else:
@@ -599,9 +806,37 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         note(f"{path}: {len(lines)} row(s) have no size and are left out of the size fits (rows "
              f"{', '.join(map(str, lines[:12]))}{' ...' if len(lines) > 12 else ''}); they are kept in "
              "Inventory.censored and counted by rate models")
-    events = _check_duplicates(events, table, path, duplicates, note)
+    return events
 
-    # Record period.
+
+def _inventory_period(path: Path, events: pd.DataFrame, sidecar: dict, side_path, start, end, duration_years,
+                   note) -> tuple:
+    """The record period: from the arguments, else the sidecar, else inferred from the dates with a note.
+
+    Parameters
+    ----------
+    path : Path
+        The inventory file (named in errors and notes).
+    events : pandas.DataFrame
+        The events (:func:`_inventory_events`).
+    sidecar : dict
+        The sidecar's ``[record]`` table.
+    side_path : Path or None
+        The sidecar file.
+    start, end : date or str or None
+        Record period given as arguments (inclusive).
+    duration_years : float or None
+        Record length given as an argument [yr].
+    note : callable
+        Records and warns one note of the reading.
+
+    Returns
+    -------
+    tuple
+        ``(start, end, duration_years, period_source)``: the period's first and last days (None when only a
+        length is known), its length [yr] (computed from ``start`` and ``end`` when they are known) and where
+        it came from.
+    """
     if start is not None or end is not None:
         if start is None or end is None:
             raise ValueError(f"start = {start!r}, end = {end!r}: give both start and end of the record period, "
@@ -637,16 +872,65 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
         if end < start:
             raise ValueError(f"record period ends ({end}) before it starts ({start})")
         duration_years = ((end - start).days + 1) / 365.25
-        outside = events["date"].notna() & ((events["date"] < pd.Timestamp(start)) |
-                                            (events["date"] > pd.Timestamp(end)))
-        outside |= events["date"].isna() & events["year"].notna() & (
-            (events["year"] < start.year) | (events["year"] > end.year))
-        if outside.any():
-            lines = events.loc[outside, "source_row"].tolist()
-            note(f"{path}: {len(lines)} event(s) dated outside the record period {start} to {end} are left "
-                 f"out (rows {', '.join(map(str, lines[:12]))}{' ...' if len(lines) > 12 else ''})")
-            events = events.loc[~outside]
-    duration_years = check_positive(duration_years, "duration_years")
+    return start, end, duration_years, period_source
+
+
+def _drop_outside_period(path: Path, events: pd.DataFrame, start: _dt.date, end: _dt.date,
+                         note) -> pd.DataFrame:
+    """Leave out, with a note naming their rows, the events dated outside the record period.
+
+    Parameters
+    ----------
+    path : Path
+        The inventory file (named in the note).
+    events : pandas.DataFrame
+        The events.
+    start, end : datetime.date
+        The record period (inclusive).
+    note : callable
+        Records and warns one note of the reading.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The events inside the period or undated.
+    """
+    outside = events["date"].notna() & ((events["date"] < pd.Timestamp(start)) |
+                                        (events["date"] > pd.Timestamp(end)))
+    outside |= events["date"].isna() & events["year"].notna() & (
+        (events["year"] < start.year) | (events["year"] > end.year))
+    if outside.any():
+        lines = events.loc[outside, "source_row"].tolist()
+        note(f"{path}: {len(lines)} event(s) dated outside the record period {start} to {end} are left "
+             f"out (rows {', '.join(map(str, lines[:12]))}{' ...' if len(lines) > 12 else ''})")
+        events = events.loc[~outside]
+    return events
+
+
+def _split_censored_events(path: Path, events: pd.DataFrame, note) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Set the censored and unsized events apart from the exact ones, with a note on the bounded ones.
+
+    Parameters
+    ----------
+    path : Path
+        The inventory file (named in the note and error).
+    events : pandas.DataFrame
+        The events inside the record period.
+    note : callable
+        Records and warns one note of the reading.
+
+    Returns
+    -------
+    events : pandas.DataFrame
+        The events with an exact size, columns :data:`_EVENT_COLUMNS`, indexed from 0.
+    censored : pandas.DataFrame
+        The censored and unsized events, indexed from 0.
+
+    Raises
+    ------
+    ValueError
+        When no event has an exact size.
+    """
     is_cens = events["censoring"] != ""
     censored = events.loc[is_cens].reset_index(drop=True)
     bounded = censored[censored["censoring"] != "unknown"]
@@ -661,19 +945,7 @@ def read_inventory(path, *, start=None, end=None, duration_years=None, density_k
     if events.empty:
         raise ValueError(f"{path}: no usable events (every row lacked an exact size or lay outside the record "
                          "period)")
-    events = events.reset_index(drop=True)
-    if _undated_note(str(path), events):
-        note(_undated_note(str(path), events))
-    _check_plausible_sizes(events, path, vcol if vcol is not None else mcol, vcol is not None,
-                           # a unit in the column name counts as declared unless it is the default one:
-                           # litres typed into a 'volume_m3' column are exactly the mistake to catch
-                           (volume_unit or (vunit if vunit != "m3" else None)) if vcol is not None
-                           else (mass_unit or (munit if munit != "kg" else None)), duration_years, note)
-    return Inventory(events=events, duration_years=duration_years, start=start, end=end,
-                     density_kg_m3=density, density_is_default=density_is_default, source=str(path),
-                     period_source=period_source, size_column=size_column,
-                     site=str(sidecar.get("site", "")), notes=tuple(notes), censored=censored,
-                     sizes=sidecar.get("sizes"))
+    return events.reset_index(drop=True), censored
 
 
 def _undated_note(source: str, events: pd.DataFrame) -> str:

@@ -247,17 +247,55 @@ def _slope_tables(site):
 def write_pdf_report(a, path, figs) -> Path:
     """Write report.pdf for the assessment ``a`` (figures read from ``figs``); returns the path."""
     figs = Path(figs)
-    site = a.site
-    tb = title_block(site)
+    tb = title_block(a.site)
     rep = _Report(tb)
+    pdf = rep.pdf
+    _title_page(rep, a, tb)
+
+    # ---- contents -------------------------------------------------------------------------------
+    pdf.add_page()
+    pdf.insert_toc_placeholder(_toc, pages=1)       # it starts the next page itself
+    rep.fresh_page = True
+
+    d = a.design
+    if d is not None and d.requirement is not None:
+        _design_values_sheet(rep, a)
+        _design_checks(rep, d)
+        if d.positions is not None:
+            _barrier_positions(rep, d, figs)
+    if a.site.hazard.get("scenario"):
+        _slope_model(rep, a.site)
+    _options_and_runout(rep, d, figs)
+    if d is not None and d.catchment is not None:
+        _catchment(rep, d.catchment, figs)
+    _hazard(rep, a, figs)
+    _ranking(rep, a, figs)
+    if getattr(a, "model_uncertainty", None) is not None:
+        _model_uncertainty(rep, a.model_uncertainty, a.study.currency, figs)
+    _inventory_and_assumptions(rep, a, figs)
+    _appendices(rep, a, figs)
+    path = Path(path)
+    tmp = path.with_suffix(".pdf.part")
+    pdf.output(str(tmp))
+    tmp.replace(path)
+    return path
+
+
+def _title_page(rep, a, tb):
+    """Write the title page: title block, design statement, recommendation and signature fields.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    tb : dict
+        The title-block fields (:func:`title_block`).
+    """
     pdf = rep.pdf
     d = a.design
     req = d.requirement if d is not None else None
-    hz = a.energy.hazard
-    rank = a.decision["ranking"]
-    cur = a.study.currency
-
-    # ---- title page -------------------------------------------------------------------------------
     pdf.add_page()
     pdf.set_font("DejaVu", "B", 18)
     pdf.multi_cell(0, 9, "Rock fall hazard assessment and barrier design", new_x="LMARGIN", new_y="NEXT")
@@ -281,108 +319,160 @@ def write_pdf_report(a, path, figs) -> Path:
              size=10)
     rep.text("Signature fields: author ____________________   checker ____________________", size=9.5)
 
-    # ---- contents -------------------------------------------------------------------------------
-    pdf.add_page()
-    pdf.insert_toc_placeholder(_toc, pages=1)       # it starts the next page itself
-    rep.fresh_page = True
 
-    # ---- design values sheet ---------------------------------------------------------------------
-    if req is not None:
-        rep.section("Design values sheet")
-        blk = a.energy.design_block
-        m = req.block_mass_kg
-        v95, v99 = (hz.velocity_percentile(q, mass_kg=m) for q in (95, 99))
-        e95, e99 = (float(x) for x in hz.energy_percentile([95, 99]))
-        if hz.mass_coupled:
-            h95, h99 = (hz.velocity.height_percentile(q, m) for q in (95, 99))
-        elif hz.heights_m is not None:
-            h95, h99 = (float(hz.height_percentile(q)) for q in (95, 99))
-        else:
-            h95 = h99 = float("nan")
-        sh = req.shares
-        rows = [
-            ("governing design basis", d.basis.basis),
-            ("barrier line", f"x = {fmt(req.x_m, 4)} m"),
-            ("design block", f"{fmt(m, 3)} kg, {fmt(m / a.inventory.density_kg_m3, 3)} m³, diameter "
-                             f"{fmt(req.block_diameter_m, 3)} m ({req.block_rule})"
-             + (f"; rule: {blk.basis}" if blk is not None else "")),
-            ("speed of the design block at the line, p95 / p99", f"{fmt(v95)} / {fmt(v99)} m/s"),
-            ("impact energy of arriving falls, p95 / p99", f"{fmt(e95)} / {fmt(e99)} kJ"),
-            ("bounce height (block centre) at the line, p95 / p99", f"{fmt(h95)} / {fmt(h99)} m"),
-            ("design energy E_d", f"{fmt(req.E_d_kj)} kJ ({req.governs})"),
-            (f"{year(d.basis.frequent_T_years)}-year energy (frequent events, against SEL)",
-             f"{fmt(req.frequent_energy_kj)} kJ"),
-            ("REQUIRED MEL", f"{fmt(req.required_mel_kj)} kJ"),
-            ("REQUIRED product class", f"{fmt(req.required_class_kj)} kJ" if np.isfinite(req.required_class_kj)
-             else f"none: above the largest class ({fmt(max(d.basis.mel_classes_kj))} kJ)"),
-            ("REQUIRED net height", f"{fmt(req.required_net_height_m)} m (design passing height h_d "
-                                    f"{fmt(req.h_d_m)} m + free border; exact {fmt(req.required_height_m)} m)"),
-            ("clearance to the road; permitted maximum elongation",
-             f"{fmt(req.clearance_m)} m; {fmt(req.permitted_elongation_m)} m"),
-            ("required residual-height category (EAD 340059)", req.residual_category),
-            ("falls at the line stopped / over / through by the required barrier",
-             f"{pct(sh.get('stopped'))} / {pct(sh.get('over'))} / {pct(sh.get('through'))}"),
-        ]
-        if d.runout:
-            rows.append(("simulated blocks reaching the road (run-out)", pct(d.runout.get("share_reaching_road"))))
-        rep.kv(rows, widths=(2, 3))
-        rep.text("Energies in kJ, lengths in m.  The shares stopped / over / through take bounce height and energy "
-                 "of the arriving falls (under the site's mass law) as independent.", size=8)
+def _design_values_sheet(rep, a):
+    """Write the design values sheet: design block, speeds, energies, bounce heights and the required barrier.
 
-        rep.section("Design basis and checks")
-        rep.text(d.basis.text())
-        rep.table(["factor", "value"], [[k, fmt(v, 3)] for k, v in d.basis.factors.items()], widths=[2, 1])
-        rep.sub("Requirement at the barrier line")
-        rep.table(["quantity", "value"], [[k, fmt(v) if not isinstance(v, str) else v]
-                                          for k, v in req.summary()["value"].items()], widths=[3, 2],
-                  align=["LEFT", "RIGHT"])
-        if len(req.candidates):
-            rep.sub("Checks of the candidate fences")
-            rep.table(["fence", "check", "demand", "capacity", "unit", "adequate"],
-                      [[r["fence"], r["check"], fmt(r["demand"]), fmt(r["capacity"]), r["unit"],
-                        "not given" if r["adequate"] is None or (isinstance(r["adequate"], float)
-                                                                  and np.isnan(r["adequate"]))
-                        else ("yes" if r["adequate"] else "NO")]
-                       for _, r in req.candidates.iterrows()], widths=[2, 4, 1.2, 1.2, 0.7, 1])
-            rep.text("Elongation: state the kit's maximum elongation at MEL (from its European Technical "
-                     "Assessment) in [design] elongation_m to check it; the permitted value is the clearance to the "
-                     "road divided by gamma_d (ONR 24810: also at most the clearance less 1 m).", size=8)
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment; its ``design.requirement`` is not None.
+    """
+    d = a.design
+    req = d.requirement
+    hz = a.energy.hazard
+    rep.section("Design values sheet")
+    blk = a.energy.design_block
+    m = req.block_mass_kg
+    v95, v99 = (hz.velocity_percentile(q, mass_kg=m) for q in (95, 99))
+    e95, e99 = (float(x) for x in hz.energy_percentile([95, 99]))
+    if hz.mass_coupled:
+        h95, h99 = (hz.velocity.height_percentile(q, m) for q in (95, 99))
+    elif hz.heights_m is not None:
+        h95, h99 = (float(hz.height_percentile(q)) for q in (95, 99))
+    else:
+        h95 = h99 = float("nan")
+    sh = req.shares
+    rows = [
+        ("governing design basis", d.basis.basis),
+        ("barrier line", f"x = {fmt(req.x_m, 4)} m"),
+        ("design block", f"{fmt(m, 3)} kg, {fmt(m / a.inventory.density_kg_m3, 3)} m³, diameter "
+                         f"{fmt(req.block_diameter_m, 3)} m ({req.block_rule})"
+         + (f"; rule: {blk.basis}" if blk is not None else "")),
+        ("speed of the design block at the line, p95 / p99", f"{fmt(v95)} / {fmt(v99)} m/s"),
+        ("impact energy of arriving falls, p95 / p99", f"{fmt(e95)} / {fmt(e99)} kJ"),
+        ("bounce height (block centre) at the line, p95 / p99", f"{fmt(h95)} / {fmt(h99)} m"),
+        ("design energy E_d", f"{fmt(req.E_d_kj)} kJ ({req.governs})"),
+        (f"{year(d.basis.frequent_T_years)}-year energy (frequent events, against SEL)",
+         f"{fmt(req.frequent_energy_kj)} kJ"),
+        ("REQUIRED MEL", f"{fmt(req.required_mel_kj)} kJ"),
+        ("REQUIRED product class", f"{fmt(req.required_class_kj)} kJ" if np.isfinite(req.required_class_kj)
+         else f"none: above the largest class ({fmt(max(d.basis.mel_classes_kj))} kJ)"),
+        ("REQUIRED net height", f"{fmt(req.required_net_height_m)} m (design passing height h_d "
+                                f"{fmt(req.h_d_m)} m + free border; exact {fmt(req.required_height_m)} m)"),
+        ("clearance to the road; permitted maximum elongation",
+         f"{fmt(req.clearance_m)} m; {fmt(req.permitted_elongation_m)} m"),
+        ("required residual-height category (EAD 340059)", req.residual_category),
+        ("falls at the line stopped / over / through by the required barrier",
+         f"{pct(sh.get('stopped'))} / {pct(sh.get('over'))} / {pct(sh.get('through'))}"),
+    ]
+    if d.runout:
+        rows.append(("simulated blocks reaching the road (run-out)", pct(d.runout.get("share_reaching_road"))))
+    rep.kv(rows, widths=(2, 3))
+    rep.text("Energies in kJ, lengths in m.  The shares stopped / over / through take bounce height and energy "
+             "of the arriving falls (under the site's mass law) as independent.", size=8)
 
-        if d.positions is not None:
-            rep.section("Barrier position along the profile")
-            t = d.positions.table
-            rep.text(f"The requirement of {d.basis.basis} repeated at {len(t)} positions from one simulation of "
-                     f"{d.positions.n:,} blocks across the site's mass range.")
-            rep.table(["x [m]", "ground z [m]", "reaching [%]", "arrivals per year", "E_d [kJ]",
-                       "required MEL [kJ]", "product class [kJ]", "net height [m]", "to road [m]"],
-                      [[fmt(r["x_m"], 4), fmt(r["ground_z_m"], 3), f"{100 * r['reach_share']:.1f}",
-                        fmt(r["arrivals_per_year"]), fmt(r["E_d_kj"]), fmt(r["required_mel_kj"]),
-                        fmt(r["required_class_kj"]) if np.isfinite(r["required_class_kj"]) else "none",
-                        fmt(r["required_net_height_m"]), fmt(r["clearance_m"], 3)] for _, r in t.iterrows()])
-            best = d.positions.cheapest()
-            if best is not None:
-                rep.text(f"Smallest product class at x = {fmt(best['x_m'], 4)} m: {fmt(best['required_class_kj'])} kJ, "
-                         f"{fmt(best['required_net_height_m'])} m.")
-            else:
-                rep.text("No searched position can be protected by a single certified kit of the listed classes.")
-            rep.figure(figs / "barrier_positions.png", "Required MEL and net height by barrier position.",
-                       max_height=150)
 
-    # ---- slope model ----------------------------------------------------------------------------
-    if site.hazard.get("scenario"):
-        sc, vert, mats = _slope_tables(site)
-        rep.section("Slope model")
-        rep.text(f"Scenario {Path(str(site.hazard['scenario'])).name}: {sc.description.strip()}", size=8.5)
-        rep.sub("Profile vertices and segment angles")
-        rep.table(["vertex", "x [m]", "z [m]", "dip of the segment to the next vertex [°]",
-                   "material of that segment"], vert, widths=[0.8, 1, 1, 2, 2])
-        rep.sub("Materials and the source of their values")
-        rep.table(["material", "normal restitution e_N", "tangential: e_T or friction", "rough-ness [m]",
-                   "ground motion", "ground friction φ_g [°]", "source or calibration"], mats,
-                  widths=[1.1, 1.6, 1.6, 1.0, 1.0, 1.0, 4.3], size=7,
-                  align=["LEFT", "LEFT", "LEFT", "RIGHT", "LEFT", "RIGHT", "LEFT"])
+def _design_checks(rep, d):
+    """Write the design basis, its factors, the requirement at the barrier line and the candidate fences' checks.
 
-    # ---- options and figures ----------------------------------------------------------------------
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    d : SiteDesign
+        The assessment's design; its ``requirement`` is not None.
+    """
+    req = d.requirement
+    rep.section("Design basis and checks")
+    rep.text(d.basis.text())
+    rep.table(["factor", "value"], [[k, fmt(v, 3)] for k, v in d.basis.factors.items()], widths=[2, 1])
+    rep.sub("Requirement at the barrier line")
+    rep.table(["quantity", "value"], [[k, fmt(v) if not isinstance(v, str) else v]
+                                      for k, v in req.summary()["value"].items()], widths=[3, 2],
+              align=["LEFT", "RIGHT"])
+    if len(req.candidates):
+        rep.sub("Checks of the candidate fences")
+        rep.table(["fence", "check", "demand", "capacity", "unit", "adequate"],
+                  [[r["fence"], r["check"], fmt(r["demand"]), fmt(r["capacity"]), r["unit"],
+                    "not given" if r["adequate"] is None or (isinstance(r["adequate"], float)
+                                                              and np.isnan(r["adequate"]))
+                    else ("yes" if r["adequate"] else "NO")]
+                   for _, r in req.candidates.iterrows()], widths=[2, 4, 1.2, 1.2, 0.7, 1])
+        rep.text("Elongation: state the kit's maximum elongation at MEL (from its European Technical "
+                 "Assessment) in [design] elongation_m to check it; the permitted value is the clearance to the "
+                 "road divided by gamma_d (ONR 24810: also at most the clearance less 1 m).", size=8)
+
+
+def _barrier_positions(rep, d, figs):
+    """Write the barrier-position search: the requirement at each searched position and the cheapest one.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    d : SiteDesign
+        The assessment's design; its ``positions`` is not None.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    """
+    rep.section("Barrier position along the profile")
+    t = d.positions.table
+    rep.text(f"The requirement of {d.basis.basis} repeated at {len(t)} positions from one simulation of "
+             f"{d.positions.n:,} blocks across the site's mass range.")
+    rep.table(["x [m]", "ground z [m]", "reaching [%]", "arrivals per year", "E_d [kJ]",
+               "required MEL [kJ]", "product class [kJ]", "net height [m]", "to road [m]"],
+              [[fmt(r["x_m"], 4), fmt(r["ground_z_m"], 3), f"{100 * r['reach_share']:.1f}",
+                fmt(r["arrivals_per_year"]), fmt(r["E_d_kj"]), fmt(r["required_mel_kj"]),
+                fmt(r["required_class_kj"]) if np.isfinite(r["required_class_kj"]) else "none",
+                fmt(r["required_net_height_m"]), fmt(r["clearance_m"], 3)] for _, r in t.iterrows()])
+    best = d.positions.cheapest()
+    if best is not None:
+        rep.text(f"Smallest product class at x = {fmt(best['x_m'], 4)} m: {fmt(best['required_class_kj'])} kJ, "
+                 f"{fmt(best['required_net_height_m'])} m.")
+    else:
+        rep.text("No searched position can be protected by a single certified kit of the listed classes.")
+    rep.figure(figs / "barrier_positions.png", "Required MEL and net height by barrier position.",
+               max_height=150)
+
+
+def _slope_model(rep, site):
+    """Write the slope model: the scenario's profile vertices with segment angles and its materials' sources.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    site : Site
+        The site; its ``hazard`` table names a scenario.
+    """
+    sc, vert, mats = _slope_tables(site)
+    rep.section("Slope model")
+    rep.text(f"Scenario {Path(str(site.hazard['scenario'])).name}: {sc.description.strip()}", size=8.5)
+    rep.sub("Profile vertices and segment angles")
+    rep.table(["vertex", "x [m]", "z [m]", "dip of the segment to the next vertex [°]",
+               "material of that segment"], vert, widths=[0.8, 1, 1, 2, 2])
+    rep.sub("Materials and the source of their values")
+    rep.table(["material", "normal restitution e_N", "tangential: e_T or friction", "rough-ness [m]",
+               "ground motion", "ground friction φ_g [°]", "source or calibration"], mats,
+              widths=[1.1, 1.6, 1.6, 1.0, 1.0, 1.0, 4.3], size=7,
+              align=["LEFT", "LEFT", "LEFT", "RIGHT", "LEFT", "RIGHT", "LEFT"])
+
+
+def _options_and_runout(rep, d, figs):
+    """Write the options on the profile, the trajectories and the stop points with their run-out statistics.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    d : SiteDesign or None
+        The assessment's design (run-out statistics when it has them).
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    """
     rep.section("Mitigation options on the profile")
     rep.figure(figs / "options_profile.png", "Every option's geometry on the slope profile, and the barrier the "
                                              "design basis requires (dashed).", max_height=110)
@@ -407,30 +497,54 @@ def write_pdf_report(a, path, figs) -> Path:
                                                                   f"{fmt(rr['stop_x_p95_m'], 4)} m"),
                     (f"with {rr['option']}: share reaching the road", pct(rr.get("share_reaching_road")))])
 
-    if d is not None and d.catchment is not None:
-        c = d.catchment
-        rep.section("Catchment ditch at the toe of the cut")
-        applies = c.to_dict()["odot_chart_geometry"]
-        rep.text(f"Retention against catchment width beyond the toe of the cut (x = {fmt(c.toe_x_m, 4)} m; cut "
-                 f"{fmt(c.cut_height_m, 3)} m high at {fmt(c.face_angle_deg, 3)}°), re-simulated with the site's "
-                 f"slope model.  Pierson, Gullixson & Chassie (2001, FHWA-OR-RD-02-04) charts: {applies}.")
-        rep.table(["retention", "catchment width needed [m]"],
-                  [[f"{q:g} %", fmt(w, 3) if np.isfinite(w) else "not reached on the profile"]
-                   for q, w in c.widths.items()], widths=[1, 2])
-        mrc = c.to_dict()["modified_ritchie_criterion"]
-        rep.text(f"Published width rule beside it: the Modified Ritchie Criterion W = 0.2 H + 4.5 m (Ryan & Pryor "
-                 f"2000, after Ritchie 1963) gives {fmt(mrc['width_m'], 3)} m for this cut, within which the "
-                 f"re-simulation retains {fmt(mrc['simulated_retained_percent'], 3)} % of the blocks that went over "
-                 "the face.  The rule is for a cut face above a flat catchment; on the ODOT test cut the "
-                 "re-simulation retains fewer blocks than the rule implies (validation: design standards and "
-                 "ditch charts).", size=8)
-        if c.chart is not None:
-            rep.table(["width [m]", "chart retained [%]", "simulated [%]", "difference [points]"],
-                      [[fmt(r["width_m"]), fmt(r["retained_percent"]), fmt(r["simulated_percent"]),
-                        fmt(r["difference_points"])] for _, r in c.chart.iterrows()])
-        rep.figure(figs / "catchment_retention.png", "Retention against catchment width.", max_height=100)
 
-    # ---- hazard --------------------------------------------------------------------------------
+def _catchment(rep, c, figs):
+    """Write the catchment ditch: widths needed for each retention, the Modified Ritchie Criterion, the chart.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    c : CatchmentStudy
+        The design's catchment study.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    """
+    rep.section("Catchment ditch at the toe of the cut")
+    applies = c.to_dict()["odot_chart_geometry"]
+    rep.text(f"Retention against catchment width beyond the toe of the cut (x = {fmt(c.toe_x_m, 4)} m; cut "
+             f"{fmt(c.cut_height_m, 3)} m high at {fmt(c.face_angle_deg, 3)}°), re-simulated with the site's "
+             f"slope model.  Pierson, Gullixson & Chassie (2001, FHWA-OR-RD-02-04) charts: {applies}.")
+    rep.table(["retention", "catchment width needed [m]"],
+              [[f"{q:g} %", fmt(w, 3) if np.isfinite(w) else "not reached on the profile"]
+               for q, w in c.widths.items()], widths=[1, 2])
+    mrc = c.to_dict()["modified_ritchie_criterion"]
+    rep.text(f"Published width rule beside it: the Modified Ritchie Criterion W = 0.2 H + 4.5 m (Ryan & Pryor "
+             f"2000, after Ritchie 1963) gives {fmt(mrc['width_m'], 3)} m for this cut, within which the "
+             f"re-simulation retains {fmt(mrc['simulated_retained_percent'], 3)} % of the blocks that went over "
+             "the face.  The rule is for a cut face above a flat catchment; on the ODOT test cut the "
+             "re-simulation retains fewer blocks than the rule implies (validation: design standards and "
+             "ditch charts).", size=8)
+    if c.chart is not None:
+        rep.table(["width [m]", "chart retained [%]", "simulated [%]", "difference [points]"],
+                  [[fmt(r["width_m"]), fmt(r["retained_percent"]), fmt(r["simulated_percent"]),
+                    fmt(r["difference_points"])] for _, r in c.chart.iterrows()])
+    rep.figure(figs / "catchment_retention.png", "Retention against catchment width.", max_height=100)
+
+
+def _hazard(rep, a, figs):
+    """Write the impact-energy hazard at the barrier line: rates, return-period energies, the design block.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    """
+    hz = a.energy.hazard
     rep.section("Impact-energy hazard at the barrier line")
     rep.text(f"Falls per year at the source {fmt(hz.rate_per_year)}; reach probability {fmt(hz.reach_probability)}; "
              f"arrivals per year {fmt(hz.arrival_rate)}.  Rate: {a.rate_source}.")
@@ -452,7 +566,22 @@ def write_pdf_report(a, path, figs) -> Path:
     rep.figure(figs / "energy_exceedance.png", "Annual frequency of impacts above an energy at the barrier line.",
                max_height=110)
 
-    # ---- ranking --------------------------------------------------------------------------------
+
+def _ranking(rep, a, figs):
+    """Write the mitigation options ranked by expected total cost, the recommendation and the tornado chart.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    """
+    rank = a.decision["ranking"]
+    rec = a.decision["recommendation"]
+    cur = a.study.currency
     rep.section("Mitigation options ranked")
     rep.table(["option", f"capital [{cur}]", f"expected total cost [{cur}]", "5-95 % [" + cur + "]",
                "road falls per year", "individual risk per year", "societal risk", "meets criteria"],
@@ -463,25 +592,51 @@ def write_pdf_report(a, path, figs) -> Path:
     rep.text(f"Recommendation: {rec['reason']}", size=8.5)
     rep.figure(figs / "tornado.png", "One-way sensitivity of the expected total cost.", max_height=100)
 
-    mu = getattr(a, "model_uncertainty", None)
-    if mu is not None:
-        rep.section("Trajectory model uncertainty")
-        rep.text(f"The slope re-simulated for {mu.ranking.n_draws} draws of its material parameters ({mu.basis}).",
-                 size=8.5)
-        for line in mu.energy.text(mu.design_T):
-            rep.text(line, size=8.5)
-        rank_mu = mu.ranking.summary()
-        rep.table(["option", f"expected total cost [{cur}]", f"trajectory model 5-95 % [{cur}]", "P(best | model)",
-                   "cost variance from the model"],
-                  [[r["option"], fmt(r["expected_total_cost"]), f"{fmt(r['model_cost_p05'])} - "
-                    f"{fmt(r['model_cost_p95'])}", f"{r['probability_best_given_model']:.2f}",
-                    f"{r.get('share_of_variance_from_trajectory_model', float('nan')):.0%}"]
-                   for _, r in rank_mu.iterrows()], widths=[2.2, 1.3, 1.9, 1, 1.2], size=7.2)
-        rep.text(mu.verdict(), size=8.5, style="B")
-        rep.figure(figs / "design_energy_model_uncertainty.png",
-                   f"The {mu.design_T:g}-year energy of each draw with its bootstrap interval.", max_height=90)
 
-    # ---- inventory -----------------------------------------------------------------------------
+def _model_uncertainty(rep, mu, cur, figs):
+    """Write the trajectory model uncertainty: design energy and ranking over draws of the material parameters.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    mu : ModelUncertaintyStudy
+        The assessment's model-uncertainty study.
+    cur : str
+        Currency of the costs.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    """
+    rep.section("Trajectory model uncertainty")
+    rep.text(f"The slope re-simulated for {mu.ranking.n_draws} draws of its material parameters ({mu.basis}).",
+             size=8.5)
+    for line in mu.energy.text(mu.design_T):
+        rep.text(line, size=8.5)
+    rank_mu = mu.ranking.summary()
+    rep.table(["option", f"expected total cost [{cur}]", f"trajectory model 5-95 % [{cur}]", "P(best | model)",
+               "cost variance from the model"],
+              [[r["option"], fmt(r["expected_total_cost"]), f"{fmt(r['model_cost_p05'])} - "
+                f"{fmt(r['model_cost_p95'])}", f"{r['probability_best_given_model']:.2f}",
+                f"{r.get('share_of_variance_from_trajectory_model', float('nan')):.0%}"]
+               for _, r in rank_mu.iterrows()], widths=[2.2, 1.3, 1.9, 1, 1.2], size=7.2)
+    rep.text(mu.verdict(), size=8.5, style="B")
+    rep.figure(figs / "design_energy_model_uncertainty.png",
+               f"The {mu.design_T:g}-year energy of each draw with its bootstrap interval.", max_height=90)
+
+
+def _inventory_and_assumptions(rep, a, figs):
+    """Write the inventory with its magnitude-frequency law, then the assumptions, defaults and warnings.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    """
+    from ..io.outputs import relative_paths
     rep.section("Inventory and magnitude-frequency law")
     gr = a.frequency.power_law
     rep.kv([("inventory", Path(str(a.inventory.source)).name), ("recorded falls", f"{a.inventory.n_events:,}"),
@@ -490,18 +645,27 @@ def write_pdf_report(a, path, figs) -> Path:
             ("falls per year at or above m_min", fmt(gr.rate_min))])
     rep.figure(figs / "magnitude_frequency.png", "Magnitude-frequency of the inventory.", max_height=110)
 
-    # ---- assumptions --------------------------------------------------------------------------
     rep.section("Assumptions, defaults and warnings")
-    from ..io.outputs import relative_paths
     for w in a.warnings:
-        rep.text("• " + str(relative_paths(str(w), site.path.parent)), size=8.5)
+        rep.text("• " + str(relative_paths(str(w), a.site.path.parent)), size=8.5)
     if a.site.defaults_used:
         rep.sub("Defaults applied (not stated in the site file)")
         rep.text("; ".join(a.site.defaults_used), size=8)
 
-    # ---- appendix: other sites --------------------------------------------------------------------
-    other = a.maxima_frequency is not None or a.rates is not None
-    if other:
+
+def _appendices(rep, a, figs):
+    """Write appendix A (data from other sites, when the assessment has them) and appendix B (the run record).
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    """
+    if a.maxima_frequency is not None or a.rates is not None:
         rep.section("Data from other sites (reference only)", appendix="A")
         rep.text("These records are not this site's: they show the methods (annual maxima, rainfall rate model) and "
                  "do not enter the design values above.", size=9)
@@ -516,11 +680,6 @@ def write_pdf_report(a, path, figs) -> Path:
     rep.section("Run record", appendix="B")
     rep.kv([("riskrf version", str(_version())), ("seed", str(a.seed)), ("simulated blocks", f"{a.n_blocks:,}"),
             ("site file", a.site.path.name), ("outputs", "report.html, summary.json, CSV tables, figures/")])
-    path = Path(path)
-    tmp = path.with_suffix(".pdf.part")
-    pdf.output(str(tmp))
-    tmp.replace(path)
-    return path
 
 
 def _version():
