@@ -18,7 +18,6 @@ import tomllib
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 A4_TEXT_WIDTH_MM = 180.0
 
