@@ -1312,7 +1312,9 @@ def command() -> int:
         if "simulation.precompile" in sys.modules:
             sys.modules["simulation.precompile"].discard_early()
     import gc
-    gc.freeze()
+    import os
+    if os.environ.get("RISKRF_NO_GC_FREEZE", "0") in ("", "0"):
+        gc.freeze()
     return status
 
 

@@ -28,7 +28,7 @@ class Precompile:
 
     def __init__(self, *, check_cache: bool = True):
         self._proc = None
-        if check_cache and _cache_exists():
+        if disabled() or (check_cache and _cache_exists()):
             return
         # A fresh interpreter (not multiprocessing): it never re-imports the caller's main script, so a user's
         # script without an ``if __name__ == "__main__"`` guard works unchanged.
@@ -57,6 +57,19 @@ class Precompile:
         return self._proc.returncode == 0
 
 
+def disabled() -> bool:
+    """True when the environment variable ``RISKRF_NO_PRECOMPILE`` is set to anything but ``""``/``"0"``: no
+    compiling child is started, the kernel compiles on first use in the run's own process (for measuring what the
+    child saves, ``tests/benchmarks/bench_startup.py``, or where a second process is unwelcome).
+
+    Returns
+    -------
+    bool
+        Whether early compilation is switched off.
+    """
+    return os.environ.get("RISKRF_NO_PRECOMPILE", "0") not in ("", "0")
+
+
 def _cache_exists() -> bool:
     """True when the kernel's on-disk cache index exists (numba internals; if they move, False: compile)."""
     try:
@@ -72,7 +85,7 @@ def start_early() -> None:
     with ``NUMBA_CACHE_DIR`` set the child starts and finishes at once if the cache is warm).  The next
     :func:`precompile` call takes this child over.  Nothing is started with ``NUMBA_DISABLE_JIT``."""
     global _early
-    if os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0") or _early is not None:
+    if os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0") or _early is not None or disabled():
         return
     if not os.environ.get("NUMBA_CACHE_DIR"):
         tag = f"py{sys.version_info[0]}{sys.version_info[1]}"

@@ -17,7 +17,8 @@ class InBackground:
     where it is safe (POSIX, no other thread, e.g. not inside a notebook kernel with threads); otherwise, or if
     the child dies, ``work`` runs in this process at :meth:`result`.  An exception raised by ``work`` in the
     child is raised again by :meth:`result`.  The value and the files are the same either way.
-    ``fork=False`` keeps the work in this process (run at :meth:`result`): for when the other core is taken.
+    ``fork=False`` keeps the work in this process (run at :meth:`result`): for when the other core is taken; the
+    environment variable ``RISKRF_NO_FORK=1`` does the same for every instance.
     Warnings the work raises are not passed on, wherever it ran (a forked child cannot pass them on): work
     whose warnings matter returns them (the rate model keeps them in its notes).
     """
@@ -27,6 +28,7 @@ class InBackground:
         import os
         import threading
         self.work, self.proc, self.conn, self._done = work, None, None, None
+        fork = fork and os.environ.get("RISKRF_NO_FORK", "0") in ("", "0")
         if fork and hasattr(os, "fork") and threading.active_count() == 1:
             import multiprocessing
             try:
@@ -35,7 +37,7 @@ class InBackground:
                 self.proc = ctx.Process(target=_send_result, args=(work, child), daemon=True)
                 # The objects alive now are frozen out of the garbage collector for the fork: the child's
                 # collections then never walk (and so never copy) the pages it shares with this process.
-                freeze = gc.get_freeze_count() == 0       # (objects someone else froze stay frozen)
+                freeze = gc.get_freeze_count() == 0 and os.environ.get("RISKRF_NO_GC_FREEZE", "0") in ("", "0")
                 if freeze:
                     gc.freeze()
                 try:

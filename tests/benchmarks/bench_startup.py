@@ -1,0 +1,111 @@
+"""Benchmark: is the start-up machinery worth its code?  ``riskrf demo`` timed with each piece on and off.
+
+Run: python tests/benchmarks/bench_startup.py [--rounds N] [-n BLOCKS] [--configs all,no_precompile,...]
+
+Each configuration runs ``riskrf demo`` twice in a row: a *first* run with an empty numba cache (a fresh
+``NUMBA_CACHE_DIR``: every kernel compiles, as on a fresh installation) and a *later* run on the cache the first
+one wrote.  The configurations are interleaved (A/B/A/B ...) over ``--rounds`` rounds so that a busy machine's
+load falls on all of them alike; the wall-clock seconds of every run, the median per configuration and the
+load average before and after are printed.  Targets (issue 22): first run < 30 s, later < 10 s on 2 quiet cores.
+
+Pieces switched off, one at a time, by environment variables the code honours:
+
+* ``no_precompile``  ``RISKRF_NO_PRECOMPILE=1``: no child compiling the simulator on the other core
+  (simulation/precompile.py); the kernel compiles on first use in the run's own process.
+* ``no_fork``        ``RISKRF_NO_FORK=1``: figures and the rate model are drawn/fitted in the run's own process,
+  not in forked children (riskrf/app/background.py).
+* ``no_gc_freeze``   ``RISKRF_NO_GC_FREEZE=1``: no ``gc.freeze()`` at the command's exit or around a fork.
+
+It also times the lazy public names (simulation/_lazy.py): ``import riskrf.cli`` against importing every public
+name at once (what an eager ``__init__`` would cost a light command such as ``riskrf --help``).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+CONFIGS = {
+    "all_on": {},
+    "no_precompile": {"RISKRF_NO_PRECOMPILE": "1"},
+    "no_fork": {"RISKRF_NO_FORK": "1"},
+    "no_gc_freeze": {"RISKRF_NO_GC_FREEZE": "1"},
+    "all_off": {"RISKRF_NO_PRECOMPILE": "1", "RISKRF_NO_FORK": "1", "RISKRF_NO_GC_FREEZE": "1"},
+}
+
+
+def _env(extra: dict, cache: str) -> dict:
+    env = {k: v for k, v in os.environ.items() if not k.startswith("RISKRF_NO_")}
+    env.update(extra, NUMBA_CACHE_DIR=cache, PYTHONPATH=str(ROOT) + os.pathsep + env.get("PYTHONPATH", ""))
+    return env
+
+
+def demo_seconds(env: dict, out: Path, n: int | None) -> float:
+    """Wall-clock seconds of one ``riskrf demo`` (the console script's entry point, ``riskrf.cli.command``)."""
+    cmd = [sys.executable, "-c", "import sys; from riskrf.cli import command; sys.argv[0] = 'riskrf'; "
+           "sys.exit(command())", "demo", "--out", str(out), "--overwrite"]
+    if n is not None:
+        cmd += ["-n", str(n)]
+    t = time.perf_counter()
+    subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return time.perf_counter() - t
+
+
+def import_seconds(code: str, repeat: int = 5) -> float:
+    """Best wall-clock seconds of a fresh interpreter running ``code`` (interpreter start-up included)."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    best = float("inf")
+    for _ in range(repeat):
+        t = time.perf_counter()
+        subprocess.run([sys.executable, "-c", code], env=env, check=True)
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=2)
+    parser.add_argument("-n", type=int, default=None, help="simulated blocks (default: the demo's own)")
+    parser.add_argument("--configs", default=",".join(CONFIGS), help="comma-separated subset of " + ", ".join(CONFIGS))
+    args = parser.parse_args()
+    names = args.configs.split(",")
+    print(f"load average before: {os.getloadavg()}  cores: {os.cpu_count()}", flush=True)
+    first = {k: [] for k in names}
+    later = {k: [] for k in names}
+    work = Path(tempfile.mkdtemp(prefix="bench_startup_"))
+    try:
+        for r in range(args.rounds):
+            for name in names:
+                cache = tempfile.mkdtemp(dir=work, prefix="numba_")
+                env = _env(CONFIGS[name], cache)
+                out = work / f"demo_{name}"
+                first[name].append(demo_seconds(env, out, args.n))
+                later[name].append(demo_seconds(env, out, args.n))
+                print(f"round {r + 1} {name:14s} first {first[name][-1]:6.1f} s  later {later[name][-1]:6.1f} s  "
+                      f"load {os.getloadavg()[0]:.2f}", flush=True)
+                shutil.rmtree(cache, ignore_errors=True)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    print(f"load average after: {os.getloadavg()}")
+    print(f"\n{'configuration':14s} {'first run [s] median (all)':>40s} {'later run [s] median (all)':>40s}")
+    for name in names:
+        f, lt = first[name], later[name]
+        print(f"{name:14s} {statistics.median(f):8.1f} ({', '.join(f'{x:.1f}' for x in f):>28s}) "
+              f"{statistics.median(lt):8.1f} ({', '.join(f'{x:.1f}' for x in lt):>28s})")
+    lazy = import_seconds("import riskrf, riskrf.cli, simulation")
+    eager = import_seconds("import riskrf, riskrf.cli, simulation\n"
+                           "for p in (riskrf, simulation):\n    [getattr(p, n) for n in p.__all__]")
+    print(f"\nimport riskrf.cli (lazy public names): {lazy:.2f} s; with every public name imported (eager): "
+          f"{eager:.2f} s (best of 5, interpreter start-up included)")
+
+
+if __name__ == "__main__":
+    main()
