@@ -53,6 +53,7 @@ import numpy as np
 import pandas as pd
 from scipy import optimize, stats
 
+from ._display import Displayed, short_repr
 from .scenario import Scenario, ScenarioError, scenario_from_dict
 
 #: Fewer observed stops than this give a warning: the calibration is weak.
@@ -329,8 +330,8 @@ def _objective(sim: dict, obs: dict, scales: dict, dist) -> float:
 
 
 # ---- result -----------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Calibration:
+@dataclass(frozen=True, repr=False)
+class Calibration(Displayed):
     """Fitted parameters, the calibrated scenario and the fit, before and after.
 
     ``parameters`` fitted values; ``bounds``; ``scenario`` the calibrated
@@ -397,6 +398,12 @@ class Calibration:
         rows[f"objective ({self.distance_name})"] = {"observed": 0.0, "before": self.distance_initial,
                                                       "after": self.distance}
         return pd.DataFrame(rows).T[["observed", "before", "after"]]
+
+    def __repr__(self) -> str:
+        return short_repr(self, repr(self.scenario.name), ", ".join(f"{k.rsplit('.', 1)[-1]}={v:.4g}"
+                                                                 for k, v in self.parameters.items()),
+                          distance=self.distance, distance_initial=self.distance_initial,
+                          n_observed=int(self.observed.size), n=self.n)
 
     def to_toml(self) -> str:
         """The calibrated scenario as TOML text (fitted values in place, a comment naming them)."""

@@ -19,6 +19,7 @@ from numba import njit
 from . import kernel3d
 from .engine import _material_arrays, check_masses
 from .scenario3d import TerrainScenario, _lipschitz, fall_line, sample_sources
+from ._display import Displayed
 from .units import J_PER_KJ, kinetic_energy_kj
 
 DEFAULT_CHUNK_3D = 20_000
@@ -339,7 +340,7 @@ def aggregate_passages(cell, block, e, h, ncell, qs_e, q_h):
 
 
 @dataclass(frozen=True)
-class TerrainResult:
+class TerrainResult(Displayed):
     """Everything a 3-D run produced.  Units: m, m/s, rad/s, kg, kJ, s; plan coordinates in the DEM's CRS."""
 
     scenario: object

@@ -7,29 +7,32 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._display import axes
+
 
 def _axes(ax, figsize=(8, 4.5)):
-    if ax is not None:
-        return ax
-    import matplotlib.pyplot as plt
-    return plt.figure(figsize=figsize).add_subplot()
+    return axes(ax, figsize)
 
 
 def plot_profile(result, ax=None, *, n_paths: int = 20, fences=()):
     """Slope profile coloured by material, collectors and barriers, and recorded trajectories.
+
+    ``result`` is a :class:`~simulation.SimulationResult` or a :class:`~simulation.Scenario` (then no
+    trajectories are drawn).
 
     ``fences``: (x [m], height [m], label) of fences to draw at their height (e.g. a study's fence options
     at the barrier line), each a vertical bar from the ground to ground + height.  The legend stands
     outside the axes, so it hides no part of the slope or a label.
     """
     ax = _axes(ax)
-    sc = result.scenario
+    sc = getattr(result, "scenario", result)
+    paths = getattr(result, "paths", None)
     prof = sc.profile
     for i, name in enumerate(prof.material_names):
         segs = np.flatnonzero(prof.material_index == i)
         for j, s in enumerate(segs):
             ax.plot(prof.x[s:s + 2], prof.z[s:s + 2], color=f"C{i}", lw=3, label=name if j == 0 else None)
-    blocks = np.unique(result.paths["block"])[:n_paths] if result.paths is not None else []
+    blocks = np.unique(paths["block"])[:n_paths] if paths is not None else []
     for b in blocks:
         p = result.path(int(b))
         ax.plot(p["x_m"], p["z_m"], color="0.4", lw=0.6, alpha=0.7)
@@ -55,7 +58,7 @@ def plot_profile(result, ax=None, *, n_paths: int = 20, fences=()):
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_ylim(zmin - 0.05 * (zmax - zmin + 1), None)
     ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
-    ax.set_title(f"{sc.name}: {len(blocks)} of {result.n:,} trajectories")
+    ax.set_title(sc.name if result is sc else f"{sc.name}: {len(blocks)} of {result.n:,} trajectories")
     return ax
 
 

@@ -31,6 +31,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ._display import Displayed, axes, short_repr
+
 
 def read_stl(path) -> np.ndarray:
     """Triangles ``(n, 3, 3)`` [m] of an ASCII or binary STL file (coordinates as stored)."""
@@ -115,8 +117,8 @@ class _TriangleLocator:
         return idx, bary
 
 
-@dataclass(frozen=True)
-class TerrainProfile:
+@dataclass(frozen=True, repr=False)
+class TerrainProfile(Displayed):
     """A vertical section of terrain along a plan polyline.
 
     ``distance_m`` (the profile's x, 0 at the polyline's first vertex unless
@@ -164,6 +166,39 @@ class TerrainProfile:
             cross = (d[i, 0] * r[:, 1] - d[i, 1] * r[:, 0]) / np.sqrt(L2[i])
             off_out = np.where(better, np.copysign(dist, cross), off_out)
         return pd.DataFrame({"distance_m": s_out, "offset_m": off_out})
+
+    def __repr__(self) -> str:
+        x, z = self.distance_m, self.elevation_m
+        return short_repr(self, f"{x.size} vertices", f"{x[0]:.4g}-{x[-1]:.4g} m", f"z {z.min():.5g}-{z.max():.5g} m",
+                          materials=None if self.materials is None else len(set(self.materials)))
+
+    def plot(self, ax=None):
+        """The section: elevation against distance along the polyline, coloured by material when labelled.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: distance along the polyline [m]; z: elevation [m], equal scales.
+        """
+        ax = axes(ax)
+        x, z = self.distance_m, self.elevation_m
+        if self.materials is None:
+            ax.plot(x, z, color="0.3")
+        else:
+            names = list(dict.fromkeys(self.materials))
+            for s, m in enumerate(self.materials):
+                k = names.index(m)
+                ax.plot(x[s:s + 2], z[s:s + 2], color=f"C{k}", lw=2, label=m if s == self.materials.index(m) else None)
+            ax.legend(fontsize="small")
+        ax.set_xlabel("distance along the section [m]")
+        ax.set_ylabel("elevation [m]")
+        ax.set_aspect("equal", adjustable="datalim")
+        return ax
 
     def to_dict(self, decimals: int = 3) -> dict:
         """The scenario ``[profile]`` table: ``x``, ``z`` [m] and ``materials`` (when labelled)."""

@@ -8,6 +8,7 @@ import pandas as pd
 from scipy import stats
 
 from .kernel import EVENTS, MODE_FLIGHT, OUTCOMES, STOP_REASONS
+from ._display import Displayed, short_repr
 from .units import J_PER_KJ, kinetic_energy_kj
 
 
@@ -27,8 +28,8 @@ def _three_figures(v: float) -> str:
     """Three significant figures without exponent notation: 1,070 not 1.07e+03."""
     return f"{v:,.0f}" if abs(v) >= 100 else f"{v:.3g}"
 
-@dataclass(frozen=True)
-class SimulationResult:
+@dataclass(frozen=True, repr=False)
+class SimulationResult(Displayed):
     """Everything a run produced.  Units: m, m/s, rad/s, kg, kJ, s."""
 
     scenario: object
@@ -185,6 +186,27 @@ class SimulationResult:
         return pd.DataFrame({"x_m": np.concatenate(xs), "z_m": np.concatenate(zs)})
 
     # ---- summary -------------------------------------------------------------------
+    def __repr__(self) -> str:
+        return short_repr(self, repr(self.scenario.name), n=self.n, seed=self.seed, elapsed_s=self.elapsed_s)
+
+    def plot(self, ax=None, *, n_paths: int = 20):
+        """The slope profile with up to ``n_paths`` recorded trajectories, the collectors and the release zone.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+        n_paths : int
+            Most trajectories drawn (those recorded with ``record_paths``).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: horizontal distance [m]; z: elevation [m] (:func:`simulation.plotting.plot_profile`).
+        """
+        from .plotting import plot_profile
+        return plot_profile(self, ax, n_paths=n_paths)
+
     def summary(self) -> pd.DataFrame:
         """Run facts and, per collector, reach probability and speed/height/energy percentiles."""
         rows = {"blocks": self.n, "seed": self.seed, "impacts": self.n_impacts,

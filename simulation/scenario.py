@@ -17,6 +17,7 @@ from scipy import stats
 from .materials import PresetError, resolve_material
 from .contact import CRSP_VELOCITY_SCALE_MS, EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_COULOMB, ET_FRICTION
 from .slope import Profile
+from ._display import Displayed, short_repr
 from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2, block_radius
 
 
@@ -348,8 +349,8 @@ class Settings:
     max_rolling_slope_deg: float = 90.0
 
 
-@dataclass(frozen=True)
-class Scenario:
+@dataclass(frozen=True, repr=False)
+class Scenario(Displayed):
     """A checked trajectory scenario (docs: File formats, "Scenario files"): slope ``profile``, ``materials``, the block
     ``seeder``, ``collectors`` (lines where crossings are recorded; barriers among them), numerical
     ``settings``, and the ``source`` file named in errors.  Run it with :func:`simulation.run`.
@@ -362,6 +363,46 @@ class Scenario:
     collectors: tuple
     settings: Settings
     source: str = "<dict>"
+
+    def __repr__(self) -> str:
+        p = self.profile
+        return short_repr(self, repr(self.name), f"profile {p.x[0]:.4g}-{p.x[-1]:.4g} m, {p.n_segments} segments",
+                          f"{len(self.materials)} materials", "collectors " + ", ".join(c.name for c in self.collectors))
+
+    def summary(self) -> pd.DataFrame:
+        """The scenario at a glance (one-column table): source, profile extent [m], materials, release zone [m],
+        collectors (barriers with capacity [kJ] and height [m]).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: quantity; column ``value``.
+        """
+        import pandas as pd
+        p, sd = self.profile, self.seeder
+        rows = {"source": self.source, "profile x [m]": f"{p.x[0]:.4g} to {p.x[-1]:.4g}",
+                "profile z [m]": f"{p.z.min():.4g} to {p.z.max():.4g}", "segments": p.n_segments,
+                "materials": ", ".join(p.material_names), "release x [m]": f"{sd.x_low:.4g} to {sd.x_high:.4g}"}
+        for c in self.collectors:
+            rows[f"collector {c.name} x [m]"] = (f"{c.x:.4g}; barrier {c.capacity_kj:g} kJ, {c.height_m:g} m high"
+                                                 if c.is_barrier else f"{c.x:.4g}")
+        return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
+
+    def plot(self, ax=None):
+        """The slope profile coloured by material, with the release zone and the collectors.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: horizontal distance [m]; z: elevation [m], equal scales (:func:`simulation.plotting.plot_profile`).
+        """
+        from .plotting import plot_profile
+        return plot_profile(self, ax)
 
     def collector_index(self, name: str) -> int:
         """Index of the collector named ``name``; a KeyError listing the collectors when there is none."""

@@ -56,6 +56,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._display import Displayed, short_repr
 from .scenario import Distribution, Material, ScenarioError, Settings, _check_keys, _number
 from .terrain import MaterialGrid, Terrain, TerrainError, read_dem, read_material_raster
 from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2, block_radius
@@ -127,8 +128,8 @@ class PlanCollector:
         return float(np.sum(np.hypot(*np.diff(self.line, axis=0).T)))
 
 
-@dataclass(frozen=True)
-class TerrainScenario:
+@dataclass(frozen=True, repr=False)
+class TerrainScenario(Displayed):
     """A checked 3-D scenario: ``terrain`` (DEM), ``materials``, ``material_grid`` (material per cell),
     ``sources``, plan ``collectors`` and ``settings``; run it with :func:`simulation.run_terrain`."""
 
@@ -141,6 +142,31 @@ class TerrainScenario:
     collectors: tuple
     settings: Settings
     source: str = "<dict>"
+
+    def __repr__(self) -> str:
+        ny, nx = self.terrain.z.shape
+        return short_repr(self, repr(self.name), f"terrain {ny} x {nx} cells of {self.terrain.dx:g} m",
+                          f"{len(self.materials)} materials",
+                          "collectors " + (", ".join(c.name for c in self.collectors) or "none"))
+
+    def summary(self):
+        """The scenario at a glance (one-column table): source, terrain, materials, release and collectors
+        (plan length [m]).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: quantity; column ``value``.
+        """
+        import pandas as pd
+        src = self.sources
+        rows = {"source": self.source, "terrain": repr(self.terrain),
+                "materials": ", ".join(m.name for m in self.materials),
+                "release": (f"{len(src.points)} points" if src.points is not None else
+                            f"polygon of {len(src.polygon)} vertices")}
+        for c in self.collectors:
+            rows[f"collector {c.name} length [m]"] = round(c.length_m, 2)
+        return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
     def collector_index(self, name: str) -> int:
         """Index of collector ``name``; a KeyError listing the collectors when there is none."""

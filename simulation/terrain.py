@@ -24,13 +24,15 @@ from pathlib import Path
 
 import numpy as np
 
+from ._display import Displayed, axes, short_repr
+
 
 class TerrainError(ValueError):
     """A DEM, material raster, source or path on the terrain is unusable; the message names file and value."""
 
 
-@dataclass(frozen=True)
-class Terrain:
+@dataclass(frozen=True, repr=False)
+class Terrain(Displayed):
     """Elevations [m] on a regular grid with georeferencing.
 
     Attributes
@@ -64,6 +66,54 @@ class Terrain:
     south_up: bool = False
     nodata: float | None = None
     source: str = "<array>"
+
+    def __repr__(self) -> str:
+        ny, nx = self.z.shape
+        x0, y0, x1, y1 = self.bounds
+        return short_repr(self, repr(Path(str(self.source)).name), f"{ny} x {nx} cells of {self.dx:g} x {self.dy:g} m",
+                          f"x {x0:.6g}-{x1:.6g}, y {y0:.6g}-{y1:.6g} m", crs=str(self.crs) if self.crs else None)
+
+    def summary(self):
+        """The grid at a glance (one-column table): source, CRS, shape, cell size [m], extent [m], elevation
+        range [m], nodata cells and mean slope [deg].
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: quantity; column ``value``.
+        """
+        import pandas as pd
+        x0, y0, x1, y1 = self.bounds
+        z = self.z
+        rows = {"source": self.source, "crs": str(self.crs) if self.crs else "none (synthetic)",
+                "cells (rows x columns)": f"{z.shape[0]} x {z.shape[1]}", "cell size [m]": f"{self.dx:g} x {self.dy:g}",
+                "x extent of cell centres [m]": f"{x0:.6g} to {x1:.6g}",
+                "y extent of cell centres [m]": f"{y0:.6g} to {y1:.6g}",
+                "elevation [m]": f"{np.nanmin(z):.5g} to {np.nanmax(z):.5g}",
+                "nodata cells": int(np.isnan(z).sum()), "mean slope [deg]": round(float(np.nanmean(self.slope_deg())), 2)}
+        return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
+
+    def plot(self, ax=None):
+        """Plan view: the hillshade of the terrain (:meth:`hillshade`).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x, y: plan coordinates [m, the CRS's units], equal scales.
+        """
+        ax = axes(ax, figsize=(7.0, 6.0))
+        x0, y0, x1, y1 = self.bounds
+        ax.imshow(self.hillshade(), origin="lower", cmap="gray", vmin=0, vmax=1,
+                  extent=(x0 - self.dx / 2, x1 + self.dx / 2, y0 - self.dy / 2, y1 + self.dy / 2))
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_aspect("equal")
+        return ax
 
     # ---- construction -------------------------------------------------------------------------------
     @classmethod

@@ -77,7 +77,7 @@ def test_frequency_methods_are_consistent():
     np.testing.assert_allclose(fit.annual_max_cdf(fit.annual_max_return_level(T)), 1 - 1 / T)
     p = fit.probability_in(30, mT[1])
     assert p == pytest.approx(1 - np.exp(-30 / 50))
-    lo, hi = fit.mass_at_return_period_ci(T)
+    lo, hi = fit.return_level_ci(T)
     assert np.all(lo < mT) and np.all(mT < hi)
     with pytest.raises(ValueError, match="below m_min"):
         fit.annual_frequency(50)

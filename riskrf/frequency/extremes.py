@@ -33,6 +33,8 @@ import numpy as np
 import pandas as pd
 from scipy import optimize, stats
 
+from simulation._display import Displayed, axes, short_repr
+
 from ..core.validation import (
     check_choice,
     check_probability_level,
@@ -128,8 +130,8 @@ def _n_unknown_years(maxima) -> int:
     return len(getattr(maxima, "attrs", {}).get("years_without_exact_size", ()))
 
 
-@dataclass(frozen=True)
-class _AnnualMaximumFit:
+@dataclass(frozen=True, repr=False)
+class _AnnualMaximumFit(Displayed):
     """Shared behaviour of the Gumbel and GEV fits (mixed model with empty years)."""
 
     p_zero: float
@@ -174,8 +176,51 @@ class _AnnualMaximumFit:
         return self._isf_params(params, q)
 
     def return_level(self, T):
-        """Annual maximum exceeded on average once in T years."""
+        """Annual maximum exceeded on average once in T years.
+
+        Parameters
+        ----------
+        T : float or array_like
+            Return period [yr], > 1/(1 - p_zero).
+
+        Returns
+        -------
+        numpy.ndarray
+            The annual maximum with annual exceedance probability 1/T [unit of the maxima, e.g. kg].
+        """
         return self.isf(1.0 / check_return_periods(T))
+
+    def __repr__(self) -> str:
+        return short_repr(self, **dict(zip(self.param_names, self.params)), n_maxima=int(np.size(self.data)),
+                          n_years=self.n_years, p_zero=self.p_zero, method=self.method)
+
+    def plot(self, ax=None, formula: str = "gringorten"):
+        """Return-level plot: the annual maxima at their plotting positions and the fitted return level.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+        formula : str
+            Plotting-position formula of the maxima (see :func:`plotting_positions`).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: return period T [yr], log scale; y: annual maximum [unit of the maxima].
+        """
+        ax = axes(ax)
+        x = np.sort(np.asarray(self.data, dtype=float))
+        # plotting positions over all years (years without a fall at the bottom), the largest maxima at the top
+        p = plotting_positions(self.n_years, formula)[self.n_years - x.size:]
+        ax.semilogx(1.0 / (1.0 - p), x, "o", ms=4, color="0.3", label=f"annual maxima ({x.size} of {self.n_years} yr)")
+        lo = max(1.05 / (1 - self.p_zero), 1.01)
+        T = np.geomspace(lo, max(1000.0, 2 * self.n_years), 200)
+        ax.semilogx(T, self.return_level(T), color="C3", label=f"{type(self).__name__} ({self.method})")
+        ax.set_xlabel("return period T [yr]")
+        ax.set_ylabel("annual maximum")
+        ax.legend(fontsize="small")
+        return ax
 
     def return_period(self, x):
         """Return period [yr] of an annual maximum x, 1 / P(annual max > x)."""
@@ -351,7 +396,7 @@ def _gumbel_lmoments(x):
     return b0 - EULER_GAMMA * scale, scale
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class GumbelFit(_AnnualMaximumFit):
     """Gumbel fit of annual maxima.  ``loc`` = alpha, ``scale`` = beta (scipy ``gumbel_r``)."""
 
@@ -422,7 +467,7 @@ class GumbelFit(_AnnualMaximumFit):
         return pd.DataFrame(rows, columns=["parameter", "value", "stderr", "note"]).set_index("parameter")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class GEVFit(_AnnualMaximumFit):
     """GEV fit of annual maxima; ``shape`` is xi in Coles' sign (scipy's c = -xi)."""
 

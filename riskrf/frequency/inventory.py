@@ -39,6 +39,7 @@ from ..io.tables import is_blank, parse_dates, parse_numbers, read_table, sniff_
 from ..core.format import sig
 from ..core.units import DEFAULT_DENSITY_KG_M3, KG_PER_TONNE
 from ..core.validation import check_density, check_positive, warn
+from simulation._display import Displayed, axes, short_repr
 
 #: Rock density used when none is given [kg/m³] (a typical value for granite
 #: and limestone; Wyllie 2014 uses 2.6-2.7 t/m³).
@@ -93,8 +94,8 @@ def _find_column(columns, roots: set, units: dict | None = None):
     return None, None
 
 
-@dataclass(frozen=True)
-class Inventory:
+@dataclass(frozen=True, repr=False)
+class Inventory(Displayed):
     """A validated rock fall inventory.
 
     Attributes
@@ -337,6 +338,34 @@ class Inventory:
             "censored or no size (not in the size fits)": self.n_censored,
         }
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
+
+    def __repr__(self) -> str:
+        m = self.masses
+        return short_repr(self, repr(Path(str(self.source)).name), f"{self.n_events} events",
+                          f"{self.duration_years:.4g} yr", f"mass {sig(m.min())}-{sig(m.max())} kg" if m.size else "")
+
+    def plot(self, ax=None):
+        """Empirical magnitude-frequency curve: falls of at least m per year against m, log-log.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: mass m [kg]; y: N(>=m), the number of recorded falls of at least m divided by the record's
+            length [1/yr].
+        """
+        ax = axes(ax)
+        m = np.sort(self.masses)[::-1]
+        ax.loglog(m, np.arange(1, m.size + 1) / self.duration_years, ".", ms=4, color="0.3",
+                  label=f"{Path(str(self.source)).name} ({m.size} falls, {self.duration_years:.3g} yr)")
+        ax.set_xlabel("mass m [kg]")
+        ax.set_ylabel("falls of at least m per year N(>=m) [1/yr]")
+        ax.legend(fontsize="small")
+        return ax
 
 
 #: What an inventory's sizes can be: detached event volumes (laser scanning, registers) or individual block sizes.

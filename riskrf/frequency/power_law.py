@@ -32,6 +32,8 @@ import numpy as np
 import pandas as pd
 from scipy import optimize, stats
 
+from simulation._display import Displayed, axes, short_repr
+
 from ..core.validation import (
     as_positive_array,
     check_choice,
@@ -230,8 +232,8 @@ def _mle_truncated_b(x, m_min, m_max):
     return b, float(1.0 / np.sqrt(info)) if info > 0 else np.nan
 
 
-@dataclass(frozen=True)
-class PowerLawBootstrap:
+@dataclass(frozen=True, repr=False)
+class PowerLawBootstrap(Displayed):
     """Result of :meth:`GutenbergRichterFit.bootstrap_test` (Clauset et al. 2009, §4.1).
 
     ``p_value`` is the share of the ``n_completed`` replicates (of ``n_requested``)
@@ -266,9 +268,12 @@ class PowerLawBootstrap:
                  f"(samples above {LARGE_SAMPLE:,} values)")]
         return pd.DataFrame(rows, columns=["quantity", "value", "note"]).set_index("quantity")
 
+    def __repr__(self) -> str:
+        return short_repr(self, p_value=self.p_value, n_completed=self.n_completed, ks_distance=self.ks_distance)
 
-@dataclass(frozen=True)
-class GutenbergRichterFit:
+
+@dataclass(frozen=True, repr=False)
+class GutenbergRichterFit(Displayed):
     """A fitted (optionally truncated) power law of annual cumulative frequency.
 
     ``log10 N(>=m) = a - b log10 m`` [N per year] for ``m_min <= m`` (``<= m_max``).
@@ -415,12 +420,64 @@ class GutenbergRichterFit:
             raise ValueError(f"T = {T.ravel()[0]!r}: the annual-maximum level lies below m_min; use a longer T")
         return _truncated_isf(p, self.b, self.m_min, self.m_max)
 
+    def return_level(self, T):
+        """Mass exceeded on average once in T years [units]: the same as :meth:`mass_at_return_period`, under
+        the name the annual-maximum fits use (:meth:`riskrf.GumbelFit.return_level`).
+
+        Parameters
+        ----------
+        T : float or array_like
+            Return period [yr], at least the return period of m_min (``1 / rate_min``).
+
+        Returns
+        -------
+        numpy.ndarray
+            Mass m with N(>=m) = 1/T [kg, or m³ for a fit to volumes].
+        """
+        return self.mass_at_return_period(T)
+
     def mass_at_return_period_ci(self, T, level: float = 0.95):
-        """Delta-method interval of :meth:`mass_at_return_period` on the log scale.
+        """Deprecated name of :meth:`return_level_ci` (the name the annual-maximum fits use).
+
+        Parameters
+        ----------
+        T : float or array_like
+            Return period [yr].
+        level : float
+            Confidence level, in (0, 1).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (lower, upper) [units].
+        """
+        import warnings
+        warnings.warn("GutenbergRichterFit.mass_at_return_period_ci is deprecated; use return_level_ci (the name "
+                      "GumbelFit and GEVFit use)", DeprecationWarning, stacklevel=2)
+        return self.return_level_ci(T, level)
+
+    def return_level_ci(self, T, level: float = 0.95):
+        """Delta-method interval of :meth:`mass_at_return_period` (:meth:`return_level`) on the log scale.
 
         Carries the uncertainty of b (``b_stderr``) and of the Poisson rate of
         falls above m_min (var ln rate = 1/n_tail), taken as independent.
-        Returns (lower, upper) arrays.
+
+        Parameters
+        ----------
+        T : float or array_like
+            Return period [yr], at least the return period of m_min.
+        level : float
+            Confidence level, in (0, 1); default 0.95.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (lower, upper) bounds of the mass [units] exceeded once in T years.
+
+        References
+        ----------
+        Coles, S. (2001). An Introduction to Statistical Modeling of Extreme Values. Springer, London, §3.3.3
+        (return-level intervals by the delta method).
         """
         level = check_probability_level(level)
         T = np.asarray(T, dtype=float)
@@ -659,6 +716,39 @@ class GutenbergRichterFit:
         ]
         return pd.DataFrame(rows, columns=["parameter", "value", "stderr", "ci_low", "ci_high", "note"]
                             ).set_index("parameter")
+
+    def __repr__(self) -> str:
+        return short_repr(self, a=self.a, b=self.b, b_stderr=self.b_stderr, m_min=self.m_min, m_max=self.m_max,
+                          n_tail=self.n_tail, duration_years=self.duration_years, method=self.method,
+                          units=self.units)
+
+    def plot(self, ax=None):
+        """Magnitude-frequency plot: the fitted N(>=m) and, when the fit keeps its data, the recorded falls.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: size m [units]; y: falls of at least m per year N(>=m) [1/yr], log-log.
+        """
+        ax = axes(ax)
+        top = self.m_max if self.m_max is not None else self.m_min * 1e3
+        if self.data is not None and np.size(self.data):
+            d = np.sort(np.asarray(self.data, dtype=float))[::-1]
+            ax.loglog(d, np.arange(1, d.size + 1) / self.duration_years, ".", ms=4, color="0.3",
+                      label=f"recorded ({d.size} values)")
+            top = max(d[0], self.m_min * 1.01) if self.m_max is None else top
+        m = np.geomspace(self.m_min, top * (0.999 if self.m_max is not None else 1.0), 200)
+        ax.loglog(m, self.annual_frequency(m), color="C3",
+                  label=f"fit: log10 N = {self.a:.3g} - {self.b:.3g} log10 m (m >= {self.m_min:.3g})")
+        ax.set_xlabel(f"size m [{self.units}]")
+        ax.set_ylabel("falls of at least m per year N(>=m) [1/yr]")
+        ax.legend(fontsize="small")
+        return ax
 
 
 def _ks_distance(x_sorted, F, statistic="sup"):

@@ -42,6 +42,7 @@ from scipy import stats
 from .inventory import Inventory
 from ..io.rainfall import Rainfall, read_rainfall
 from ..core.validation import RiskrfWarning, warn
+from simulation._display import Displayed, axes, short_repr
 
 #: Fewest periods a count model is fitted to.
 MIN_PERIODS = 20
@@ -62,8 +63,8 @@ def _band_name(lo: int, hi: int) -> tuple[str, str]:
     return f"rain_d{lo}_{hi}_mm", f"rainfall {lo}-{hi} days before"
 
 
-@dataclass(frozen=True)
-class RateModel:
+@dataclass(frozen=True, repr=False)
+class RateModel(Displayed):
     """Poisson and negative-binomial regressions of event counts (see :func:`rate_model`).
 
     Attributes
@@ -284,6 +285,36 @@ class RateModel:
         return float(np.sum(weights * mu) / (np.sum(weights * d["exposure_days"].to_numpy(float)) / 365.25))
 
     # --- text and files ---------------------------------------------------
+    def __repr__(self) -> str:
+        return short_repr(self, f"{self.n_events} events in {self.n_periods} {self.period} periods",
+                          preferred=self.preferred)
+
+    def plot(self, ax=None):
+        """Events per year: recorded, and expected by the preferred model.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: year; y: events per calendar year (recorded bars, the preferred model's expected count as a line).
+        """
+        ax = axes(ax)
+        year = pd.to_datetime(self.design["period_start"]).dt.year.to_numpy()
+        observed = pd.Series(self.design["count"].to_numpy(), index=year).groupby(level=0).sum()
+        ax.bar(observed.index, observed.to_numpy(), color="0.75", label="recorded")
+        fit = self.fitted()
+        if fit is not None and len(fit):
+            expected = pd.Series(np.asarray(fit, dtype=float), index=year).groupby(level=0).sum()
+            ax.plot(expected.index, expected.to_numpy(), "o-", ms=3, color="C3", label=f"expected ({self.preferred})")
+        ax.set_xlabel("year")
+        ax.set_ylabel("events per year")
+        ax.legend(fontsize="small")
+        return ax
+
     def summary_text(self) -> str:
         """A readable report (what ``riskrf rates`` prints)."""
         lines = [f"Rate model: events per {self.period}, {self.start.date()} to {self.end.date()} "

@@ -25,11 +25,12 @@ from .power_law import (
 from ..core.format import sig
 from ..core.units import DESIGN_RETURN_PERIODS  # noqa: F401  (also importable from here, as before)
 from ..core.validation import RiskrfWarning
+from simulation._display import Displayed, axes, short_repr
 
 
 
-@dataclass(frozen=True)
-class FrequencyAnalysis:
+@dataclass(frozen=True, repr=False)
+class FrequencyAnalysis(Displayed):
     """Every magnitude-frequency model fitted to one inventory.
 
     The fits, the comparison table and the bootstrap are computed when the object is built
@@ -82,7 +83,7 @@ class FrequencyAnalysis:
         valid = T * gr.rate_min >= 1
         if valid.any():
             Tv = T[valid]
-            lo, hi = gr.mass_at_return_period_ci(Tv, level)
+            lo, hi = gr.return_level_ci(Tv, level)
             fill = np.full(T.size, np.nan)
             vals, los, his = fill.copy(), fill.copy(), fill.copy()
             vals[valid], los[valid], his[valid] = gr.mass_at_return_period(Tv), lo, hi
@@ -183,6 +184,54 @@ class FrequencyAnalysis:
         if self.deviance is not None:
             out["gumbel_vs_gev"] = self.deviance
         return out
+
+    def __repr__(self) -> str:
+        gr = self.power_law
+        fitted = ["power law"] + [n for n, f in (("Gumbel", self.gumbel), ("GEV", self.gev)) if f is not None]
+        return short_repr(self, repr(Path(str(self.inventory.source)).name), "+".join(fitted), b=gr.b,
+                          m_min=gr.m_min, bootstrap_p=self.bootstrap_p)
+
+    def summary(self) -> pd.DataFrame:
+        """One row per fitted model: its parameters, log-likelihood and how well it fits.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by model (``power law``, ``power law (least squares)``, ``Gumbel``, ``GEV``), columns
+            ``parameters`` (text, masses in kg), ``n`` (values fitted), ``loglik`` (NaN where not defined) and
+            ``note`` (KS distance and bootstrap p-value of the power law; the method of the others).
+        """
+        gr = self.power_law
+        rows = [("power law", f"a = {gr.a:.4g}, b = {gr.b:.4g} ± {gr.b_stderr:.3g}, m_min = {gr.m_min:.4g} kg",
+                 gr.n_tail, np.nan, f"KS distance {gr.ks_distance:.4f}" + (
+                     f"; bootstrap p = {self.bootstrap_p:.3f} ({self.n_bootstrap} replicates)"
+                     if self.bootstrap_p is not None else ""))]
+        if self.power_law_lsq is not None:
+            lsq = self.power_law_lsq
+            rows.append(("power law (least squares)", f"a = {lsq.a:.4g}, b = {lsq.b:.4g} ± {lsq.b_stderr:.3g}",
+                         lsq.n_tail, np.nan, "practitioners' method, for comparison"))
+        for name, fit in (("Gumbel", self.gumbel), ("GEV", self.gev)):
+            if fit is not None:
+                rows.append((name, ", ".join(f"{p} = {v:.4g}" for p, v in zip(fit.param_names, fit.params)),
+                             int(fit.data.size), fit.loglik, f"{fit.method}; p_zero = {fit.p_zero:.3f}"))
+        for name, why in self.skipped.items():
+            rows.append((name, "", 0, np.nan, f"not fitted: {why}"))
+        return pd.DataFrame(rows, columns=["model", "parameters", "n", "loglik", "note"]).set_index("model")
+
+    def plot(self, ax=None):
+        """The power law over the inventory's magnitude-frequency curve (:meth:`GutenbergRichterFit.plot`).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: mass m [kg]; y: falls of at least m per year [1/yr], log-log.
+        """
+        return self.power_law.plot(axes(ax))
 
     def summary_text(self) -> str:
         """A readable report of the fits (what ``riskrf fit`` prints)."""

@@ -28,6 +28,7 @@ from ..frequency.power_law import GutenbergRichterFit
 from ..core.format import sig
 from ..core.units import DESIGN_RETURN_PERIODS, SPHERE_INERTIA
 from ..core.validation import check_positive, check_probability_level, check_return_periods
+from simulation._display import Displayed, axes, short_repr
 
 
 def inertia_factors(df) -> np.ndarray:
@@ -38,8 +39,8 @@ def inertia_factors(df) -> np.ndarray:
 _E_GRID = np.geomspace(1e-3, 1e12, 301)     # kJ: the grid on which hazard curves are inverted
 
 
-@dataclass(frozen=True)
-class EnergyHazard:
+@dataclass(frozen=True, repr=False)
+class EnergyHazard(Displayed):
     """Impact-energy hazard at one barrier line.
 
     Attributes
@@ -305,6 +306,39 @@ class EnergyHazard:
             for q in (95, 99):
                 rows[f"bounce height p{q} [m]"] = float(self.height_percentile(q))
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
+
+    def __repr__(self) -> str:
+        return short_repr(self, repr(self.collector) if self.collector else "",
+                          f"{type(self.mass).__name__} x {type(self.velocity).__name__}",
+                          rate_per_year=self.rate_per_year, reach_probability=self.reach_probability,
+                          mass_coupled=self.mass_coupled)
+
+    def plot(self, ax=None):
+        """Annual frequency of impacts above an energy at the line, against the energy, log-log.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: impact energy e [kJ]; y: impacts above e per year [1/yr] (:meth:`annual_frequency`), with the
+            10-, 100- and 1000-year levels marked.
+        """
+        ax = axes(ax)
+        lo, hi = self.energy_percentile([1.0, 99.99])
+        e = np.geomspace(max(float(lo), 1e-6), float(hi), 200)
+        ax.loglog(e, self.annual_frequency(e), color="C0", label=f"{self.collector or 'line'}: "
+                                                                  f"{sig(self.arrival_rate)} arrivals per year")
+        for T in (10, 100, 1000):
+            ax.axhline(1.0 / T, color="0.7", lw=0.8, ls=":")
+            ax.text(e[0], 1.0 / T, f" {T} yr", va="bottom", fontsize="x-small", color="0.4")
+        ax.set_xlabel("impact energy e [kJ]")
+        ax.set_ylabel("impacts above e per year [1/yr]")
+        ax.legend(fontsize="small")
+        return ax
 
 
 def _interp_log_inverse(curve, p):

@@ -36,6 +36,7 @@ import pandas as pd
 from ..core.validation import RiskrfError
 from ..core.format import sig
 from ..core.units import J_PER_KJ, kinetic_energy_kj
+from simulation._display import Displayed, axes, short_repr
 
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
 #: Return period [yr] of the largest fall at the source that the default simulated range must include
@@ -48,8 +49,8 @@ class NoArrivalsError(RiskrfError, ValueError):
     section takes it as such; elsewhere it is an error naming the collector)."""
 
 
-@dataclass(frozen=True, eq=False)
-class MassCoupledSamples:
+@dataclass(frozen=True, eq=False, repr=False)
+class MassCoupledSamples(Displayed):
     """Simulated blocks across a mass range: each block's mass and what it did at one line.
 
     Attributes
@@ -307,6 +308,46 @@ class MassCoupledSamples:
                          "velocity_p95_ms": float(np.percentile(s, 95)) if s.size else np.nan,
                          "height_p95_m": float(np.percentile(h, 95)) if h.size else np.nan})
         return pd.DataFrame(rows)
+
+    def summary(self) -> pd.DataFrame:
+        """Per mass class: what the blocks of that class did at the line (the :meth:`class_table`).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per mass class: ``mass_low_kg``, ``mass_high_kg`` [kg], ``released``, ``reached``,
+            ``reach_probability``, ``velocity_p50_ms``, ``velocity_p95_ms`` [m/s], ``height_p95_m`` [m].
+        """
+        return self.class_table()
+
+    def __repr__(self) -> str:
+        return short_repr(self, repr(self.collector) if self.collector else "",
+                          f"{self.mass_kg.size} blocks, {int(self.reached.sum())} reached",
+                          f"{sig(self.edges_kg[0])}-{sig(self.edges_kg[-1])} kg in {self.n_bins} classes")
+
+    def plot(self, ax=None):
+        """Reach probability and median speed at the line by mass class.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None); the speed is drawn on a twin y axis.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: block mass [kg], log scale; left y: P(reach the line); right y (twin): median speed [m/s].
+        """
+        ax = axes(ax)
+        t = self.class_table()
+        mid = np.sqrt(t["mass_low_kg"] * t["mass_high_kg"])
+        ax.semilogx(mid, t["reach_probability"], "o-", color="C0", label="P(reach)")
+        ax.set_xlabel("block mass [kg]")
+        ax.set_ylabel("P(reach the line)", color="C0")
+        twin = ax.twinx()
+        twin.semilogx(mid, t["velocity_p50_ms"], "s--", color="C3")
+        twin.set_ylabel("median speed at the line [m/s]", color="C3")
+        return ax
 
     @property
     def description(self) -> str:

@@ -30,10 +30,11 @@ import pandas as pd
 
 from .tables import sniff_delimiter  # noqa: F401 (re-exported: public before)
 from ..core.validation import warn
+from simulation._display import Displayed, axes, short_repr
 
 
-@dataclass(frozen=True)
-class Rainfall:
+@dataclass(frozen=True, repr=False)
+class Rainfall(Displayed):
     """A daily rainfall record on a complete calendar (missing days are NaN, never filled).
 
     Attributes
@@ -93,6 +94,31 @@ class Rainfall:
             "wettest day [mm]": f"{d.max():.1f} on {d.idxmax().date()}",
         }
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
+
+    def __repr__(self) -> str:
+        return short_repr(self, repr(Path(str(self.source)).name),
+                          f"{self.first_day.date()} to {self.last_day.date()}", f"{len(self.daily)} days",
+                          f"{int(self.daily.isna().sum())} missing")
+
+    def plot(self, ax=None):
+        """Daily rainfall against date (missing days left blank).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: date; y: daily rainfall [mm].
+        """
+        ax = axes(ax, figsize=(9.0, 3.5))
+        ax.plot(self.daily.index, self.daily.to_numpy(), lw=0.5, color="C0")
+        ax.set_xlabel("date")
+        ax.set_ylabel("daily rainfall [mm]")
+        ax.set_title(Path(str(self.source)).name, fontsize="small")
+        return ax
 
     def _row_label(self, day) -> str:
         r = int(self.rows.get(day, 0))

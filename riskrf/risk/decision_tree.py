@@ -38,6 +38,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.validation import RiskrfError
+from simulation._display import Displayed, axes, short_repr
 
 PROBABILITY_TOLERANCE = 1e-6
 
@@ -127,7 +128,7 @@ class Rollback:
     node_values: dict = field(default_factory=dict)   # node path -> rolled-back value (for diagrams)
 
 
-class DecisionTree:
+class DecisionTree(Displayed):
     """A decision tree with rollback, ranking, risk profiles, sensitivity and value of information."""
 
     def __init__(self, root: Node, objective: str = "min", parameters: dict | None = None, source: str = "<dict>"):
@@ -280,6 +281,47 @@ class DecisionTree:
         df["difference_from_best"] = (df["expected_value"] - best).abs()
         df["rank"] = np.arange(1, len(df) + 1)
         return df
+
+    def summary(self) -> pd.DataFrame:
+        """The options of the top decision ranked by expected value (:meth:`ranking` at the tree's parameters).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``option``, ``expected_value`` (net cost for ``objective="min"``, net payoff for ``"max"``,
+            in the tree's currency), ``difference_from_best`` and ``rank``, best first.
+        """
+        return self.ranking()
+
+    def __repr__(self) -> str:
+        n = 0
+        stack = [self.root]
+        while stack:
+            node = stack.pop()
+            n += 1
+            stack.extend(b.child for b in node.branches if b.child is not None)
+        return short_repr(self, repr(self.root.name), f"{n} nodes", objective=self.objective,
+                          source=self.source if self.source != "<dict>" else None)
+
+    def plot(self, ax=None):
+        """Expected value of each option of the top decision, best first, as horizontal bars.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            y: option; x: expected value (net cost or payoff, in the tree's currency).
+        """
+        ax = axes(ax)
+        r = self.ranking()
+        ax.barh(r["option"][::-1], r["expected_value"][::-1], color=["0.7"] * (len(r) - 1) + ["C2"])
+        ax.set_xlabel("expected net " + ("cost" if self.objective == "min" else "payoff"))
+        ax.set_title(f"{self.root.name}: best option {r['option'].iloc[0]!r}", fontsize="small")
+        return ax
 
     # ---- risk profiles ------------------------------------------------------------------
     def risk_profile(self, option: str | None = None) -> pd.DataFrame:
