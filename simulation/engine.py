@@ -37,7 +37,25 @@ def _material_arrays(scenario: Scenario):
 
 
 def check_masses(masses_kg, n=None) -> np.ndarray:
-    """Block masses [kg] given to :func:`run`: a 1-d array of finite values > 0 (n of them when n is given)."""
+    """Block masses [kg] given to :func:`run`: a 1-d array of finite values > 0 (n of them when n is given).
+
+    Parameters
+    ----------
+    masses_kg : array_like
+        Block masses [kg].
+    n : int, optional
+        The number of blocks they must number.
+
+    Returns
+    -------
+    numpy.ndarray
+        1-d float array [kg].
+
+    Raises
+    ------
+    ValueError
+        Naming the first bad mass and its position, or the count mismatch.
+    """
     m = np.asarray(masses_kg, dtype=float)
     if m.ndim != 1 or m.size == 0:
         raise ValueError(f"masses_kg must be a non-empty 1-d array of masses [kg]; got shape {m.shape}")
@@ -54,7 +72,25 @@ def seed_blocks(scenario: Scenario, n: int, seed, masses_kg=None) -> dict:
     """Initial state of n blocks: position [m], velocity [m/s], spin [rad/s], mass [kg], radius [m], I/(m r^2).
 
     With ``masses_kg`` the blocks get those masses and the seeder's mass distribution is not used (the other
-    quantities are drawn exactly as without it, from the same streams)."""
+    quantities are drawn exactly as without it, from the same streams).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Its seeder gives the release zone and the distributions.
+    n : int
+        Number of blocks.
+    seed : int, numpy.random.SeedSequence or None
+        Seed of the independent streams (one per quantity, :meth:`numpy.random.SeedSequence.spawn`).
+    masses_kg : array_like, optional
+        The mass of each block [kg].
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        ``x``, ``z`` [m], ``vx``, ``vz`` [m/s], ``w`` [rad/s], ``mass`` [kg], ``radius`` [m], ``inertia_factor`` [-],
+        one entry per block.
+    """
     sd = scenario.seeder
     ss = np.random.SeedSequence(seed)
     g_x, g_h, g_m, g_vx, g_vz, g_w = (np.random.default_rng(c) for c in ss.spawn(6))
@@ -113,6 +149,12 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
         Keep the full event sequence of the first ``record_paths`` blocks for plotting.
     progress : bool, optional
         Show a progress bar on standard error (default: when n >= 200,000 and stderr is a terminal).
+
+    Returns
+    -------
+    SimulationResult
+        Every block's stop, the collectors' crossings (velocity [m/s], height [m], energy [kJ]), envelopes and
+        the recorded paths.
     """
     if masses_kg is not None:
         masses_kg = check_masses(masses_kg, None if n is None else n)

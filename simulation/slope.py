@@ -31,7 +31,30 @@ class Profile:
 
     @classmethod
     def build(cls, x, z, material_index, material_names, source: str = "profile") -> "Profile":
-        """Profile from vertex coordinates [m] and per-segment material indices, checked (x strictly increasing)."""
+        """Profile from vertex coordinates [m] and per-segment material indices, checked (x strictly increasing).
+
+        Parameters
+        ----------
+        x, z : array_like
+            Vertex coordinates [m]: horizontal distance (strictly increasing) and elevation.
+        material_index : array_like of int
+            Material of each segment (one fewer than vertices), an index into ``material_names``.
+        material_names : sequence of str
+            Names of the materials.
+        source : str
+            Where the profile came from, named in errors.
+
+        Returns
+        -------
+        Profile
+            With the search tree (largest height of a vertex above each node's chord [m]) and the runs of
+            collinear same-material segments the kernel uses.
+
+        Raises
+        ------
+        ValueError
+            Naming ``source`` and the vertex or segment at fault (x not increasing, not finite, counts differ).
+        """
         x = np.asarray(x, dtype=float)
         z = np.asarray(z, dtype=float)
         mi = np.asarray(material_index, dtype=np.int64)
@@ -86,17 +109,49 @@ class Profile:
         return self.x.size - 1
 
     def ground(self, x) -> np.ndarray:
-        """Ground elevation at x [m] (linear between vertices)."""
+        """Ground elevation at x [m] (linear between vertices).
+
+        Parameters
+        ----------
+        x : float or array_like
+            Horizontal position(s) [m].
+
+        Returns
+        -------
+        numpy.ndarray or float
+            Elevation of the ground [m] (the end vertices' elevation beyond the profile).
+        """
         return np.interp(x, self.x, self.z)
 
     def segment_at(self, x) -> np.ndarray:
-        """Index of the segment below x (the left one at a vertex)."""
+        """Index of the segment below x (the left one at a vertex).
+
+        Parameters
+        ----------
+        x : float or array_like
+            Horizontal position(s) [m].
+
+        Returns
+        -------
+        numpy.ndarray or int
+            Segment index, clipped to 0 .. n_segments - 1.
+        """
         return np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, self.n_segments - 1)
 
     def downslope_direction(self, x):
         """(cos, sin) of the unit vector along the ground at x [m] pointing down the slope (+x on flat ground).
 
         The segment under x decides (the left one at a vertex).  Arrays in, arrays out.
+
+        Parameters
+        ----------
+        x : float or array_like
+            Horizontal position(s) [m].
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (cos, sin) components [-] of the downslope unit vector.
         """
         k = self.segment_at(np.asarray(x, dtype=float))
         dx, dz = self.x[k + 1] - self.x[k], self.z[k + 1] - self.z[k]
@@ -105,5 +160,15 @@ class Profile:
         return sign * dx / length, sign * dz / length
 
     def contains(self, x) -> bool:
-        """Whether abscissa ``x`` [m] lies within the profile."""
+        """Whether abscissa ``x`` [m] lies within the profile.
+
+        Parameters
+        ----------
+        x : float
+            Horizontal position [m].
+
+        Returns
+        -------
+        bool
+        """
         return bool(self.x[0] <= x <= self.x[-1])

@@ -31,6 +31,22 @@ def block_radius(mass, density_kg_m3, shape="sphere", aspect_ratio=1.0):
     """Radius [m] of blocks of the given masses [kg] and density [kg/m3].
 
     A sphere: m = 4/3 pi rho r^3.  A cylinder or disc of length 2 r x aspect_ratio: m = 2 pi rho r^3 aspect_ratio.
+
+    Parameters
+    ----------
+    mass : float or array_like
+        Block mass(es) [kg].
+    density_kg_m3 : float
+        Bulk density [kg/m³].
+    shape : str
+        ``"sphere"`` (default), ``"cylinder"`` or ``"disc"``.
+    aspect_ratio : float
+        Length of a cylinder or disc over its diameter [-] (1: as long as wide).
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Radius [m], the shape of ``mass``.
     """
     import numpy as np
     if shape in ("cylinder", "disc"):
@@ -42,8 +58,30 @@ def block_radius(mass, density_kg_m3, shape="sphere", aspect_ratio=1.0):
 def kinetic_energy_kj(mass_kg, speed_ms, angular_velocity_rads=0.0, radius_m=0.0, inertia_factor=SPHERE_INERTIA):
     """Translational plus rotational kinetic energy [kJ]: (1/2 m v^2 + 1/2 k m r^2 w^2) / 1000.
 
-    Wyllie (2014) eq. 3.1 (translation) and eq. 3.2 (rotation, I = k m r^2).  Works on scalars
-    and NumPy arrays.
+    Works on scalars and NumPy arrays.
+
+    Parameters
+    ----------
+    mass_kg : float or array_like
+        Block mass [kg].
+    speed_ms : float or array_like
+        Translational speed of the centre of mass [m/s].
+    angular_velocity_rads : float or array_like
+        Angular velocity [rad/s] (default 0: translation only).
+    radius_m : float or array_like
+        Block radius [m].
+    inertia_factor : float
+        k = I / (m r²) [-]: 0.4 for a sphere, 0.5 for a cylinder (:data:`INERTIA_FACTORS`).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Kinetic energy [kJ].
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, eq. 3.1 (translation) and eq. 3.2 (rotation,
+    I = k m r²).
     """
     return 0.5 * mass_kg * (speed_ms * speed_ms
                             + inertia_factor * radius_m * radius_m * angular_velocity_rads * angular_velocity_rads) \
@@ -53,8 +91,24 @@ def kinetic_energy_kj(mass_kg, speed_ms, angular_velocity_rads=0.0, radius_m=0.0
 def mass_for_energy_kg(energy_kj, speed_ms):
     """Mass [kg] whose translational kinetic energy at ``speed_ms`` is ``energy_kj``: m = 2 E / v^2.
 
-    The inverse of Wyllie (2014) eq. 3.1; the speed is floored at 1e-150 m/s so that v = 0 gives a huge
-    mass rather than a division error.  Works on scalars and NumPy arrays.
+    The speed is floored at 1e-150 m/s so that v = 0 gives a huge mass rather than a division error.  Works on
+    scalars and NumPy arrays.
+
+    Parameters
+    ----------
+    energy_kj : float or array_like
+        Translational kinetic energy [kJ].
+    speed_ms : float or array_like
+        Speed [m/s].
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Mass [kg].
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, eq. 3.1 (inverted).
     """
     import numpy as np
     v2 = np.maximum(np.asarray(speed_ms, dtype=float) ** 2, 1e-300)

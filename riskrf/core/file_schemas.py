@@ -361,7 +361,20 @@ ALL_SCHEMAS = (SITE_SCHEMA, OPTIONS_SCHEMA, CORRIDOR_SCHEMA, SCENARIO_SCHEMA)
 
 
 def check_scenario_file(path, *, error=ValueError) -> None:
-    """Hold a scenario TOML against :data:`SCENARIO_SCHEMA` (the simulator's own reader runs after)."""
+    """Hold a scenario TOML against :data:`SCENARIO_SCHEMA` (the simulator's own reader runs after).
+
+    Parameters
+    ----------
+    path : str or path
+        The scenario file; one that cannot be read or parsed is left to the simulator's reader to report.
+    error : type
+        Exception class raised for an invalid field.
+
+    Raises
+    ------
+    error
+        Naming the file, table, field and value.
+    """
     import tomllib
 
     from .schema import check
@@ -375,7 +388,18 @@ def check_scenario_file(path, *, error=ValueError) -> None:
 
 def write_reference(path=None) -> str:
     """Write the file-format reference (:func:`riskrf.core.schema.render_markdown` of :data:`ALL_SCHEMAS`) to
-    ``path`` (default ``docs/reference/file-formats-generated.md`` of the source tree) and return its text."""
+    ``path`` (default ``docs/reference/file-formats-generated.md`` of the source tree) and return its text.
+
+    Parameters
+    ----------
+    path : str or path, optional
+        Where to write; None for the source tree's ``docs/reference/file-formats-generated.md``.
+
+    Returns
+    -------
+    str
+        The Markdown written.
+    """
     from pathlib import Path
 
     from .schema import render_markdown

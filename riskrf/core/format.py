@@ -15,6 +15,20 @@ _SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 def sig(x, digits: int = 3) -> str:
     """``x`` to ``digits`` significant figures, with thousands separators and no exponent notation
     between 10⁻³ and 10¹²; outside that range as "a.b × 10ⁿ".  NaN and None give an empty string.
+
+    Parameters
+    ----------
+    x : float, int, None or object
+        The number, in whatever unit the caller prints beside it; a value ``float()`` cannot read is returned
+        as ``str(x)``.
+    digits : int
+        Significant figures kept (default 3).
+
+    Returns
+    -------
+    str
+        E.g. ``sig(304412.7)`` → ``"304,000"``, ``sig(0.000029)`` → ``"2.9 × 10⁻⁵"``; ``"∞"`` for infinity,
+        a minus sign (U+2212) for negatives.
     """
     if x is None:
         return ""
@@ -46,9 +60,21 @@ def sig(x, digits: int = 3) -> str:
 def money(x, currency: str = "", sig: int | None = None) -> str:
     """Money for a manager: whole units with thousands separators and the currency, e.g. "1,250,000 CHF".
 
-    ``sig``: round to that many significant figures first, for uncertain amounts (means, intervals, expected
-    losses): ``money(775390, "CHF", sig=3)`` gives "775,000 CHF".  Typed inputs (capital costs) are shown in
-    full (``sig=None``).
+    Parameters
+    ----------
+    x : float or None
+        The amount, in ``currency``; None or NaN give an empty string.
+    currency : str
+        Currency label written after the number (e.g. ``"CHF"``); empty for none.
+    sig : int, optional
+        Round to that many significant figures first, for uncertain amounts (means, intervals, expected
+        losses): ``money(775390, "CHF", sig=3)`` gives "775,000 CHF".  Typed inputs (capital costs) are shown in
+        full (``sig=None``).
+
+    Returns
+    -------
+    str
+        Whole units with thousands separators, then the currency.
     """
     if x is None or (isinstance(x, float) and math.isnan(x)):
         return ""
@@ -60,5 +86,16 @@ def money(x, currency: str = "", sig: int | None = None) -> str:
 
 
 def probability(p) -> str:
-    """A probability or annual frequency: 2 significant figures, powers of ten below 0.001."""
+    """A probability or annual frequency: 2 significant figures, powers of ten below 0.001.
+
+    Parameters
+    ----------
+    p : float
+        A probability [-] or an annual frequency [1/yr].
+
+    Returns
+    -------
+    str
+        ``sig(p, 2)``: e.g. ``"0.012"``, ``"2.9 × 10⁻⁶"``.
+    """
     return sig(p, 2)

@@ -47,7 +47,13 @@ class Field:
     choices: tuple = ()
 
     def need(self) -> str:
-        """What a valid value is, in words (the end of an error message)."""
+        """What a valid value is, in words (the end of an error message).
+
+        Returns
+        -------
+        str
+            E.g. ``"must be a number > 0 kg/m3"`` or ``"must be one of 'fence', 'ditch'"`` (with the field's unit).
+        """
         if self.choices:
             return "must be one of " + ", ".join(repr(c) for c in self.choices)
         what = {"integer": "a whole number", "number": "a number", "numbers": "a list of numbers",
@@ -64,7 +70,18 @@ class Field:
                                                                        "number|numbers") else "")
 
     def problem(self, value) -> str | None:
-        """``None`` when ``value`` is valid, else :meth:`need`."""
+        """``None`` when ``value`` is valid, else :meth:`need`.
+
+        Parameters
+        ----------
+        value : object
+            The value read from the file (None when the field is absent), in the field's ``unit``.
+
+        Returns
+        -------
+        str or None
+            None when valid; else what a valid value is.
+        """
         if value is None:
             return None if self.default is not REQUIRED else self.need()
         if self.choices:
@@ -119,11 +136,27 @@ class Table:
     array: bool = False
 
     def field(self, name: str) -> Field | None:
-        """The declaration of ``name`` (None when the table has no such field)."""
+        """The declaration of ``name`` (None when the table has no such field).
+
+        Parameters
+        ----------
+        name : str
+            Field name as written in the file.
+
+        Returns
+        -------
+        Field or None
+        """
         return next((f for f in self.fields if f.name == name), None)
 
     def defaults(self) -> dict:
-        """``{field: default}`` of every field (``None`` for optional fields without a default)."""
+        """``{field: default}`` of every field (``None`` for optional fields without a default).
+
+        Returns
+        -------
+        dict
+            Field name → default value (in the field's unit), required fields mapped to None.
+        """
         return {f.name: (None if f.default is REQUIRED else f.default) for f in self.fields}
 
 
@@ -135,14 +168,39 @@ class FileSchema:
     doc: str = ""
 
     def table(self, name: str) -> Table | None:
-        """The declaration of table ``name`` (dotted for sub-tables, e.g. ``"materials.*"``)."""
+        """The declaration of table ``name`` (dotted for sub-tables, e.g. ``"materials.*"``).
+
+        Parameters
+        ----------
+        name : str
+            Dotted table name (``*`` for any key).
+
+        Returns
+        -------
+        Table or None
+        """
         return next((t for t in self.tables if t.name == name), None)
 
 
 def problems(data: dict, schema: FileSchema, source) -> list[str]:
     """Every field of ``data`` that breaks its declaration in ``schema``, as ``"source: table.field = value must
     be ..."`` messages, in the order of the declarations.  Tables and fields that ``schema`` does not declare
-    are left to the file's own reader (it names unknown fields with a did-you-mean)."""
+    are left to the file's own reader (it names unknown fields with a did-you-mean).
+
+    Parameters
+    ----------
+    data : dict
+        The file as read (e.g. by :mod:`tomllib`).
+    schema : FileSchema
+        The declarations to hold it against.
+    source : str or path
+        The file's name, for the messages.
+
+    Returns
+    -------
+    list of str
+        One message per invalid or missing required field; empty when all are valid.
+    """
     out = []
     if not isinstance(data, dict):
         return out
@@ -189,7 +247,25 @@ def _lookup(data: dict, parts: list) -> list:
 
 def check(data: dict, schema: FileSchema, source, *, error=ValueError) -> None:
     """Raise ``error`` with the first problem :func:`problems` finds (file, table, field, value, what is
-    allowed); return quietly when every declared field is valid."""
+    allowed); return quietly when every declared field is valid.
+
+    Parameters
+    ----------
+    data : dict
+        The file as read.
+    schema : FileSchema
+        The declarations to hold it against.
+    source : str or path
+        The file's name, for the message.
+    error : type
+        Exception class raised (default :class:`ValueError`; readers pass their :class:`~riskrf.RiskrfError`
+        subclass).
+
+    Raises
+    ------
+    error
+        With the first problem found.
+    """
     found = problems(data, schema, source)
     if found:
         raise error(found[0])
@@ -201,7 +277,18 @@ def _cell(text) -> str:
 
 def render_markdown(schemas) -> str:
     """The file-format reference: one section per file, one table per TOML table (field, type, unit, allowed
-    values, default, meaning), generated from the declarations so that the documentation cannot drift."""
+    values, default, meaning), generated from the declarations so that the documentation cannot drift.
+
+    Parameters
+    ----------
+    schemas : iterable of FileSchema
+        The files to document, in order.
+
+    Returns
+    -------
+    str
+        Markdown text.
+    """
     lines = ["# Input file formats (generated)", "",
              "Generated from the declarations in `riskrf/core/file_schemas.py` by",
              "`riskrf.core.file_schemas.write_reference()`; do not edit by hand.  Every field below is checked",

@@ -17,14 +17,39 @@ class RiskrfWarning(UserWarning):
 
 
 def warn(message: str) -> None:
-    """Issue a :class:`RiskrfWarning` that points at the caller's caller."""
+    """Issue a :class:`RiskrfWarning` that points at the caller's caller.
+
+    Parameters
+    ----------
+    message : str
+        The warning's text (naming the file, field or argument it is about).
+    """
     warnings.warn(message, RiskrfWarning, stacklevel=3)
 
 
 def as_positive_array(values, name: str, *, allow_empty: bool = False) -> np.ndarray:
     """Return ``values`` as a 1-D float array, all finite and > 0.
 
-    Raises ``ValueError`` naming ``name``, the first bad position and its value.
+    Parameters
+    ----------
+    values : array_like
+        Numbers in any unit (masses [kg], volumes [m³], ...); flattened.
+    name : str
+        The argument's name, for the message.
+    allow_empty : bool
+        Accept an empty input (default: refuse it).
+
+    Returns
+    -------
+    numpy.ndarray
+        1-D float64 array, same unit as ``values``.
+
+    Raises
+    ------
+    TypeError
+        ``values`` is not numeric.
+    ValueError
+        Naming ``name``, the first bad position and its value (not finite or <= 0), or an empty input.
     """
     try:
         arr = np.asarray(values, dtype=float).ravel()
@@ -40,7 +65,25 @@ def as_positive_array(values, name: str, *, allow_empty: bool = False) -> np.nda
 
 
 def check_positive(value, name: str) -> float:
-    """Return ``value`` as a float, raising if it is not finite and > 0."""
+    """Return ``value`` as a float, raising if it is not finite and > 0.
+
+    Parameters
+    ----------
+    value : float
+        The number, in any unit.
+    name : str
+        The argument's name, for the message.
+
+    Returns
+    -------
+    float
+        ``float(value)``, same unit.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming ``name`` and ``value``.
+    """
     try:
         v = float(value)
     except (TypeError, ValueError) as exc:
@@ -67,6 +110,11 @@ def check_density(value, name: str = "density_kg_m3") -> float:
     name : str
         The argument or field, for the message (e.g. ``"--density"`` or ``"site.toml: inventory.density_kg_m3"``).
 
+    Returns
+    -------
+    float
+        The density [kg/m³].
+
     Raises
     ------
     TypeError, ValueError
@@ -83,7 +131,20 @@ def check_density(value, name: str = "density_kg_m3") -> float:
 
 
 def check_probability_level(level, name: str = "level") -> float:
-    """Return a confidence level in (0, 1)."""
+    """Return a confidence level in (0, 1).
+
+    Parameters
+    ----------
+    level : float
+        Confidence level, e.g. 0.95 (not 95).
+    name : str
+        The argument's name, for the message.
+
+    Returns
+    -------
+    float
+        The level [-].
+    """
     v = float(level)
     if not 0.0 < v < 1.0:
         raise ValueError(f"{name} must lie strictly between 0 and 1; got {level!r}")
@@ -91,7 +152,25 @@ def check_probability_level(level, name: str = "level") -> float:
 
 
 def check_return_periods(T, name: str = "T") -> np.ndarray:
-    """Return periods in years must be > 1 (a T-year event has annual probability 1/T)."""
+    """Return periods in years must be > 1 (a T-year event has annual probability 1/T).
+
+    Parameters
+    ----------
+    T : float or array_like
+        Return period(s) [yr].
+    name : str
+        The argument's name, for the message.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``T`` as a float array [yr], same shape.
+
+    Raises
+    ------
+    ValueError
+        Naming ``name`` and the first value not finite or not > 1 yr.
+    """
     arr = np.asarray(T, dtype=float)
     bad = ~np.isfinite(arr) | (arr <= 1.0)
     if bad.any():
@@ -100,7 +179,22 @@ def check_return_periods(T, name: str = "T") -> np.ndarray:
 
 
 def check_choice(value, name: str, choices) -> str:
-    """Return ``value`` if it is one of ``choices``, else raise naming the options."""
+    """Return ``value`` if it is one of ``choices``, else raise naming the options.
+
+    Parameters
+    ----------
+    value : object
+        The value given.
+    name : str
+        The argument's name, for the message.
+    choices : iterable
+        The accepted values.
+
+    Returns
+    -------
+    object
+        ``value`` unchanged.
+    """
     if value not in choices:
         raise ValueError(f"{name} = {value!r} is not one of {', '.join(map(repr, choices))}")
     return value

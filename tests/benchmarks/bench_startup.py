@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import statistics
 import subprocess
@@ -48,15 +49,19 @@ def _env(extra: dict, cache: str) -> dict:
     return env
 
 
-def demo_seconds(env: dict, out: Path, n: int | None) -> float:
-    """Wall-clock seconds of one ``riskrf demo`` (the console script's entry point, ``riskrf.cli.command``)."""
+def demo_seconds(env: dict, out: Path, n: int | None) -> tuple[float, float]:
+    """Wall-clock and CPU seconds (user + system, the command and every child it waited for) of one ``riskrf demo``
+    (the console script's entry point, ``riskrf.cli.command``)."""
     cmd = [sys.executable, "-c", "import sys; from riskrf.cli import command; sys.argv[0] = 'riskrf'; "
            "sys.exit(command())", "demo", "--out", str(out), "--overwrite"]
     if n is not None:
         cmd += ["-n", str(n)]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
     subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return time.perf_counter() - t
+    wall = time.perf_counter() - t
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def import_seconds(code: str, repeat: int = 5) -> float:
@@ -80,6 +85,8 @@ def main() -> None:
     print(f"load average before: {os.getloadavg()}  cores: {os.cpu_count()}", flush=True)
     first = {k: [] for k in names}
     later = {k: [] for k in names}
+    cpu_first = {k: [] for k in names}
+    cpu_later = {k: [] for k in names}
     work = Path(tempfile.mkdtemp(prefix="bench_startup_"))
     try:
         for r in range(args.rounds):
@@ -87,19 +94,24 @@ def main() -> None:
                 cache = tempfile.mkdtemp(dir=work, prefix="numba_")
                 env = _env(CONFIGS[name], cache)
                 out = work / f"demo_{name}"
-                first[name].append(demo_seconds(env, out, args.n))
-                later[name].append(demo_seconds(env, out, args.n))
-                print(f"round {r + 1} {name:14s} first {first[name][-1]:6.1f} s  later {later[name][-1]:6.1f} s  "
+                for wall, cpu in (first, cpu_first), (later, cpu_later):
+                    w, c = demo_seconds(env, out, args.n)
+                    wall[name].append(w)
+                    cpu[name].append(c)
+                print(f"round {r + 1} {name:14s} first {first[name][-1]:6.1f} s (CPU {cpu_first[name][-1]:5.1f} s)  "
+                      f"later {later[name][-1]:6.1f} s (CPU {cpu_later[name][-1]:5.1f} s)  "
                       f"load {os.getloadavg()[0]:.2f}", flush=True)
                 shutil.rmtree(cache, ignore_errors=True)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     print(f"load average after: {os.getloadavg()}")
-    print(f"\n{'configuration':14s} {'first run [s] median (all)':>40s} {'later run [s] median (all)':>40s}")
+    print(f"\n{'configuration':14s} {'first run wall [s] median (all)':>40s} {'later run wall [s] median (all)':>40s}"
+          f" {'CPU first / later [s] median':>30s}")
     for name in names:
         f, lt = first[name], later[name]
         print(f"{name:14s} {statistics.median(f):8.1f} ({', '.join(f'{x:.1f}' for x in f):>28s}) "
-              f"{statistics.median(lt):8.1f} ({', '.join(f'{x:.1f}' for x in lt):>28s})")
+              f"{statistics.median(lt):8.1f} ({', '.join(f'{x:.1f}' for x in lt):>28s}) "
+              f"{statistics.median(cpu_first[name]):14.1f} / {statistics.median(cpu_later[name]):.1f}")
     lazy = import_seconds("import riskrf, riskrf.cli, simulation")
     eager = import_seconds("import riskrf, riskrf.cli, simulation\n"
                            "for p in (riskrf, simulation):\n    [getattr(p, n) for n in p.__all__]")
