@@ -13,7 +13,27 @@ from .units import J_PER_KJ, kinetic_energy_kj
 
 
 def wilson_interval(k, n, level: float = 0.95):
-    """Wilson score interval of a binomial proportion k/n (Monte Carlo confidence interval)."""
+    """Wilson score interval of a binomial proportion k/n (Monte Carlo confidence interval).
+
+    Parameters
+    ----------
+    k : int or array_like
+        Successes (e.g. blocks reaching a line).
+    n : int or array_like
+        Trials (blocks released), > 0.
+    level : float
+        Confidence level, in (0, 1).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (lower, upper) bounds of the proportion [-], clipped to [0, 1].
+
+    References
+    ----------
+    Wilson, E. B. (1927). Probable inference, the law of succession, and statistical inference. Journal of the
+    American Statistical Association 22(158), 209-212.
+    """
     k, n = np.asarray(k, dtype=float), np.asarray(n, dtype=float)
     z = stats.norm.isf((1 - level) / 2)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -53,6 +73,18 @@ class SimulationResult(Displayed):
         ``energy_rotational_kj``, ``energy_kj`` (total), ``crossing_angle_deg``
         (below horizontal), ``outcome`` (crossed / caught / through / over).
         With ``first_only`` only each block's first crossing is kept.
+
+        Parameters
+        ----------
+        name : str
+            The collector's name in the scenario.
+        first_only : bool
+            Keep only each block's first crossing.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per crossing, the columns above (units in their names: m/s, rad/s, m, kg, kJ, deg).
         """
         j = self.scenario.collector_index(name)
         sel = self.crossings["coll"] == j
@@ -77,13 +109,43 @@ class SimulationResult(Displayed):
         return df.reset_index(drop=True)
 
     def reach_probability(self, name: str, level: float = 0.95):
-        """Fraction of released blocks that cross collector ``name``, with its Wilson interval."""
+        """Fraction of released blocks that cross collector ``name``, with its Wilson interval.
+
+        Parameters
+        ----------
+        name : str
+            The collector's name.
+        level : float
+            Confidence level of the interval.
+
+        Returns
+        -------
+        tuple of float
+            (probability, lower, upper) [-].
+        """
         k = self.collector(name, first_only=True).shape[0]
         lo, hi = wilson_interval(k, self.n, level)
         return k / self.n, float(lo), float(hi)
 
     def exceedance(self, name: str, column: str, value, level: float = 0.95) -> pd.DataFrame:
-        """P(column > value) among blocks reaching ``name`` (first crossings), with Monte Carlo intervals."""
+        """P(column > value) among blocks reaching ``name`` (first crossings), with Monte Carlo intervals.
+
+        Parameters
+        ----------
+        name : str
+            The collector's name.
+        column : str
+            A column of :meth:`collector` (e.g. ``"energy_kj"``, ``"height_m"``).
+        value : float or array_like
+            Threshold(s), in the column's unit.
+        level : float
+            Confidence level of the Wilson intervals.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per value: the value, ``probability`` [-], ``ci_low``, ``ci_high``, ``n_reaching``.
+        """
         df = self.collector(name, first_only=True)
         if column not in df.columns:
             raise KeyError(f"column {column!r} not in collector table; columns are {list(df.columns)}")
@@ -136,6 +198,21 @@ class SimulationResult(Displayed):
         (1/2 m v^2 + 1/2 I w^2), ``potential_energy_kj`` (m g z), ``total_energy_kj``, ``event``.
         Without ``allow_energy_gain`` the total never increases from one row to the next.
         Blocks 0 .. ``record_paths`` - 1 of the run are recorded.
+
+        Parameters
+        ----------
+        block : int
+            Index of a recorded block.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per event, the columns above.
+
+        Raises
+        ------
+        KeyError
+            The block was not recorded.
         """
         sel = self.paths["block"] == block
         if not sel.any():
@@ -167,7 +244,20 @@ class SimulationResult(Displayed):
         return ev[cols].reset_index(drop=True)
 
     def path(self, block: int, dt: float = 0.01) -> pd.DataFrame:
-        """Sampled path (x, z) of one of the recorded blocks, exact between events."""
+        """Sampled path (x, z) of one of the recorded blocks, exact between events.
+
+        Parameters
+        ----------
+        block : int
+            Index of a recorded block (one of the first ``record_paths``).
+        dt : float
+            Time step of the samples [s].
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``x_m``, ``z_m`` [m].
+        """
         sel = self.paths["block"] == block
         if not sel.any():
             raise KeyError(f"block {block} was not recorded; run with record_paths > {block}")
@@ -208,7 +298,13 @@ class SimulationResult(Displayed):
         return plot_profile(self, ax, n_paths=n_paths)
 
     def summary(self) -> pd.DataFrame:
-        """Run facts and, per collector, reach probability and speed/height/energy percentiles."""
+        """Run facts and, per collector, reach probability and speed/height/energy percentiles.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: quantity (with its unit: s, m/s, m, kJ); column ``value``.
+        """
         rows = {"blocks": self.n, "seed": self.seed, "impacts": self.n_impacts,
                 "run time [s]": round(self.elapsed_s, 3),
                 "impacts per second": round(self.n_impacts / max(self.elapsed_s, 1e-9)),

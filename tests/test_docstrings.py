@@ -75,6 +75,8 @@ NUMPYDOC_MODULES = (
     "simulation/units.py",
     "simulation/slope.py",
     "simulation/engine.py",
+    "simulation/result.py",
+    "riskrf/frequency/extremes.py",
 )
 
 

@@ -55,6 +55,23 @@ def plotting_positions(n: int, formula: str = "gringorten") -> np.ndarray:
 
     ``(i - a) / (n + 1 - 2a)`` with a = 0 (Weibull, i/(n+1)), 0.44 (Gringorten,
     recommended for Gumbel), 0.4 (Cunnane), 0.5 (Hazen, (i-0.5)/n) or 0.375 (Blom).
+
+    Parameters
+    ----------
+    n : int
+        Number of ordered values (years), >= 1.
+    formula : str
+        ``"gringorten"`` (default), ``"weibull"``, ``"cunnane"``, ``"hazen"`` or ``"blom"``.
+
+    Returns
+    -------
+    numpy.ndarray
+        n non-exceedance probabilities [-], increasing.
+
+    References
+    ----------
+    Gringorten, I. I. (1963). A plotting rule for extreme probability paper. Journal of Geophysical Research
+    68(3), 813-814.
     """
     check_choice(formula, "formula", tuple(PLOTTING_POSITIONS))
     if int(n) < 1:
@@ -65,18 +82,63 @@ def plotting_positions(n: int, formula: str = "gringorten") -> np.ndarray:
 
 
 def gumbel_reduced_variate(T):
-    """y_T = -ln(-ln(1 - 1/T)): the Gumbel reduced variate of return period T [yr]."""
+    """y_T = -ln(-ln(1 - 1/T)): the Gumbel reduced variate of return period T [yr].
+
+    Parameters
+    ----------
+    T : float or array_like
+        Return period [yr], > 1.
+
+    Returns
+    -------
+    numpy.ndarray
+        Reduced variate y_T [-].
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, section 8.4.2.
+    """
     T = check_return_periods(T)
     return -np.log(-np.log1p(-1.0 / T))
 
 
 def gumbel_frequency_factor(T):
-    """K_T = (sqrt(6)/pi)(y_T - 0.5772), so that x_T = M + K_T S (Wyllie 2014, 8.4.2; Chow 1951)."""
+    """K_T = (sqrt(6)/pi)(y_T - 0.5772), so that x_T = M + K_T S (Wyllie 2014, 8.4.2; Chow 1951).
+
+    Parameters
+    ----------
+    T : float or array_like
+        Return period [yr], > 1.
+
+    Returns
+    -------
+    numpy.ndarray
+        Frequency factor K_T [-] (M the mean, S the standard deviation of the annual maxima).
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, section 8.4.2.
+    Chow, V. T. (1951). A general formula for hydrologic frequency analysis. Transactions, American
+    Geophysical Union 32(2), 231-237.
+    """
     return np.sqrt(6.0) / np.pi * (gumbel_reduced_variate(T) - EULER_GAMMA)
 
 
 def encounter_probability(T, years):
-    """P(the T-year event is exceeded at least once in ``years``) = 1 - (1 - 1/T)^years."""
+    """P(the T-year event is exceeded at least once in ``years``) = 1 - (1 - 1/T)^years.
+
+    Parameters
+    ----------
+    T : float or array_like
+        Return period [yr], > 1.
+    years : float or array_like
+        Exposure time, e.g. a design life [yr].
+
+    Returns
+    -------
+    numpy.ndarray
+        Probability [-] of at least one exceedance (independent years).
+    """
     T = check_return_periods(T)
     return -np.expm1(np.asarray(years, dtype=float) * np.log1p(-1.0 / T))
 
@@ -455,7 +517,14 @@ class GumbelFit(_AnnualMaximumFit):
         return super()._return_level_variance(T)
 
     def summary(self) -> pd.DataFrame:
-        """Parameters with standard errors and the fitting method, one row each."""
+        """Parameters with standard errors and the fitting method, one row each.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by parameter; columns ``value`` (loc and scale in the unit of the maxima), ``stderr``,
+            ``note``.
+        """
         se = self.stderr
         label = {"mle": "maximum likelihood", "moments": "method of moments (Wyllie: S with ddof=1)",
                  "lmoments": "L-moments (Hosking 1990)"}[self.method]
@@ -536,6 +605,15 @@ class GEVFit(_AnnualMaximumFit):
 
         D = 2 (l_GEV - l_Gumbel) ~ chi2(1) under the Gumbel; a small p-value
         says the Gumbel is not adequate.
+
+        Returns
+        -------
+        dict
+            ``deviance`` D [-], ``p_value``, ``gumbel_adequate`` (p >= 0.05), ``loglik_gev``, ``loglik_gumbel``.
+
+        References
+        ----------
+        Coles, S. (2001). An Introduction to Statistical Modeling of Extreme Values. Springer, §2.6.6.
         """
         gum = GumbelFit(p_zero=self.p_zero, n_years=self.n_years, method="mle", level=self.level, cov=None,
                         data=self.data, **dict(zip(("loc", "scale"), GumbelFit._fit_params(self.data, "mle"))))
@@ -545,7 +623,14 @@ class GEVFit(_AnnualMaximumFit):
                 "loglik_gev": self.loglik, "loglik_gumbel": gum.loglik}
 
     def summary(self) -> pd.DataFrame:
-        """Parameters with standard errors, the shape's meaning and the fitting method, one row each."""
+        """Parameters with standard errors, the shape's meaning and the fitting method, one row each.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by parameter; columns ``value`` (loc and scale in the unit of the maxima, shape [-]),
+            ``stderr``, ``note``.
+        """
         se = self.stderr
         rows = [("loc (mu)", self.loc, se[0], "maximum likelihood"),
                 ("scale (sigma)", self.scale, se[1], "maximum likelihood"),
@@ -608,6 +693,17 @@ def fit_gumbel(maxima, method: str = "mle", *, zero_years: str = "mixed", level:
         How years without a fall enter (default: the mixed model).
     level : float
         Default confidence level recorded with the fit.
+
+    Returns
+    -------
+    GumbelFit
+        ``loc`` (alpha) and ``scale`` (beta) in the unit of the maxima [kg], the share of years without a fall,
+        and the covariance (maximum likelihood).
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, section 8.4.2 (method of moments).
+    Hosking, J. R. M. (1990). L-moments. Journal of the Royal Statistical Society B 52(1), 105-124.
     """
     check_choice(method, "method", ("mle", "moments", "lmoments"))
     x, p0, n_years = _split_maxima(maxima, zero_years, "gumbel")
@@ -626,6 +722,24 @@ def fit_gev(maxima, *, zero_years: str = "mixed", level: float = 0.95) -> GEVFit
     The optimiser starts from the L-moment Gumbel fit with several shapes and
     keeps the best; the covariance is the inverse observed information (a
     numerical Hessian).  ``shape`` is xi in Coles' sign convention.
+
+    Parameters
+    ----------
+    maxima : array_like or pandas.Series
+        Annual maxima [kg]; NaN marks a year without a fall.
+    zero_years : {"mixed", "drop"}
+        How years without a fall enter (default: the mixed model).
+    level : float
+        Default confidence level recorded with the fit.
+
+    Returns
+    -------
+    GEVFit
+        ``loc`` (mu), ``scale`` (sigma) [unit of the maxima] and ``shape`` (xi, Coles' sign), with the covariance.
+
+    References
+    ----------
+    Coles, S. (2001). An Introduction to Statistical Modeling of Extreme Values. Springer, chapter 3 (eq. 3.2).
     """
     x, p0, n_years = _split_maxima(maxima, zero_years, "gev")
     params = _fit_gev_mle(x)
