@@ -77,6 +77,9 @@ NUMPYDOC_MODULES = (
     "simulation/engine.py",
     "simulation/result.py",
     "riskrf/frequency/extremes.py",
+    "riskrf/io/velocities.py",
+    "riskrf/io/records.py",
+    "riskrf/io/rainfall.py",
 )
 
 

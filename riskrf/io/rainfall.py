@@ -78,6 +78,11 @@ class Rainfall(Displayed):
     def summary(self) -> pd.DataFrame:
         """Key figures of the record (one-column table): source, format, first and last day, days, missing days,
         gaps, trace days, mean annual rainfall [mm] and the wettest day [mm].
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: quantity; column ``value``.
         """
         d = self.daily
         years = d.groupby(d.index.year).sum(min_count=300)
@@ -127,8 +132,18 @@ class Rainfall(Displayed):
     def check_covers(self, start, end, what: str) -> None:
         """Raise ``ValueError`` unless every day from ``start`` to ``end`` has rainfall.
 
-        ``what`` names the caller's need (e.g. ``"inventory X, row 12, date
-        1984-01-02 (with its 30-day antecedent window)"``) and appears in the message.
+        Parameters
+        ----------
+        start, end : date-like
+            First and last day needed.
+        what : str
+            The caller's need (e.g. ``"inventory X, row 12, date 1984-01-02 (with its 30-day antecedent
+            window)"``), in the message.
+
+        Raises
+        ------
+        ValueError
+            Naming the record, the missing days and the rows around them.
         """
         start, end = pd.Timestamp(start).normalize(), pd.Timestamp(end).normalize()
         if start < self.first_day:
@@ -150,6 +165,18 @@ class Rainfall(Displayed):
 
         ``window_total(1)`` is the day's own rainfall; ``window_total(14, lag=1)``
         the 14 days before it.  NaN where any day of the window is missing.
+
+        Parameters
+        ----------
+        days : int
+            Window length [days], >= 1.
+        lag : int
+            Days between the window's last day and the day it is reported on, >= 0.
+
+        Returns
+        -------
+        pandas.Series
+            Rainfall total [mm] per calendar day.
         """
         if days < 1 or lag < 0:
             raise ValueError(f"days = {days!r} must be >= 1 and lag = {lag!r} >= 0")
@@ -362,7 +389,19 @@ def read_rainfall(path, *, sheet=None, header_row: int | None = None, decimal: s
 
 
 def rainfall_from_series(daily: pd.Series, source: str = "<series>") -> Rainfall:
-    """A :class:`Rainfall` from a pandas Series of daily totals [mm] indexed by date."""
+    """A :class:`Rainfall` from a pandas Series of daily totals [mm] indexed by date.
+
+    Parameters
+    ----------
+    daily : pandas.Series
+        Daily totals [mm] (NaN for missing days), on a DatetimeIndex.
+    source : str
+        Name used in messages.
+
+    Returns
+    -------
+    Rainfall
+    """
     if not isinstance(daily, pd.Series) or not isinstance(daily.index, pd.DatetimeIndex):
         raise TypeError(f"{source}: daily rainfall must be a pandas Series indexed by dates")
     values = daily.to_numpy(dtype=float)

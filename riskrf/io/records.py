@@ -70,6 +70,11 @@ class RegisterExtract:
     def summary(self) -> pd.DataFrame:
         """Key figures of the extract (one-column table): source, incidents in the file, selected, with a numeric,
         censored or no size, dated by FAILDATE or CALLDATE, and rows with invalid UTF-8.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: quantity; column ``value``.
         """
         t = self.table
         sized = t["volume_m3"].str.fullmatch(r"\d+(\.\d+)?")

@@ -73,6 +73,18 @@ def free_fall_drop_m(scenario, collector: str) -> tuple[float, float]:
     of ``sqrt(vx^2 + vz^2)`` the seeder can draw (from the largest magnitudes: a component may be
     negative).  A block cannot pass the collector faster than ``sqrt(v0^2 + 2 g H)`` (energy
     conservation without losses).
+
+    Parameters
+    ----------
+    scenario : simulation.Scenario or path
+        The scenario, or its TOML file.
+    collector : str
+        The collector's name.
+
+    Returns
+    -------
+    tuple of float
+        (H [m], v0 [m/s]); H is 0 where the line stands above the release.
     """
     import simulation
     sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
@@ -90,6 +102,22 @@ def plausible_velocity_ms(drop_height_m=None, release_speed_ms: float = 0.0) -> 
 
     With a height drop H [m]: ``(1 + FREE_FALL_MARGIN) sqrt(v0^2 + 2 g H)``; without one:
     :data:`PLAUSIBLE_MAX_MS` (50 m/s, a free fall of about 127 m), an assumption.
+
+    Parameters
+    ----------
+    drop_height_m : float, optional
+        Height drop H from the release to the line [m], > 0; None for the assumed 50 m/s.
+    release_speed_ms : float
+        Largest release speed v0 [m/s].
+
+    Returns
+    -------
+    tuple of (float, str)
+        The limit [m/s] and a sentence saying how it was obtained (labelled ASSUMPTION without a drop height).
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, chapter 3 (free fall, v = sqrt(2 g H)).
     """
     g = STANDARD_GRAVITY_MS2
     if drop_height_m is None:
@@ -129,6 +157,27 @@ def read_velocities(path, *, collector: str | None = None, velocity_unit: str | 
     ``1.1 sqrt(v0^2 + 2 g H)`` with ``drop_height_m`` H [m] (e.g. from
     :func:`free_fall_drop_m` of the scenario) and ``release_speed_ms`` v0, else
     50 m/s (a 127 m free fall; an assumption the warning states).
+
+    Parameters
+    ----------
+    path : str or path
+        CSV/TXT, Excel or Parquet file.
+    collector : str, optional
+        Keep only this collector's rows.
+    velocity_unit : {"m/s", "km/h"}, optional
+        Unit of the velocity column when its header does not say.
+    decimal, sheet, header_row, encoding : optional
+        Table-reading options (:func:`riskrf.io.tables.read_table`).
+    drop_height_m : float, optional
+        Height drop to the line [m] for the plausibility limit.
+    release_speed_ms : float
+        Largest release speed [m/s] for the plausibility limit.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``velocity_ms`` [m/s] and, when present, ``height_m`` [m], ``angular_velocity_rads`` [rad/s],
+        ``mass_kg`` [kg], ``radius_m`` [m], ``collector``; ``attrs["warnings"]`` lists the warnings raised.
     """
     from .tables import parse_numbers, read_table
     path = Path(path)
