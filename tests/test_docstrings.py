@@ -80,6 +80,8 @@ NUMPYDOC_MODULES = (
     "riskrf/io/velocities.py",
     "riskrf/io/records.py",
     "riskrf/io/rainfall.py",
+    "riskrf/hazard/simulated.py",
+    "riskrf/report/format.py",
 )
 
 

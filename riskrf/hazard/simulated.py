@@ -75,7 +75,9 @@ def energy_hazard(mass, scenario, collector: str = "barrier", *, rate_per_year=N
 
     Returns
     -------
-    EnergyHazard with ``velocity`` a :class:`~riskrf.hazard.mass_coupling.MassCoupledSamples` and the mass-averaged reach probability.
+    EnergyHazard
+        With ``velocity`` a :class:`~riskrf.hazard.mass_coupling.MassCoupledSamples` and the mass-averaged reach
+        probability; energies in kJ, rates per year.
     """
     return simulate_energy_hazard(mass, scenario, collector, rate_per_year=rate_per_year, n=n, seed=seed,
                                   mass_range_kg=mass_range_kg, design_masses_kg=design_masses_kg, n_bins=n_bins,
@@ -112,7 +114,20 @@ def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_p
                            seed=1, mass_range_kg=None, design_masses_kg=(), n_bins: int | None = None,
                            rotational: bool = True, return_periods=DESIGN_RETURN_PERIODS, workers: int = 1):
     """:func:`energy_hazard` that also returns the run (a :class:`simulation.SimulationResult`, or a
-    :class:`simulation.TerrainResult` on 3-D terrain, run on ``workers`` threads): (hazard, result)."""
+    :class:`simulation.TerrainResult` on 3-D terrain, run on ``workers`` threads): (hazard, result).
+
+    Parameters
+    ----------
+    mass, scenario, collector, rate_per_year, n, seed, mass_range_kg, design_masses_kg, n_bins, rotational, return_periods
+        As for :func:`energy_hazard` (masses kg, rates per year, return periods yr).
+    workers : int
+        Threads of a 3-D run.
+
+    Returns
+    -------
+    tuple of (EnergyHazard, simulation.SimulationResult or simulation.TerrainResult)
+        The hazard and the run behind it (blocks of the simulated masses).
+    """
     mm = mass_model(mass)
     if rate_per_year is None:
         if not isinstance(mass, GutenbergRichterFit):

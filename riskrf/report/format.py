@@ -21,7 +21,17 @@ from ..core.format import money, probability, sig  # noqa: F401  (one home: risk
 
 
 def escape(text) -> str:
-    """HTML-escaped text of any value (user text is never markup)."""
+    """HTML-escaped text of any value (user text is never markup).
+
+    Parameters
+    ----------
+    text : object
+        Any value; ``str()`` of it is escaped.
+
+    Returns
+    -------
+    str
+    """
     return html.escape(str(text))
 
 
@@ -39,6 +49,16 @@ def human_header(name: str) -> str:
     """A column name as a reader expects it: ``energy_kj`` -> "Energy [kJ]", ``T_years`` -> "T [yr]".
 
     Names that already read as text (with spaces or brackets) are returned unchanged.
+
+    Parameters
+    ----------
+    name : str
+        A column name with its unit as a suffix (``_kj``, ``_kg``, ``_m3``, ``_ms``, ``_per_year`` ...).
+
+    Returns
+    -------
+    str
+        Words with the unit in brackets.
     """
     name = str(name)
     if " " in name or "[" in name or "(" in name:
@@ -62,13 +82,40 @@ _PLAIN_INTEGER_COLUMN = re.compile(r"(^|_)(year|years|t_years|seed|block|id|row|
 
 
 def plain_integer_column(name) -> bool:
-    """Whether a column holds years or identifiers (printed "2020", "1000", never "2,020")."""
+    """Whether a column holds years or identifiers (printed "2020", "1000", never "2,020").
+
+    Parameters
+    ----------
+    name : str
+        Column name.
+
+    Returns
+    -------
+    bool
+    """
     return bool(_PLAIN_INTEGER_COLUMN.search(str(name)))
 
 
 def cell(value, *, digits: int = 3, money_columns: bool = False, currency: str = "") -> str:
     """One table cell as text: numbers to ``digits`` significant figures (or money), booleans as yes/no,
-    dictionaries and lists as readable text."""
+    dictionaries and lists as readable text.
+
+    Parameters
+    ----------
+    value : object
+        The cell's value.
+    digits : int
+        Significant figures of numbers.
+    money_columns : bool
+        The cell is money: whole units with the currency.
+    currency : str
+        Currency label of money cells.
+
+    Returns
+    -------
+    str
+        Empty for None or NaN.
+    """
     if isinstance(value, (bool, np.bool_)):
         return "yes" if value else "no"
     if isinstance(value, (int, np.integer)) and not money_columns:
@@ -109,11 +156,23 @@ class Document:
         return f"Figure {self.n_figures + 1}"
 
     def add(self, *fragments: str) -> None:
-        """Append HTML fragments (empty ones are skipped)."""
+        """Append HTML fragments (empty ones are skipped).
+
+        Parameters
+        ----------
+        *fragments : str
+            HTML text, already escaped where it holds user text.
+        """
         self.parts.extend(f for f in fragments if f)
 
     def section(self, title: str) -> None:
-        """Start numbered section ``title`` (listed in the table of contents)."""
+        """Start numbered section ``title`` (listed in the table of contents).
+
+        Parameters
+        ----------
+        title : str
+            Plain text (escaped here).
+        """
         number = len(self.sections) + 1
         anchor = f"s{number}"
         self.sections.append((anchor, f"{number}. {title}"))
@@ -122,7 +181,30 @@ class Document:
     def table(self, df: pd.DataFrame, caption: str, *, digits: int = 3, money_columns=(), currency: str = "",
               headers: dict | None = None, index: bool = False) -> str:
         """A numbered table: human headers with units, numbers to ``digits`` significant figures,
-        ``money_columns`` as whole currency units."""
+        ``money_columns`` as whole currency units.
+
+        Parameters
+        ----------
+        df : pandas.DataFrame
+            The table; column names with unit suffixes become headers with units (:func:`human_header`).
+        caption : str
+            Caption after "Table N.".
+        digits : int
+            Significant figures of numbers.
+        money_columns : collection of str
+            Columns shown as money.
+        currency : str
+            Currency label of money columns.
+        headers : dict, optional
+            Column name → header text, overriding :func:`human_header`.
+        index : bool
+            Show the index as the first column.
+
+        Returns
+        -------
+        str
+            HTML (empty for an empty table, which is not numbered).
+        """
         if df is None or len(df) == 0:
             return ""
         self.n_tables += 1
@@ -147,7 +229,20 @@ class Document:
                 "</table></div>")
 
     def figure(self, path: Path, caption: str) -> str:
-        """A numbered figure embedded as a data URI (the report needs no network); empty if the file is absent."""
+        """A numbered figure embedded as a data URI (the report needs no network); empty if the file is absent.
+
+        Parameters
+        ----------
+        path : path
+            PNG file.
+        caption : str
+            Caption after "Figure N.".
+
+        Returns
+        -------
+        str
+            HTML ``<figure>`` (empty when the file is absent).
+        """
         path = Path(path)
         if not path.exists():
             return ""
@@ -157,7 +252,18 @@ class Document:
                 f"<figcaption>Figure {self.n_figures}. {escape(caption)}</figcaption></figure>")
 
     def render(self, *, header: str = "", footer: str = "") -> str:
-        """The whole page: head with viewport and print styles, title, table of contents, body."""
+        """The whole page: head with viewport and print styles, title, table of contents, body.
+
+        Parameters
+        ----------
+        header, footer : str
+            HTML placed before the table of contents and after the body.
+
+        Returns
+        -------
+        str
+            A complete HTML document.
+        """
         toc = "".join(f"<li><a href='#{a}'>{escape(t)}</a></li>" for a, t in self.sections)
         return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
                 "<meta name='viewport' content='width=device-width, initial-scale=1'>"
