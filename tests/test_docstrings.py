@@ -82,6 +82,8 @@ NUMPYDOC_MODULES = (
     "riskrf/io/rainfall.py",
     "riskrf/hazard/simulated.py",
     "riskrf/report/format.py",
+    "riskrf/frequency/study.py",
+    "riskrf/frequency/inventory.py",
 )
 
 

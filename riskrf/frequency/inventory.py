@@ -153,6 +153,11 @@ class Inventory(Displayed):
         The columns of :attr:`events` plus ``censoring`` (``""`` for an exact
         size) and ``size_text``.  Use it to count events (rate models); use
         :attr:`events` or :attr:`masses` for size statistics.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per event (sizes in m³ and kg), dates ascending.
         """
         exact = self.events.assign(censoring="", size_text="")
         if self.censored.empty:
@@ -201,11 +206,22 @@ class Inventory(Displayed):
         return int(self.events["year"].isna().sum())
 
     def undated_note(self) -> str:
-        """The sentence every output carries for a partly dated inventory ("" when all or none are dated)."""
+        """The sentence every output carries for a partly dated inventory ("" when all or none are dated).
+
+        Returns
+        -------
+        str
+        """
         return _undated_note(self.source, self.events)
 
     def record_years(self) -> list[int]:
-        """Calendar years covered (wholly or partly) by the record period."""
+        """Calendar years covered (wholly or partly) by the record period.
+
+        Returns
+        -------
+        list of int
+            The years, ascending (from the dated events when the period is not known; empty when none is dated).
+        """
         if self.start is None or self.end is None:
             years = self.events["year"].dropna()
             if years.empty:
@@ -226,6 +242,16 @@ class Inventory(Displayed):
         warning says how many such years there are.  Partly covered first and
         last years are kept and named in a warning.  Raises ``ValueError`` for
         an inventory without any date; events without a date are left out with a warning listing their rows.
+
+        Parameters
+        ----------
+        unit : {"kg", "m3"}
+            Mass [kg] (default) or volume [m³].
+
+        Returns
+        -------
+        pandas.Series
+            Largest exact size of each year [kg or m³], indexed by year; NaN for a year without a fall.
         """
         if not self.has_dates:
             raise ValueError(
@@ -299,6 +325,12 @@ class Inventory(Displayed):
         A rising smallest size or a falling count over time shows a change in
         recording practice (completeness), which the magnitude-frequency fit
         must respect.  Undated inventories give one row for the whole record.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by year (or ``"all"``): ``n_events``, ``smallest_m3``, ``median_m3``, ``largest_m3``,
+            ``smallest_kg``, ``largest_kg``.
         """
         ev = self.events
         key = ev["year"].astype("Int64") if self.is_dated else pd.Series("all", index=ev.index)
@@ -318,7 +350,13 @@ class Inventory(Displayed):
         return table
 
     def summary(self) -> pd.DataFrame:
-        """One-column table describing the inventory (sizes, period, density and its origin)."""
+        """One-column table describing the inventory (sizes, period, density and its origin).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: quantity (units in brackets: yr, kg/m3, m3, kg); column ``value``.
+        """
         v, m = self.volumes, self.masses
         rows = {
             "source": self.source,

@@ -63,6 +63,19 @@ class FrequencyAnalysis(Displayed):
         ``power law annual max`` (the T-year annual maximum the Poisson power law
         implies), ``Gumbel`` and ``GEV`` (annual maxima).  ``extrapolated`` marks
         return periods longer than twice the record.
+
+        Parameters
+        ----------
+        T : float or sequence of float
+            Return periods [yr] (default :data:`riskrf.core.units.DESIGN_RETURN_PERIODS`).
+        level : float
+            Confidence level of the intervals.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per (model, return period): ``model``, ``T_years``, ``mass_kg``, ``ci_low_kg``,
+            ``ci_high_kg``, ``volume_m3``, ``ci_method`` and ``extrapolated``.
         """
         key = (tuple(np.atleast_1d(T).tolist()), level)
         if key not in self._cache:          # profile-likelihood intervals are worth computing once
@@ -110,7 +123,18 @@ class FrequencyAnalysis(Displayed):
         Mikosch 1997, section 3.3.1), and
         the power law, with an upper truncation m_max where one can be
         justified, is preferred for design masses; the GEV's return levels are
-        not used beyond the record.  Returns ``{"model", "reason", "gev_shape_plausible"}``.
+        not used beyond the record.
+
+        Returns
+        -------
+        dict
+            ``model`` (``"Gumbel"``, ``"GEV"`` or ``"power law"``), ``reason`` (a sentence),
+            ``gev_shape_plausible`` (bool or None).
+
+        References
+        ----------
+        Embrechts, P., Klüppelberg, C. & Mikosch, T. (1997). Modelling Extremal Events. Springer, section 3.3.1.
+        Coles, S. (2001). An Introduction to Statistical Modeling of Extreme Values. Springer, §2.6.6 (deviance).
         """
         gr, gev, d = self.power_law, self.gev, self.deviance
         if gev is None or d is None:
@@ -146,12 +170,29 @@ class FrequencyAnalysis(Displayed):
                              if self.bootstrap_p is not None and self.bootstrap_p <= 0.1 else "")}
 
     def design_table(self, T=DESIGN_RETURN_PERIODS) -> pd.DataFrame:
-        """Wide table of design masses [kg]: one row per return period, one column per model."""
+        """Wide table of design masses [kg]: one row per return period, one column per model.
+
+        Parameters
+        ----------
+        T : float or sequence of float
+            Return periods [yr].
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by ``T_years``; one column of masses [kg] per model.
+        """
         d = self.design_masses(T)
         return d.pivot(index="T_years", columns="model", values="mass_kg")
 
     def to_dict(self) -> dict:
-        """The fits as plain JSON-ready values (for summary.json)."""
+        """The fits as plain JSON-ready values (for summary.json).
+
+        Returns
+        -------
+        dict
+            Inventory facts, units, each model's parameters, the design masses [kg] and the preferred model.
+        """
         gr = self.power_law
         out = {
             "inventory": self.inventory.summary()["value"].to_dict(),
@@ -234,7 +275,13 @@ class FrequencyAnalysis(Displayed):
         return self.power_law.plot(axes(ax))
 
     def summary_text(self) -> str:
-        """A readable report of the fits (what ``riskrf fit`` prints)."""
+        """A readable report of the fits (what ``riskrf fit`` prints).
+
+        Returns
+        -------
+        str
+            Several lines of text (masses in kg, rates per year).
+        """
         inv, gr = self.inventory, self.power_law
         lines = [f"Inventory: {inv.source}" + (f"  ({inv.site})" if inv.site else ""),
                  f"  {inv.n_events} falls over {inv.duration_years:.3g} years (record period from "
@@ -301,6 +348,20 @@ class FrequencyAnalysis(Displayed):
         whole wall's fit and another record's so): a ``basis`` column in the table, written as
         ``design_masses_name``.csv, and in summary.json the table under ``design_masses_name`` with
         ``design_masses_name``_basis.
+
+        Parameters
+        ----------
+        out_dir : str or path
+            An existing directory.
+        design_masses_name : str
+            File stem of the design-mass table.
+        basis : str, optional
+            What the design-mass table is, when it is not the site's own.
+
+        Returns
+        -------
+        list of pathlib.Path
+            The files written.
         """
         out = Path(out_dir)
         data, table = self.to_dict(), self.design_masses()
@@ -322,8 +383,36 @@ def analyse_inventory(inventory: Inventory, *, m_min=None, method: str = "mle", 
 
     Every warning raised by the fits is collected in ``warnings``; models the
     data cannot support are listed in ``skipped`` with the reason.
-    ``bootstrap_workers``, ``progress`` and ``bootstrap_grid`` are passed to
-    :meth:`GutenbergRichterFit.bootstrap_test` (``workers``, ``progress``, ``grid``).
+    Parameters
+    ----------
+    inventory : Inventory
+        The record (masses [kg], duration [yr]).
+    m_min : float, optional
+        Completeness threshold [kg]; None for the Kolmogorov-Smirnov search (Clauset et al. 2009).
+    method : {"mle", "lsq"}
+        Power-law fitting method.
+    m_max : float, optional
+        Upper truncation [kg].
+    gumbel_method : {"mle", "moments", "lmoments"}
+        Gumbel fitting method.
+    n_bootstrap : int
+        Replicates of the power law's goodness-of-fit bootstrap (0: none).
+    seed : int, optional
+        Seed of the bootstrap.
+    compare_lsq : bool
+        Also fit the least-squares power law, for comparison.
+    bootstrap_workers, progress, bootstrap_grid
+        Passed to :meth:`GutenbergRichterFit.bootstrap_test` (``workers``, ``progress``, ``grid``).
+
+    Returns
+    -------
+    FrequencyAnalysis
+        The fits, the comparison of the power law with its alternatives, the bootstrap and the warnings.
+
+    References
+    ----------
+    Clauset, A., Shalizi, C. R. & Newman, M. E. J. (2009). Power-law distributions in empirical data. SIAM Review
+    51(4), 661-703.
     """
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RiskrfWarning)
