@@ -84,6 +84,7 @@ NUMPYDOC_MODULES = (
     "riskrf/report/format.py",
     "riskrf/frequency/study.py",
     "riskrf/frequency/inventory.py",
+    "riskrf/hazard/barriers.py",
 )
 
 

@@ -42,7 +42,23 @@ UNI11211_FACTORS = {
 
 
 def service_energy_level(mel_kj):
-    """SEL = MEL / 3 (ETAG 027) [kJ]."""
+    """SEL = MEL / 3 (ETAG 027) [kJ].
+
+    Parameters
+    ----------
+    mel_kj : float
+        Maximum energy level of the kit [kJ].
+
+    Returns
+    -------
+    float
+        Service energy level [kJ].
+
+    References
+    ----------
+    EOTA (2008/2013). ETAG 027, Guideline for European Technical Approval of falling rock protection kits;
+    replaced by EAD 340059-00-0106 (2018).
+    """
     return check_positive(mel_kj, "mel_kj") * SEL_PER_MEL
 
 
@@ -57,7 +73,20 @@ class UNI11211Design:
     factors: dict
 
     def check(self, barrier_energy_kj: float, gamma_E: float) -> bool:
-        """E_d <= E_barrier / gamma_E."""
+        """E_d <= E_barrier / gamma_E.
+
+        Parameters
+        ----------
+        barrier_energy_kj : float
+            The barrier's rated energy (SEL or MEL) [kJ].
+        gamma_E : float
+            Partial factor on the barrier energy [-] (1.0 against SEL, 1.2 against MEL: :data:`UNI11211_FACTORS`).
+
+        Returns
+        -------
+        bool
+            Whether the design energy is within the factored capacity.
+        """
         return self.design_energy_kj <= check_positive(barrier_energy_kj, "barrier_energy_kj") / gamma_E
 
 
@@ -68,7 +97,29 @@ def uni11211_design_energy(volume_m3: float, density_kg_m3: float, velocity_ms: 
 
     Defaults are the cautious values (restitution from literature, low-quality
     topography, rough block survey); pass 1.02 where the better case applies.
-    ``velocity_ms`` is the 95th-percentile velocity at the barrier.
+
+    Parameters
+    ----------
+    volume_m3 : float
+        Design block volume Vol [m³].
+    density_kg_m3 : float
+        Rock density rho [kg/m³].
+    velocity_ms : float
+        The 95th-percentile velocity v_t at the barrier [m/s].
+    gamma_Tr, gamma_Dp, gamma_VolF, gamma_gamma : float
+        Partial factors [-] on the trajectory simulation, the topography, the volume and the unit weight
+        (1.0-2.0).
+
+    Returns
+    -------
+    UNI11211Design
+        Characteristic and design energy [kJ], design mass [kg] and velocity [m/s], the factors used.
+
+    References
+    ----------
+    UNI 11211-4:2012, Opere di difesa dai crolli in roccia, parte 4: progetto definitivo ed esecutivo.
+    Peila, D. & Ronco, C. (2009). Technical note: Design of rockfall net fences and the new ETAG 027 European
+    guideline. Natural Hazards and Earth System Sciences 9, 1291-1298.
     """
     vol = check_positive(volume_m3, "volume_m3")
     rho = check_positive(density_kg_m3, "density_kg_m3")
@@ -92,8 +143,38 @@ def check_fence(hazard, mel_kj: float, height_m: float, *, T: float = 100.0, fre
     the annual frequency and design-life probability of impacts above each.
     Height: the 95th-percentile bounce height plus ``free_board_m`` against the
     fence height (UNI 11211-4 form), and the share of arriving falls passing over.
-    ``design_energy`` = (e_T, lower, upper) reuses an energy already computed.
-    Returns a table of checks with a verdict column.
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard at the fence line.
+    mel_kj : float
+        The fence's maximum energy level [kJ].
+    height_m : float
+        The fence's height [m].
+    T : float
+        Return period of the design energy [yr].
+    free_board_m : float
+        Margin added to the 95th-percentile bounce height [m].
+    design_life_years : float
+        Period of the probabilities of an impact above MEL and SEL [yr].
+    n_bootstrap : int
+        Replicates of the energy's interval.
+    seed : int
+        Seed of the interval.
+    design_energy : tuple of float, optional
+        (e_T, lower, upper) [kJ] computed before, reused.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per check: ``check``, ``demand``, ``capacity``, ``unit`` (kJ or m), ``interval``, ``adequate``,
+        ``note``.
+
+    References
+    ----------
+    EOTA (2008/2013). ETAG 027, Guideline for European Technical Approval of falling rock protection kits;
+    replaced by EAD 340059-00-0106 (2018).
+    UNI 11211-4:2012 (the height check).
     """
     mel = check_positive(mel_kj, "mel_kj")
     H = check_positive(height_m, "height_m")
@@ -130,9 +211,22 @@ def damage_state_shares(energy_kj, over, mel_kj: float):
     """Shares of falls per column of ``energy_kj`` (rows: simulated blocks; columns e.g. mass classes) that pass
     over (``over``, per row, or per row and column), are held below SEL, held between SEL and MEL, or break through above MEL.
 
-    Returns (passing, held_repair, destroyed), each a share per column; passing = over + destroyed.
     With no simulated falls (no rows: none reached the barrier in that slope model) every share is 0, not
     nan: the shares multiply an arrival rate of zero.
+
+    Parameters
+    ----------
+    energy_kj : array_like
+        Impact energies [kJ], rows the simulated blocks (columns optional).
+    over : array_like of bool
+        Whether each block passes over the barrier (per row, or per row and column).
+    mel_kj : float
+        Maximum energy level [kJ]; SEL = MEL/3.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (passing, held_repair, destroyed) shares [-] per column; passing = over + destroyed.
     """
     e = np.asarray(energy_kj, dtype=float)
     over = np.asarray(over, dtype=bool)
@@ -154,6 +248,23 @@ def out_of_service_share(destructive_rate_per_year, repair_days):
     Impacts above MEL arrive at ``destructive_rate_per_year`` while it works (Poisson); each
     leaves it down for ``repair_days`` (an assumption stated with the results), during which
     it takes no impacts: an alternating renewal process with mean up time 1/lambda.
+
+    Parameters
+    ----------
+    destructive_rate_per_year : float or array_like
+        Rate lambda of impacts above MEL while in service [1/yr].
+    repair_days : float or array_like
+        Time out of service after each [days].
+
+    Returns
+    -------
+    numpy.ndarray
+        Long-run share of time out of service [-].
+
+    References
+    ----------
+    Ross, S. M. (2014). Introduction to Probability Models, 11th ed. Academic Press, chapter 7 (alternating
+    renewal processes: the long-run share of time "on" is E[on] / (E[on] + E[off])).
     """
     lam = np.asarray(destructive_rate_per_year, dtype=float)
     t = np.asarray(repair_days, dtype=float) / DAYS_PER_YEAR
@@ -169,6 +280,28 @@ def barrier_history(times_years, energies_kj, heights_m, *, mel_kj: float, heigh
     it, passes and costs ``replacement_cost``, and the barrier is out of service for
     ``repair_days`` so every later fall in that time passes; a fall between SEL = MEL/3
     and MEL is held and costs ``repair_cost``; below SEL it is held at no cost.
+
+    Parameters
+    ----------
+    times_years : array_like
+        Times of the falls [yr], increasing.
+    energies_kj : array_like
+        Impact energies [kJ].
+    heights_m : array_like or None
+        Bounce heights at the barrier [m] (None: zero).
+    mel_kj : float
+        Maximum energy level [kJ].
+    height_m : float, optional
+        Barrier height [m] (None: a shed roof).
+    repair_days : float
+        Time out of service after a destruction [days].
+    repair_cost, replacement_cost : float
+        Cost of a repair and of a replacement [currency].
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per fall: ``time_years``, ``energy_kj``, ``height_m``, ``outcome``, ``cost``, ``passes``.
     """
     t = np.asarray(times_years, dtype=float)
     e = np.asarray(energies_kj, dtype=float)
