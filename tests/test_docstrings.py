@@ -85,6 +85,7 @@ NUMPYDOC_MODULES = (
     "riskrf/frequency/study.py",
     "riskrf/frequency/inventory.py",
     "riskrf/hazard/barriers.py",
+    "riskrf/io/tables.py",
 )
 
 

@@ -47,7 +47,22 @@ def _header_line(text: str, header_row: int | None) -> str:
 
 
 def sniff_delimiter(path, *, encoding: str | None = None, header_row: int | None = None) -> str:
-    """The most frequent of ``;``, tab, ``|`` and ``,`` on the header line (outside quotes); ``,`` when none."""
+    """The most frequent of ``;``, tab, ``|`` and ``,`` on the header line (outside quotes); ``,`` when none.
+
+    Parameters
+    ----------
+    path : str or path
+        A text table.
+    encoding : str, optional
+        Its encoding (default: detected, as :func:`read_table` does).
+    header_row : int, optional
+        1-based line of the header (default: the first non-empty line).
+
+    Returns
+    -------
+    str
+        The delimiter.
+    """
     return _sniff_text(_decode(Path(path).read_bytes()[:65536], encoding, path)[0], header_row)
 
 
@@ -115,6 +130,26 @@ def read_table(path, *, sheet=None, header_row: int | None = None, encoding: str
     ``comment`` (text files): lines starting with it (after blanks) are read as empty rows,
     so line numbers stay the file's; without ``header_row`` the header is then the first
     line that is neither empty nor a comment.
+
+    Parameters
+    ----------
+    path : str or path
+        CSV/TXT (any of ``;``, tab, ``|``, ``,``), Excel (.xlsx, .xls) or Parquet file.
+    sheet : str or int, optional
+        Excel sheet (default: the first).
+    header_row : int, optional
+        1-based line (spreadsheet row) of the header.
+    encoding : str, optional
+        Text encoding (default: UTF-8 with BOM detection, then the fall-backs of this module).
+    what : str
+        What the table is, for messages (``"inventory"``, ``"velocity"`` ...).
+    comment : str, optional
+        Comment marker of text files.
+
+    Returns
+    -------
+    tuple of (pandas.DataFrame, int, list of str)
+        The table (text cells), the file line of its first data row, and notes (e.g. the encoding used).
     """
     path = Path(path)
     if not path.exists():
@@ -208,12 +243,28 @@ def _excel_cell(v):
 
 
 def is_blank(table: pd.DataFrame) -> pd.Series:
-    """Rows whose every cell is empty text."""
+    """Rows whose every cell is empty text.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A table of text cells (:func:`read_table`).
+
+    Returns
+    -------
+    pandas.Series of bool
+    """
     return (table.astype(str).apply(lambda c: c.str.strip()) == "").all(axis=1)
 
 
 def csv_error():
-    """The csv module's error class (imported on demand), for ``except`` clauses around CSV reading."""
+    """The csv module's error class (imported on demand), for ``except`` clauses around CSV reading.
+
+    Returns
+    -------
+    type
+        :class:`csv.Error`.
+    """
     import csv
     return csv.Error
 
@@ -269,6 +320,26 @@ def parse_numbers(raw: pd.Series, path, col: str, rows, *, decimal: str | None =
     file, row, column and value of the first cell that is not a number; with
     ``errors="coerce"`` such cells give NaN instead (a column mixing decimal marks is
     still refused: that is a property of the file, not of one cell).
+
+    Parameters
+    ----------
+    raw : pandas.Series
+        Text cells.
+    path : str or path
+        The file, for messages.
+    col : str
+        The column, for messages.
+    rows : array_like of int
+        File line of each cell.
+    decimal : {".", ","}, optional
+        Decimal mark, when the file's is known; default: decided from the column.
+    errors : {"raise", "coerce"}
+        What a cell that is not a number does.
+
+    Returns
+    -------
+    pandas.Series
+        Floats (unit as written in the file), NaN for empty cells.
     """
     if errors not in ("raise", "coerce"):
         raise ValueError(f"errors = {errors!r} is not 'raise' or 'coerce'")
@@ -331,7 +402,24 @@ def read_numeric_table(path, *, decimal: str | None = None, numeric=(), **kwargs
     """:func:`read_table`, with every column whose filled cells are all numbers (by the decimal-mark rule)
     converted to float; other columns stay text.  Rows wholly empty are dropped; the index holds each
     row's file line (spreadsheet row; Parquet rows count from 1).  Columns named in ``numeric`` must be
-    numbers: the first cell that is not raises ``ValueError`` naming the file, row, column and value."""
+    numbers: the first cell that is not raises ``ValueError`` naming the file, row, column and value.
+
+    Parameters
+    ----------
+    path : str or path
+        The table file.
+    decimal : {".", ","}, optional
+        Decimal mark, when known.
+    numeric : collection of str
+        Columns that must be numbers.
+    **kwargs
+        Passed to :func:`read_table`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Numeric columns as float, others as text; indexed by file line.
+    """
     table, first, _ = read_table(path, **kwargs)
     rows = np.arange(len(table)) + first
     keep = ~is_blank(table).to_numpy() if len(table) else np.ones(0, bool)
@@ -361,9 +449,26 @@ def _to_dates(year, month, day) -> pd.Series:
 def parse_dates(raw: pd.Series, path, col: str, rows, *, date_format: str | None = None):
     """Dates and years from text cells by the date rule of this module.
 
-    Returns ``(dates, years)``: datetime64 (NaT for a year alone or an empty cell) and Int64
-    years.  Raises ``ValueError`` naming the file, row, column and value for an unreadable or
+    Raises ``ValueError`` naming the file, row, column and value for an unreadable or
     ambiguous date, or a date in the future.
+
+    Parameters
+    ----------
+    raw : pandas.Series
+        Text cells (ISO dates, day-first or month-first dates when unambiguous, years alone).
+    path : str or path
+        The file, for messages.
+    col : str
+        The column, for messages.
+    rows : array_like of int
+        File line of each cell.
+    date_format : str, optional
+        An explicit :func:`~datetime.datetime.strptime` format.
+
+    Returns
+    -------
+    tuple of pandas.Series
+        (dates, years): datetime64 (NaT for a year alone or an empty cell) and Int64 years.
     """
     # Dates repeat: parse each distinct value once (in order of first appearance, so that messages
     # name the first row holding a value) and spread the results over the rows.
