@@ -140,7 +140,7 @@ def read_table(path, *, sheet=None, header_row: int | None = None, encoding: str
     header_row : int, optional
         1-based line (spreadsheet row) of the header.
     encoding : str, optional
-        Text encoding (default: UTF-8 with BOM detection, then the fall-backs of this module).
+        Text encoding (default: UTF-8, a byte-order mark skipped; cp1252 when the file is not UTF-8).
     what : str
         What the table is, for messages (``"inventory"``, ``"velocity"`` ...).
     comment : str, optional
