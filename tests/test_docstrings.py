@@ -86,6 +86,7 @@ NUMPYDOC_MODULES = (
     "riskrf/frequency/inventory.py",
     "riskrf/hazard/barriers.py",
     "riskrf/io/tables.py",
+    "riskrf/io/outputs.py",
 )
 
 

@@ -28,6 +28,26 @@ def check_output(path, *, overwrite: bool = False, kind: str = "dir", option: st
     directory is refused unless ``overwrite`` (it is then replaced whole, see
     :func:`atomic_outputs`); an empty one is used.  ``kind="file"``: an existing
     directory is always refused, an existing file unless ``overwrite``.
+
+    Parameters
+    ----------
+    path : str or path
+        The output asked for.
+    overwrite : bool
+        Whether an existing output may be replaced.
+    kind : {"dir", "file"}
+        What the output is.
+    option : str
+        The command-line option that named it, for the message.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    ValueError
+        Naming the path and the option.
     """
     path = Path(path)
     for parent in path.parents:
@@ -113,7 +133,20 @@ def files_named_in_toml(path, *, label: str = "") -> dict:
     """Every existing file a TOML input names (relative to its folder), with the TOML itself and each named
     file's sidecar ``<stem>.toml``: ``{"what it is": path}`` for :func:`check_output_spares_inputs`.
 
-    Unreadable TOML gives just the file itself (its own reader reports the error)."""
+    Unreadable TOML gives just the file itself (its own reader reports the error).
+
+    Parameters
+    ----------
+    path : str or path
+        A TOML input (site, scenario, corridor, options).
+    label : str
+        What the TOML is, for the keys.
+
+    Returns
+    -------
+    dict
+        ``{"what it is": pathlib.Path}``.
+    """
     import tomllib
     path = Path(path)
     label = label or "input file"
@@ -159,7 +192,17 @@ def _neutralise_cell(cell: str) -> str:
 
 
 def neutralise_csv(path) -> None:
-    """Prefix with ``'`` every text cell that a spreadsheet would execute as a formula (=, +, -, @)."""
+    """Prefix with ``'`` every text cell that a spreadsheet would execute as a formula (=, +, -, @).
+
+    Parameters
+    ----------
+    path : str or path
+        A CSV file (UTF-8), rewritten in place when a cell changes.
+
+    References
+    ----------
+    OWASP, CSV Injection (https://owasp.org/www-community/attacks/CSV_Injection).
+    """
     path = Path(path)
     with open(path, newline="", encoding="utf-8", errors="surrogateescape") as fh:
         rows = list(csv.reader(fh))
@@ -197,6 +240,20 @@ def atomic_outputs(targets, *, overwrite: bool = False, option: str = "--out"):
     success each is renamed into place; an existing target is replaced only with ``overwrite``
     (it is renamed aside first and restored if a later rename fails).  On any exception,
     including Ctrl-C, the temporary siblings are removed and the targets are left as they were.
+
+    Parameters
+    ----------
+    targets : list of (path, str)
+        Each output and its kind, ``"dir"`` or ``"file"``.
+    overwrite : bool
+        Whether existing targets may be replaced.
+    option : str
+        The command-line option that named them, for messages.
+
+    Yields
+    ------
+    list of pathlib.Path
+        The temporary siblings, in the order of ``targets``.
     """
     targets = [(Path(p), k) for p, k in targets]
     for p, k in targets:
@@ -248,6 +305,18 @@ def atomic_output_dir(path, *, overwrite: bool = False):
 
     An existing non-empty ``path`` is refused unless ``overwrite``, and then replaced whole
     (never merged); an existing file is always refused.
+
+    Parameters
+    ----------
+    path : str or path
+        The output directory.
+    overwrite : bool
+        Whether an existing one may be replaced.
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary directory to write into.
     """
     with atomic_outputs([(path, "dir")], overwrite=overwrite) as tmp:
         yield tmp
@@ -275,7 +344,15 @@ def _clean(value):
 
 
 def write_json(data, path) -> None:
-    """Write ``data`` as indented JSON; NaN and infinity become null."""
+    """Write ``data`` as indented JSON; NaN and infinity become null.
+
+    Parameters
+    ----------
+    data : object
+        JSON-ready values (numpy scalars and arrays, DataFrames and paths are converted).
+    path : str or path
+        The file written (UTF-8).
+    """
     Path(path).write_text(json.dumps(_clean(data), indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
 
 
@@ -287,7 +364,20 @@ _ABSOLUTE_PATH = re.compile(r"(?<![\w.:/&;+=,<~-])/(?:[\w.-]+/)+[\w.-]+")
 def shown_path(path, base) -> str:
     """``path`` as written in outputs: relative to ``base`` (the site file's folder) when it lies there; a file
     of the installed package (bundled data, shipped scenarios) as its name inside the package
-    (``riskrf/data/NAME``); anything else relative to ``base`` (with ``..``), never the machine's absolute path."""
+    (``riskrf/data/NAME``); anything else relative to ``base`` (with ``..``), never the machine's absolute path.
+
+    Parameters
+    ----------
+    path : str or path
+        The path to show.
+    base : str or path
+        The folder paths are relative to.
+
+    Returns
+    -------
+    str
+        POSIX form.
+    """
     p = Path(os.path.abspath(str(path)))
     base = Path(os.path.abspath(str(base)))
     if p.is_relative_to(base):
@@ -300,7 +390,20 @@ def shown_path(path, base) -> str:
 
 def relative_paths(value, base):
     """``value`` (text, or a dict/list of them, e.g. a JSON summary) with every absolute path in its text
-    written by :func:`shown_path` relative to ``base``; other values unchanged."""
+    written by :func:`shown_path` relative to ``base``; other values unchanged.
+
+    Parameters
+    ----------
+    value : object
+        Text, or nested dicts and lists holding text.
+    base : str or path
+        The folder paths are made relative to.
+
+    Returns
+    -------
+    object
+        The same structure with paths rewritten.
+    """
     if isinstance(value, str):
         return _ABSOLUTE_PATH.sub(lambda m: shown_path(m.group(0), base), value)
     if isinstance(value, Path):
@@ -315,7 +418,17 @@ def relative_paths(value, base):
 def relative_paths_in_json_files(folder, base, *, skip=("inputs",)) -> None:
     """Rewrite every ``*.json`` below ``folder`` with :func:`relative_paths` (base: the site file's folder), so
     that no output names a directory of the machine it ran on.  Subfolders named in ``skip`` (the copy of the
-    inputs and the command as typed, kept for exact reruns) are left as they are."""
+    inputs and the command as typed, kept for exact reruns) are left as they are.
+
+    Parameters
+    ----------
+    folder : str or path
+        The output folder.
+    base : str or path
+        The site file's folder.
+    skip : tuple of str
+        Subfolders left alone.
+    """
     for path in sorted(Path(folder).rglob("*.json")):
         if set(path.relative_to(folder).parts[:-1]) & set(skip):
             continue
