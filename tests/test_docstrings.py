@@ -87,6 +87,7 @@ NUMPYDOC_MODULES = (
     "riskrf/hazard/barriers.py",
     "riskrf/io/tables.py",
     "riskrf/io/outputs.py",
+    "riskrf/hazard/impact_energy.py",
 )
 
 

@@ -59,7 +59,14 @@ class VelocityFit:
     n: int
 
     def summary(self) -> pd.DataFrame:
-        """The candidate table: distribution, parameters, log-likelihood, AIC and whether it was chosen."""
+        """The candidate table: distribution, parameters, log-likelihood, AIC and whether it was chosen.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by model, lowest AIC first: ``params`` (scipy's, velocities in m/s), ``loglik``, ``aic``,
+            ``ks_distance``, ``ks_p_value``, ``delta_aic``.
+        """
         return self.table
 
 
@@ -71,6 +78,15 @@ def is_mass_coupled(velocity) -> bool:
     (e [kJ] -> P(E > e) per arriving fall), ``velocity_percentile(q, mass_kg)``, ``class_of(mass_kg)``,
     ``n_bins`` and ``mass_kg``.  A declared flag, not the class, so that this module does not import the
     module that builds such models from simulations.
+
+    Parameters
+    ----------
+    velocity : object
+        Any velocity model.
+
+    Returns
+    -------
+    bool
     """
     return getattr(type(velocity), "mass_coupled_velocity", False) is True
 
@@ -80,6 +96,24 @@ def fit_velocity(samples, candidates=("normal", "lognormal", "gamma", "weibull")
     The table reports for each candidate its parameters, log-likelihood, AIC,
     ΔAIC and the KS distance and p-value (the p-value is optimistic because the
     parameters were fitted to the same data).
+
+    Parameters
+    ----------
+    samples : array_like
+        Velocities [m/s], finite and > 0.
+    candidates : sequence of str
+        Families among ``"normal"``, ``"lognormal"``, ``"gamma"``, ``"weibull"`` (location fixed at 0 except the
+        normal).
+
+    Returns
+    -------
+    VelocityFit
+        The chosen family, its frozen distribution [m/s] and the table of candidates.
+
+    References
+    ----------
+    Akaike, H. (1974). A new look at the statistical model identification. IEEE Transactions on Automatic Control
+    19(6), 716-723.
     """
     v = _positive_samples(samples, "velocity")
     families = {"normal": stats.norm, "lognormal": stats.lognorm, "gamma": stats.gamma,
@@ -120,12 +154,28 @@ class PairedSamples:
     def from_collector(cls, df: pd.DataFrame, n_bins: int = 10) -> "PairedSamples":
         """Paired samples from a collector table (columns ``velocity_ms`` [m/s] and ``mass_kg`` [kg], e.g.
         :meth:`simulation.SimulationResult.collector`), in ``n_bins`` mass classes.
+
+        Parameters
+        ----------
+        df : pandas.DataFrame
+            With columns ``velocity_ms`` [m/s] and ``mass_kg`` [kg].
+        n_bins : int
+            Most mass classes.
+
+        Returns
+        -------
+        PairedSamples
         """
         return cls(np.asarray(df["velocity_ms"], dtype=float), np.asarray(df["mass_kg"], dtype=float), n_bins)
 
     def classes(self):
         """Mass classes of equal counts (at most ``n_bins``, at least 20 blocks each): the class edges [kg]
         (geometric means of neighbouring masses) and the sorted speeds [m/s] of each class.
+
+        Returns
+        -------
+        tuple of (numpy.ndarray, list of numpy.ndarray)
+            Class edges [kg] and the sorted speeds [m/s] of each class.
         """
         order = np.argsort(self.mass_kg)
         groups = np.array_split(order, min(self.n_bins, max(1, self.mass_kg.size // 20)))
@@ -155,7 +205,18 @@ class _MassModel:
 
 
 def mass_model(mass) -> _MassModel:
-    """Wrap any accepted mass description in a uniform interface (sf, isf, rvs)."""
+    """Wrap any accepted mass description in a uniform interface (sf, isf, rvs).
+
+    Parameters
+    ----------
+    mass : GutenbergRichterFit, GumbelFit, GEVFit, scipy frozen distribution or array_like
+        Mass model or samples [kg] (a power law must be in kg: :meth:`GutenbergRichterFit.to_mass`).
+
+    Returns
+    -------
+    _MassModel
+        ``sf(m)``, ``isf(p)``, ``rvs(n, rng)`` of the mass of one fall [kg], a ``description`` and the support.
+    """
     if isinstance(mass, GutenbergRichterFit):
         if mass.units != "kg":
             raise ValueError(f"the power-law fit is in {mass.units!r}; convert it with .to_mass(density) first")
@@ -467,6 +528,16 @@ def exceedance_probability(energy_kj, mass, velocity, *, angular_velocity=None, 
         Numerical integration (default) or Monte Carlo with ``n_samples`` draws.
     n_samples, seed
         Draws and seed of ``method="mc"``.
+
+    Returns
+    -------
+    numpy.ndarray
+        P(E > e) [-], the shape of ``energy_kj``: the integral over the mass model of P(V > v(e, m)), with
+        E = 1/2 m v² (+ 1/2 k m r² ω²) / 1000 [kJ].
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, eq. 3.1-3.2 (kinetic energy).
     """
     e = _check_energies(energy_kj)
     check_choice(method, "method", ("quad", "mc"))
@@ -485,6 +556,18 @@ def exceedance_function(mass, velocity):
 
     The same values as :func:`exceedance_probability` (default quadrature); use it where one
     curve is evaluated many times (root finding for design energies).
+
+    Parameters
+    ----------
+    mass : mass model
+        As for :func:`exceedance_probability` [kg].
+    velocity : velocity model
+        As for :func:`exceedance_probability` [m/s].
+
+    Returns
+    -------
+    callable
+        ``f(energy_kj) -> P(E > e)``.
     """
     return velocity_model(velocity).exceedance_function(mass_model(mass))
 
@@ -561,6 +644,22 @@ def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=Non
     Same models and arguments as :func:`exceedance_probability` (``inertia_factor`` k = I / (m r^2),
     the sphere's 2/5 by default); ``n_samples`` draws with ``seed``; the interval is the Wilson
     score interval at ``level``.
+
+    Parameters
+    ----------
+    energy_kj, mass, velocity, angular_velocity, density_kg_m3, inertia_factor
+        As for :func:`exceedance_probability` (kJ, kg, m/s, rad/s, kg/m³).
+    n_samples : int
+        Monte Carlo draws.
+    seed : int, optional
+        Seed of the draws.
+    level : float
+        Confidence level of the Wilson interval.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (p, lower, upper) [-], each the shape of ``energy_kj``.
     """
     from simulation.result import wilson_interval
 
@@ -578,7 +677,22 @@ def exceedance_probability_mc(energy_kj, mass, velocity, *, angular_velocity=Non
 
 
 def energy_quantile(p, mass, velocity, **kwargs):
-    """Energy [kJ] exceeded with probability p by one fall (inverse of :func:`exceedance_probability`)."""
+    """Energy [kJ] exceeded with probability p by one fall (inverse of :func:`exceedance_probability`).
+
+    Parameters
+    ----------
+    p : float or array_like
+        Exceedance probabilities, in (0, 1).
+    mass, velocity
+        As for :func:`exceedance_probability`.
+    **kwargs
+        Passed to :func:`exceedance_probability`.
+
+    Returns
+    -------
+    numpy.ndarray
+        Energies [kJ] (Brent's root of log P(E > e) = log p).
+    """
     p = np.atleast_1d(np.asarray(p, dtype=float))
     if np.any((p <= 0) | (p >= 1)):
         raise ValueError(f"p = {p[(p <= 0) | (p >= 1)][0]!r}: probabilities must lie strictly between 0 and 1")
