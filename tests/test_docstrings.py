@@ -88,6 +88,7 @@ NUMPYDOC_MODULES = (
     "riskrf/io/tables.py",
     "riskrf/io/outputs.py",
     "riskrf/hazard/impact_energy.py",
+    "riskrf/hazard/annual_hazard.py",
 )
 
 

@@ -126,3 +126,12 @@ def test_power_law_interval_has_the_annual_maximum_fits_name(objects):
     with pytest.warns(DeprecationWarning, match="return_level_ci"):
         old = gr.mass_at_return_period_ci(T)
     np.testing.assert_array_equal(old, (lo, hi))
+
+
+def test_energy_hazard_has_the_return_level_names(objects):
+    """``EnergyHazard.return_level``/``return_level_ci``: the T-year energy under the mass models' names."""
+    hz = objects["EnergyHazard"]
+    T = np.array([100.0, 1000.0])
+    np.testing.assert_array_equal(hz.return_level(T), hz.energy_at_return_period(T))
+    np.testing.assert_array_equal(hz.return_level_ci(T, n_bootstrap=20, seed=3),
+                                  hz.energy_at_return_period_ci(T, n_bootstrap=20, seed=3))

@@ -32,7 +32,18 @@ from simulation._display import Displayed, axes, short_repr
 
 
 def inertia_factors(df) -> np.ndarray:
-    """I / (m r^2) of each block in a collector table (0.4, a sphere, when the table does not say)."""
+    """I / (m r^2) of each block in a collector table (0.4, a sphere, when the table does not say).
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        A collector table (:meth:`simulation.SimulationResult.collector`).
+
+    Returns
+    -------
+    numpy.ndarray
+        k [-] per row.
+    """
     return df["inertia_factor"].to_numpy(dtype=float) if "inertia_factor" in df else np.full(len(df), SPHERE_INERTIA)
 
 
@@ -84,6 +95,25 @@ class EnergyHazard(Displayed):
         velocities are pooled over the seeder's masses (``condition_on_mass`` classes them by the
         seeder's masses, without simulating beyond them).  The mass-coupled hazard, which simulates
         the whole range of the mass model, is :func:`riskrf.energy_hazard`.
+
+        Parameters
+        ----------
+        mass : mass model
+            Usually a :class:`~riskrf.GutenbergRichterFit` [kg].
+        result : simulation.SimulationResult
+            The run.
+        collector : str
+            The line.
+        rate_per_year : float, optional
+            Falls per year described by ``mass`` [1/yr] (default: the power law's rate above m_min).
+        rotational : bool
+            Include the rotational energy: v_eff² = v² + k (ω r)².
+        condition_on_mass : bool
+            Class the velocities by the seeder's masses (:class:`~riskrf.hazard.impact_energy.PairedSamples`).
+
+        Returns
+        -------
+        EnergyHazard
         """
         if rate_per_year is None:
             if not isinstance(mass, GutenbergRichterFit):
@@ -112,7 +142,19 @@ class EnergyHazard(Displayed):
         return velocity_model(self.velocity).mass_coupled
 
     def with_mass(self, mass, rate_per_year: float | None = None) -> "EnergyHazard":
-        """The same slope with another mass model (and rate): a mass-coupled reach probability is recomputed."""
+        """The same slope with another mass model (and rate): a mass-coupled reach probability is recomputed.
+
+        Parameters
+        ----------
+        mass : mass model
+            The new mass model [kg].
+        rate_per_year : float, optional
+            Its falls per year [1/yr] (default: unchanged).
+
+        Returns
+        -------
+        EnergyHazard
+        """
         rate = self.rate_per_year if rate_per_year is None else check_positive(rate_per_year, "rate_per_year")
         if self.mass_coupled:
             mm = mass_model(mass)
@@ -123,11 +165,33 @@ class EnergyHazard(Displayed):
 
     # ---- per fall -------------------------------------------------------------------
     def exceedance_probability(self, energy_kj):
-        """P(E > e) for one fall that reaches the line."""
+        """P(E > e) for one fall that reaches the line.
+
+        Parameters
+        ----------
+        energy_kj : float or array_like
+            Energies [kJ].
+
+        Returns
+        -------
+        numpy.ndarray
+            Probabilities [-].
+        """
         return exceedance_probability(energy_kj, self.mass, self.velocity)
 
     def energy_percentile(self, q):
-        """Energy [kJ] not exceeded by q % of the falls that reach the line (e.g. q = 95, 99)."""
+        """Energy [kJ] not exceeded by q % of the falls that reach the line (e.g. q = 95, 99).
+
+        Parameters
+        ----------
+        q : float or array_like
+            Percentiles, in (0, 100).
+
+        Returns
+        -------
+        numpy.ndarray
+            Energies [kJ].
+        """
         q = np.atleast_1d(np.asarray(q, dtype=float))
         if np.any((q <= 0) | (q >= 100)):
             raise ValueError(f"percentiles must lie strictly between 0 and 100; got {q.tolist()}")
@@ -136,17 +200,52 @@ class EnergyHazard(Displayed):
     def velocity_percentile(self, q, mass_kg=None) -> float:
         """Velocity [m/s] not exceeded by q % of the falls reaching the line, whatever the velocity model.
 
-        With a mass-coupled model and ``mass_kg``: of the simulated blocks of that mass (its mass class)."""
+        With a mass-coupled model and ``mass_kg``: of the simulated blocks of that mass (its mass class).
+
+        Parameters
+        ----------
+        q : float
+            Percentile, in [0, 100].
+        mass_kg : float, optional
+            Block mass [kg] (mass-coupled models only).
+
+        Returns
+        -------
+        float
+            Velocity [m/s].
+        """
         return velocity_model(self.velocity).percentile(q, mass_kg)
 
     def height_percentile(self, q):
-        """Bounce height [m] not exceeded by q % of the falls reaching the line (from simulated heights)."""
+        """Bounce height [m] not exceeded by q % of the falls reaching the line (from simulated heights).
+
+        Parameters
+        ----------
+        q : float or array_like
+            Percentile(s), in [0, 100].
+
+        Returns
+        -------
+        numpy.ndarray or float
+            Height of the block centre above the ground [m].
+        """
         if self.heights_m is None:
             raise ValueError("no bounce heights: build the hazard with EnergyHazard.from_simulation")
         return np.percentile(self.heights_m, q)
 
     def height_exceedance(self, height_m):
-        """P(bounce height > h) for a fall reaching the line (the share that would pass over a fence)."""
+        """P(bounce height > h) for a fall reaching the line (the share that would pass over a fence).
+
+        Parameters
+        ----------
+        height_m : float or array_like
+            Height above the ground [m].
+
+        Returns
+        -------
+        numpy.ndarray or float
+            Share of the simulated arriving falls [-].
+        """
         if self.heights_m is None:
             raise ValueError("no bounce heights: build the hazard with EnergyHazard.from_simulation")
         h = np.sort(self.heights_m)
@@ -159,20 +258,66 @@ class EnergyHazard(Displayed):
         return self.rate_per_year * self.reach_probability
 
     def annual_frequency(self, energy_kj):
-        """Impacts with energy above e per year at the line [1/yr]."""
+        """Impacts with energy above e per year at the line [1/yr].
+
+        Parameters
+        ----------
+        energy_kj : float or array_like
+            Energies [kJ].
+
+        Returns
+        -------
+        numpy.ndarray
+            lambda(e) = arrivals per year x P(E > e) [1/yr].
+        """
         return self.arrival_rate * self.exceedance_probability(energy_kj)
 
     def return_period(self, energy_kj):
-        """Mean time [yr] between impacts above e."""
+        """Mean time [yr] between impacts above e.
+
+        Parameters
+        ----------
+        energy_kj : float or array_like
+            Energies [kJ].
+
+        Returns
+        -------
+        numpy.ndarray
+            1 / lambda(e) [yr] (infinite where no impact exceeds e).
+        """
         with np.errstate(divide="ignore"):
             return 1.0 / self.annual_frequency(energy_kj)
 
     def probability_in(self, years, energy_kj):
-        """P(at least one impact above e in ``years``), Poisson: 1 - exp(-lambda(e) years)."""
+        """P(at least one impact above e in ``years``), Poisson: 1 - exp(-lambda(e) years).
+
+        Parameters
+        ----------
+        years : float
+            Period [yr], e.g. a design life.
+        energy_kj : float or array_like
+            Energies [kJ].
+
+        Returns
+        -------
+        numpy.ndarray
+            Probabilities [-].
+        """
         return -np.expm1(-check_positive(years, "years") * self.annual_frequency(energy_kj))
 
     def energy_at_return_period(self, T):
-        """Energy [kJ] exceeded on average once in T years at the line."""
+        """Energy [kJ] exceeded on average once in T years at the line.
+
+        Parameters
+        ----------
+        T : float or array_like
+            Return period [yr], longer than the mean time between arrivals.
+
+        Returns
+        -------
+        numpy.ndarray
+            Energy e with lambda(e) = 1/T [kJ].
+        """
         T = check_return_periods(T)
         p = 1.0 / (T * self.arrival_rate)
         if np.any(p >= 1):
@@ -180,6 +325,43 @@ class EnergyHazard(Displayed):
             raise ValueError(f"T = {bad:g} yr is shorter than the mean time between arrivals at the line "
                              f"({1 / self.arrival_rate:.3g} yr): every arriving fall exceeds the T-year energy")
         return self._invert(np.atleast_1d(p), scale=1.0).reshape(np.shape(T))
+
+    def return_level(self, T):
+        """Energy [kJ] exceeded on average once in T years: :meth:`energy_at_return_period` under the name the
+        mass models use (:meth:`riskrf.GumbelFit.return_level`, :meth:`riskrf.GutenbergRichterFit.return_level`).
+
+        Parameters
+        ----------
+        T : float or array_like
+            Return period [yr].
+
+        Returns
+        -------
+        numpy.ndarray
+            Energy [kJ].
+        """
+        return self.energy_at_return_period(T)
+
+    def return_level_ci(self, T, level: float = 0.95, n_bootstrap: int = 300, seed=None):
+        """Interval of :meth:`return_level`: :meth:`energy_at_return_period_ci` under the mass models' name.
+
+        Parameters
+        ----------
+        T : float or array_like
+            Return period [yr].
+        level : float
+            Confidence level.
+        n_bootstrap : int
+            Replicates.
+        seed : int, optional
+            Seed of the replicates.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (lower, upper) energies [kJ].
+        """
+        return self.energy_at_return_period_ci(T, level, n_bootstrap, seed)
 
     def _invert(self, p, scale):
         """Energy where scale x P(E > e) = p: grid interpolation, then refined by root finding."""
@@ -216,7 +398,26 @@ class EnergyHazard(Displayed):
         credible block m_max and the rate share of the source (judgement inputs:
         see ``riskrf.hazard.energy_study.design_energy_sensitivity``), the simulation's
         physical parameters, the record's completeness.
-        Returns (lower, upper) arrays.
+
+        Parameters
+        ----------
+        T : float or array_like
+            Return period [yr].
+        level : float
+            Confidence level.
+        n_bootstrap : int
+            Replicates.
+        seed : int, optional
+            Seed of the replicates.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (lower, upper) energies [kJ].
+
+        References
+        ----------
+        Jeffreys, H. (1961). Theory of Probability, 3rd ed. Oxford University Press (the scale-invariant prior).
         """
         T = check_return_periods(T)
         level = check_probability_level(level)
@@ -279,7 +480,25 @@ class EnergyHazard(Displayed):
     # ---- tables ---------------------------------------------------------------------
     def design_table(self, T=DESIGN_RETURN_PERIODS, level: float = 0.95, n_bootstrap: int = 300,
                      seed=1) -> pd.DataFrame:
-        """Energy [kJ] for each return period, with bootstrap intervals."""
+        """Energy [kJ] for each return period, with bootstrap intervals.
+
+        Parameters
+        ----------
+        T : sequence of float
+            Return periods [yr].
+        level : float
+            Confidence level.
+        n_bootstrap : int
+            Replicates of the intervals.
+        seed : int
+            Seed of the intervals.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``T_years``, ``annual_exceedance`` [1/yr], ``energy_kj``, ``ci_low_kj``, ``ci_high_kj``,
+            ``probability_in_50_years``.
+        """
         T = np.asarray(T, dtype=float)
         ok = T * self.arrival_rate > 1
         e = np.full(T.size, 0.0)
@@ -293,6 +512,11 @@ class EnergyHazard(Displayed):
     def summary(self) -> pd.DataFrame:
         """Key figures of the hazard at the line (one-column table): falls per year, reach probability, arrivals
         per year [1/yr], the mass model, mass coupling and the 95th/99th-percentile energies [kJ].
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: quantity; column ``value``.
         """
         rows = {"collector": self.collector, "falls per year (mass model)": self.rate_per_year,
                 "reach probability": self.reach_probability, "arrivals per year": self.arrival_rate,
