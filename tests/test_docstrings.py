@@ -89,6 +89,7 @@ NUMPYDOC_MODULES = (
     "riskrf/io/outputs.py",
     "riskrf/hazard/impact_energy.py",
     "riskrf/hazard/annual_hazard.py",
+    "riskrf/frequency/power_law.py",
 )
 
 

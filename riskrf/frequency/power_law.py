@@ -106,6 +106,14 @@ def find_m_min(masses, *, min_tail: int = 10, exhaustive: bool = False, statisti
     fraction of a second.  ``exhaustive=True`` computes D for every candidate
     (O(N^2), the reference for tests).
 
+    Parameters
+    ----------
+    masses : array_like
+        Sizes [kg or m³], finite and > 0.
+    min_tail : int
+        Fewest values at or above a candidate threshold.
+    exhaustive : bool
+        Compute D for every candidate.
     statistic : {"clauset", "sup"}
         The KS statistic (see :data:`KS_STATISTICS`); ``"clauset"`` (default)
         reproduces the published thresholds and p-values of Clauset et al. (2009).
@@ -118,7 +126,14 @@ def find_m_min(masses, *, min_tail: int = 10, exhaustive: bool = False, statisti
 
     Returns
     -------
-    (m_min, D, b) : threshold, its KS distance, and the exponent above it.
+    tuple of float
+        (m_min, D, b): the threshold [unit of ``masses``], its KS distance [-] and the cumulative exponent b
+        above it.
+
+    References
+    ----------
+    Clauset, A., Shalizi, C. R. & Newman, M. E. J. (2009). Power-law distributions in empirical data. SIAM Review
+    51(4), 661-703.
     """
     check_choice(statistic, "statistic", KS_STATISTICS)
     x = np.sort(as_positive_array(masses, "masses"))
@@ -256,7 +271,13 @@ class PowerLawBootstrap(Displayed):
         return float(np.sqrt(self.p_value * (1 - self.p_value) / self.n_completed))
 
     def summary(self) -> pd.DataFrame:
-        """p-value, its Monte Carlo error, the KS statistic used and the replicates completed."""
+        """p-value, its Monte Carlo error, the KS statistic used and the replicates completed.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by quantity; columns ``value``, ``note``.
+        """
         label = {"clauset": "Clauset et al. (2009) code: max |F(x_i) - (i-1)/n|",
                  "sup": "supremum distance of the empirical CDF (ties exact)"}[self.ks_statistic]
         rows = [("p_value", self.p_value, f"Monte Carlo SE {self.p_stderr:.3f}; > 0.1: power law plausible"),
@@ -336,22 +357,66 @@ class GutenbergRichterFit(Displayed):
 
     # -- distribution of one fall ------------------------------------------------
     def sf(self, m):
-        """P(one fall of at least m_min is larger than m) [-]; 1 below m_min."""
+        """P(one fall of at least m_min is larger than m) [-]; 1 below m_min.
+
+        Parameters
+        ----------
+        m : float or array_like
+            Size [units: kg, or m³ for a fit to volumes].
+
+        Returns
+        -------
+        numpy.ndarray
+            (m / m_min)^-b, renormalised between m_min and m_max when truncated.
+        """
         return _truncated_sf(m, self.b, self.m_min, self.m_max)
 
     def cdf(self, m):
-        """P(M <= m) of the fitted law above m_min (truncated at m_max where given)."""
+        """P(M <= m) of the fitted law above m_min (truncated at m_max where given).
+
+        Parameters
+        ----------
+        m : float or array_like
+            Size [units].
+
+        Returns
+        -------
+        numpy.ndarray
+            1 - :meth:`sf`.
+        """
         return 1.0 - self.sf(m)
 
     def isf(self, p):
-        """Mass exceeded with probability p by one fall of at least m_min [units]."""
+        """Mass exceeded with probability p by one fall of at least m_min [units].
+
+        Parameters
+        ----------
+        p : float or array_like
+            Probabilities, in (0, 1].
+
+        Returns
+        -------
+        numpy.ndarray
+            Sizes [units].
+        """
         p = np.asarray(p, dtype=float)
         if np.any((p <= 0) | (p > 1)):
             raise ValueError(f"p = {p[(p <= 0) | (p > 1)].ravel()[0]!r}: probabilities must lie in (0, 1]")
         return _truncated_isf(p, self.b, self.m_min, self.m_max)
 
     def pdf(self, m):
-        """Probability density [1/kg] of the fitted law, zero outside its support."""
+        """Probability density [1/kg] of the fitted law, zero outside its support.
+
+        Parameters
+        ----------
+        m : float or array_like
+            Size [units].
+
+        Returns
+        -------
+        numpy.ndarray
+            Density [1/units].
+        """
         m = np.asarray(m, dtype=float)
         inside = (m >= self.m_min) & (m <= (self.m_max if self.m_max is not None else np.inf))
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -359,7 +424,20 @@ class GutenbergRichterFit(Displayed):
         return np.where(inside, dens, 0.0)
 
     def rvs(self, size=None, random_state=None):
-        """Random masses of falls of at least m_min (inverse-CDF sampling)."""
+        """Random masses of falls of at least m_min (inverse-CDF sampling).
+
+        Parameters
+        ----------
+        size : int or tuple, optional
+            Output shape.
+        random_state : int or numpy.random.Generator, optional
+            Seed or generator.
+
+        Returns
+        -------
+        numpy.ndarray
+            Sizes [units].
+        """
         rng = np.random.default_rng(random_state)
         return _truncated_isf(1.0 - rng.uniform(size=size), self.b, self.m_min, self.m_max)
 
@@ -378,11 +456,37 @@ class GutenbergRichterFit(Displayed):
         return m
 
     def annual_frequency(self, m):
-        """N(>=m): falls of at least m per year [1/yr], for m >= m_min."""
+        """N(>=m): falls of at least m per year [1/yr], for m >= m_min.
+
+        Parameters
+        ----------
+        m : float or array_like
+            Size [units], >= m_min.
+
+        Returns
+        -------
+        numpy.ndarray
+            rate_min x sf(m) [1/yr] (10^(a - b log10 m) when untruncated).
+
+        References
+        ----------
+        Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, section 8.4.1.
+        """
         return self.rate_min * self.sf(self._check_above_m_min(m))
 
     def return_period(self, m):
-        """Mean time between falls of at least m [yr], 1 / N(>=m)."""
+        """Mean time between falls of at least m [yr], 1 / N(>=m).
+
+        Parameters
+        ----------
+        m : float or array_like
+            Size [units], >= m_min.
+
+        Returns
+        -------
+        numpy.ndarray
+            Return period [yr].
+        """
         with np.errstate(divide="ignore"):
             return 1.0 / self.annual_frequency(m)
 
@@ -391,6 +495,20 @@ class GutenbergRichterFit(Displayed):
 
         This is Wyllie's return period of a magnitude.  The T-year level of the
         *annual maximum* is :meth:`annual_max_return_level` (slightly larger).
+
+        Parameters
+        ----------
+        T : float or array_like
+            Return period [yr], at least 1 / rate_min.
+
+        Returns
+        -------
+        numpy.ndarray
+            Size [units].
+
+        References
+        ----------
+        Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, section 8.4.1.
         """
         T = np.asarray(T, dtype=float)
         p = 1.0 / (T * self.rate_min)
@@ -400,12 +518,36 @@ class GutenbergRichterFit(Displayed):
         return _truncated_isf(p, self.b, self.m_min, self.m_max)
 
     def probability_in(self, years, m):
-        """P(at least one fall of mass >= m in ``years``), Poisson: 1 - exp(-N(>=m) years)."""
+        """P(at least one fall of mass >= m in ``years``), Poisson: 1 - exp(-N(>=m) years).
+
+        Parameters
+        ----------
+        years : float or array_like
+            Period [yr].
+        m : float or array_like
+            Size [units], >= m_min.
+
+        Returns
+        -------
+        numpy.ndarray
+            Probability [-].
+        """
         years = check_positive(years, "years") if np.ndim(years) == 0 else np.asarray(years, dtype=float)
         return -np.expm1(-np.asarray(years) * self.annual_frequency(m))
 
     def annual_max_cdf(self, m):
-        """P(largest fall of a year <= m) = exp(-N(>=m)) (a Frechet law when untruncated)."""
+        """P(largest fall of a year <= m) = exp(-N(>=m)) (a Frechet law when untruncated).
+
+        Parameters
+        ----------
+        m : float or array_like
+            Size [units], >= m_min.
+
+        Returns
+        -------
+        numpy.ndarray
+            Probability [-].
+        """
         return np.exp(-self.annual_frequency(m))
 
     def annual_max_return_level(self, T):
@@ -413,6 +555,16 @@ class GutenbergRichterFit(Displayed):
 
         Solves exp(-N(>=m)) = 1 - 1/T, i.e. ``m = (10^a / -ln(1 - 1/T))^(1/b)``
         when untruncated (a Frechet, or GEV with xi = 1/b, law).
+
+        Parameters
+        ----------
+        T : float or array_like
+            Return period [yr], > 1.
+
+        Returns
+        -------
+        numpy.ndarray
+            Size [units].
         """
         T = np.asarray(T, dtype=float)
         p = -np.log1p(-1.0 / T) / self.rate_min
@@ -496,7 +648,18 @@ class GutenbergRichterFit(Displayed):
         return np.exp(centre - z * se), np.exp(centre + z * se)
 
     def to_mass(self, density_kg_m3: float) -> "GutenbergRichterFit":
-        """Convert a fit to volumes [m³] into one to masses [kg]: b is unchanged, a shifts by b log10 rho."""
+        """Convert a fit to volumes [m³] into one to masses [kg]: b is unchanged, a shifts by b log10 rho.
+
+        Parameters
+        ----------
+        density_kg_m3 : float
+            Rock density [kg/m³].
+
+        Returns
+        -------
+        GutenbergRichterFit
+            In kg.
+        """
         if self.units != "m3":
             raise ValueError(f"to_mass converts a fit to volumes (units 'm3'); this fit is in {self.units!r}")
         rho = check_positive(density_kg_m3, "density_kg_m3")
@@ -527,8 +690,17 @@ class GutenbergRichterFit(Displayed):
         distance is at least the observed one, and the result says how many
         completed.  Replicate i draws from the i-th child of
         ``SeedSequence(seed).spawn(n_bootstrap)``, so the result does not depend
-        on ``workers`` or on the order in which replicates finish.
+        on ``workers`` or on the order in which replicates finish.  A Ctrl-C (``KeyboardInterrupt``) stops the
+        remaining replicates and propagates.
 
+        Parameters
+        ----------
+        n_bootstrap : int
+            Replicates.
+        seed : int, optional
+            Seed of the replicates.
+        min_tail : int
+            Fewest values above a threshold in a replicate's search.
         workers : int, optional
             Threads running replicates (the compiled threshold scan releases the
             interpreter lock).  None: one per core for samples of 20,000 to
@@ -551,7 +723,15 @@ class GutenbergRichterFit(Displayed):
             then takes about 0.05 s instead of 3-7 s; neighbouring candidates
             are under 0.6 % apart in tail size.
 
-        A Ctrl-C (``KeyboardInterrupt``) stops the remaining replicates and propagates.
+        Returns
+        -------
+        PowerLawBootstrap
+            p-value, replicates completed, KS distance and statistic.
+
+        References
+        ----------
+        Clauset, A., Shalizi, C. R. & Newman, M. E. J. (2009). Power-law distributions in empirical data. SIAM Review
+        51(4), 661-703., §4.1.
         """
         import os
         import threading
@@ -663,7 +843,24 @@ class GutenbergRichterFit(Displayed):
                                  ks_distance=float(observed), ks_statistic=self.ks_statistic, grid=grid)
 
     def bootstrap_pvalue(self, n_bootstrap: int = 1000, seed=None, *, min_tail: int = 10, **kwargs) -> float:
-        """p-value of :meth:`bootstrap_test` (over the completed replicates; warns if any were skipped)."""
+        """p-value of :meth:`bootstrap_test` (over the completed replicates; warns if any were skipped).
+
+        Parameters
+        ----------
+        n_bootstrap : int
+            Replicates.
+        seed : int, optional
+            Seed.
+        min_tail : int
+            Fewest values above a threshold in a replicate's search.
+        **kwargs
+            Passed to :meth:`bootstrap_test`.
+
+        Returns
+        -------
+        float
+            p [-].
+        """
         return self.bootstrap_test(n_bootstrap, seed, min_tail=min_tail, **kwargs).p_value
 
     def compare(self) -> pd.DataFrame:
@@ -673,6 +870,18 @@ class GutenbergRichterFit(Displayed):
         (m >= m_min), conditioned on exceeding m_min (Clauset et al. 2009, §5).
         ``R`` > 0 favours the power law; ``p`` is the two-sided significance of
         the sign of R (small p: the sign can be trusted).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by alternative: ``loglik_ratio_R``, ``normalised_R``, ``p_value``, ``favoured``.
+
+        References
+        ----------
+        Vuong, Q. H. (1989). Likelihood ratio tests for model selection and non-nested hypotheses. Econometrica
+        57(2), 307-333.
+        Clauset, A., Shalizi, C. R. & Newman, M. E. J. (2009). Power-law distributions in empirical data. SIAM Review
+        51(4), 661-703., §5.
         """
         x = self._tail()
         ll_pl = _loglik_power(x, self.b, self.m_min, self.m_max)
@@ -690,7 +899,14 @@ class GutenbergRichterFit(Displayed):
 
     # -- reporting ---------------------------------------------------------------
     def summary(self) -> pd.DataFrame:
-        """Parameters with standard errors and intervals, and how they were obtained."""
+        """Parameters with standard errors and intervals, and how they were obtained.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by parameter; columns ``value`` (sizes in ``units``, rate per year), ``stderr``, ``ci_low``,
+            ``ci_high``, ``note``.
+        """
         method = ("maximum likelihood (Aki 1965; Clauset et al. 2009)" + (", unbiased (n-1)/n" if self.unbiased else "")
                   if self.method == "mle" else
                   "least squares on log10 cumulative frequency (practitioners' method: biased, SE too small)")
@@ -824,6 +1040,11 @@ def fit_gutenberg_richter(masses, duration_years=None, m_min=None, method: str =
         integer data below 100 stay continuous with a warning recommending
         ``discrete=True``.  Above 100 the half-unit correction changes b by well
         under 1 % (their Appendix B).
+
+    Returns
+    -------
+    GutenbergRichterFit
+        a, b with its standard error and interval, m_min, m_max, the rate above m_min [1/yr] and the KS distance.
     """
     from .inventory import Inventory
 
