@@ -35,7 +35,18 @@ from ._display import Displayed, axes, short_repr
 
 
 def read_stl(path) -> np.ndarray:
-    """Triangles ``(n, 3, 3)`` [m] of an ASCII or binary STL file (coordinates as stored)."""
+    """Triangles ``(n, 3, 3)`` [m] of an ASCII or binary STL file (coordinates as stored).
+
+    Parameters
+    ----------
+    path : str or path
+        The STL file.
+
+    Returns
+    -------
+    numpy.ndarray
+        Vertices of each triangle [m].
+    """
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"STL file not found: {path}")
@@ -141,6 +152,16 @@ class TerrainProfile(Displayed):
         are projected on the nearest polyline segment (the end segments are
         extended), so a stop point's ``distance_m`` is its horizontal runout as
         the 2-D profile sees it.
+
+        Parameters
+        ----------
+        points_xy : array_like
+            Plan points (n, 2) [m].
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``distance_m`` and ``offset_m`` [m] per point.
         """
         q = np.atleast_2d(np.asarray(points_xy, dtype=float))
         if q.ndim != 2 or q.shape[1] != 2:
@@ -201,7 +222,17 @@ class TerrainProfile(Displayed):
         return ax
 
     def to_dict(self, decimals: int = 3) -> dict:
-        """The scenario ``[profile]`` table: ``x``, ``z`` [m] and ``materials`` (when labelled)."""
+        """The scenario ``[profile]`` table: ``x``, ``z`` [m] and ``materials`` (when labelled).
+
+        Parameters
+        ----------
+        decimals : int
+            Decimals kept [m].
+
+        Returns
+        -------
+        dict
+        """
         out = {"x": [round(float(v), decimals) for v in self.distance_m],
                "z": [round(float(v), decimals) for v in self.elevation_m]}
         if self.materials is not None:
@@ -209,7 +240,13 @@ class TerrainProfile(Displayed):
         return out
 
     def summary(self) -> pd.DataFrame:
-        """One row per run of consecutive segments with the same material: extent, drop, mean slope."""
+        """One row per run of consecutive segments with the same material: extent, drop, mean slope.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``material``, ``from_m``, ``to_m``, ``z_from_m``, ``z_to_m`` [m], ``mean_slope_deg`` [deg].
+        """
         x, z = self.distance_m, self.elevation_m
         mats = self.materials if self.materials is not None else ("",) * (len(x) - 1)
         rows, start = [], 0

@@ -90,6 +90,14 @@ NUMPYDOC_MODULES = (
     "riskrf/hazard/impact_energy.py",
     "riskrf/hazard/annual_hazard.py",
     "riskrf/frequency/power_law.py",
+    "riskrf/core/units.py",
+    "riskrf/report/axes.py",
+    "riskrf/report/html.py",
+    "riskrf/report/road_validation_figure.py",
+    "riskrf/report/rate_figures.py",
+    "riskrf/report/mitigation_text.py",
+    "simulation/impact.py",
+    "simulation/profile_extraction.py",
 )
 
 

@@ -228,7 +228,20 @@ SOFTWARE_METRICS = ("run time [s]", "impacts per second", "blocks per second")
 
 
 def render_report(a, figs: Path) -> str:
-    """HTML of the hazard and mitigation report for assessment ``a`` (figures read from ``figs``)."""
+    """HTML of the hazard and mitigation report for assessment ``a`` (figures read from ``figs``).
+
+    Parameters
+    ----------
+    a : riskrf.app.assess.Assessment
+        The assessment.
+    figs : pathlib.Path
+        Folder of its figures (PNG), embedded as data URIs.
+
+    Returns
+    -------
+    str
+        A complete HTML document.
+    """
     site = a.site
     doc = Document(title=f"{site.name} - rock fall hazard and mitigation")
     header = (f"<h1>Rock fall hazard and mitigation: {_e(site.name)}</h1><p>{_e(site.description)}</p>"

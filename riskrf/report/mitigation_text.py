@@ -8,7 +8,20 @@ from .format import money, probability   # money for a manager: "1,250,000 CHF";
 
 
 def option_entries(study, ranking: pd.DataFrame) -> list:
-    """The ``options`` entries of summary.json: one dict per option, ranked."""
+    """The ``options`` entries of summary.json: one dict per option, ranked.
+
+    Parameters
+    ----------
+    study : MitigationStudy
+        The study.
+    ranking : pandas.DataFrame
+        Its ranking (:meth:`MitigationStudy.ranking`).
+
+    Returns
+    -------
+    list of dict
+        Name, kind, rank, description and the option's costs [currency] and risks.
+    """
     out = []
     table = study.options_table().set_index("option")
     for _, r in ranking.iterrows():
@@ -36,7 +49,19 @@ def option_entries(study, ranking: pd.DataFrame) -> list:
 
 
 def study_report(study) -> dict:
-    """Ranking, recommendation, tornado, break-even, value of information and a printable text."""
+    """Ranking, recommendation, tornado, break-even, value of information and a printable text.
+
+    Parameters
+    ----------
+    study : MitigationStudy
+        The study.
+
+    Returns
+    -------
+    dict
+        ``ranking``, ``tornado``, ``break_even``, ``options_table`` (DataFrames), ``value_of_information``,
+        ``recommendation``, ``options``, ``uncertainty`` and ``text``.
+    """
     ranking = study.ranking()
     tornado = study.tornado()
     be = study.break_even_table()
@@ -108,7 +133,15 @@ def study_report(study) -> dict:
 
 
 def write_tree_figure(study, tmp) -> None:
-    """The decision tree of the options (``tree.png``)."""
+    """The decision tree of the options (``tree.png``).
+
+    Parameters
+    ----------
+    study : MitigationStudy
+        The study.
+    tmp : pathlib.Path
+        Folder the figure is written into.
+    """
     from .decision_figures import plot_tree
     from .files import save_figure
     ax = plot_tree(study.to_tree())
@@ -117,7 +150,19 @@ def write_tree_figure(study, tmp) -> None:
 
 def write_mitigation_outputs(study, report, tmp, *, tree_figure: bool = True) -> None:
     """Ranking, tornado, break-even and decision tables, and the tree (unless ``tree_figure`` is False: drawn
-    apart by :func:`write_tree_figure`), tornado and F-N figures."""
+    apart by :func:`write_tree_figure`), tornado and F-N figures.
+
+    Parameters
+    ----------
+    study : MitigationStudy
+        The study.
+    report : dict
+        Its :func:`study_report`.
+    tmp : pathlib.Path
+        Folder written into.
+    tree_figure : bool
+        Draw the tree here.
+    """
     from ..io.outputs import write_json
     from .decision_figures import plot_fn, plot_tornado
     from .files import save_figure

@@ -8,7 +8,22 @@ from .files import save_figure
 
 def write_rate_figures(model, out: Path, response) -> list[Path]:
     """Seasonality (observed and expected events per calendar month) and, for daily models, the expected
-    daily rate against the first rainfall band with its interval; PNG files in ``out``."""
+    daily rate against the first rainfall band with its interval; PNG files in ``out``.
+
+    Parameters
+    ----------
+    model : RateModel
+        The fitted rate model.
+    out : pathlib.Path
+        Existing folder.
+    response : object
+        The model's rainfall response (:meth:`RateModel.rainfall_response`).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The PNG files written.
+    """
     from matplotlib.figure import Figure     # object API: no pyplot, no backend change
 
     written = []
@@ -45,6 +60,19 @@ def write_rate_figures(model, out: Path, response) -> list[Path]:
 
 def write_rate_study(model, out: Path) -> list[Path]:
     """Every file of a :class:`~riskrf.RateModel`: its tables (:meth:`~riskrf.RateModel.write`), then the
-    seasonality and (daily models with rainfall terms) rainfall-response figures."""
+    seasonality and (daily models with rainfall terms) rainfall-response figures.
+
+    Parameters
+    ----------
+    model : RateModel
+        The fitted rate model.
+    out : pathlib.Path
+        Existing folder.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
     written = model.write(out)
     return written + write_rate_figures(model, Path(out), model.rainfall_response())

@@ -8,7 +8,20 @@ from .axes import _axes
 
 def plot_road_validation(validation, ax=None):
     """Per fall reaching a road, on a log axis: the prediction's 5-95 % range and mean (bar and dot) and the
-    record's exact 95 % Poisson interval and rate (line and square), for vehicles involved, deaths, injuries."""
+    record's exact 95 % Poisson interval and rate (line and square), for vehicles involved, deaths, injuries.
+
+    Parameters
+    ----------
+    validation : object
+        A road-risk validation with ``summary()`` (:mod:`riskrf.risk.road_validation`).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        x: consequences per fall reaching a road (log); y: the consequence.
+    """
     ax = _axes(ax)
     s = validation.summary()
     y = np.arange(len(s))
