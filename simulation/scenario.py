@@ -59,7 +59,27 @@ class Distribution:
     def parse(cls, spec, where: str, source: str, *, lo=-math.inf, hi=math.inf, lo_open=False) -> "Distribution":
         """A distribution from a scenario field: a number (constant) or a table with ``dist`` (uniform, normal,
         lognormal, triangular) and its parameters, checked within [lo, hi] (``lo_open``: lo excluded).
-        ``where`` and ``source`` name the field and file in a ScenarioError.
+        Parameters
+        ----------
+        spec : float or dict
+            The field's value as read.
+        where : str
+            The field, for messages (e.g. ``"seeder.mass_kg"``).
+        source : str
+            The file, for messages.
+        lo, hi : float
+            Bounds every draw must respect, in the field's unit.
+        lo_open : bool
+            ``lo`` itself excluded.
+
+        Returns
+        -------
+        Distribution
+
+        Raises
+        ------
+        ScenarioError
+            Naming the file, the field and the value.
         """
         if isinstance(spec, (int, float)) and not isinstance(spec, bool):
             return cls("constant", {"value": _number(spec, where, source, lo=lo, hi=hi, lo_open=lo_open)})
@@ -100,7 +120,13 @@ class Distribution:
 
     def bounds(self):
         """(lowest, highest) value the distribution can draw (-inf/inf for an untruncated normal; 0/inf for a lognormal
-        without ``max``)."""
+        without ``max``).
+
+        Returns
+        -------
+        tuple of float
+            In the field's unit.
+        """
         p = self.params
         if self.kind == "constant":
             return p["value"], p["value"]
@@ -113,7 +139,20 @@ class Distribution:
 
 
     def sample(self, rng: np.random.Generator, n: int) -> np.ndarray:
-        """``n`` draws with ``rng`` (a NumPy Generator)."""
+        """``n`` draws with ``rng`` (a NumPy Generator).
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            The stream.
+        n : int
+            Draws.
+
+        Returns
+        -------
+        numpy.ndarray
+            In the field's unit.
+        """
         p = self.params
         if self.kind == "constant":
             return np.full(n, p["value"])
@@ -179,6 +218,19 @@ class Material:
     def parse(cls, name: str, spec: dict, source: str) -> "Material":
         """A material from its scenario table ``materials.<name>`` (a preset and/or restitution, tangential,
         roughness [m], ground motion and friction angle [deg] fields), checked; errors name ``source`` and field.
+
+        Parameters
+        ----------
+        name : str
+            The material's name.
+        spec : dict
+            Its table as read.
+        source : str
+            The file, for messages.
+
+        Returns
+        -------
+        Material
         """
         where = f"materials.{name}."
         if not isinstance(spec, dict):
@@ -304,7 +356,18 @@ class Seeder:
     downslope_speed_ms: Distribution | None = None
 
     def radius(self, mass):
-        """Radius [m] of blocks of the given masses [kg]."""
+        """Radius [m] of blocks of the given masses [kg].
+
+        Parameters
+        ----------
+        mass : float or array_like
+            Block mass [kg].
+
+        Returns
+        -------
+        numpy.ndarray or float
+            Radius [m] (:func:`simulation.units.block_radius` with the seeder's density, shape and aspect ratio).
+        """
         return block_radius(mass, self.density_kg_m3, self.shape, self.aspect_ratio)
 
     @property
@@ -369,7 +432,7 @@ class Scenario(Displayed):
         return short_repr(self, repr(self.name), f"profile {p.x[0]:.4g}-{p.x[-1]:.4g} m, {p.n_segments} segments",
                           f"{len(self.materials)} materials", "collectors " + ", ".join(c.name for c in self.collectors))
 
-    def summary(self) -> pd.DataFrame:
+    def summary(self):
         """The scenario at a glance (one-column table): source, profile extent [m], materials, release zone [m],
         collectors (barriers with capacity [kJ] and height [m]).
 
@@ -405,14 +468,38 @@ class Scenario(Displayed):
         return plot_profile(self, ax)
 
     def collector_index(self, name: str) -> int:
-        """Index of the collector named ``name``; a KeyError listing the collectors when there is none."""
+        """Index of the collector named ``name``; a KeyError listing the collectors when there is none.
+
+        Parameters
+        ----------
+        name : str
+            Collector name.
+
+        Returns
+        -------
+        int
+        """
         names = [c.name for c in self.collectors]
         if name not in names:
             raise KeyError(f"{self.source}: no collector named {name!r}; collectors are {names}")
         return names.index(name)
 
     def with_barrier(self, name: str, capacity_kj: float, height_m: float) -> "Scenario":
-        """A copy whose collector ``name`` is a barrier of the given capacity [kJ] and height [m]."""
+        """A copy whose collector ``name`` is a barrier of the given capacity [kJ] and height [m].
+
+        Parameters
+        ----------
+        name : str
+            Collector name.
+        capacity_kj : float
+            Barrier capacity [kJ].
+        height_m : float
+            Barrier height [m].
+
+        Returns
+        -------
+        Scenario
+        """
         from dataclasses import replace
         i = self.collector_index(name)
         cols = list(self.collectors)
@@ -421,7 +508,26 @@ class Scenario(Displayed):
 
 
 def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None = None) -> Scenario:
-    """Build and validate a :class:`Scenario` from a parsed TOML dictionary."""
+    """Build and validate a :class:`Scenario` from a parsed TOML dictionary.
+
+    Parameters
+    ----------
+    data : dict
+        The scenario's tables (docs: File formats, "Scenario files"); lengths in m, masses in kg, speeds in m/s.
+    source : str
+        Name used in messages.
+    base_dir : pathlib.Path, optional
+        Folder that relative file names are read from.
+
+    Returns
+    -------
+    Scenario
+
+    Raises
+    ------
+    ScenarioError
+        Naming the file, the field and the value.
+    """
     _check_keys(data, {"name", "description", "profile", "materials", "seeder", "collectors", "settings"}, "",
                 source)
     for key in ("profile", "materials", "seeder"):
@@ -533,7 +639,21 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
 
 
 def load_scenario(path) -> Scenario:
-    """Read a scenario TOML file (documentation: File formats, "Scenario files")."""
+    """Read a scenario TOML file (documentation: File formats, "Scenario files").
+
+    Parameters
+    ----------
+    path : str or path
+        The TOML file.
+
+    Returns
+    -------
+    Scenario
+
+    Raises
+    ------
+    FileNotFoundError, ScenarioError
+    """
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"scenario file not found: {path}")

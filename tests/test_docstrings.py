@@ -98,6 +98,7 @@ NUMPYDOC_MODULES = (
     "riskrf/report/mitigation_text.py",
     "simulation/impact.py",
     "simulation/profile_extraction.py",
+    "simulation/scenario.py",
 )
 
 
