@@ -99,6 +99,7 @@ NUMPYDOC_MODULES = (
     "simulation/impact.py",
     "simulation/profile_extraction.py",
     "simulation/scenario.py",
+    "riskrf/frequency/rates.py",
 )
 
 

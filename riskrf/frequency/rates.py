@@ -138,7 +138,13 @@ class RateModel(Displayed):
         return _exog(frame, self.terms)
 
     def summary(self) -> pd.DataFrame:
-        """Key figures (one-column table): periods, events, preferred model, tests, rate ratios."""
+        """Key figures (one-column table): periods, events, preferred model, tests, rate ratios.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: quantity (rates in events per year); column ``value``.
+        """
         od, rows = self.overdispersion, {}
         rows["inventory"] = self.inventory_source
         rows["rainfall"] = self.rainfall_source
@@ -172,7 +178,13 @@ class RateModel(Displayed):
                              "ci_high": sf["mean_ci_upper"].to_numpy()}, index=frame.index)
 
     def fitted(self) -> pd.Series:
-        """Expected count of each period from the preferred model."""
+        """Expected count of each period from the preferred model.
+
+        Returns
+        -------
+        pandas.Series
+            Expected events per period, indexed by ``period_start``.
+        """
         X = self._exog(self.design)
         mu = self._glm_preferred.predict(X, offset=np.log(self.design["exposure_days"].to_numpy(float)))
         return pd.Series(np.asarray(mu), index=self.design["period_start"], name="expected_count")
@@ -184,6 +196,11 @@ class RateModel(Displayed):
         record's actual rainfall (the rate over the rainfall climate), so the
         table shows how well season and rainfall together reproduce the
         seasonal cycle.  Units: events per month (of that name) per year.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by month (1-12): ``observed_per_month``, ``expected_per_month``.
         """
         if self.period == "year":
             raise ValueError("predicted_by_season: yearly counts carry no season; count per day or month")
@@ -204,6 +221,18 @@ class RateModel(Displayed):
         averaged over the year (the rate is computed for every day of the year
         and averaged) and the trend is at the end of the record.  Only for
         daily models.  ``band`` defaults to the first (the day's own rainfall).
+
+        Parameters
+        ----------
+        rain_mm : array_like, optional
+            Rainfall totals of the band [mm] (default: 41 values from 0 to the record's 99.9th percentile).
+        band : str, optional
+            The rainfall term (e.g. ``"rain_d0_mm"``).
+
+        Returns
+        -------
+        pandas.DataFrame
+            The band [mm], ``events_per_day``, ``ci_low``, ``ci_high``, ``events_per_year_equivalent``.
         """
         if self.period != "day":
             raise ValueError(f"predicted_by_rainfall: needs a daily model; this one counts per {self.period}")
@@ -256,6 +285,20 @@ class RateModel(Displayed):
           ``heavy_day_mm`` become ``1 + heavy_day_change`` times as frequent (e.g. 0.1 for +10 % heavy-rain
           days), each with its recorded rainfall pattern, and the other days correspondingly rarer so the
           year keeps its length.  The rate is the reweighted mean of the fitted daily rates.
+
+        Parameters
+        ----------
+        rain_factor : float
+            Multiplier of every rainfall total [-].
+        heavy_day_mm : float, optional
+            Daily rainfall [mm] from which a day counts as heavy.
+        heavy_day_change : float
+            Relative change of the frequency of heavy days [-].
+
+        Returns
+        -------
+        float
+            Events per year [1/yr].
         """
         if not (np.isfinite(rain_factor) and rain_factor >= 0):
             raise ValueError(f"rain_factor = {rain_factor!r} must be a number >= 0")
@@ -316,7 +359,12 @@ class RateModel(Displayed):
         return ax
 
     def summary_text(self) -> str:
-        """A readable report (what ``riskrf rates`` prints)."""
+        """A readable report (what ``riskrf rates`` prints).
+
+        Returns
+        -------
+        str
+        """
         lines = [f"Rate model: events per {self.period}, {self.start.date()} to {self.end.date()} "
                  f"({self.n_periods} periods, {self.n_events} events)",
                  f"  inventory {self.inventory_source}", f"  rainfall  {self.rainfall_source}", "",
@@ -353,7 +401,18 @@ class RateModel(Displayed):
         """Write rate_ratios.csv, model_comparison.csv, season.csv, design.csv, rainfall_response.csv
         (daily models with rainfall terms) into ``out_dir``; returns the files written.  The figures
         (seasonality.png, rainfall_response.png) are drawn by :func:`riskrf.report.rate_figures.write_rate_study`,
-        which calls this first."""
+        which calls this first.
+
+        Parameters
+        ----------
+        out_dir : str or path
+            Folder (created if needed).
+
+        Returns
+        -------
+        list of pathlib.Path
+            The files written.
+        """
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         written = []
@@ -372,7 +431,12 @@ class RateModel(Displayed):
 
     def rainfall_response(self):
         """:meth:`predicted_by_rainfall` for a daily model with rainfall terms, else None (the table and figure
-        ``rainfall_response`` are written only then)."""
+        ``rainfall_response`` are written only then).
+
+        Returns
+        -------
+        pandas.DataFrame or None
+        """
         if self.period == "day" and any(self.terms["term"].str.startswith("rain_")):
             return self.predicted_by_rainfall()
         return None
