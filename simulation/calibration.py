@@ -67,7 +67,18 @@ class CalibrationWarning(UserWarning):
 
 # ---- scenario dictionaries and dotted paths --------------------------------------------------------------
 def scenario_dict(scenario) -> tuple[dict, str]:
-    """The dictionary form of a scenario given as a path, a dict or a Scenario loaded from a TOML file."""
+    """The dictionary form of a scenario given as a path, a dict or a Scenario loaded from a TOML file.
+
+    Parameters
+    ----------
+    scenario : str, path, dict or Scenario
+        The scenario.
+
+    Returns
+    -------
+    tuple of (dict, str)
+        Its tables and its source (file name or ``"<dict>"``).
+    """
     if isinstance(scenario, (str, Path)):
         path = Path(scenario)
         if not path.exists():
@@ -106,7 +117,17 @@ def set_parameter(data: dict, name: str, value: float, *, source: str | None = N
     a missing last field (a default) or a missing law table (e.g.
     ``normal_restitution.mean`` where the file gives ``normal_restitution =
     0.35``) is created.  ``collectors.NAME.FIELD`` addresses a collector by name.
-    ``source``: the scenario file (or other origin) named in error messages.
+
+    Parameters
+    ----------
+    data : dict
+        Scenario tables, changed in place.
+    name : str
+        Dotted path, e.g. ``"materials.talus.ground_friction_angle_deg"``.
+    value : float
+        The value, in the field's unit.
+    source : str, optional
+        The scenario file (or other origin) named in error messages.
     """
     where = f"{source}: " if source else ""
     parts = name.split(".")
@@ -143,8 +164,21 @@ def set_parameter(data: dict, name: str, value: float, *, source: str | None = N
 
 
 def apply_parameters(data: dict, values: dict, *, source: str | None = None) -> dict:
-    """A deep copy of the scenario dictionary with each dotted path set to its value (``source`` names the
-    scenario in errors)."""
+    """A deep copy of the scenario dictionary with each dotted path set to its value.
+
+    Parameters
+    ----------
+    data : dict
+        Scenario tables (not changed).
+    values : dict
+        Dotted path → value (in the field's unit).
+    source : str, optional
+        The scenario, named in errors.
+
+    Returns
+    -------
+    dict
+    """
     out = copy.deepcopy(data)
     for k, v in values.items():
         set_parameter(out, k, v, source=source)
@@ -192,6 +226,22 @@ def read_observed(path, *, column: str = "x_stop_m", select: dict | None = None,
     with other rules, e.g. ``riskrf.io.tables.read_numeric_table`` for separators, decimal commas,
     encodings, Excel sheets and header rows); ``path`` then only names it and the table's index
     is kept as the row labels of messages (that reader's index holds the file lines).
+
+    Parameters
+    ----------
+    path : str or path
+        The file.
+    column : str
+        Column of the stop positions [m].
+    select : dict, optional
+        Column → value rows must match.
+    table : pandas.DataFrame, optional
+        The file already read.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``x_stop_m`` [m] and any collector columns.
     """
     path = Path(path)
     if not path.exists():
@@ -295,7 +345,23 @@ def _check_observed(df: pd.DataFrame, source: str, scenario: Scenario, collector
 
 # ---- distances --------------------------------------------------------------------------------------------
 def cvm_distance(a, b) -> float:
-    """Cramér-von Mises criterion: mean of (F_a - F_b)^2 over the pooled sample (0 for equal samples)."""
+    """Cramér-von Mises criterion: mean of (F_a - F_b)^2 over the pooled sample (0 for equal samples).
+
+    Parameters
+    ----------
+    a, b : array_like
+        Two samples (e.g. stop positions [m]).
+
+    Returns
+    -------
+    float
+        The mean [-]; Anderson's statistic T is N M / (N + M) times it (N, M the sample sizes).
+
+    References
+    ----------
+    Anderson, T. W. (1962). On the distribution of the two-sample Cramér-von Mises criterion. Annals of
+    Mathematical Statistics 33(3), 1148-1159.
+    """
     a, b = np.sort(np.asarray(a, float)), np.sort(np.asarray(b, float))
     z = np.concatenate([a, b])
     fa = np.searchsorted(a, z, side="right") / a.size
@@ -362,7 +428,18 @@ class Calibration(Displayed):
     notes: tuple = ()
 
     def summary(self, level: float = 0.95) -> pd.DataFrame:
-        """One row per parameter: fitted value, bounds, initial value, bootstrap interval and standard deviation."""
+        """One row per parameter: fitted value, bounds, initial value, bootstrap interval and standard deviation.
+
+        Parameters
+        ----------
+        level : float
+            Level of the bootstrap interval.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by parameter (values in the parameter's unit).
+        """
         a = (1 - level) / 2
         rows = []
         for k, v in self.parameters.items():
@@ -382,6 +459,10 @@ class Calibration(Displayed):
         Rows: quantiles p10-p90 and mean [m], 1-Wasserstein distance [m],
         two-sample Kolmogorov-Smirnov D and its p-value (scipy.stats.ks_2samp),
         the objective; columns observed, before, after.
+
+        Returns
+        -------
+        pandas.DataFrame
         """
         qs = (0.1, 0.25, 0.5, 0.75, 0.9)
         cols = {"observed": self.observed, "before": self.simulated_initial, "after": self.simulated}
@@ -406,12 +487,28 @@ class Calibration(Displayed):
                           n_observed=int(self.observed.size), n=self.n)
 
     def to_toml(self) -> str:
-        """The calibrated scenario as TOML text (fitted values in place, a comment naming them)."""
+        """The calibrated scenario as TOML text (fitted values in place, a comment naming them).
+
+        Returns
+        -------
+        str
+        """
         head = "# calibrated by simulation.calibrate: " + ", ".join(f"{k} = {v:.6g}" for k, v in self.parameters.items())
         return head + "\n" + dump_toml(self.scenario_data)
 
     def plot(self, ax=None):
-        """Empirical CDFs of observed and simulated stop positions, before and after calibration."""
+        """Empirical CDFs of observed and simulated stop positions, before and after calibration.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            x: stop position [m]; y: fraction of blocks stopped before x.
+        """
         if ax is None:
             import matplotlib.pyplot as plt
             ax = plt.figure(figsize=(7, 4.2)).add_subplot()
@@ -430,7 +527,17 @@ class Calibration(Displayed):
 
 
 def dump_toml(data: dict) -> str:
-    """TOML text of a scenario dictionary (tables, inline tables for distributions, [[collectors]])."""
+    """TOML text of a scenario dictionary (tables, inline tables for distributions, [[collectors]]).
+
+    Parameters
+    ----------
+    data : dict
+        Scenario tables.
+
+    Returns
+    -------
+    str
+    """
     def val(v):
         if isinstance(v, bool):
             return "true" if v else "false"

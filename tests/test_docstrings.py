@@ -100,6 +100,7 @@ NUMPYDOC_MODULES = (
     "simulation/profile_extraction.py",
     "simulation/scenario.py",
     "riskrf/frequency/rates.py",
+    "simulation/calibration.py",
 )
 
 
