@@ -119,7 +119,25 @@ class Terrain(Displayed):
     @classmethod
     def from_array(cls, z, transform, crs=None, nodata=None, source: str = "<array>") -> "Terrain":
         """A terrain from a raster array in file order and its affine transform (north-up: ``e`` < 0,
-        south-up: ``e`` > 0).  Cells equal to ``nodata`` or non-finite become holes (NaN)."""
+        south-up: ``e`` > 0).  Cells equal to ``nodata`` or non-finite become holes (NaN).
+
+        Parameters
+        ----------
+        z : array_like
+            Elevations [m], rows in the file's order.
+        transform : affine.Affine or sequence
+            The raster's affine transform (no rotation or shear).
+        crs : rasterio.crs.CRS, optional
+            Coordinate reference system.
+        nodata : float, optional
+            The nodata value.
+        source : str
+            Name used in messages.
+
+        Returns
+        -------
+        Terrain
+        """
         from affine import Affine
         t = transform if isinstance(transform, Affine) else Affine(*tuple(transform)[:6])
         z = np.array(z, dtype=float)
@@ -151,7 +169,23 @@ class Terrain(Displayed):
     @classmethod
     def from_function(cls, f, x_range, y_range, cell: float, crs="EPSG:2056") -> "Terrain":
         """A synthetic north-up terrain with cell centres covering ``x_range`` x ``y_range`` [m] every ``cell``
-        m and elevation ``f(x, y)`` [m] (for tests and examples)."""
+        m and elevation ``f(x, y)`` [m] (for tests and examples).
+
+        Parameters
+        ----------
+        f : callable
+            ``f(x, y)`` → elevation [m], on arrays.
+        x_range, y_range : tuple of float
+            (low, high) plan extent of the cell centres [m].
+        cell : float
+            Cell size [m].
+        crs : str
+            Coordinate reference system (default Swiss LV95).
+
+        Returns
+        -------
+        Terrain
+        """
         from affine import Affine
         from rasterio.crs import CRS
         xs = np.arange(x_range[0], x_range[1] + 0.5 * cell, cell)
@@ -174,7 +208,17 @@ class Terrain(Displayed):
         return self.x0, self.y0, self.x0 + (nx - 1) * self.dx, self.y0 + (ny - 1) * self.dy
 
     def contains(self, x, y) -> np.ndarray:
-        """True where plan points lie in the domain and on a bilinear cell without a nodata corner."""
+        """True where plan points lie in the domain and on a bilinear cell without a nodata corner.
+
+        Parameters
+        ----------
+        x, y : float or array_like
+            Plan coordinates [m, the CRS's units].
+
+        Returns
+        -------
+        numpy.ndarray of bool
+        """
         return np.isfinite(self.elevation(x, y))
 
     def _cell(self, x, y):
@@ -191,7 +235,18 @@ class Terrain(Displayed):
         return inside, i, j, fu, fv
 
     def elevation(self, x, y) -> np.ndarray:
-        """Bilinear elevation [m] at plan points; NaN outside the domain or on a cell touching nodata."""
+        """Bilinear elevation [m] at plan points; NaN outside the domain or on a cell touching nodata.
+
+        Parameters
+        ----------
+        x, y : float or array_like
+            Plan coordinates [m, the CRS's units].
+
+        Returns
+        -------
+        numpy.ndarray
+            Elevation [m].
+        """
         inside, i, j, fu, fv = self._cell(x, y)
         z = self.z
         out = (z[i, j] * (1 - fu) * (1 - fv) + z[i, j + 1] * fu * (1 - fv) + z[i + 1, j] * (1 - fu) * fv
@@ -199,7 +254,18 @@ class Terrain(Displayed):
         return np.where(inside, out, np.nan)
 
     def gradient(self, x, y) -> tuple[np.ndarray, np.ndarray]:
-        """(dz/dx, dz/dy) of the bilinear surface at plan points [-]; NaN outside."""
+        """(dz/dx, dz/dy) of the bilinear surface at plan points [-]; NaN outside.
+
+        Parameters
+        ----------
+        x, y : float or array_like
+            Plan coordinates [m, the CRS's units].
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (dz/dx, dz/dy) [-].
+        """
         inside, i, j, fu, fv = self._cell(x, y)
         z = self.z
         gx = ((z[i, j + 1] - z[i, j]) * (1 - fv) + (z[i + 1, j + 1] - z[i + 1, j]) * fv) / self.dx
@@ -207,19 +273,48 @@ class Terrain(Displayed):
         return np.where(inside, gx, np.nan), np.where(inside, gy, np.nan)
 
     def cell_centres(self) -> tuple[np.ndarray, np.ndarray]:
-        """Plan coordinates (x, y) [m] of the cell centres, arrays of shape (ny, nx) in internal order."""
+        """Plan coordinates (x, y) [m] of the cell centres, arrays of shape (ny, nx) in internal order.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+        """
         ny, nx = self.z.shape
         return np.meshgrid(self.x0 + self.dx * np.arange(nx), self.y0 + self.dy * np.arange(ny))
 
     def slope_deg(self) -> np.ndarray:
-        """Slope angle [deg] at every cell centre (central differences; internal order)."""
+        """Slope angle [deg] at every cell centre (central differences; internal order).
+
+        Returns
+        -------
+        numpy.ndarray
+            (ny, nx) angles [deg].
+        """
         gy, gx = np.gradient(self.z, self.dy, self.dx)
         return np.degrees(np.arctan(np.hypot(gx, gy)))
 
     def hillshade(self, azimuth_deg: float = 315.0, altitude_deg: float = 45.0) -> np.ndarray:
         """Hillshade in [0, 1] at every cell centre (internal order), sun from ``azimuth_deg`` (clockwise from
         north) at ``altitude_deg`` above the horizon: cos of the angle between the surface normal and the sun
-        (Horn-style shading with central differences; Burrough & McDonnell 1998, ch. 8)."""
+        (Horn-style shading with central differences; Burrough & McDonnell 1998, ch. 8).
+
+        Parameters
+        ----------
+        azimuth_deg : float
+            Sun azimuth [deg], clockwise from north.
+        altitude_deg : float
+            Sun altitude above the horizon [deg].
+
+        Returns
+        -------
+        numpy.ndarray
+            (ny, nx) shading in [0, 1].
+
+        References
+        ----------
+        Burrough, P. A. & McDonnell, R. A. (1998). Principles of Geographical Information Systems. Oxford
+        University Press, chapter 8.
+        """
         gy, gx = np.gradient(self.z, self.dy, self.dx)
         az, alt = math.radians(azimuth_deg), math.radians(altitude_deg)
         sun = np.array([math.sin(az) * math.cos(alt), math.cos(az) * math.cos(alt), math.sin(alt)])
@@ -229,7 +324,17 @@ class Terrain(Displayed):
 
     # ---- writing ------------------------------------------------------------------------------------
     def to_file_order(self, grid: np.ndarray) -> np.ndarray:
-        """A (ny, nx) array in internal order (row = increasing y) turned into the file's row order."""
+        """A (ny, nx) array in internal order (row = increasing y) turned into the file's row order.
+
+        Parameters
+        ----------
+        grid : numpy.ndarray
+            (ny, nx) values in internal order.
+
+        Returns
+        -------
+        numpy.ndarray
+        """
         grid = np.asarray(grid)
         if grid.shape != self.z.shape:
             raise TerrainError(f"grid of shape {grid.shape} is not on the DEM's grid {self.z.shape}")
@@ -237,7 +342,23 @@ class Terrain(Displayed):
 
     def write_geotiff(self, path, grid, nodata=np.nan, dtype="float32") -> Path:
         """Write a (ny, nx) grid in internal order as a single-band GeoTIFF on the DEM's grid and CRS
-        (written to a temporary name, then renamed: never half-written)."""
+        (written to a temporary name, then renamed: never half-written).
+
+        Parameters
+        ----------
+        path : str or path
+            The GeoTIFF written.
+        grid : numpy.ndarray
+            (ny, nx) values in internal order.
+        nodata : float
+            The nodata value written.
+        dtype : str
+            Pixel type.
+
+        Returns
+        -------
+        pathlib.Path
+        """
         import rasterio
         path = Path(path)
         data = self.to_file_order(grid).astype(dtype)
@@ -251,7 +372,20 @@ class Terrain(Displayed):
 
     def check_points(self, xy, what: str) -> np.ndarray:
         """Plan points (n, 2) checked to lie on the terrain: a TerrainError naming ``what``, the first point
-        outside (or on a nodata hole) and the domain otherwise."""
+        outside (or on a nodata hole) and the domain otherwise.
+
+        Parameters
+        ----------
+        xy : array_like
+            Plan points (n, 2) [m].
+        what : str
+            What they are, for the message.
+
+        Returns
+        -------
+        numpy.ndarray
+            (n, 2) float array [m].
+        """
         p = np.atleast_2d(np.asarray(xy, dtype=float))
         if p.ndim != 2 or p.shape[1] != 2 or not np.all(np.isfinite(p)):
             raise TerrainError(f"{what}: need plan points [[x, y], ...]; got {np.asarray(xy).tolist()!r}")
@@ -369,7 +503,19 @@ class MaterialGrid:
     names: tuple
 
     def at(self, terrain: Terrain, x, y) -> np.ndarray:
-        """Material index of the cell containing each plan point (nearest cell centre)."""
+        """Material index of the cell containing each plan point (nearest cell centre).
+
+        Parameters
+        ----------
+        terrain : Terrain
+            The DEM whose grid the raster shares.
+        x, y : float or array_like
+            Plan coordinates [m].
+
+        Returns
+        -------
+        numpy.ndarray of int
+        """
         ny, nx = self.index.shape
         j = np.clip(np.rint((np.asarray(x, float) - terrain.x0) / terrain.dx).astype(np.int64), 0, nx - 1)
         i = np.clip(np.rint((np.asarray(y, float) - terrain.y0) / terrain.dy).astype(np.int64), 0, ny - 1)
@@ -380,7 +526,23 @@ def read_material_raster(path, terrain: Terrain, codes: dict, material_names) ->
     """A material raster on the DEM's grid: integer codes per cell, mapped to material names by ``codes``
     (``{code: name}``).  The raster must have the DEM's shape, transform (to 1e-6 of a cell) and CRS (a
     raster without CRS is taken to share the DEM's); a clear error otherwise, naming both grids.  A code not
-    in ``codes`` (outside the DEM's nodata holes) is an error naming it and a cell where it occurs."""
+    in ``codes`` (outside the DEM's nodata holes) is an error naming it and a cell where it occurs.
+
+    Parameters
+    ----------
+    path : str or path
+        The raster file.
+    terrain : Terrain
+        The DEM.
+    codes : dict
+        Integer code → material name.
+    material_names : sequence of str
+        The scenario's materials, in order.
+
+    Returns
+    -------
+    MaterialGrid
+    """
     import rasterio
     path = Path(path)
     if not path.exists():

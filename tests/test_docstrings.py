@@ -101,6 +101,7 @@ NUMPYDOC_MODULES = (
     "simulation/scenario.py",
     "riskrf/frequency/rates.py",
     "simulation/calibration.py",
+    "simulation/terrain.py",
 )
 
 
