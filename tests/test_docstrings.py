@@ -102,6 +102,8 @@ NUMPYDOC_MODULES = (
     "riskrf/frequency/rates.py",
     "simulation/calibration.py",
     "simulation/terrain.py",
+    "riskrf/report/decision_figures.py",
+    "riskrf/report/design_figures.py",
 )
 
 

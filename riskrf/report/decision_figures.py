@@ -26,6 +26,19 @@ def plot_tree(tree, ax=None, *, max_label: int = 28):
     """Decision-tree diagram: squares decide, circles are chance, triangles end; the optimal path is red.
 
     Each node shows its rolled-back value; each branch its name, probability and cost.
+
+    Parameters
+    ----------
+    tree : DecisionTree
+        The tree.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+    max_label : int
+        Longest branch label [characters] before it is shortened.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
     """
     rb = tree.rollback()
     leaves = []
@@ -93,7 +106,25 @@ def plot_tornado(table, ax=None, *, currency: str = "", xlabel: str | None = Non
     ``parameter``, ``base`` and ``cost_at_low``/``cost_at_high`` or ``value_at_low``/``value_at_high``.
 
     ``xlabel``: the quantity on the x axis (default: the expected total cost of the best option);
-    ``annotate``: write the value at the end of each bar."""
+    ``annotate``: write the value at the end of each bar.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The tornado table (values in ``currency``).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+    currency : str
+        Currency label of the axis.
+    xlabel : str, optional
+        Axis label.
+    annotate : bool
+        Write the values.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = _axes(ax, figsize=(7, 0.5 * len(table) + 1.5))
     base = float(table["base"].iloc[0])
     lo_col = "cost_at_low" if "cost_at_low" in table else "value_at_low"
@@ -117,7 +148,19 @@ def plot_tornado(table, ax=None, *, currency: str = "", xlabel: str | None = Non
 
 
 def plot_risk_profiles(profile, ax=None):
-    """Cumulative risk profiles (outcome distributions) of the options, from ``DecisionTree.risk_profile()``."""
+    """Cumulative risk profiles (outcome distributions) of the options, from ``DecisionTree.risk_profile()``.
+
+    Parameters
+    ----------
+    profile : pandas.DataFrame
+        Columns ``option``, ``value``, cumulative probability.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = _axes(ax)
     for i, (name, g) in enumerate(profile.groupby("option", sort=False)):
         x = np.concatenate([[g["value"].min()], g["value"].to_numpy()])
@@ -133,7 +176,27 @@ def plot_risk_profiles(profile, ax=None):
 def plot_fn(curves: dict, ax=None, *, criteria: dict | None = None):
     """F-N curves ``{label: DataFrame(N, F)}`` on the Hong Kong GEO diagram (GEO Report 75, ERM-Hong Kong 1998):
     lines F = C / N^k up to N = 1,000, the "intense scrutiny" band for N = 1,000-5,000 and the
-    unacceptable region beyond."""
+    unacceptable region beyond.
+
+    Parameters
+    ----------
+    curves : dict
+        Label → DataFrame with ``N`` (fatalities) and ``F`` (frequency of N or more per year [1/yr]).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+    criteria : dict, optional
+        Name → (C, k) of the lines F = C / N^k [1/yr], with an ``"unacceptable above"`` entry (default: the GEO
+        lines, ``HK_GEO_FN_LINES``).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    References
+    ----------
+    ERM-Hong Kong (1998). Landslides and Boulder Falls from Natural Terrain: Interim Risk Guidelines. GEO Report
+    No. 75, Geotechnical Engineering Office, Hong Kong.
+    """
     ax = _axes(ax)
     criteria = HK_GEO_FN_LINES if criteria is None else criteria
     for i, (label, df) in enumerate(curves.items()):

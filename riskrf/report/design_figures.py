@@ -25,7 +25,23 @@ def options_profile_figure(scenario, options, *, barrier_x=None, road_x=None, re
     """The slope profile with each option's geometry: ditches dug into it, fences and attenuators at their height,
     a shed roof over the road, the scaling zone on the face, a realigned road; and the required barrier (dashed)
     at the barrier line.  ``options``: :class:`~riskrf.mitigation_inputs.Option` objects; ``requirement``: a
-    :class:`~riskrf.hazard.design_basis.DesignRequirement` or None."""
+    :class:`~riskrf.hazard.design_basis.DesignRequirement` or None.
+
+    Parameters
+    ----------
+    scenario : simulation.Scenario
+        The slope (profile in m).
+    options : sequence of Option
+        The mitigation options.
+    barrier_x, road_x : float, optional
+        Barrier line and road edge [m].
+    requirement : DesignRequirement, optional
+        The required barrier.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     import matplotlib.pyplot as plt
 
     from ..risk.measures import ditch_profile, ground_z
@@ -87,7 +103,23 @@ def options_profile_figure(scenario, options, *, barrier_x=None, road_x=None, re
 def stop_points_figure(result, *, road_x=None, ditches=(), option=None):
     """Where the simulated blocks stopped: histogram of the stop x and the share travelling beyond each x
     (run-out exceedance), with the road line and ditch spans marked; ``option`` = (name, result) adds the stop
-    points on the slope with that option built."""
+    points on the slope with that option built.
+
+    Parameters
+    ----------
+    result : simulation.SimulationResult
+        The run.
+    road_x : float, optional
+        Road edge [m].
+    ditches : sequence of (float, float)
+        Ditch spans (from, to) [m].
+    option : tuple of (str, simulation.SimulationResult), optional
+        An option's name and its run.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     import matplotlib.pyplot as plt
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     runs = [("existing slope", result, "tab:gray", "k")]
@@ -118,8 +150,20 @@ def stop_points_figure(result, *, road_x=None, ditches=(), option=None):
 def plot_position_search(search, ax=None):
     """Required MEL [kJ] and product class at each searched barrier position, with the required net height [m] on
     a second y axis; with ``ax=None`` a new two-panel figure also shows the slope profile and the positions above.
-    Returns the axes of the requirement panel (its figure: ``ax.figure``).  ``search``: a
-    :class:`~riskrf.hazard.design_basis.PositionSearch`."""
+
+    Parameters
+    ----------
+    search : PositionSearch
+        A :class:`~riskrf.hazard.design_basis.PositionSearch` (its ``table``: position [m], required MEL [kJ],
+        height [m]).
+    ax : matplotlib.axes.Axes, optional
+        Axes of the requirement panel (a new two-panel figure when None).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The requirement panel (its figure: ``ax.figure``).
+    """
     import matplotlib.pyplot as plt
     t = search.table
     if ax is None:
@@ -155,6 +199,7 @@ def plot_position_search(search, ax=None):
     return a1
 
 
+<<<<<<< HEAD
 def position_search_figure(search):
     """The two-panel position-search figure (slope with positions; requirement per position)."""
     return plot_position_search(search).figure
@@ -164,6 +209,20 @@ def plot_catchment(study, ax=None):
     """Retention against catchment width from the re-simulation, with the widths for 90/95/99 %, the Modified
     Ritchie Criterion width and the chart values beside it (when given).  Returns the matplotlib axes.
     ``study``: a :class:`~riskrf.hazard.catchment.CatchmentStudy`."""
+=======
+def catchment_figure(study):
+    """Retention against catchment width from the re-simulation, with the chart values beside it (when given).
+
+    Parameters
+    ----------
+    study : object
+        A catchment study with ``curve`` (``width_m`` [m], ``retained`` [-]).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+>>>>>>> cbfaec7 (numpydoc sections in riskrf.report decision and design figures)
     import matplotlib.pyplot as plt
 
     from ..hazard.catchment import modified_ritchie_width_m
