@@ -104,6 +104,7 @@ NUMPYDOC_MODULES = (
     "simulation/terrain.py",
     "riskrf/report/decision_figures.py",
     "riskrf/report/design_figures.py",
+    "riskrf/io/gis.py",
 )
 
 

@@ -76,7 +76,22 @@ def _wkb_geoms(buf: bytes, where: str):
 
 
 def linestring_wkb(xy) -> bytes:
-    """ISO WKB (little endian) of a 2-D LineString with vertices ``xy`` (n x 2, metres)."""
+    """ISO WKB (little endian) of a 2-D LineString with vertices ``xy`` (n x 2, metres).
+
+    Parameters
+    ----------
+    xy : array_like
+        Vertices (n, 2) [m].
+
+    Returns
+    -------
+    bytes
+
+    References
+    ----------
+    OGC 06-103r4, OpenGIS Implementation Standard for Geographic information - Simple feature access - Part 1,
+    section 8.2 (well-known binary).
+    """
     xy = np.ascontiguousarray(np.asarray(xy, dtype="<f8").reshape(-1, 2))
     return struct.pack("<BII", 1, 2, len(xy)) + xy.tobytes()
 
@@ -153,7 +168,18 @@ class Centreline:
         return np.where(c < dc[0], ds[0] + (c - dc[0]), np.where(c > dc[-1], ds[-1] + (c - dc[-1]), s))
 
     def point_at(self, chainage):
-        """Coordinates (x, y) [m] of the points at ``chainage`` [m] (scalar or array); outside the line: an error."""
+        """Coordinates (x, y) [m] of the points at ``chainage`` [m] (scalar or array); outside the line: an error.
+
+        Parameters
+        ----------
+        chainage : float or array_like
+            Chainage [m].
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (x, y) [m].
+        """
         c = np.atleast_1d(np.asarray(chainage, dtype=float))
         lo, hi = self.chainage_range_m
         bad = (c < lo - 1e-6) | (c > hi + 1e-6) | ~np.isfinite(c)
@@ -170,7 +196,18 @@ class Centreline:
     def chainage_at(self, x, y):
         """Chainage [m] of the nearest point of the line to (x, y) [m], and the offset from the line [m].
 
-        Scalars or arrays; each point is projected onto every segment (O(points x segments))."""
+        Scalars or arrays; each point is projected onto every segment (O(points x segments)).
+
+        Parameters
+        ----------
+        x, y : float or array_like
+            Plan coordinates [m].
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (chainage [m], offset [m]).
+        """
         p = np.column_stack([np.atleast_1d(x), np.atleast_1d(y)]).astype(float)
         a, b = self.xy[:-1], self.xy[1:]
         ab = b - a
@@ -185,7 +222,18 @@ class Centreline:
         return (float(c[0]), float(off[0])) if np.ndim(x) == 0 else (c, off)
 
     def cut(self, chainage_from_m: float, chainage_to_m: float) -> np.ndarray:
-        """Vertices (k x 2) [m] of the line from ``chainage_from_m`` to ``chainage_to_m`` (the section's geometry)."""
+        """Vertices (k x 2) [m] of the line from ``chainage_from_m`` to ``chainage_to_m`` (the section's geometry).
+
+        Parameters
+        ----------
+        chainage_from_m, chainage_to_m : float
+            Start and end chainage [m].
+
+        Returns
+        -------
+        numpy.ndarray
+            (k, 2) vertices [m].
+        """
         if not chainage_to_m > chainage_from_m:
             raise GISError(f"chainage_to = {chainage_to_m:g} must exceed chainage_from = {chainage_from_m:g}")
         x0, y0 = self.point_at(np.array([chainage_from_m, chainage_to_m]))
@@ -196,7 +244,18 @@ class Centreline:
 
     def cuts(self, chainage_from_m, chainage_to_m) -> list:
         """:meth:`cut` for many intervals at once (arrays of equal length): a list of vertex arrays, O(intervals
-        x log vertices) plus the vertices returned."""
+        x log vertices) plus the vertices returned.
+
+        Parameters
+        ----------
+        chainage_from_m, chainage_to_m : array_like
+            Start and end chainages [m], of equal length.
+
+        Returns
+        -------
+        list of numpy.ndarray
+            One (k, 2) vertex array [m] per interval.
+        """
         c0, c1 = (np.atleast_1d(np.asarray(a, dtype=float)) for a in (chainage_from_m, chainage_to_m))
         if c0.shape != c1.shape:
             raise ValueError(f"{c0.size} start chainages for {c1.size} end chainages")
@@ -211,7 +270,12 @@ class Centreline:
         return [np.vstack([[a, b], self.xy[j:k], [e, f]]) for a, b, j, k, e, f in zip(x0, y0, i0, i1, x1, y1)]
 
     def summary(self) -> pd.DataFrame:
-        """One row: CRS, vertices, drawn length [m], chainage range [m], calibration points, source."""
+        """One row: CRS, vertices, drawn length [m], chainage range [m], calibration points, source.
+
+        Returns
+        -------
+        pandas.DataFrame
+        """
         lo, hi = self.chainage_range_m
         return pd.DataFrame([{"crs": self.crs, "vertices": len(self.xy), "length_m": self.length_m,
                               "chainage_from_m": lo, "chainage_to_m": hi,
@@ -225,6 +289,23 @@ def centreline_from_vertices(xy, *, crs: str, chainage_start_m: float = 0.0, cal
     ``calibration``: optional (chainage [m], x [m], y [m]) rows: points of known chainage, projected onto the
     line; their distances along the line and chainages must both increase.  Without it chainage is
     ``chainage_start_m`` + distance along the line.
+
+    Parameters
+    ----------
+    xy : array_like
+        Vertices (n, 2) [m].
+    crs : str
+        Projected coordinate reference system (metres).
+    chainage_start_m : float
+        Chainage of the first vertex [m].
+    calibration : array_like, optional
+        (chainage [m], x [m], y [m]) rows.
+    source : str
+        Name used in messages.
+
+    Returns
+    -------
+    Centreline
     """
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     where = source or "centreline"
@@ -254,7 +335,25 @@ def read_centreline(path, *, layer=None, chainage_start_m: float = 0.0, calibrat
                     calibration_field: str = "chainage_m") -> Centreline:
     """Read a road centreline (GeoPackage, GeoJSON, shapefile; one LineString, or a MultiLineString whose parts
     join end to end) and optional calibration points (a point layer of the same file with ``calibration_field``
-    [m]).  The CRS must be projected (metres)."""
+    [m]).  The CRS must be projected (metres).
+
+    Parameters
+    ----------
+    path : str or path
+        The vector file.
+    layer : str or int, optional
+        The line layer.
+    chainage_start_m : float
+        Chainage of the first vertex [m] (without calibration points).
+    calibration_layer : str or int, optional
+        The point layer of known chainages.
+    calibration_field : str
+        Its chainage field [m].
+
+    Returns
+    -------
+    Centreline
+    """
     crs, geoms, _, where = _read_layer(Path(path), layer, "centreline")
     parts = []
     for i, g in enumerate(geoms):
@@ -290,7 +389,21 @@ def read_centreline(path, *, layer=None, chainage_start_m: float = 0.0, calibrat
 def write_centreline(line: Centreline, path, *, layer: str = "centreline", calibration_layer: str | None = None,
                      calibration_chainage_m=None) -> None:
     """Write ``line`` as one LineString (and optionally its calibration points with a ``chainage_m`` field) to a
-    GeoPackage."""
+    GeoPackage.
+
+    Parameters
+    ----------
+    line : Centreline
+        The centreline.
+    path : str or path
+        The GeoPackage.
+    layer : str
+        Line layer name.
+    calibration_layer : str, optional
+        Point layer name, when calibration points are written.
+    calibration_chainage_m : array_like, optional
+        Their chainages [m].
+    """
     from pyogrio.raw import write
     path = Path(path)
     write(path, np.array([linestring_wkb(line.xy)], dtype=object),
@@ -313,6 +426,23 @@ def write_lines_gpkg(path, table: pd.DataFrame, lines, *, crs: str, layer: str =
 
     ``lines``: a sequence of (k x 2) vertex arrays [m], one per row.  Object columns are written as text,
     booleans as integers 0/1, other numbers as they are.  Written to a temporary name, then renamed.
+
+    Parameters
+    ----------
+    path : str or path
+        The GeoPackage.
+    table : pandas.DataFrame
+        One row per line (fields).
+    lines : sequence of numpy.ndarray
+        (k, 2) vertex arrays [m].
+    crs : str
+        Coordinate reference system.
+    layer : str
+        Layer name.
+
+    Returns
+    -------
+    pathlib.Path
     """
     import os
 
