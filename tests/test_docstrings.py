@@ -105,6 +105,7 @@ NUMPYDOC_MODULES = (
     "riskrf/report/decision_figures.py",
     "riskrf/report/design_figures.py",
     "riskrf/io/gis.py",
+    "riskrf/report/fit_figures.py",
 )
 
 

@@ -193,3 +193,27 @@ def test_every_input_error_is_a_riskrf_error():
         assert issubclass(cls, riskrf.RiskrfError) and issubclass(cls, ValueError), cls
     with pytest.raises(riskrf.RiskrfError, match="node type 'nonsense'"):
         riskrf.DecisionTree.from_dict({"name": "tree", "type": "nonsense"})
+
+
+
+def test_no_precompile_switch_starts_no_child(fake_precompile, monkeypatch):
+    """``RISKRF_NO_PRECOMPILE=1``: no early child (tests/benchmarks/bench_startup.py measures with it)."""
+    monkeypatch.delenv("NUMBA_DISABLE_JIT", raising=False)
+    monkeypatch.setenv("RISKRF_NO_PRECOMPILE", "1")
+    pc.start_early()
+    assert fake_precompile == [] and pc.disabled()
+
+
+def test_no_precompile_switch_keeps_the_compilation_in_the_run(monkeypatch):
+    """``RISKRF_NO_PRECOMPILE=1``: the real :class:`Precompile` starts no child even when asked to."""
+    monkeypatch.setenv("RISKRF_NO_PRECOMPILE", "1")
+    monkeypatch.setattr(pc, "_cache_exists", lambda: False)
+    assert pc.Precompile(check_cache=False)._proc is None
+
+
+def test_no_fork_switch_keeps_the_work_in_this_process(monkeypatch):
+    """``RISKRF_NO_FORK=1``: :class:`~riskrf.app.background.InBackground` runs its work here, same value."""
+    from riskrf.app.background import InBackground
+    monkeypatch.setenv("RISKRF_NO_FORK", "1")
+    work = InBackground(lambda: 6 * 7)
+    assert work.proc is None and work.result() == 42

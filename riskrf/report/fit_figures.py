@@ -17,6 +17,24 @@ def plot_magnitude_frequency(fit, ax=None, *, level_label=True):
     Points: the observed annual frequency of falls at least as large as each
     recorded size (above 4,000 distinct sizes, 4,000 of them log-spaced in rank).  Line: the fitted law above m_min, with the band spanned by
     the confidence interval of b (rate at m_min held).  m_min is marked.
+
+    Parameters
+    ----------
+    fit : GutenbergRichterFit
+        A fit that keeps its data (sizes in ``fit.units``).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+    level_label : bool
+        Name the confidence level in the legend.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        x: size [kg or m³]; y: falls of at least that size per year [1/yr].
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, section 8.4.1.
     """
     ax = _axes(ax)
     x = np.sort(np.asarray(fit.data))
@@ -49,6 +67,30 @@ def plot_gumbel(fit, ax=None, *, formula: str = "gringorten", level: float = 0.9
     Empirical non-exceedance probabilities use ``formula`` plotting positions
     over all years (years without a fall sit below every maximum, as in the
     mixed model).  The fitted line and its delta-method band follow.
+
+    Parameters
+    ----------
+    fit : GumbelFit
+        The fit.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+    formula : str
+        Plotting-position formula (:func:`riskrf.plotting_positions`).
+    level : float
+        Level of the band.
+    units : str
+        Unit of the maxima, for the axis.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        x: Gumbel reduced variate [-]; y: annual maximum [``units``].
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, section 8.4.2.
+    Gringorten, I. I. (1963). A plotting rule for extreme probability paper. Journal of Geophysical Research
+    68(3), 813-814.
     """
     ax = _axes(ax)
     x = np.sort(fit.data)
@@ -87,6 +129,32 @@ def plot_return_levels(fits, ax=None, *, power_law=None, maxima=None, formula: s
     likelihood for maximum-likelihood fits); a lower end at or below zero is
     drawn at the bottom of the axis (a mass is never negative) and an upper end
     the data do not bound (inf) is left open.
+
+    Parameters
+    ----------
+    fits : GumbelFit, GEVFit or dict
+        A fit or ``{label: fit}``.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+    power_law : GutenbergRichterFit, optional
+        Also draw its annual-maximum law.
+    maxima : array_like, optional
+        Annual maxima to draw as points [``units``].
+    formula : str
+        Plotting-position formula.
+    level : float
+        Level of the bands.
+    units : str
+        Unit of the maxima.
+    T_max : float
+        Longest return period drawn [yr].
+    ci_method : str, optional
+        Interval method (``"profile"``, ``"delta"``, ``"bootstrap"``).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        x: return period [yr], log; y: annual maximum [``units``].
     """
     ax = _axes(ax)
     if not isinstance(fits, dict):
@@ -131,7 +199,28 @@ def plot_return_levels(fits, ax=None, *, power_law=None, maxima=None, formula: s
 
 def plot_energy_exceedance(hazard, ax=None, *, fences=(), level: float = 0.95, n_bootstrap: int = 200, seed=1):
     """Annual frequency of impacts above each energy at the barrier line (log-log), with the
-    bootstrap band of the energy for each frequency and candidate fence capacities marked."""
+    bootstrap band of the energy for each frequency and candidate fence capacities marked.
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+    fences : sequence of float
+        Fence capacities to mark [kJ].
+    level : float
+        Level of the band.
+    n_bootstrap : int
+        Replicates of the band.
+    seed : int
+        Seed of the band.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        x: energy [kJ]; y: impacts above it per year [1/yr].
+    """
     ax = _axes(ax)
     e = np.geomspace(1.0, 1e8, 200)
     lam = hazard.annual_frequency(e)
@@ -154,7 +243,30 @@ def plot_energy_exceedance(hazard, ax=None, *, fences=(), level: float = 0.95, n
 
 def plot_mass_velocity(hazard, ax=None, *, energies=(100, 500, 1000, 2000, 5000, 10000), n_points: int = 3000,
                        seed=1):
-    """Sampled masses and velocities of falls reaching the line, with iso-energy curves E = 1/2 m v^2."""
+    """Sampled masses and velocities of falls reaching the line, with iso-energy curves E = 1/2 m v^2.
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+    energies : sequence of float
+        Iso-energy curves drawn [kJ].
+    n_points : int
+        Falls sampled.
+    seed : int
+        Seed of the sample.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        x: velocity at the barrier [m/s]; y: block mass [kg], log.
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, eq. 3.1.
+    """
     from ..hazard.impact_energy import mass_model
     ax = _axes(ax)
     rng = np.random.default_rng(seed)
@@ -189,7 +301,19 @@ def plot_mass_velocity(hazard, ax=None, *, energies=(100, 500, 1000, 2000, 5000,
 
 def plot_design_energy_sensitivity(table, ax=None):
     """The T-year energy [kJ] against the rate share, one line per maximum credible block m_max
-    (a table from :func:`riskrf.hazard.energy_study.design_energy_sensitivity`)."""
+    (a table from :func:`riskrf.hazard.energy_study.design_energy_sensitivity`).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Columns ``m_max_kg`` [kg], ``rate_share`` [-] and ``energy_kj``, the T-year energy [kJ].
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = _axes(ax)
     for i, (m_max, g) in enumerate(table.groupby("m_max_kg")):
         g = g.sort_values("rate_share")
@@ -209,7 +333,18 @@ def plot_design_energy_tornado(tornado, axes=None):
     """One tornado per design energy of a :class:`~riskrf.hazard.energy_study.DesignEnergyTornado` (stacked panels,
     each with its own base line and x axis in kJ), drawn by :func:`riskrf.report.decision_figures.plot_tornado`.
 
-    Returns the list of axes, one per design energy."""
+    Parameters
+    ----------
+    tornado : DesignEnergyTornado
+        The tornado tables.
+    axes : sequence of matplotlib.axes.Axes, optional
+        One per design energy (a new figure when None).
+
+    Returns
+    -------
+    list of matplotlib.axes.Axes
+        One per design energy.
+    """
     from .decision_figures import plot_tornado
     names = tornado.design_energies
     subs = [tornado.table[tornado.table["design_energy"] == n] for n in names]
