@@ -106,6 +106,7 @@ NUMPYDOC_MODULES = (
     "riskrf/report/design_figures.py",
     "riskrf/io/gis.py",
     "riskrf/report/fit_figures.py",
+    "riskrf/report/files.py",
 )
 
 

@@ -67,7 +67,21 @@ def _sparse_minor_log_ticks(fig) -> None:
 
 
 def save_figure(fig, path, *, tight_layout: bool = False) -> Path:
-    """Write ``fig`` to ``path`` (PNG, :data:`FIGURE_DPI`) and close it; returns the path."""
+    """Write ``fig`` to ``path`` (PNG, :data:`FIGURE_DPI`) and close it; returns the path.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str or path
+        The PNG written.
+    tight_layout : bool
+        Apply ``tight_layout`` first.
+
+    Returns
+    -------
+    pathlib.Path
+    """
     import matplotlib.pyplot as plt
     _plain_log_labels(fig)
     _sparse_minor_log_ticks(fig)
@@ -80,7 +94,20 @@ def save_figure(fig, path, *, tight_layout: bool = False) -> Path:
 
 
 def write_frequency_figures(analysis, out: Path) -> list[Path]:
-    """Magnitude-frequency, Gumbel and return-level figures of a :class:`~riskrf.FrequencyAnalysis`."""
+    """Magnitude-frequency, Gumbel and return-level figures of a :class:`~riskrf.FrequencyAnalysis`.
+
+    Parameters
+    ----------
+    analysis : FrequencyAnalysis
+        The fits.
+    out : pathlib.Path
+        Existing folder.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
     from .fit_figures import plot_gumbel, plot_magnitude_frequency, plot_return_levels
     ax = plot_magnitude_frequency(analysis.power_law)
     ax.set_title("Magnitude - cumulative frequency")
@@ -99,7 +126,22 @@ def write_frequency_figures(analysis, out: Path) -> list[Path]:
 
 
 def write_energy_figures(analysis, out: Path, fence_capacities_kj) -> list[Path]:
-    """Energy exceedance and mass-velocity figures of an energy study (``riskrf energy``)."""
+    """Energy exceedance and mass-velocity figures of an energy study (``riskrf energy``).
+
+    Parameters
+    ----------
+    analysis : EnergyAnalysis
+        The study.
+    out : pathlib.Path
+        Existing folder.
+    fence_capacities_kj : sequence of float
+        Fence capacities marked on the exceedance curve [kJ].
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
     from .fit_figures import plot_energy_exceedance, plot_mass_velocity
     ax = plot_energy_exceedance(analysis.hazard, fences=list(fence_capacities_kj),
                                 n_bootstrap=min(analysis.n_bootstrap, 200), seed=analysis.seed)
@@ -123,8 +165,23 @@ def write_energy_figures(analysis, out: Path, fence_capacities_kj) -> list[Path]
 def write_simulation_figures(result, out: Path, collectors, *, file_names=None, fences=()) -> list[Path]:
     """Profile with trajectories, one distribution figure per collector, and envelopes (when binned).
 
-    ``file_names`` maps a collector name to its file name (default ``collector_<name>.png``); ``fences``:
-    (x [m], height [m], label) drawn on the profile at their height.
+    Parameters
+    ----------
+    result : simulation.SimulationResult
+        The run.
+    out : pathlib.Path
+        Existing folder.
+    collectors : sequence of str
+        Collectors with a distribution figure.
+    file_names : dict, optional
+        Collector name → file name (default ``collector_<name>.png``).
+    fences : sequence of (float, float, str)
+        (x [m], height [m], label) drawn on the profile at their height.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
     """
     from simulation.plotting import (
         plot_collector_distributions,
@@ -144,12 +201,40 @@ def write_simulation_figures(result, out: Path, collectors, *, file_names=None, 
 
 def write_frequency_study(analysis, out: Path, **options) -> list[Path]:
     """Every file of a :class:`~riskrf.FrequencyAnalysis`: its data files (:meth:`~riskrf.FrequencyAnalysis.write`,
-    ``options`` passed on) then its figures; returns every file written."""
+    ``options`` passed on) then its figures; returns every file written.
+
+    Parameters
+    ----------
+    analysis : FrequencyAnalysis
+        The fits.
+    out : pathlib.Path
+        Existing folder.
+    **options
+        Passed to :meth:`~riskrf.FrequencyAnalysis.write`.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
     return analysis.write(out, **options) + write_frequency_figures(analysis, Path(out))
 
 
 def write_energy_study(analysis, out: Path) -> list[Path]:
     """Every file of an energy study (:class:`~riskrf.hazard.energy_study.EnergyAnalysis`): its data files, then
-    the figures, with the checked fences' capacities drawn on the exceedance curve; returns every file written."""
+    the figures, with the checked fences' capacities drawn on the exceedance curve; returns every file written.
+
+    Parameters
+    ----------
+    analysis : EnergyAnalysis
+        The study.
+    out : pathlib.Path
+        Existing folder.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
     written = analysis.write(out)
     return written + write_energy_figures(analysis, Path(out), [float(n.split(" kJ")[0]) for n in analysis.fences])
