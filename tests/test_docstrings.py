@@ -107,6 +107,8 @@ NUMPYDOC_MODULES = (
     "riskrf/io/gis.py",
     "riskrf/report/fit_figures.py",
     "riskrf/report/files.py",
+    "riskrf/report/pdf.py",
+    "riskrf/report/corridor_report.py",
 )
 
 

@@ -41,7 +41,18 @@ def _binned(t, bins):
 def plot_corridor(res):
     """Along chainage: RHRS score, individual risk (criterion line), deaths per year per km now and with the
     best option.  Above :data:`AGGREGATE_ABOVE` sections the curves are binned (:data:`CHAINAGE_BINS` bins; RHRS
-    and individual risk the bin's maximum, deaths per km the bin's total over its length)."""
+    and individual risk the bin's maximum, deaths per km the bin's total over its length).
+
+    Parameters
+    ----------
+    res : CorridorResult
+        The corridor's results.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Panels against chainage [m].
+    """
     import matplotlib.pyplot as plt
     t = res.table.sort_values("chainage_from_m")
     fig, ax = plt.subplots(3, 1, figsize=(10, 7.5), sharex=True)
@@ -89,7 +100,21 @@ def plot_corridor(res):
 
 def plot_map(res, lines, programme=None):
     """Map of the sections on the road (projected CRS, metres): each section's line coloured by deaths per year
-    per km of doing nothing (log scale); sections the programme funds drawn wide with a black casing."""
+    per km of doing nothing (log scale); sections the programme funds drawn wide with a black casing.
+
+    Parameters
+    ----------
+    res : CorridorResult
+        The corridor's results.
+    lines : sequence of numpy.ndarray
+        Each section's (k, 2) vertices [m].
+    programme : Programme, optional
+        The funded programme.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     import matplotlib.pyplot as plt
     import numpy as np
     from matplotlib.collections import LineCollection
@@ -128,7 +153,23 @@ def plot_map(res, lines, programme=None):
 
 
 def plot_frontier(frontier, ax=None, *, currency: str = "", chosen_budget: float | None = None):
-    """The efficient frontier: benefit of the best programme against the budget (steps: each point exact)."""
+    """The efficient frontier: benefit of the best programme against the budget (steps: each point exact).
+
+    Parameters
+    ----------
+    frontier : Frontier
+        Its ``table`` (``budget``, ``benefit``) and the cost and benefit columns.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+    currency : str
+        Currency label.
+    chosen_budget : float, optional
+        Budget marked [currency].
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     import matplotlib.pyplot as plt
     t = frontier.table
     own = ax is None
@@ -154,7 +195,23 @@ def plot_frontier(frontier, ax=None, *, currency: str = "", chosen_budget: float
 
 def render_rating_sheets(res) -> str:
     """One RHRS rating sheet per rated section (HTML): category, rated value, level x, score and whole points,
-    the total as a sheet prints it; built as plain strings so that it costs O(sections)."""
+    the total as a sheet prints it; built as plain strings so that it costs O(sections).
+
+    Parameters
+    ----------
+    res : CorridorResult
+        The corridor's results.
+
+    Returns
+    -------
+    str
+        A complete HTML document.
+
+    References
+    ----------
+    Pierson, L. A. & Van Vickle, R. (1993). Rockfall Hazard Rating System: Participant's Manual. Federal Highway
+    Administration, FHWA-SA-93-057.
+    """
     c = res.corridor
     parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>RHRS rating sheets: "
              f"{escape(c.name)}</title><style>body{{font-family:Georgia,serif;max-width:900px;margin:2em auto}}"
@@ -190,7 +247,28 @@ def render_corridor_html(res, figure_png: Path, *, figures: dict | None = None, 
                          budget_basis: str = "total") -> str:
     """Self-contained HTML corridor report: key figures, chainage figure, map, the budget programme and its
     efficient frontier, ranked table (first :data:`HTML_ROWS` rows), budget curve, where the RHRS and the
-    quantitative ranking disagree, rejected rows, failures and assumptions."""
+    quantitative ranking disagree, rejected rows, failures and assumptions.
+
+    Parameters
+    ----------
+    res : CorridorResult
+        The corridor's results.
+    figure_png : pathlib.Path
+        The chainage figure.
+    figures : dict, optional
+        Other figures by name (``map``, ``frontier`` ...).
+    programme : Programme, optional
+        The budget programme.
+    frontier : Frontier, optional
+        Its efficient frontier.
+    budget_basis : str
+        What the budget counts: ``"total"`` (capital paid now) or ``"year"`` (equivalent annual cost).
+
+    Returns
+    -------
+    str
+        A complete HTML document.
+    """
     figures = figures or {}
     c = res.corridor
     cur = c.currency

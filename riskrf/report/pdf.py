@@ -30,7 +30,21 @@ def _font_paths():
 
 def fmt(v, digits: int = 3, *, thousands: bool = True) -> str:
     """A number for an engineering table: ``digits`` significant figures, thousands separators for large values
-    (never for years or identifiers: pass ``thousands=False`` or use :func:`year`), "n/a" for NaN/None."""
+    (never for years or identifiers: pass ``thousands=False`` or use :func:`year`), "n/a" for NaN/None.
+
+    Parameters
+    ----------
+    v : float, bool, str or None
+        The value (text is returned as it is, None as "").
+    digits : int
+        Significant figures.
+    thousands : bool
+        Thousands separators for large values.
+
+    Returns
+    -------
+    str
+    """
     if v is None or isinstance(v, str):
         return "" if v is None else v
     if isinstance(v, (bool, np.bool_)):
@@ -50,12 +64,36 @@ def fmt(v, digits: int = 3, *, thousands: bool = True) -> str:
 
 
 def year(v) -> str:
-    """A year or return period: an integer without thousands separator."""
+    """A year or return period: an integer without thousands separator.
+
+    Parameters
+    ----------
+    v : float or None
+        The year or return period [yr].
+
+    Returns
+    -------
+    str
+        "n/a" for None or NaN.
+    """
     return "n/a" if v is None or not np.isfinite(float(v)) else f"{float(v):.0f}"
 
 
 def pct(v, digits: int = 1) -> str:
-    """A share [-] as a percentage."""
+    """A share [-] as a percentage.
+
+    Parameters
+    ----------
+    v : float or None
+        The share [-].
+    digits : int
+        Decimals of the percentage.
+
+    Returns
+    -------
+    str
+        E.g. "12.5 %"; "n/a" for None or NaN.
+    """
     return "n/a" if v is None or not np.isfinite(float(v)) else f"{100 * float(v):.{digits}f} %"
 
 
@@ -197,7 +235,20 @@ def _toc(pdf, outline):
 
 
 def title_block(site, now: datetime.date | None = None) -> dict:
-    """The title-block fields from the site file's ``[report]`` table, with their defaults."""
+    """The title-block fields from the site file's ``[report]`` table, with their defaults.
+
+    Parameters
+    ----------
+    site : Site
+        The site (its ``report`` table and name).
+    now : datetime.date, optional
+        Date used when the table gives none (default: today).
+
+    Returns
+    -------
+    dict
+        ``project``, ``site``, ``location``, ``revision``, ``date``, ``author``, ``checker``, ``client``.
+    """
     r = dict(getattr(site, "report", {}) or {})
     d = r.get("date")
     return {"project": str(r.get("project") or site.name), "site": site.name,
@@ -244,7 +295,21 @@ def _slope_tables(site):
 
 
 def write_pdf_report(a, path, figs) -> Path:
-    """Write report.pdf for the assessment ``a`` (figures read from ``figs``); returns the path."""
+    """Write report.pdf for the assessment ``a`` (figures read from ``figs``); returns the path.
+
+    Parameters
+    ----------
+    a : riskrf.app.assess.Assessment
+        The assessment.
+    path : str or path
+        The PDF written.
+    figs : str or path
+        Folder of its figures (PNG).
+
+    Returns
+    -------
+    pathlib.Path
+    """
     figs = Path(figs)
     tb = title_block(a.site)
     rep = _Report(tb)
