@@ -109,6 +109,7 @@ NUMPYDOC_MODULES = (
     "riskrf/report/files.py",
     "riskrf/report/pdf.py",
     "riskrf/report/corridor_report.py",
+    "riskrf/hazard/mass_coupling.py",
 )
 
 

@@ -105,7 +105,18 @@ class MassCoupledSamples(Displayed):
         return np.isfinite(self.speed_ms)
 
     def class_of(self, mass_kg) -> np.ndarray:
-        """Mass class of each mass (masses outside the simulated range take the nearest class)."""
+        """Mass class of each mass (masses outside the simulated range take the nearest class).
+
+        Parameters
+        ----------
+        mass_kg : float or array_like
+            Masses [kg].
+
+        Returns
+        -------
+        numpy.ndarray of int
+            Class index, 0 .. n_bins - 1.
+        """
         k = np.searchsorted(self.edges_kg, np.asarray(mass_kg, dtype=float), side="right") - 1
         return np.clip(k, 0, self.edges_kg.size - 2)
 
@@ -206,13 +217,37 @@ class MassCoupledSamples(Displayed):
         return np.clip(out, 0.0, 1.0).reshape(e.shape)
 
     def joint_exceedance(self, energy_kj, mm) -> np.ndarray:
-        """P(a fall reaches the line with energy above e) [-] under mass model ``mm`` (a ``mass_model``)."""
+        """P(a fall reaches the line with energy above e) [-] under mass model ``mm`` (a ``mass_model``).
+
+        Parameters
+        ----------
+        energy_kj : float or array_like
+            Energies [kJ].
+        mm : _MassModel
+            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+
+        Returns
+        -------
+        numpy.ndarray
+            Probabilities [-].
+        """
         e = np.asarray(energy_kj, dtype=float)
         return self._joint(np.atleast_1d(e), self._groups(mm)[0]).reshape(e.shape)
 
     def exceedance_function(self, mm):
         """e [kJ] -> P(E > e) [-] for a fall reaching the line under ``mm``: the joint exceedance over P(reach),
-        with the mass-model quadrature prepared once (for root finding and repeated evaluation)."""
+        with the mass-model quadrature prepared once (for root finding and repeated evaluation).
+
+        Parameters
+        ----------
+        mm : _MassModel
+            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+
+        Returns
+        -------
+        callable
+            ``f(energy_kj) -> P(E > e)``.
+        """
         groups, reach = self._groups(mm)
         if reach <= 0:
             raise ValueError("no simulated block of the mass model's range reached the line")
@@ -223,11 +258,35 @@ class MassCoupledSamples(Displayed):
         return fn
 
     def reach_probability(self, mm) -> float:
-        """P(a fall reaches the line) under mass model ``mm``: sum over classes of P(M in class) P(reach | class)."""
+        """P(a fall reaches the line) under mass model ``mm``: sum over classes of P(M in class) P(reach | class).
+
+        Parameters
+        ----------
+        mm : _MassModel
+            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+
+        Returns
+        -------
+        float
+            Probability [-].
+        """
         return self._groups(mm)[1]
 
     def arrival_sf(self, mass_kg, mm) -> float:
-        """P(a fall is heavier than m and reaches the line) [-] under ``mm`` (reach constant within a class)."""
+        """P(a fall is heavier than m and reaches the line) [-] under ``mm`` (reach constant within a class).
+
+        Parameters
+        ----------
+        mass_kg : float
+            Mass m [kg].
+        mm : _MassModel
+            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+
+        Returns
+        -------
+        float
+            Probability [-].
+        """
         m = float(mass_kg)
         lo = self.edges_kg[:-1].copy()
         lo[0] = 0.0                                   # the end classes take the mass outside the range
@@ -238,16 +297,48 @@ class MassCoupledSamples(Displayed):
         return float(np.sum(self.reach_by_class * np.clip(sf_lo - sf_hi, 0.0, None)))
 
     def class_weights(self, mm) -> np.ndarray:
-        """P(M in class) under ``mm`` (the classes at the ends take the mass outside the simulated range)."""
+        """P(M in class) under ``mm`` (the classes at the ends take the mass outside the simulated range).
+
+        Parameters
+        ----------
+        mm : _MassModel
+            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+
+        Returns
+        -------
+        numpy.ndarray
+            One probability [-] per class, summing to 1.
+        """
         m, w, cls = self._nodes(mm)
         return np.bincount(cls, weights=w, minlength=self.n_bins)
 
     def outside_range(self, mm) -> tuple:
-        """(P(M < lowest simulated class), P(M > highest)) under ``mm``."""
+        """(P(M < lowest simulated class), P(M > highest)) under ``mm``.
+
+        Parameters
+        ----------
+        mm : _MassModel
+            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+
+        Returns
+        -------
+        tuple of float
+            Probabilities [-].
+        """
         return float(1.0 - mm.sf(self.edges_kg[0])), float(mm.sf(self.edges_kg[-1]))
 
     def with_representative(self, mm) -> "MassCoupledSamples":
-        """A copy whose pooled samples represent the arriving falls under ``mm`` (systematic resampling)."""
+        """A copy whose pooled samples represent the arriving falls under ``mm`` (systematic resampling).
+
+        Parameters
+        ----------
+        mm : _MassModel
+            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+
+        Returns
+        -------
+        MassCoupledSamples
+        """
         arrived_cls = self.class_of(self.mass_kg[self.reached])
         n_c = np.array([n for n, _, _ in self._classes], dtype=float)
         w = self.class_weights(mm)[arrived_cls] / n_c[arrived_cls]
@@ -275,7 +366,22 @@ class MassCoupledSamples(Displayed):
 
     def resampled_joint_exceedance(self, rng, energy_kj, mm) -> np.ndarray:
         """:meth:`joint_exceedance` of one bootstrap replicate: the blocks of each mass class drawn with
-        replacement (reach and speed together), counted as multiplicities of the simulated blocks."""
+        replacement (reach and speed together), counted as multiplicities of the simulated blocks.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            Stream of the replicate.
+        energy_kj : array_like
+            Energies [kJ].
+        mm : _MassModel
+            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+
+        Returns
+        -------
+        numpy.ndarray
+            Probabilities [-].
+        """
         arrivals = []
         for n_c, position, n_arrived in self._bootstrap_layout:
             drawn = position[rng.integers(0, n_c, n_c)]
@@ -285,21 +391,64 @@ class MassCoupledSamples(Displayed):
 
     # ---- conditional percentiles and tables -----------------------------------------------------
     def velocity_percentile(self, q, mass_kg) -> float:
-        """Speed [m/s] not exceeded by q % of the arriving blocks of the class of ``mass_kg``."""
+        """Speed [m/s] not exceeded by q % of the arriving blocks of the class of ``mass_kg``.
+
+        Parameters
+        ----------
+        q : float
+            Percentile, in [0, 100].
+        mass_kg : float
+            Block mass [kg].
+
+        Returns
+        -------
+        float
+            Speed [m/s].
+        """
         speeds = self._classes[int(self.class_of(mass_kg))][1]
         return float(np.percentile(speeds, q)) if speeds.size else float("nan")
 
     def height_percentile(self, q, mass_kg) -> float:
-        """Bounce height [m] not exceeded by q % of the arriving blocks of the class of ``mass_kg``."""
+        """Bounce height [m] not exceeded by q % of the arriving blocks of the class of ``mass_kg``.
+
+        Parameters
+        ----------
+        q : float
+            Percentile, in [0, 100].
+        mass_kg : float
+            Block mass [kg].
+
+        Returns
+        -------
+        float
+            Height of the block centre above the ground [m].
+        """
         h = self._classes[int(self.class_of(mass_kg))][2]
         return float(np.percentile(h, q)) if h.size else float("nan")
 
     def contains(self, mass_kg) -> bool:
-        """Whether ``mass_kg`` lies inside the simulated mass range."""
+        """Whether ``mass_kg`` lies inside the simulated mass range.
+
+        Parameters
+        ----------
+        mass_kg : float
+            Mass [kg].
+
+        Returns
+        -------
+        bool
+        """
         return bool(self.edges_kg[0] <= float(mass_kg) <= self.edges_kg[-1])
 
     def class_table(self) -> pd.DataFrame:
-        """Per mass class: range [kg], blocks released and arriving, P(reach), speed p50/p95 [m/s], height p95 [m]."""
+        """Per mass class: range [kg], blocks released and arriving, P(reach), speed p50/p95 [m/s], height p95 [m].
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per class: ``mass_low_kg``, ``mass_high_kg``, ``released``, ``reached``, ``reach_probability``,
+            ``velocity_p50_ms``, ``velocity_p95_ms``, ``height_p95_m``.
+        """
         rows = []
         for c, (n_c, s, h) in enumerate(self._classes):
             rows.append({"mass_low_kg": self.edges_kg[c], "mass_high_kg": self.edges_kg[c + 1], "released": n_c,
@@ -363,7 +512,22 @@ class MassCoupledSamples(Displayed):
 
 
 def stratified_log_uniform(low_kg: float, high_kg: float, n: int, rng) -> np.ndarray:
-    """n masses [kg], one uniformly in each of n equal slices of ln m over [low, high], in random order."""
+    """n masses [kg], one uniformly in each of n equal slices of ln m over [low, high], in random order.
+
+    Parameters
+    ----------
+    low_kg, high_kg : float
+        Mass range [kg].
+    n : int
+        Masses drawn.
+    rng : numpy.random.Generator
+        The stream.
+
+    Returns
+    -------
+    numpy.ndarray
+        Masses [kg].
+    """
     u = (np.arange(n) + rng.uniform(size=n)) / n
     m = np.exp(np.log(low_kg) + u * (np.log(high_kg) - np.log(low_kg)))
     return rng.permutation(m)
@@ -371,7 +535,20 @@ def stratified_log_uniform(low_kg: float, high_kg: float, n: int, rng) -> np.nda
 
 def default_mass_range(mm, rate_per_year: float) -> tuple:
     """The simulated mass range [kg] for mass model ``mm``: its lower end, and its upper end when finite
-    (a truncated law), else the mass exceeded once in RANGE_RETURN_PERIOD_YEARS at ``rate_per_year``."""
+    (a truncated law), else the mass exceeded once in RANGE_RETURN_PERIOD_YEARS at ``rate_per_year``.
+
+    Parameters
+    ----------
+    mm : _MassModel
+        Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+    rate_per_year : float
+        Falls per year described by the mass model [1/yr].
+
+    Returns
+    -------
+    tuple of float
+        (low, high) [kg].
+    """
     lo, hi = (float(v) for v in mm.support)
     if not np.isfinite(lo) or lo <= 0:
         lo = float(mm.isf(1.0 - 1e-6))
