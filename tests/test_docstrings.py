@@ -110,6 +110,7 @@ NUMPYDOC_MODULES = (
     "riskrf/report/pdf.py",
     "riskrf/report/corridor_report.py",
     "riskrf/hazard/mass_coupling.py",
+    "riskrf/hazard/energy_study.py",
 )
 
 

@@ -39,7 +39,13 @@ class EnergyAnalysis:
     tornado: object = None               # DesignEnergyTornado or None
 
     def fence_verdicts(self) -> pd.DataFrame:
-        """One row per fence checked: whether every check passed (``adequate``) and the names of those that failed."""
+        """One row per fence checked: whether every check passed (``adequate``) and the names of those that failed.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``fence``, ``adequate``, ``failed checks``.
+        """
         rows = []
         for name, table in self.fences.items():
             rows.append({"fence": name, "adequate": bool(table["adequate"].all()),
@@ -49,6 +55,10 @@ class EnergyAnalysis:
     def summary_text(self) -> str:
         """The analysis in a few plain-text lines (rates [1/yr], reach probability, design energies [kJ], fence
         verdicts), for the CLI's closing summary; the caller prints it.
+
+        Returns
+        -------
+        str
         """
         hz = self.hazard
         lines = ["Impact energy hazard at the barrier line (Wyllie 2014, 8.1-8.3)",
@@ -132,6 +142,10 @@ class EnergyAnalysis:
     def to_dict(self) -> dict:
         """The analysis as a JSON-ready dict (``energy_summary.json``): units, hazard figures, design energies [kJ],
         fence checks, interval coverage and notes.
+
+        Returns
+        -------
+        dict
         """
         hz = self.hazard
         out = {"units": {"energy": "kJ", "height": "m", "rate": "1/yr", "return_period": "yr"},
@@ -164,6 +178,16 @@ class EnergyAnalysis:
         """Write ``energy_summary.json`` and the CSV tables (design energies, sensitivity, tornado) into ``out_dir``
         (which must exist); returns every file written.  The figures are drawn by
         :func:`riskrf.report.files.write_energy_study`, which calls this first.
+
+        Parameters
+        ----------
+        out_dir : str or path
+            Existing folder.
+
+        Returns
+        -------
+        list of pathlib.Path
+            The files written.
         """
         out = Path(out_dir)
         written = [out / "energy_summary.json", out / "design_energies.csv"]
@@ -192,7 +216,46 @@ def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_
     speed of simulated blocks of its mass when the hazard is mass-coupled) instead of the T-year block, and each
     fence gets an over-topping check by the block's top.  ``sensitivity``: a table from
     :func:`design_energy_sensitivity`, carried into the outputs; ``tornado``: a :class:`DesignEnergyTornado`
-    (:func:`design_energy_tornado`), likewise."""
+    (:func:`design_energy_tornado`), likewise.
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard at the line.
+    fences : sequence of float
+        Fence capacities (MEL) to check [kJ].
+    fence_height_m : float or sequence of float
+        Fence height(s) [m].
+    free_board_m : float
+        Margin over the 95th-percentile bounce height [m].
+    T : sequence of float
+        Return periods of the design table [yr].
+    design_T : float
+        Design return period [yr].
+    density_kg_m3 : float
+        Rock density [kg/m³] (UNI 11211-4 volume).
+    n_bootstrap : int
+        Replicates of the intervals.
+    seed : int
+        Seed of the intervals.
+    uni_factors : dict, optional
+        UNI 11211-4 partial factors (:func:`riskrf.hazard.barriers.uni11211_design_energy`).
+    design_block : DesignBlock, optional
+        The design block.
+    sensitivity : pandas.DataFrame, optional
+        A :func:`design_energy_sensitivity` table.
+    tornado : DesignEnergyTornado, optional
+        A :func:`design_energy_tornado` result.
+
+    Returns
+    -------
+    EnergyAnalysis
+        Design table [kJ], fence checks, the UNI 11211-4 design and the carried tables.
+
+    References
+    ----------
+    UNI 11211-4:2012; EOTA ETAG 027 / EAD 340059-00-0106 (see :mod:`riskrf.hazard.barriers`).
+    """
     from ..core.validation import check_return_periods
     try:
         check_return_periods(design_T, "design_T")
@@ -284,6 +347,29 @@ def design_energy_sensitivity(hazard: EnergyHazard, masses_kg, duration_years: f
     above ``m_min``) with that truncation; its rate is multiplied by each share; the slope model (the hazard's
     simulated reach and speeds, by mass when mass-coupled) stays.  ``simulated`` says whether the m_max lies
     inside the simulated masses (else its heaviest blocks borrow the top mass class's speeds).
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard (its slope model is kept).
+    masses_kg : array_like
+        The inventory's masses [kg].
+    duration_years : float
+        Its record length [yr].
+    m_min : float
+        Completeness threshold [kg].
+    m_max_values : sequence of float
+        Maximum credible blocks [kg].
+    rate_shares : sequence of float
+        Rate shares [-].
+    T : float
+        Return period [yr].
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (m_max, share): ``m_max_kg``, ``rate_share``, ``falls_per_year``, ``b``, ``T_years``,
+        ``energy_kj``, ``simulated``.
     """
     rows = []
     top = hazard.velocity.edges_kg[-1] if hazard.mass_coupled else None
@@ -301,7 +387,17 @@ def design_energy_sensitivity(hazard: EnergyHazard, masses_kg, duration_years: f
 
 
 def sensitivity_grid(table: pd.DataFrame) -> pd.DataFrame:
-    """The sensitivity table as a grid: m_max [kg] rows, rate share columns, T-year energy [kJ] values."""
+    """The sensitivity table as a grid: m_max [kg] rows, rate share columns, T-year energy [kJ] values.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A :func:`design_energy_sensitivity` table.
+
+    Returns
+    -------
+    pandas.DataFrame
+    """
     g = table.pivot(index="m_max_kg", columns="rate_share", values="energy_kj")
     g.index = [f"m_max {sig(v)} kg" if np.isfinite(v) else "m_max none" for v in g.index]
     g.columns = [f"share {c:g}" for c in g.columns]
@@ -333,7 +429,12 @@ class DesignEnergyTornado:
     notes: tuple = ()
 
     def summary(self) -> pd.DataFrame:
-        """The tornado table: one row per input and design energy; low/high inputs and the energy [kJ] at each."""
+        """The tornado table: one row per input and design energy; low/high inputs and the energy [kJ] at each.
+
+        Returns
+        -------
+        pandas.DataFrame
+        """
         return self.table
 
     @property
@@ -343,7 +444,12 @@ class DesignEnergyTornado:
 
     def dominant(self) -> pd.DataFrame:
         """Per design energy: the input with the largest swing [kJ], its low-high energies and its share of the
-        sum of swings."""
+        sum of swings.
+
+        Returns
+        -------
+        pandas.DataFrame
+        """
         rows = []
         for name in self.design_energies:
             sub = self.table[self.table["design_energy"] == name]
@@ -357,7 +463,12 @@ class DesignEnergyTornado:
         return pd.DataFrame(rows)
 
     def text(self) -> str:
-        """The table for a terminal, numbers by :func:`sig`."""
+        """The table for a terminal, numbers by :func:`sig`.
+
+        Returns
+        -------
+        str
+        """
         lines = []
         for name in self.design_energies:
             sub = self.table[self.table["design_energy"] == name]
@@ -371,7 +482,12 @@ class DesignEnergyTornado:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
-        """The tornado as a JSON-ready dict: design return period [yr], rows, dominant inputs and notes."""
+        """The tornado as a JSON-ready dict: design return period [yr], rows, dominant inputs and notes.
+
+        Returns
+        -------
+        dict
+        """
         return {"design_T_years": self.design_T, "rows": self.table.to_dict(orient="records"),
                 "dominant": self.dominant().to_dict(orient="records"), "notes": list(self.notes)}
 
@@ -434,6 +550,41 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
     T-year energy (which integrates over every speed), and the law's inputs do not move a percentile block taken
     from a survey.  ``sensitivity``: a :func:`design_energy_sensitivity` table whose T-year energies at
     (m_max, rate share) are reused instead of recomputed.
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard at the line.
+    design_T : float
+        Design return period [yr].
+    block : DesignBlock, optional
+        The design block.
+    masses_kg : array_like, optional
+        The inventory's masses [kg] (for refits with another m_max).
+    duration_years : float, optional
+        Its record length [yr].
+    m_max_range : tuple of float, optional
+        (low, high) maximum credible block [kg].
+    rate_share : float
+        Base rate share [-].
+    rate_share_range : tuple of float, optional
+        (low, high) rate share [-].
+    velocity_percentile : float, optional
+        Percentile [%] of the design-block speed (default 95).
+    velocity_percentile_range : tuple of float, optional
+        (low, high) percentile [%].
+    fractal_dimension_range : tuple of float, optional
+        (low, high) fractal dimension D [-].
+    iterations_range : tuple of int, optional
+        (low, high) fragmentation generations.
+    sensitivity : pandas.DataFrame, optional
+        A :func:`design_energy_sensitivity` table to reuse.
+    rate_label : str
+        Name of the rate row.
+
+    Returns
+    -------
+    DesignEnergyTornado
     """
     from .barriers import UNI11211_FACTORS
     from .design_block import check_percentile, design_block as _design_block, fractal_fragments
