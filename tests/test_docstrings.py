@@ -111,6 +111,7 @@ NUMPYDOC_MODULES = (
     "riskrf/report/corridor_report.py",
     "riskrf/hazard/mass_coupling.py",
     "riskrf/hazard/energy_study.py",
+    "riskrf/hazard/design_block.py",
 )
 
 

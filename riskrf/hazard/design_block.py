@@ -60,19 +60,54 @@ RULES = ("percentile", "return_period", "fragmentation")
 def resolve_sizes(stated, inventory=None) -> str:
     """What the inventory's sizes are: ``stated`` (site file ``inventory.sizes`` or ``--inventory-sizes``) when
     given, else the inventory sidecar's ``sizes``, else ``"event_volumes"`` (the default: a detached volume is taken
-    as one block, an upper bound)."""
+    as one block, an upper bound).
+
+    Parameters
+    ----------
+    stated : str or None
+        ``"event_volumes"`` or ``"blocks"`` as stated by the user.
+    inventory : Inventory, optional
+        The inventory (its sidecar's ``sizes``).
+
+    Returns
+    -------
+    str
+    """
     if stated is not None:
         return stated
     return getattr(inventory, "sizes", None) or "event_volumes"
 
 
 def sphere_diameter_m(volume_m3):
-    """Diameter [m] of the sphere of the given volume [m³]: d = (6 V / pi)^(1/3)."""
+    """Diameter [m] of the sphere of the given volume [m³]: d = (6 V / pi)^(1/3).
+
+    Parameters
+    ----------
+    volume_m3 : float or array_like
+        Volume [m³].
+
+    Returns
+    -------
+    numpy.ndarray
+        Diameter [m].
+    """
     return (6.0 * np.asarray(volume_m3, dtype=float) / np.pi) ** (1.0 / 3.0)
 
 
 def check_percentile(percentile, where: str = "percentile") -> float:
-    """A percentile strictly between 0 and 100 [%]."""
+    """A percentile strictly between 0 and 100 [%].
+
+    Parameters
+    ----------
+    percentile : float
+        The value [%].
+    where : str
+        The argument or field, for the message.
+
+    Returns
+    -------
+    float
+    """
     if isinstance(percentile, bool) or not isinstance(percentile, (int, float, np.integer, np.floating)):
         raise TypeError(f"{where} = {percentile!r} must be a number between 0 and 100 (exclusive)")
     p = float(percentile)
@@ -82,7 +117,25 @@ def check_percentile(percentile, where: str = "percentile") -> float:
 
 
 def percentile_block(volumes_m3, percentile: float = 97.0) -> float:
-    """The ``percentile``-th percentile [m³] of block volumes (ONR 24810 design block, 95th-98th)."""
+    """The ``percentile``-th percentile [m³] of block volumes (ONR 24810 design block, 95th-98th).
+
+    Parameters
+    ----------
+    volumes_m3 : array_like
+        Block volumes [m³].
+    percentile : float
+        Percentile [%], in (0, 100).
+
+    Returns
+    -------
+    float
+        Volume [m³].
+
+    References
+    ----------
+    ONR 24810:2021, Technischer Steinschlagschutz (Austrian Standards): design block the 95th-98th percentile of the
+    block sizes.
+    """
     p = check_percentile(percentile)
     v = np.asarray(volumes_m3, dtype=float).ravel()
     if v.size == 0:
@@ -102,7 +155,22 @@ def read_block_survey(path, density_kg_m3: float, *, sheet=None, header_row: int
     any separator (``#`` comment lines skipped), Excel (``sheet``, ``header_row``) or Parquet;
     decimal commas decided per column (``decimal`` overrides); UTF-8 with or without BOM, else
     cp1252.  Empty rows are skipped.  Errors name the file and the column, or the row (file
-    line) and the value."""
+    line) and the value.
+
+    Parameters
+    ----------
+    path : str or path
+        The survey file.
+    density_kg_m3 : float
+        Rock density [kg/m³] converting masses to volumes.
+    sheet, header_row, decimal, encoding : optional
+        Table-reading options (:func:`riskrf.io.tables.read_table`).
+
+    Returns
+    -------
+    numpy.ndarray
+        Block volumes [m³].
+    """
     from ..frequency.inventory import _MASS_NAMES, _MASS_UNITS, _VOLUME_NAMES, _VOLUME_UNITS, _find_column
     from ..io.tables import is_blank, parse_numbers, read_table
     path = Path(path)
@@ -146,7 +214,27 @@ def fractal_fragments(volume_m3: float, fractal_dimension: float, iterations: in
     so the expected number of fragments of generation k is b^(3k) p^(k-1) (1 - p) (k < iterations) and
     b^(3 iterations) p^(iterations - 1) for the last; successive counts grow by b^D and the volumes add to V.
 
-    Returns a DataFrame: ``volume_m3`` per fragment, ``count`` (expected), ``volume_share``.
+    Parameters
+    ----------
+    volume_m3 : float
+        Detached volume V [m³].
+    fractal_dimension : float
+        Fractal dimension D [-] (< 3).
+    iterations : int
+        Generations of splitting.
+    branching : int
+        Splits per edge b (each block into b³).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per generation: ``generation``, ``volume_m3`` per fragment, ``count`` (expected),
+        ``volume_share``.
+
+    References
+    ----------
+    Perfect, E. (1997). Fractal models for the fragmentation of rocks and soils: a review. Engineering Geology
+    48(3-4), 185-198.
     """
     v0 = float(volume_m3)
     if not np.isfinite(v0) or v0 <= 0:
@@ -168,7 +256,20 @@ def fractal_fragments(volume_m3: float, fractal_dimension: float, iterations: in
 
 
 def fragment_percentile(fragments: pd.DataFrame, percentile: float) -> float:
-    """The fragment volume [m³] at ``percentile`` (by count) of a :func:`fractal_fragments` table."""
+    """The fragment volume [m³] at ``percentile`` (by count) of a :func:`fractal_fragments` table.
+
+    Parameters
+    ----------
+    fragments : pandas.DataFrame
+        A :func:`fractal_fragments` table.
+    percentile : float
+        Percentile [%] by count.
+
+    Returns
+    -------
+    float
+        Volume [m³].
+    """
     q = check_percentile(percentile) / 100.0
     f = fragments.sort_values("volume_m3")
     cdf = np.cumsum(f["count"].to_numpy()) / f["count"].sum()
@@ -203,6 +304,11 @@ class DesignBlock:
     def summary(self) -> pd.DataFrame:
         """The chosen design block (one-column table): rule, mass [kg], volume [m3], equivalent sphere diameter [m],
         basis and each assumption.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: quantity; column ``value``.
         """
         rows = {"rule": self.rule, "design block mass [kg]": self.mass_kg, "volume [m3]": self.volume_m3,
                 "equivalent sphere diameter [m]": self.diameter_m, "basis": self.basis}
@@ -211,7 +317,12 @@ class DesignBlock:
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
     def to_dict(self) -> dict:
-        """The design block and its alternatives as a JSON-ready dict (mass_kg, volume_m3, diameter_m, ...)."""
+        """The design block and its alternatives as a JSON-ready dict (mass_kg, volume_m3, diameter_m, ...).
+
+        Returns
+        -------
+        dict
+        """
         return {"rule": self.rule, "mass_kg": self.mass_kg, "volume_m3": self.volume_m3,
                 "diameter_m": self.diameter_m, "basis": self.basis, "assumptions": list(self.assumptions),
                 "alternatives": self.alternatives.to_dict(orient="records")}
@@ -219,7 +330,20 @@ class DesignBlock:
 
 def line_return_period_mass(hazard, T) -> np.ndarray:
     """The T-year block reaching the line [kg]: rate x P(M > m, reaches) = 1/T (mass-coupled reach), NaN when
-    fewer than one fall a T years reaches it."""
+    fewer than one fall a T years reaches it.
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard (mass law, rate, reach by mass).
+    T : float or array_like
+        Return period [yr].
+
+    Returns
+    -------
+    numpy.ndarray
+        Mass [kg].
+    """
     from .impact_energy import mass_model
     T = np.atleast_1d(np.asarray(T, dtype=float))
     mm = mass_model(hazard.mass)
@@ -258,7 +382,22 @@ def site_design_masses(hazard, T=DESIGN_RETURN_PERIODS,
                        density_kg_m3: float = DEFAULT_DENSITY_KG_M3) -> pd.DataFrame:
     """Design masses [kg] of the site's law (the hazard's: truncated at m_max, rate scaled to the source above the
     line): the T-year fall at the source and the T-year fall reaching the line; NaN where fewer than one such fall
-    is expected in T years.  Never above the law's m_max."""
+    is expected in T years.  Never above the law's m_max.
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard.
+    T : sequence of float
+        Return periods [yr].
+    density_kg_m3 : float
+        Rock density [kg/m³].
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``T_years``, the source and line masses [kg] and volumes [m³].
+    """
     from .impact_energy import mass_model
     T = np.atleast_1d(np.asarray(T, dtype=float))
     mm = mass_model(hazard.mass)
@@ -290,6 +429,16 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
     density_kg_m3 : rock density [kg/m³]
     fractal_dimension, iterations : parameters of the fragmentation step (:func:`fractal_fragments`); needed for
         ``rule="fragmentation"``, shown as an alternative whenever given
+
+    Returns
+    -------
+    DesignBlock
+        The chosen block (mass [kg], volume [m³], diameter [m]) with its alternatives and assumptions.
+
+    References
+    ----------
+    ONR 24810:2021, Technischer Steinschlagschutz (Austrian Standards): design block the 95th-98th percentile of the
+    block sizes.
     """
     from ..core.validation import check_choice, check_positive
     inputs = dict(rule=rule, percentile=percentile, survey_volumes_m3=survey_volumes_m3, survey_source=survey_source,
@@ -391,7 +540,26 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
 
 def design_block_candidates_kg(*, rule, percentile, survey_volumes_m3, inventory, density_kg_m3) -> list:
     """Masses [kg] the design-block rule can pick before the hazard exists (the percentile band), so that the
-    simulated mass range can include them."""
+    simulated mass range can include them.
+
+    Parameters
+    ----------
+    rule : str
+        The design-block rule.
+    percentile : float
+        Percentile [%].
+    survey_volumes_m3 : array_like or None
+        Block-survey volumes [m³].
+    inventory : Inventory or None
+        The inventory standing in for a survey.
+    density_kg_m3 : float
+        Rock density [kg/m³].
+
+    Returns
+    -------
+    list of float
+        Masses [kg].
+    """
     out = []
     if survey_volumes_m3 is not None:
         vols = np.asarray(survey_volumes_m3, dtype=float)
@@ -409,7 +577,30 @@ def fragment_block_kg(law, rate_per_year: float, *, design_T: float, fractal_dim
     """Mass [kg] of the fragmentation alternative of :func:`design_block` from the site's law alone (before the
     hazard is simulated): the ``percentile`` fragment of the ``design_T``-year fall at the source.  None when no
     fragmentation is stated or fewer than one such fall is expected; so that the simulated mass range can
-    include it."""
+    include it.
+
+    Parameters
+    ----------
+    law : mass model
+        The site's mass law [kg].
+    rate_per_year : float
+        Falls per year it describes [1/yr].
+    design_T : float
+        Return period [yr].
+    fractal_dimension : float or None
+        Fractal dimension D [-].
+    iterations : int or None
+        Generations of splitting.
+    percentile : float
+        Percentile [%] of the fragments by count.
+    density_kg_m3 : float
+        Rock density [kg/m³].
+
+    Returns
+    -------
+    float or None
+        Mass [kg].
+    """
     if fractal_dimension is None or iterations is None:
         return None
     from .impact_energy import mass_model
