@@ -199,30 +199,36 @@ def plot_position_search(search, ax=None):
     return a1
 
 
-<<<<<<< HEAD
 def position_search_figure(search):
-    """The two-panel position-search figure (slope with positions; requirement per position)."""
-    return plot_position_search(search).figure
-
-
-def plot_catchment(study, ax=None):
-    """Retention against catchment width from the re-simulation, with the widths for 90/95/99 %, the Modified
-    Ritchie Criterion width and the chart values beside it (when given).  Returns the matplotlib axes.
-    ``study``: a :class:`~riskrf.hazard.catchment.CatchmentStudy`."""
-=======
-def catchment_figure(study):
-    """Retention against catchment width from the re-simulation, with the chart values beside it (when given).
+    """The two-panel position-search figure (slope with positions; requirement per position).
 
     Parameters
     ----------
-    study : object
-        A catchment study with ``curve`` (``width_m`` [m], ``retained`` [-]).
+    search : PositionSearch
+        A :class:`~riskrf.hazard.design_basis.PositionSearch`.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
->>>>>>> cbfaec7 (numpydoc sections in riskrf.report decision and design figures)
+    return plot_position_search(search).figure
+
+
+def plot_catchment(study, ax=None):
+    """Retention against catchment width from the re-simulation, with the widths for 90/95/99 %, the Modified
+    Ritchie Criterion width and the chart values beside it (when given).
+
+    Parameters
+    ----------
+    study : CatchmentStudy
+        A :class:`~riskrf.hazard.catchment.CatchmentStudy` (its ``curve``: ``width_m`` [m], ``retained`` [-]).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     import matplotlib.pyplot as plt
 
     from ..hazard.catchment import modified_ritchie_width_m
