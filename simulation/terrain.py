@@ -404,9 +404,24 @@ def fall_line_to_nodata(terrain: Terrain, xy, max_steps: int | None = None):
     """Follow the steepest descent on the DEM's cells (D8: to the lowest of the 8 neighbours) from each plan
     point until a pit, the DEM's edge or a cell next to a nodata hole (where the bilinear surface ends).
 
-    Returns (index of the first point whose fall line meets a hole, or -1; the plan point [m] of the cell where
-    it does, or None).  A pre-flight check: bouncing blocks may leave the fall line, so it finds the holes
-    that the terrain leads blocks to, not every hole a block could reach."""
+    A pre-flight check: bouncing blocks may leave the fall line, so it finds the holes that the terrain leads
+    blocks to, not every hole a block could reach.
+
+    Parameters
+    ----------
+    terrain : Terrain
+        The DEM.
+    xy : array_like
+        Plan points (n, 2) [m].
+    max_steps : int, optional
+        Most cells followed from each point.
+
+    Returns
+    -------
+    tuple
+        (index of the first point whose fall line meets a hole, or -1; the plan point [m] of the cell where it
+        does, or None).
+    """
     z = terrain.z
     ny, nx = z.shape
     hole = np.isnan(z)

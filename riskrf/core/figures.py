@@ -25,6 +25,21 @@ FIGURES = {
 def draw(key: str, result, ax=None, **kwargs):
     """Draw ``result`` with the report function registered under ``key``; returns what it returns (the axes).
 
+    Parameters
+    ----------
+    key : str
+        A key of :data:`FIGURES`.
+    result : object
+        The science result to draw.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+    **kwargs
+        Passed to the report function.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
     Raises
     ------
     KeyError

@@ -428,7 +428,22 @@ class EnergyHazard(Displayed):
 
     def energy_at_return_period_replicates(self, T, n_bootstrap: int = 300, seed=None) -> np.ndarray:
         """The bootstrap replicates behind :meth:`energy_at_return_period_ci`: T-year energies [kJ], an array
-        (n_bootstrap, number of T); NaN where a replicate has fewer than one arrival in T years."""
+        (n_bootstrap, number of T); NaN where a replicate has fewer than one arrival in T years.
+
+        Parameters
+        ----------
+        T : float or array_like
+            Return period(s) [yr].
+        n_bootstrap : int
+            Replicates.
+        seed : int, optional
+            Seed of the replicates.
+
+        Returns
+        -------
+        numpy.ndarray
+            Energies [kJ].
+        """
         Tv = np.atleast_1d(check_return_periods(T)).astype(float)
         sims = np.empty((int(n_bootstrap), Tv.size))
         for i, (curve, scale) in enumerate(self._bootstrap_curves(int(n_bootstrap), seed)):

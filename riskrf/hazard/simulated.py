@@ -23,7 +23,17 @@ from .mass_coupling import MassCoupledSamples, NoArrivalsError, default_mass_ran
 
 def load_any_scenario(scenario):
     """A 2-D :class:`simulation.Scenario` or a 3-D :class:`simulation.TerrainScenario` as given, or read from a
-    TOML file (a ``[terrain]`` table makes it 3-D, a ``[profile]`` table 2-D)."""
+    TOML file (a ``[terrain]`` table makes it 3-D, a ``[profile]`` table 2-D).
+
+    Parameters
+    ----------
+    scenario : simulation.Scenario, simulation.TerrainScenario, str or path
+        The scenario or its TOML file.
+
+    Returns
+    -------
+    simulation.Scenario or simulation.TerrainScenario
+    """
     if isinstance(scenario, (simulation.Scenario, simulation.TerrainScenario)):
         return scenario
     if simulation.is_terrain_scenario_file(scenario):
@@ -34,7 +44,23 @@ def load_any_scenario(scenario):
 def run_any(scenario, *, seed, masses_kg, workers: int = 1):
     """Run a 2-D scenario (:func:`simulation.run`) or a 3-D one (:func:`simulation.run_terrain`, ``workers``
     threads) with the given block masses [kg]; both results give ``collector(name, first_only=True)`` rows with
-    ``block``, ``velocity_ms``, ``angular_velocity_rads``, ``radius_m``, ``height_m``."""
+    ``block``, ``velocity_ms``, ``angular_velocity_rads``, ``radius_m``, ``height_m``.
+
+    Parameters
+    ----------
+    scenario : simulation.Scenario or simulation.TerrainScenario
+        The scenario.
+    seed : int
+        Seed of the run.
+    masses_kg : array_like
+        One mass per block [kg].
+    workers : int
+        Threads of a 3-D run.
+
+    Returns
+    -------
+    simulation.SimulationResult or simulation.TerrainResult
+    """
     if isinstance(scenario, simulation.TerrainScenario):
         return simulation.run_terrain(scenario, seed=seed, masses_kg=masses_kg, workers=workers)
     return simulation.run(scenario, seed=seed, masses_kg=masses_kg)
@@ -93,6 +119,25 @@ def coupled_samples(result, collector: str, masses_kg, edges_kg, mass_model, *, 
     v_eff^2 = v^2 + k (omega r)^2 (:func:`~riskrf.hazard.annual_hazard.inertia_factors`), so that 1/2 m v_eff^2 is
     the translational plus rotational energy.  ``edges_kg`` are the mass-class edges [kg]; the classes take their
     representative mass from ``mass_model``.
+
+    Parameters
+    ----------
+    result : simulation.SimulationResult or simulation.TerrainResult
+        The run.
+    collector : str
+        The line.
+    masses_kg : array_like
+        Each released block's mass [kg], in the order simulated.
+    edges_kg : array_like
+        Mass-class edges [kg].
+    mass_model : _MassModel
+        The mass model of the falls [kg].
+    rotational : bool
+        Use the effective speed including rotation.
+
+    Returns
+    -------
+    MassCoupledSamples or None
     """
     df = result.collector(collector, first_only=True)
     if df.empty:

@@ -256,5 +256,15 @@ def plot_catchment(study, ax=None):
 
 
 def catchment_figure(study):
-    """The catchment retention figure (:func:`plot_catchment` on a new figure)."""
+    """The catchment retention figure (:func:`plot_catchment` on a new figure).
+
+    Parameters
+    ----------
+    study : CatchmentStudy
+        The catchment study.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     return plot_catchment(study).figure
