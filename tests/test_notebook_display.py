@@ -29,6 +29,9 @@ FRICTION = "materials.talus.ground_friction_angle_deg"
 EXEMPT = {
     "PooledCalibration": "simulation/pooled.py is being edited in another change (no _repr_html_ yet)",
     "Release": "simulation/pooled.py is being edited in another change (no summary() yet)",
+    "ReachConstraint": "simulation/pooled.py is being edited in another change (no summary() yet)",
+    "ModelUncertainRanking": "new in main while this change was made (riskrf/risk/model_decision.py): it has "
+                             "summary() and plot() but a generated repr and no _repr_html_ yet",
 }
 
 
