@@ -19,6 +19,14 @@ import importlib
 FIGURES = {
     "position_search": "riskrf.report.design_figures:plot_position_search",
     "catchment": "riskrf.report.design_figures:plot_catchment",
+    "inventory": "riskrf.report.fit_figures:plot_inventory",
+    "magnitude_frequency": "riskrf.report.fit_figures:plot_magnitude_frequency",
+    "return_levels": "riskrf.report.fit_figures:plot_return_levels",
+    "energy_exceedance": "riskrf.report.fit_figures:plot_energy_exceedance",
+    "mass_classes": "riskrf.report.fit_figures:plot_mass_classes",
+    "rainfall": "riskrf.report.rate_figures:plot_rainfall",
+    "rate_counts": "riskrf.report.rate_figures:plot_rate_counts",
+    "decision_tree": "riskrf.report.decision_figures:plot_tree",
 }
 
 

@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 from scipy import optimize, stats
 
-from simulation._display import Displayed, axes, short_repr
+from simulation._display import Displayed, short_repr
 
 from ..core.validation import (
     check_choice,
@@ -256,33 +256,22 @@ class _AnnualMaximumFit(Displayed):
         return short_repr(self, **dict(zip(self.param_names, self.params)), n_maxima=int(np.size(self.data)),
                           n_years=self.n_years, p_zero=self.p_zero, method=self.method)
 
-    def plot(self, ax=None, formula: str = "gringorten"):
-        """Return-level plot: the annual maxima at their plotting positions and the fitted return level.
+    def plot(self, ax=None, **kwargs):
+        """Return-level plot: the fitted annual maximum against the return period [yr], with its interval band (drawn by :func:`riskrf.report.fit_figures.plot_return_levels`).
 
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
             Axes to draw on (a new figure when None).
-        formula : str
-            Plotting-position formula of the maxima (see :func:`plotting_positions`).
+        **kwargs
+            Passed to the drawing function.
 
         Returns
         -------
         matplotlib.axes.Axes
-            x: return period T [yr], log scale; y: annual maximum [unit of the maxima].
         """
-        ax = axes(ax)
-        x = np.sort(np.asarray(self.data, dtype=float))
-        # plotting positions over all years (years without a fall at the bottom), the largest maxima at the top
-        p = plotting_positions(self.n_years, formula)[self.n_years - x.size:]
-        ax.semilogx(1.0 / (1.0 - p), x, "o", ms=4, color="0.3", label=f"annual maxima ({x.size} of {self.n_years} yr)")
-        lo = max(1.05 / (1 - self.p_zero), 1.01)
-        T = np.geomspace(lo, max(1000.0, 2 * self.n_years), 200)
-        ax.semilogx(T, self.return_level(T), color="C3", label=f"{type(self).__name__} ({self.method})")
-        ax.set_xlabel("return period T [yr]")
-        ax.set_ylabel("annual maximum")
-        ax.legend(fontsize="small")
-        return ax
+        from ..core.figures import draw
+        return draw("return_levels", self, ax=ax, **kwargs)
 
     def return_period(self, x):
         """Return period [yr] of an annual maximum x, 1 / P(annual max > x)."""

@@ -39,7 +39,7 @@ from ..io.tables import is_blank, parse_dates, parse_numbers, read_table, sniff_
 from ..core.format import sig
 from ..core.units import DEFAULT_DENSITY_KG_M3, KG_PER_TONNE
 from ..core.validation import check_density, check_positive, warn
-from simulation._display import Displayed, axes, short_repr
+from simulation._display import Displayed, short_repr
 
 #: Rock density used when none is given [kg/m³] (a typical value for granite
 #: and limestone; Wyllie 2014 uses 2.6-2.7 t/m³).
@@ -382,29 +382,22 @@ class Inventory(Displayed):
         return short_repr(self, repr(Path(str(self.source)).name), f"{self.n_events} events",
                           f"{self.duration_years:.4g} yr", f"mass {sig(m.min())}-{sig(m.max())} kg" if m.size else "")
 
-    def plot(self, ax=None):
-        """Empirical magnitude-frequency curve: falls of at least m per year against m, log-log.
+    def plot(self, ax=None, **kwargs):
+        """Empirical magnitude-frequency curve: falls of at least m per year [1/yr] against m [kg], log-log (drawn by :func:`riskrf.report.fit_figures.plot_inventory`).
 
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
             Axes to draw on (a new figure when None).
+        **kwargs
+            Passed to the drawing function.
 
         Returns
         -------
         matplotlib.axes.Axes
-            x: mass m [kg]; y: N(>=m), the number of recorded falls of at least m divided by the record's
-            length [1/yr].
         """
-        ax = axes(ax)
-        m = np.sort(self.masses)[::-1]
-        ax.loglog(m, np.arange(1, m.size + 1) / self.duration_years, ".", ms=4, color="0.3",
-                  label=f"{Path(str(self.source)).name} ({m.size} falls, {self.duration_years:.3g} yr)")
-        ax.set_xlabel("mass m [kg]")
-        ax.set_ylabel("falls of at least m per year N(>=m) [1/yr]")
-        ax.legend(fontsize="small")
-        return ax
-
+        from ..core.figures import draw
+        return draw("inventory", self, ax=ax, **kwargs)
 
 #: What an inventory's sizes can be: detached event volumes (laser scanning, registers) or individual block sizes.
 SIZES = ("event_volumes", "blocks")

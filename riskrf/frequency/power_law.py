@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 from scipy import optimize, stats
 
-from simulation._display import Displayed, axes, short_repr
+from simulation._display import Displayed, short_repr
 
 from ..core.validation import (
     as_positive_array,
@@ -938,34 +938,22 @@ class GutenbergRichterFit(Displayed):
                           n_tail=self.n_tail, duration_years=self.duration_years, method=self.method,
                           units=self.units)
 
-    def plot(self, ax=None):
-        """Magnitude-frequency plot: the fitted N(>=m) and, when the fit keeps its data, the recorded falls.
+    def plot(self, ax=None, **kwargs):
+        """Magnitude-frequency plot: the recorded falls and the fitted N(>=m) [1/yr] with the band of b, log-log (drawn by :func:`riskrf.report.fit_figures.plot_magnitude_frequency`).
 
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
             Axes to draw on (a new figure when None).
+        **kwargs
+            Passed to the drawing function.
 
         Returns
         -------
         matplotlib.axes.Axes
-            x: size m [units]; y: falls of at least m per year N(>=m) [1/yr], log-log.
         """
-        ax = axes(ax)
-        top = self.m_max if self.m_max is not None else self.m_min * 1e3
-        if self.data is not None and np.size(self.data):
-            d = np.sort(np.asarray(self.data, dtype=float))[::-1]
-            ax.loglog(d, np.arange(1, d.size + 1) / self.duration_years, ".", ms=4, color="0.3",
-                      label=f"recorded ({d.size} values)")
-            top = max(d[0], self.m_min * 1.01) if self.m_max is None else top
-        m = np.geomspace(self.m_min, top * (0.999 if self.m_max is not None else 1.0), 200)
-        ax.loglog(m, self.annual_frequency(m), color="C3",
-                  label=f"fit: log10 N = {self.a:.3g} - {self.b:.3g} log10 m (m >= {self.m_min:.3g})")
-        ax.set_xlabel(f"size m [{self.units}]")
-        ax.set_ylabel("falls of at least m per year N(>=m) [1/yr]")
-        ax.legend(fontsize="small")
-        return ax
-
+        from ..core.figures import draw
+        return draw("magnitude_frequency", self, ax=ax, **kwargs)
 
 def _ks_distance(x_sorted, F, statistic="sup"):
     """KS distance between the empirical CDF of sorted ``x`` and model CDF values F (see KS_STATISTICS)."""

@@ -42,7 +42,7 @@ from scipy import stats
 from .inventory import Inventory
 from ..io.rainfall import Rainfall, read_rainfall
 from ..core.validation import RiskrfWarning, warn
-from simulation._display import Displayed, axes, short_repr
+from simulation._display import Displayed, short_repr
 
 #: Fewest periods a count model is fitted to.
 MIN_PERIODS = 20
@@ -332,31 +332,22 @@ class RateModel(Displayed):
         return short_repr(self, f"{self.n_events} events in {self.n_periods} {self.period} periods",
                           preferred=self.preferred)
 
-    def plot(self, ax=None):
-        """Events per year: recorded, and expected by the preferred model.
+    def plot(self, ax=None, **kwargs):
+        """Events per year: recorded, and expected by the preferred model (drawn by :func:`riskrf.report.rate_figures.plot_rate_counts`).
 
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
             Axes to draw on (a new figure when None).
+        **kwargs
+            Passed to the drawing function.
 
         Returns
         -------
         matplotlib.axes.Axes
-            x: year; y: events per calendar year (recorded bars, the preferred model's expected count as a line).
         """
-        ax = axes(ax)
-        year = pd.to_datetime(self.design["period_start"]).dt.year.to_numpy()
-        observed = pd.Series(self.design["count"].to_numpy(), index=year).groupby(level=0).sum()
-        ax.bar(observed.index, observed.to_numpy(), color="0.75", label="recorded")
-        fit = self.fitted()
-        if fit is not None and len(fit):
-            expected = pd.Series(np.asarray(fit, dtype=float), index=year).groupby(level=0).sum()
-            ax.plot(expected.index, expected.to_numpy(), "o-", ms=3, color="C3", label=f"expected ({self.preferred})")
-        ax.set_xlabel("year")
-        ax.set_ylabel("events per year")
-        ax.legend(fontsize="small")
-        return ax
+        from ..core.figures import draw
+        return draw("rate_counts", self, ax=ax, **kwargs)
 
     def summary_text(self) -> str:
         """A readable report (what ``riskrf rates`` prints).

@@ -25,7 +25,7 @@ from .power_law import (
 from ..core.format import sig
 from ..core.units import DESIGN_RETURN_PERIODS  # noqa: F401  (also importable from here, as before)
 from ..core.validation import RiskrfWarning
-from simulation._display import Displayed, axes, short_repr
+from simulation._display import Displayed, short_repr
 
 
 
@@ -272,7 +272,7 @@ class FrequencyAnalysis(Displayed):
         matplotlib.axes.Axes
             x: mass m [kg]; y: falls of at least m per year [1/yr], log-log.
         """
-        return self.power_law.plot(axes(ax))
+        return self.power_law.plot(ax)
 
     def summary_text(self) -> str:
         """A readable report of the fits (what ``riskrf fit`` prints).

@@ -28,7 +28,7 @@ from ..frequency.power_law import GutenbergRichterFit
 from ..core.format import sig
 from ..core.units import DESIGN_RETURN_PERIODS, SPHERE_INERTIA
 from ..core.validation import check_positive, check_probability_level, check_return_periods
-from simulation._display import Displayed, axes, short_repr
+from simulation._display import Displayed, short_repr
 
 
 def inertia_factors(df) -> np.ndarray:
@@ -552,33 +552,22 @@ class EnergyHazard(Displayed):
                           rate_per_year=self.rate_per_year, reach_probability=self.reach_probability,
                           mass_coupled=self.mass_coupled)
 
-    def plot(self, ax=None):
-        """Annual frequency of impacts above an energy at the line, against the energy, log-log.
+    def plot(self, ax=None, **kwargs):
+        """Annual frequency of impacts above an energy at the line [1/yr] against the energy [kJ], log-log, with the bootstrap band (drawn by :func:`riskrf.report.fit_figures.plot_energy_exceedance`).
 
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
             Axes to draw on (a new figure when None).
+        **kwargs
+            Passed to the drawing function.
 
         Returns
         -------
         matplotlib.axes.Axes
-            x: impact energy e [kJ]; y: impacts above e per year [1/yr] (:meth:`annual_frequency`), with the
-            10-, 100- and 1000-year levels marked.
         """
-        ax = axes(ax)
-        lo, hi = self.energy_percentile([1.0, 99.99])
-        e = np.geomspace(max(float(lo), 1e-6), float(hi), 200)
-        ax.loglog(e, self.annual_frequency(e), color="C0", label=f"{self.collector or 'line'}: "
-                                                                  f"{sig(self.arrival_rate)} arrivals per year")
-        for T in (10, 100, 1000):
-            ax.axhline(1.0 / T, color="0.7", lw=0.8, ls=":")
-            ax.text(e[0], 1.0 / T, f" {T} yr", va="bottom", fontsize="x-small", color="0.4")
-        ax.set_xlabel("impact energy e [kJ]")
-        ax.set_ylabel("impacts above e per year [1/yr]")
-        ax.legend(fontsize="small")
-        return ax
-
+        from ..core.figures import draw
+        return draw("energy_exceedance", self, ax=ax, **kwargs)
 
 def _interp_log_inverse(curve, p):
     """Energy on _E_GRID where the non-increasing curve P(E > e) crosses p (log-log interpolation)."""

@@ -36,7 +36,7 @@ import pandas as pd
 from ..core.validation import RiskrfError
 from ..core.format import sig
 from ..core.units import J_PER_KJ, kinetic_energy_kj
-from simulation._display import Displayed, axes, short_repr
+from simulation._display import Displayed, short_repr
 
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
 #: Return period [yr] of the largest fall at the source that the default simulated range must include
@@ -474,29 +474,22 @@ class MassCoupledSamples(Displayed):
                           f"{self.mass_kg.size} blocks, {int(self.reached.sum())} reached",
                           f"{sig(self.edges_kg[0])}-{sig(self.edges_kg[-1])} kg in {self.n_bins} classes")
 
-    def plot(self, ax=None):
-        """Reach probability and median speed at the line by mass class.
+    def plot(self, ax=None, **kwargs):
+        """Reach probability and median speed [m/s] at the line by mass class [kg] (drawn by :func:`riskrf.report.fit_figures.plot_mass_classes`).
 
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
-            Axes to draw on (a new figure when None); the speed is drawn on a twin y axis.
+            Axes to draw on (a new figure when None).
+        **kwargs
+            Passed to the drawing function.
 
         Returns
         -------
         matplotlib.axes.Axes
-            x: block mass [kg], log scale; left y: P(reach the line); right y (twin): median speed [m/s].
         """
-        ax = axes(ax)
-        t = self.class_table()
-        mid = np.sqrt(t["mass_low_kg"] * t["mass_high_kg"])
-        ax.semilogx(mid, t["reach_probability"], "o-", color="C0", label="P(reach)")
-        ax.set_xlabel("block mass [kg]")
-        ax.set_ylabel("P(reach the line)", color="C0")
-        twin = ax.twinx()
-        twin.semilogx(mid, t["velocity_p50_ms"], "s--", color="C3")
-        twin.set_ylabel("median speed at the line [m/s]", color="C3")
-        return ax
+        from ..core.figures import draw
+        return draw("mass_classes", self, ax=ax, **kwargs)
 
     @property
     def description(self) -> str:

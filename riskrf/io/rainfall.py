@@ -30,7 +30,7 @@ import pandas as pd
 
 from .tables import sniff_delimiter  # noqa: F401 (re-exported: public before)
 from ..core.validation import warn
-from simulation._display import Displayed, axes, short_repr
+from simulation._display import Displayed, short_repr
 
 
 @dataclass(frozen=True, repr=False)
@@ -105,25 +105,22 @@ class Rainfall(Displayed):
                           f"{self.first_day.date()} to {self.last_day.date()}", f"{len(self.daily)} days",
                           f"{int(self.daily.isna().sum())} missing")
 
-    def plot(self, ax=None):
-        """Daily rainfall against date (missing days left blank).
+    def plot(self, ax=None, **kwargs):
+        """Daily rainfall [mm] against date (drawn by :func:`riskrf.report.rate_figures.plot_rainfall`).
 
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
             Axes to draw on (a new figure when None).
+        **kwargs
+            Passed to the drawing function.
 
         Returns
         -------
         matplotlib.axes.Axes
-            x: date; y: daily rainfall [mm].
         """
-        ax = axes(ax, figsize=(9.0, 3.5))
-        ax.plot(self.daily.index, self.daily.to_numpy(), lw=0.5, color="C0")
-        ax.set_xlabel("date")
-        ax.set_ylabel("daily rainfall [mm]")
-        ax.set_title(Path(str(self.source)).name, fontsize="small")
-        return ax
+        from ..core.figures import draw
+        return draw("rainfall", self, ax=ax, **kwargs)
 
     def _row_label(self, day) -> str:
         r = int(self.rows.get(day, 0))

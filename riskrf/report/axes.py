@@ -1,10 +1,9 @@
 """The axes a ``plot_x(..., ax=None)`` function draws on, shared by the figure modules of :mod:`riskrf.report`."""
 from __future__ import annotations
 
+from simulation._display import axes
+
 
 def _axes(ax, figsize=(6.4, 4.8)):
     """``ax``, or the axes of a new figure of ``figsize`` [in] when ``ax`` is None (pyplot imported only then)."""
-    if ax is not None:
-        return ax
-    import matplotlib.pyplot as plt
-    return plt.figure(figsize=figsize).add_subplot()
+    return axes(ax, figsize)

@@ -371,3 +371,56 @@ def plot_design_energy_tornado(tornado, axes=None):
 def _short(v) -> str:
     from .format import sig
     return sig(v, 3)
+
+
+def plot_inventory(inventory, ax=None):
+    """Empirical magnitude-frequency curve of an inventory: falls of at least m per year against m, log-log.
+
+    Parameters
+    ----------
+    inventory : Inventory
+        The record (masses [kg], duration [yr]).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        x: mass m [kg]; y: N(>=m), the recorded falls of at least m divided by the record's length [1/yr].
+    """
+    from pathlib import Path
+    ax = _axes(ax)
+    m = np.sort(inventory.masses)[::-1]
+    ax.loglog(m, np.arange(1, m.size + 1) / inventory.duration_years, ".", ms=4, color="0.3",
+              label=f"{Path(str(inventory.source)).name} ({m.size} falls, {inventory.duration_years:.3g} yr)")
+    ax.set_xlabel("mass m [kg]")
+    ax.set_ylabel("falls of at least m per year N(>=m) [1/yr]")
+    ax.legend(fontsize="small")
+    return ax
+
+
+def plot_mass_classes(samples, ax=None):
+    """Reach probability and median speed at the line by mass class of a mass-coupled simulation.
+
+    Parameters
+    ----------
+    samples : MassCoupledSamples
+        The simulated blocks by mass class.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None); the speed is drawn on a twin y axis.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        x: block mass [kg], log; left y: P(reach the line) [-]; right y (twin): median speed [m/s].
+    """
+    ax = _axes(ax)
+    t = samples.class_table()
+    mid = np.sqrt(t["mass_low_kg"] * t["mass_high_kg"])
+    ax.semilogx(mid, t["reach_probability"], "o-", color="C0", label="P(reach)")
+    ax.set_xlabel("block mass [kg]")
+    ax.set_ylabel("P(reach the line)", color="C0")
+    twin = ax.twinx()
+    twin.semilogx(mid, t["velocity_p50_ms"], "s--", color="C3")
+    twin.set_ylabel("median speed at the line [m/s]", color="C3")
+    return ax

@@ -76,3 +76,58 @@ def write_rate_study(model, out: Path) -> list[Path]:
     """
     written = model.write(out)
     return written + write_rate_figures(model, Path(out), model.rainfall_response())
+
+
+def plot_rainfall(rainfall, ax=None):
+    """Daily rainfall against date (missing days left blank).
+
+    Parameters
+    ----------
+    rainfall : Rainfall
+        The daily record [mm].
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        x: date; y: daily rainfall [mm].
+    """
+    from .axes import _axes
+    ax = _axes(ax, figsize=(9.0, 3.5))
+    ax.plot(rainfall.daily.index, rainfall.daily.to_numpy(), lw=0.5, color="C0")
+    ax.set_xlabel("date")
+    ax.set_ylabel("daily rainfall [mm]")
+    ax.set_title(Path(str(rainfall.source)).name, fontsize="small")
+    return ax
+
+
+def plot_rate_counts(model, ax=None):
+    """Events per calendar year: recorded (bars) and expected by the preferred model (line).
+
+    Parameters
+    ----------
+    model : RateModel
+        The fitted rate model.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        x: year; y: events per year.
+    """
+    import numpy as np
+    import pandas as pd
+
+    from .axes import _axes
+    ax = _axes(ax)
+    year = pd.to_datetime(model.design["period_start"]).dt.year.to_numpy()
+    observed = pd.Series(model.design["count"].to_numpy(), index=year).groupby(level=0).sum()
+    ax.bar(observed.index, observed.to_numpy(), color="0.75", label="recorded")
+    expected = pd.Series(np.asarray(model.fitted(), dtype=float), index=year).groupby(level=0).sum()
+    ax.plot(expected.index, expected.to_numpy(), "o-", ms=3, color="C3", label=f"expected ({model.preferred})")
+    ax.set_xlabel("year")
+    ax.set_ylabel("events per year")
+    ax.legend(fontsize="small")
+    return ax

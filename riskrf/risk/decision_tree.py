@@ -38,7 +38,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.validation import RiskrfError
-from simulation._display import Displayed, axes, short_repr
+from simulation._display import Displayed, short_repr
 
 PROBABILITY_TOLERANCE = 1e-6
 
@@ -303,25 +303,22 @@ class DecisionTree(Displayed):
         return short_repr(self, repr(self.root.name), f"{n} nodes", objective=self.objective,
                           source=self.source if self.source != "<dict>" else None)
 
-    def plot(self, ax=None):
-        """Expected value of each option of the top decision, best first, as horizontal bars.
+    def plot(self, ax=None, **kwargs):
+        """The tree: squares decide, circles are chance, triangles end; the optimal path in red (drawn by :func:`riskrf.report.decision_figures.plot_tree`).
 
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
             Axes to draw on (a new figure when None).
+        **kwargs
+            Passed to the drawing function.
 
         Returns
         -------
         matplotlib.axes.Axes
-            y: option; x: expected value (net cost or payoff, in the tree's currency).
         """
-        ax = axes(ax)
-        r = self.ranking()
-        ax.barh(r["option"][::-1], r["expected_value"][::-1], color=["0.7"] * (len(r) - 1) + ["C2"])
-        ax.set_xlabel("expected net " + ("cost" if self.objective == "min" else "payoff"))
-        ax.set_title(f"{self.root.name}: best option {r['option'].iloc[0]!r}", fontsize="small")
-        return ax
+        from ..core.figures import draw
+        return draw("decision_tree", self, ax=ax, **kwargs)
 
     # ---- risk profiles ------------------------------------------------------------------
     def risk_profile(self, option: str | None = None) -> pd.DataFrame:
