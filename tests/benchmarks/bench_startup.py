@@ -17,7 +17,10 @@ Pieces switched off, one at a time, by environment variables the code honours:
 * ``no_gc_freeze``   ``RISKRF_NO_GC_FREEZE=1``: no ``gc.freeze()`` at the command's exit or around a fork.
 
 It also times the lazy public names (simulation/_lazy.py): ``import riskrf.cli`` against importing every public
-name at once (what an eager ``__init__`` would cost a light command such as ``riskrf --help``).
+name at once (what an eager ``__init__`` would cost a light command such as ``riskrf --help``), and, with ``--gc``,
+the two uses of ``gc.freeze()`` on the demo's heap: the CPU seconds of the interpreter's exit after ``riskrf demo``
+with and without it (riskrf/cli.py), and of a full collection in a forked child with and without it
+(riskrf/app/background.py, which freezes before each fork).
 """
 from __future__ import annotations
 
@@ -80,6 +83,54 @@ def demo_seconds(env: dict, out: Path, n: int | None) -> tuple[float, float, flo
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), own
 
 
+_EXIT = """import gc, resource as r, sys
+from riskrf.cli import main
+main(["demo", "--out", sys.argv[1], "--overwrite"])
+if sys.argv[2] == "freeze":
+    gc.freeze()
+print(sum(x.ru_utime + x.ru_stime for x in (r.getrusage(r.RUSAGE_SELF), r.getrusage(r.RUSAGE_CHILDREN))))
+"""
+
+_FORK = """import gc, os, sys
+from riskrf.cli import main
+main(["demo", "--out", sys.argv[1], "--overwrite"])
+for _ in range(int(sys.argv[2])):
+    for freeze in (True, False):
+        if freeze:
+            gc.freeze()
+        pid = os.fork()
+        if pid == 0:
+            gc.collect()
+            os._exit(0)
+        ru = os.wait4(pid, 0)[2]
+        if freeze:
+            gc.unfreeze()
+        print(f"  forked child's full collection, gc.freeze() {'before' if freeze else 'not before'} the fork: "
+              f"CPU {ru.ru_utime + ru.ru_stime:.3f} s, {ru.ru_minflt} page faults (copied pages)", flush=True)
+"""
+
+
+def gc_freeze_figures(rounds: int) -> None:
+    """Print the exit cost and a forked child's collection cost with and without ``gc.freeze()`` (warm cache)."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith("RISKRF_NO_")}
+    env["PYTHONPATH"] = str(ROOT) + os.pathsep + env.get("PYTHONPATH", "")
+    with tempfile.TemporaryDirectory() as work:
+        env["NUMBA_CACHE_DIR"] = work
+        subprocess.run([sys.executable, "-c", _EXIT, f"{work}/warm", "no"], env=env, check=True,
+                       capture_output=True)                                    # fills the numba cache
+        for _ in range(rounds):
+            for mode in ("freeze", "no"):
+                before = resource.getrusage(resource.RUSAGE_CHILDREN)
+                out = subprocess.run([sys.executable, "-c", _EXIT, f"{work}/{mode}", mode], env=env, check=True,
+                                     capture_output=True, text=True)
+                after = resource.getrusage(resource.RUSAGE_CHILDREN)
+                total = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+                at_end = float(out.stdout.strip().splitlines()[-1])
+                print(f"  exit after riskrf demo, gc.freeze() {'at the end' if mode == 'freeze' else 'not called'}: "
+                      f"CPU {total - at_end:.3f} s  (load {os.getloadavg()[0]:.2f})", flush=True)
+        subprocess.run([sys.executable, "-c", _FORK, f"{work}/fork", str(rounds)], env=env, check=True)
+
+
 def import_seconds(code: str, repeat: int = 5) -> float:
     """Best wall-clock seconds of a fresh interpreter running ``code`` (interpreter start-up included)."""
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
@@ -96,7 +147,12 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("-n", type=int, default=None, help="simulated blocks (default: the demo's own)")
     parser.add_argument("--configs", default=",".join(CONFIGS), help="comma-separated subset of " + ", ".join(CONFIGS))
+    parser.add_argument("--gc", action="store_true", help="only the gc.freeze() figures (see the module notes)")
     args = parser.parse_args()
+    if args.gc:
+        print(f"load average before: {os.getloadavg()}  cores: {os.cpu_count()}", flush=True)
+        gc_freeze_figures(args.rounds)
+        return
     names = args.configs.split(",")
     print(f"load average before: {os.getloadavg()}  cores: {os.cpu_count()}", flush=True)
     first = {k: [] for k in names}
