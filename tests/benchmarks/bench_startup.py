@@ -128,7 +128,9 @@ def gc_freeze_figures(rounds: int) -> None:
                 at_end = float(out.stdout.strip().splitlines()[-1])
                 print(f"  exit after riskrf demo, gc.freeze() {'at the end' if mode == 'freeze' else 'not called'}: "
                       f"CPU {total - at_end:.3f} s  (load {os.getloadavg()[0]:.2f})", flush=True)
-        subprocess.run([sys.executable, "-c", _FORK, f"{work}/fork", str(rounds)], env=env, check=True)
+        out = subprocess.run([sys.executable, "-c", _FORK, f"{work}/fork", str(rounds)], env=env, check=True,
+                             capture_output=True, text=True)
+        print("\n".join(line for line in out.stdout.splitlines() if line.startswith("  forked")))
 
 
 def import_seconds(code: str, repeat: int = 5) -> float:
