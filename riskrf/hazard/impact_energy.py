@@ -308,32 +308,97 @@ class VelocityModel(ABC):
     @abstractmethod
     def exceedance(self, energy_kj: np.ndarray, mass: _MassModel) -> np.ndarray:
         """P(E > e) for one (arriving) fall at energies ``energy_kj`` [kJ] (checked, >= 0), by quadrature over
-        the mass model ``mass`` (from :func:`mass_model`)."""
+        the mass model ``mass`` (from :func:`mass_model`).
+
+        Parameters
+        ----------
+        energy_kj : numpy.ndarray
+            Energies [kJ].
+        mass : _MassModel
+            The mass model [kg].
+
+        Returns
+        -------
+        numpy.ndarray
+            Probabilities [-], the shape of ``energy_kj``.
+        """
 
     @abstractmethod
     def sample_energy_kj(self, mass_kg: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, int]:
         """Monte Carlo: impact energies [kJ] of falls of masses ``mass_kg`` [kg] (one speed drawn per mass with
-        ``rng``; -inf for a fall that does not arrive) and the number of arriving falls."""
+        ``rng``; -inf for a fall that does not arrive) and the number of arriving falls.
+
+        Parameters
+        ----------
+        mass_kg : numpy.ndarray
+            Masses [kg].
+        rng : numpy.random.Generator
+            The stream.
+
+        Returns
+        -------
+        tuple of (numpy.ndarray, int)
+            Energies [kJ] and the number of arriving falls.
+        """
 
     @abstractmethod
     def percentile(self, q, mass_kg=None) -> float:
         """Velocity [m/s] not exceeded by q % of the arriving falls (of blocks of ``mass_kg`` [kg] when the model
-        depends on mass; otherwise ``mass_kg`` is ignored)."""
+        depends on mass; otherwise ``mass_kg`` is ignored).
+
+        Parameters
+        ----------
+        q : float
+            Percentile, in [0, 100].
+        mass_kg : float, optional
+            Block mass [kg].
+
+        Returns
+        -------
+        float
+            Velocity [m/s].
+        """
 
     def speed_samples_ms(self) -> np.ndarray:
         """The speeds [m/s] of the arriving falls as samples (for consumers that resample them)."""
         raise ValueError(f"velocity model {self!r} has no speed samples: give simulated or observed velocities")
 
     def exceedance_function(self, mass: _MassModel):
-        """e [kJ] -> P(E > e) per arriving fall, with whatever does not depend on e prepared once."""
+        """e [kJ] -> P(E > e) per arriving fall, with whatever does not depend on e prepared once.
+
+        Parameters
+        ----------
+        mass : _MassModel
+            The mass model [kg].
+
+        Returns
+        -------
+        callable
+            ``f(energy_kj) -> P(E > e)``.
+        """
         return lambda energy_kj: self.exceedance(_check_energies(energy_kj), mass)
 
     def bootstrap_nodes(self) -> "VelocityModel":
-        """The model as resampled by the bootstrap (samples compressed to at most 2048 quantiles)."""
+        """The model as resampled by the bootstrap (samples compressed to at most 2048 quantiles).
+
+        Returns
+        -------
+        VelocityModel
+        """
         return self
 
     def resample(self, rng: np.random.Generator) -> "VelocityModel":
-        """One bootstrap replicate of the model (samples drawn with replacement; parametric models unchanged)."""
+        """One bootstrap replicate of the model (samples drawn with replacement; parametric models unchanged).
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            The stream.
+
+        Returns
+        -------
+        VelocityModel
+        """
         return self
 
 
