@@ -16,7 +16,6 @@ import numpy as np
 import pandas as pd
 from scipy import optimize
 
-from ..frequency.extremes import _AnnualMaximumFit
 from .impact_energy import (
     PairedSamples,
     exceedance_function,
@@ -24,7 +23,6 @@ from .impact_energy import (
     mass_model,
     velocity_model,
 )
-from ..frequency.power_law import GutenbergRichterFit
 from ..core.format import sig
 from ..core.units import DESIGN_RETURN_PERIODS, SPHERE_INERTIA
 from ..core.validation import check_positive, check_probability_level, check_return_periods
@@ -116,9 +114,9 @@ class EnergyHazard(Displayed):
         EnergyHazard
         """
         if rate_per_year is None:
-            if not isinstance(mass, GutenbergRichterFit):
+            rate_per_year = mass_model(mass).rate_per_year
+            if rate_per_year is None:
                 raise ValueError("rate_per_year is needed unless the mass model is a power-law fit")
-            rate_per_year = mass.rate_min
         df = result.collector(collector, first_only=True)
         if df.empty:
             raise ValueError(f"no simulated block reached collector {collector!r}: the hazard there is nil "
@@ -478,19 +476,7 @@ class EnergyHazard(Displayed):
         return out
 
     def _perturbed_mass(self, rng):
-        m = self.mass
-        if isinstance(m, GutenbergRichterFit):
-            n = m.n_tail
-            b = m.b * rng.gamma(n) / n
-            rate = self.rate_per_year * rng.gamma(n) / n
-            return replace(m, b=float(b), a=float(np.log10(rate) + b * np.log10(m.m_min)), rate_min=float(rate)), \
-                rate
-        if isinstance(m, _AnnualMaximumFit) and m.cov is not None:
-            params = rng.multivariate_normal(np.asarray(m.params), m.cov)
-            if params[1] <= 0:
-                params[1] = m.params[1]
-            return replace(m, **dict(zip(m.param_names, map(float, params)))), self.rate_per_year
-        return m, self.rate_per_year
+        return mass_model(self.mass).perturbed(rng, self.rate_per_year)
 
     # ---- tables ---------------------------------------------------------------------
     def design_table(self, T=DESIGN_RETURN_PERIODS, level: float = 0.95, n_bootstrap: int = 300,

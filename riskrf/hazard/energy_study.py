@@ -8,9 +8,10 @@ import numpy as np
 import pandas as pd
 
 from .annual_hazard import EnergyHazard
+from .impact_energy import mass_model
 from .barriers import UNI11211_FACTORS, check_fence, uni11211_design_energy
 from ..io.outputs import write_json
-from ..frequency.power_law import GutenbergRichterFit, fit_gutenberg_richter
+from ..frequency.power_law import fit_gutenberg_richter
 from ..core.format import sig
 from ..core.units import DEFAULT_DENSITY_KG_M3, DESIGN_RETURN_PERIODS, kinetic_energy_kj
 
@@ -131,7 +132,7 @@ class EnergyAnalysis:
             return ""
         hz = self.hazard
         expected = self.design_T * hz.rate_per_year
-        if isinstance(hz.mass, GutenbergRichterFit) and expected <= 1:
+        if mass_model(hz.mass).rate_per_year is not None and expected <= 1:
             return (f"the {self.design_T:g}-year block is not defined because fewer than one fall is expected in "
                     f"{self.design_T:g} years ({sig(expected, 3)} at {sig(hz.rate_per_year, 3)} falls per year); "
                     "a design block (riskrf energy --design-percentile or --block-survey; design_block= in Python) "
@@ -286,8 +287,9 @@ def analyse_energy(hazard: EnergyHazard, *, fences=(), fence_height_m=5.0, free_
     block = None
     if design_block is not None:
         block = design_block.mass_kg
-    elif isinstance(hazard.mass, GutenbergRichterFit) and design_T * hazard.rate_per_year > 1:
-        block = float(hazard.mass.isf(1.0 / (design_T * hazard.rate_per_year)))   # the T-year block at this line
+    elif mass_model(hazard.mass).rate_per_year is not None and design_T * hazard.rate_per_year > 1:
+        # the T-year block at this line
+        block = float(mass_model(hazard.mass).isf(1.0 / (design_T * hazard.rate_per_year)))
     if block is not None:
         v95 = hazard.velocity_percentile(UNI11211_FACTORS["velocity_percentile"], mass_kg=block)
         uni = uni11211_design_energy(block / density_kg_m3, density_kg_m3, v95, **(uni_factors or {}))
@@ -602,7 +604,7 @@ def design_energy_tornado(hazard: EnergyHazard, *, design_T: float = 100.0, bloc
     q_range = velocity_percentile_range if velocity_percentile_range is not None \
         else TORNADO_DEFAULTS["velocity_percentile_range"]
     q_lo, q_hi = _pair(q_range, "velocity_percentile_range", check_percentile)
-    gr = hazard.mass if isinstance(hazard.mass, GutenbergRichterFit) else None
+    gr = mass_model(hazard.mass).power_law
     m_max = getattr(gr, "m_max", None)
     masses = None
     if masses_kg is not None:

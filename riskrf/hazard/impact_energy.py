@@ -29,7 +29,7 @@ a millisecond per energy.  ``method="mc"`` samples instead, for cross-checks.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
@@ -195,55 +195,192 @@ def _positive_samples(values, name):
 
 
 # ---------------------------------------------------------------- mass models
-@dataclass(frozen=True)
-class _MassModel:
-    sf: object           # callable m [kg] -> P(M > m)
-    isf: object          # callable p -> m
-    rvs: object          # callable (n, rng) -> masses
-    description: str
-    support: tuple
+class MassModel(ABC):
+    """What the energy, hazard and risk calculations ask of a mass model [kg] of one fall.
+
+    Every accepted mass description (a :class:`~riskrf.GutenbergRichterFit`, a Gumbel/GEV fit of annual maxima,
+    a scipy frozen distribution or an array of masses) is wrapped by :func:`mass_model`, the one place that looks
+    at its type; the calculations then call these methods.  A user-written model subclasses this class and gives
+    at least ``sf``, ``isf`` and ``rvs``; the other members have the defaults of a law with no parameters to vary.
+
+    Attributes
+    ----------
+    description : str
+        One line naming the model (in summaries and reports).
+    support : tuple of float
+        Lowest and highest mass [kg] the model gives.
+    rate_per_year : float or None
+        Falls per year the model itself carries (a fitted power law: its rate above m_min), else None.  Callers
+        must then be given the rate; the T-year block isf(1 / (T rate)) is reported only for models that carry
+        their rate, so that the law and the rate come from the same inventory.
+    power_law : GutenbergRichterFit or None
+        The power law behind the model, for the calculations that vary its exponent b or truncation m_max
+        (risk-engine sampling, design-energy tornado); None for models without those parameters.
+    """
+
+    description: str = "user mass model"
+    rate_per_year: float | None = None
+    power_law = None
+
+    @abstractmethod
+    def sf(self, mass_kg):
+        """P(M > m) for masses ``mass_kg`` [kg] (vectorised)."""
+
+    @abstractmethod
+    def isf(self, p):
+        """The mass [kg] exceeded with probability ``p`` (vectorised)."""
+
+    @abstractmethod
+    def rvs(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        """``n`` masses [kg] drawn with ``rng``."""
+
+    @property
+    def support(self) -> tuple:
+        return (float(self.isf(1.0)), float(self.isf(0.0)))
+
+    def perturbed(self, rng: np.random.Generator, rate_per_year: float):
+        """One bootstrap replicate of the model and of the fall rate [1/yr]: (mass model, rate).  Default: both
+        unchanged (no fitted parameters to resample)."""
+        return self, rate_per_year
+
+    def grid_bounds_kg(self, top_kg: float | None = None) -> tuple:
+        """Lowest and highest mass [kg] of a mass grid covering the model (``top_kg``: a sampled m_max the grid
+        must reach, used by power laws only).  Default: the 1 - 1e-9 and 1e-9 quantiles."""
+        return float(self.isf(1 - 1e-9)), float(self.isf(1e-9))
+
+    def bin_probabilities(self, edges_kg: np.ndarray, b=None, m_max=None) -> np.ndarray:
+        """Probability of each mass bin between ``edges_kg`` [kg] for one fall, the last bin taking the tail: an
+        array (1, J), or (S, J) for sampled power-law exponents ``b`` and truncations ``m_max`` [kg] (power laws
+        only; ignored by other models)."""
+        sf = np.asarray(self.sf(edges_kg), dtype=float)
+        sf[-1] = 0.0
+        return np.clip(-np.diff(sf), 0.0, None)[None, :]
 
 
-def mass_model(mass) -> _MassModel:
-    """Wrap any accepted mass description in a uniform interface (sf, isf, rvs).
+class _FunctionMass(MassModel):
+    """A mass model given by its functions (scipy distribution, annual maximum, empirical masses)."""
+
+    def __init__(self, sf, isf, rvs, description, support, source=None):
+        self._sf, self._isf, self._rvs = sf, isf, rvs
+        self.description, self._support, self.source = description, support, source
+
+    def sf(self, mass_kg):
+        return self._sf(mass_kg)
+
+    def isf(self, p):
+        return self._isf(p)
+
+    def rvs(self, n, rng):
+        return self._rvs(n, rng)
+
+    @property
+    def support(self):
+        return self._support
+
+
+class _AnnualMaximumMass(_FunctionMass):
+    """A Gumbel/GEV fit of annual maxima: the bootstrap draws its parameters from their covariance."""
+
+    def perturbed(self, rng, rate_per_year):
+        m = self.source
+        if m.cov is None:
+            return m, rate_per_year
+        params = rng.multivariate_normal(np.asarray(m.params), m.cov)
+        if params[1] <= 0:
+            params[1] = m.params[1]
+        return replace(m, **dict(zip(m.param_names, map(float, params)))), rate_per_year
+
+
+class _PowerLawMass(_FunctionMass):
+    """A :class:`~riskrf.GutenbergRichterFit` in kg: carries its rate above m_min and its exponent b."""
+
+    def __init__(self, fit):
+        super().__init__(fit.sf, fit.isf, lambda n, rng: fit.rvs(n, rng),
+                         f"power law b = {sig(fit.b)} above {sig(fit.m_min)} kg"
+                         + (f", truncated at {sig(fit.m_max)} kg" if fit.m_max else ""), fit.support, fit)
+
+    @property
+    def power_law(self):
+        return self.source
+
+    @property
+    def rate_per_year(self):
+        return self.source.rate_min
+
+    def perturbed(self, rng, rate_per_year):
+        """b and the rate from their Jeffreys-prior posteriors, b x Gamma(n)/n and rate x Gamma(n)/n (n falls in
+        the tail), the rate at m_min following the rate."""
+        m = self.source
+        n = m.n_tail
+        b = m.b * rng.gamma(n) / n
+        rate = rate_per_year * rng.gamma(n) / n
+        return replace(m, b=float(b), a=float(np.log10(rate) + b * np.log10(m.m_min)), rate_min=float(rate)), rate
+
+    def grid_bounds_kg(self, top_kg=None):
+        m = self.source
+        return m.m_min, max([m.m_max or m.m_min * 1e6] + ([top_kg] if top_kg else []))
+
+    def bin_probabilities(self, edges_kg, b=None, m_max=None):
+        if b is None:
+            return super().bin_probabilities(edges_kg)
+        m_min = self.source.m_min
+        b = np.atleast_1d(b)[:, None]
+        top = np.atleast_1d(m_max if m_max is not None else np.inf)[:, None]
+        z = np.clip(edges_kg[None, :], m_min, top)
+        with np.errstate(divide="ignore"):
+            t = np.where(np.isfinite(top), top ** -b, 0.0)
+        sf = (z ** -b - t) / (m_min ** -b - t)
+        sf[:, -1] = 0.0                                     # the last bin takes the tail
+        return np.clip(-np.diff(sf, axis=1), 0.0, None)
+
+
+_MassModel = MassModel      # the former name
+
+
+def mass_model(mass) -> MassModel:
+    """Wrap any accepted mass description in the :class:`MassModel` interface (the one place that looks at its
+    type); a :class:`MassModel` is returned as is.
 
     Parameters
     ----------
-    mass : GutenbergRichterFit, GumbelFit, GEVFit, scipy frozen distribution or array_like
+    mass : MassModel, GutenbergRichterFit, GumbelFit, GEVFit, scipy frozen distribution or array_like
         Mass model or samples [kg] (a power law must be in kg: :meth:`GutenbergRichterFit.to_mass`).
 
     Returns
     -------
-    _MassModel
-        ``sf(m)``, ``isf(p)``, ``rvs(n, rng)`` of the mass of one fall [kg], a ``description`` and the support.
+    MassModel
+        ``sf(m)``, ``isf(p)``, ``rvs(n, rng)`` of the mass of one fall [kg], a ``description``, the support and
+        the protocol members the calculations call (``rate_per_year``, ``perturbed``, ``grid_bounds_kg``,
+        ``bin_probabilities``, ``power_law``).
     """
+    if isinstance(mass, MassModel):
+        return mass
     if isinstance(mass, GutenbergRichterFit):
         if mass.units != "kg":
             raise ValueError(f"the power-law fit is in {mass.units!r}; convert it with .to_mass(density) first")
-        return _MassModel(mass.sf, mass.isf, lambda n, rng: mass.rvs(n, rng),
-                          f"power law b = {sig(mass.b)} above {sig(mass.m_min)} kg"
-                          + (f", truncated at {sig(mass.m_max)} kg" if mass.m_max else ""), mass.support)
+        return _PowerLawMass(mass)
     if isinstance(mass, _AnnualMaximumFit):
         d = mass.dist
         lo = float(d.ppf(1e-12))
         if lo <= 0:
             # Annual-maximum laws fitted to masses can put a little probability below zero: condition on m > 0.
             p0 = float(d.cdf(0.0))
-            return _MassModel(lambda m: np.minimum(d.sf(np.maximum(m, 0.0)) / (1 - p0), 1.0),
-                              lambda p: d.isf(np.asarray(p) * (1 - p0)),
-                              lambda n, rng: d.isf(rng.uniform(size=n) * (1 - p0)),
-                              f"{type(mass).__name__[:-3]} annual maximum (conditioned on m > 0)", (0.0, np.inf))
-        return _MassModel(d.sf, d.isf, lambda n, rng: d.rvs(size=n, random_state=rng),
-                          f"{type(mass).__name__[:-3]} annual maximum", (lo, float(d.isf(1e-12))))
+            return _AnnualMaximumMass(lambda m: np.minimum(d.sf(np.maximum(m, 0.0)) / (1 - p0), 1.0),
+                                      lambda p: d.isf(np.asarray(p) * (1 - p0)),
+                                      lambda n, rng: d.isf(rng.uniform(size=n) * (1 - p0)),
+                                      f"{type(mass).__name__[:-3]} annual maximum (conditioned on m > 0)",
+                                      (0.0, np.inf), mass)
+        return _AnnualMaximumMass(d.sf, d.isf, lambda n, rng: d.rvs(size=n, random_state=rng),
+                                  f"{type(mass).__name__[:-3]} annual maximum", (lo, float(d.isf(1e-12))), mass)
     if hasattr(mass, "sf") and hasattr(mass, "isf") and hasattr(mass, "rvs"):
         lo = float(mass.ppf(0.0)) if hasattr(mass, "ppf") else 0.0
         if not np.isfinite(lo) or lo < 0:
             raise ValueError(f"mass model {getattr(mass.dist, 'name', mass)!r} has support reaching {lo:g} kg: "
                              "masses must be positive; use a positive distribution (lognormal, gamma, ...) or "
                              "truncate it")
-        return _MassModel(mass.sf, mass.isf, lambda n, rng: mass.rvs(size=n, random_state=rng),
-                          f"scipy {getattr(getattr(mass, 'dist', None), 'name', 'distribution')}",
-                          (lo, float(mass.isf(0.0))))
+        return _FunctionMass(mass.sf, mass.isf, lambda n, rng: mass.rvs(size=n, random_state=rng),
+                             f"scipy {getattr(getattr(mass, 'dist', None), 'name', 'distribution')}",
+                             (lo, float(mass.isf(0.0))), mass)
     m = np.sort(_positive_samples(mass, "mass"))
     if np.any(m <= 0):
         raise ValueError(f"mass samples must be > 0; found {int(np.sum(m <= 0))} zero masses")
@@ -253,8 +390,8 @@ def mass_model(mass) -> _MassModel:
 
     def isf(p):
         return np.quantile(m, 1.0 - np.asarray(p), method="inverted_cdf")
-    return _MassModel(sf, isf, lambda n, rng: rng.choice(m, size=n), f"empirical ({m.size:,} masses)",
-                      (float(m[0]), float(m[-1])))
+    return _FunctionMass(sf, isf, lambda n, rng: rng.choice(m, size=n), f"empirical ({m.size:,} masses)",
+                         (float(m[0]), float(m[-1])), mass)
 
 
 def _threshold_mass(e_kj, v, w, density, inertia_factor=SPHERE_INERTIA):
@@ -306,7 +443,7 @@ class VelocityModel(ABC):
     mass_coupled: bool = False
 
     @abstractmethod
-    def exceedance(self, energy_kj: np.ndarray, mass: _MassModel) -> np.ndarray:
+    def exceedance(self, energy_kj: np.ndarray, mass: MassModel) -> np.ndarray:
         """P(E > e) for one (arriving) fall at energies ``energy_kj`` [kJ] (checked, >= 0), by quadrature over
         the mass model ``mass`` (from :func:`mass_model`).
 
@@ -314,7 +451,7 @@ class VelocityModel(ABC):
         ----------
         energy_kj : numpy.ndarray
             Energies [kJ].
-        mass : _MassModel
+        mass : MassModel
             The mass model [kg].
 
         Returns
@@ -363,12 +500,12 @@ class VelocityModel(ABC):
         """The speeds [m/s] of the arriving falls as samples (for consumers that resample them)."""
         raise ValueError(f"velocity model {self!r} has no speed samples: give simulated or observed velocities")
 
-    def exceedance_function(self, mass: _MassModel):
+    def exceedance_function(self, mass: MassModel):
         """e [kJ] -> P(E > e) per arriving fall, with whatever does not depend on e prepared once.
 
         Parameters
         ----------
-        mass : _MassModel
+        mass : MassModel
             The mass model [kg].
 
         Returns

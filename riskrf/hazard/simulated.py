@@ -15,7 +15,6 @@ import simulation
 from ..core.format import sig
 from ..core.units import DESIGN_RETURN_PERIODS
 from ..core.validation import check_positive
-from ..frequency.power_law import GutenbergRichterFit
 from .annual_hazard import EnergyHazard, inertia_factors
 from .impact_energy import mass_model
 from .mass_coupling import MassCoupledSamples, NoArrivalsError, default_mass_range, stratified_log_uniform
@@ -175,9 +174,9 @@ def simulate_energy_hazard(mass, scenario, collector: str = "barrier", *, rate_p
     """
     mm = mass_model(mass)
     if rate_per_year is None:
-        if not isinstance(mass, GutenbergRichterFit):
+        rate_per_year = mm.rate_per_year
+        if rate_per_year is None:
             raise ValueError("rate_per_year is needed unless the mass model is a power-law fit")
-        rate_per_year = mass.rate_min
     rate = check_positive(rate_per_year, "rate_per_year")
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 100:
         raise ValueError(f"n = {n!r}: simulate at least 100 blocks across the mass range")

@@ -22,7 +22,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..frequency.power_law import GutenbergRichterFit
 from ..hazard.barriers import out_of_service_share
 from ..hazard.impact_energy import mass_model
 from .economics import pv_factor, renewal_factor
@@ -72,20 +71,13 @@ def mass_grid(mass, small_fall_masses_kg, small_falls_per_year: float, uncertain
     the sampled m_max; or the 1 - 1e-9 quantile).  With fragmentation the grid reaches down to the finest
     generation (each generation divides the mass by 8)."""
     mm = mass_model(mass)
-    gr = mass if isinstance(mass, GutenbergRichterFit) else None
-    lo_candidates = [float(mm.isf(1 - 1e-9))] if gr is None else [gr.m_min]
+    lo_model, hi = mm.grid_bounds_kg(uncertainty.m_max_kg[1] if uncertainty.m_max_kg else None)
+    lo_candidates = [lo_model]
     if small_fall_masses_kg is not None and len(small_fall_masses_kg):
         lo_candidates.append(float(np.min(small_fall_masses_kg)))
     lo = 0.999 * min(lo_candidates)
     if uncertainty.fractal_dimension:     # fragments keep their own masses: down to the finest generation
         lo /= 8.0 ** uncertainty.fragmentation_iterations
-    if gr is not None:
-        tops = [gr.m_max or gr.m_min * 1e6]
-        if uncertainty.m_max_kg:
-            tops.append(uncertainty.m_max_kg[1])
-        hi = max(tops)
-    else:
-        hi = float(mm.isf(1e-9))
     edges = np.geomspace(lo, hi, MASS_BINS + 1)
     mid = np.sqrt(edges[:-1] * edges[1:])
     small = np.zeros(MASS_BINS)
@@ -99,18 +91,7 @@ def mass_pmf(edges: np.ndarray, mass, b=None, m_max=None) -> np.ndarray:
     """Probability of each mass bin for one fall of at least m_min; arrays (S, J) for sampled b and m_max [kg]
     (a power law truncated at m_max), else (1, J) from the mass model's survival function.  The last bin takes
     the tail."""
-    if isinstance(mass, GutenbergRichterFit) and b is not None:
-        b = np.atleast_1d(b)[:, None]
-        top = np.atleast_1d(m_max if m_max is not None else np.inf)[:, None]
-        z = np.clip(edges[None, :], mass.m_min, top)
-        with np.errstate(divide="ignore"):
-            t = np.where(np.isfinite(top), top ** -b, 0.0)
-        sf = (z ** -b - t) / (mass.m_min ** -b - t)
-        sf[:, -1] = 0.0                                     # the last bin takes the tail
-        return np.clip(-np.diff(sf, axis=1), 0.0, None)
-    sf = mass_model(mass).sf(edges)
-    sf[-1] = 0.0
-    return np.clip(-np.diff(sf), 0.0, None)[None, :]
+    return mass_model(mass).bin_probabilities(edges, b, m_max)
 
 
 def fragment_matrix(grid: MassGrid, fractal_dimension, iterations: int) -> np.ndarray:

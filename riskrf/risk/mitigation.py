@@ -37,8 +37,8 @@ import numpy as np
 import pandas as pd
 
 from ..core.format import money, probability
-from ..frequency.power_law import GutenbergRichterFit
 from ..hazard.annual_hazard import EnergyHazard
+from ..hazard.impact_energy import mass_model
 from .economics import pv_factor
 from .loss_engine import LossEngine, LossResult, ParameterSpace, fragment_matrix, mass_grid, mass_pmf
 from .measures import SimulationContext, material_value
@@ -240,11 +240,12 @@ class MitigationStudy:
              "discount_rate": ec.discount_rate}
         if self.uncertainty.fractal_dimension:
             p["fractal_dimension"] = float(np.mean(self.uncertainty.fractal_dimension))
-        if isinstance(hz.mass, GutenbergRichterFit):
-            p["b"] = float(hz.mass.b)
+        gr = mass_model(hz.mass).power_law
+        if gr is not None:
+            p["b"] = float(gr.b)
             p["rate_sampling_factor"] = 1.0
-            if hz.mass.m_max is not None:
-                p["m_max_kg"] = float(hz.mass.m_max)
+            if gr.m_max is not None:
+                p["m_max_kg"] = float(gr.m_max)
         for o in self.options:
             p.update(effect_of(o).parameters())
         for key, (ret, _, _, _) in self._derived.items():
@@ -260,7 +261,7 @@ class MitigationStudy:
         out = {}
         hz = self.hazard
         if "b" in c and u.sample_power_law:
-            n = hz.mass.n_tail
+            n = mass_model(hz.mass).power_law.n_tail
             g = stats.gamma(n, scale=1.0 / n)
             out["b"] = (c["b"] * g.ppf(0.05), c["b"] * g.ppf(0.95), "b x Gamma(n)/n (Jeffreys-prior posterior of b)")
             out["rate_sampling_factor"] = (g.ppf(0.05), g.ppf(0.95),
@@ -309,7 +310,8 @@ class MitigationStudy:
             if name.startswith("material:"):
                 continue
             if name in ("b", "rate_sampling_factor"):
-                g = rng.gamma(self.hazard.mass.n_tail, size=n) / self.hazard.mass.n_tail
+                n_tail = mass_model(self.hazard.mass).power_law.n_tail
+                g = rng.gamma(n_tail, size=n) / n_tail
                 out[name] = c[name] * g if name == "b" else g
             elif name.startswith("retention:") and "Beta" in how:
                 key = name.split(":", 1)[1]
