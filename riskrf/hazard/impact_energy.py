@@ -236,6 +236,7 @@ class MassModel(ABC):
 
     @property
     def support(self) -> tuple:
+        """Lowest and highest mass [kg] of the model (default: ``isf(1)`` and ``isf(0)``)."""
         return (float(self.isf(1.0)), float(self.isf(0.0)))
 
     def perturbed(self, rng: np.random.Generator, rate_per_year: float):
