@@ -9,7 +9,7 @@ velocities are given with velocity samples).
 Mass models: a fitted power law (:class:`~riskrf.GutenbergRichterFit`, the truncated
 law between m_min and m_max), a Gumbel/GEV fit of annual maxima (then E is the
 energy of the year's largest block), any scipy frozen distribution, or an array of
-masses (empirical).  Velocity models: a scipy frozen distribution, an array of
+masses (empirical), or a user-written :class:`MassModel`.  Velocity models: a scipy frozen distribution, an array of
 samples (a simulator collector, or a RocFall/RAMMS export), a :class:`VelocityFit`
 (parametric model chosen by AIC), :class:`PairedSamples` (velocity samples with
 the mass of each block, to condition on mass), or
