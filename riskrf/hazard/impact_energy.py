@@ -224,15 +224,50 @@ class MassModel(ABC):
 
     @abstractmethod
     def sf(self, mass_kg):
-        """P(M > m) for masses ``mass_kg`` [kg] (vectorised)."""
+        """P(M > m) for masses ``mass_kg`` [kg] (vectorised).
+
+        Parameters
+        ----------
+        mass_kg : float or numpy.ndarray
+            Masses [kg].
+
+        Returns
+        -------
+        numpy.ndarray
+            Probabilities [-], the shape of ``mass_kg``.
+        """
 
     @abstractmethod
     def isf(self, p):
-        """The mass [kg] exceeded with probability ``p`` (vectorised)."""
+        """The mass [kg] exceeded with probability ``p`` (vectorised).
+
+        Parameters
+        ----------
+        p : float or numpy.ndarray
+            Exceedance probabilities [-].
+
+        Returns
+        -------
+        numpy.ndarray
+            Masses [kg], the shape of ``p``.
+        """
 
     @abstractmethod
     def rvs(self, n: int, rng: np.random.Generator) -> np.ndarray:
-        """``n`` masses [kg] drawn with ``rng``."""
+        """``n`` masses [kg] drawn with ``rng``.
+
+        Parameters
+        ----------
+        n : int
+            Number of masses.
+        rng : numpy.random.Generator
+            Random generator.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``n`` masses [kg].
+        """
 
     @property
     def support(self) -> tuple:
@@ -241,18 +276,57 @@ class MassModel(ABC):
 
     def perturbed(self, rng: np.random.Generator, rate_per_year: float):
         """One bootstrap replicate of the model and of the fall rate [1/yr]: (mass model, rate).  Default: both
-        unchanged (no fitted parameters to resample)."""
+        unchanged (no fitted parameters to resample).
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            Random generator of the bootstrap.
+        rate_per_year : float
+            Falls per year [1/yr] of the hazard.
+
+        Returns
+        -------
+        tuple
+            (mass model accepted by :func:`mass_model`, rate [1/yr]) of the replicate.
+        """
         return self, rate_per_year
 
     def grid_bounds_kg(self, top_kg: float | None = None) -> tuple:
         """Lowest and highest mass [kg] of a mass grid covering the model (``top_kg``: a sampled m_max the grid
-        must reach, used by power laws only).  Default: the 1 - 1e-9 and 1e-9 quantiles."""
+        must reach, used by power laws only).  Default: the 1 - 1e-9 and 1e-9 quantiles.
+
+        Parameters
+        ----------
+        top_kg : float, optional
+            Largest sampled truncation m_max [kg] the grid must reach (power laws only).
+
+        Returns
+        -------
+        tuple of float
+            (lowest, highest) mass [kg].
+        """
         return float(self.isf(1 - 1e-9)), float(self.isf(1e-9))
 
     def bin_probabilities(self, edges_kg: np.ndarray, b=None, m_max=None) -> np.ndarray:
         """Probability of each mass bin between ``edges_kg`` [kg] for one fall, the last bin taking the tail: an
         array (1, J), or (S, J) for sampled power-law exponents ``b`` and truncations ``m_max`` [kg] (power laws
-        only; ignored by other models)."""
+        only; ignored by other models).
+
+        Parameters
+        ----------
+        edges_kg : numpy.ndarray
+            Bin edges [kg], increasing (J + 1).
+        b : numpy.ndarray, optional
+            Sampled power-law exponents (S); None for the model's own law.
+        m_max : numpy.ndarray, optional
+            Sampled truncations [kg] (S), with ``b``.
+
+        Returns
+        -------
+        numpy.ndarray
+            Bin probabilities [-], (1, J) or (S, J).
+        """
         sf = np.asarray(self.sf(edges_kg), dtype=float)
         sf[-1] = 0.0
         return np.clip(-np.diff(sf), 0.0, None)[None, :]
