@@ -1,4 +1,4 @@
-"""Figures of a simulation: profile with trajectories, collector distributions, envelopes.
+"""Figures of a simulation: profile with trajectories, collector distributions, envelopes, pooled calibration.
 
 Each function draws on ``ax`` (or a new figure) and returns the Axes; matplotlib
 is imported only when called and no global style is changed.
@@ -131,3 +131,107 @@ def plot_envelopes(result, axes=None):
     axes[-1].set_xlabel("x [m]")
     axes[0].set_title("Envelopes along the slope")
     return axes
+
+
+def plot_posterior_pairs(calibration, ax=None, fig=None):
+    """Pairwise scatter of a pooled posterior sample: histograms against the prior box on the diagonal,
+    scatter below, Pearson correlations above.
+
+    Parameters
+    ----------
+    calibration : PooledCalibration
+        The calibration (:func:`simulation.pooled.calibrate_pooled`).
+    ax : matplotlib.axes.Axes, optional
+        Axes for a single parameter's histogram (more parameters need a figure of their own).
+    fig : matplotlib.figure.Figure, optional
+        Figure to draw the panels in (a new one when None).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The lower-left panel; its ``figure`` holds every panel.
+
+    Raises
+    ------
+    ValueError
+        ``ax`` given for more than one parameter.
+    """
+    names = list(calibration.posterior.columns)
+    d = len(names)
+    if ax is not None and d > 1:
+        raise ValueError(f"plot_posterior_pairs: {d} parameters need a figure of their own (pass fig=, not ax=)")
+    if ax is not None:
+        grid = [[ax]]
+    else:
+        if fig is None:
+            import matplotlib.pyplot as plt
+            fig = plt.figure(figsize=(2.6 * d + 1, 2.6 * d + 0.5))
+        grid = fig.subplots(d, d, squeeze=False)
+    post, bounds = calibration.posterior, calibration.bounds
+    corr = calibration.correlations() if d > 1 else None
+    for i, a in enumerate(names):
+        for j, b in enumerate(names):
+            panel = grid[i][j]
+            if i == j:
+                panel.hist(post[a], bins=30, color="C0")
+                panel.set_xlim(*bounds[a])
+            elif i > j:
+                panel.plot(post[b], post[a], ".", ms=2, alpha=0.4)
+                panel.set_xlim(*bounds[b])
+                panel.set_ylim(*bounds[a])
+            else:
+                panel.axis("off")
+                panel.text(0.5, 0.5, f"r = {corr.loc[a, b]:.2f}", ha="center", va="center",
+                           transform=panel.transAxes)
+            if i == d - 1:
+                panel.set_xlabel(b.split(".", 1)[-1], fontsize="small")
+            if j == 0 and i > 0:
+                panel.set_ylabel(a.split(".", 1)[-1], fontsize="small")
+    grid[0][0].figure.suptitle(f"pooled posterior ({len(calibration.releases)} releases, ESS {calibration.ess:.0f})",
+                               fontsize="small")
+    return grid[d - 1][0]
+
+
+def plot_pooled_coverage(calibration, ax=None):
+    """Per release of a pooled calibration: the central 90 % (thick) and 99 % (thin) posterior-predictive
+    intervals of the stops and the observed stops (points), with the share of stops inside each interval.
+
+    Parameters
+    ----------
+    calibration : PooledCalibration
+        The calibration; its ``coverage_table`` must have rows (``n_predictive`` > 0).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Raises
+    ------
+    ValueError
+        The calibration has no posterior-predictive coverage (it was run with ``n_predictive=0``).
+    """
+    t = calibration.coverage_table
+    if len(t) == 0:
+        raise ValueError("plot_pooled_coverage: the calibration has no posterior-predictive coverage "
+                         "(calibrate_pooled(..., n_predictive=0)); run it with n_predictive > 0")
+    ax = _axes(ax, figsize=(7, 0.35 * len(t) + 1.5))
+    y = np.arange(len(t))
+    ax.hlines(y, t["p005"], t["p995"], color="C0", lw=1, label="99 % predictive interval")
+    ax.hlines(y, t["p05"], t["p95"], color="C0", lw=4, alpha=0.6, label="90 % predictive interval")
+    observed = {r.name: np.asarray(r.x_stop_m, dtype=float).ravel() for r in calibration.releases}
+    first = True
+    for i, name in enumerate(t.index):
+        x = observed.get(name)
+        if x is not None and x.size:
+            ax.plot(x, np.full(x.size, y[i]), "o", color="C3", ms=3, label="observed stops" if first else None)
+            first = False
+    cov = calibration.coverage()
+    ax.set_yticks(y, list(t.index))
+    ax.invert_yaxis()
+    ax.set_xlabel("stop position (plan runout of a 3-D release) [m]")
+    ax.set_title(f"{cov['inside_90']:.0%} of {cov['observed_stops']} stops inside their 90 % interval, "
+                 f"{cov['inside_99']:.0%} inside the 99 %", fontsize="small")
+    ax.legend(fontsize="small")
+    return ax

@@ -59,6 +59,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from ._display import Displayed, short_repr
 from .scenario import Distribution, Material, Scenario, ScenarioError, scenario_from_dict
 
 #: Share of the predictive density spread uniformly over the profile (the defensive mixture).
@@ -73,7 +74,7 @@ class PooledCalibrationWarning(UserWarning):
 
 
 @dataclass(frozen=True)
-class Release:
+class Release(Displayed):
     """One release: observed stops of blocks released the same way, with their own scenario.
 
     Parameters
@@ -113,9 +114,47 @@ class Release:
     shape: str | None = None
     source: str = "<releases>"
 
+    def __repr__(self) -> str:
+        x = np.asarray(self.x_stop_m, dtype=float).ravel()
+        return short_repr(self, repr(self.name), f"{x.size} stops", scenario=_scenario_name(self.scenario),
+                          mass_kg=self.mass_kg, radius_m=self.radius_m)
+
+    def summary(self) -> pd.DataFrame:
+        """The release as one row: its scenario, release state (None: the scenario's seeder value) and observed
+        stops.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``release``, ``scenario``, ``n_observed``, ``stop_min_m``/``stop_median_m``/``stop_max_m`` (stop
+            positions, or plan runouts of a 3-D release [m]), ``mass_kg``, ``radius_m``, ``x_m``, ``height_m``,
+            ``vx_ms``, ``vz_ms``, ``downslope_speed_ms``, ``shape`` and ``source``.
+        """
+        x = np.asarray(self.x_stop_m, dtype=float).ravel()
+        ok = x[np.isfinite(x)]
+        stats_ = np.quantile(ok, [0.0, 0.5, 1.0]) if ok.size else [np.nan] * 3
+        return pd.DataFrame([{"release": self.name, "scenario": _scenario_name(self.scenario), "n_observed": x.size,
+                              "stop_min_m": stats_[0], "stop_median_m": stats_[1], "stop_max_m": stats_[2],
+                              "mass_kg": self.mass_kg, "radius_m": self.radius_m, "x_m": self.x_m,
+                              "height_m": self.height_m, "vx_ms": self.vx_ms, "vz_ms": self.vz_ms,
+                              "downslope_speed_ms": self.downslope_speed_ms, "shape": self.shape,
+                              "source": self.source}])
+
+
+def _scenario_name(scenario) -> str:
+    """A short name of a release's scenario: the file name of a path or of a loaded Scenario, a dict's name."""
+    if isinstance(scenario, (str, Path)):
+        return Path(scenario).name
+    if isinstance(scenario, dict):
+        return str(scenario.get("name", "<dict>"))
+    src = getattr(scenario, "source", None)
+    if src and not str(src).startswith("<"):
+        return Path(str(src)).name
+    return str(getattr(scenario, "name", type(scenario).__name__))
+
 
 @dataclass(frozen=True)
-class ReachConstraint:
+class ReachConstraint(Displayed):
     """A published far limit of deposition, used as one more term of a pooled likelihood.
 
     Some data sets give no stop positions but the **shadow angle** of the farthest deposits below a talus: the
@@ -161,6 +200,24 @@ class ReachConstraint:
         dx = np.asarray(x_stop_m, float) - self.apex_x_m
         dz = self.apex_z_m - np.asarray(z_stop_m, float)
         return np.degrees(np.arctan2(dz, np.maximum(dx, 1e-9)))
+
+    def __repr__(self) -> str:
+        return short_repr(self, repr(self.name), shadow_angle_deg=self.shadow_angle_deg, sd_deg=self.sd_deg,
+                          quantile=self.quantile, scenario=_scenario_name(self.scenario))
+
+    def summary(self) -> pd.DataFrame:
+        """The constraint as one row.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``constraint``, ``scenario``, ``apex_x_m``/``apex_z_m`` [m], ``shadow_angle_deg`` and ``sd_deg``
+            [deg], ``quantile``, ``n_blocks`` and ``source``.
+        """
+        return pd.DataFrame([{"constraint": self.name, "scenario": _scenario_name(self.scenario),
+                              "apex_x_m": self.apex_x_m, "apex_z_m": self.apex_z_m,
+                              "shadow_angle_deg": self.shadow_angle_deg, "sd_deg": self.sd_deg,
+                              "quantile": self.quantile, "n_blocks": self.n_blocks, "source": self.source}])
 
     def _release(self):
         return Release(name=self.name, scenario=self.scenario, x_stop_m=[self.apex_x_m], source=self.source)
@@ -573,7 +630,7 @@ def stop_bandwidth(simulated_x_m, obs_error_m: float = 0.5) -> float:
 
 # ---- the result ---------------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
-class PooledCalibration:
+class PooledCalibration(Displayed):
     """Posterior of material parameters shared by many releases (:func:`calibrate_pooled`).
 
     ``posterior``: a sample (one row per draw, one column per dotted parameter); ``parameters``: its median;
@@ -638,34 +695,43 @@ class PooledCalibration:
             self.posterior.to_csv(fh, index=False)
         return path
 
-    def plot(self, fig=None):
-        """Pairwise scatter of the posterior sample (diagonal: histograms against the prior box)."""
-        import matplotlib.pyplot as plt
-        names = list(self.posterior.columns)
-        d = len(names)
-        if fig is None:
-            fig = plt.figure(figsize=(2.6 * d + 1, 2.6 * d + 0.5))
-        axes = fig.subplots(d, d, squeeze=False)
-        for i, a in enumerate(names):
-            for j, b in enumerate(names):
-                ax = axes[i][j]
-                if i == j:
-                    ax.hist(self.posterior[a], bins=30, color="C0")
-                    ax.set_xlim(*self.bounds[a])
-                elif i > j:
-                    ax.plot(self.posterior[b], self.posterior[a], ".", ms=2, alpha=0.4)
-                    ax.set_xlim(*self.bounds[b])
-                    ax.set_ylim(*self.bounds[a])
-                else:
-                    ax.axis("off")
-                    ax.text(0.5, 0.5, f"r = {self.correlations().loc[a, b]:.2f}", ha="center", va="center",
-                            transform=ax.transAxes)
-                if i == d - 1:
-                    ax.set_xlabel(b.split(".", 1)[1], fontsize="small")
-                if j == 0 and i > 0:
-                    ax.set_ylabel(a.split(".", 1)[1], fontsize="small")
-        fig.suptitle(f"pooled posterior ({len(self.releases)} releases, ESS {self.ess:.0f})", fontsize="small")
-        return fig
+    def __repr__(self) -> str:
+        return short_repr(self, f"{len(self.releases)} releases", f"{len(self.bounds)} parameters",
+                          f"{len(self.posterior)} draws", ess=self.ess, n_per_release=self.n_per_release,
+                          seed=self.seed if isinstance(self.seed, (int, np.integer)) else None)
+
+    def plot(self, kind: str = "pairs", ax=None, *, fig=None):
+        """The posterior sample's pairs or the releases' posterior-predictive coverage
+        (:mod:`simulation.plotting`).
+
+        Parameters
+        ----------
+        kind : {"pairs", "coverage"}
+            ``"pairs"``: pairwise scatter of the posterior sample, histograms against the prior box on the
+            diagonal, correlations above (:func:`simulation.plotting.plot_posterior_pairs`); ``"coverage"``: per
+            release, the 90 % and 99 % posterior-predictive intervals of the stops with the observed stops
+            (:func:`simulation.plotting.plot_pooled_coverage`).
+        ax : matplotlib.axes.Axes, optional
+            Axes for ``"coverage"`` (a new figure when None); for ``"pairs"`` only with one parameter.
+        fig : matplotlib.figure.Figure, optional
+            Figure to draw the pairs in (a new one when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            For ``"pairs"`` the lower-left panel; ``ax.figure`` holds every panel.
+
+        Raises
+        ------
+        ValueError
+            An unknown ``kind``, or ``"coverage"`` of a calibration run with ``n_predictive=0``.
+        """
+        from . import plotting
+        if kind == "pairs":
+            return plotting.plot_posterior_pairs(self, ax=ax, fig=fig)
+        if kind == "coverage":
+            return plotting.plot_pooled_coverage(self, ax=ax)
+        raise ValueError(f"plot: kind must be 'pairs' or 'coverage', not {kind!r}")
 
 
 def read_posterior(path, scenario=None) -> pd.DataFrame:

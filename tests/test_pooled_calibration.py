@@ -88,8 +88,14 @@ def test_result_tables(synthetic_fit, tmp_path):
     path = cal.write(tmp_path / "posterior.csv")
     back = read_posterior(path, _profile("A"))
     pd.testing.assert_frame_equal(back, cal.posterior, check_exact=False, rtol=1e-12)
-    fig = cal.plot()
-    assert len(fig.axes) == 4
+    ax = cal.plot()                              # the pairs: the lower-left panel of a 2 x 2 grid
+    assert len(ax.figure.axes) == 4
+    np.testing.assert_allclose(ax.lines[0].get_xdata(), cal.posterior[list(BOUNDS)[0]])
+    ax = cal.plot("coverage")                    # one 90 % bar per release at the coverage table's quantiles
+    np.testing.assert_allclose(ax.collections[1].get_segments()[0][:, 0],
+                               cal.coverage_table[["p05", "p95"]].iloc[0].to_numpy())
+    with pytest.raises(ValueError, match="'pie'"):
+        cal.plot("pie")
 
 
 def test_posterior_file_that_does_not_match_the_scenario(synthetic_fit, tmp_path):

@@ -27,6 +27,8 @@ FIGURES = {
     "rainfall": "riskrf.report.rate_figures:plot_rainfall",
     "rate_counts": "riskrf.report.rate_figures:plot_rate_counts",
     "decision_tree": "riskrf.report.decision_figures:plot_tree",
+    "mitigation_tornado": "riskrf.report.decision_figures:plot_study_tornado",
+    "mitigation_ranking": "riskrf.report.decision_figures:plot_study_ranking",
 }
 
 

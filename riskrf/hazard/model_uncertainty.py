@@ -36,6 +36,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from simulation._display import Displayed, short_repr
+
 from ..core.format import sig
 from ..core.units import DESIGN_RETURN_PERIODS
 from ..core.validation import RiskrfError
@@ -55,7 +57,7 @@ MODEL_PART = "trajectory model: the slope's material parameters (draws re-simula
 
 
 @dataclass(frozen=True)
-class DesignEnergySplit:
+class DesignEnergySplit(Displayed):
     """T-year energies at a line over K draws of the trajectory model, with the interval split by source.
 
     ``table``: one row per return period T [yr]: ``energy_kj_reference`` (the hazard at the scenario's own
@@ -73,12 +75,38 @@ class DesignEnergySplit:
     basis: str = ""
     notes: tuple = ()
 
+    def __repr__(self) -> str:
+        return short_repr(self, f"{self.n_draws} draws", f"T={[float(t) for t in self.table['T_years']]}",
+                          n_bootstrap=self.n_bootstrap, level=self.level)
+
     def summary(self) -> pd.DataFrame:
-        """The split per return period (a copy of :attr:`table`)."""
+        """The split per return period.
+
+        Returns
+        -------
+        pandas.DataFrame
+            A copy of :attr:`table` (energies [kJ], variances [kJ^2], share 0-1).
+        """
         return self.table.copy()
 
     def row(self, T: float) -> pd.Series:
-        """The split of the T-year energy (KeyError naming the return periods there are)."""
+        """The split of the T-year energy.
+
+        Parameters
+        ----------
+        T : float
+            Return period [yr], one of the table's.
+
+        Returns
+        -------
+        pandas.Series
+            The table's row for ``T``.
+
+        Raises
+        ------
+        KeyError
+            No row for ``T`` (the message names the return periods there are).
+        """
         hit = self.table[np.isclose(self.table["T_years"], float(T))]
         if hit.empty:
             raise KeyError(f"no {T:g}-year row; return periods: {self.table['T_years'].tolist()}")
@@ -86,7 +114,18 @@ class DesignEnergySplit:
 
     def text(self, T: float | None = None) -> list[str]:
         """Plain-text lines for reports: per return period (or only ``T``), the combined interval and the shares
-        of its variance from the trajectory model and from the statistical sources."""
+        of its variance from the trajectory model and from the statistical sources.
+
+        Parameters
+        ----------
+        T : float, optional
+            Only this return period [yr]; None for every row.
+
+        Returns
+        -------
+        list of str
+            One line per return period.
+        """
         lvl = f"{self.level:.0%}"
         rows = self.table if T is None else self.table[np.isclose(self.table["T_years"], float(T))]
         out = []
@@ -104,14 +143,33 @@ class DesignEnergySplit:
         return out
 
     def to_dict(self) -> dict:
-        """JSON-ready: the table, what each part covers, the draws' basis and the notes."""
+        """JSON-ready: the table, what each part covers, the draws' basis and the notes.
+
+        Returns
+        -------
+        dict
+            ``rows`` (the table as records), ``draws``, ``bootstrap_per_draw``, ``level``, ``basis``,
+            ``model_part``, ``statistical_part``, ``notes``.
+        """
         return {"rows": self.table.to_dict(orient="records"), "draws": self.n_draws,
                 "bootstrap_per_draw": self.n_bootstrap, "level": self.level, "basis": self.basis,
                 "model_part": MODEL_PART, "statistical_part": STATISTICAL_PART, "notes": list(self.notes)}
 
     def plot(self, T: float | None = None, ax=None):
         """Each draw's T-year energy with its bootstrap interval (points and bars), the combined interval
-        (band) and the reference value (line); T defaults to the largest return period defined in every draw."""
+        (band) and the reference value (line).
+
+        Parameters
+        ----------
+        T : float, optional
+            Return period [yr]; None for the largest return period defined in every draw.
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+        """
         import matplotlib.pyplot as plt
         ok = self.table[self.table["variance_total_kj2"] > 0]
         T = float(ok["T_years"].max() if T is None else T)
@@ -225,7 +283,7 @@ def design_energy_split(hazards, T=DESIGN_RETURN_PERIODS, *, n_bootstrap: int = 
 
 
 @dataclass(frozen=True)
-class EnergyHazardEnsemble:
+class EnergyHazardEnsemble(Displayed):
     """Energy hazards at one line for K draws of the slope's material parameters (:func:`energy_hazard_ensemble`).
 
     ``draws``: the material values of each draw (one row per draw, dotted ``materials.NAME.FIELD`` columns);
@@ -240,19 +298,60 @@ class EnergyHazardEnsemble:
     n: int = 0
     seed: object = 1
 
+    def __repr__(self) -> str:
+        return short_repr(self, f"{len(self.hazards)} draws", repr(self.basis) if self.basis else "", n=self.n,
+                          seed=self.seed if isinstance(self.seed, (int, np.integer)) else None,
+                          reference=self.reference is not None)
+
     def summary(self) -> pd.DataFrame:
-        """One row per draw: its material values, reach probability and arrivals per year [1/yr]."""
+        """One row per draw.
+
+        Returns
+        -------
+        pandas.DataFrame
+            The draw's material values (``materials.NAME.FIELD`` columns), ``reach_probability`` and
+            ``arrivals_per_year`` [1/yr].
+        """
         return self.draws.assign(reach_probability=[h.reach_probability for h in self.hazards],
                                  arrivals_per_year=[h.arrival_rate for h in self.hazards])
 
     def design_energies(self, T=DESIGN_RETURN_PERIODS, *, n_bootstrap: int = 100, seed=1,
                         level: float = 0.95) -> DesignEnergySplit:
-        """The T-year energies with their interval split (:func:`design_energy_split`)."""
+        """The T-year energies with their interval split (:func:`design_energy_split`).
+
+        Parameters
+        ----------
+        T : sequence of float
+            Return periods [yr].
+        n_bootstrap : int
+            Bootstrap replicates per draw.
+        seed : int
+            Seed of the bootstrap.
+        level : float
+            Level of the intervals.
+
+        Returns
+        -------
+        DesignEnergySplit
+        """
         return design_energy_split(self.hazards, T, n_bootstrap=n_bootstrap, seed=seed, level=level,
                                    reference=self.reference, basis=self.basis)
 
     def plot(self, T: float = 100.0, ax=None):
-        """The T-year energy of each draw with its bootstrap interval (:meth:`DesignEnergySplit.plot`)."""
+        """The T-year energy of each draw with its bootstrap interval (:meth:`DesignEnergySplit.plot`, 50
+        bootstrap replicates per draw).
+
+        Parameters
+        ----------
+        T : float
+            Return period [yr].
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+        """
         return self.design_energies([T], n_bootstrap=50).plot(T, ax=ax)
 
 
@@ -318,7 +417,27 @@ def energy_hazard_ensemble(mass, scenario, collector: str = "barrier", *, poster
 
 def read_model_posterior(path, scenario) -> pd.DataFrame:
     """A posterior sample file checked against the scenario's materials before any simulation
-    (:func:`simulation.read_posterior`); a :class:`ModelUncertaintyError` names the file and the column."""
+    (:func:`simulation.read_posterior`).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The posterior file (written by :meth:`simulation.PooledCalibration.write`).
+    scenario : str, pathlib.Path or Scenario
+        The scenario whose materials the columns must name.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per draw, ``materials.NAME.FIELD`` columns.
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    ModelUncertaintyError
+        A bad column or value (the message names the file and the column).
+    """
     import simulation
     try:
         return simulation.read_posterior(path, scenario)

@@ -147,6 +147,54 @@ def plot_tornado(table, ax=None, *, currency: str = "", xlabel: str | None = Non
     return ax
 
 
+def plot_study_tornado(study, ax=None):
+    """Tornado chart of a mitigation study (:meth:`MitigationStudy.tornado`) in its currency.
+
+    Parameters
+    ----------
+    study : MitigationStudy
+        The study.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    return plot_tornado(study.tornado(), ax, currency=study.currency)
+
+
+def plot_study_ranking(study, ax=None):
+    """Expected total cost of each option of a mitigation study with its 5-95 % interval over the joint samples
+    (:meth:`MitigationStudy.ranking`), cheapest at the top; the cost at central values as an open circle.
+
+    Parameters
+    ----------
+    study : MitigationStudy
+        The study.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    rank = study.ranking()
+    ax = _axes(ax, figsize=(7, 0.45 * len(rank) + 1.5))
+    y = np.arange(len(rank))
+    mean = rank["expected_total_cost"].to_numpy(dtype=float)
+    err = np.vstack([mean - rank["cost_p05"].to_numpy(dtype=float), rank["cost_p95"].to_numpy(dtype=float) - mean])
+    ax.errorbar(mean, y, xerr=np.clip(err, 0, None), fmt="o", color="C0", capsize=3,
+                label="expected total cost, 5-95 %")
+    ax.plot(rank["cost_at_central_values"], y, "o", mfc="none", color="C3", label="at central values")
+    ax.set_yticks(y, rank["option"])
+    ax.invert_yaxis()
+    ax.set_xlabel(f"expected total cost {study.currency}".strip())
+    ax.legend(fontsize="small")
+    ax.grid(True, axis="x", alpha=0.3)
+    return ax
+
+
 def plot_risk_profiles(profile, ax=None):
     """Cumulative risk profiles (outcome distributions) of the options, from ``DecisionTree.risk_profile()``.
 

@@ -36,6 +36,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from simulation._display import Displayed, short_repr
+
+from ..core.figures import draw
 from ..core.format import money, probability
 from ..hazard.annual_hazard import EnergyHazard
 from ..hazard.impact_energy import mass_model
@@ -68,7 +71,7 @@ _quantile_map = quantile_map          # the name this function had here before t
 
 
 @dataclass(frozen=True)
-class OptionResult:
+class OptionResult(Displayed):
     """Central-value results of one option (rates per year, money in the study currency)."""
 
     option: Option
@@ -90,9 +93,30 @@ class OptionResult:
         """
         return self.repairs_per_year
 
+    def __repr__(self) -> str:
+        return short_repr(self, repr(self.option.name), kind=self.option.kind,
+                          road_falls_per_year=self.road_falls_per_year, deaths_per_year=self.deaths_per_year,
+                          expected_annual_loss=self.expected_annual_loss)
+
+    def summary(self) -> pd.DataFrame:
+        """The central-value results as one row.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row: ``option``, ``kind`` and every rate [1/yr], the expected annual loss [study currency/yr],
+            the individual risk [1/yr], the retention and the effectiveness (shares, 0-1).
+        """
+        row = {"option": self.option.name, "kind": self.option.kind}
+        row.update({k: getattr(self, k) for k in (
+            "road_falls_per_year", "repairs_per_year", "replacements_per_year", "vehicle_hits_per_year",
+            "rock_strikes_per_year", "deaths_per_year", "expected_annual_loss", "individual_risk", "retention",
+            "effectiveness")})
+        return pd.DataFrame([row])
+
 
 @dataclass(frozen=True)
-class MitigationStudy:
+class MitigationStudy(Displayed):
     """A hazard at the barrier line, the road exposure, consequences, economics and options.
 
     ``context`` (a :class:`~riskrf.risk.measures.SimulationContext`) is the slope model used to
@@ -845,7 +869,44 @@ class MitigationStudy:
                          "effectiveness": float(r.effectiveness[0, k]), "effect_basis": self._basis(o)})
         return pd.DataFrame(rows)
 
+    # ---- notebook display --------------------------------------------------------------------
+    def __repr__(self) -> str:
+        return short_repr(self, f"{len(self.options)} options", repr(Path(str(self.source)).name),
+                          currency=self.currency, samples=self.uncertainty.samples)
 
+    def summary(self) -> pd.DataFrame:
+        """The options ranked by expected total cost: :meth:`ranking`.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per option, cheapest first (money in the study currency, rates per year).
+        """
+        return self.ranking()
+
+    def plot(self, kind: str = "tornado", ax=None):
+        """The study's figure, drawn by :mod:`riskrf.report.decision_figures` (through :mod:`riskrf.core.figures`).
+
+        Parameters
+        ----------
+        kind : {"tornado", "ranking"}
+            ``"tornado"``: one-way sensitivity of the lowest expected total cost (:meth:`tornado`);
+            ``"ranking"``: each option's expected total cost with its 5-95 % interval (:meth:`ranking`).
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+
+        Raises
+        ------
+        MitigationError
+            ``kind`` is neither ``"tornado"`` nor ``"ranking"``.
+        """
+        if kind not in ("tornado", "ranking"):
+            raise MitigationError(f"plot: kind must be 'tornado' or 'ranking', not {kind!r}")
+        return draw(f"mitigation_{kind}", self, ax=ax)
 
 
 def study_inputs(data: dict, source: str, *, require_options: bool = True) -> dict:

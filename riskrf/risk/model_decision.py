@@ -48,6 +48,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from simulation._display import Displayed, short_repr
+
 from ..core.format import money
 from ..core.validation import RiskrfError
 
@@ -141,7 +143,7 @@ class CalibrationValue:
 
 
 @dataclass(frozen=True)
-class ModelUncertainRanking:
+class ModelUncertainRanking(Displayed):
     """Expected total cost of each option under each draw of the trajectory model.
 
     ``costs`` (draws x options): expected total cost [currency] given the draw (over the study's other uncertain
@@ -173,6 +175,11 @@ class ModelUncertainRanking:
                 raise DecisionValueError(f"sample_costs must be draws x samples x options {C.shape[0]} x S x "
                                          f"{C.shape[1]}; got shape {S.shape}")
             object.__setattr__(self, "sample_costs", S)
+
+    def __repr__(self) -> str:
+        return short_repr(self, f"{len(self.options)} options", f"{self.n_draws} draws", best=self.best_now(),
+                          evpi=self.evpi(), currency=self.currency or None,
+                          joint_samples=None if self.sample_costs is None else self.sample_costs.shape[1])
 
     @property
     def n_draws(self) -> int:
