@@ -405,160 +405,500 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RiskrfWarning)
-        inv_cfg = site.inventory
         hz_cfg = site.hazard
-        # On a fresh installation the simulator is compiled once (numba, cached on disk): that takes the other
-        # core while this one fits, fits the rate model and draws the fits' figures (below); otherwise those
-        # two go to forked children on the other core.
-        from simulation.precompile import precompile
-        compiling = precompile() if hz_cfg["scenario"] else None
-        beside = compiling is None or not compiling.running
-        if not beside:
-            log("      first run of this installation: the simulator is compiled once on the other core (numba, "
-                "cached on disk for later runs)")
-        # The site's rate model (hazard rate, closure rules).
-        rates = None
-        if site.rates is not None:
-            from ..risk.site_rates import evaluate_rates
-            rates = InBackground(lambda: evaluate_rates(site.rates, site.path.parent, inv_cfg,
-                                                        site.mitigation["options"]), fork=beside)
+        compiling, beside, rates = _start_compilation_and_rates(site, log)
         t = stage(1, "reading the inventory and fitting magnitude-frequency models")
-        from ..frequency.inventory import READER_OPTIONS
-        reader = {k: inv_cfg[k] for k in READER_OPTIONS if inv_cfg.get(k) is not None}
-        inventory = read_inventory(site.resolve(inv_cfg["path"]), start=inv_cfg["start"], end=inv_cfg["end"],
-                                   duration_years=inv_cfg["duration_years"], density_kg_m3=inv_cfg["density_kg_m3"],
-                                   **reader)
-        dated = read_inventory(site.resolve(inv_cfg["annual_maxima"])) if inv_cfg["annual_maxima"] else None
-        frequency = analyse_inventory(inventory, m_min=inv_cfg["m_min_kg"], n_bootstrap=500, seed=seed)
-        maxima_frequency = None
-        if dated is not None:
-            maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
+        inventory, frequency, maxima_frequency = _fit_inventory(site, seed)
         timings["fits"] = round(time.perf_counter() - t, 2)
         if figures is not None:
             pending.append(InBackground(partial(_frequency_outputs, frequency, maxima_frequency, figures),
                                         fork=beside))
-
-        db_cfg = site.design_block
-        survey = read_block_survey(site.resolve(db_cfg["survey"]), inventory.density_kg_m3) \
-            if db_cfg["survey"] else None
-        rate_scale, rate_note, site_rates = inv_cfg["rate_scale"], None, None
-        if inv_cfg.get("rate_from") == "rate_model":
-            site_rates = rates.result()
-            rate_scale = inv_cfg["rate_scale"] * site_rates.hazard_factor(inventory)
-            rate_note = "rate from the " + site_rates.rate_text() + (
-                f"; times rate_scale {inv_cfg['rate_scale']:g}" if inv_cfg["rate_scale"] != 1 else "")
-        m_max_values, shares = sensitivity_inputs(site, rate_scale)
-        # masses design values are read at: the percentile band of the design block, the largest m_max studied
-        extra = design_block_candidates_kg(rule=db_cfg["rule"], percentile=db_cfg["percentile"],
-                                           survey_volumes_m3=survey, inventory=inventory,
-                                           density_kg_m3=inventory.density_kg_m3)
-        extra += [m for m in m_max_values if m is not None]
-
-        def design_masses(law, rate):
-            """The masses above and the fragmentation alternative of the site's law (simulated, not borrowed)."""
-            frag = fragment_block_kg(law, rate, design_T=hz_cfg["design_period_years"],
-                                     fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"],
-                                     percentile=db_cfg["percentile"], density_kg_m3=inventory.density_kg_m3)
-            finest = []
-            u = site.mitigation["uncertainty"]
-            if u is not None and u.fractal_dimension:     # fragments travel: simulate down to the finest one
-                masses = np.asarray(inventory.masses, dtype=float)
-                finest = [min(float(law.m_min), float(masses[masses > 0].min(initial=np.inf)))
-                          / 8.0 ** u.fragmentation_iterations]
-            return extra + ([frag] if frag is not None else []) + finest
-        if compiling is not None and (not beside or compiling.running):
-            t = time.perf_counter()
-            if not beside:          # this core's work while the simulator compiles on the other
-                for part in [rates] + pending:
-                    if part is not None:
-                        part.result()
-            compiling.wait()
-            timings["compilation"] = round(time.perf_counter() - t, 2)
+        survey, rate_scale, rate_note, site_rates, m_max_values, shares, extra = _rate_and_design_inputs(
+            site, inventory, rates)
+        design_masses = partial(_design_masses, site=site, inventory=inventory, extra=extra)
+        _wait_for_compilation(compiling, beside, [rates] + pending, timings)
         t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
-        gr, hazard, result, road_hits = energy_hazard_from_inputs(
-            inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=rate_scale,
-            scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
-            velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
-            collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
-            mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=design_masses,
-            velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note,
-            road_collector=hz_cfg["road_collector"])
+        gr, hazard, result, road_hits = _simulate_hazard(site, inventory, rate_scale, rate_note, n_blocks, seed,
+                                                         design_masses)
         timings["simulation"] = round(time.perf_counter() - t, 2)
-        release_factor = 1.0
-        if inv_cfg.get("rate_basis", "release") == "road":
-            # the record counts falls that reached the road: release rate = recorded / P(road | release)
-            release_factor = release_factor_for_road_record(
-                hazard, road_share(result, hz_cfg["collector"], hz_cfg["road_collector"]),
-                study_context(result, hz_cfg["collector"], hz_cfg["road_collector"], hz_cfg["option_blocks"], seed,
-                              inventory, hazard, rate_scale, road_hits), str(site.path),
-                uncertainty=site.mitigation.get("uncertainty"))
-            hazard = replace(hazard, rate_per_year=hazard.rate_per_year * release_factor)
-            rate_scale = rate_scale * release_factor
-            m_max_values, shares = sensitivity_inputs(site, rate_scale)
+        release_factor, hazard, rate_scale, m_max_values, shares = _release_rate_of_road_record(
+            site, inventory, hazard, result, road_hits, rate_scale, seed, m_max_values, shares)
         if figures is not None:
             pending.append(InBackground(partial(_simulation_figures, result, hz_cfg["collector"], figures,
                                                 fences_to_draw(site))))
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
-        block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
-                             survey_source=db_cfg["survey"], inventory=inventory,
-                             sizes=resolve_sizes(inv_cfg["sizes"], inventory),
-                             design_T=hz_cfg["design_period_years"], density_kg_m3=inventory.density_kg_m3,
-                             fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"])
-        sensitivity = design_energy_sensitivity(
-            hazard, inventory.masses, inventory.duration_years, m_min=gr.m_min, m_max_values=m_max_values,
-            rate_shares=shares, T=hz_cfg["design_period_years"]) \
-            if hz_cfg["design_period_years"] * hazard.arrival_rate > 1 else None
-        tornado = design_energy_tornado(
-            hazard, design_T=hz_cfg["design_period_years"], block=block, masses_kg=inventory.masses,
-            duration_years=inventory.duration_years, m_max_range=_ends(m_max_values),
-            rate_share=rate_scale, rate_share_range=_ends(shares), sensitivity=sensitivity,
-            **({"rate_label": "rate factor on the inventory's rate (rate model x rate_scale)"}
-               if site_rates is not None else {})) \
-            if sensitivity is not None else None
-        fences, heights = fence_checks_from_site(site)
-        energy = analyse_energy(hazard, fences=fences, fence_height_m=heights,
-                                free_board_m=hz_cfg["free_board_m"], design_T=hz_cfg["design_period_years"],
-                                density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed,
-                                design_block=block, sensitivity=sensitivity, tornado=tornado)
-        site_design = design_for_site(site, hazard, block, result, inventory.density_kg_m3, seed)
+        energy, site_design = _energy_stage(site, inventory, gr, hazard, result, survey, m_max_values, shares,
+                                            rate_scale, site_rates, seed)
         timings["energy"] = round(time.perf_counter() - t, 2)
         if figures is not None:
             from ..report.files import write_energy_study
             pending.append(InBackground(partial(write_energy_study, energy, figures)))
 
         t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
-        share = road_share(result, hz_cfg["collector"], hz_cfg["road_collector"])
-        mitigation = site.mitigation
-        if rates is not None:
-            from ..risk.site_rates import resolve_closures
-            site_rates = rates.result()
-            mitigation = dict(mitigation, options=resolve_closures(mitigation["options"], site_rates))
-        study = MitigationStudy(hazard=hazard, road_share=share, source=str(site.path),
-                                defaults_used=site.defaults_used,
-                                **study_context(result, hz_cfg["collector"], hz_cfg["road_collector"],
-                                                hz_cfg["option_blocks"], seed, inventory, hazard,
-                                                rate_scale, road_hits),
-                                **mitigation)
-        study = replace(study, design_checks=fence_design_checks(study.options, energy))
-        decision = study_report(study)
-        site_design = with_recommended_run(site_design, site, result, decision["recommendation"]["option"], seed)
+        mitigation, site_rates, study, decision, site_design = _decision_stage(
+            site, inventory, hazard, result, road_hits, rate_scale, energy, rates, site_rates, site_design, seed,
+            study_report)
         timings["decision"] = round(time.perf_counter() - t, 2)
-        model_uncertainty = None
-        if site.model_uncertainty is not None:
-            from .model_uncertainty import run_model_uncertainty
-            t = time.perf_counter()
-            log(f"      the trajectory model's uncertainty: {site.model_uncertainty['draws']} draws of the material "
-                "parameters re-simulated (design energies, ranking, value of a field calibration)")
-            evaluate = partial(draw_evaluator, site, inventory, rate_scale=rate_scale / release_factor,
-                               rate_note=rate_note, mitigation=mitigation, design_masses=design_masses)
-            model_uncertainty = run_model_uncertainty(
-                site, evaluate, reference_hazard=hazard, design_T=hz_cfg["design_period_years"],
-                T=energy.design["T_years"].tolist(), log=log)
-            timings["model_uncertainty"] = round(time.perf_counter() - t, 2)
+        model_uncertainty = _model_uncertainty_stage(
+            site, inventory, hazard, energy, rate_scale, release_factor, rate_note, mitigation, design_masses, log,
+            timings)
+    notes = _assessment_notes(frequency, [str(c.message) for c in caught], site_rates, inventory)
+    return Assessment(site=site, inventory=inventory, frequency=frequency, maxima_frequency=maxima_frequency,
+                      result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
+                      warnings=notes, timings=timings, rates=site_rates, release_factor=release_factor,
+                      design=site_design, model_uncertainty=model_uncertainty,
+                      drawing={"dir": figures, "pending": pending} if figures is not None else {})
+
+
+def _start_compilation_and_rates(site: Site, log):
+    """Start, beside the fits, the simulator's first compilation and the site's rate model.
+
+    On a fresh installation the simulator is compiled once (numba, cached on disk): that takes the other core
+    while this one fits, fits the rate model and draws the fits' figures; otherwise those two go to forked
+    children on the other core.
+
+    Parameters
+    ----------
+    site : Site
+        The validated site.
+    log : callable
+        Called with one line of progress text.
+
+    Returns
+    -------
+    compiling : object or None
+        The compilation under way (``simulation.precompile.precompile``), None without a scenario.
+    beside : bool
+        True when work may be forked to the other core (no compilation running there).
+    rates : InBackground or None
+        The site's rate model (hazard rate, closure rules) being evaluated, None when the site has none.
+    """
+    inv_cfg = site.inventory
+    from simulation.precompile import precompile
+    compiling = precompile() if site.hazard["scenario"] else None
+    beside = compiling is None or not compiling.running
+    if not beside:
+        log("      first run of this installation: the simulator is compiled once on the other core (numba, "
+            "cached on disk for later runs)")
+    # The site's rate model (hazard rate, closure rules).
+    rates = None
+    if site.rates is not None:
+        from ..risk.site_rates import evaluate_rates
+        rates = InBackground(lambda: evaluate_rates(site.rates, site.path.parent, inv_cfg,
+                                                    site.mitigation["options"]), fork=beside)
+    return compiling, beside, rates
+
+
+def _fit_inventory(site: Site, seed):
+    """Read the site's inventory (and its annual maxima, if given) and fit the magnitude-frequency models.
+
+    Parameters
+    ----------
+    site : Site
+        The validated site; its ``[inventory]`` table names the files and the reader's options.
+    seed : int or None
+        Seed of the bootstrap of the fits.
+
+    Returns
+    -------
+    inventory : Inventory
+        The inventory read (masses in kg).
+    frequency : FrequencyAnalysis
+        Its magnitude-frequency analysis (500 bootstrap replicates).
+    maxima_frequency : FrequencyAnalysis or None
+        The analysis of the dated annual maxima (200 replicates), None when the site gives none.
+    """
+    inv_cfg = site.inventory
+    from ..frequency.inventory import READER_OPTIONS
+    reader = {k: inv_cfg[k] for k in READER_OPTIONS if inv_cfg.get(k) is not None}
+    inventory = read_inventory(site.resolve(inv_cfg["path"]), start=inv_cfg["start"], end=inv_cfg["end"],
+                               duration_years=inv_cfg["duration_years"], density_kg_m3=inv_cfg["density_kg_m3"],
+                               **reader)
+    dated = read_inventory(site.resolve(inv_cfg["annual_maxima"])) if inv_cfg["annual_maxima"] else None
+    frequency = analyse_inventory(inventory, m_min=inv_cfg["m_min_kg"], n_bootstrap=500, seed=seed)
+    maxima_frequency = None
+    if dated is not None:
+        maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
+    return inventory, frequency, maxima_frequency
+
+
+def _rate_and_design_inputs(site: Site, inventory, rates):
+    """The block survey, the rate factor on the inventory's rate and the masses design values are read at.
+
+    Parameters
+    ----------
+    site : Site
+        The validated site.
+    inventory : Inventory
+        The site's inventory (masses in kg, density in kg/m3).
+    rates : InBackground or None
+        The site's rate model being evaluated; waited for when ``inventory.rate_from = "rate_model"``.
+
+    Returns
+    -------
+    survey : numpy.ndarray or None
+        Block volumes of the survey (m3), None without a survey.
+    rate_scale : float
+        Factor on the inventory's rate (dimensionless): ``rate_scale``, times the rate model's hazard factor
+        when the rate comes from the rate model.
+    rate_note : str or None
+        How the rate was obtained, None when it is the inventory's times ``rate_scale``.
+    site_rates : object or None
+        The evaluated rate model when the rate comes from it, else None.
+    m_max_values, shares : list
+        The upper bounds (kg) and rate factors of the design-energy sensitivity (:func:`sensitivity_inputs`).
+    extra : list of float
+        Masses (kg) design values are read at: the percentile band of the design block, the largest m_max studied.
+    """
+    inv_cfg = site.inventory
+    db_cfg = site.design_block
+    survey = read_block_survey(site.resolve(db_cfg["survey"]), inventory.density_kg_m3) \
+        if db_cfg["survey"] else None
+    rate_scale, rate_note, site_rates = inv_cfg["rate_scale"], None, None
+    if inv_cfg.get("rate_from") == "rate_model":
+        site_rates = rates.result()
+        rate_scale = inv_cfg["rate_scale"] * site_rates.hazard_factor(inventory)
+        rate_note = "rate from the " + site_rates.rate_text() + (
+            f"; times rate_scale {inv_cfg['rate_scale']:g}" if inv_cfg["rate_scale"] != 1 else "")
+    m_max_values, shares = sensitivity_inputs(site, rate_scale)
+    # masses design values are read at: the percentile band of the design block, the largest m_max studied
+    extra = design_block_candidates_kg(rule=db_cfg["rule"], percentile=db_cfg["percentile"],
+                                       survey_volumes_m3=survey, inventory=inventory,
+                                       density_kg_m3=inventory.density_kg_m3)
+    extra += [m for m in m_max_values if m is not None]
+    return survey, rate_scale, rate_note, site_rates, m_max_values, shares, extra
+
+
+def _design_masses(law, rate, *, site: Site, inventory, extra) -> list:
+    """The masses above and the fragmentation alternative of the site's law (simulated, not borrowed).
+
+    Parameters
+    ----------
+    law : GutenbergRichterFit
+        The mass law of the hazard (kg).
+    rate : float
+        Its rate of falls at or above m_min (1/year).
+    site : Site
+        The validated site (design period, design-block and uncertainty tables).
+    inventory : Inventory
+        The site's inventory (masses in kg, density in kg/m3).
+    extra : list of float
+        Masses (kg) design values are read at anyway (:func:`_rate_and_design_inputs`).
+
+    Returns
+    -------
+    list of float
+        Masses (kg) to simulate: ``extra``, the fragmented design block if any, and the finest fragment when
+        the uncertainty table fragments the blocks.
+    """
+    db_cfg = site.design_block
+    frag = fragment_block_kg(law, rate, design_T=site.hazard["design_period_years"],
+                             fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"],
+                             percentile=db_cfg["percentile"], density_kg_m3=inventory.density_kg_m3)
+    finest = []
+    u = site.mitigation["uncertainty"]
+    if u is not None and u.fractal_dimension:     # fragments travel: simulate down to the finest one
+        masses = np.asarray(inventory.masses, dtype=float)
+        finest = [min(float(law.m_min), float(masses[masses > 0].min(initial=np.inf)))
+                  / 8.0 ** u.fragmentation_iterations]
+    return extra + ([frag] if frag is not None else []) + finest
+
+
+def _wait_for_compilation(compiling, beside: bool, parts: list, timings: dict) -> None:
+    """Wait for the simulator's compilation, if one runs, doing this core's share of work meanwhile.
+
+    Parameters
+    ----------
+    compiling : object or None
+        The compilation under way, None without a scenario.
+    beside : bool
+        False when the compilation took the other core: ``parts`` are then finished here first.
+    parts : list
+        Background work (:class:`InBackground` or None) to finish on this core while compiling.
+    timings : dict
+        Stage timings (s); ``"compilation"`` is added when there was a compilation to wait for.
+    """
+    if compiling is not None and (not beside or compiling.running):
+        t = time.perf_counter()
+        if not beside:          # this core's work while the simulator compiles on the other
+            for part in parts:
+                if part is not None:
+                    part.result()
+        compiling.wait()
+        timings["compilation"] = round(time.perf_counter() - t, 2)
+
+
+def _simulate_hazard(site: Site, inventory, rate_scale: float, rate_note, n_blocks: int, seed, design_masses):
+    """The impact-energy hazard of the site: simulated trajectories, or velocities read from a file.
+
+    Parameters
+    ----------
+    site : Site
+        The validated site (``[inventory]`` and ``[hazard]`` tables).
+    inventory : Inventory
+        The site's inventory (masses in kg).
+    rate_scale : float
+        Factor on the inventory's rate (dimensionless).
+    rate_note : str or None
+        How the rate was obtained, carried into the hazard.
+    n_blocks : int
+        Trajectories simulated.
+    seed : int or None
+        Seed of the simulation.
+    design_masses : callable
+        ``design_masses(law, rate)``: masses (kg) to simulate (:func:`_design_masses`).
+
+    Returns
+    -------
+    tuple
+        ``(gr, hazard, result, road_hits)`` of :func:`energy_hazard_from_inputs`.
+    """
+    inv_cfg, hz_cfg = site.inventory, site.hazard
+    return energy_hazard_from_inputs(
+        inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=rate_scale,
+        scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
+        velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
+        collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
+        mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=design_masses,
+        velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note,
+        road_collector=hz_cfg["road_collector"])
+
+
+def _release_rate_of_road_record(site: Site, inventory, hazard, result, road_hits, rate_scale: float, seed,
+                                 m_max_values, shares):
+    """Turn a record of falls that reached the road (``rate_basis = "road"``) into a release rate.
+
+    The release rate is the recorded rate divided by P(road | release); with ``rate_basis = "release"`` (the
+    default) everything is returned unchanged.
+
+    Parameters
+    ----------
+    site : Site
+        The validated site.
+    inventory : Inventory
+        The site's inventory (masses in kg).
+    hazard : EnergyHazard
+        The hazard at the recorded rate.
+    result : object
+        The simulation result (collectors at the barrier line and the road).
+    road_hits : object
+        The road hits of the simulation (:func:`energy_hazard_from_inputs`).
+    rate_scale : float
+        Factor on the inventory's rate (dimensionless).
+    seed : int or None
+        Seed of the option runs.
+    m_max_values, shares : list
+        The design-energy sensitivity inputs (:func:`sensitivity_inputs`).
+
+    Returns
+    -------
+    tuple
+        ``(release_factor, hazard, rate_scale, m_max_values, shares)``: the factor (dimensionless, 1.0 for a
+        release record) and the inputs rescaled by it.
+    """
+    inv_cfg, hz_cfg = site.inventory, site.hazard
+    release_factor = 1.0
+    if inv_cfg.get("rate_basis", "release") == "road":
+        # the record counts falls that reached the road: release rate = recorded / P(road | release)
+        release_factor = release_factor_for_road_record(
+            hazard, road_share(result, hz_cfg["collector"], hz_cfg["road_collector"]),
+            study_context(result, hz_cfg["collector"], hz_cfg["road_collector"], hz_cfg["option_blocks"], seed,
+                          inventory, hazard, rate_scale, road_hits), str(site.path),
+            uncertainty=site.mitigation.get("uncertainty"))
+        hazard = replace(hazard, rate_per_year=hazard.rate_per_year * release_factor)
+        rate_scale = rate_scale * release_factor
+        m_max_values, shares = sensitivity_inputs(site, rate_scale)
+    return release_factor, hazard, rate_scale, m_max_values, shares
+
+
+def _energy_stage(site: Site, inventory, gr, hazard, result, survey, m_max_values, shares, rate_scale: float,
+                  site_rates, seed):
+    """Design block, design-energy sensitivity and tornado, fence checks and the site's design masses.
+
+    Parameters
+    ----------
+    site : Site
+        The validated site.
+    inventory : Inventory
+        The site's inventory (masses in kg, duration in years, density in kg/m3).
+    gr : GutenbergRichterFit
+        The mass law of the hazard (kg).
+    hazard : EnergyHazard
+        The impact-energy hazard at the barrier line.
+    result : object
+        The simulation result.
+    survey : numpy.ndarray or None
+        Block volumes of the survey (m3).
+    m_max_values, shares : list
+        The design-energy sensitivity inputs (:func:`sensitivity_inputs`).
+    rate_scale : float
+        Factor on the inventory's rate (dimensionless).
+    site_rates : object or None
+        The site's rate model when the rate comes from it (changes the tornado's rate label).
+    seed : int or None
+        Seed of the bootstrap and of the design runs.
+
+    Returns
+    -------
+    energy : EnergyAnalysis
+        Design energies (kJ) and fence checks.
+    site_design : object
+        The site's design masses (:func:`design_for_site`).
+    """
+    db_cfg, hz_cfg, inv_cfg = site.design_block, site.hazard, site.inventory
+    block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
+                         survey_source=db_cfg["survey"], inventory=inventory,
+                         sizes=resolve_sizes(inv_cfg["sizes"], inventory),
+                         design_T=hz_cfg["design_period_years"], density_kg_m3=inventory.density_kg_m3,
+                         fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"])
+    sensitivity = design_energy_sensitivity(
+        hazard, inventory.masses, inventory.duration_years, m_min=gr.m_min, m_max_values=m_max_values,
+        rate_shares=shares, T=hz_cfg["design_period_years"]) \
+        if hz_cfg["design_period_years"] * hazard.arrival_rate > 1 else None
+    tornado = design_energy_tornado(
+        hazard, design_T=hz_cfg["design_period_years"], block=block, masses_kg=inventory.masses,
+        duration_years=inventory.duration_years, m_max_range=_ends(m_max_values),
+        rate_share=rate_scale, rate_share_range=_ends(shares), sensitivity=sensitivity,
+        **({"rate_label": "rate factor on the inventory's rate (rate model x rate_scale)"}
+           if site_rates is not None else {})) \
+        if sensitivity is not None else None
+    fences, heights = fence_checks_from_site(site)
+    energy = analyse_energy(hazard, fences=fences, fence_height_m=heights,
+                            free_board_m=hz_cfg["free_board_m"], design_T=hz_cfg["design_period_years"],
+                            density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed,
+                            design_block=block, sensitivity=sensitivity, tornado=tornado)
+    site_design = design_for_site(site, hazard, block, result, inventory.density_kg_m3, seed)
+    return energy, site_design
+
+
+def _decision_stage(site: Site, inventory, hazard, result, road_hits, rate_scale: float, energy, rates, site_rates,
+                    site_design, seed, study_report):
+    """Rank the mitigation options and re-run the recommended one on the site.
+
+    Parameters
+    ----------
+    site : Site
+        The validated site.
+    inventory : Inventory
+        The site's inventory (masses in kg).
+    hazard : EnergyHazard
+        The impact-energy hazard at the release rate.
+    result : object
+        The simulation result.
+    road_hits : object
+        The road hits of the simulation.
+    rate_scale : float
+        Factor on the inventory's rate (dimensionless).
+    energy : EnergyAnalysis
+        Design energies (kJ) and fence checks.
+    rates : InBackground or None
+        The site's rate model being evaluated; its closure rules resolve the closure options.
+    site_rates : object or None
+        The evaluated rate model so far.
+    site_design : object
+        The site's design masses.
+    seed : int or None
+        Seed of the option runs.
+    study_report : callable
+        :func:`riskrf.report.mitigation_text.study_report`.
+
+    Returns
+    -------
+    tuple
+        ``(mitigation, site_rates, study, decision, site_design)``: the mitigation table used, the rate model,
+        the :class:`MitigationStudy` with its fence design checks, the decision report and the site's design
+        with the recommended option's run.
+    """
+    hz_cfg = site.hazard
+    share = road_share(result, hz_cfg["collector"], hz_cfg["road_collector"])
+    mitigation = site.mitigation
+    if rates is not None:
+        from ..risk.site_rates import resolve_closures
+        site_rates = rates.result()
+        mitigation = dict(mitigation, options=resolve_closures(mitigation["options"], site_rates))
+    study = MitigationStudy(hazard=hazard, road_share=share, source=str(site.path),
+                            defaults_used=site.defaults_used,
+                            **study_context(result, hz_cfg["collector"], hz_cfg["road_collector"],
+                                            hz_cfg["option_blocks"], seed, inventory, hazard,
+                                            rate_scale, road_hits),
+                            **mitigation)
+    study = replace(study, design_checks=fence_design_checks(study.options, energy))
+    decision = study_report(study)
+    site_design = with_recommended_run(site_design, site, result, decision["recommendation"]["option"], seed)
+    return mitigation, site_rates, study, decision, site_design
+
+
+def _model_uncertainty_stage(site: Site, inventory, hazard, energy, rate_scale: float, release_factor: float,
+                             rate_note, mitigation, design_masses, log, timings: dict):
+    """Carry the trajectory model's uncertainty to the decision, when the site asks for it.
+
+    Parameters
+    ----------
+    site : Site
+        The validated site; nothing is done when it has no ``[model_uncertainty]`` table.
+    inventory : Inventory
+        The site's inventory (masses in kg).
+    hazard : EnergyHazard
+        The reference impact-energy hazard.
+    energy : EnergyAnalysis
+        Its design energies (the return periods, years, are reused).
+    rate_scale : float
+        Factor on the inventory's rate (dimensionless), including ``release_factor``.
+    release_factor : float
+        Factor turning a road record into a release rate (dimensionless); each draw recomputes its own.
+    rate_note : str or None
+        How the rate was obtained.
+    mitigation : dict
+        The mitigation table used by the study.
+    design_masses : callable
+        ``design_masses(law, rate)``: masses (kg) to simulate.
+    log : callable
+        Called with one line of progress text.
+    timings : dict
+        Stage timings (s); ``"model_uncertainty"`` is added when the stage runs.
+
+    Returns
+    -------
+    object or None
+        The result of :func:`run_model_uncertainty`, None when the site does not ask for it.
+    """
+    if site.model_uncertainty is None:
+        return None
+    from .model_uncertainty import run_model_uncertainty
+    t = time.perf_counter()
+    log(f"      the trajectory model's uncertainty: {site.model_uncertainty['draws']} draws of the material "
+        "parameters re-simulated (design energies, ranking, value of a field calibration)")
+    evaluate = partial(draw_evaluator, site, inventory, rate_scale=rate_scale / release_factor,
+                       rate_note=rate_note, mitigation=mitigation, design_masses=design_masses)
+    model_uncertainty = run_model_uncertainty(
+        site, evaluate, reference_hazard=hazard, design_T=site.hazard["design_period_years"],
+        T=energy.design["T_years"].tolist(), log=log)
+    timings["model_uncertainty"] = round(time.perf_counter() - t, 2)
+    return model_uncertainty
+
+
+def _assessment_notes(frequency, caught: list, site_rates, inventory) -> list:
+    """The warnings of an assessment, each once, and the notes on the fits' reach.
+
+    Parameters
+    ----------
+    frequency : FrequencyAnalysis
+        The inventory's magnitude-frequency analysis.
+    caught : list of str
+        The warnings caught while the assessment ran, in order.
+    site_rates : object or None
+        The site's rate model, whose notes are added.
+    inventory : Inventory
+        The site's inventory (duration in years).
+
+    Returns
+    -------
+    list of str
+        The notes: warnings without repeats, then the extrapolation, bootstrap p and tail-size notes.
+    """
     notes = []
-    for w in list(frequency.warnings) + [str(c.message) for c in caught] + list(site_rates.notes if site_rates
-                                                                                else ()):
+    for w in list(frequency.warnings) + caught + list(site_rates.notes if site_rates else ()):
         if w not in notes:
             notes.append(w)
     T_max = float(max(frequency.design_masses()["T_years"]))
@@ -569,11 +909,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         notes.append(f"the power law is questionable for this inventory (bootstrap p = {frequency.bootstrap_p:.3f})")
     if frequency.power_law.n_tail < 50:
         notes.append(f"only {frequency.power_law.n_tail} falls above m_min: the exponent b is uncertain")
-    return Assessment(site=site, inventory=inventory, frequency=frequency, maxima_frequency=maxima_frequency,
-                      result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
-                      warnings=notes, timings=timings, rates=site_rates, release_factor=release_factor,
-                      design=site_design, model_uncertainty=model_uncertainty,
-                      drawing={"dir": figures, "pending": pending} if figures is not None else {})
+    return notes
 
 
 def write_assessment(a: Assessment, out: Path, log=None) -> dict:
