@@ -46,7 +46,28 @@ FIELDS = MODEL_UNCERTAINTY.defaults()
 def check_model_uncertainty(data, site_path: Path, hazard: dict, *, error=ModelUncertaintyError):
     """The ``[model_uncertainty]`` table checked before any work: (config with defaults, defaults used), or
     (None, []) when absent.  A posterior file is read and held against the scenario's materials here (an error
-    names the file and the column); without one the scenario must name presets."""
+    names the file and the column); without one the scenario must name presets.
+
+    Parameters
+    ----------
+    data : dict or None
+        The site file's ``[model_uncertainty]`` table as parsed from TOML (None when absent).
+    site_path : pathlib.Path
+        The site file; relative paths (``posterior``, ``hazard.scenario``) are resolved against its folder.
+    hazard : dict
+        The site's checked ``[hazard]`` table (its ``scenario`` [path] and ``seed`` are used).
+    error : type, optional
+        Exception class raised on bad input (a subclass of :class:`riskrf.RiskrfError`; default
+        :class:`~riskrf.hazard.model_uncertainty.ModelUncertaintyError`).
+
+    Returns
+    -------
+    cfg : dict or None
+        The table with defaults filled in, plus ``scenario_path``, ``posterior_table`` (the read posterior or None),
+        ``calibration_cost`` [site currency] and ``calibration_cost_is_assumption``; None when the table is absent.
+    used : list of str
+        The defaults used (``model_uncertainty.<field> = <value>``), for labelling the outputs.
+    """
     if data is None:
         return None, []
     where = f"{site_path}: model_uncertainty"
@@ -120,11 +141,24 @@ class ModelUncertaintyStudy:
     notes: tuple = ()
 
     def verdict(self) -> str:
-        """Calibrate first or decide now, with the numbers."""
+        """Calibrate first or decide now, with the numbers.
+
+        Returns
+        -------
+        str
+            The sentence of :meth:`riskrf.risk.model_decision.CalibrationValue.verdict` (EVSI and calibration cost in
+            the site currency).
+        """
         return self.calibration.verdict()
 
     def text(self) -> list[str]:
-        """Plain-text lines for the CLI and the report."""
+        """Plain-text lines for the CLI and the report.
+
+        Returns
+        -------
+        list of str
+            One line per entry: design energies [kJ] with their split, the ranking over the draws, the verdict.
+        """
         lines = [f"Trajectory model uncertainty ({self.basis}):"]
         lines += ["  " + t for t in self.energy.text(self.design_T)]
         lines += ["  " + t for t in self.ranking.text()]
@@ -132,7 +166,15 @@ class ModelUncertaintyStudy:
         return lines
 
     def to_dict(self) -> dict:
-        """The lines of ``summary.json`` (``model_uncertainty``)."""
+        """The lines of ``summary.json`` (``model_uncertainty``).
+
+        Returns
+        -------
+        dict
+            JSON-ready values: basis, draws, design energy [kJ] with its intervals and variance share, the ranking
+            (expected costs [site currency/yr]), EVPI [site currency/yr], the calibration value, verdict, notes and
+            timings [s].
+        """
         cfg = self.config
         row = self.energy.row(self.design_T) if np.isclose(self.energy.table["T_years"], self.design_T).any() \
             else None
@@ -163,7 +205,18 @@ class ModelUncertaintyStudy:
 
     def write(self, out_dir) -> list[Path]:
         """``model_uncertainty_ranking.csv``, ``model_uncertainty_draws.csv`` and
-        ``design_energy_model_uncertainty.csv`` into ``out_dir``; returns the files written."""
+        ``design_energy_model_uncertainty.csv`` into ``out_dir``; returns the files written.
+
+        Parameters
+        ----------
+        out_dir : str or pathlib.Path
+            Existing output folder.
+
+        Returns
+        -------
+        list of pathlib.Path
+            The three CSV files written.
+        """
         out = Path(out_dir)
         files = [out / "model_uncertainty_ranking.csv", out / "model_uncertainty_draws.csv",
                  out / "design_energy_model_uncertainty.csv"]
@@ -173,7 +226,18 @@ class ModelUncertaintyStudy:
         return files
 
     def figures(self, figs) -> list[Path]:
-        """The draws' design energies and costs as PNG figures in ``figs``."""
+        """The draws' design energies and costs as PNG figures in ``figs``.
+
+        Parameters
+        ----------
+        figs : pathlib.Path
+            Existing folder for the figures.
+
+        Returns
+        -------
+        list of pathlib.Path
+            ``design_energy_model_uncertainty.png`` and ``ranking_model_uncertainty.png``.
+        """
         from ..report.files import save_figure
         a = figs / "design_energy_model_uncertainty.png"
         b = figs / "ranking_model_uncertainty.png"
@@ -201,6 +265,28 @@ def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_
     share) (:func:`riskrf.app.assess.draw_evaluator`); ``uncertainty`` is the study's uncertainty to use (its
     material draws switched off).  ``reference_hazard``: the assessment's own hazard (reported beside the
     draws); ``T``: return periods [yr] of the design energies (default the design period).
+
+    Parameters
+    ----------
+    site : Site
+        The checked site (:func:`riskrf.app.site.load_site`); its ``model_uncertainty`` table (from
+        :func:`check_model_uncertainty`), ``hazard`` and ``mitigation`` are used.
+    evaluate_draw : callable
+        ``evaluate_draw(scenario, n_blocks, option_blocks, seed, uncertainty)`` -> (EnergyHazard, MitigationStudy,
+        SimulationResult, road share [-]); see above.
+    reference_hazard : EnergyHazard, optional
+        The assessment's own hazard, reported beside the draws.
+    design_T : float, optional
+        Design return period [yr] (default 100).
+    T : sequence of float, optional
+        Further return periods [yr] of the design energies (the design period is always included).
+    log : callable, optional
+        ``log(str)`` for progress lines (default silent).
+
+    Returns
+    -------
+    ModelUncertaintyStudy
+        Draws, design energy split [kJ], ranking over the draws [site currency/yr], calibration value, notes.
     """
     import simulation
 
