@@ -70,7 +70,30 @@ def _weights(weights, J: int) -> np.ndarray:
 
 def expected_value_of_perfect_information(costs, weights=None) -> float:
     """EVPI [currency] of the uncertain draws for a table ``costs`` (draws x options) of expected costs:
-    min_k E[C_k] - E[min_k C_k] (>= 0)."""
+    min_k E[C_k] - E[min_k C_k] (>= 0).
+
+    Parameters
+    ----------
+    costs : array_like, shape (J, K)
+        Expected cost of option k given draw j [currency]; at least one draw and one option.
+    weights : array_like, shape (J,), optional
+        Prior weights of the draws [-] (finite, >= 0, positive sum; normalised here).  None: equal weights.
+
+    Returns
+    -------
+    float
+        EVPI [currency], ``min_k sum_j pi_j C[j, k] - sum_j pi_j min_k C[j, k]``, clipped at 0.
+
+    Raises
+    ------
+    DecisionValueError
+        When ``weights`` does not fit the draws.
+
+    References
+    ----------
+    Raiffa, H. & Schlaifer, R. (1961) Applied Statistical Decision Theory. Harvard, ch. 4.  Brennan, A.,
+    Kharroubi, S., O'Hagan, A. & Chilcott, J. (2007) Medical Decision Making 27:448-470, eq. 3.
+    """
     C = np.asarray(costs, dtype=float)
     w = _weights(weights, C.shape[0])
     return max(float((w @ C).min() - w @ C.min(axis=1)), 0.0)
@@ -109,7 +132,14 @@ class CalibrationValue:
         return None if self.calibration_cost is None else bool(self.evsi > self.calibration_cost)
 
     def verdict(self) -> str:
-        """One sentence: calibrate first or decide now, with the numbers."""
+        """One sentence: calibrate first or decide now, with the numbers.
+
+        Returns
+        -------
+        str
+            "calibrate first, then decide: ..." or "decide now: ..." with the EVSI, its 2 standard errors, the EVPI
+            and the calibration cost [currency]; or the EVSI alone when no cost is stated.
+        """
         cur = f" {self.currency}" if self.currency else ""
         head = (f"EVSI of a field calibration with {self.n_releases} released blocks: {money(self.evsi, sig=3)}{cur} "
                 f"(+- {money(2 * self.standard_error, sig=2)}{cur}, 2 s.e.; EVPI of the material parameters "
@@ -125,7 +155,14 @@ class CalibrationValue:
         return f"decide now: {head} does not exceed the calibration's cost {cost}{tail}"
 
     def to_dict(self) -> dict:
-        """JSON-ready fields and the verdict."""
+        """JSON-ready fields and the verdict.
+
+        Returns
+        -------
+        dict
+            EVSI, its raw estimate and standard error, EVPI, calibration cost [currency], release and data-set counts,
+            the choices before and after calibration, ``calibrate_first``, the verdict and the notes.
+        """
         return {"evsi": self.evsi, "evsi_estimate": self.evsi_estimate, "standard_error": self.standard_error,
                 "evpi_material_parameters": self.evpi, "calibration_releases": self.n_releases,
                 "synthetic_calibrations": self.n_datasets, "best_now": self.best_now,
@@ -135,7 +172,14 @@ class CalibrationValue:
                 "calibrate_first": self.calibrate_first, "verdict": self.verdict(), "notes": list(self.notes)}
 
     def summary(self) -> pd.DataFrame:
-        """The figures as a one-column table."""
+        """The figures as a one-column table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Column ``value`` indexed by field name (the fields of :meth:`to_dict` except the notes; money in
+            [currency]).
+        """
         d = self.to_dict()
         d.pop("notes")
         d["chosen_after_calibration"] = "; ".join(f"{k} {v:.0%}" for k, v in self.after_calibration.items())
@@ -187,26 +231,64 @@ class ModelUncertainRanking(Displayed):
         return self.costs.shape[0]
 
     def expected_costs(self) -> np.ndarray:
-        """Expected total cost of each option over the draws [currency]."""
+        """Expected total cost of each option over the draws [currency].
+
+        Returns
+        -------
+        numpy.ndarray, shape (K,)
+            ``sum_j pi_j C[j, k]`` per option [currency], in the order of ``options``.
+        """
         return self.weights @ self.costs
 
     def best_now(self) -> str:
-        """The option of least expected cost with the current information."""
+        """The option of least expected cost with the current information.
+
+        Returns
+        -------
+        str
+            Name of the option with the least expected cost over the draws.
+        """
         return self.options[int(np.argmin(self.expected_costs()))]
 
     def probability_best(self) -> np.ndarray:
-        """P(option is best | trajectory model), over the draws (the study's other inputs at their expectation)."""
+        """P(option is best | trajectory model), over the draws (the study's other inputs at their expectation).
+
+        Returns
+        -------
+        numpy.ndarray, shape (K,)
+            Probability [-] that each option (order of ``options``) has the least cost, summed prior weight of the
+            draws where it does; sums to 1.
+        """
         best = np.argmin(self.costs, axis=1)
         return np.bincount(best, weights=self.weights, minlength=len(self.options))
 
     def evpi(self) -> float:
-        """EVPI of the material parameters [currency] (partial EVPI; see the module docstring)."""
+        """EVPI of the material parameters [currency] (partial EVPI; see the module docstring).
+
+        Returns
+        -------
+        float
+            EVPI [currency], from :func:`expected_value_of_perfect_information`.
+
+        References
+        ----------
+        Brennan, A., Kharroubi, S., O'Hagan, A. & Chilcott, J. (2007) Medical Decision Making 27:448-470, eq. 3.
+        """
         return expected_value_of_perfect_information(self.costs, self.weights)
 
     def summary(self) -> pd.DataFrame:
         """One row per option, least expected cost first: expected total cost, the trajectory model's 5-95 %
         range of the expected cost, P(best) given the model, and with ``sample_costs`` the joint 5-95 % range,
-        the joint P(best) and the share of the cost's variance that comes from the trajectory model."""
+        the joint P(best) and the share of the cost's variance that comes from the trajectory model.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``rank``, ``option``, ``expected_total_cost`` [currency], ``model_cost_p05``/``model_cost_p95``
+            [currency], ``probability_best_given_model`` [-]; with ``sample_costs`` also ``joint_cost_p05``/
+            ``joint_cost_p95`` [currency], ``share_of_variance_from_trajectory_model`` [-] and
+            ``probability_best_joint`` [-].
+        """
         exp = self.expected_costs()
         rows = []
         for k, name in enumerate(self.options):
@@ -232,7 +314,14 @@ class ModelUncertainRanking(Displayed):
         return df
 
     def per_draw(self) -> pd.DataFrame:
-        """One row per draw: its material values, each option's expected cost and the best option."""
+        """One row per draw: its material values, each option's expected cost and the best option.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per draw: ``draw`` (0, 1, ...), the material values (when ``draws`` is given),
+            ``cost:<option>`` [currency], ``best_option`` and ``weight`` [-].
+        """
         t = pd.DataFrame(self.costs, columns=[f"cost:{o}" for o in self.options])
         t["best_option"] = [self.options[i] for i in np.argmin(self.costs, axis=1)]
         t["weight"] = self.weights
@@ -340,7 +429,14 @@ class ModelUncertainRanking(Displayed):
                                 obs_error_m=float(obs_error_m), notes=tuple(notes))
 
     def text(self) -> list[str]:
-        """Plain-text lines: the ranking over the draws and the EVPI."""
+        """Plain-text lines: the ranking over the draws and the EVPI.
+
+        Returns
+        -------
+        list of str
+            A heading, one line per option (expected cost and 5-95 % range [currency], P(best | model), variance share)
+            and the EVPI [currency].
+        """
         cur = f" {self.currency}" if self.currency else ""
         lines = [f"Ranking over {self.n_draws} draws of the trajectory model:"]
         for _, r in self.summary().iterrows():
@@ -354,7 +450,18 @@ class ModelUncertainRanking(Displayed):
         return lines
 
     def plot(self, ax=None):
-        """Each option's expected cost under every draw (points) and over the draws (bar)."""
+        """Each option's expected cost under every draw (points) and over the draws (bar).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (default a new figure).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on (expected total cost [currency] on x, log scale when all costs are positive).
+        """
         import matplotlib.pyplot as plt
         if ax is None:
             _, ax = plt.subplots(figsize=(7, 0.45 * len(self.options) + 1.5))
