@@ -196,7 +196,20 @@ class ReachConstraint(Displayed):
     source: str = "<constraint>"
 
     def shadow_angle(self, x_stop_m, z_stop_m):
-        """Shadow angle [deg] of stops at (x, z) [m] seen from the apex (90 deg for stops above or behind it)."""
+        """Shadow angle [deg] of stops at (x, z) [m] seen from the apex (90 deg for stops above or behind it).
+
+        Parameters
+        ----------
+        x_stop_m : array_like
+            Horizontal positions of the stops along the profile [m].
+        z_stop_m : array_like
+            Elevations of the stops [m] (broadcast with ``x_stop_m``).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``degrees(arctan2(apex_z_m - z, max(x - apex_x_m, 1e-9)))`` [deg], one per stop.
+        """
         dx = np.asarray(x_stop_m, float) - self.apex_x_m
         dz = self.apex_z_m - np.asarray(z_stop_m, float)
         return np.degrees(np.arctan2(dz, np.maximum(dx, 1e-9)))
@@ -303,6 +316,28 @@ def read_releases(path, scenarios: dict, *, release_column: str = "release") -> 
     ``radius_m``, ``x_m``, ``height_m``, ``vx_ms``, ``vz_ms``, ``downslope_speed_ms``, ``shape`` -- one value
     per release (rows of a release must agree).  A column given for some releases must be given for all.
     Errors name the file, the release (and line) and the field.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The CSV file of observed stops.
+    scenarios : dict
+        Scenario name (as in the ``scenario`` column) -> scenario path, dict or :class:`Scenario`.
+    release_column : str, optional
+        Name of the column that names the release (default ``"release"``).
+
+    Returns
+    -------
+    list of Release
+        One per release name, in file order, checked by :func:`check_releases`; ``x_stop_m`` [m], ``mass_kg``
+        [kg], ``radius_m`` [m], release state in [m] and [m/s].
+
+    Raises
+    ------
+    FileNotFoundError
+        When ``path`` does not exist.
+    ValueError
+        A missing column, an unknown scenario, a non-numeric stop or a field that differs between a release's rows.
     """
     path = Path(path)
     if not path.exists():
@@ -343,7 +378,26 @@ def read_releases(path, scenarios: dict, *, release_column: str = "release") -> 
 def check_releases(releases) -> list[Release]:
     """The releases checked before any simulation: observed stops and release points inside each release's
     profile, positive finite masses and radii, and mass / radius given for all releases or none.  Errors name
-    the file, the release and the field."""
+    the file, the release and the field.
+
+    Parameters
+    ----------
+    releases : iterable of Release
+        The releases to pool (names unique).
+
+    Returns
+    -------
+    list of Release
+        The same releases, as a list, when all checks pass.
+
+    Raises
+    ------
+    ValueError
+        Empty input, repeated names, a release without observed stops or with stops [m] not finite, a mass [kg] or
+        radius [m] not finite and > 0, or a mass / radius given for only some releases.
+    TypeError
+        An item that is not a :class:`Release`.
+    """
     releases = list(releases)
     if not releases:
         raise ValueError("no releases given")
@@ -610,7 +664,34 @@ def stop_density(simulated_x_m, x_m, length_m: float, obs_error_m: float = 0.5) 
     """Predictive density [1/m] of stops at ``x_m`` given one release's simulated stops: the per-stop likelihood
     of :func:`calibrate_pooled` (Gaussian kernel of Silverman's width, at least ``obs_error_m`` [m], mixed with a
     uniform share ``DEFENSIVE_SHARE`` over the profile length ``length_m`` [m]).  Exact inference for the
-    simulator plus a Gaussian observation error of the kernel's width (Wilkinson 2013)."""
+    simulator plus a Gaussian observation error of the kernel's width (Wilkinson 2013).
+
+    Parameters
+    ----------
+    simulated_x_m : array_like
+        The release's simulated stops [m] (at least 2, finite).
+    x_m : array_like
+        Stops at which to evaluate the density [m] (any shape).
+    length_m : float
+        Length of the profile [m] over which the defensive uniform share is spread (> 0).
+    obs_error_m : float, optional
+        Least kernel width [m], the observation error of a stop (default 0.5).
+
+    Returns
+    -------
+    numpy.ndarray
+        Density [1/m], the shape of ``x_m``.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 2 finite simulated stops, or ``length_m`` not > 0.
+
+    References
+    ----------
+    Wilkinson, R.D. (2013) Stat. Appl. Genet. Mol. Biol. 12:129.  Diggle, P.J. & Gratton, R.J. (1984) JRSS B
+    46:193.
+    """
     s = np.asarray(simulated_x_m, dtype=float).ravel()
     x = np.asarray(x_m, dtype=float)
     if s.size < 2 or not np.isfinite(s).all():
@@ -624,7 +705,20 @@ def stop_density(simulated_x_m, x_m, length_m: float, obs_error_m: float = 0.5) 
 
 
 def stop_bandwidth(simulated_x_m, obs_error_m: float = 0.5) -> float:
-    """Kernel width [m] of :func:`stop_density` for one release's simulated stops."""
+    """Kernel width [m] of :func:`stop_density` for one release's simulated stops.
+
+    Parameters
+    ----------
+    simulated_x_m : array_like
+        The release's simulated stops [m].
+    obs_error_m : float, optional
+        Least kernel width [m] (default 0.5).
+
+    Returns
+    -------
+    float
+        The larger of ``obs_error_m`` and Silverman's rule for the simulated stops [m].
+    """
     return float(_bandwidths(np.asarray(simulated_x_m, dtype=float).ravel()[None, :], obs_error_m)[0])
 
 
@@ -654,7 +748,15 @@ class PooledCalibration(Displayed):
 
     def summary(self) -> pd.DataFrame:
         """One row per parameter: posterior median, mean, sd, 5/95 % and 0.5/99.5 % quantiles, prior sd (uniform
-        within the bounds) and the ratio of posterior to prior sd (near 1: the data do not constrain it)."""
+        within the bounds) and the ratio of posterior to prior sd (near 1: the data do not constrain it).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by ``parameter``; columns ``median``, ``mean``, ``sd``, ``q05``, ``q95``, ``q005``, ``q995``,
+            ``bound_low``, ``bound_high``, ``prior_sd`` (in the parameter's own unit, e.g. [-] for a restitution
+            coefficient) and ``sd_ratio`` [-].
+        """
         rows = []
         for k in self.posterior.columns:
             v = self.posterior[k].to_numpy()
@@ -668,17 +770,43 @@ class PooledCalibration(Displayed):
 
     def correlations(self) -> pd.DataFrame:
         """Pearson correlations between parameters in the posterior sample (identifiability: |r| near 1 means two
-        parameters trade off against each other and only a combination is constrained)."""
+        parameters trade off against each other and only a combination is constrained).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Square matrix of Pearson r [-], indexed and labelled by the dotted parameter names.
+        """
         return self.posterior.corr()
 
     def interval(self, parameter: str, level: float = 0.9) -> tuple[float, float]:
-        """Central posterior interval of one parameter."""
+        """Central posterior interval of one parameter.
+
+        Parameters
+        ----------
+        parameter : str
+            A dotted parameter name (a column of ``posterior``).
+        level : float, optional
+            Central probability of the interval [-] (default 0.9).
+
+        Returns
+        -------
+        (float, float)
+            Lower and upper posterior quantiles, in the parameter's own unit.
+        """
         a = (1.0 - level) / 2.0
         v = self.posterior[parameter].to_numpy()
         return float(np.quantile(v, a)), float(np.quantile(v, 1.0 - a))
 
     def coverage(self) -> pd.Series:
-        """Share of all observed stops inside their release's 90 % and 99 % posterior-predictive intervals."""
+        """Share of all observed stops inside their release's 90 % and 99 % posterior-predictive intervals.
+
+        Returns
+        -------
+        pandas.Series
+            ``inside_90``, ``inside_99`` and ``beyond_p99`` (shares [-] of all observed stops, weighted by each
+            release's number of stops) and ``observed_stops`` (count).
+        """
         t = self.coverage_table
         n = t["n_observed"].sum()
         return pd.Series({"inside_90": float((t["inside_90"] * t["n_observed"]).sum() / n),
@@ -688,7 +816,18 @@ class PooledCalibration(Displayed):
 
     def write(self, path) -> Path:
         """Write the posterior sample as CSV (a first comment line records the bounds); read it back with
-        :func:`read_posterior`."""
+        :func:`read_posterior`.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The CSV file to write (overwritten).
+
+        Returns
+        -------
+        pathlib.Path
+            ``path``.
+        """
         path = Path(path)
         with open(path, "w") as fh:
             fh.write("# simulation pooled posterior; bounds = " + json.dumps(self.bounds) + "\n")
@@ -737,7 +876,28 @@ class PooledCalibration(Displayed):
 def read_posterior(path, scenario=None) -> pd.DataFrame:
     """A posterior sample written by :meth:`PooledCalibration.write`, checked against ``scenario`` (path, dict
     or Scenario): every column must be a dotted material path naming a material the scenario defines, with
-    values inside the recorded bounds.  Errors name the file, the column (field) and the scenario."""
+    values inside the recorded bounds.  Errors name the file, the column (field) and the scenario.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A CSV written by :meth:`PooledCalibration.write`.
+    scenario : str, pathlib.Path, dict or Scenario, optional
+        Scenario whose materials the columns must name (None: not checked against a scenario).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per draw, one column per dotted parameter (values in the parameter's own unit).
+
+    Raises
+    ------
+    FileNotFoundError
+        When ``path`` does not exist.
+    ValueError
+        A file not written by :meth:`PooledCalibration.write`, a column without bounds, not numeric, outside its
+        bounds or not naming a material of ``scenario``.
+    """
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"posterior file not found: {path}")
