@@ -76,7 +76,8 @@ NUMPYDOC_MODULES = tuple(
      if str(p.relative_to(ROOT)) not in NUMPYDOC_NOT_YET and not p.name.startswith("_")]
     + [f"simulation/{m}.py" for m in NUMPYDOC_SIMULATION])
 # numpydoc sections added in the "docrest" pass (issue 22, Build item 3)
-NUMPYDOC_REST = ("riskrf/app/model_uncertainty.py", "riskrf/risk/model_decision.py", "simulation/pooled.py")
+NUMPYDOC_REST = ("riskrf/app/model_uncertainty.py", "riskrf/risk/model_decision.py", "simulation/pooled.py",
+                 "riskrf/app/assess.py")
 NUMPYDOC_MODULES = NUMPYDOC_MODULES + NUMPYDOC_REST
 
 

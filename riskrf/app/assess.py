@@ -67,6 +67,59 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
     array, None without a mass-coupled run or such a line) as a fourth element: the road share by block size.
 
     Returns (power-law fit, EnergyHazard, SimulationResult or None[, road crossings or None]).
+
+    Parameters
+    ----------
+    inventory : Inventory
+        The rock fall inventory (masses [kg], record duration [yr]).
+    m_min, m_max : float, optional
+        Lower completeness mass and upper truncation of the power law [kg] (None: estimated / untruncated).
+    rate_scale : float, optional
+        Factor [-] on the fitted rate of falls at or above m_min (default 1).
+    scenario : str, pathlib.Path or simulation.Scenario, optional
+        Slope to simulate; give exactly one of ``scenario`` and ``velocities``.
+    velocities : str or pathlib.Path, optional
+        A file of velocities at the barrier line (:func:`riskrf.io.velocities.read_velocities`).
+    collector : str, optional
+        The barrier line (see above).
+    n : int, optional
+        Simulated blocks (default 50 000).
+    seed : int, optional
+        Seed of the simulation (default 1).
+    reach_probability : float, optional
+        P(a fall reaches the line) [-] with a velocity file (default 1: every fall).
+    condition_on_mass : bool, optional
+        Use the seeder's own masses (the older form; default False).
+    mass_coupling : {"simulated", "independent"}, optional
+        How reach and speed depend on the mass (default ``"simulated"``).
+    design_masses_kg : sequence of float or callable, optional
+        Masses [kg] the simulated mass range must cover, or ``f(fit, rate [1/yr])`` returning them.
+    velocity_unit : {"m/s", "km/h"}, optional
+        Unit of the velocity file's velocity column when its header does not say.
+    drop_height_m : float, optional
+        Height drop to the line [m] for the velocity file's plausibility limit.
+    velocity_reader : dict, optional
+        Further keyword arguments of :func:`riskrf.io.velocities.read_velocities`.
+    rate_note : str, optional
+        Note on the rate replacing the one on ``rate_scale``.
+    road_collector : str, optional
+        The road line, for the road crossings per block.
+
+    Returns
+    -------
+    fit : GutenbergRichterFit
+        The power-law fit of the inventory (rate at or above m_min [1/yr]).
+    hazard : EnergyHazard
+        Annual energy hazard at the barrier line (falls [1/yr], energies [kJ]).
+    result : simulation.SimulationResult or None
+        The scenario's seeder run (None with a velocity file).
+    road_hits : numpy.ndarray of bool or None
+        Only when ``road_collector`` is given: per block of the mass-coupled run, did it cross the road line.
+
+    Raises
+    ------
+    ValueError
+        Neither or both of ``scenario`` and ``velocities``, or an unknown ``mass_coupling``.
     """
     import simulation
 
@@ -124,7 +177,22 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
 
 
 def road_share(result, barrier: str, road: str | None) -> float:
-    """P(reaches the road | reaches the barrier line) from a simulation (1 without a road collector)."""
+    """P(reaches the road | reaches the barrier line) from a simulation (1 without a road collector).
+
+    Parameters
+    ----------
+    result : simulation.SimulationResult or None
+        The seeder run of the scenario (None with a velocity file).
+    barrier : str
+        Name of the barrier line's collector.
+    road : str or None
+        Name of the road's collector (None: no road line).
+
+    Returns
+    -------
+    float
+        P(road | barrier line) [-], at most 1.
+    """
     if result is None or road is None or road not in [c.name for c in result.scenario.collectors]:
         return 1.0
     b = result.reach_probability(barrier)[0]
@@ -138,6 +206,34 @@ def study_context(result, barrier: str, road: str | None, option_blocks: int, se
     Falls below the power law's m_min: the inventory's own (their masses, and their count
     over the record scaled by ``rate_scale``), so that every size that reaches the road counts.  ``road_hits``:
     per block of the hazard's mass-coupled run, did it cross the road line (road share by block size).
+
+    Parameters
+    ----------
+    result : simulation.SimulationResult or None
+        The seeder run of the scenario (None with a velocity file: no slope model).
+    barrier : str
+        Name of the barrier line's collector.
+    road : str or None
+        Name of the road's collector (the barrier line when absent from the scenario).
+    option_blocks : int
+        Blocks per re-simulation of an option.
+    seed : int
+        Seed of the options' re-simulations.
+    inventory : Inventory or None
+        The inventory (masses [kg], duration [yr]) for the falls below m_min.
+    hazard : EnergyHazard
+        The energy hazard (its power law's ``m_min`` [kg]).
+    rate_scale : float, optional
+        Factor [-] on the small falls' count (default 1).
+    road_hits : numpy.ndarray of bool, optional
+        Road crossings per block of the mass-coupled run.
+
+    Returns
+    -------
+    dict
+        Keyword arguments of :class:`MitigationStudy`: ``context`` (SimulationContext) and ``reference``,
+        ``coupled_road_hits``, ``small_fall_masses_kg`` [kg] and ``small_falls_per_year`` [1/yr], each when
+        available.
     """
     from ..risk.measures import SimulationContext
     out = {}
@@ -159,7 +255,20 @@ def study_context(result, barrier: str, road: str | None, option_blocks: int, se
 
 def fence_checks_from_site(site) -> tuple:
     """(capacities kJ, heights m) of the fences to check: those of the site's fence and attenuator options
-    (each at its own height), else hazard.fences_kj at hazard.fence_height_m."""
+    (each at its own height), else hazard.fences_kj at hazard.fence_height_m.
+
+    Parameters
+    ----------
+    site : Site
+        The checked site.
+
+    Returns
+    -------
+    capacities : tuple of float
+        Energy capacities of the fences [kJ].
+    heights : tuple of float
+        Their heights [m].
+    """
     opts = [o for o in site.mitigation["options"] if o.kind in ("fence", "attenuator") and o.x_m is None]
     if opts:
         return tuple(o.capacity_kj for o in opts), tuple(o.height_m for o in opts)
@@ -173,7 +282,31 @@ def release_factor_for_road_record(hazard, share: float, context: dict, source: 
     """Factor from falls recorded on the road to falls released: recorded / P(road | release), with P(road |
     release) from the same engine as the ranking (reach of the barrier line by mass, road share by mass, the
     inventory's small falls), so that doing nothing reproduces the recorded road falls exactly.  The released
-    sizes are taken to follow the recorded law (an approximation: large blocks reach the road more often)."""
+    sizes are taken to follow the recorded law (an approximation: large blocks reach the road more often).
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard with the recorded rate (falls [1/yr] at or above m_min).
+    share : float
+        P(road | barrier line) [-] (:func:`road_share`).
+    context : dict
+        The slope model and small falls (:func:`study_context`).
+    source : str, optional
+        The site file, named in errors.
+    uncertainty : riskrf.risk.mitigation_inputs.Uncertainty, optional
+        The study's uncertain inputs (its material draws are switched off here).
+
+    Returns
+    -------
+    float
+        Released falls per fall recorded on the road [-].
+
+    Raises
+    ------
+    SiteError
+        When no simulated fall reaches the road.
+    """
     from ..risk.mitigation import MitigationStudy, Option
     from .site import SiteError
     kw = {} if uncertainty is None else {"uncertainty": replace(uncertainty, materials={}, calibration=None)}
@@ -194,7 +327,44 @@ def draw_evaluator(site, inventory, scenario, n_blocks: int, option_blocks: int,
     simulated on ``scenario`` with ``n_blocks`` blocks, the road-basis release factor recomputed when the record
     counts road falls, and the mitigation study with ``option_blocks`` per option re-simulation and the study's
     uncertainty ``uncertainty``.  ``rate_scale``, ``rate_note``, ``mitigation`` and ``design_masses``: as the
-    assessment used them (before its own release factor).  Returns (hazard, study, seeder run, road share)."""
+    assessment used them (before its own release factor).  Returns (hazard, study, seeder run, road share).
+
+    Parameters
+    ----------
+    site : Site
+        The checked site.
+    inventory : Inventory
+        The site's inventory (masses [kg], duration [yr]).
+    scenario : simulation.Scenario
+        The slope with the draw's material values.
+    n_blocks : int
+        Blocks of the hazard's simulation.
+    option_blocks : int
+        Blocks per option re-simulation.
+    seed : int
+        Seed of every simulation (common random numbers across draws).
+    uncertainty : riskrf.risk.mitigation_inputs.Uncertainty or None
+        The study's uncertain inputs for this draw.
+    rate_scale : float
+        Factor [-] on the fitted rate, as the assessment used it.
+    rate_note : str or None
+        Note on the rate, as the assessment used it.
+    mitigation : dict
+        The site's mitigation keyword arguments of :class:`MitigationStudy`.
+    design_masses : sequence of float or callable
+        Design masses [kg] (or a function of the fit and rate [1/yr]), as the assessment used them.
+
+    Returns
+    -------
+    hazard : EnergyHazard
+        Energy hazard at the barrier line for the draw (falls [1/yr], energies [kJ]).
+    study : MitigationStudy
+        The mitigation study for the draw (costs [site currency]).
+    result : simulation.SimulationResult
+        The seeder run of ``scenario``.
+    share : float
+        P(road | barrier line) [-].
+    """
     hz_cfg, inv_cfg = site.hazard, site.inventory
     collector, road = hz_cfg["collector"], hz_cfg["road_collector"]
     _, hz, result, hits = energy_hazard_from_inputs(
@@ -217,7 +387,20 @@ def draw_evaluator(site, inventory, scenario, n_blocks: int, option_blocks: int,
 
 def fence_design_checks(options, energy) -> dict:
     """Option name -> verdict of its fence checks in ``energy`` (an EnergyAnalysis): "adequate" or "NOT ADEQUATE:
-    <failed checks>", for the fence and attenuator options checked there; shown in the ranking itself."""
+    <failed checks>", for the fence and attenuator options checked there; shown in the ranking itself.
+
+    Parameters
+    ----------
+    options : sequence of Option
+        The mitigation options.
+    energy : EnergyAnalysis
+        The energy study with its fence checks (keyed ``"<capacity> kJ / <height> m"``).
+
+    Returns
+    -------
+    dict
+        Option name -> ``"adequate"`` or ``"NOT ADEQUATE: <failed checks>"``.
+    """
     out = {}
     for o in options:
         if o.kind not in ("fence", "attenuator") or o.capacity_kj is None or o.height_m is None:
@@ -235,7 +418,22 @@ def sensitivity_inputs(site, rate_scale: float | None = None) -> tuple:
 
     m_max: the site's uncertainty.m_max_kg range, else x0.5 and x2 of inventory.m_max_kg (only the stated value,
     None, when the law is not truncated); rate share: inventory.rate_scale x uncertainty.rate_factor, else x0.5
-    and x2.  ``rate_scale`` replaces inventory.rate_scale (a rate from the site's rate model)."""
+    and x2.  ``rate_scale`` replaces inventory.rate_scale (a rate from the site's rate model).
+
+    Parameters
+    ----------
+    site : Site
+        The checked site (``inventory`` and ``mitigation["uncertainty"]`` are read).
+    rate_scale : float, optional
+        Replaces inventory.rate_scale [-].
+
+    Returns
+    -------
+    m_values : list of float or [None]
+        Upper truncation masses [kg], sorted.
+    shares : list of float
+        Rate shares [-], sorted.
+    """
     m_max = site.inventory["m_max_kg"]
     unc = site.mitigation.get("uncertainty")
     if m_max is None:
@@ -308,7 +506,14 @@ class Assessment:
         return text + "; rate_basis = 'release': the record counts falls released from the slope"
 
     def summary(self) -> dict:
-        """Every headline number, machine-readable, with units."""
+        """Every headline number, machine-readable, with units.
+
+        Returns
+        -------
+        dict
+            JSON-ready headline numbers (``summary.json``); the units are listed under ``units``: mass [kg], volume
+            [m3], energy [kJ], height [m], velocity [m/s], rate [1/yr], return period [yr] and money [site currency].
+        """
         fr, gr = self.frequency, self.frequency.power_law
         hz = self.energy.hazard
         ranking = self.decision["ranking"]
@@ -384,6 +589,25 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
     ``figures_dir``: a directory (created here, must not exist) that ``write_assessment`` will use as
     ``OUT/figures``; the figures and tables of each stage are then drawn there beside the later stages (on the
     second core, where forking is safe) instead of all at the end.  The outputs are the same either way.
+
+    Parameters
+    ----------
+    site : Site
+        The validated site (:func:`riskrf.app.site.load_site`).
+    seed : int, optional
+        Seed of the simulations (default the site's ``hazard.seed``).
+    n_blocks : int, optional
+        Simulated blocks (default the site's ``hazard.n_blocks``).
+    log : callable, optional
+        ``log(str)`` for stage messages (default the ``riskrf`` logger at INFO).
+    figures_dir : str or pathlib.Path, optional
+        Directory for figures drawn beside the computation (see above).
+
+    Returns
+    -------
+    Assessment
+        Every stage's result: frequency fit, simulation, energy study (energies [kJ]), mitigation study and
+        decision (costs [site currency]), warnings and timings [s].
     """
     log = log or logger.info
     figures = None if figures_dir is None else Path(figures_dir)
@@ -913,7 +1137,22 @@ def _assessment_notes(frequency, caught: list, site_rates, inventory) -> list:
 
 
 def write_assessment(a: Assessment, out: Path, log=None) -> dict:
-    """Write every output of an assessment into ``out`` (an empty directory); returns the summary."""
+    """Write every output of an assessment into ``out`` (an empty directory); returns the summary.
+
+    Parameters
+    ----------
+    a : Assessment
+        The result of :func:`run_assessment`.
+    out : pathlib.Path
+        An empty, existing output directory.
+    log : callable, optional
+        ``log(str)`` for stage messages (default the ``riskrf`` logger at INFO).
+
+    Returns
+    -------
+    dict
+        :meth:`Assessment.summary` with paths relative to the site file's folder.
+    """
     log = log or logger.info
     from ..report.html import render_report
     from ..report.mitigation_text import write_mitigation_outputs, write_tree_figure
@@ -988,7 +1227,18 @@ def _frequency_outputs(frequency, maxima_frequency, figs: Path) -> None:
 
 def fences_to_draw(site) -> list:
     """(x [m] or None for the barrier line, height [m], label) of the site's fence and attenuator options, else
-    of the candidate fences of ``hazard.fences_kj``: what the profile figure draws at its height."""
+    of the candidate fences of ``hazard.fences_kj``: what the profile figure draws at its height.
+
+    Parameters
+    ----------
+    site : Site
+        The checked site.
+
+    Returns
+    -------
+    list of tuple
+        ``(x [m] or None, height [m], label)`` per fence.
+    """
     opts = [o for o in site.mitigation["options"] if o.kind in ("fence", "attenuator")]
     if opts:
         return [(o.x_m, o.height_m, f"{o.name} ({o.height_m:g} m high)" if f"{o.capacity_kj:g}" in o.name
