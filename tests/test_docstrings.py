@@ -77,7 +77,7 @@ NUMPYDOC_MODULES = tuple(
     + [f"simulation/{m}.py" for m in NUMPYDOC_SIMULATION])
 # numpydoc sections added in the "docrest" pass (issue 22, Build item 3)
 NUMPYDOC_REST = ("riskrf/app/model_uncertainty.py", "riskrf/risk/model_decision.py", "simulation/pooled.py",
-                 "riskrf/app/assess.py")
+                 "riskrf/app/assess.py", "riskrf/risk/mitigation.py")
 NUMPYDOC_MODULES = NUMPYDOC_MODULES + NUMPYDOC_REST
 
 

@@ -163,7 +163,23 @@ class MitigationStudy(Displayed):
         return self.consequences.currency
 
     def option(self, name: str) -> Option:
-        """The option named ``name``; a MitigationError listing the options when there is none."""
+        """The option named ``name``; a MitigationError listing the options when there is none.
+
+        Parameters
+        ----------
+        name : str
+            Name of an option of the study.
+
+        Returns
+        -------
+        Option
+            The option of that name.
+
+        Raises
+        ------
+        MitigationError
+            When no option has that name (the message lists the options).
+        """
         opt = next((o for o in self.options if o.name == name), None)
         if opt is None:
             raise MitigationError(f"no option named {name!r}; options are {[o.name for o in self.options]}")
@@ -212,11 +228,25 @@ class MitigationStudy(Displayed):
         return self._slopes.derived
 
     def material_models(self) -> pd.DataFrame:
-        """The slope models used: material values, reach probability and road share of each."""
+        """The slope models used: material values, reach probability and road share of each.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per slope model (the reference, the joint material draws, the low and high variants): its material
+            values, reach probability at the barrier line [-] and road share [-].
+        """
         return self._slopes.table()
 
     def road_share_by_mass(self) -> pd.DataFrame:
-        """P(reaches the road | reaches the barrier line) used for each mass bin [kg] of the reference model."""
+        """P(reaches the road | reaches the barrier line) used for each mass bin [kg] of the reference model.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``mass_kg`` (representative mass of the bin [kg]) and ``road_share`` (P(road | barrier line) [-],
+            at most 1).
+        """
         mid = self._grid.mid
         return pd.DataFrame({"mass_kg": mid, "road_share": np.minimum(self.road_share * self._slopes.road_profile,
                                                                       1.0)})
@@ -256,7 +286,16 @@ class MitigationStudy(Displayed):
 
     # ---- parameters -------------------------------------------------------------------------------
     def central_parameters(self) -> dict:
-        """Every input the engine varies, at its central value (names used by tornado and break-even)."""
+        """Every input the engine varies, at its central value (names used by tornado and break-even).
+
+        Returns
+        -------
+        dict
+            Parameter name -> central value, in the parameter's own unit: ``rate_factor`` [-],
+            ``value_of_statistical_life`` [study currency], ``vulnerability_factor`` [-], ``vehicles_per_day``
+            [1/day], ``discount_rate`` [1/yr], ``b`` [-], ``m_max_kg`` [kg], the options' parameters, the derived
+            retentions ``retention:<key>`` [-] and ``material_draw`` (index of the slope model, 0 the reference).
+        """
         self._effects
         hz, ex, co, ec = self.hazard, self.exposure, self.consequences, self.economics
         p = {"rate_factor": 1.0, "value_of_statistical_life": co.value_of_statistical_life,
@@ -278,7 +317,15 @@ class MitigationStudy(Displayed):
         return p
 
     def parameter_ranges(self) -> dict:
-        """name -> (low, high, how): the range each uncertain input is sampled over (and the tornado uses)."""
+        """name -> (low, high, how): the range each uncertain input is sampled over (and the tornado uses).
+
+        Returns
+        -------
+        dict
+            Parameter name (as in :meth:`central_parameters`, plus ``material:<path>`` for the uncertain material
+            parameters) -> ``(low, high, how)``: the 5 % and 95 % points or the stated bounds, in the parameter's own
+            unit, and the sampling law and its basis in words.
+        """
         from scipy import stats
         u = self.uncertainty
         c = self.central_parameters()
@@ -320,7 +367,21 @@ class MitigationStudy(Displayed):
         return out
 
     def sample_parameters(self, n: int | None = None, seed=None) -> dict:
-        """Joint samples of every uncertain input (arrays of length n), the rest at central values."""
+        """Joint samples of every uncertain input (arrays of length n), the rest at central values.
+
+        Parameters
+        ----------
+        n : int, optional
+            Number of joint samples (default ``uncertainty.samples``).
+        seed : int, optional
+            Seed of the sampling (default ``uncertainty.seed``).
+
+        Returns
+        -------
+        dict
+            Parameter name -> numpy.ndarray of length ``n`` (units as in :meth:`central_parameters`);
+            ``material_draw`` holds the index of the slope model used by each sample.
+        """
         from scipy import stats
         u = self.uncertainty
         n = int(u.samples if n is None else n)
@@ -372,7 +433,29 @@ class MitigationStudy(Displayed):
         return self._central(per_bin=True)
 
     def evaluate(self, option: Option | str) -> OptionResult:
-        """Central-value results of one option."""
+        """Central-value results of one option.
+
+        Parameters
+        ----------
+        option : Option or str
+            The option, or its name.
+
+        Returns
+        -------
+        OptionResult
+            Rates [1/yr] (road falls, repairs, replacements, vehicle hits, rock strikes, deaths), expected annual
+            loss [study currency/yr], individual risk [1/yr], retention and effectiveness [-].
+
+        Raises
+        ------
+        MitigationError
+            When the study has no such option.
+
+        References
+        ----------
+        Bunce, C.M., Cruden, D.M. & Morgenstern, N.R. (1997) Assessment of the hazard from rock fall on a highway.
+        Can. Geotech. J. 34:344-356 (a moving vehicle at the impact point).
+        """
         opt = self.option(option if isinstance(option, str) else option.name)
         r = self._central_result
         k = r.names.index(opt.name)
@@ -385,7 +468,22 @@ class MitigationStudy(Displayed):
     # ---- uncertainty ----------------------------------------------------------------------------
     @cached_property
     def uncertain(self) -> dict:
-        """Joint samples: total cost per sample and option (S, K) and the derived statistics per option."""
+        """Joint samples: total cost per sample and option (S, K) and the derived statistics per option.
+
+        Returns
+        -------
+        dict
+            ``names`` (options), ``total`` (S, K) total cost per joint sample and option [study currency, present
+            value], per option ``mean``, ``p05`` and ``p95`` [study currency], ``probability_best``,
+            ``expected_regret`` [study currency], ``probability_meets_individual_risk`` and
+            ``probability_meets_criteria`` [-]; ``evpi`` of all sampled inputs [study currency] and ``samples`` (S).
+
+        References
+        ----------
+        Wyllie, D.C. (2014) Rock Fall Engineering. CRC Press, sec. 8.5.5.  Wyllie, D.C., McCammon, N.R. &
+        Brumund, W.F. (1980) Planning slope stabilization programs by using decision analysis. Transportation
+        Research Record 749:34-39.
+        """
         P = self.sample_parameters()
         r = self._evaluate(P, per_bin=True)
         total = r.total
@@ -422,7 +520,23 @@ class MitigationStudy(Displayed):
     # ---- societal risk -------------------------------------------------------------------------
     def fn_curve(self, option: str) -> pd.DataFrame:
         """F-N curve of an option: direct hits and strikes on fallen rocks, every block size, occupants as a
-        distribution, N = 1 ... largest occupancy."""
+        distribution, N = 1 ... largest occupancy.
+
+        Parameters
+        ----------
+        option : str
+            Name of an option of the study.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``N`` (number of deaths, 1 ... largest occupancy) and ``F`` (frequency of N or more deaths [1/yr]).
+
+        References
+        ----------
+        Bunce, C.M., Cruden, D.M. & Morgenstern, N.R. (1997) Assessment of the hazard from rock fall on a highway.
+        Can. Geotech. J. 34:344-356.
+        """
         opt = self.option(option)
         r = self._central_result
         k = r.names.index(opt.name)
@@ -435,7 +549,27 @@ class MitigationStudy(Displayed):
     # ---- ranking ---------------------------------------------------------------------------
     def ranking(self) -> pd.DataFrame:
         """Options ranked by expected total cost (mean over the joint samples), with the central-value
-        breakdown, 5-95 % of the total, probability of being cheapest, expected regret and road-user risk."""
+        breakdown, 5-95 % of the total, probability of being cheapest, expected regret and road-user risk.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per option, cheapest expected total cost first: ``rank``, ``option``, ``kind``, the central-value
+            breakdown ``capital``, ``pv_renewals``, ``pv_maintenance``, ``pv_expected_loss`` and
+            ``cost_at_central_values`` [study currency], ``expected_total_cost``, ``cost_p05``, ``cost_p95`` and
+            ``expected_regret`` [study currency], ``probability_best`` [-], ``road_falls_per_year``,
+            ``repairs_per_year``, ``replacements_per_year``, ``deaths_per_year`` and ``individual_risk`` [1/yr],
+            ``retention`` and ``effectiveness`` [-], the tolerability columns (``meets_criteria``, ``fn_zone``,
+            ``F_N1_per_year`` [1/yr], ``fn_ratio_to_limit`` [-], ``alarp``), the cost-effectiveness columns
+            (``benefit_cost_ratio`` [-], ``cost_per_life_saved`` [study currency], ``deaths_avoided_per_million``) and
+            ``effect_basis`` / ``design_check``.
+
+        References
+        ----------
+        Wyllie, D.C. (2014) Rock Fall Engineering. CRC Press, sec. 8.5.5.  Wyllie, D.C., McCammon, N.R. &
+        Brumund, W.F. (1980) Planning slope stabilization programs by using decision analysis. Transportation
+        Research Record 749:34-39.
+        """
         r = self._central_result
         u = self.uncertain
         rows = []
@@ -545,7 +679,19 @@ class MitigationStudy(Displayed):
         sd / sqrt(S), and the standard error of P(best) of the cheapest, sqrt(p (1 - p) / S).  They are
         "distinguishable" when the mean difference exceeds twice its standard error and P(best) is known within
         +-0.03 (two standard errors).  The slope re-simulations (``material_draws``) add an error these samples do
-        not show; more draws and samples (``[uncertainty]``) narrow both."""
+        not show; more draws and samples (``[uncertainty]``) narrow both.
+
+        Parameters
+        ----------
+        ranking : pandas.DataFrame, optional
+            A table from :meth:`ranking` (computed when None).
+
+        Returns
+        -------
+        dict
+            ``first`` and ``second`` (option names), ``difference`` and ``difference_se`` [study currency],
+            ``probability_best`` and ``probability_best_se`` [-], ``distinguishable`` (bool) and ``text``.
+        """
         t = self.ranking() if ranking is None else ranking
         u = self.uncertain
         names = u["names"]
@@ -568,12 +714,30 @@ class MitigationStudy(Displayed):
                 "probability_best": p, "probability_best_se": se_p, "distinguishable": ok, "text": text + "."}
 
     def best(self) -> str:
-        """Name of the first option of :meth:`ranking` (the lowest expected total cost over the joint samples)."""
+        """Name of the first option of :meth:`ranking` (the lowest expected total cost over the joint samples).
+
+        Returns
+        -------
+        str
+            Name of the option ranked first.
+        """
         return self.ranking()["option"].iloc[0]
 
     def recommendation(self, ranking: pd.DataFrame | None = None) -> dict:
         """The cheapest option meeting the tolerability criteria, else the one reducing risk most per unit cost,
-        with the reasoning in plain words."""
+        with the reasoning in plain words.
+
+        Parameters
+        ----------
+        ranking : pandas.DataFrame, optional
+            A table from :meth:`ranking` (computed when None).
+
+        Returns
+        -------
+        dict
+            ``option`` (name), ``basis`` (the rule that chose it), ``reason`` (plain words), ``resolution``
+            (:meth:`resolution`), ``expected_total_cost`` [study currency] and ``probability_best`` [-].
+        """
         t = self.ranking() if ranking is None else ranking
         cur = self.currency
         lim = self.criteria.individual_risk_per_year
@@ -645,7 +809,13 @@ class MitigationStudy(Displayed):
 
     # ---- sensitivity ---------------------------------------------------------------------------
     def sensitivity_parameters(self) -> list:
-        """Every input that can change the order: all engine parameters with an effect."""
+        """Every input that can change the order: all engine parameters with an effect.
+
+        Returns
+        -------
+        list of str
+            The names of :meth:`central_parameters`.
+        """
         return list(self.central_parameters())
 
     def _tornado_range(self, name, value):
@@ -664,7 +834,15 @@ class MitigationStudy(Displayed):
         """Lowest expected total cost (central values) as each input moves over its stated range (or x0.5/x2),
         with the best option at each end, whether the best or the whole order changes; inputs that change the
         best first, then those that change the order, each by swing.  Material parameters are re-simulated at
-        both ends of their ranges."""
+        both ends of their ranges.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per input: ``parameter``, ``low``, ``high`` (its own unit), ``range`` (basis in words),
+            ``changes_order``, ``cost_at_low``, ``cost_at_high`` and ``base`` (lowest total cost [study currency]),
+            ``best_at_low``, ``best_at_high``, ``changes_best`` and ``swing`` [study currency].
+        """
         c = self.central_parameters()
         base_r = self._central_result
         base = float(base_r.total[0].min())
@@ -713,7 +891,26 @@ class MitigationStudy(Displayed):
 
     def break_even(self, parameter: str, *, option_a: str | None = None, option_b: str | None = None):
         """Value of ``parameter`` (others central) at which options a and b (default: the two cheapest at
-        central values) cost the same; None if they do not tie within the searched range."""
+        central values) cost the same; None if they do not tie within the searched range.
+
+        Parameters
+        ----------
+        parameter : str
+            A name of :meth:`central_parameters`.
+        option_a, option_b : str, optional
+            The two options to tie (default the cheapest and second-cheapest at central values).
+
+        Returns
+        -------
+        (float, float) or None
+            ``(factor, value)``: the tie value in the parameter's own unit and its ratio to the central value [-] (NaN
+            when the central value is 0); None when the options do not tie within the searched range.
+
+        Raises
+        ------
+        MitigationError
+            When ``parameter`` is not a parameter of the study.
+        """
         r = self._central_result
         names = r.names
         order = np.argsort(r.total[0], kind="stable")
@@ -745,7 +942,14 @@ class MitigationStudy(Displayed):
 
     def break_even_table(self) -> pd.DataFrame:
         """For every input: the value at which the second-cheapest option would tie with the cheapest, and
-        whether that value lies inside the stated range."""
+        whether that value lies inside the stated range.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per input: ``parameter``, ``current``, ``break_even``, ``range_low``, ``range_high`` (its own
+            unit), ``factor`` [-], ``within_stated_range`` and ``note``.
+        """
         r = self._central_result
         order = np.argsort(r.total[0], kind="stable")
         a, b = r.names[order[0]], r.names[order[1]]
@@ -799,7 +1003,31 @@ class MitigationStudy(Displayed):
 
     def value_of_information(self, factors=(0.5, 1.0, 2.0), weights=(0.25, 0.5, 0.25)) -> dict:
         """Expected value of perfect information about the rate of falls (``factors`` x the estimate with
-        ``weights``), and about every sampled input at once (from the joint samples)."""
+        ``weights``), and about every sampled input at once (from the joint samples).
+
+        Parameters
+        ----------
+        factors : sequence of float, optional
+            Multiples [-] of the estimated rate of falls (each > 0; default 0.5, 1, 2).
+        weights : sequence of float, optional
+            Their probabilities [-] (as many, >= 0, summing to 1; default 0.25, 0.5, 0.25).
+
+        Returns
+        -------
+        dict
+            ``evpi``, ``expected_cost_now`` and ``expected_cost_informed`` [study currency], ``best_now``,
+            ``best_by_rate`` (factor -> best option), ``factors``, ``weights`` and ``evpi_all_sampled_inputs``
+            [study currency].
+
+        Raises
+        ------
+        MitigationError
+            When ``factors`` and ``weights`` do not fit.
+
+        References
+        ----------
+        Raiffa, H. & Schlaifer, R. (1961) Applied Statistical Decision Theory. Harvard, ch. 4.
+        """
         f = np.asarray(factors, dtype=float)
         w = np.asarray(weights, dtype=float)
         if f.shape != w.shape or np.any(f <= 0) or np.any(w < 0) or abs(w.sum() - 1) > 1e-9:
@@ -826,6 +1054,19 @@ class MitigationStudy(Displayed):
         branch costs are that outcome's mean cost (over the sizes reaching the road) times
         the discounted expected number of such falls, so the rollback equals the central
         cost of the ranking.
+
+        Returns
+        -------
+        DecisionTree
+            A decision node with one branch per option (its capital and present-value renewals and maintenance
+            [study currency]) and under each a chance node of the outcomes of one fall reaching the road (costs in
+            present value [study currency]).
+
+        References
+        ----------
+        Wyllie, D.C. (2014) Rock Fall Engineering. CRC Press, sec. 8.5.5.  Wyllie, D.C., McCammon, N.R. &
+        Brumund, W.F. (1980) Planning slope stabilization programs by using decision analysis. Transportation
+        Research Record 749:34-39.
         """
         from .decision_tree import DecisionTree
         r = self._central_result
@@ -859,7 +1100,14 @@ class MitigationStudy(Displayed):
                                       source=self.source)
 
     def options_table(self) -> pd.DataFrame:
-        """What each option is and assumes, and its effect as used."""
+        """What each option is and assumes, and its effect as used.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per option: ``option``, ``kind``, ``what it is and assumes``, ``retention`` and
+            ``effectiveness`` [-] and ``effect_basis``.
+        """
         r = self._central_result
         rows = []
         for k, o in enumerate(self.options):
@@ -911,7 +1159,23 @@ class MitigationStudy(Displayed):
 
 def study_inputs(data: dict, source: str, *, require_options: bool = True) -> dict:
     """Keyword arguments of :class:`MitigationStudy` from a parsed mitigation (or site) table
-    (``require_options=False``: none needed, :func:`parse_mitigation`)."""
+    (``require_options=False``: none needed, :func:`parse_mitigation`).
+
+    Parameters
+    ----------
+    data : dict
+        The parsed TOML tables of the mitigation (or site) file.
+    source : str
+        The file, named in errors.
+    require_options : bool, optional
+        Whether ``[[option]]`` entries are required (default True).
+
+    Returns
+    -------
+    dict
+        ``options``, ``exposure``, ``consequences``, ``economics``, ``defaults_used``, ``uncertainty`` and
+        ``criteria``.
+    """
     options, exposure, consequences, economics, used, uncertainty, criteria = parse_mitigation(
         data, source, require_options=require_options)
     return {"options": options, "exposure": exposure, "consequences": consequences, "economics": economics,
@@ -921,7 +1185,29 @@ def study_inputs(data: dict, source: str, *, require_options: bool = True) -> di
 def check_mitigation_file(path):
     """Read and check a mitigation TOML file (a site file works too) before any work: every table and option
     against its declaration and rules, and a closure rule's [rates] table.  Returns (study inputs, the parsed
-    TOML, the checked [rates] or None when no closure rule needs it)."""
+    TOML, the checked [rates] or None when no closure rule needs it).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The mitigation or site TOML file.
+
+    Returns
+    -------
+    inputs : dict
+        Keyword arguments of :class:`MitigationStudy` (:func:`study_inputs`).
+    raw : dict
+        The parsed TOML.
+    rates : dict or None
+        The checked ``[rates]`` table, or None.
+
+    Raises
+    ------
+    FileNotFoundError
+        When ``path`` does not exist.
+    MitigationError
+        Invalid TOML, or a table, option or ``[rates]`` entry that does not fit its declaration.
+    """
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"mitigation file not found: {path}")
@@ -948,6 +1234,22 @@ def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0, **kw
 
     Keyword arguments (``context``, ``reference``, ``small_fall_masses_kg``, ``small_falls_per_year``)
     pass to :class:`MitigationStudy`.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The mitigation or site TOML file.
+    hazard : EnergyHazard
+        Annual energy hazard at the barrier line (falls [1/yr], energies [kJ]).
+    road_share : float, optional
+        P(reaches the road | reaches the barrier line) [-] (default 1).
+    **kw
+        Further keyword arguments of :class:`MitigationStudy` (see above).
+
+    Returns
+    -------
+    MitigationStudy
+        The study (lazy: only its inputs are checked here).
     """
     path = Path(path)
     inputs, raw, rates = check_mitigation_file(path)
