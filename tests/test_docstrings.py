@@ -70,7 +70,7 @@ if __name__ == "__main__":
 NUMPYDOC_PACKAGES = ("riskrf/core", "riskrf/io", "riskrf/frequency", "riskrf/hazard", "riskrf/report")
 NUMPYDOC_SIMULATION = ("engine", "result", "slope", "scenario", "units", "impact", "calibration",
                        "profile_extraction", "terrain")
-NUMPYDOC_NOT_YET = ("riskrf/hazard/catchment.py",)
+NUMPYDOC_NOT_YET = ()
 NUMPYDOC_MODULES = tuple(
     [str(p.relative_to(ROOT)) for pkg in NUMPYDOC_PACKAGES for p in sorted((ROOT / pkg).glob("*.py"))
      if str(p.relative_to(ROOT)) not in NUMPYDOC_NOT_YET and not p.name.startswith("_")]
