@@ -77,7 +77,8 @@ NUMPYDOC_MODULES = tuple(
     + [f"simulation/{m}.py" for m in NUMPYDOC_SIMULATION])
 #: App, CLI and further simulator modules brought to numpydoc form (issue 22, item 3).
 NUMPYDOC_APP_SIM = ("simulation/contact.py", "simulation/engine3d.py", "riskrf/app/corridor.py", "riskrf/cli.py",
-                    "simulation/scenario3d.py", "simulation/sources.py", "simulation/materials.py")
+                    "simulation/scenario3d.py", "simulation/sources.py", "simulation/materials.py",
+                    "simulation/plotting.py")
 NUMPYDOC_MODULES += NUMPYDOC_APP_SIM
 # numpydoc sections added in the "docrest" pass (issue 22, Build item 3)
 NUMPYDOC_REST = ("riskrf/app/model_uncertainty.py", "riskrf/risk/model_decision.py", "simulation/pooled.py",
