@@ -81,7 +81,7 @@ NUMPYDOC_APP_SIM = ("simulation/contact.py", "simulation/engine3d.py", "riskrf/a
                     "simulation/plotting.py", "simulation/material_uncertainty.py", "simulation/precompile.py",
                     "simulation/kernel.py", "simulation/kernel3d.py", "riskrf/app/background.py",
                     "riskrf/app/hazard_map.py", "riskrf/app/preflight.py", "riskrf/app/site.py",
-                    "riskrf/app/site_design.py", "riskrf/app/assess3d.py")
+                    "riskrf/app/site_design.py", "riskrf/app/assess3d.py", "riskrf/app/__init__.py")
 NUMPYDOC_MODULES += NUMPYDOC_APP_SIM
 # numpydoc sections added in the "docrest" pass (issue 22, Build item 3)
 NUMPYDOC_REST = ("riskrf/app/model_uncertainty.py", "riskrf/risk/model_decision.py", "simulation/pooled.py",
