@@ -232,7 +232,7 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
         Directory against which relative file paths (the DEM) are resolved.
     terrain : Terrain, optional
         The DEM, given directly.
-    crs : str or pyproj.CRS, optional
+    crs : str or rasterio.crs.CRS, optional
         The DEM's coordinate reference system when the file has none.
 
     Returns
@@ -503,7 +503,7 @@ def load_terrain_scenario(path, crs=None) -> TerrainScenario:
     ----------
     path : str or pathlib.Path
         Scenario TOML file.
-    crs : str or pyproj.CRS, optional
+    crs : str or rasterio.crs.CRS, optional
         The DEM's coordinate reference system when the file has none.
 
     Returns

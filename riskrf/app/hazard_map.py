@@ -59,7 +59,7 @@ class HazardMap:
         Returns
         -------
         pandas.DataFrame
-            One row per raster (and runout quantile) with its unit.
+            Columns ``layer``, ``unit``, ``pixels_with_value`` and ``max``, one row per raster.
         """
         rows = []
         for name, unit in RASTERS.items():
