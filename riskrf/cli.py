@@ -95,7 +95,18 @@ def _read(args, path):
 
 
 def cmd_fit(args) -> int:
-    """``riskrf fit``: read an inventory, fit the power law (and Gumbel/GEV when dated), print and write the results."""
+    """``riskrf fit``: read an inventory, fit the power law (and Gumbel/GEV when dated), print and write the results.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
+    """
     from .frequency.study import analyse_inventory
     from .io.outputs import atomic_output_dir
 
@@ -150,7 +161,17 @@ class _BootstrapBar:
 
 
 def write_table(df, path: Path, suffix: str | None = None) -> None:
-    """Write a DataFrame as Parquet or CSV by the file suffix, atomically (temporary name, then rename)."""
+    """Write a DataFrame as Parquet or CSV by the file suffix, atomically (temporary name, then rename).
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        The table.
+    path : pathlib.Path
+        Output file (``.parquet`` or ``.csv``).
+    suffix : str, optional
+        Format to use instead of the file's suffix.
+    """
     import os
     import tempfile
     suffix = (suffix or path.suffix).lower()
@@ -171,7 +192,18 @@ def write_table(df, path: Path, suffix: str | None = None) -> None:
 
 
 def cmd_simulate(args) -> int:
-    """``riskrf simulate``: run a scenario, print its summary, write the crossings table and figures."""
+    """``riskrf simulate``: run a scenario, print its summary, write the crossings table and figures.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
+    """
     import pandas as pd
 
     import simulation
@@ -228,7 +260,24 @@ def _drop_height(args):
 
 
 def build_energy_hazard(args, inventory):
-    """Power-law fit of the inventory combined with a simulation or a velocity file (energy and decide)."""
+    """Power-law fit of the inventory combined with a simulation or a velocity file (energy and decide).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``energy`` or ``decide``.
+    inventory : Inventory
+        The fall inventory.
+
+    Returns
+    -------
+    fit : GutenbergRichterFit
+        The power-law fit of the inventory.
+    hazard : EnergyHazard
+        The impact-energy hazard at the barrier line.
+    result : SimulationResult or None
+        The simulation behind it (None with a velocity file).
+    """
     from .app.assess import energy_hazard_from_inputs
     return energy_hazard_from_inputs(
         inventory, m_min=args.m_min, m_max=args.m_max, rate_scale=args.rate_scale, scenario=args.scenario,
@@ -269,7 +318,18 @@ def _energy_design_masses(args, inventory):
 
 
 def cmd_energy(args) -> int:
-    """``riskrf energy``: impact-energy hazard at a barrier line, design energies and fence checks."""
+    """``riskrf energy``: impact-energy hazard at a barrier line, design energies and fence checks.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
+    """
     from .hazard.energy_study import analyse_energy
     from .io.outputs import atomic_output_dir
 
@@ -323,7 +383,18 @@ def cmd_energy(args) -> int:
 
 
 def cmd_decide(args) -> int:
-    """``riskrf decide``: rank mitigation options (site file) or roll back a decision tree file."""
+    """``riskrf decide``: rank mitigation options (site file) or roll back a decision tree file.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
+    """
     from .risk.decision_tree import DecisionTree
     from .risk.mitigation import load_mitigation
     from .io.outputs import atomic_output_dir, write_json
@@ -454,7 +525,18 @@ def _add_energy_arguments(p):
 
 
 def cmd_assess(args) -> int:
-    """``riskrf assess``: the whole chain for a site file, written atomically to ``--out``."""
+    """``riskrf assess``: the whole chain for a site file, written atomically to ``--out``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
+    """
     from .app.assess import run_assessment, write_assessment
     from .io.outputs import atomic_output_dir
     from .app.site import load_site
@@ -510,7 +592,18 @@ def _assess_terrain(site, args, out) -> int:
 
 
 def cmd_demo(args) -> int:
-    """``riskrf demo``: ``assess`` on the bundled demo site."""
+    """``riskrf demo``: ``assess`` on the bundled demo site.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
+    """
     from importlib import resources
 
     with resources.as_file(resources.files("riskrf") / "data" / "demo_site.toml") as site:
@@ -523,7 +616,18 @@ def cmd_demo(args) -> int:
 
 
 def cmd_calibrate(args) -> int:
-    """``riskrf calibrate``: fit scenario material parameters to observed stop points."""
+    """``riskrf calibrate``: fit scenario material parameters to observed stop points.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
+    """
     import simulation
     from simulation.calibration import read_observed
 
@@ -595,6 +699,16 @@ def cmd_calibrate(args) -> int:
 def cmd_corridor(args) -> int:
     """``riskrf corridor FILE``: read and check the corridor (sections table, mass law, study inputs), run every
     section and write the tables, figures and report to ``--out``.  Returns the exit code (0 on success).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
     from .app.corridor import load_corridor, run_corridor, write_corridor
     from .app.preflight import check_number, check_out
@@ -659,7 +773,18 @@ def cmd_corridor(args) -> int:
 
 def cmd_hazard_map(args) -> int:
     """``riskrf hazard-map``: run a 3-D ``[terrain]`` scenario and write hazard GeoTIFFs on the DEM's grid, stop
-    points and trajectories (GeoPackage) and a hillshade figure."""
+    points and trajectories (GeoPackage) and a hillshade figure.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
+    """
     from .app.hazard_map import hazard_map
     from .io.outputs import check_output
     out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-hazard-map")
@@ -677,7 +802,18 @@ def cmd_hazard_map(args) -> int:
 
 def cmd_profile(args) -> int:
     """``riskrf profile``: cut a 2-D slope profile from a DEM raster along a plan polyline and write it as the
-    ``[profile]`` table of a scenario (TOML)."""
+    ``[profile]`` table of a scenario (TOML).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
+    """
     import simulation
 
     from .io.outputs import atomic_outputs, check_output
@@ -1071,7 +1207,13 @@ def _add_profile_parser(sub) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The ``riskrf`` argument parser with one sub-command per task."""
+    """The ``riskrf`` argument parser with one sub-command per task.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser.
+    """
     parser = argparse.ArgumentParser(
         prog="riskrf", description="Rock fall hazard, risk and mitigation decisions (after Wyllie 2014, "
         "Rock Fall Engineering, chapters 3-8).  Start with 'riskrf demo' (the whole chain on a bundled site, "
@@ -1105,6 +1247,16 @@ def build_parser() -> argparse.ArgumentParser:
 def cmd_rates(args) -> int:
     """``riskrf rates``: fit the rate model of falls (Poisson and negative binomial regressions on rainfall
     over ``--windows`` days, season and trend) and write its tables and figures.  Returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
     from .io.outputs import atomic_output_dir
     from .frequency.rates import rate_model
@@ -1172,7 +1324,18 @@ def _readable_numbers():
 
 
 def main(argv=None) -> int:
-    """Entry point of the ``riskrf`` command; returns the exit status (0 ok, 2 bad input)."""
+    """Entry point of the ``riskrf`` command; returns the exit status (0 ok, 2 bad input).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Command-line arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status: 0 ok, 2 bad input, 3 internal error.
+    """
     # Figures are written to files: a non-interactive backend, unless the user chose one.
     os.environ.setdefault("MPLBACKEND", "Agg")
     # Library code logs its stages (logger "riskrf"); the command line shows them as plain lines.
@@ -1304,7 +1467,13 @@ def command() -> int:
     """The ``riskrf`` console script: the simulator's compilation started early where it is needed
     (:func:`_compile_early`), :func:`main`, then the objects left from the run are frozen out of the
     garbage collector, so that the interpreter's collection at exit does not walk them one by one (about
-    0.7 s after a demo); the process ends right after, nothing is lost."""
+    0.7 s after a demo); the process ends right after, nothing is lost.
+
+    Returns
+    -------
+    int
+        Exit status of :func:`main`.
+    """
     _compile_early(sys.argv[1:])
     try:
         status = main()

@@ -109,14 +109,51 @@ CRSP_VELOCITY_SCALE_MS = 9.144    # 30 ft/s (Pfeiffer & Bowen 1989)
 
 @njit(cache=True)
 def wyllie_normal_restitution(impact_angle_deg):
-    """e_N = 19.5 theta^-1.03 (theta in degrees), capped at 2.5 (Wyllie 2014)."""
+    """e_N = 19.5 theta^-1.03 (theta in degrees), capped at 2.5 (Wyllie 2014).
+
+    Parameters
+    ----------
+    impact_angle_deg : float
+        Impact angle theta between the incoming velocity and the surface [deg].
+
+    Returns
+    -------
+    float
+        Normal coefficient of restitution e_N [-], at most ``EN_WYLLIE_MAX``.
+
+    References
+    ----------
+    Wyllie, D.C. (2014) Calibration of rock fall modeling parameters. IJRMMS 67: 170-180.
+    """
     theta = max(impact_angle_deg, 1e-6)
     return min(19.5 * theta ** -1.03, EN_WYLLIE_MAX)
 
 
 @njit(cache=True)
 def normal_restitution(law, e_n, vn, vt):
-    """Coefficient e_N for an impact with normal velocity vn (< 0) and tangential vt."""
+    """Coefficient e_N for an impact with normal velocity vn (< 0) and tangential vt.
+
+    Parameters
+    ----------
+    law : int
+        ``EN_CONSTANT``, ``EN_WYLLIE`` or ``EN_VELOCITY``.
+    e_n : float
+        e_N for the constant and velocity laws; the deviation added to the law's value for Wyllie's law [-].
+    vn : float
+        Incoming normal velocity [m/s] (< 0).
+    vt : float
+        Incoming tangential velocity [m/s].
+
+    Returns
+    -------
+    float
+        Normal coefficient of restitution e_N for this impact [-].
+
+    References
+    ----------
+    Wyllie, D.C. (2014) Calibration of rock fall modeling parameters. IJRMMS 67: 170-180.
+    Pfeiffer & Bowen (1989), the CRSP velocity scaling of e_N.
+    """
     if law == EN_WYLLIE:
         angle = math.degrees(math.atan2(-vn, abs(vt)))
         return min(max(wyllie_normal_restitution(angle) + e_n, 0.0), EN_WYLLIE_MAX)   # e_n: this impact's deviation
@@ -130,13 +167,72 @@ def stronge_sphere(vn, vt, w, r, e_n, mu):
     """Tangential velocity and spin after a rough impact of a solid sphere (I = 0.4 m r^2).
 
     Returns (vt_out, w_out, stuck).  ``vn`` < 0 is the incoming normal velocity.
+
+    Parameters
+    ----------
+    vn : float
+        Incoming normal velocity [m/s] (< 0).
+    vt : float
+        Incoming tangential velocity [m/s].
+    w : float
+        Incoming spin [rad/s].
+    r : float
+        Block radius [m].
+    e_n : float
+        Normal coefficient of restitution [-].
+    mu : float
+        Friction coefficient tan(phi) [-].
+
+    Returns
+    -------
+    vt_out : float
+        Outgoing tangential velocity [m/s].
+    w_out : float
+        Outgoing spin [rad/s].
+    stuck : bool
+        True when the contact stuck (the sphere leaves rolling).
+
+    References
+    ----------
+    Stronge (2000), as set out by Wyllie (2014, ch. 5).
     """
     return stronge_body(vn, vt, w, r, e_n, mu, SPHERE_INERTIA)
 
 
 @njit(cache=True)
 def stronge_body(vn, vt, w, r, e_n, mu, k):
-    """Rough impact of a round body with inertia I = k m r^2 (k = 0.4 sphere, 0.5 cylinder or disc)."""
+    """Rough impact of a round body with inertia I = k m r^2 (k = 0.4 sphere, 0.5 cylinder or disc).
+
+    Parameters
+    ----------
+    vn : float
+        Incoming normal velocity [m/s] (< 0).
+    vt : float
+        Incoming tangential velocity [m/s].
+    w : float
+        Incoming spin [rad/s].
+    r : float
+        Block radius [m].
+    e_n : float
+        Normal coefficient of restitution [-].
+    mu : float
+        Friction coefficient tan(phi) [-].
+    k : float
+        Inertia factor I / (m r^2) [-].
+
+    Returns
+    -------
+    vt_out : float
+        Outgoing tangential velocity [m/s].
+    w_out : float
+        Outgoing spin [rad/s].
+    stuck : bool
+        True when the contact stuck (the body leaves rolling).
+
+    References
+    ----------
+    Stronge (2000), as set out by Wyllie (2014, ch. 5).
+    """
     pn = (1.0 + e_n) * (-vn)              # normal impulse per unit mass
     slip = vt - r * w
     # Impulse per unit mass that brings the slip to zero: slip / (1 + 1/k) = 2/7 slip for a solid sphere.
@@ -150,7 +246,32 @@ def stronge_body(vn, vt, w, r, e_n, mu, k):
 
 @njit(cache=True)
 def impact(vn, vt, w, r, en_law, e_n, et_law, e_t, mu, allow_energy_gain):
-    """Outgoing (vn', vt', w', e_N used) of a solid sphere; see :func:`impact_body`."""
+    """Outgoing (vn', vt', w', e_N used) of a solid sphere; see :func:`impact_body`.
+
+    Parameters
+    ----------
+    vn, vt, w : float
+        Incoming normal velocity [m/s] (< 0), tangential velocity [m/s] and spin [rad/s].
+    r : float
+        Block radius [m].
+    en_law : int
+        ``EN_CONSTANT``, ``EN_WYLLIE`` or ``EN_VELOCITY``.
+    e_n : float
+        Normal coefficient (or its deviation for Wyllie's law) [-].
+    et_law : int
+        ``ET_FRICTION``, ``ET_CONSTANT`` or ``ET_COULOMB``.
+    e_t : float
+        Tangential coefficient [-].
+    mu : float
+        Friction coefficient tan(phi) [-].
+    allow_energy_gain : bool
+        When False the kinetic energy never increases.
+
+    Returns
+    -------
+    tuple of float
+        Outgoing vn' [m/s], vt' [m/s], w' [rad/s] and the e_N used [-].
+    """
     return impact_body(vn, vt, w, r, en_law, e_n, et_law, e_t, mu, allow_energy_gain, SPHERE_INERTIA)
 
 
@@ -159,13 +280,58 @@ def impact_body(vn, vt, w, r, en_law, e_n, et_law, e_t, mu, allow_energy_gain, k
     """Outgoing (vn', vt', w', e_N used) for an incoming (vn < 0, vt, w) on a surface, without velocity scaling.
 
     The same as :func:`rebound` with ``v0`` = inf (kept with this argument order for callers that use it).
+
+    Parameters
+    ----------
+    vn, vt, w : float
+        Incoming normal velocity [m/s] (< 0), tangential velocity [m/s] and spin [rad/s].
+    r : float
+        Block radius [m].
+    en_law : int
+        ``EN_CONSTANT``, ``EN_WYLLIE`` or ``EN_VELOCITY``.
+    e_n : float
+        Normal coefficient (or its deviation for Wyllie's law) [-].
+    et_law : int
+        ``ET_FRICTION``, ``ET_CONSTANT`` or ``ET_COULOMB``.
+    e_t : float
+        Tangential coefficient [-].
+    mu : float
+        Friction coefficient tan(phi) [-].
+    allow_energy_gain : bool
+        When False the kinetic energy never increases.
+    k_inertia : float
+        Inertia factor I / (m r^2) [-].
+
+    Returns
+    -------
+    tuple of float
+        Outgoing vn' [m/s], vt' [m/s], w' [rad/s] and the e_N used [-].
     """
     return rebound(vn, vt, w, r, k_inertia, en_law, e_n, math.inf, et_law, e_t, mu, allow_energy_gain)
 
 
 @njit(cache=True)
 def velocity_scaled(e_n, vn, v0):
-    """e_N / (1 + (vn / v0)^2): the Pfeiffer & Bowen (1989) velocity scaling; ``v0`` [m/s] inf = none."""
+    """e_N / (1 + (vn / v0)^2): the Pfeiffer & Bowen (1989) velocity scaling; ``v0`` [m/s] inf = none.
+
+    Parameters
+    ----------
+    e_n : float
+        Normal coefficient of restitution [-].
+    vn : float
+        Normal impact velocity [m/s].
+    v0 : float
+        Velocity scale [m/s] (inf: no scaling).
+
+    Returns
+    -------
+    float
+        The scaled e_N [-].
+
+    References
+    ----------
+    Pfeiffer & Bowen (1989), the CRSP "scale by velocity" form, v0 = 9.144 m/s.
+    """
     if v0 == math.inf or v0 <= 0.0:
         return e_n
     return e_n / (1.0 + (vn / v0) ** 2)
@@ -274,6 +440,22 @@ def roll_on_speed(v_along, w, r, k):
     m v r + k m r^2 w = (m r + k m r^2 / r) v'  =>  v' = (v + k r w) / (1 + k), w' = v' / r,
     with I = k m r^2 (k = 2/5 sphere, 1/2 cylinder) and w > 0 meaning rolling in the +v direction.
     Kinetic energy never increases through it (it falls by 1/2 m k (v - r w)^2 / (1 + k)).
+
+    Parameters
+    ----------
+    v_along : float
+        Speed along the surface before the transition [m/s].
+    w : float
+        Spin [rad/s] (> 0 rolling in the +v direction).
+    r : float
+        Block radius [m].
+    k : float
+        Inertia factor I / (m r^2) [-].
+
+    Returns
+    -------
+    float
+        Speed along the surface once rolling without slip [m/s].
     """
     return (v_along + k * r * w) / (1.0 + k)
 
@@ -286,6 +468,22 @@ def roughness_tilt_max(roughness_m, r):
     of height h tilts by up to atan(h / r) (the CRSP "random impact angle variation limited by rock size
     and slope irregularity", Pfeiffer & Bowen 1989; PlatRock and Rockyfor3D use the same ratio; Dorren
     2016).  The kernel draws the tilt uniformly within +- this angle, so larger blocks see a smoother slope.
+
+    Parameters
+    ----------
+    roughness_m : float
+        Asperity height of the surface [m].
+    r : float
+        Block radius [m].
+
+    Returns
+    -------
+    float
+        Largest tilt of the surface normal [rad] (0 for r <= 0).
+
+    References
+    ----------
+    Pfeiffer & Bowen (1989), CRSP; Dorren (2016), Rockyfor3D.
     """
     return math.atan(roughness_m / r) if r > 0.0 else 0.0
 
@@ -299,6 +497,22 @@ def contact_speed(v_floor, g, cos_beta, hop_height_m):
     rolling resistance stands for what those asperities take.  The speed is sqrt(2 g cos(beta) h),
     never below ``v_floor`` (the scenario's ``contact_velocity_ms``, a purely numerical threshold that
     only ends trains of ever smaller hops).  With h = 0 it is the floor (the former behaviour).
+
+    Parameters
+    ----------
+    v_floor : float
+        Numerical floor of the contact speed [m/s].
+    g : float
+        Gravitational acceleration [m/s^2].
+    cos_beta : float
+        Cosine of the slope angle [-].
+    hop_height_m : float
+        Least rebound height that counts as flight [m].
+
+    Returns
+    -------
+    float
+        Normal contact speed [m/s].
     """
     hop = math.sqrt(2.0 * g * max(cos_beta, 0.0) * hop_height_m) if hop_height_m > 0.0 else 0.0
     return max(v_floor, hop)
@@ -314,6 +528,26 @@ def rolling_resistance(mu_0, size_k, roughness_m, r):
     (Kirkby & Statham 1975, J. Geol. 83:349, mu = tan(phi) + K d/D, d and D the sizes of surface and moving
     stones [R]; Statham 1976, Earth Surf. Process. 1:43, the resulting downslope size sorting of screes).
     With ``size_k`` = 0 it is mu_0 (the former behaviour).
+
+    Parameters
+    ----------
+    mu_0 : float
+        Rolling-resistance coefficient of a large block, tan(phi_g) [-].
+    size_k : float
+        Size coefficient K [-].
+    roughness_m : float
+        Asperity height of the surface [m].
+    r : float
+        Block radius [m].
+
+    Returns
+    -------
+    float
+        Rolling-resistance coefficient [-].
+
+    References
+    ----------
+    Kirkby, M.J. & Statham, I. (1975), J. Geol. 83: 349 (mu = tan(phi) + K d/D).
     """
     if size_k <= 0.0 or r <= 0.0:
         return mu_0
@@ -329,6 +563,26 @@ def contact_acceleration(g, sin_beta, cos_beta, direction, mu_r, k, roll):
     Rolling (``roll``): a = (-g sin(beta) direction - mu_r g cos(beta)) / (1 + k), the resisting torque
     being mu_r N r (a round body of inertia k m r^2 rolling without slip; 5/7 for a sphere, 2/3 for a
     cylinder); sliding: the same without the 1 / (1 + k).
+
+    Parameters
+    ----------
+    g : float
+        Gravitational acceleration [m/s^2].
+    sin_beta, cos_beta : float
+        Sine and cosine of the slope angle [-].
+    direction : float
+        Sense of motion along +x (+1 or -1).
+    mu_r : float
+        Rolling-resistance or sliding-friction coefficient [-].
+    k : float
+        Inertia factor I / (m r^2) [-].
+    roll : bool
+        True when rolling, False when sliding.
+
+    Returns
+    -------
+    float
+        Acceleration along the motion [m/s^2].
     """
     a = -g * sin_beta * direction - mu_r * g * cos_beta
     return a / (1.0 + k) if roll else a
@@ -342,6 +596,18 @@ def steep_face_launch(v_along, v_sep):
     its outward normal component is ``v_sep`` (the contact speed), or straight out when the block is
     slower than that.  The block then flies and meets the face again in impacts, so on a cliff it bounces
     down the face instead of rolling on it.
+
+    Parameters
+    ----------
+    v_along : float
+        Velocity along the face [m/s] (signed).
+    v_sep : float
+        Outward normal speed to leave with [m/s].
+
+    Returns
+    -------
+    tuple of float
+        (vt, vn) in the frame of the face [m/s].
     """
     u = abs(v_along)
     vn = min(v_sep, u)
@@ -360,7 +626,24 @@ def steep_face_launch(v_along, v_sep):
 @njit(cache=True)
 def contact_speed_at(u, a, c, s):
     """Speed [m/s] after a distance s [m] in contact from speed u [m/s], acceleration a [m/s^2] along the
-    motion and drag coefficient c [1/m] (dv/dt = a - c v^2); 0 once the block has stopped."""
+    motion and drag coefficient c [1/m] (dv/dt = a - c v^2); 0 once the block has stopped.
+
+    Parameters
+    ----------
+    u : float
+        Initial speed [m/s].
+    a : float
+        Acceleration along the motion [m/s^2].
+    c : float
+        Drag coefficient [1/m].
+    s : float
+        Distance travelled in contact [m].
+
+    Returns
+    -------
+    float
+        Speed after the distance [m/s].
+    """
     if c <= 1e-12:
         return math.sqrt(max(u * u + 2.0 * a * s, 0.0))
     ac = a / c
@@ -370,7 +653,22 @@ def contact_speed_at(u, a, c, s):
 @njit(cache=True)
 def contact_stop_distance(u, a, c):
     """Distance [m] at which a block in contact (speed u, acceleration a, drag c; see :func:`contact_speed_at`)
-    comes to rest; inf when it never does (a >= 0)."""
+    comes to rest; inf when it never does (a >= 0).
+
+    Parameters
+    ----------
+    u : float
+        Initial speed [m/s].
+    a : float
+        Acceleration along the motion [m/s^2].
+    c : float
+        Drag coefficient [1/m].
+
+    Returns
+    -------
+    float
+        Stopping distance [m] (inf when the block never stops).
+    """
     if a >= 0.0:
         return math.inf
     if c <= 1e-12:
@@ -382,7 +680,26 @@ def contact_stop_distance(u, a, c):
 @njit(cache=True)
 def contact_time(u, v, a, c, s):
     """Time [s] to go from speed u to speed v >= 0 [m/s] over the distance s [m] (dv/dt = a - c v^2); -1 when
-    the block does not move (u = 0 and no acceleration)."""
+    the block does not move (u = 0 and no acceleration).
+
+    Parameters
+    ----------
+    u : float
+        Initial speed [m/s].
+    v : float
+        Final speed [m/s].
+    a : float
+        Acceleration along the motion [m/s^2].
+    c : float
+        Drag coefficient [1/m].
+    s : float
+        Distance travelled [m].
+
+    Returns
+    -------
+    float
+        Time [s], -1 when the block does not move.
+    """
     if c <= 1e-12:
         if abs(a) > 1e-12:
             return (v - u) / a

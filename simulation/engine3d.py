@@ -29,7 +29,25 @@ _KERNEL3D_MATERIALS = ("m_en_law", "m_en_mean", "m_en_std", "m_et_law", "m_et_me
 
 def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> dict:
     """Initial state of n blocks: plan position and elevation [m], velocity [m/s] (``speed_ms`` horizontally
-    along the local fall line, ``vz_ms`` vertically), spin [rad/s], mass [kg], radius [m], I / (m r^2)."""
+    along the local fall line, ``vz_ms`` vertically), spin [rad/s], mass [kg], radius [m], I / (m r^2).
+
+    Parameters
+    ----------
+    scenario : TerrainScenario
+        The 3-D scenario (sources, DEM, blocks).
+    n : int
+        Number of blocks.
+    seed : int or None
+        Random seed.
+    masses_kg : array_like, optional
+        The mass of each block [kg] (the sources' mass distribution is then ignored).
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        Per block: ``x``, ``y``, ``z`` [m], ``vx``, ``vy``, ``vz`` [m/s], spin [rad/s], mass [kg], radius [m] and
+        inertia factor [-].
+    """
     sd = scenario.sources
     ss = np.random.SeedSequence(seed)
     g_xy, g_h, g_m, g_v, g_vz, g_w = (np.random.default_rng(c) for c in ss.spawn(6))
@@ -139,6 +157,11 @@ def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, m
         pixel crossed).
     record_paths : int
         Keep the event sequence of the first ``record_paths`` blocks (plots, trajectory layers).
+
+    Returns
+    -------
+    TerrainResult
+        Stops, collector crossings, recorded paths and (with ``hazard``) the pixel passages of the run.
     """
     if masses_kg is not None:
         masses_kg = check_masses(masses_kg, None if n is None else n)
@@ -200,17 +223,56 @@ class TerrainRunPlan:
     record_paths: int = 20
 
     def tile_blocks(self, i: int) -> dict:
-        """The initial states of tile ``i``'s blocks (what its task needs), with their indices under ``ids``."""
+        """The initial states of tile ``i``'s blocks (what its task needs), with their indices under ``ids``.
+
+        Parameters
+        ----------
+        i : int
+            Index of the tile.
+
+        Returns
+        -------
+        dict of numpy.ndarray
+            Initial states of the tile's blocks (as :func:`seed_blocks_3d`) and their indices under ``ids``.
+        """
         ids = self.tiles[i]
         return {"ids": ids, **{k: v[ids] for k, v in self.blocks.items()}}
 
     def run_tile(self, part: dict, chunk_size: int = DEFAULT_CHUNK_3D):
-        """Run one tile (``part`` from :meth:`tile_blocks`); returns its outputs for :meth:`merge`."""
+        """Run one tile (``part`` from :meth:`tile_blocks`); returns its outputs for :meth:`merge`.
+
+        Parameters
+        ----------
+        part : dict
+            A tile's blocks, from :meth:`tile_blocks`.
+        chunk_size : int, optional
+            Blocks per kernel call.
+
+        Returns
+        -------
+        dict
+            The tile's outputs (see :func:`run_tile`).
+        """
         return run_tile(self.scenario, part, self.key, hazard=self.hazard, n_paths=min(self.record_paths, self.n),
                         chunk_size=chunk_size)
 
     def merge(self, outputs, elapsed_s: float = 0.0, workers: int = 1) -> "TerrainResult":
-        """The :class:`TerrainResult` of the whole run from every tile's output (any order)."""
+        """The :class:`TerrainResult` of the whole run from every tile's output (any order).
+
+        Parameters
+        ----------
+        outputs : iterable of dict
+            Every tile's output from :meth:`run_tile`, in any order.
+        elapsed_s : float, optional
+            Wall time of the run [s] (reported in the summary).
+        workers : int, optional
+            Number of workers that ran the tiles (reported in the summary).
+
+        Returns
+        -------
+        TerrainResult
+            The result of the whole run.
+        """
         outputs = list(outputs)
         ids = np.concatenate([o["ids"] for o in outputs]) if outputs else np.empty(0, np.int64)
         if ids.size != self.n or np.unique(ids).size != self.n:
@@ -237,7 +299,32 @@ def plan_terrain_run(scenario: TerrainScenario, n: int, seed=None, *, tile_m: fl
                      50_000, masses_kg=None, hazard: bool = True, record_paths: int = 20) -> TerrainRunPlan:
     """Seed ``n`` blocks as :func:`run_terrain` does and split them into tiles by source: squares of ``tile_m``
     metres of the release points (in plan, from the DEM's corner), each cut into pieces of at most
-    ``max_tile_blocks`` blocks.  Tiles hold block indices in increasing order; their order is by square."""
+    ``max_tile_blocks`` blocks.  Tiles hold block indices in increasing order; their order is by square.
+
+    Parameters
+    ----------
+    scenario : TerrainScenario
+        The 3-D scenario.
+    n : int
+        Number of blocks.
+    seed : int, optional
+        Random seed.
+    tile_m : float, optional
+        Side of a tile's square in plan [m].
+    max_tile_blocks : int, optional
+        Largest number of blocks in one tile.
+    masses_kg : array_like, optional
+        The mass of each block [kg].
+    hazard : bool, optional
+        Record the DEM pixels each block crosses.
+    record_paths : int, optional
+        Keep the event sequence of the first ``record_paths`` blocks.
+
+    Returns
+    -------
+    TerrainRunPlan
+        The seeded blocks and their tiles.
+    """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n <= 0:
         raise ValueError(f"n must be a positive whole number of blocks; got {n!r}")
     if not (np.isfinite(tile_m) and tile_m > 0) or int(max_tile_blocks) < 1:
@@ -262,7 +349,28 @@ def plan_terrain_run(scenario: TerrainScenario, n: int, seed=None, *, tile_m: fl
 def run_tile(scenario: TerrainScenario, part: dict, key: int, *, hazard: bool = True, n_paths: int = 20,
              chunk_size: int = DEFAULT_CHUNK_3D) -> dict:
     """Run the blocks of one tile (``part``: their indices ``ids`` and initial states, from
-    :meth:`TerrainRunPlan.tile_blocks`) with the run's ``key``; the kernel's outputs for the tile."""
+    :meth:`TerrainRunPlan.tile_blocks`) with the run's ``key``; the kernel's outputs for the tile.
+
+    Parameters
+    ----------
+    scenario : TerrainScenario
+        The 3-D scenario.
+    part : dict
+        The tile's block indices ``ids`` and initial states.
+    key : int
+        The run's random key.
+    hazard : bool, optional
+        Record the DEM pixels each block crosses.
+    n_paths : int, optional
+        Keep the paths of the blocks with index below ``n_paths``.
+    chunk_size : int, optional
+        Blocks per kernel call.
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        ``ids``, ``per_block``, ``crossings``, ``passages`` and ``paths`` of the tile.
+    """
     ter = scenario.terrain
     grid = (ter.z, ter.x0, ter.y0, ter.dx, ter.dy, _lipschitz(ter.z, ter.dx, ter.dy), scenario.material_grid.index)
     mats = {k: v for k, v in _material_arrays(scenario).items() if k in _KERNEL3D_MATERIALS}
@@ -296,6 +404,32 @@ def aggregate_passages(cell, block, e, h, ncell, qs_e, q_h):
 
     A counting sort by pixel keeps the passages' block order, which is non-decreasing (chunks are
     concatenated in block order), so a block's visits to one pixel are adjacent and merge in one pass.
+
+    Parameters
+    ----------
+    cell : numpy.ndarray of int
+        Pixel index of each passage.
+    block : numpy.ndarray of int
+        Block index of each passage (non-decreasing).
+    e : numpy.ndarray of float
+        Kinetic energy of each passage [kJ].
+    h : numpy.ndarray of float
+        Height of the block centre above the ground at each passage [m].
+    ncell : int
+        Number of pixels of the grid.
+    qs_e : numpy.ndarray of float
+        Quantiles of the energy to compute [-].
+    q_h : float
+        Quantile of the height to compute [-].
+
+    Returns
+    -------
+    count : numpy.ndarray
+        Blocks that passed each pixel.
+    eq : numpy.ndarray
+        Energy quantiles per pixel [kJ], shape (len(qs_e), ncell).
+    hq : numpy.ndarray
+        Height quantile per pixel [m].
     """
     count_raw = np.zeros(ncell + 1, np.int64)
     for k in range(cell.shape[0]):
@@ -356,7 +490,13 @@ class TerrainResult(Displayed):
 
     def stops(self) -> pd.DataFrame:
         """One row per block: release point, final point (x_m, y_m, z_m), reason, impacts, time, mass, and
-        the horizontal runout from the release point [m]."""
+        the horizontal runout from the release point [m].
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per block.
+        """
         pb, b = self.per_block, self.blocks
         reasons = [kernel3d.STOP_REASONS[i] for i in sorted(kernel3d.STOP_REASONS)]
         return pd.DataFrame({
@@ -366,13 +506,35 @@ class TerrainResult(Displayed):
             "time_s": pb["t"], "mass_kg": b["mass"]})
 
     def reach_probability(self, name: str) -> float:
-        """Share of the released blocks that reached the line ``name`` (crossed it or met it, at a barrier)."""
+        """Share of the released blocks that reached the line ``name`` (crossed it or met it, at a barrier).
+
+        Parameters
+        ----------
+        name : str
+            Name of a collector or barrier.
+
+        Returns
+        -------
+        float
+            Share of the released blocks that reached it [-].
+        """
         j = self.scenario.collector_index(name)
         return np.unique(self.crossings["block"][self.crossings["coll"] == j]).size / self.n
 
     def barrier(self, name: str) -> pd.DataFrame:
         """Blocks meeting the barrier ``name`` (first meeting each): :meth:`collector` rows, with ``outcome``
-        "caught", "through" or "over"; the summary of shares is :meth:`barrier_summary`."""
+        "caught", "through" or "over"; the summary of shares is :meth:`barrier_summary`.
+
+        Parameters
+        ----------
+        name : str
+            Name of a barrier.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per block meeting the barrier, with ``outcome``.
+        """
         c = self.scenario.collectors[self.scenario.collector_index(name)]
         if c.height_m is None:
             raise KeyError(f"{self.scenario.source}: collector {name!r} is not a barrier (it has no height_m)")
@@ -380,7 +542,18 @@ class TerrainResult(Displayed):
 
     def barrier_summary(self, name: str) -> pd.DataFrame:
         """Per outcome at barrier ``name``: blocks, share of the blocks meeting it, share of the blocks
-        released, and the largest energy [kJ] and centre height [m] among them."""
+        released, and the largest energy [kJ] and centre height [m] among them.
+
+        Parameters
+        ----------
+        name : str
+            Name of a barrier.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per outcome, indexed by ``outcome``.
+        """
         df = self.barrier(name)
         rows = []
         for o in ("caught", "through", "over"):
@@ -393,7 +566,13 @@ class TerrainResult(Displayed):
 
     def energy_excess_j(self) -> np.ndarray:
         """Per block, the largest rise [J] of its total energy (kinetic + m g z) from one impact or contact step
-        to the next (the energy audit: 0 or rounding-small unless a material allows energy gain)."""
+        to the next (the energy audit: 0 or rounding-small unless a material allows energy gain).
+
+        Returns
+        -------
+        numpy.ndarray
+            Largest energy rise per block [J].
+        """
         return self.per_block["excess"]
 
     def collector(self, name: str, *, first_only: bool = False) -> pd.DataFrame:
@@ -401,7 +580,20 @@ class TerrainResult(Displayed):
         line), ``x_m``, ``y_m``, ``time_s``, ``velocity_ms``, ``vx_ms``, ``vy_ms``, ``vz_ms``,
         ``angular_velocity_rads``, ``height_m`` (centre above the ground), ``mass_kg``, ``radius_m``,
         ``inertia_factor``, ``energy_kj`` and ``outcome`` ("crossed" at a plain collector; at a barrier
-        "caught", "through" or "over", :func:`simulation.kernel.barrier_outcome`)."""
+        "caught", "through" or "over", :func:`simulation.kernel.barrier_outcome`).
+
+        Parameters
+        ----------
+        name : str
+            Name of a collector or barrier.
+        first_only : bool, optional
+            Keep only each block's first crossing.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per crossing, columns as above.
+        """
         j = self.scenario.collector_index(name)
         c = self.crossings
         sel = c["coll"] == j
@@ -420,7 +612,13 @@ class TerrainResult(Displayed):
         return df.reset_index(drop=True)
 
     def summary(self) -> pd.DataFrame:
-        """Runout quantiles, stop reasons, impacts, energy audit and speed of the run, one row per quantity."""
+        """Runout quantiles, stop reasons, impacts, energy audit and speed of the run, one row per quantity.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``quantity``, ``value`` and ``unit``.
+        """
         st = self.stops()
         rows = [("blocks", self.n, ""), ("seconds", self.elapsed_s, "s"),
                 ("trajectories per second", self.n / max(self.elapsed_s, 1e-12), "1/s")]
@@ -454,6 +652,11 @@ class TerrainResult(Displayed):
         block's largest kinetic energy in the pixel [kJ]; ``jump_height_p95_m`` the 95th percentile of each
         block's largest height of its centre above the ground there [m]; ``deposition_density`` blocks stopped
         in the pixel per released block per m^2 [1/m^2].
+
+        Returns
+        -------
+        dict of numpy.ndarray
+            The rasters named above, each of the DEM's shape.
         """
         if self.passages is None:
             raise ValueError("this run recorded no pixel passages: run_terrain(..., hazard=True)")
@@ -476,7 +679,20 @@ class TerrainResult(Displayed):
         return out
 
     def plot(self, ax=None, paths: bool = True):
-        """Plan view: hillshade of the DEM, recorded paths, stop points and collectors (matplotlib axes)."""
+        """Plan view: hillshade of the DEM, recorded paths, stop points and collectors (matplotlib axes).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+        paths : bool, optional
+            Draw the recorded paths.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         import matplotlib.pyplot as plt
         ter = self.scenario.terrain
         if ax is None:

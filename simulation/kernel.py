@@ -202,6 +202,34 @@ def find_impact(px, pz, tree, n_leaves, run_first, run_last, x0, z0, vx, vz, g, 
     current leaf and descends only into sibling subtrees ahead of the block whose
     ground the parabola can reach.  Cost O(log d) for a flight over d segments,
     independent of the total number of segments.
+
+    Parameters
+    ----------
+    px, pz : numpy.ndarray
+        Profile vertices [m].
+    tree : numpy.ndarray
+        Chord-offset tree of the profile (``TerrainProfile.tree_offset``) [m].
+    n_leaves : int
+        Number of leaves of the tree.
+    run_first, run_last : numpy.ndarray of int
+        First and last segment of the straight run each segment belongs to.
+    x0, z0 : float
+        Start of the flight [m].
+    vx, vz : float
+        Velocity at the start [m/s].
+    g : float
+        Gravitational acceleration [m/s^2].
+    seg_now : int
+        Segment the block leaves from.
+    stack : numpy.ndarray of int
+        Work array (3, depth) of the tree search.
+
+    Returns
+    -------
+    t : float
+        Time of flight to the impact [s] (or to leaving the profile).
+    k : int
+        Segment hit, -1 when the block leaves the profile.
     """
     n_seg = px.shape[0] - 1
     if abs(vx) < 1e-12:
@@ -273,6 +301,26 @@ def barrier_outcome(energy_kj, centre_height_m, radius_m, capacity_kj, height_m)
     ground as a point), so the block passes over when its underside (centre height minus radius) is
     above the barrier height; otherwise the barrier holds it when the energy is within the capacity (MEL) and lets it
     through with the excess energy (E - capacity) when not.  Returns (outcome, energy share kept).
+
+    Parameters
+    ----------
+    energy_kj : float
+        Kinetic energy of the block [kJ].
+    centre_height_m : float
+        Height of the block centre above the ground at the barrier [m].
+    radius_m : float
+        Block radius [m].
+    capacity_kj : float
+        Capacity (MEL) of the barrier [kJ].
+    height_m : float
+        Barrier height [m].
+
+    Returns
+    -------
+    outcome : int
+        ``BARRIER_CAUGHT``, ``BARRIER_THROUGH`` or ``BARRIER_OVER``.
+    share : float
+        Share of the kinetic energy kept [-].
     """
     if centre_height_m - radius_m > height_m:
         return BARRIER_OVER, 1.0
@@ -380,6 +428,107 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
     ``m_size_k`` the size term of the rolling resistance (:func:`rolling_resistance`), ``m_drag`` the rolling drag (the contact's v^2 resistance c = m_drag / r [1/m], :func:`contact_speed_at`),
     ``sin_max_roll`` the sine of the steepest slope a block may roll or slide on in contact (1: any slope);
     on steeper segments it leaves the face (:func:`steep_face_launch`) and meets it in impacts.
+
+    Parameters
+    ----------
+    block_ids : numpy.ndarray of int64
+        Global index of each block of the chunk (seeds its random stream).
+    bx, bz : numpy.ndarray
+        Release position [m].
+    bvx, bvz : numpy.ndarray
+        Release velocity [m/s].
+    bw : numpy.ndarray
+        Release spin [rad/s].
+    bmass : numpy.ndarray
+        Block mass [kg].
+    bradius : numpy.ndarray
+        Block radius [m].
+    bk : numpy.ndarray
+        Inertia factor I / (m r^2) [-].
+    px, pz : numpy.ndarray
+        Profile vertices [m].
+    tree : numpy.ndarray
+        Chord-offset tree of the profile [m].
+    n_leaves : int
+        Number of leaves of the tree.
+    seg_mat : numpy.ndarray of int
+        Material index of each segment.
+    run_first, run_last : numpy.ndarray of int
+        First and last segment of each segment's straight run.
+    m_en_law, m_en_mean, m_en_std : numpy.ndarray
+        Per material: normal restitution law code, mean and standard deviation of e_N [-].
+    m_et_law, m_et_mean, m_et_std : numpy.ndarray
+        Per material: tangential law code, mean and standard deviation of e_T [-].
+    m_phi, m_phi_std : numpy.ndarray
+        Per material: impact friction angle and its standard deviation [deg].
+    m_rough : numpy.ndarray
+        Per material: roughness (asperity height) [m].
+    m_roll : numpy.ndarray of bool
+        Per material: the block rolls (True) or slides in contact.
+    m_mu_ground : numpy.ndarray
+        Per material: rolling-resistance or sliding coefficient tan(phi_g) [-].
+    m_gain : numpy.ndarray of bool
+        Per material: energy gain allowed at impacts.
+    m_en_v0 : numpy.ndarray
+        Per material: velocity scale of e_N [m/s] (inf: none).
+    m_hop : numpy.ndarray
+        Per material: hop height [m].
+    m_drag : numpy.ndarray
+        Per material: rolling drag coefficient [-] (c = m_drag / r [1/m]).
+    m_size_k : numpy.ndarray
+        Per material: size coefficient of the rolling resistance [-].
+    c_x : numpy.ndarray
+        Collector positions [m].
+    c_cap : numpy.ndarray
+        Barrier capacity [kJ] (NaN: plain collector).
+    c_h : numpy.ndarray
+        Barrier height [m] (NaN: plain collector).
+    c_order : numpy.ndarray of int
+        Collectors in increasing x.
+    env_x : numpy.ndarray
+        Centres of the envelope bins [m].
+    env_acc : numpy.ndarray
+        Envelope accumulator (bins, 7): count, max and sum of speed [m/s], height [m] and energy [kJ].
+    g : float
+        Gravitational acceleration [m/s^2].
+    v_contact : float
+        Numerical floor of the contact speed [m/s].
+    v_stop : float
+        Stop speed [m/s].
+    sin_max_roll : float
+        Sine of the steepest slope a block may roll or slide on [-].
+    max_events : int
+        Largest number of events per block.
+    key : numpy.uint64
+        Random key of the run.
+    n_path_blocks : int
+        Record the paths of the blocks with index below this.
+    out_x, out_z : numpy.ndarray
+        Output: stop position [m].
+    out_reason : numpy.ndarray of int
+        Output: stop reason code (``STOP_REASONS``).
+    out_impacts : numpy.ndarray of int
+        Output: number of impacts.
+    out_t : numpy.ndarray
+        Output: travel time [s].
+    r_block, r_coll : numpy.ndarray of int
+        Output per crossing: block and collector index.
+    r_t : numpy.ndarray
+        Output per crossing: time [s].
+    r_vx, r_vz : numpy.ndarray
+        Output per crossing: velocity [m/s].
+    r_w : numpy.ndarray
+        Output per crossing: spin [rad/s].
+    r_h : numpy.ndarray
+        Output per crossing: height of the centre above the ground [m].
+    r_outcome : numpy.ndarray of int
+        Output per crossing: outcome code (``OUTCOMES``).
+    r_count : numpy.ndarray of int
+        Output: crossings written and crossings that did not fit.
+    pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev : numpy.ndarray
+        Output per path point: block, time [s], position [m], velocity [m/s], spin [rad/s], mode and event code.
+    pcount : numpy.ndarray of int
+        Output: path points written.
     """
     n_coll = c_x.shape[0]
     n_seg = px.shape[0] - 1

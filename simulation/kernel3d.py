@@ -386,6 +386,119 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
     [m] there (hazard maps).
     Buffers that fill up count the rows that did not fit (``r_count[1]``, ``p_count[1]``): the caller reruns
     the chunk with larger ones (results depend only on the seed and block index).
+
+    Parameters
+    ----------
+    block_ids : numpy.ndarray of int64
+        Global index of each block of the chunk (seeds its random stream).
+    bx, by, bz : numpy.ndarray
+        Release position [m].
+    bvx, bvy, bvz : numpy.ndarray
+        Release velocity [m/s].
+    bw : numpy.ndarray
+        Release spin [rad/s].
+    bmass : numpy.ndarray
+        Block mass [kg].
+    bradius : numpy.ndarray
+        Block radius [m].
+    bk : numpy.ndarray
+        Inertia factor I / (m r^2) [-].
+    zg : numpy.ndarray
+        Elevations (ny, nx) [m], NaN holes.
+    x0, y0 : float
+        Centre of cell (0, 0) [m].
+    dx, dy : float
+        Cell size [m].
+    lip : float
+        Upper bound of the surface slope |grad z| [-].
+    mat_grid : numpy.ndarray of int
+        Material index per cell.
+    m_en_law, m_en_mean, m_en_std : numpy.ndarray
+        Per material: normal restitution law code, mean and standard deviation of e_N [-].
+    m_et_law, m_et_mean, m_et_std : numpy.ndarray
+        Per material: tangential law code, mean and standard deviation of e_T [-].
+    m_phi, m_phi_std : numpy.ndarray
+        Per material: impact friction angle and its standard deviation [deg].
+    m_rough : numpy.ndarray
+        Per material: roughness (asperity height) [m].
+    m_roll : numpy.ndarray of bool
+        Per material: the block rolls (True) or slides in contact.
+    m_mu_ground : numpy.ndarray
+        Per material: rolling-resistance or sliding coefficient tan(phi_g) [-].
+    m_gain : numpy.ndarray of bool
+        Per material: energy gain allowed at impacts.
+    c_ax, c_ay, c_bx, c_by : numpy.ndarray
+        Ends of the collector segments in plan [m].
+    c_id : numpy.ndarray of int
+        Collector of each segment.
+    c_s0 : numpy.ndarray
+        Distance of each segment's start along its polyline [m].
+    c_cap : numpy.ndarray
+        Barrier capacity [kJ] (NaN: plain collector).
+    c_net : numpy.ndarray
+        Barrier net height above the ground [m] (NaN: plain collector).
+    g : float
+        Gravitational acceleration [m/s^2].
+    v_contact : float
+        Numerical floor of the contact speed [m/s].
+    v_stop : float
+        Stop speed [m/s].
+    max_events : int
+        Largest number of events per block.
+    key : numpy.uint64
+        Random key of the run.
+    n_path_blocks : int
+        Record the paths of the blocks with index below this.
+    rec_pass : bool
+        Record the pixels each block crosses.
+    out_x, out_y, out_z : numpy.ndarray
+        Output: stop position [m].
+    out_reason : numpy.ndarray of int
+        Output: stop reason code.
+    out_impacts : numpy.ndarray of int
+        Output: number of impacts.
+    out_t : numpy.ndarray
+        Output: travel time [s].
+    out_excess : numpy.ndarray
+        Output: largest rise of the total energy between events [J].
+    out_events : numpy.ndarray of int
+        Output: number of events.
+    r_block, r_coll : numpy.ndarray of int
+        Output per crossing: block and collector index.
+    r_s : numpy.ndarray
+        Output per crossing: distance along the collector [m].
+    r_t : numpy.ndarray
+        Output per crossing: time [s].
+    r_x, r_y : numpy.ndarray
+        Output per crossing: plan position [m].
+    r_vx, r_vy, r_vz : numpy.ndarray
+        Output per crossing: velocity [m/s].
+    r_w : numpy.ndarray
+        Output per crossing: spin [rad/s].
+    r_h : numpy.ndarray
+        Output per crossing: height of the centre above the ground [m].
+    r_out : numpy.ndarray of int
+        Output per crossing: outcome code.
+    r_count : numpy.ndarray of int
+        Output: crossings written and crossings that did not fit.
+    p_block, p_cell : numpy.ndarray of int
+        Output per pixel passage: block and cell index.
+    p_e : numpy.ndarray
+        Output per pixel passage: largest kinetic energy [kJ].
+    p_h : numpy.ndarray
+        Output per pixel passage: largest height above the ground [m].
+    p_count : numpy.ndarray of int
+        Output: passages written and passages that did not fit.
+    pb, pt : numpy.ndarray
+        Output per path point: block and time [s].
+    ppx, ppy, ppz : numpy.ndarray
+        Output per path point: position [m].
+    ppv : numpy.ndarray
+        Output per path point: speed [m/s].
+    pmode : numpy.ndarray of int
+        Output per path point: mode code.
+    pcount : numpy.ndarray of int
+        Output: path points written.
     """
     ny, nx = zg.shape
     step_len = 0.5 * min(dx, dy)

@@ -94,7 +94,20 @@ def _get(table: dict, field: str):
 def assumed_spread(preset: str, table: dict) -> dict:
     """The ASSUMED range of each parameter of ``preset`` that ``table`` (the material's resolved table) uses:
     {field: (low, high, basis)}, centred on the table's value (see :data:`ASSUMED_HALF_WIDTHS`); bounds kept
-    >= 0 (restitution coefficients, angles)."""
+    >= 0 (restitution coefficients, angles).
+
+    Parameters
+    ----------
+    preset : str
+        Name of the material preset.
+    table : dict
+        The material's resolved table.
+
+    Returns
+    -------
+    dict
+        {field: (low, high, basis)}, bounds in the field's units.
+    """
     out = {}
     for field, w in ASSUMED_HALF_WIDTHS.get(ALIASES.get(preset, preset), {}).items():
         v = _get(table, field)
@@ -118,6 +131,11 @@ def _scenario_data(scenario) -> tuple[dict, str, Path | None]:
 def preset_spread(scenario) -> pd.DataFrame:
     """The range of every material parameter of ``scenario`` (TOML path, dict or Scenario loaded from a file)
     that the presets' spread covers.
+
+    Parameters
+    ----------
+    scenario : str, pathlib.Path, dict or Scenario
+        The scenario.
 
     Returns
     -------
@@ -200,7 +218,20 @@ def material_draws(scenario, draws: int, *, posterior=None, seed=1) -> pd.DataFr
 
 def scenario_with_values(scenario, values: dict) -> Scenario:
     """The scenario (TOML path, dict or Scenario loaded from a file) with dotted parameters set to ``values``
-    (e.g. one row of :func:`material_draws`), re-read and checked (a ScenarioError names the file and field)."""
+    (e.g. one row of :func:`material_draws`), re-read and checked (a ScenarioError names the file and field).
+
+    Parameters
+    ----------
+    scenario : str, pathlib.Path, dict or Scenario
+        The scenario.
+    values : dict
+        Dotted parameter paths (``materials.NAME.FIELD``) and their values, in the fields' units.
+
+    Returns
+    -------
+    Scenario
+        The checked scenario with the values set.
+    """
     from .calibration import apply_parameters
     data, src, base = _scenario_data(scenario)
     try:

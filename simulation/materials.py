@@ -158,7 +158,13 @@ class PresetError(ValueError):
 
 
 def preset_names() -> list[str]:
-    """Names of the presets (without aliases)."""
+    """Names of the presets (without aliases).
+
+    Returns
+    -------
+    list of str
+        Sorted preset names.
+    """
     return sorted(PRESETS)
 
 
@@ -317,6 +323,20 @@ def resolve_material(spec: dict, where: str = "materials.?", source: str = "<dic
 
     ``where`` names the table (e.g. ``"materials.apron"``) and ``source`` the file, for error messages.
     A table without ``preset`` is returned unchanged (a copy).
+
+    Parameters
+    ----------
+    spec : dict
+        A material table of a scenario.
+    where : str, optional
+        Name of the table, for error messages.
+    source : str, optional
+        The scenario file, for error messages.
+
+    Returns
+    -------
+    dict
+        The expanded material table (a copy).
     """
     if not isinstance(spec, dict):
         raise PresetError(f"{source}: {where} must be a table of material fields; got {spec!r}")
@@ -337,7 +357,20 @@ def resolve_material(spec: dict, where: str = "materials.?", source: str = "<dic
 
 
 def resolve_materials(data: dict, source: str = "<dict>") -> dict:
-    """A copy of a scenario dictionary with every material preset expanded."""
+    """A copy of a scenario dictionary with every material preset expanded.
+
+    Parameters
+    ----------
+    data : dict
+        A parsed scenario dictionary.
+    source : str, optional
+        The scenario file, for error messages.
+
+    Returns
+    -------
+    dict
+        A copy of ``data`` with every preset expanded.
+    """
     out = copy.deepcopy(data)
     mats = out.get("materials")
     if isinstance(mats, dict):
@@ -348,7 +381,13 @@ def resolve_materials(data: dict, source: str = "<dict>") -> dict:
 
 
 def presets_table():
-    """The presets as a DataFrame: one row per preset with its fields and sources."""
+    """The presets as a DataFrame: one row per preset with its fields and sources.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per preset, indexed by ``preset``.
+    """
     import pandas as pd
     rows = []
     for name in sorted(PRESETS):

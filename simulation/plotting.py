@@ -23,6 +23,22 @@ def plot_profile(result, ax=None, *, n_paths: int = 20, fences=()):
     ``fences``: (x [m], height [m], label) of fences to draw at their height (e.g. a study's fence options
     at the barrier line), each a vertical bar from the ground to ground + height.  The legend stands
     outside the axes, so it hides no part of the slope or a label.
+
+    Parameters
+    ----------
+    result : SimulationResult or Scenario
+        The run (or scenario) to draw.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when None).
+    n_paths : int, optional
+        Number of recorded trajectories to draw.
+    fences : sequence of (float, float, str), optional
+        Fences to draw: (x [m], height [m], label).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
     """
     ax = _axes(ax)
     sc = getattr(result, "scenario", result)
@@ -63,7 +79,22 @@ def plot_profile(result, ax=None, *, n_paths: int = 20, fences=()):
 
 
 def plot_collector_distributions(result, name: str, axes=None):
-    """Histograms and exceedance curves of speed, height and energy at collector ``name`` (2 x 3 axes)."""
+    """Histograms and exceedance curves of speed, height and energy at collector ``name`` (2 x 3 axes).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The run.
+    name : str
+        Name of the collector.
+    axes : numpy.ndarray of matplotlib.axes.Axes, optional
+        2 x 3 axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    numpy.ndarray of matplotlib.axes.Axes
+        The 2 x 3 axes: speed [m/s], height [m] and energy [kJ].
+    """
     import matplotlib.pyplot as plt
     df = result.collector(name, first_only=True)
     if axes is None:
@@ -112,7 +143,20 @@ def plot_collector_distributions(result, name: str, axes=None):
 
 
 def plot_envelopes(result, axes=None):
-    """Maximum and mean speed, bounce height and energy along the slope (3 stacked axes)."""
+    """Maximum and mean speed, bounce height and energy along the slope (3 stacked axes).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The run.
+    axes : sequence of matplotlib.axes.Axes, optional
+        3 axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    sequence of matplotlib.axes.Axes
+        The 3 axes: speed [m/s], bounce height [m] and energy [kJ] against x [m].
+    """
     import matplotlib.pyplot as plt
     env = result.envelopes
     if axes is None:

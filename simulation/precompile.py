@@ -46,7 +46,18 @@ class Precompile:
         return self._proc is not None and self._proc.poll() is None
 
     def wait(self, timeout: float | None = 300.0) -> bool:
-        """Block until the compilation is done; True when the child finished cleanly (or was not needed)."""
+        """Block until the compilation is done; True when the child finished cleanly (or was not needed).
+
+        Parameters
+        ----------
+        timeout : float or None, optional
+            Longest wait [s] (None: no limit); the child is killed after it.
+
+        Returns
+        -------
+        bool
+            True when the compilation finished cleanly or was not needed.
+        """
         if self._proc is None:
             return True
         try:
@@ -98,7 +109,13 @@ def precompile() -> Precompile:
     """The compilation for a run about to simulate: nothing to do where the kernel's cache is there (numba's
     own lookup, which also knows ``NUMBA_CACHE_DIR`` and its fall-back folder: an early child is then stopped,
     it was only loading the cache), else the child :func:`start_early` started (taken over once), else a new
-    :class:`Precompile`."""
+    :class:`Precompile`.
+
+    Returns
+    -------
+    Precompile
+        The compilation (possibly one that starts nothing).
+    """
     global _early
     if _cache_exists():
         discard_early()
@@ -132,7 +149,13 @@ def compile_kernel() -> None:
 
 def empty_kernel_arguments() -> dict:
     """Arguments of :func:`simulation.kernel.simulate` for no blocks, by name: empty arrays of each argument's
-    dtype, the envelope accumulator 2-d, scalars of the run's types."""
+    dtype, the envelope accumulator 2-d, scalars of the run's types.
+
+    Returns
+    -------
+    dict
+        Argument name -> empty array or scalar.
+    """
     import inspect
 
     import numpy as np

@@ -87,7 +87,18 @@ class Sources:
     basis: str = ""
 
     def radius(self, mass):
-        """Radius [m] of spheres (or cylinders of aspect ratio 1) of the given masses [kg]."""
+        """Radius [m] of spheres (or cylinders of aspect ratio 1) of the given masses [kg].
+
+        Parameters
+        ----------
+        mass : float or array_like
+            Block mass [kg].
+
+        Returns
+        -------
+        float or numpy.ndarray
+            Block radius [m].
+        """
         return block_radius(mass, self.density_kg_m3, self.shape)
 
     @property
@@ -115,7 +126,13 @@ class PlanCollector:
         return self.height_m is not None
 
     def description(self) -> str:
-        """One line: what the line is (collector, or barrier with its height and capacity)."""
+        """One line: what the line is (collector, or barrier with its height and capacity).
+
+        Returns
+        -------
+        str
+            The description, lengths and heights in metres, capacity in kJ.
+        """
         if not self.is_barrier:
             return f"collector {self.name!r} ({self.length_m:.1f} m)"
         cap = ("capacity not given: ASSUMED to hold every block below the net's top" if self.capacity_kj is None
@@ -169,7 +186,18 @@ class TerrainScenario(Displayed):
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
     def collector_index(self, name: str) -> int:
-        """Index of collector ``name``; a KeyError listing the collectors when there is none."""
+        """Index of collector ``name``; a KeyError listing the collectors when there is none.
+
+        Parameters
+        ----------
+        name : str
+            Name of a collector or barrier.
+
+        Returns
+        -------
+        int
+            Its index among the scenario's collectors.
+        """
         names = [c.name for c in self.collectors]
         if name not in names:
             raise KeyError(f"{self.source}: no collector named {name!r}; collectors are {names}")
@@ -193,6 +221,24 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
 
     ``terrain`` gives the DEM directly (then ``[terrain] dem`` may be left out); ``crs`` states the DEM's CRS
     when the file has none (it overrides ``[terrain] crs``).
+
+    Parameters
+    ----------
+    data : dict
+        The parsed scenario TOML.
+    source : str, optional
+        Where the dictionary came from, for error messages.
+    base_dir : pathlib.Path, optional
+        Directory against which relative file paths (the DEM) are resolved.
+    terrain : Terrain, optional
+        The DEM, given directly.
+    crs : str or rasterio.crs.CRS, optional
+        The DEM's coordinate reference system when the file has none.
+
+    Returns
+    -------
+    TerrainScenario
+        The checked scenario.
     """
     _check_keys(data, {"name", "description", "terrain", "materials", "sources", "collectors", "settings"}, "",
                 source)
@@ -335,7 +381,18 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
 
 def is_terrain_scenario_file(path) -> bool:
     """True when the scenario TOML file has a ``[terrain]`` table (a 3-D scenario); False for any other file
-    (a 2-D scenario, or a file :func:`simulation.load_scenario` will report on)."""
+    (a 2-D scenario, or a file :func:`simulation.load_scenario` will report on).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Scenario TOML file.
+
+    Returns
+    -------
+    bool
+        True for a 3-D scenario.
+    """
     try:
         with open(path, "rb") as fh:
             return isinstance(tomllib.load(fh).get("terrain"), dict)
@@ -440,7 +497,20 @@ def _source_places(sd, terrain, base, source, slope_rule) -> dict:
 
 
 def load_terrain_scenario(path, crs=None) -> TerrainScenario:
-    """Read a 3-D scenario TOML file (a ``[terrain]`` table; see this module's docstring)."""
+    """Read a 3-D scenario TOML file (a ``[terrain]`` table; see this module's docstring).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Scenario TOML file.
+    crs : str or rasterio.crs.CRS, optional
+        The DEM's coordinate reference system when the file has none.
+
+    Returns
+    -------
+    TerrainScenario
+        The checked scenario.
+    """
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"scenario file not found: {path}")
@@ -467,7 +537,24 @@ def _in_polygon(poly: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 def sample_sources(sources: Sources, terrain: Terrain, rng: np.random.Generator, n: int) -> np.ndarray:
     """n plan release points (n, 2): uniform among ``points``, or uniform inside ``polygon`` (rejection
-    sampling in its bounding box; points on nodata holes are rejected too)."""
+    sampling in its bounding box; points on nodata holes are rejected too).
+
+    Parameters
+    ----------
+    sources : Sources
+        The release sources (points, lines or polygon).
+    terrain : Terrain
+        The DEM.
+    rng : numpy.random.Generator
+        Random generator.
+    n : int
+        Number of release points.
+
+    Returns
+    -------
+    numpy.ndarray
+        Plan release points (x, y) [m], shape (n, 2).
+    """
     if sources.points is not None:
         return sources.points[rng.integers(0, len(sources.points), n)]
     if sources.lines is not None:
@@ -507,7 +594,20 @@ def sample_sources(sources: Sources, terrain: Terrain, rng: np.random.Generator,
 
 
 def fall_line(terrain: Terrain, x, y) -> tuple[np.ndarray, np.ndarray]:
-    """Unit horizontal direction of steepest descent at plan points (+x where the ground is flat)."""
+    """Unit horizontal direction of steepest descent at plan points (+x where the ground is flat).
+
+    Parameters
+    ----------
+    terrain : Terrain
+        The DEM.
+    x, y : array_like
+        Plan coordinates [m].
+
+    Returns
+    -------
+    ux, uy : numpy.ndarray
+        Components of the unit horizontal direction of steepest descent [-].
+    """
     gx, gy = terrain.gradient(x, y)
     n = np.hypot(gx, gy)
     flat = ~(n > 1e-12)

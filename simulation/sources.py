@@ -107,7 +107,22 @@ class VectorLayer:
 
 def read_vector_layer(path, layer=None, terrain: Terrain | None = None) -> VectorLayer:
     """Read a vector layer with pyogrio (GeoPackage, shapefile, GeoJSON, ...); with ``terrain``, refuse a layer in
-    another CRS than the DEM's (see the module docstring)."""
+    another CRS than the DEM's (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Vector file.
+    layer : str or int, optional
+        Layer name or index (default: the first layer).
+    terrain : Terrain, optional
+        The DEM whose CRS the layer must share.
+
+    Returns
+    -------
+    VectorLayer
+        The layer's geometries [m], fields and CRS.
+    """
     from pyogrio.errors import DataSourceError, DataLayerError
     from pyogrio.raw import read
     path = Path(path)
@@ -137,7 +152,20 @@ def read_vector_layer(path, layer=None, terrain: Terrain | None = None) -> Vecto
 
 def rasterise(terrain: Terrain, shapes) -> np.ndarray:
     """Burn (geometry, integer value) pairs onto the DEM's grid (a cell takes the value of the last feature
-    whose polygon contains its centre; 0 elsewhere); the result in the terrain's internal order."""
+    whose polygon contains its centre; 0 elsewhere); the result in the terrain's internal order.
+
+    Parameters
+    ----------
+    terrain : Terrain
+        The DEM whose grid is burnt onto.
+    shapes : iterable of (dict, int)
+        (GeoJSON-like polygon geometry, integer value) pairs.
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        Values on the grid, shape (ny, nx), in the terrain's internal order.
+    """
     from rasterio.features import rasterize
     ny, nx = terrain.shape
     shapes = list(shapes)
@@ -223,7 +251,13 @@ class SlopeThreshold:
     n_units: int = 0
 
     def label(self) -> str:
-        """One line for outputs: the threshold and where it came from (an explicit parameter or the rule)."""
+        """One line for outputs: the threshold and where it came from (an explicit parameter or the rule).
+
+        Returns
+        -------
+        str
+            The threshold [deg] and its origin.
+        """
         if self.basis == "given":
             return f"source cells: slope angle > {self.angle_deg:.1f} deg (sources.slope_above_deg, given)"
         units = ", ".join(f"{m:.1f}+-{s:.1f} deg ({w:.0%})" for m, s, w in zip(self.means_deg, self.stds_deg,
@@ -233,7 +267,13 @@ class SlopeThreshold:
                 f"(Loye et al. 2009; units {units})")
 
     def summary(self):
-        """One row per Gaussian unit (mean, standard deviation, weight), the threshold in the attrs."""
+        """One row per Gaussian unit (mean, standard deviation, weight), the threshold in the attrs.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``mean_deg``, ``std_deg`` [deg] and ``weight`` [-], one row per unit.
+        """
         import pandas as pd
         df = pd.DataFrame({"mean_deg": self.means_deg, "std_deg": self.stds_deg, "weight": self.weights})
         df.attrs["threshold_deg"] = self.angle_deg
@@ -242,7 +282,28 @@ class SlopeThreshold:
 
 def gaussian_mixture_1d(values, n_units: int = 4, *, bin_deg: float = 0.1, iterations: int = 500, tol: float = 1e-10):
     """Fit a mixture of ``n_units`` Gaussians to angles [deg] by expectation-maximisation on their histogram
-    (bins of ``bin_deg``), started at evenly spaced quantiles; returns (means, stds, weights), ascending means."""
+    (bins of ``bin_deg``), started at evenly spaced quantiles; returns (means, stds, weights), ascending means.
+
+    Parameters
+    ----------
+    values : array_like
+        Slope angles [deg].
+    n_units : int, optional
+        Number of Gaussian units.
+    bin_deg : float, optional
+        Histogram bin width [deg].
+    iterations : int, optional
+        Largest number of EM iterations.
+    tol : float, optional
+        Convergence tolerance on the log-likelihood [-].
+
+    Returns
+    -------
+    means, stds : numpy.ndarray
+        Means and standard deviations of the units [deg], ascending means.
+    weights : numpy.ndarray
+        Weights of the units [-].
+    """
     v = np.asarray(values, dtype=float)
     v = v[np.isfinite(v)]
     if v.size < 20 * n_units:
@@ -318,7 +379,22 @@ def loye_threshold(terrain: Terrain, n_units: int = 4) -> SlopeThreshold:
 
 def source_cells(terrain: Terrain, threshold: SlopeThreshold, within=None) -> np.ndarray:
     """Flat indices (internal order) of the DEM cells steeper than the threshold (and, with ``within``, a
-    boolean (ny, nx) mask, inside it)."""
+    boolean (ny, nx) mask, inside it).
+
+    Parameters
+    ----------
+    terrain : Terrain
+        The DEM.
+    threshold : SlopeThreshold
+        The slope-angle threshold.
+    within : numpy.ndarray of bool, optional
+        (ny, nx) mask the cells must lie inside.
+
+    Returns
+    -------
+    numpy.ndarray of int
+        Flat cell indices in the terrain's internal order.
+    """
     mask = np.nan_to_num(terrain.slope_deg(), nan=-1.0) > threshold.angle_deg
     if within is not None:
         mask &= within

@@ -70,11 +70,19 @@ if __name__ == "__main__":
 NUMPYDOC_PACKAGES = ("riskrf/core", "riskrf/io", "riskrf/frequency", "riskrf/hazard", "riskrf/report")
 NUMPYDOC_SIMULATION = ("engine", "result", "slope", "scenario", "units", "impact", "calibration",
                        "profile_extraction", "terrain")
-NUMPYDOC_NOT_YET = ("riskrf/hazard/design_basis.py", "riskrf/hazard/catchment.py")
+NUMPYDOC_NOT_YET = ()
 NUMPYDOC_MODULES = tuple(
     [str(p.relative_to(ROOT)) for pkg in NUMPYDOC_PACKAGES for p in sorted((ROOT / pkg).glob("*.py"))
      if str(p.relative_to(ROOT)) not in NUMPYDOC_NOT_YET and not p.name.startswith("_")]
     + [f"simulation/{m}.py" for m in NUMPYDOC_SIMULATION])
+#: App, CLI and further simulator modules brought to numpydoc form (issue 22, item 3).
+NUMPYDOC_APP_SIM = ("simulation/contact.py", "simulation/engine3d.py", "riskrf/app/corridor.py", "riskrf/cli.py",
+                    "simulation/scenario3d.py", "simulation/sources.py", "simulation/materials.py",
+                    "simulation/plotting.py", "simulation/material_uncertainty.py", "simulation/precompile.py",
+                    "simulation/kernel.py", "simulation/kernel3d.py", "riskrf/app/background.py",
+                    "riskrf/app/hazard_map.py", "riskrf/app/preflight.py", "riskrf/app/site.py",
+                    "riskrf/app/site_design.py", "riskrf/app/assess3d.py", "riskrf/app/__init__.py")
+NUMPYDOC_MODULES += NUMPYDOC_APP_SIM
 # numpydoc sections added in the "docrest" pass (issue 22, Build item 3)
 NUMPYDOC_REST = ("riskrf/app/model_uncertainty.py", "riskrf/risk/model_decision.py", "simulation/pooled.py",
                  "riskrf/app/assess.py", "riskrf/risk/mitigation.py")

@@ -65,11 +65,23 @@ class TerrainAssessment:
     timings: dict = field(default_factory=dict)
 
     def barrier_crossings(self) -> pd.DataFrame:
-        """First crossing of the barrier line by each simulated block (see :meth:`TerrainResult.collector`)."""
+        """First crossing of the barrier line by each simulated block (see :meth:`TerrainResult.collector`).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per block crossing the barrier line.
+        """
         return self.result.collector(self.site.hazard["collector"], first_only=True)
 
     def summary(self) -> dict:
-        """Machine-readable summary: rate, reach, design energies, fence verdicts, road totals, assumptions."""
+        """Machine-readable summary: rate, reach, design energies, fence verdicts, road totals, assumptions.
+
+        Returns
+        -------
+        dict
+            The summary, JSON-ready.
+        """
         hz = self.hazard
         design = self.energy.design
         line = self.result.scenario.collectors[self.result.scenario.collector_index(self.site.hazard["collector"])]
@@ -89,7 +101,18 @@ class TerrainAssessment:
         return out
 
     def write(self, out) -> dict:
-        """Write every output into the existing empty directory ``out``; returns the summary."""
+        """Write every output into the existing empty directory ``out``; returns the summary.
+
+        Parameters
+        ----------
+        out : str or pathlib.Path
+            Existing empty output directory.
+
+        Returns
+        -------
+        dict
+            The summary, with paths relative to the site file's folder.
+        """
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
@@ -115,7 +138,26 @@ class TerrainAssessment:
 
 def run_terrain_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None = None,
                            log=None, workers: int = 1) -> TerrainAssessment:
-    """Run the 3-D chain for a checked site (``site.three_d``); see the module docstring."""
+    """Run the 3-D chain for a checked site (``site.three_d``); see the module docstring.
+
+    Parameters
+    ----------
+    site : Site
+        A checked 3-D site (``site.three_d``).
+    seed : int, optional
+        Random seed (default: the site's).
+    n_blocks : int, optional
+        Blocks simulated (default: the site's).
+    log : callable, optional
+        Receives progress lines.
+    workers : int, optional
+        Threads running the kernel.
+
+    Returns
+    -------
+    TerrainAssessment
+        Inventory, frequency, hazard, simulation, design and road outputs of the site.
+    """
     log = log or logger.info
     if not site.three_d:
         raise ValueError(f"{site.path}: hazard.scenario is not a 3-D terrain scenario; use run_assessment")

@@ -52,6 +52,11 @@ class InBackground:
     def result(self):
         """The work's return value: waits for the background process (or runs the work here when no process
         could be started or it failed) and re-raises an exception the work raised.  Computed once, then kept.
+
+        Returns
+        -------
+        object
+            What the work returned.
         """
         if self._done is not None:
             return self._done[0]

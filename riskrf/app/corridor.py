@@ -135,7 +135,18 @@ class Corridor:
     rhrs_variant: str = "fhwa"
 
     def section(self, sid: str) -> Section:
-        """The section with id ``sid`` (StopIteration when there is none)."""
+        """The section with id ``sid`` (StopIteration when there is none).
+
+        Parameters
+        ----------
+        sid : str
+            Section id.
+
+        Returns
+        -------
+        Section
+            The section with that id.
+        """
         return next(s for s in self.sections if s.id == sid)
 
 
@@ -202,6 +213,42 @@ def cut_scenario_dict(materials: dict, settings: dict, *, cut_height_m, face_ang
     ``face_angle_deg``.  Blocks are released from the upper ``release_zone_share`` of the (upper) face.
     Collectors: ``barrier`` at the middle of the shoulder (at the ditch's outer rim without a shoulder), ``road``
     0.01 m onto the road.
+
+    Parameters
+    ----------
+    materials : dict
+        Scenario materials table (name -> material).
+    settings : dict
+        Scenario settings (time step, stop criteria, ...).
+    cut_height_m : float
+        Height of the rock face [m].
+    face_angle_deg : float
+        Angle of the face [deg].
+    ditch_width_m, ditch_depth_m : float
+        Width and depth of the ditch at the toe [m].
+    runout_to_road_m : float
+        Width of the flat shoulder between the ditch and the road [m].
+    road_width_m : float
+        Width of the road [m].
+    face_material, ditch_material, road_material : str
+        Names of the materials of the face, the ditch (and bench) and the road.
+    seeder_mass : dict
+        The seeder's ``mass_kg`` distribution [kg].
+    release_zone_share : float, optional
+        Upper share of the face from which blocks are released [-].
+    density_kg_m3 : float, optional
+        Rock density [kg/m3].
+    name : str, optional
+        Scenario name.
+    bench_width_m : float, optional
+        Width of a catch bench [m] (0: none).
+    bench_height_m : float, optional
+        Height of the bench above the toe [m].
+
+    Returns
+    -------
+    dict
+        Scenario dictionary for :func:`simulation.scenario_from_dict`.
     """
     from ..risk.measures import DITCH_INNER_SLOPE_HV, DITCH_OUTER_SLOPE_HV
     h, ang = float(cut_height_m), math.radians(float(face_angle_deg))
@@ -330,7 +377,24 @@ def inventory_rate(path: Path, m_min_kg: float, where: str) -> tuple[float, str]
     """Falls >= ``m_min_kg`` per year of an inventory file: :func:`riskrf.read_inventory` (its sidecar gives the
     record period) and the power law fitted above the corridor's m_min (:func:`riskrf.fit_gutenberg_richter`,
     whose rate_min is the falls >= m_min over the record length; its b is reported, the corridor's mass law is
-    unchanged).  Falls without a size are left out, as in every size fit.  Returns (rate [1/yr], note)."""
+    unchanged).  Falls without a size are left out, as in every size fit.  Returns (rate [1/yr], note).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        Inventory file.
+    m_min_kg : float
+        The corridor's smallest mass of the rate [kg].
+    where : str
+        Where the path was given (section and column), for error messages.
+
+    Returns
+    -------
+    rate : float
+        Falls >= ``m_min_kg`` per year [1/yr].
+    note : str
+        How the rate was obtained (falls, record length, fitted b).
+    """
     import warnings
 
     from ..frequency.inventory import read_inventory
@@ -1005,6 +1069,26 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     as an editor or spreadsheet numbers them, comment lines ``#`` of a CSV included).  With ``keep_going`` the bad rows
     are left out and listed in :attr:`Corridor.errors`; otherwise any bad row raises :class:`CorridorError`
     listing all of them.  Errors in the corridor file itself always raise.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Corridor TOML file.
+    keep_going : bool, optional
+        Leave bad section rows out (listed in :attr:`Corridor.errors`) instead of raising.
+    sheet : str or int, optional
+        Excel sheet of the sections table.
+    header_row : int, optional
+        Header row of the sections table.
+    decimal : str, optional
+        Decimal separator of the sections table.
+    encoding : str, optional
+        Text encoding of the sections table.
+
+    Returns
+    -------
+    Corridor
+        The checked corridor with its sections.
     """
     path = Path(path)
     data, src = _read_corridor_toml(path)
@@ -1083,7 +1167,18 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
 def rhrs_columns(rating) -> dict:
     """RHRS columns of a section's result row: ``rhrs_<category>`` whole-point score of every category and
     ``rhrs_total`` (their sum, as a rating sheet prints it); empty (NaN) without a rating.  The category set is
-    the union of both geologic cases, so every section's row has the same columns."""
+    the union of both geologic cases, so every section's row has the same columns.
+
+    Parameters
+    ----------
+    rating : RHRSRating or None
+        The section's RHRS rating.
+
+    Returns
+    -------
+    dict
+        ``rhrs_<category>`` and ``rhrs_total`` scores [points] (NaN without a rating).
+    """
     cats = ("slope_height", "ditch_effectiveness", "average_vehicle_risk", "percent_decision_sight_distance",
             "roadway_width", "structural_condition", "rock_friction", "difference_in_erosion_rates",
             "block_size_or_volume", "climate_and_water", "rockfall_history")
@@ -1127,6 +1222,23 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
     A second run of ``n`` blocks with the scenario's own seeder is the reference of the option effects
     (:class:`~riskrf.risk.mitigation.MitigationStudy` ``reference`` and ``context``), as in ``riskrf assess``.
     Deterministic given the corridor seed and the section id (see the module docstring).
+
+    Parameters
+    ----------
+    section : Section
+        The section to assess.
+    corridor : Corridor
+        The corridor it belongs to (mass law, traffic, consequences, economics, criteria).
+    n_blocks : int, optional
+        Blocks simulated per run (default: the corridor's).
+    seed : int, optional
+        Corridor seed (default: the corridor's).
+
+    Returns
+    -------
+    dict
+        One row of the corridor table: rates [1/yr], risks [deaths/yr], costs in the corridor currency, the best
+        option and the RHRS columns.
     """
     import simulation
 
@@ -1235,6 +1347,24 @@ def connect(scheduler: str | None = None, n_workers: int | None = None, *, timeo
     else a new LocalCluster of ``n_workers`` single-threaded workers (default: one per core).
 
     Returns (client, cluster or None).  An unreachable scheduler raises ConnectionError within ``timeout_s``.
+
+    Parameters
+    ----------
+    scheduler : str, optional
+        Address of a running dask scheduler.
+    n_workers : int, optional
+        Workers of a new LocalCluster (default: one per core).
+    timeout_s : float, optional
+        Time allowed to reach the scheduler [s].
+    processes : bool, optional
+        Workers as processes (True) or threads.
+
+    Returns
+    -------
+    client : distributed.Client
+        The client.
+    cluster : distributed.LocalCluster or None
+        The cluster started here (None when connected to ``scheduler``).
     """
     from distributed import Client, LocalCluster
     address = scheduler or os.environ.get("DASK_SCHEDULER_ADDRESS")
@@ -1300,7 +1430,13 @@ class CorridorResult:
 
     def summary(self) -> pd.DataFrame:
         """Sections ranked by quantitative risk (deaths per year of doing nothing) with the RHRS rank beside it,
-        the best option and its cost; ``rank_difference`` = RHRS rank - risk rank (large: they disagree)."""
+        the best option and its cost; ``rank_difference`` = RHRS rank - risk rank (large: they disagree).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per section, ranked by risk [deaths/yr], with ``rank_rhrs``, ``rank_risk`` and ``rank_difference``.
+        """
         t = self.table.copy()
         # ranks of values rounded to 12 significant digits: risks equal but for float noise share a rank, stably
         t["rank_risk"] = _sig12(t["deaths_per_year"]).rank(ascending=False, method="min").astype(int)
@@ -1316,7 +1452,14 @@ class CorridorResult:
 
     def budget_curve(self) -> pd.DataFrame:
         """Sections in order of deaths avoided per unit spent (best option of each): cumulative spend and
-        cumulative deaths avoided per year (how much risk a budget buys)."""
+        cumulative deaths avoided per year (how much risk a budget buys).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per section: ``id``, ``option``, cumulative spend (corridor currency) and cumulative deaths avoided
+            [1/yr].
+        """
         t = self.table[self.table["best_option_spend"] > 0].copy() if "best_option_spend" in self.table else \
             self.table.iloc[0:0].copy()
         t["avoided_per_spend"] = t["deaths_avoided_per_year"] / t["best_option_spend"]
@@ -1329,7 +1472,13 @@ class CorridorResult:
 
     def figure(self):
         """Along chainage: RHRS score, individual risk and deaths per year per km (see
-        :func:`riskrf.report.corridor_report.plot_corridor`)."""
+        :func:`riskrf.report.corridor_report.plot_corridor`).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            The chainage figure.
+        """
         from ..report.corridor_report import plot_corridor
         return plot_corridor(self)
 
@@ -1341,6 +1490,11 @@ class CorridorResult:
         maintenance discounted at the corridor's rate over its horizon), ``equivalent_annual_cost``
         (present_value / annuity factor (1 - (1 + r)^-n) / r: the same money as a level cost per year);
         ``deaths_avoided_per_year`` and ``expected_total_cost_saving`` against the section's do-nothing option.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per (section, option), with the columns above.
         """
         import json
         pv = _pv(self.corridor)
@@ -1369,20 +1523,62 @@ class CorridorResult:
         ``"year"`` -- it caps their summed equivalent annual cost (present value of capital, renewals and
         maintenance spread as a level yearly cost at the discount rate).  ``objective``: ``"risk"`` maximises
         deaths avoided per year, ``"cost"`` minimises the corridor's expected total cost.
+
+        Parameters
+        ----------
+        budget : float
+            Budget in the corridor currency.
+        basis : str, optional
+            ``"total"`` (capital) or ``"year"`` (equivalent annual cost).
+        objective : str, optional
+            ``"risk"`` or ``"cost"``.
+
+        Returns
+        -------
+        Programme
+            The chosen option of each funded section and the programme's cost and benefit.
         """
         from ..risk.programme import optimise_programme
         return optimise_programme(self.options_table(), budget, objective=objective,
                                   cost_column=BUDGET_BASES[basis] if basis in BUDGET_BASES else _bad_basis(basis))
 
     def frontier(self, *, basis: str = "total", objective: str = "risk", points: int = 25, budgets=None):
-        """Efficient frontier: the best programme's benefit at each budget (exact at every point)."""
+        """Efficient frontier: the best programme's benefit at each budget (exact at every point).
+
+        Parameters
+        ----------
+        basis : str, optional
+            ``"total"`` (capital) or ``"year"`` (equivalent annual cost).
+        objective : str, optional
+            ``"risk"`` or ``"cost"``.
+        points : int, optional
+            Number of budgets (when ``budgets`` is not given).
+        budgets : sequence of float, optional
+            Budgets to solve at, in the corridor currency.
+
+        Returns
+        -------
+        Frontier
+            The best benefit at each budget.
+        """
         from ..risk.programme import efficient_frontier
         return efficient_frontier(self.options_table(), budgets, objective=objective, points=points,
                                   cost_column=BUDGET_BASES[basis] if basis in BUDGET_BASES else _bad_basis(basis))
 
     def programme_table(self, programme) -> pd.DataFrame:
         """Every section with the programme's choice: ``programme_option`` ("" = not funded: do nothing), its
-        capital, present value and equivalent annual cost, deaths per year before and after."""
+        capital, present value and equivalent annual cost, deaths per year before and after.
+
+        Parameters
+        ----------
+        programme : Programme
+            A programme from :meth:`programme`.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per section with the programme's choice, its costs and deaths per year before and after.
+        """
         t = self.table[["id", "chainage_from_m", "chainage_to_m", "rhrs_total", "deaths_per_year",
                         "do_nothing_total_cost"]].copy()
         ch = programme.chosen.set_index("id")
@@ -1398,7 +1594,18 @@ class CorridorResult:
     def sections_table(self, programme=None) -> pd.DataFrame:
         """The result rows by chainage as written to sections.csv and sections.gpkg (same columns): everything
         but the per-option list (the text ``geometry`` of the cut renamed ``cut_geometry``), with the programme's
-        choice when one is given."""
+        choice when one is given.
+
+        Parameters
+        ----------
+        programme : Programme, optional
+            Add the programme's choice of each section.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per section by chainage [m].
+        """
         t = self.table.drop(columns=[c for c in ("options_json",) if c in self.table]).rename(
             columns={"geometry": "cut_geometry"})          # text: a GIS reserves "geometry" for the line itself
         if programme is not None:
@@ -1408,7 +1615,13 @@ class CorridorResult:
 
     def lines(self) -> list | None:
         """Line geometry (k x 2 vertices, metres in :attr:`Corridor.crs`) of every row of :attr:`table`, or None
-        when the corridor has no centreline."""
+        when the corridor has no centreline.
+
+        Returns
+        -------
+        list of numpy.ndarray or None
+            One (k, 2) vertex array [m] per row of :attr:`table`.
+        """
         if self.corridor.centreline is None:
             return None
         return self.corridor.centreline.cuts(self.table["chainage_from_m"], self.table["chainage_to_m"])
@@ -1416,6 +1629,11 @@ class CorridorResult:
     def to_json(self) -> dict:
         """The run as a JSON-ready dict (``corridor_summary.json``): counts, failures, rejected rows, seed, blocks,
         workers, seconds, units (chainage m, rates 1/yr, money in the corridor's currency) and totals.
+
+        Returns
+        -------
+        dict
+            The run summary.
         """
         s = self.summary()
         return {"corridor": self.corridor.name, "sections": int(len(self.table)), "failures": list(self.failures),
@@ -1476,6 +1694,36 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
     times; then the run stops, or with ``keep_going`` the failure is listed and the rest continue.
     ``progress(done, total, section_id)`` is called as each section finishes; ``log(text)`` once connected
     (the cluster's dashboard address).
+
+    Parameters
+    ----------
+    corridor : Corridor
+        From :func:`load_corridor`.
+    client : distributed.Client, optional
+        An existing client.
+    scheduler : str, optional
+        Address of a dask scheduler.
+    n_workers : int, optional
+        Workers of a new LocalCluster.
+    n_blocks : int, optional
+        Blocks simulated per run (default: the corridor's).
+    partitions : pathlib.Path, optional
+        Directory for one Parquet file per finished section.
+    resume : bool, optional
+        Skip the sections already in ``partitions``.
+    keep_going : bool, optional
+        List failed sections instead of stopping.
+    progress : callable, optional
+        ``progress(done, total, section_id)``.
+    retries : int, optional
+        Retries of a failed task.
+    log : callable, optional
+        ``log(text)``, called once connected.
+
+    Returns
+    -------
+    CorridorResult
+        One row per section, the failures and the run's figures.
     """
     from distributed import as_completed
     if n_blocks is not None and (isinstance(n_blocks, bool) or not isinstance(n_blocks, (int, np.integer))
@@ -1550,6 +1798,25 @@ def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False, b
     section with the option the exact programme gives it, or none), frontier.csv and frontier.png.
     ``programme`` and ``frontier``: already solved (:meth:`CorridorResult.programme` and ``frontier`` of the same
     budget, basis and objective), written as they are instead of solved again.
+
+    Parameters
+    ----------
+    res : CorridorResult
+        The corridor run.
+    out : pathlib.Path
+        Output directory.
+    overwrite : bool, optional
+        Replace an existing non-empty ``out``.
+    budget : float, optional
+        Budget in the corridor currency (adds the programme outputs).
+    budget_basis : str, optional
+        ``"total"`` or ``"year"``.
+    objective : str, optional
+        ``"risk"`` or ``"cost"``.
+    programme : Programme, optional
+        Already solved programme.
+    frontier : Frontier, optional
+        Already solved frontier.
     """
     from ..io.gis import write_lines_gpkg
     from ..io.outputs import atomic_output_dir, write_json

@@ -54,7 +54,13 @@ class HazardMap:
         return self.result.scenario
 
     def summary(self) -> pd.DataFrame:
-        """One row per raster: unit, pixels reached, largest value, and the run's runout quantiles."""
+        """One row per raster: unit, pixels reached, largest value, and the run's runout quantiles.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``layer``, ``unit``, ``pixels_with_value`` and ``max``, one row per raster.
+        """
         rows = []
         for name, unit in RASTERS.items():
             g = self.grids[name]
@@ -64,7 +70,18 @@ class HazardMap:
         return pd.DataFrame(rows)
 
     def plot(self, ax=None):
-        """Reach probability over the DEM's hillshade, with stop points and the recorded paths."""
+        """Reach probability over the DEM's hillshade, with stop points and the recorded paths.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         import matplotlib.pyplot as plt
         from matplotlib.colors import LogNorm
         ter = self.scenario.terrain
@@ -82,7 +99,20 @@ class HazardMap:
         return ax
 
     def write(self, out, *, overwrite: bool = False) -> Path:
-        """Write every layer to directory ``out`` (all or nothing; see the module docstring)."""
+        """Write every layer to directory ``out`` (all or nothing; see the module docstring).
+
+        Parameters
+        ----------
+        out : str or pathlib.Path
+            Output directory.
+        overwrite : bool, optional
+            Replace an existing output directory.
+
+        Returns
+        -------
+        pathlib.Path
+            The output directory.
+        """
         from ..io.outputs import atomic_output_dir
         out = Path(out)
         ter = self.scenario.terrain
@@ -119,7 +149,20 @@ def _wkb_linestring(x, y, z) -> bytes:
 
 def write_geopackage(result, path) -> Path:
     """Stop points (layer ``stop_points``) and the recorded trajectories (layer ``trajectories``) of a
-    :class:`simulation.TerrainResult` as a GeoPackage in the DEM's CRS (pyogrio)."""
+    :class:`simulation.TerrainResult` as a GeoPackage in the DEM's CRS (pyogrio).
+
+    Parameters
+    ----------
+    result : TerrainResult
+        A 3-D run.
+    path : str or pathlib.Path
+        GeoPackage file to write.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
     from pyogrio.raw import write
     path = Path(path)
     crs = result.scenario.terrain.crs
@@ -174,6 +217,12 @@ def hazard_map(scenario, n: int = 10_000, seed=1, *, crs=None, workers: int = 1,
         Tile size: squares of release points [m], at most this many blocks a tile.
     log : callable, optional
         Receives progress lines (tiles done).
+
+    Returns
+    -------
+    HazardMap
+        The run and its hazard rasters (reach probability [-], energy percentiles [kJ], jump height [m],
+        deposition density [1/m^2]).
     """
     import simulation
     if isinstance(scenario, (str, Path)):
@@ -199,7 +248,40 @@ def run_tiled(scenario, n: int, seed=1, *, client=None, scheduler: str | None = 
     """A 3-D run recording hazard pixels, tiled by source on a dask.distributed client (see the module
     docstring); the :class:`simulation.TerrainResult` equals :func:`simulation.run_terrain`'s with
     ``hazard=True``.  ``client`` is used as is; else :func:`riskrf.app.corridor.connect` (``scheduler``, or a
-    LocalCluster of ``n_workers``), closed at the end."""
+    LocalCluster of ``n_workers``), closed at the end.
+
+    Parameters
+    ----------
+    scenario : str, pathlib.Path or TerrainScenario
+        The 3-D scenario.
+    n : int
+        Blocks released.
+    seed : int, optional
+        Random seed.
+    client : distributed.Client, optional
+        An existing dask client.
+    scheduler : str, optional
+        Address of a dask scheduler.
+    n_workers : int, optional
+        Workers of a new LocalCluster.
+    tile_m : float, optional
+        Side of a tile's square of release points [m].
+    max_tile_blocks : int, optional
+        Largest number of blocks in one tile.
+    record_paths : int, optional
+        Trajectories kept.
+    masses_kg : array_like, optional
+        Block masses [kg] instead of the sources' distribution.
+    chunk_size : int, optional
+        Blocks per kernel call.
+    log : callable, optional
+        Receives progress lines.
+
+    Returns
+    -------
+    TerrainResult
+        The run, with the pixel passages recorded.
+    """
     import time
     import uuid
 

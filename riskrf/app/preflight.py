@@ -18,7 +18,21 @@ def _fail(option, value, need):
 
 
 def check_number(value, option, *, low=None, high=None, low_open=False, high_open=False, what="") -> None:
-    """Raise unless ``value`` is finite and within the bounds; None passes (not given)."""
+    """Raise unless ``value`` is finite and within the bounds; None passes (not given).
+
+    Parameters
+    ----------
+    value : float or None
+        The value given.
+    option : str
+        Name of the option, for the error message.
+    low, high : float, optional
+        Bounds (None: unbounded).
+    low_open, high_open : bool, optional
+        Exclude the bound itself.
+    what : str, optional
+        Unit or note appended to the error message (e.g. " kg/m3").
+    """
     if value is None:
         return
     ok = isinstance(value, (int, float)) and math.isfinite(value)
@@ -33,7 +47,13 @@ def check_number(value, option, *, low=None, high=None, low_open=False, high_ope
 
 
 def check_inventory_args(args) -> None:
-    """Options shared by fit, energy and decide."""
+    """Options shared by fit, energy and decide.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+    """
     check_number(_num(args, "density"), "--density", low=0, low_open=True, what=" kg/m3")
     if _num(args, "density") is not None:
         from ..core.validation import check_density
@@ -49,7 +69,15 @@ def check_inventory_args(args) -> None:
 
 
 def check_energy_args(args, *, road_collector=None) -> None:
-    """Every option `riskrf energy` and `riskrf decide --options` will use, with the scenario's collectors."""
+    """Every option `riskrf energy` and `riskrf decide --options` will use, with the scenario's collectors.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+    road_collector : str, optional
+        Name of the road collector of the scenario.
+    """
     check_inventory_args(args)
     check_number(args.n, "-n", low=1)
     check_number(args.reach_probability, "--reach-probability", low=0, high=1, low_open=True)
@@ -95,7 +123,24 @@ def check_energy_args(args, *, road_collector=None) -> None:
 def check_out(args, default, *, kind="dir", inputs=None) -> Path:
     """The output path of a command, refused up front when it would clobber something: an existing output
     without ``--overwrite``, or (:func:`riskrf.outputs.check_output_spares_inputs`) an ``--out`` that is, holds
-    or lies inside one of ``inputs`` (``{"what it is": path}``), and ``--out ''`` or ``.``."""
+    or lies inside one of ``inputs`` (``{"what it is": path}``), and ``--out ''`` or ``.``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (``--out``, ``--overwrite``).
+    default : str or pathlib.Path
+        Output path when ``--out`` is not given.
+    kind : str, optional
+        ``"dir"`` or ``"file"``.
+    inputs : dict, optional
+        ``{"what it is": path}`` of the command's inputs.
+
+    Returns
+    -------
+    pathlib.Path
+        The checked output path.
+    """
     from ..io.outputs import check_output_spares_inputs
     given = getattr(args, "out", None)
     out = Path(default) if given is None else check_output_spares_inputs(given, {}, option="--out")
@@ -112,7 +157,18 @@ INPUT_ARGUMENTS = {"inventory": "inventory", "scenario": "scenario", "velocities
 
 def command_inputs(args) -> dict:
     """Every input file a command's arguments name, TOML inputs with the files they name, tables with their
-    sidecar ``<stem>.toml``: ``{"what it is": path}``."""
+    sidecar ``<stem>.toml``: ``{"what it is": path}``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    dict
+        ``{"what it is": path}``.
+    """
     from ..io.outputs import files_named_in_toml
     found = {}
     for attr, label in INPUT_ARGUMENTS.items():
@@ -131,7 +187,15 @@ def command_inputs(args) -> dict:
 
 
 def check_rates_args(args, windows) -> None:
-    """Every numeric option of `riskrf rates`, checked before any file is read."""
+    """Every numeric option of `riskrf rates`, checked before any file is read.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+    windows : sequence of int
+        Rainfall windows [days].
+    """
     for w in windows:
         check_number(w, "--windows", low=1, what=" days (whole days)")
     for mm in args.closure_mm or ():
@@ -151,7 +215,13 @@ BYTES_PER_BLOCK = 200
 
 
 def physical_memory_bytes() -> int | None:
-    """The machine's physical memory [bytes], or None where the system does not say."""
+    """The machine's physical memory [bytes], or None where the system does not say.
+
+    Returns
+    -------
+    int or None
+        Physical memory [bytes].
+    """
     try:
         return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
     except (AttributeError, ValueError, OSError):
@@ -161,7 +231,13 @@ def physical_memory_bytes() -> int | None:
 def check_common(args) -> None:
     """Options most commands share, checked before anything is read: ``--seed`` a whole number >= 0 (NumPy's
     seeds), ``-n`` at least one block and small enough that the simulation fits in memory
-    (:data:`BYTES_PER_BLOCK` x n against the physical memory)."""
+    (:data:`BYTES_PER_BLOCK` x n against the physical memory).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+    """
     seed = getattr(args, "seed", None)
     if seed is not None:
         check_number(seed, "--seed", low=0, what=" (a whole number; NumPy seeds are >= 0)")

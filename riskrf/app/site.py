@@ -62,7 +62,18 @@ class Site:
     model_uncertainty: dict | None = None
 
     def resolve(self, relative) -> Path:
-        """A path given in the site file, resolved against the site file's folder."""
+        """A path given in the site file, resolved against the site file's folder.
+
+        Parameters
+        ----------
+        relative : str or pathlib.Path
+            Path as given in the site file.
+
+        Returns
+        -------
+        pathlib.Path
+            The absolute path.
+        """
         return (self.path.parent / relative).resolve()
 
 
@@ -73,7 +84,18 @@ def _unknown(key, allowed, where, source):
 
 
 def load_site(path) -> Site:
-    """Read and validate a site file; raises :class:`SiteError` before anything is computed."""
+    """Read and validate a site file; raises :class:`SiteError` before anything is computed.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Site TOML file.
+
+    Returns
+    -------
+    Site
+        The checked site.
+    """
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"site file not found: {path}")

@@ -33,7 +33,13 @@ class SiteDesign:
     recommended: tuple | None = None
 
     def summary(self) -> pd.DataFrame:
-        """The requirement at the barrier line (one-column table; the reason when there is none)."""
+        """The requirement at the barrier line (one-column table; the reason when there is none).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One column ``value``, one row per quantity with its unit.
+        """
         if self.requirement is None:
             return pd.DataFrame({"value": pd.Series({"design basis": self.basis.basis,
                                                      "requirement": "; ".join(self.notes)}, dtype=object)})
@@ -41,7 +47,13 @@ class SiteDesign:
 
     def to_dict(self) -> dict:
         """The design entries of summary.json: design_basis, required_barrier, deflection_check, position_search,
-        runout, ditch_chart_comparison."""
+        runout, ditch_chart_comparison.
+
+        Returns
+        -------
+        dict
+            The design entries, JSON-ready.
+        """
         r = self.requirement
         if r is None:
             return {"design_basis": {"basis": self.basis.basis, "text": self.basis.text(),
@@ -73,7 +85,13 @@ class SiteDesign:
 
     def recommended_runout(self) -> dict | None:
         """Run-out of the recommended option's slope: its name, the shares of released blocks reaching the road
-        with and without it, and the stop-point percentiles [m]; None without such a simulation."""
+        with and without it, and the stop-point percentiles [m]; None without such a simulation.
+
+        Returns
+        -------
+        dict or None
+            Option name, shares of released blocks reaching the road [-] and stop-point percentiles [m].
+        """
         if self.recommended is None:
             return None
         name, res = self.recommended
@@ -90,7 +108,22 @@ class SiteDesign:
 def option_scenario(site, scenario, option_name: str):
     """The scenario with the option ``option_name`` built into it (its ditches dug, its fences and attenuators
     standing as barriers at their lines), or None when the option does not change the slope (scaling, shed,
-    closure, realignment, doing nothing)."""
+    closure, realignment, doing nothing).
+
+    Parameters
+    ----------
+    site : Site
+        The checked site.
+    scenario : Scenario
+        The site's slope scenario.
+    option_name : str
+        Name of a mitigation option of the site.
+
+    Returns
+    -------
+    Scenario or None
+        The scenario with the option built in.
+    """
     from dataclasses import replace
 
     from ..risk.measures import Ditch, scenario_with_ditches
@@ -120,7 +153,26 @@ def option_scenario(site, scenario, option_name: str):
 
 def with_recommended_run(design: SiteDesign, site, result, option_name: str, seed) -> SiteDesign:
     """``design`` with the recommended option's slope simulated (``hazard.option_blocks`` blocks, the seeder's
-    masses), for its trajectories and stop points; unchanged when the option leaves the slope as it is."""
+    masses), for its trajectories and stop points; unchanged when the option leaves the slope as it is.
+
+    Parameters
+    ----------
+    design : SiteDesign
+        The site's design outputs.
+    site : Site
+        The checked site.
+    result : SimulationResult or None
+        The site's simulation (None: no slope to re-run).
+    option_name : str
+        Name of the recommended option.
+    seed : int
+        Random seed.
+
+    Returns
+    -------
+    SiteDesign
+        ``design`` with the recommended option's run.
+    """
     from dataclasses import replace
 
     import simulation
@@ -134,7 +186,28 @@ def with_recommended_run(design: SiteDesign, site, result, option_name: str, see
 
 
 def design_for_site(site, hazard, block, result, density_kg_m3: float, seed) -> SiteDesign:
-    """Compute the site's design outputs (see :class:`SiteDesign`)."""
+    """Compute the site's design outputs (see :class:`SiteDesign`).
+
+    Parameters
+    ----------
+    site : Site
+        The checked site.
+    hazard : EnergyHazard
+        Impact-energy hazard at the barrier line.
+    block : DesignBlock or None
+        The design block.
+    result : SimulationResult or None
+        The site's simulation.
+    density_kg_m3 : float
+        Rock density [kg/m3].
+    seed : int
+        Random seed.
+
+    Returns
+    -------
+    SiteDesign
+        Design basis, requirement, position search, run-out and catchment outputs.
+    """
     cfg = dict(site.design)
     positions_x = cfg.pop("positions_x_m", None)
     n_pos = cfg.pop("position_blocks", None) or site.hazard["option_blocks"]

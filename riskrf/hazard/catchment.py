@@ -65,7 +65,18 @@ class CatchmentStudy:
     n_over_face: int | None = None
 
     def retained_at(self, width_m) -> np.ndarray:
-        """Share [-] of the released blocks retained within ``width_m`` of the toe."""
+        """Share [-] of the released blocks retained within ``width_m`` of the toe.
+
+        Parameters
+        ----------
+        width_m : float or array_like
+            Catchment width measured from the toe [m].
+
+        Returns
+        -------
+        numpy.ndarray
+            Share of the released blocks retained within the width [-].
+        """
         return np.interp(np.asarray(width_m, dtype=float), self.curve["width_m"], self.curve["retained"])
 
     def summary(self) -> pd.DataFrame:
@@ -74,6 +85,11 @@ class CatchmentStudy:
 
         Columns: ``source``, ``width_m``, ``retained_percent`` (what the source says is retained at that width;
         NaN for the Ritchie rule, which states no level), ``simulated_percent`` (re-simulated share at the width).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per compared width with the columns above.
         """
         rows = [{"source": f"re-simulated ({self.blocks_counted} blocks over the face)", "width_m": w,
                  "retained_percent": q,
@@ -95,12 +111,29 @@ class CatchmentStudy:
 
     def plot(self, ax=None):
         """Retention against catchment width with the Ritchie width and chart values; returns the matplotlib axes
-        (drawn by :func:`riskrf.report.design_figures.plot_catchment`)."""
+        (drawn by :func:`riskrf.report.design_figures.plot_catchment`).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         from ..core.figures import draw
         return draw("catchment", self, ax=ax)
 
     def to_dict(self) -> dict:
-        """JSON-ready summary: geometry, widths for 90/95/99 %, chart comparison (or why there is none)."""
+        """JSON-ready summary: geometry, widths for 90/95/99 %, chart comparison (or why there is none).
+
+        Returns
+        -------
+        dict
+            Geometry [m, deg], widths for 90/95/99 % retention [m] and the chart comparison.
+        """
         w_mrc = modified_ritchie_width_m(self.cut_height_m)
         return {"title": self.title, "toe_x_m": self.toe_x_m, "cut_height_m": self.cut_height_m,
                 "face_angle_deg": self.face_angle_deg, "blocks_simulated": self.n,
@@ -127,6 +160,24 @@ def modified_ritchie_width_m(height_m: float) -> float:
     W = 0.2 H + 4.5 m (Ryan & Pryor 2000, the mining form of Ritchie's 1963 highway ditch rule, as quoted in the
     abstract of Warren et al. 2025, who measure catch benches against 90 % retention).  A single linear rule: it
     takes no account of rock size, face angle or catchment material, which Warren et al. found also govern rollout.
+
+    Parameters
+    ----------
+    height_m : float
+        Height of the cut face H [m].
+
+    Returns
+    -------
+    float
+        Catchment width W [m].
+
+    References
+    ----------
+    Ryan, T.M. & Pryor, P.R. (2000) Designing catch benches and interramp slopes. In Slope Stability in Surface
+    Mining, SME, 27-38.
+    Ritchie, A.M. (1963) Evaluation of rockfall and its control. Highway Research Record 17: 13-28.
+    Warren, S. et al. (2025) Preliminary expansion of the Modified Ritchie Criterion. SSIM 2025, ACG Perth,
+    doi 10.36487/ACG_repo/2535_04 (abstract).
     """
     h = float(height_m)
     if not (np.isfinite(h) and h > 0):
@@ -149,7 +200,18 @@ def _face_span(profile) -> tuple:
 
 def cut_geometry(profile) -> tuple:
     """(toe x [m], cut height [m], overall face angle [deg]) of the cut face: the steepest segment of a profile with
-    the segments of at least :data:`CUT_FACE_MIN_DEG` next to it."""
+    the segments of at least :data:`CUT_FACE_MIN_DEG` next to it.
+
+    Parameters
+    ----------
+    profile : TerrainProfile
+        Slope profile with vertices ``x``, ``z`` [m].
+
+    Returns
+    -------
+    tuple of float
+        Toe x [m], cut height [m] and overall face angle [deg].
+    """
     x, z = np.asarray(profile.x, dtype=float), np.asarray(profile.z, dtype=float)
     lo, hi = _face_span(profile)
     height = float(z[lo] - z[hi + 1])
@@ -168,6 +230,16 @@ def catchment_retention(scenario, *, n: int = 2000, seed=1, toe_x_m: float | Non
     chart : optional table or sequence of (width [m], percent retained) read from a published chart
     chart_source : where the chart values come from (figure and page), required with ``chart``
     max_width_m : widest catchment of the curve [m] (default: to the end of the profile)
+
+    Returns
+    -------
+    CatchmentStudy
+        Retention curve against width [m], widths for 90/95/99 % retention and the chart comparison.
+
+    References
+    ----------
+    Pierson, L.A., Gullixson, C.F. & Chassie, R.G. (2001) Rockfall Catchment Area Design Guide. Oregon DOT / FHWA,
+    FHWA-OR-RD-02-04.
     """
     import simulation
     sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
@@ -189,7 +261,25 @@ ODOT_FACE_DEG = (45.0, 90.0)
 
 
 def odot_chart_applies(cut_height_m: float, face_angle_deg: float) -> str:
-    """'' when a cut lies within the ODOT charts' geometry, else why not (in words)."""
+    """'' when a cut lies within the ODOT charts' geometry, else why not (in words).
+
+    Parameters
+    ----------
+    cut_height_m : float
+        Height of the cut [m].
+    face_angle_deg : float
+        Overall face angle [deg].
+
+    Returns
+    -------
+    str
+        Empty when the cut lies within the charts' geometry, else the reasons in words.
+
+    References
+    ----------
+    Pierson, L.A., Gullixson, C.F. & Chassie, R.G. (2001) Rockfall Catchment Area Design Guide. Oregon DOT / FHWA,
+    FHWA-OR-RD-02-04.
+    """
     why = []
     if not ODOT_HEIGHTS_M[0] - 0.5 <= cut_height_m <= ODOT_HEIGHTS_M[1] + 0.5:
         why.append(f"cut height {cut_height_m:.1f} m outside the charts' 40-80 ft (12.2-24.4 m)")
@@ -199,7 +289,22 @@ def odot_chart_applies(cut_height_m: float, face_angle_deg: float) -> str:
 
 
 def with_chart(study, chart, chart_source: str):
-    """``study`` with chart values (width [m], percent retained) and the simulated percent at the same widths."""
+    """``study`` with chart values (width [m], percent retained) and the simulated percent at the same widths.
+
+    Parameters
+    ----------
+    study : CatchmentStudy
+        The re-simulated study.
+    chart : pandas.DataFrame or sequence of (float, float)
+        Chart values (width [m], percent retained [%]).
+    chart_source : str
+        Where the chart values come from (figure and page).
+
+    Returns
+    -------
+    CatchmentStudy
+        A copy of ``study`` with the chart values and the simulated percent at the same widths.
+    """
     if not chart_source:
         raise ValueError("chart values need chart_source (the chart's report, figure and page)")
     c = pd.DataFrame(chart, columns=["width_m", "retained_percent"]) if not isinstance(chart, pd.DataFrame) \
@@ -211,7 +316,22 @@ def with_chart(study, chart, chart_source: str):
 
 
 def retention_from_result(res, *, toe_x_m: float | None = None, max_width_m: float | None = None) -> CatchmentStudy:
-    """:class:`CatchmentStudy` from a simulation already run (its blocks' stop points beyond the toe)."""
+    """:class:`CatchmentStudy` from a simulation already run (its blocks' stop points beyond the toe).
+
+    Parameters
+    ----------
+    res : SimulationResult
+        A simulation of a cut above a catchment.
+    toe_x_m : float, optional
+        Toe of the cut [m] (default: from :func:`cut_geometry`).
+    max_width_m : float, optional
+        Widest catchment of the curve [m] (default: to the end of the profile).
+
+    Returns
+    -------
+    CatchmentStudy
+        The retention curve and the widths for 90/95/99 % retention.
+    """
     sc = res.scenario
     toe, height, angle = cut_geometry(sc.profile)
     if toe_x_m is not None:

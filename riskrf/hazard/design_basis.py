@@ -86,7 +86,20 @@ FACTOR_SOURCES = {
 
 
 def check_basis(basis, where: str = "design.basis") -> str:
-    """The basis name if it is one of :data:`BASES`, else a ValueError naming the field and the choices."""
+    """The basis name if it is one of :data:`BASES`, else a ValueError naming the field and the choices.
+
+    Parameters
+    ----------
+    basis : str
+        Name of the design basis, one of :data:`BASES`.
+    where : str, optional
+        Name of the site-file field, for the error message.
+
+    Returns
+    -------
+    str
+        ``basis`` unchanged.
+    """
     if basis not in BASES:
         raise ValueError(f"{where} = {basis!r} is not one of {', '.join(map(repr, BASES))}")
     return basis
@@ -94,7 +107,22 @@ def check_basis(basis, where: str = "design.basis") -> str:
 
 def residual_height_category(residual_share: float) -> str:
     """EAD 340059 / ETAG 027 residual-height category of a kit from its residual height after the MEL test as a
-    share of the nominal height [-]: "A" (>= 0.5), "B" (0.3-0.5) or "C" (< 0.3)."""
+    share of the nominal height [-]: "A" (>= 0.5), "B" (0.3-0.5) or "C" (< 0.3).
+
+    Parameters
+    ----------
+    residual_share : float
+        Residual height after the MEL test as a share of the nominal height [-].
+
+    Returns
+    -------
+    str
+        The category "A", "B" or "C".
+
+    References
+    ----------
+    EAD 340059-00-0106 / ETAG 027, residual-height categories of flexible rock fall kits.
+    """
     r = float(residual_share)
     if not (np.isfinite(r) and 0.0 <= r <= 1.0):
         raise ValueError(f"residual_share = {residual_share!r} must lie between 0 and 1 (residual / nominal height)")
@@ -105,19 +133,71 @@ def residual_height_category(residual_share: float) -> str:
 
 
 def required_product_class(energy_kj: float, classes_kj=MEL_PRODUCT_CLASSES_KJ) -> float:
-    """The smallest MEL class [kJ] at or above ``energy_kj``; NaN when the largest class is too small."""
+    """The smallest MEL class [kJ] at or above ``energy_kj``; NaN when the largest class is too small.
+
+    Parameters
+    ----------
+    energy_kj : float
+        Required energy [kJ].
+    classes_kj : sequence of float, optional
+        The MEL product classes [kJ], ascending.
+
+    Returns
+    -------
+    float
+        The smallest class at or above ``energy_kj`` [kJ], NaN when none is.
+    """
     c = np.sort(np.asarray(classes_kj, dtype=float))
     above = c[c >= float(energy_kj) * (1 - 1e-12)]
     return float(above[0]) if above.size else float("nan")
 
 
 def round_up(value: float, step: float = HEIGHT_STEP_M) -> float:
-    """``value`` rounded up to a multiple of ``step`` (a kit's nominal height) [m]."""
+    """``value`` rounded up to a multiple of ``step`` (a kit's nominal height) [m].
+
+    Parameters
+    ----------
+    value : float
+        Value to round [m].
+    step : float, optional
+        Step [m] (a kit's nominal height step).
+
+    Returns
+    -------
+    float
+        ``value`` rounded up to a multiple of ``step`` [m].
+    """
     return float(math.ceil(float(value) / step - 1e-9) * step)
 
 
 def uni11211_energy(volume_m3, density_kg_m3, velocity_ms, *, gamma_Tr, gamma_Dp, gamma_VolF, gamma_gamma=1.0):
-    """UNI 11211-4 design energy [kJ]: E_d = 1/2 (Vol rho gamma_VolF gamma_gamma) (v_t gamma_Tr gamma_Dp)^2."""
+    """UNI 11211-4 design energy [kJ]: E_d = 1/2 (Vol rho gamma_VolF gamma_gamma) (v_t gamma_Tr gamma_Dp)^2.
+
+    Parameters
+    ----------
+    volume_m3 : float or array_like
+        Design block volume Vol [m3].
+    density_kg_m3 : float or array_like
+        Rock density rho [kg/m3].
+    velocity_ms : float or array_like
+        95th-percentile speed v_t at the line [m/s].
+    gamma_Tr, gamma_Dp : float
+        Partial factors on the speed for the trajectory calculation and the slope data [-].
+    gamma_VolF : float
+        Partial factor on the block volume [-].
+    gamma_gamma : float, optional
+        Partial factor on the rock density [-].
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Design energy E_d [kJ].
+
+    References
+    ----------
+    UNI 11211-4:2012 (rev. 2018); Peila D. & Ronco C. (2009), Technical Note: Design of rockfall net fences and the
+    new ETAG 027 European guideline, NHESS 9:1291-1298.
+    """
     return kinetic_energy_kj(volume_m3 * density_kg_m3 * gamma_VolF * gamma_gamma, velocity_ms * gamma_Tr * gamma_Dp)
 
 
@@ -131,6 +211,18 @@ def onr24810_min_distance_m(elongation_m, factor: float = ONR_DISTANCE_FACTOR) -
     """Least distance [m] from an ONR 24810 fence to the element at risk for a kit whose maximum elongation in the
     MEL test is ``elongation_m`` [m]: D_min = max(factor x D_MEL, D_MEL + 1 m), factor 1.2 (so D_MEL + 1 m governs
     below 5 m of elongation and 1.2 D_MEL above).
+
+    Parameters
+    ----------
+    elongation_m : float
+        Maximum elongation of the kit in the MEL test D_MEL [m].
+    factor : float, optional
+        Factor on the elongation [-] (1.2 in ONR 24810).
+
+    Returns
+    -------
+    float
+        Least distance D_min to the element at risk [m].
 
     References
     ----------
@@ -147,7 +239,20 @@ def onr24810_min_distance_m(elongation_m, factor: float = ONR_DISTANCE_FACTOR) -
 def permitted_elongation_m(basis: "DesignBasis", clearance_m: float) -> float:
     """The largest maximum elongation [m] of a kit that the clearance to the road [m] permits under ``basis``:
     clearance / gamma_d (UNI 11211-4, return period), and for ONR 24810 also clearance - 1 m
-    (:func:`onr24810_min_distance_m` inverted)."""
+    (:func:`onr24810_min_distance_m` inverted).
+
+    Parameters
+    ----------
+    basis : DesignBasis
+        The governing design basis (gives gamma_d).
+    clearance_m : float
+        Distance available from the fence line to the road [m].
+
+    Returns
+    -------
+    float
+        The largest permitted maximum elongation of a kit [m].
+    """
     g = basis.factors["gamma_d"]
     if basis.basis == "ONR 24810":
         return min(clearance_m / g, clearance_m - ONR_MIN_EXTRA_DISTANCE_M)
@@ -156,14 +261,46 @@ def permitted_elongation_m(basis: "DesignBasis", clearance_m: float) -> float:
 
 def required_distance_m(basis: "DesignBasis", elongation_m: float) -> float:
     """Distance [m] a kit of maximum elongation ``elongation_m`` needs to the road under ``basis``: D_MEL x gamma_d,
-    and for ONR 24810 :func:`onr24810_min_distance_m` (gamma_d as the factor)."""
+    and for ONR 24810 :func:`onr24810_min_distance_m` (gamma_d as the factor).
+
+    Parameters
+    ----------
+    basis : DesignBasis
+        The governing design basis (gives gamma_d).
+    elongation_m : float
+        Maximum elongation of the kit in the MEL test [m].
+
+    Returns
+    -------
+    float
+        Distance the kit needs to the road [m].
+    """
     if basis.basis == "ONR 24810":
         return onr24810_min_distance_m(elongation_m, basis.factors["gamma_d"])
     return float(elongation_m) * basis.factors["gamma_d"]
 
 
 def onr24810_energy(mass_kg, velocity_ms, *, gamma_m, gamma_v):
-    """ONR 24810 design energy [kJ]: E_d = 1/2 (m_k gamma_m) (v_k gamma_v)^2."""
+    """ONR 24810 design energy [kJ]: E_d = 1/2 (m_k gamma_m) (v_k gamma_v)^2.
+
+    Parameters
+    ----------
+    mass_kg : float or array_like
+        Characteristic mass of the design block m_k [kg].
+    velocity_ms : float or array_like
+        Characteristic speed at the line v_k [m/s].
+    gamma_m, gamma_v : float
+        Partial factors on the mass and on the speed [-].
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Design energy E_d [kJ].
+
+    References
+    ----------
+    ONR 24810:2021, Technical protection against rockfall.
+    """
     return kinetic_energy_kj(mass_kg * gamma_m, velocity_ms * gamma_v)
 
 
@@ -229,7 +366,13 @@ class DesignBasis:
         return [k for k in recalled if k not in self.stated]
 
     def text(self) -> str:
-        """The basis in one sentence, for every output."""
+        """The basis in one sentence, for every output.
+
+        Returns
+        -------
+        str
+            One sentence naming the basis, its factors and which of them are riskrf defaults.
+        """
         f = ", ".join(f"{k} {v:g}" for k, v in self.factors.items())
         s = f"design basis {self.basis} ({f}); {FACTOR_SOURCES[self.basis]}"
         if self.unverified:
@@ -239,7 +382,22 @@ class DesignBasis:
 
 
 def design_basis_from_site(cfg: dict | None, *, design_T: float = 100.0, free_board_m: float = 0.5) -> DesignBasis:
-    """A :class:`DesignBasis` from a site file's ``[design]`` table (already checked for unknown keys)."""
+    """A :class:`DesignBasis` from a site file's ``[design]`` table (already checked for unknown keys).
+
+    Parameters
+    ----------
+    cfg : dict or None
+        The site file's ``[design]`` table (None: all defaults).
+    design_T : float, optional
+        Design return period [years] (from ``hazard.design_period_years``).
+    free_board_m : float, optional
+        Least free border above the design height [m].
+
+    Returns
+    -------
+    DesignBasis
+        The stated basis with its partial factors.
+    """
     cfg = dict(cfg or {})
     basis = cfg.pop("basis", DEFAULT_BASIS)
     check_basis(basis)
@@ -305,7 +463,13 @@ class DesignRequirement:
     candidates: pd.DataFrame = field(default_factory=pd.DataFrame, repr=False)
 
     def summary(self) -> pd.DataFrame:
-        """The requirement as a one-column table with plain-language row names and units."""
+        """The requirement as a one-column table with plain-language row names and units.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One column ``value``, one row per quantity with its unit in the row name.
+        """
         rows = {
             "design basis (governs)": self.basis.basis,
             "barrier line x [m]": self.x_m,
@@ -330,7 +494,13 @@ class DesignRequirement:
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
     def text(self) -> str:
-        """The requirement in one sentence."""
+        """The requirement in one sentence.
+
+        Returns
+        -------
+        str
+            The governing basis, E_d [kJ], the required MEL [kJ], product class and net height [m] in one sentence.
+        """
         cls = (f"{self.required_class_kj:,.0f} kJ class" if np.isfinite(self.required_class_kj)
                else f"above the largest product class ({max(self.basis.mel_classes_kj):,.0f} kJ): no single kit")
         return (f"{self.basis.basis} governs: E_d = {self.E_d_kj:,.0f} kJ; required MEL {self.required_mel_kj:,.0f} kJ "
@@ -339,7 +509,13 @@ class DesignRequirement:
                 + f", residual-height category {self.residual_category}")
 
     def to_dict(self) -> dict:
-        """JSON-ready: every field, the basis with its factors, the candidate checks as records."""
+        """JSON-ready: every field, the basis with its factors, the candidate checks as records.
+
+        Returns
+        -------
+        dict
+            Every field, the basis with its factors and the candidate checks as records.
+        """
         out = {k: getattr(self, k) for k in (
             "x_m", "block_mass_kg", "block_diameter_m", "block_rule", "v_k_ms", "v_d_ms", "E_k_kj", "E_d_kj",
             "frequent_energy_kj", "design_event", "required_mel_kj", "required_class_kj", "governs", "h_k_m",
@@ -384,14 +560,44 @@ def _class_value(hazard, what: str, q: float, mass_kg: float) -> float:
 
 
 def frequent_energy(hazard, T: float) -> float:
-    """The T-year impact energy at the line [kJ]; NaN when fewer than one fall reaches it in T years."""
+    """The T-year impact energy at the line [kJ]; NaN when fewer than one fall reaches it in T years.
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        Impact-energy hazard at the line.
+    T : float
+        Return period [years].
+
+    Returns
+    -------
+    float
+        The T-year impact energy [kJ], NaN when fewer than one fall reaches the line in T years.
+    """
     return float(hazard.energy_at_return_period(T)) if T * hazard.arrival_rate > 1 else float("nan")
 
 
 def barrier_shares(hazard, mel_kj: float, height_m: float, *, block_top_m: float = 0.0) -> dict:
     """Shares [-] of the falls reaching the line that a fence of MEL [kJ] and height [m] stops, that pass over
     it (centre + ``block_top_m`` above the height) and that break through it (energy above MEL, not over; height and
-    energy taken as independent).  NaN shares without simulated heights."""
+    energy taken as independent).  NaN shares without simulated heights.
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        Impact-energy hazard at the line (with simulated passing heights).
+    mel_kj : float
+        Maximum energy level of the fence [kJ].
+    height_m : float
+        Net height of the fence [m].
+    block_top_m : float, optional
+        Height of the block top above its centre [m].
+
+    Returns
+    -------
+    dict
+        Shares [-] under "stopped", "over" and "through".
+    """
     p_e = float(hazard.exceedance_probability(mel_kj))
     over = float(hazard.height_exceedance(height_m - block_top_m)) if hazard.heights_m is not None else float("nan")
     through = (1.0 - over) * p_e if np.isfinite(over) else p_e
@@ -413,6 +619,16 @@ def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3:
     x_m : position of the line [m] (for the outputs)
     clearance_m : distance [m] from the line to the road (``basis.clearance_m`` replaces it when stated)
     candidates : sequence of (name, MEL [kJ], height [m]) fences to check against the requirement
+
+    Returns
+    -------
+    DesignRequirement
+        Design energy [kJ], required MEL [kJ] and product class, required net height [m], permitted elongation [m]
+        and the candidate checks.
+
+    References
+    ----------
+    UNI 11211-4:2012 (rev. 2018); Peila & Ronco (2009), NHESS 9:1291-1298; ONR 24810:2021.
     """
     f = basis.factors
     m, rule = _block_for_basis(hazard, basis, block, density_kg_m3)
@@ -525,7 +741,14 @@ class PositionSearch:
 
     def summary(self) -> pd.DataFrame:
         """The per-position table with plain-language headers and units, one row per position, the cheapest
-        position marked (column "cheapest")."""
+        position marked (column "cheapest").
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per position [m] with the required MEL [kJ], class [kJ] and net height [m]; column "cheapest" marks
+            the cheapest position.
+        """
         names = {"x_m": "position x [m]", "ground_z_m": "ground z [m]", "reach_share": "share of blocks reaching",
                  "arrivals_per_year": "arrivals per year", "E_d_kj": "design energy E_d [kJ]",
                  "required_mel_kj": "required MEL [kJ]", "required_class_kj": "product class MEL [kJ]",
@@ -538,13 +761,30 @@ class PositionSearch:
 
     def plot(self, ax=None):
         """Required MEL, product class and net height per position; returns the matplotlib axes (drawn by
-        :func:`riskrf.report.design_figures.plot_position_search`)."""
+        :func:`riskrf.report.design_figures.plot_position_search`).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         from ..core.figures import draw
         return draw("position_search", self, ax=ax)
 
     def cheapest(self) -> pd.Series | None:
         """The position with the smallest required class, then the lowest net height (None when no position has a
-        class)."""
+        class).
+
+        Returns
+        -------
+        pandas.Series or None
+            The row of the cheapest position, None when no position has a class.
+        """
         t = self.table.dropna(subset=["required_class_kj"])
         if t.empty:
             return None
@@ -553,7 +793,24 @@ class PositionSearch:
 
 def default_positions(scenario, barrier_x: float, road_x: float | None, k: int = 9) -> list:
     """``k`` positions [m] between a quarter of the way from the release zone to the road and 2 m before the road,
-    with the barrier line among them."""
+    with the barrier line among them.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The site's simulation scenario (gives the release zone).
+    barrier_x : float
+        Position of the barrier line along the profile [m].
+    road_x : float or None
+        Position of the road along the profile [m] (None: the profile end).
+    k : int, optional
+        Number of positions.
+
+    Returns
+    -------
+    list of float
+        Sorted positions along the profile [m].
+    """
     start = float(scenario.seeder.x_high)
     end = (road_x if road_x is not None else float(scenario.profile.x[-1])) - 2.0
     lo = start + 0.25 * (end - start)
@@ -569,6 +826,34 @@ def position_search(hazard, scenario, basis: DesignBasis, *, block=None, density
     The blocks are simulated over the hazard's own mass range (log-uniform, stratified, as the mass-coupled
     hazard) with a collector at each position; each position's reach, speeds and heights by mass class give its
     hazard under the site's mass law and rate, and the chosen basis gives the required MEL and height there.
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        Mass-coupled hazard at the barrier line (gives the mass range, mass law and rate).
+    scenario : Scenario
+        The site's simulation scenario.
+    basis : DesignBasis
+        The governing design basis.
+    block : DesignBlock, optional
+        The design block (needed by ONR 24810 and UNI 11211-4).
+    density_kg_m3 : float, optional
+        Rock density [kg/m3].
+    positions_m : sequence of float, optional
+        Positions along the profile [m] (default :func:`default_positions`).
+    road_collector : str or None, optional
+        Name of the road collector (gives the clearance).
+    barrier_x : float, optional
+        Position of the barrier line [m].
+    n : int, optional
+        Number of simulated blocks.
+    seed : int, optional
+        Random seed.
+
+    Returns
+    -------
+    PositionSearch
+        The requirement per position, the profile and the basis.
     """
     import simulation
 
