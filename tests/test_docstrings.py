@@ -79,6 +79,9 @@ NUMPYDOC_MODULES = tuple(
 NUMPYDOC_REST = ("riskrf/app/model_uncertainty.py", "riskrf/risk/model_decision.py", "simulation/pooled.py",
                  "riskrf/app/assess.py", "riskrf/risk/mitigation.py")
 NUMPYDOC_MODULES = NUMPYDOC_MODULES + NUMPYDOC_REST
+#: riskrf.risk modules in numpydoc form (issue 22, item 3); mitigation.py and model_decision.py are being rewritten.
+NUMPYDOC_RISK = ("riskrf/risk/options.py",)
+NUMPYDOC_MODULES += NUMPYDOC_RISK
 
 
 def _section(doc: str, title: str) -> bool:
