@@ -120,6 +120,8 @@ def lanes_from_traffic(vehicles_per_day, speed_kmh: float, lanes: int = 2, direc
     ValueError
         When a number is out of range or ``fall_shares`` has the wrong length.
 
+    Examples
+    --------
     >>> [round(l.vehicles_per_day) for l in lanes_from_traffic(6000, 80)]
     [3000, 3000]
     """
@@ -187,6 +189,8 @@ def lane_hit_probability(lanes, vehicle_length_m: float, traffic_factor=1.0):
     Bunce, C. M., Cruden, D. M. and Morgenstern, N. R. (1997). Assessment of the hazard from rock fall on a highway.
     Canadian Geotechnical Journal 34, 344-356.
 
+    Examples
+    --------
     >>> round(lane_hit_probability(lanes_from_traffic(6000, 80), 5.0), 7)   # 3000 x 5 / (24000 x 80)
     0.0078125
     """
@@ -232,6 +236,8 @@ def lane_strike_probability(lanes, hours_on_road: float, p_cannot_stop: float, t
     Bunce, C. M., Cruden, D. M. and Morgenstern, N. R. (1997). Assessment of the hazard from rock fall on a highway.
     Canadian Geotechnical Journal 34, 344-356.
 
+    Examples
+    --------
     >>> round(lane_strike_probability(lanes_from_traffic(6000, 80), 0.5, 0.002), 8)  # 0.002 (1 - exp(-3000*0.5/24))
     0.002
     """
