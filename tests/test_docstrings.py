@@ -82,7 +82,8 @@ NUMPYDOC_MODULES = NUMPYDOC_MODULES + NUMPYDOC_REST
 #: riskrf.risk modules in numpydoc form (issue 22, item 3); mitigation.py and model_decision.py are being rewritten.
 NUMPYDOC_RISK = tuple(f"riskrf/risk/{m}.py" for m in (
     "options", "road_risk", "rhrs", "decision_tree", "measures", "loss_engine", "slope_models", "tolerability",
-    "road_users", "site_rates", "mitigation_inputs", "closure", "geometry_measures", "road_profile"))
+    "road_users", "site_rates", "mitigation_inputs", "closure", "geometry_measures", "road_profile",
+    "road_validation"))
 NUMPYDOC_MODULES += NUMPYDOC_RISK
 
 
