@@ -83,7 +83,7 @@ NUMPYDOC_MODULES = NUMPYDOC_MODULES + NUMPYDOC_REST
 NUMPYDOC_RISK = tuple(f"riskrf/risk/{m}.py" for m in (
     "options", "road_risk", "rhrs", "decision_tree", "measures", "loss_engine", "slope_models", "tolerability",
     "road_users", "site_rates", "mitigation_inputs", "closure", "geometry_measures", "road_profile",
-    "road_validation", "economics"))
+    "road_validation", "economics", "programme"))
 NUMPYDOC_MODULES += NUMPYDOC_RISK
 
 
