@@ -87,6 +87,12 @@ NUMPYDOC_MODULES += NUMPYDOC_APP_SIM
 NUMPYDOC_REST = ("riskrf/app/model_uncertainty.py", "riskrf/risk/model_decision.py", "simulation/pooled.py",
                  "riskrf/app/assess.py", "riskrf/risk/mitigation.py")
 NUMPYDOC_MODULES = NUMPYDOC_MODULES + NUMPYDOC_REST
+#: The other riskrf.risk modules in numpydoc form (issue 22, item 3; mitigation and model_decision: NUMPYDOC_REST).
+NUMPYDOC_RISK = tuple(f"riskrf/risk/{m}.py" for m in (
+    "options", "road_risk", "rhrs", "decision_tree", "measures", "loss_engine", "slope_models", "tolerability",
+    "road_users", "site_rates", "mitigation_inputs", "closure", "geometry_measures", "road_profile",
+    "road_validation", "economics", "programme"))
+NUMPYDOC_MODULES += NUMPYDOC_RISK
 
 
 def _section(doc: str, title: str) -> bool:

@@ -78,6 +78,11 @@ class ClosureRule:
     def summary(self) -> pd.DataFrame:
         """Key figures of the rule (one-column table): period evaluated, effectiveness (share of falls while closed,
         model and recorded), falls per year [1/yr] in all and while closed, hours closed per year.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One column ``value`` indexed by the figure's name (units in the names).
         """
         rows = {
             "rule": self.rule,
@@ -100,7 +105,23 @@ class ClosureRule:
         """The closure as an option table for a mitigation file (``[[options]]``, kind ``closure``) with the share and
         hours TYPED from this evaluation: the outputs label such an option an assumption.  In a site file give the
         rule instead (``threshold_mm`` + ``window_days`` or ``warning_levels``, with a ``[rates]`` table): the share
-        and hours are then computed in the run (:mod:`riskrf.risk.site_rates`)."""
+        and hours are then computed in the run (:mod:`riskrf.risk.site_rates`).
+
+        Parameters
+        ----------
+        name : str
+            The option's name.
+        capital_cost : float, optional
+            Capital cost [currency], e.g. [CHF].
+        life_years : float, optional
+            Life of the option [yr].
+
+        Returns
+        -------
+        dict
+            The ``[[options]]`` table: share while closed [-], closure hours per year [h/yr], cost per closure hour
+            [currency/h].
+        """
         spec = {"name": name, "kind": "closure", "capital_cost": float(capital_cost),
                 "share_while_closed": float(self.effectiveness),
                 "closure_hours_per_year": float(self.closure_hours_per_year),
@@ -151,6 +172,17 @@ def closure_rule(model: RateModel, threshold_mm: float, *, window_days: int = 1,
         Window length [days], 1 = the day's rainfall.
     cost_per_hour : float
         Cost of one closure hour (detours and delay), in the study's currency.
+
+    Returns
+    -------
+    ClosureRule
+        Effectiveness (share of falls while closed) [-], closure hours per year [h/yr], closures per year [1/yr] and
+        cost per hour [currency/h].
+
+    Raises
+    ------
+    ValueError
+        When an input is out of range or the model is not a daily model fitted with rainfall.
     """
     what = "closure_rule"
     if not (np.isfinite(threshold_mm) and threshold_mm > 0):
@@ -176,6 +208,23 @@ def read_rainstorm_warnings(path) -> pd.DataFrame:
     end date, duration``; dates like ``12-Apr-98``): one row per signal with ``level``, ``start``, ``end``.
 
     Raises ``ValueError`` naming the row and value for an unreadable time or date, or an end before the start.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The CSV file.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``level``, ``start``, ``end`` (timestamps) and ``row`` (file line).
+
+    Raises
+    ------
+    FileNotFoundError
+        When the file does not exist.
+    ValueError
+        Naming the row and value of an unreadable time or date, a missing column, or an end before the start.
     """
     path = Path(path)
     if not path.exists():
@@ -216,6 +265,28 @@ def warning_closure(model: RateModel, warnings, *, levels=("Red", "Black"), cost
     The rule is evaluated over the days both the rate model and the warning
     record cover (the first to the last warning's year); hours of closure per
     day come from the signals (overlapping signals counted once).
+
+    Parameters
+    ----------
+    model : RateModel
+        A daily rate model fitted with rainfall (:func:`riskrf.frequency.rates`).
+    warnings : pandas.DataFrame or str or pathlib.Path
+        The warning list (:func:`read_rainstorm_warnings`) or its file.
+    levels : sequence of str, optional
+        Warning levels that close the road.
+    cost_per_hour : float, optional
+        Cost of one closure hour [currency/h].
+
+    Returns
+    -------
+    ClosureRule
+        Effectiveness (share of falls while closed) [-], closure hours per year [h/yr], closures per year [1/yr] and
+        cost per hour [currency/h].
+
+    Raises
+    ------
+    ValueError
+        When an input is out of range or the model is not a daily model fitted with rainfall.
     """
     what = "warning_closure"
     if not isinstance(warnings, pd.DataFrame):

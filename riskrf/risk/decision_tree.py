@@ -143,7 +143,25 @@ class DecisionTree(Displayed):
     # ---- construction ---------------------------------------------------------------
     @classmethod
     def from_dict(cls, spec: dict, source: str = "<dict>") -> "DecisionTree":
-        """Tree from a dict as read from TOML/JSON; ``source`` names it in error messages."""
+        """Tree from a dict as read from TOML/JSON; ``source`` names it in error messages.
+
+        Parameters
+        ----------
+        spec : dict
+            The tree as read from TOML/JSON (``type``, ``branches``, optional ``parameters``, ``objective``, ``nodes``).
+        source : str, optional
+            Name of the tree's origin in error messages.
+
+        Returns
+        -------
+        DecisionTree
+            The checked tree.
+
+        Raises
+        ------
+        TreeError
+            When the tree is malformed (names the source and the node path).
+        """
         if not isinstance(spec, dict):
             raise TreeError(f"{source}: a tree must be a table/object; got {type(spec).__name__}")
         params = spec.get("parameters", {})
@@ -162,7 +180,25 @@ class DecisionTree(Displayed):
 
     @classmethod
     def from_file(cls, path) -> "DecisionTree":
-        """Tree from a TOML or JSON file; every field is checked before use."""
+        """Tree from a TOML or JSON file; every field is checked before use.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            A ``.toml`` or ``.json`` tree file.
+
+        Returns
+        -------
+        DecisionTree
+            The checked tree.
+
+        Raises
+        ------
+        FileNotFoundError
+            When ``path`` does not exist.
+        TreeError
+            When the file cannot be parsed or the tree is malformed.
+        """
         path = Path(path)
         if not path.exists():
             raise FileNotFoundError(f"decision tree file not found: {path}")
@@ -181,7 +217,23 @@ class DecisionTree(Displayed):
         return cls.from_dict(data, source=str(path))
 
     def with_parameters(self, **values) -> "DecisionTree":
-        """A copy of the tree with some parameters set to new values (unknown names are refused)."""
+        """A copy of the tree with some parameters set to new values (unknown names are refused).
+
+        Parameters
+        ----------
+        **values : float
+            New values of existing parameters (units as in the tree: probabilities [-], costs in its currency).
+
+        Returns
+        -------
+        DecisionTree
+            The new tree (this one is unchanged).
+
+        Raises
+        ------
+        TreeError
+            When a name is not a parameter of the tree.
+        """
         unknown = set(values) - set(self.parameters)
         if unknown:
             raise TreeError(f"{self.source}: unknown parameter(s) {sorted(unknown)}; parameters are "
@@ -225,6 +277,24 @@ class DecisionTree(Displayed):
         ``risk_tolerance`` R switches to exponential utility (certainty equivalents).
         ``fixed`` maps a chance ``variable`` to the outcome known to occur (used for
         the value of perfect information).
+
+        Parameters
+        ----------
+        risk_tolerance : float, optional
+            Risk tolerance R of the exponential utility u(x) = 1 - exp(-x/R), in the tree's currency (e.g.
+            [CHF]); expected values when None.
+        fixed : dict, optional
+            Chance variable -> outcome known to occur.
+
+        Returns
+        -------
+        Rollback
+            Value of the tree, of every option of the top decision and of every node (net cost for ``"min"``, net payoff
+            for ``"max"``, in the tree's currency), and the optimal policy.
+
+        References
+        ----------
+        Clemen, R. T. and Reilly, T. (2001). Making Hard Decisions with DecisionTools. Duxbury, ch. 4.
         """
         policy = {}
         node_values = {}
@@ -272,7 +342,19 @@ class DecisionTree(Displayed):
         return Rollback(options[best], options, policy, self.objective, node_values)
 
     def ranking(self, **kwargs) -> pd.DataFrame:
-        """Options of the top decision, best first, with their expected value and rank."""
+        """Options of the top decision, best first, with their expected value and rank.
+
+        Parameters
+        ----------
+        **kwargs
+            Passed to :meth:`rollback` (``risk_tolerance``, ``fixed``).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``option``, ``expected_value`` (in the tree's currency), ``difference_from_best`` and ``rank``, best
+            first.
+        """
         rb = self.rollback(**kwargs)
         values = dict(rb.option_values) or {self._whole_tree_name(): rb.value}   # no decision: the tree is one course
         df = pd.DataFrame({"option": list(values), "expected_value": list(values.values())})
@@ -325,6 +407,22 @@ class DecisionTree(Displayed):
         """Distribution of outcomes (net value) of an option under the optimal later policy.
 
         Columns: option, outcome value, probability, cumulative probability.
+
+        Parameters
+        ----------
+        option : str, optional
+            One option of the top decision; all options when None.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``option``, ``value`` (net outcome, in the tree's currency), ``probability`` [-] and ``cumulative``
+            [-].
+
+        Raises
+        ------
+        TreeError
+            When ``option`` is not an option of the top decision.
         """
         rb = self.rollback()
         names = [b.name for b in self.root.branches] if self.root.type == "decision" else [self._whole_tree_name()]
@@ -359,7 +457,25 @@ class DecisionTree(Displayed):
 
     # ---- sensitivity ----------------------------------------------------------------------
     def sensitivity(self, parameter: str, values) -> pd.DataFrame:
-        """One-way sensitivity: the value of every option as ``parameter`` takes each of ``values``."""
+        """One-way sensitivity: the value of every option as ``parameter`` takes each of ``values``.
+
+        Parameters
+        ----------
+        parameter : str
+            Name of a tree parameter.
+        values : array_like
+            Values it takes (its units: probability [-] or the tree's currency).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per value: the parameter, the value of every option (in the tree's currency) and ``best``.
+
+        Raises
+        ------
+        TreeError
+            When a value makes the tree invalid (names the parameter and value).
+        """
         rows = []
         for v in np.asarray(values, dtype=float):
             t = self.with_parameters(**{parameter: float(v)})
@@ -374,6 +490,22 @@ class DecisionTree(Displayed):
         """Value of ``parameter`` in [low, high] at which options a and b (default: best and second) tie.
 
         Returns None when they do not cross in the range.
+
+        Parameters
+        ----------
+        parameter : str
+            Name of a tree parameter.
+        low, high : float
+            The search range of the parameter (its units).
+        option_a, option_b : str, optional
+            The two options compared; the best and second best at the tree's parameters by default.
+        tol : float, optional
+            Relative tolerance of the root [-].
+
+        Returns
+        -------
+        float or None
+            The break-even value of ``parameter`` (its units), or None when the options do not cross in the range.
         """
         rank = self.ranking()
         a = option_a or rank["option"].iloc[0]
@@ -394,6 +526,19 @@ class DecisionTree(Displayed):
         """Swing of the optimal value as each parameter moves over its range (default +-``swing``).
 
         Sorted by swing, widest first (the bars of a tornado chart).
+
+        Parameters
+        ----------
+        ranges : dict, optional
+            Parameter name -> (low, high) (the parameter's units); others vary by +-``swing``.
+        swing : float, optional
+            Relative change of a parameter without a range [-].
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``parameter``, ``low``, ``high``, ``value_at_low``, ``value_at_high``, ``swing`` and ``base``
+            (values in the tree's currency), widest swing first.
         """
         base = self.rollback().value
         rows = []
@@ -410,7 +555,13 @@ class DecisionTree(Displayed):
 
     # ---- value of information ------------------------------------------------------------
     def variables(self) -> dict:
-        """Chance variables: name -> {outcome: probability} (from their first occurrence)."""
+        """Chance variables: name -> {outcome: probability} (from their first occurrence).
+
+        Returns
+        -------
+        dict
+            Variable name -> {outcome name: probability [-]}.
+        """
         out = {}
 
         def walk(node):
@@ -428,6 +579,25 @@ class DecisionTree(Displayed):
         The decision maker learns the outcome before the first decision: the
         expectation over outcomes of the best value given each outcome, compared
         with the best value now.  Non-negative by construction.
+
+        Parameters
+        ----------
+        variable : str
+            A chance variable of the tree.
+
+        Returns
+        -------
+        float
+            EVPI, in the tree's currency, >= 0.
+
+        Raises
+        ------
+        TreeError
+            When no chance node has that variable.
+
+        References
+        ----------
+        Clemen, R. T. and Reilly, T. (2001). Making Hard Decisions with DecisionTools. Duxbury, ch. 4.
         """
         variables = self.variables()
         if variable not in variables:
@@ -440,7 +610,29 @@ class DecisionTree(Displayed):
 
     def evsi(self, with_information: str, without_information: str) -> float:
         """Expected value of sample information: value of the option that gathers information (a survey,
-        monitoring) before its cost, minus the value of deciding without it."""
+        monitoring) before its cost, minus the value of deciding without it.
+
+        Parameters
+        ----------
+        with_information : str
+            The option of the top decision that gathers the information.
+        without_information : str
+            The option of deciding without it.
+
+        Returns
+        -------
+        float
+            EVSI, in the tree's currency.
+
+        Raises
+        ------
+        TreeError
+            When either name is not an option of the top decision.
+
+        References
+        ----------
+        Clemen, R. T. and Reilly, T. (2001). Making Hard Decisions with DecisionTools. Duxbury, ch. 4.
+        """
         rb = self.rollback()
         branches = {b.name: b for b in self.root.branches}
         for name in (with_information, without_information):

@@ -15,6 +15,27 @@ def pv_factor(rate, years):
 
     e.g. 18.256 for 5 % over 50 years, 25.730 for 3 % over 50 years (domain-methods.md section 5).
     ``rate`` may be an array (one factor per rate).
+
+    Parameters
+    ----------
+    rate : float or array_like
+        Discount rate [1/yr] as a fraction (0.03 = 3 %), in [0, 1).
+    years : float
+        Horizon n [yr], > 0.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Present value of 1 a year for n years [yr], one per rate.
+
+    Raises
+    ------
+    ValueError
+        When a rate lies outside [0, 1).
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, section 8.5.5.
     """
     r = np.asarray(rate, dtype=float)
     n = check_positive(years, "years")
@@ -29,6 +50,24 @@ def renewal_factor(life_years, horizon_years, rate):
     """Present value of re-building every ``life_years`` within the horizon per unit of first cost.
 
     sum over k = 1, 2, ... with k L < horizon of (1 + r)^-(k L) (the first build excluded).
+
+    Parameters
+    ----------
+    life_years : float
+        Life L of the structure [yr], > 0.
+    horizon_years : float
+        Horizon [yr].
+    rate : float or array_like
+        Discount rate [1/yr] as a fraction (0.03 = 3 %), in [0, 1).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Present value of the renewals per unit of first cost [-], one per rate.
+
+    References
+    ----------
+    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, section 8.5.5.
     """
     life = check_positive(life_years, "life_years")
     k = np.arange(1, int(np.floor((float(horizon_years) - 1e-9) / life)) + 1)
@@ -38,7 +77,24 @@ def renewal_factor(life_years, horizon_years, rate):
 
 
 def pv_of_renewals(cost, life_years, horizon_years, rate):
-    """Present value of re-building every ``life_years`` within the horizon (the first build excluded)."""
+    """Present value of re-building every ``life_years`` within the horizon (the first build excluded).
+
+    Parameters
+    ----------
+    cost : float
+        Cost of one build [currency], e.g. [CHF].
+    life_years : float
+        Life L of the structure [yr], > 0.
+    horizon_years : float
+        Horizon [yr].
+    rate : float
+        Discount rate [1/yr] as a fraction.
+
+    Returns
+    -------
+    float
+        Present value of the renewals [currency].
+    """
     return float(cost * renewal_factor(life_years, horizon_years, float(rate)))
 
 

@@ -67,7 +67,33 @@ def _check_inside(profile, x0, x1, where):
 
 
 def bench_profile(profile, x_m, width_m, *, inner_slope_hv=BENCH_INNER_SLOPE_HV, material=None, where="bench"):
-    """A copy of ``profile`` with a catch bench cut from ``x_m`` to ``x_m + width_m`` (see the module docstring)."""
+    """A copy of ``profile`` with a catch bench cut from ``x_m`` to ``x_m + width_m`` (see the module docstring).
+
+    Parameters
+    ----------
+    profile : simulation.slope.Profile
+        The slope profile.
+    x_m : float
+        Upslope edge of the bench [m].
+    width_m : float
+        Width of the bench along x [m].
+    inner_slope_hv : float, optional
+        Back wall, horizontal run per unit drop [m/m].
+    material : int, optional
+        Material index of the new surface; the neighbouring ground's by default.
+    where : str, optional
+        What to name in error messages.
+
+    Returns
+    -------
+    simulation.slope.Profile
+        The new profile.
+
+    Raises
+    ------
+    MeasureError
+        When the measure leaves the profile or does not fit the ground.
+    """
     from simulation.slope import Profile
     x0, x1 = float(x_m), float(x_m) + float(width_m)
     _check_inside(profile, x0, x1, where)
@@ -92,7 +118,35 @@ def bench_profile(profile, x_m, width_m, *, inner_slope_hv=BENCH_INNER_SLOPE_HV,
 def bund_profile(profile, x_m, width_m, height_m, *, inner_slope_hv=BUND_INNER_SLOPE_HV,
                  outer_slope_hv=BUND_OUTER_SLOPE_HV, material=None, where="bund"):
     """A copy of ``profile`` with a bund of crest ``height_m`` above the ground between ``x_m`` and ``x_m +
-    width_m`` (see the module docstring)."""
+    width_m`` (see the module docstring).
+
+    Parameters
+    ----------
+    profile : simulation.slope.Profile
+        The slope profile.
+    x_m : float
+        Upslope toe of the bund [m].
+    width_m : float
+        Base width of the bund along x [m].
+    height_m : float
+        Crest height above the ground [m], > 0.
+    inner_slope_hv, outer_slope_hv : float, optional
+        Slope-side and road-side faces, horizontal run per unit rise [m/m].
+    material : int, optional
+        Material index of the new surface; the neighbouring ground's by default.
+    where : str, optional
+        What to name in error messages.
+
+    Returns
+    -------
+    simulation.slope.Profile
+        The new profile.
+
+    Raises
+    ------
+    MeasureError
+        When the measure leaves the profile or does not fit the ground.
+    """
     from simulation.slope import Profile
     x0, x1, h = float(x_m), float(x_m) + float(width_m), float(height_m)
     _check_inside(profile, x0, x1, where)
@@ -116,7 +170,27 @@ def bund_profile(profile, x_m, width_m, height_m, *, inner_slope_hv=BUND_INNER_S
 
 
 def drape_scenario(scenario, zone_x_m, where="drape"):
-    """A copy of ``scenario`` whose surface between ``zone_x_m`` takes the drape material (added once)."""
+    """A copy of ``scenario`` whose surface between ``zone_x_m`` takes the drape material (added once).
+
+    Parameters
+    ----------
+    scenario : simulation.scenario.Scenario
+        The slope scenario.
+    zone_x_m : tuple of float
+        (x_lo, x_hi) of the draped zone [m].
+    where : str, optional
+        What to name in error messages.
+
+    Returns
+    -------
+    simulation.scenario.Scenario
+        The new scenario, with the material ``drape`` (:data:`DRAPE_MATERIAL`, an ASSUMPTION).
+
+    Raises
+    ------
+    MeasureError
+        When the zone leaves the profile.
+    """
     from simulation.scenario import Material
     from simulation.slope import Profile
     prof = scenario.profile
@@ -139,7 +213,29 @@ def drape_scenario(scenario, zone_x_m, where="drape"):
 
 def scenario_with_measures(scenario, measures, where: str = "measures", road_collector: str | None = "road"):
     """A copy of ``scenario`` carrying every ditch (:class:`~riskrf.measures.Ditch`) and slope measure
-    (:class:`SlopeMeasure`) of ``measures``; spans must not overlap and must not cross the road line."""
+    (:class:`SlopeMeasure`) of ``measures``; spans must not overlap and must not cross the road line.
+
+    Parameters
+    ----------
+    scenario : simulation.scenario.Scenario
+        The slope scenario.
+    measures : iterable
+        Ditches and :class:`SlopeMeasure` objects (lengths [m]).
+    where : str, optional
+        What to name in error messages.
+    road_collector : str or None, optional
+        Name of the road collector no measure may cover.
+
+    Returns
+    -------
+    simulation.scenario.Scenario
+        The new scenario (named ``<name>+measures``).
+
+    Raises
+    ------
+    MeasureError
+        When measures overlap, a material is unknown, a measure covers the road line or does not fit the ground.
+    """
     ms = sorted(measures, key=lambda m: m.span[0])
     for a, b in zip(ms[:-1], ms[1:]):
         if b.span[0] < a.span[1]:

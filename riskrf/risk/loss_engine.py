@@ -69,7 +69,25 @@ def mass_grid(mass, small_fall_masses_kg, small_falls_per_year: float, uncertain
     """The mass grid of a study: geometric bins from below the smallest fall (the power law's m_min, or the mass
     model's 1e-9 quantile, and the small falls' masses) to the largest (the power law's m_max, else 1e6 m_min, and
     the sampled m_max; or the 1 - 1e-9 quantile).  With fragmentation the grid reaches down to the finest
-    generation (each generation divides the mass by 8)."""
+    generation (each generation divides the mass by 8).
+
+    Parameters
+    ----------
+    mass : object
+        The study's mass distribution, as accepted by :func:`riskrf.hazard.impact_energy.mass_model`.
+    small_fall_masses_kg : array_like or None
+        Masses of the inventory's falls below the power law's m_min [kg].
+    small_falls_per_year : float
+        Frequency of those small falls [1/yr].
+    uncertainty : object
+        The study's uncertainty settings (``m_max_kg`` range [kg], ``fractal_dimension``,
+        ``fragmentation_iterations``).
+
+    Returns
+    -------
+    MassGrid
+        Bin edges and middle masses [kg] and the small falls' histogram [-].
+    """
     mm = mass_model(mass)
     lo_model, hi = mm.grid_bounds_kg(uncertainty.m_max_kg[1] if uncertainty.m_max_kg else None)
     lo_candidates = [lo_model]
@@ -90,7 +108,24 @@ def mass_grid(mass, small_fall_masses_kg, small_falls_per_year: float, uncertain
 def mass_pmf(edges: np.ndarray, mass, b=None, m_max=None) -> np.ndarray:
     """Probability of each mass bin for one fall of at least m_min; arrays (S, J) for sampled b and m_max [kg]
     (a power law truncated at m_max), else (1, J) from the mass model's survival function.  The last bin takes
-    the tail."""
+    the tail.
+
+    Parameters
+    ----------
+    edges : numpy.ndarray
+        Mass bin edges (J + 1) [kg].
+    mass : object
+        The study's mass distribution, as accepted by :func:`riskrf.hazard.impact_energy.mass_model`.
+    b : numpy.ndarray, optional
+        Sampled power-law exponents (S,) [-].
+    m_max : numpy.ndarray, optional
+        Sampled largest masses (S,) [kg].
+
+    Returns
+    -------
+    numpy.ndarray
+        Bin probabilities [-], shape (S, J) or (1, J).
+    """
     return mass_model(mass).bin_probabilities(edges, b, m_max)
 
 
@@ -99,7 +134,27 @@ def fragment_matrix(grid: MassGrid, fractal_dimension, iterations: int) -> np.nd
     (Perfect 1997, :func:`riskrf.hazard.design_block.fractal_fragments`) of the bin's middle mass for each sampled
     D, over ``iterations`` generations.  With fragmentation the mass grid reaches down to the finest generation of
     its lightest event, so every fragment keeps its own mass (fragments' masses add up to the event's, within the
-    bins' widths)."""
+    bins' widths).
+
+    Parameters
+    ----------
+    grid : MassGrid
+        The mass grid.
+    fractal_dimension : float or array_like
+        Fractal dimension D of fragmentation [-], one per sample (S,).
+    iterations : int
+        Number of fragmentation generations.
+
+    Returns
+    -------
+    numpy.ndarray
+        Expected fragments per event [-], shape (S, J, J).
+
+    References
+    ----------
+    Perfect, E. (1997). Fractal models for the fragmentation of rocks and soils: a review. Engineering Geology 48,
+    185-198.
+    """
     from ..hazard.design_block import fractal_fragments
     edges, mid, _ = grid
     D = np.atleast_1d(np.asarray(fractal_dimension, dtype=float))
@@ -132,7 +187,24 @@ def events_at_road(frag: Fragments, x, v_d, v_s):
     reaching fragments are taken as Poisson, so the event reaches the road with probability
     1 - exp(-sum_k F_jk tau_k).  A vehicle meets an event's debris once (the exposure is per event, as for an
     intact block); it is fatal unless every reaching fragment spares it: 1 - exp(-sum_k F_jk tau_k v_k),
-    given the event reaches the road, divided by that probability."""
+    given the event reaches the road, divided by that probability.
+
+    Parameters
+    ----------
+    frag : Fragments
+        Events per year (S, J) [1/yr], fragment matrix (S, J, J) [-] and fragments per year (S, J) [1/yr].
+    x : numpy.ndarray
+        Fragments per year reaching the road by mass bin (S, J) [1/yr].
+    v_d, v_s : numpy.ndarray
+        Vulnerability of a fragment of each mass bin, direct hit and strike (S, J) or (J,) [-].
+
+    Returns
+    -------
+    events : numpy.ndarray
+        Events per year reaching the road by event mass bin (S, J) [1/yr].
+    v_d_event, v_s_event : numpy.ndarray
+        Vulnerability given the event meets a vehicle, moving and striking (S, J) [-].
+    """
     lam_events, F, blocks = frag
     with np.errstate(invalid="ignore", divide="ignore"):
         tau = np.where(blocks > 0, np.clip(x / blocks, 0.0, 1.0), 0.0)
@@ -147,7 +219,20 @@ def events_at_road(frag: Fragments, x, v_d, v_s):
 
 def released_share(frag: Fragments, event_scale) -> np.ndarray:
     """(S, J): share of each fragment mass bin still released when a source measure scales the events by
-    ``event_scale`` (S, J) (by the event's mass bin)."""
+    ``event_scale`` (S, J) (by the event's mass bin).
+
+    Parameters
+    ----------
+    frag : Fragments
+        Events per year (S, J) [1/yr], fragment matrix (S, J, J) [-] and fragments per year (S, J) [1/yr].
+    event_scale : numpy.ndarray
+        Factor on the events of each mass bin (S, J) [-].
+
+    Returns
+    -------
+    numpy.ndarray
+        Share of each fragment mass bin still released (S, J) [-].
+    """
     lam_events, F, blocks = frag
     released = np.einsum("sj,sjk->sk", lam_events * event_scale, F)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -205,11 +290,33 @@ class ParameterSpace:
         self.effects: dict[str, int] = {}
 
     def column(self, name: str) -> int:
-        """Column of ``Parameters.effect`` holding the effect parameter ``name`` (allocated on first use)."""
+        """Column of ``Parameters.effect`` holding the effect parameter ``name`` (allocated on first use).
+
+        Parameters
+        ----------
+        name : str
+            Effect parameter name, e.g. ``"retention:fence"``.
+
+        Returns
+        -------
+        int
+            Column index in ``Parameters.effect``.
+        """
         return self.effects.setdefault(name, len(self.effects))
 
     def typed(self, named: dict) -> Parameters:
-        """The :class:`Parameters` of a dict of named arrays (all of one length S)."""
+        """The :class:`Parameters` of a dict of named arrays (all of one length S).
+
+        Parameters
+        ----------
+        named : dict
+            Input name -> array of S values (units as in :class:`Parameters`).
+
+        Returns
+        -------
+        Parameters
+            The typed inputs.
+        """
         S = len(next(iter(named.values())))
         N = len(self.options)
         per_option = {f: np.zeros((S, N)) for f in _PER_OPTION}
@@ -266,7 +373,17 @@ class ReleaseStage:
     moves_road = False
 
     def apply(self, flow: _Flow, P: Parameters, d) -> None:
-        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place)."""
+        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place).
+
+        Parameters
+        ----------
+        flow : _Flow
+            Falls per year by mass bin (S, J) [1/yr] and the totals the stages add up; changed in place.
+        P : Parameters
+            The S parameter samples.
+        d : numpy.ndarray of int
+            Slope model of each sample (S,), ``P.material_draw``.
+        """
         if self.target is not None:
             m = 1.0 - np.clip(P.effect[:, self.param], 0.0, 1.0)[:, None] * self.target[None, :]
         else:
@@ -295,7 +412,17 @@ class RetentionStage:
     moves_road = False
 
     def apply(self, flow: _Flow, P: Parameters, d) -> None:
-        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place)."""
+        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place).
+
+        Parameters
+        ----------
+        flow : _Flow
+            Falls per year by mass bin (S, J) [1/yr] and the totals the stages add up; changed in place.
+        P : Parameters
+            The S parameter samples.
+        d : numpy.ndarray of int
+            Slope model of each sample (S,), ``P.material_draw``.
+        """
         ret = P.effect[:, self.param][:, None] + (self.shift[d] if self.shift is not None else 0.0)
         flow.x = flow.x * (1.0 - np.clip(ret, 0.0, 1.0))
 
@@ -323,7 +450,17 @@ class BarrierStage:
     moves_road = False
 
     def apply(self, flow: _Flow, P: Parameters, d) -> None:
-        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place)."""
+        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place).
+
+        Parameters
+        ----------
+        flow : _Flow
+            Falls per year by mass bin (S, J) [1/yr] and the totals the stages add up; changed in place.
+        P : Parameters
+            The S parameter samples.
+        d : numpy.ndarray of int
+            Slope model of each sample (S,), ``P.material_draw``.
+        """
         reach = flow.x * self.coverage
         lam_d = (reach * self.destroy[d]).sum(axis=1)
         down = out_of_service_share(lam_d, P.repair_days[:, self.component])
@@ -351,7 +488,17 @@ class ClosureStage:
     moves_road = False
 
     def apply(self, flow: _Flow, P: Parameters, d) -> None:
-        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place)."""
+        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place).
+
+        Parameters
+        ----------
+        flow : _Flow
+            Falls per year by mass bin (S, J) [1/yr] and the totals the stages add up; changed in place.
+        P : Parameters
+            The S parameter samples.
+        d : numpy.ndarray of int
+            Slope model of each sample (S,), ``P.material_draw``.
+        """
         flow.users = flow.users * (1.0 - P.effect[:, self.param])
 
 
@@ -367,7 +514,17 @@ class ExposureStage:
     moves_road = True
 
     def apply(self, flow: _Flow, P: Parameters, d) -> None:
-        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place)."""
+        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place).
+
+        Parameters
+        ----------
+        flow : _Flow
+            Falls per year by mass bin (S, J) [1/yr] and the totals the stages add up; changed in place.
+        P : Parameters
+            The S parameter samples.
+        d : numpy.ndarray of int
+            Slope model of each sample (S,), ``P.material_draw``.
+        """
         flow.x = flow.x * self.factor[d][:, None]
 
 
@@ -444,7 +601,21 @@ class LossEngine:
     chains: tuple
 
     def evaluate(self, P: Parameters, *, per_bin: bool = False) -> LossResult:
-        """Every option for the S samples of ``P``; arrays (S, K)."""
+        """Every option for the S samples of ``P``; arrays (S, K).
+
+        Parameters
+        ----------
+        P : Parameters
+            The S parameter samples.
+        per_bin : bool, optional
+            Also return falls on the road by mass bin, the vulnerabilities and the hit and strike probabilities.
+
+        Returns
+        -------
+        LossResult
+            Arrays (S, K): present values in the study's currency (e.g. [CHF]), frequencies [1/yr], deaths [1/yr],
+            individual risk [1/yr] and shares [-].
+        """
         edges, mid, small_pmf = self.grid
         S = P.size
         ex, co, ec = self.exposure, self.consequences, self.economics

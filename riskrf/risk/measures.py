@@ -35,7 +35,20 @@ class MeasureError(RiskrfError, ValueError):
 
 
 def ground_z(profile, x):
-    """Ground elevation [m] of a profile at x [m] (linear between vertices)."""
+    """Ground elevation [m] of a profile at x [m] (linear between vertices).
+
+    Parameters
+    ----------
+    profile : simulation.slope.Profile
+        The slope profile.
+    x : float or array_like
+        Horizontal positions [m].
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Ground elevation [m], shaped as ``x``.
+    """
     return np.interp(x, profile.x, profile.z)
 
 
@@ -48,6 +61,40 @@ def ditch_profile(profile, x_m: float, width_m: float, depth_m: float, *, inner_
     horizontally per m of drop, the road-side foreslope ``outer_slope_hv``.  The
     floor takes material index ``material`` (default: the material under the
     ditch's upslope rim).  Vertices inside the ditch are replaced.
+
+    Parameters
+    ----------
+    profile : simulation.slope.Profile
+        The slope profile.
+    x_m : float
+        Upslope rim of the ditch [m].
+    width_m : float
+        Width of the ditch along x [m], > 0.
+    depth_m : float
+        Depth of the floor below the lower rim [m], > 0.
+    inner_slope_hv : float, optional
+        Slope-side wall, horizontal run per unit drop [m/m].
+    outer_slope_hv : float, optional
+        Road-side foreslope, horizontal run per unit drop [m/m].
+    material : int, optional
+        Material index of the floor; the material under the upslope rim by default.
+    where : str, optional
+        What to name in error messages (file and option).
+
+    Returns
+    -------
+    simulation.slope.Profile
+        The new profile.
+
+    Raises
+    ------
+    MeasureError
+        When the ditch leaves the profile or is too narrow for its depth and walls.
+
+    References
+    ----------
+    Pierson, L. A., Gullixson, C. F. and Chassie, R. G. (2001). Rockfall catchment area design guide.
+    FHWA-OR-RD-02-04, Oregon Department of Transportation / Federal Highway Administration.
     """
     from simulation.slope import Profile
 
@@ -96,7 +143,20 @@ class Ditch:
 
 
 def check_ditches_disjoint(ditches, where: str):
-    """Overlapping ditches are an error naming both."""
+    """Overlapping ditches are an error naming both.
+
+    Parameters
+    ----------
+    ditches : iterable of Ditch
+        The ditches of an option.
+    where : str
+        What to name in error messages.
+
+    Raises
+    ------
+    MeasureError
+        When two ditches overlap.
+    """
     ds = sorted(ditches, key=lambda d: d.x_m)
     for a, b in zip(ds[:-1], ds[1:]):
         if b.x_m < a.span[1]:
@@ -106,7 +166,29 @@ def check_ditches_disjoint(ditches, where: str):
 
 def scenario_with_ditches(scenario, ditches, where: str = "ditch", road_collector: str | None = "road"):
     """A copy of ``scenario`` whose profile carries every ditch in ``ditches`` (they must not overlap and
-    must not cut through the ``road_collector`` line)."""
+    must not cut through the ``road_collector`` line).
+
+    Parameters
+    ----------
+    scenario : simulation.scenario.Scenario
+        The slope scenario.
+    ditches : iterable of Ditch
+        The ditches, not overlapping.
+    where : str, optional
+        What to name in error messages (file and option).
+    road_collector : str or None, optional
+        Name of the road collector a ditch must not cut through.
+
+    Returns
+    -------
+    simulation.scenario.Scenario
+        The new scenario (named ``<name>+ditch``).
+
+    Raises
+    ------
+    MeasureError
+        When ditches overlap, a material is unknown or a ditch cuts the road line.
+    """
     check_ditches_disjoint(ditches, where)
     prof = scenario.profile
     names = list(prof.material_names)
@@ -128,7 +210,27 @@ def scenario_with_ditches(scenario, ditches, where: str = "ditch", road_collecto
 
 
 def seeder_share(scenario, zone, where: str) -> float:
-    """Share of released blocks whose release point lies in ``zone`` = (x_lo, x_hi) [m] (uniform line seeder)."""
+    """Share of released blocks whose release point lies in ``zone`` = (x_lo, x_hi) [m] (uniform line seeder).
+
+    Parameters
+    ----------
+    scenario : simulation.scenario.Scenario
+        The slope scenario.
+    zone : tuple of float
+        (x_lo, x_hi) of the zone [m], x_lo < x_hi.
+    where : str
+        What to name in error messages.
+
+    Returns
+    -------
+    float
+        Share of the releases in the zone [-], in [0, 1].
+
+    Raises
+    ------
+    MeasureError
+        When the zone is empty or outside the release zone.
+    """
     s = scenario.seeder
     lo, hi = float(zone[0]), float(zone[1])
     if hi <= lo:
@@ -161,13 +263,34 @@ class SimulationContext:
     def run(self, scenario):
         """Simulate ``scenario`` with this context's number of blocks and seed (no recorded paths); a
         :class:`simulation.SimulationResult`.
+
+        Parameters
+        ----------
+        scenario : simulation.scenario.Scenario
+            The slope scenario.
+
+        Returns
+        -------
+        simulation.SimulationResult
+            The simulated run of ``n_blocks`` blocks with ``seed``.
         """
         import simulation
         return simulation.run(scenario, n=self.n_blocks, seed=self.seed, record_paths=0)
 
     def run_many(self, scenarios) -> list:
         """:meth:`run` for each scenario, several at once on threads (the kernel releases the GIL); the results
-        are those of one-by-one runs, in order."""
+        are those of one-by-one runs, in order.
+
+        Parameters
+        ----------
+        scenarios : iterable of simulation.scenario.Scenario
+            The scenarios to simulate.
+
+        Returns
+        -------
+        list of simulation.SimulationResult
+            One result per scenario, in order.
+        """
         scenarios = list(scenarios)
         threads = min(self.threads or os.cpu_count() or 1, len(scenarios))
         if threads <= 1:
@@ -177,12 +300,38 @@ class SimulationContext:
 
 
 def road_crossings(result, road: str) -> np.ndarray:
-    """Indices of blocks that cross the road line (first crossings)."""
+    """Indices of blocks that cross the road line (first crossings).
+
+    Parameters
+    ----------
+    result : simulation.SimulationResult
+        A simulated run.
+    road : str
+        Name of the road collector.
+
+    Returns
+    -------
+    numpy.ndarray of int
+        Sorted block indices.
+    """
     return np.unique(result.collector(road, first_only=True)["block"].to_numpy())
 
 
 def runout_beyond(result, x_m: float) -> np.ndarray:
-    """Boolean per block: did it travel past x [m] (stopped beyond it or left the profile)?"""
+    """Boolean per block: did it travel past x [m] (stopped beyond it or left the profile)?
+
+    Parameters
+    ----------
+    result : simulation.SimulationResult
+        A simulated run.
+    x_m : float
+        Horizontal position [m].
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        One value per block.
+    """
     ro = result.runout
     return (ro["x_stop_m"].to_numpy() > x_m) | (ro["reason"].astype(str).to_numpy() == "left profile")
 
@@ -205,13 +354,53 @@ def _material_path(scenario, path: str, where: str):
 
 
 def material_value(scenario, path: str, where: str = "materials"):
-    """Current value of a material parameter "material.field" (e.g. "talus.ground_friction_angle_deg")."""
+    """Current value of a material parameter "material.field" (e.g. "talus.ground_friction_angle_deg").
+
+    Parameters
+    ----------
+    scenario : simulation.scenario.Scenario
+        The slope scenario.
+    path : str
+        ``"material.field"``, the field one of :data:`MATERIAL_FIELDS`.
+    where : str, optional
+        What to name in error messages (file and option).
+
+    Returns
+    -------
+    float
+        The value, in the field's units (restitution [-], angles [deg], roughness [m]).
+
+    Raises
+    ------
+    MeasureError
+        When the material or field is unknown.
+    """
     i, attr = _material_path(scenario, path, where)
     return float(getattr(scenario.materials[i], attr))
 
 
 def scenario_with_materials(scenario, values: dict, where: str = "materials"):
-    """A copy of ``scenario`` with material parameters {"material.field": value} replaced."""
+    """A copy of ``scenario`` with material parameters {"material.field": value} replaced.
+
+    Parameters
+    ----------
+    scenario : simulation.scenario.Scenario
+        The slope scenario.
+    values : dict
+        ``"material.field"`` -> new value (the field's units: restitution [-], angles [deg], roughness [m]).
+    where : str, optional
+        What to name in error messages (file and option).
+
+    Returns
+    -------
+    simulation.scenario.Scenario
+        The new scenario.
+
+    Raises
+    ------
+    MeasureError
+        When a material or field is unknown.
+    """
     mats = list(scenario.materials)
     for path, v in values.items():
         i, attr = _material_path(scenario, path, where)
@@ -221,7 +410,22 @@ def scenario_with_materials(scenario, values: dict, where: str = "materials"):
 
 def effective_samples(result, collector: str):
     """Effective speeds [m/s] (rotation included: v^2 + k (w r)^2) and bounce heights [m] of the first
-    crossings of ``collector``."""
+    crossings of ``collector``.
+
+    Parameters
+    ----------
+    result : simulation.SimulationResult
+        A simulated run.
+    collector : str
+        Name of the collector.
+
+    Returns
+    -------
+    speed : numpy.ndarray
+        Effective speed of each first crossing [m/s].
+    height : numpy.ndarray
+        Bounce height of each first crossing [m].
+    """
     df = result.collector(collector, first_only=True)
     v = df["velocity_ms"].to_numpy()
     k = inertia_factors(df)

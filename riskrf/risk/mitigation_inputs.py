@@ -53,7 +53,13 @@ class Exposure:
     lane_fall_shares: tuple | None = None
 
     def lane_list(self) -> tuple:
-        """The lanes (:class:`riskrf.risk.road_users.Lane`) carrying this traffic."""
+        """The lanes (:class:`riskrf.risk.road_users.Lane`) carrying this traffic.
+
+        Returns
+        -------
+        tuple of riskrf.risk.road_users.Lane
+            The lanes, nearest the slope first (traffic [vehicles/day], speed [km/h]).
+        """
         from .road_users import lanes_from_traffic
         return lanes_from_traffic(self.vehicles_per_day, self.speed_kmh, int(self.lanes), self.directional_split,
                                   self.lane_fall_shares)
@@ -135,7 +141,13 @@ class Criteria:
         return cs
 
     def describe(self) -> str:
-        """The criteria in force in one sentence."""
+        """The criteria in force in one sentence.
+
+        Returns
+        -------
+        str
+            The sentence, individual risk limit in [1/yr].
+        """
         cs = self.criteria_set
         return cs.describe(self.slope).replace(f"{cs.individual_limit(self.slope):.0e}/yr",
                                                f"{self.individual_risk_per_year:.0e}/yr")
@@ -234,7 +246,14 @@ class Option:
 
     def scaling_effect(self) -> tuple:
         """Scaling and bolting by zone and mass: (initial effectiveness, its range, half-life [yr], mean over a
-        renewal cycle, mean at the range's ends); see :meth:`riskrf.risk.options.Scaling.effect`."""
+        renewal cycle, mean at the range's ends); see :meth:`riskrf.risk.options.Scaling.effect`.
+
+        Returns
+        -------
+        tuple
+            Initial effectiveness [-], its range [-], half-life [yr], mean over a cycle [-] and the means at the range's
+            ends [-].
+        """
         return scaling_effect(self)
 
     @property
@@ -249,11 +268,28 @@ class Option:
 
     def describe(self, currency: str = "") -> str:
         """What the option is and assumes, in words (money in ``currency``); each kind's text is its class's in
-        :mod:`riskrf.risk.options`."""
+        :mod:`riskrf.risk.options`.
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            The description, assumptions labelled ASSUMED.
+        """
         return (self.description + ": " if self.description else "") + effect_of(self).describe(currency)
 
     def rule_text(self) -> str:
-        """A closure rule in words (rainfall or warning rule)."""
+        """A closure rule in words (rainfall or warning rule).
+
+        Returns
+        -------
+        str
+            The rule (rainfall [mm] over a window [day], or warning levels); empty for a closure without a rule.
+        """
         if self.threshold_mm is not None:
             w = int(self.window_days or 1)
             return f"close while the {w}-day rainfall reaches {self.threshold_mm:g} mm (whole day)"
@@ -329,6 +365,25 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
 
     Every field is checked before any work (kind, costs >= 0, geometry, ranges low <= high); a
     MitigationError names the source, the option and the field with its value.
+
+    Parameters
+    ----------
+    spec : dict
+        One ``[[options]]`` table (costs in the study's currency, lengths [m], masses [kg], energies [kJ]).
+    i : int
+        Its position in the study (named in errors).
+    source : str
+        The file it was read from.
+
+    Returns
+    -------
+    Option
+        The checked option.
+
+    Raises
+    ------
+    MitigationError
+        Naming the source, option and field with its value.
     """
     where = f"options[{i}]"
     if not isinstance(spec, dict):
@@ -576,7 +631,30 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
 def parse_mitigation(data: dict, source: str = "<dict>", *, require_options: bool = True) -> tuple:
     """Validate a mitigation table: returns (options, exposure, consequences, economics, defaults_used,
     uncertainty, criteria).  ``require_options=False``: no [[options]] is accepted (a site on 3-D terrain,
-    whose traffic and consequences are used without ranking options)."""
+    whose traffic and consequences are used without ranking options).
+
+    Parameters
+    ----------
+    data : dict
+        The tables ``[[options]]``, ``[traffic]``, ``[consequences]``, ``[economics]``, ``[uncertainty]`` and
+        ``[criteria]`` as read from TOML.
+    source : str, optional
+        The file they were read from (named in errors).
+    require_options : bool, optional
+        Require at least two options.
+
+    Returns
+    -------
+    tuple
+        ``(options, exposure, consequences, economics, defaults_used, uncertainty, criteria)``: a tuple of
+        :class:`Option`, :class:`Exposure`, :class:`Consequences`, :class:`Economics`, the names of the defaults
+        used, :class:`Uncertainty` and :class:`Criteria`.
+
+    Raises
+    ------
+    MitigationError
+        Naming the source, table and field with its value.
+    """
     allowed = {"options", "traffic", "consequences", "economics", "uncertainty", "criteria"}
     for key in data:
         if key not in allowed:

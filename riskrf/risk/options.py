@@ -90,7 +90,18 @@ class OptionEffect:
         return self.option.retention is not None or self.option.rate_reduction is not None
 
     def describe(self, currency: str = "") -> str:
-        """What the option does, in words (money in ``currency``)."""
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         raise NotImplementedError
 
     @property
@@ -99,21 +110,61 @@ class OptionEffect:
         return None
 
     def assumed_basis(self, n_components: int) -> tuple | None:
-        """(priority, text): the effect basis of an option with an assumed part of this kind, lower first."""
+        """(priority, text): the effect basis of an option with an assumed part of this kind, lower first.
+
+        Parameters
+        ----------
+        n_components : int
+            Number of components of the option whose basis is wanted.
+
+        Returns
+        -------
+        tuple or None
+            ``(priority, text)``: lower priority wins when several components have an assumed part; None when this kind
+            assumes nothing.
+        """
         return None
 
     def check(self, source: str) -> None:
-        """Raise a MitigationError if the option cannot enter the engine yet."""
+        """Raise a MitigationError if the option cannot enter the engine yet.
+
+        Parameters
+        ----------
+        source : str
+            The file (or other source) the option came from, named in the error message.
+
+        Raises
+        ------
+        MitigationError
+            When the option cannot enter the engine yet.
+        """
 
     def components(self, option_named) -> list:
         """The options acting for this one (itself; a combined option's components), ``option_named`` giving the
-        study's option of a name."""
+        study's option of a name.
+
+        Parameters
+        ----------
+        option_named : callable
+            ``option_named(name)`` returns the study's option record of that name.
+
+        Returns
+        -------
+        list
+            The option records acting for this option.
+        """
         return [self.option]
 
     # ---- costs and effect parameters -----------------------------------------------------------------------
     def parameters(self) -> list:
         """(name, central value) of every input of this option the engine varies: capital cost, annual
-        maintenance, typed effects, and the kind's own (scaling effectiveness, closure share, repair days)."""
+        maintenance, typed effects, and the kind's own (scaling effectiveness, closure share, repair days).
+
+        Returns
+        -------
+        list of tuple
+            ``(name, central value)`` pairs; costs in the study's currency, effects as shares [-], repair times [day].
+        """
         o = self.option
         p = [(f"capital_cost:{o.name}", o.capital_cost), (f"annual_maintenance:{o.name}", o.annual_maintenance)]
         if o.rate_reduction is not None:
@@ -130,7 +181,19 @@ class OptionEffect:
         return []
 
     def stated_ranges(self, central: dict) -> dict:
-        """name -> (low, high, how) of the option's stated ranges (costs and typed effects)."""
+        """name -> (low, high, how) of the option's stated ranges (costs and typed effects).
+
+        Parameters
+        ----------
+        central : dict
+            ``name -> central value`` of the parameters the engine varies; only ranges of names in it are returned.
+
+        Returns
+        -------
+        dict
+            ``name -> (low, high, how)``: the stated bounds (costs in the study's currency, effects as shares [-]) and
+            the sampling, typed effectiveness labelled as an assumption.
+        """
         o = self.option
         out = {}
         for fld in ("capital_cost", "annual_maintenance", "retention", "rate_reduction"):
@@ -142,14 +205,36 @@ class OptionEffect:
         return out
 
     def assumed_ranges(self) -> dict:
-        """name -> (low, high, how) of the option's assumed (not stated) ranges."""
+        """name -> (low, high, how) of the option's assumed (not stated) ranges.
+
+        Returns
+        -------
+        dict
+            ``name -> (low, high, how)``: bounds of each assumed range (same units as the parameter) and how it is
+            sampled.
+        """
         return {}
 
     # ---- effect on the falls -------------------------------------------------------------------------------
     def stages(self, site, space, index: int) -> list:
         """The option's typed stages (:mod:`riskrf.risk.loss_engine`), derived with the slope models ``site``
         (:class:`riskrf.risk.slope_models.SlopeModels`); effect parameters get their columns from ``space``;
-        ``index``: the option's position in the study."""
+        ``index``: the option's position in the study.
+
+        Parameters
+        ----------
+        site : riskrf.risk.slope_models.SlopeModels
+            The site's slope models (simulated runs, mass grid, exposed road).
+        space : object
+            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
+        index : int
+            The option's position in the study.
+
+        Returns
+        -------
+        list
+            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
+        """
         return []
 
     def geometry_measure(self):
@@ -161,6 +246,18 @@ class DoNothing(OptionEffect):
     """``none``: the site as it is."""
 
     def describe(self, currency=""):
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         return "the site as it is"
 
     @property
@@ -178,7 +275,14 @@ class Scaling(OptionEffect):
         renewal cycle, mean at the range's ends).  ASSUMED defaults: 0.8 of the targeted releases removed when new
         (range 0.6-0.95), halving every ``life_years`` (10 years without one): loosening, new joints opening and
         missed blocks make scaling neither complete nor lasting.  Mean over a cycle of length L of e0 2^(-t/h):
-        e0 h (1 - 2^(-L/h)) / (L ln 2)."""
+        e0 h (1 - 2^(-L/h)) / (L ln 2).
+
+        Returns
+        -------
+        tuple
+            ``(e0, (low, high), half_life, mean, (mean_low, mean_high))``: initial effectiveness [-], its range [-],
+            half-life [yr], mean effectiveness over a renewal cycle [-] and the mean at the range's ends [-].
+        """
         o = self.option
         e0 = SCALING_EFFECTIVENESS if o.effectiveness is None else o.effectiveness
         rng = o.effectiveness_range or ((SCALING_EFFECTIVENESS_RANGE if o.effectiveness is None
@@ -189,6 +293,18 @@ class Scaling(OptionEffect):
         return e0, tuple(rng), h, e0 * k, (rng[0] * k, rng[1] * k)
 
     def describe(self, currency=""):
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         o = self.option
         if o.rate_reduction is not None:
             return f"scaling and bolting; ASSUMED to prevent {o.rate_reduction:.0%} of falls (typed)"
@@ -200,6 +316,19 @@ class Scaling(OptionEffect):
                 f"blocks {size}{zone} when new, halving every {h:g} years (ASSUMED): {mean:.0%} on average")
 
     def assumed_basis(self, n_components):
+        """(priority, text): the effect basis of an option with an assumed part of this kind.
+
+        Parameters
+        ----------
+        n_components : int
+            Number of components of the option whose basis is wanted.
+
+        Returns
+        -------
+        tuple or None
+            ``(priority, text)``: lower priority wins when several components have an assumed part; None when this kind
+            assumes nothing.
+        """
         e0, _, h, mean, _ = self.effect()
         return 1, (f"derived zone and mass range, ASSUMED effectiveness ({self.option.name}: {e0:.0%} when new, "
                    f"halving every {h:g} yr, {mean:.0%} on average)"
@@ -211,6 +340,14 @@ class Scaling(OptionEffect):
         return [(f"scaling_effectiveness:{self.option.name}", self.effect()[3])]
 
     def assumed_ranges(self):
+        """name -> (low, high, how) of the option's assumed (not stated) ranges.
+
+        Returns
+        -------
+        dict
+            ``name -> (low, high, how)``: bounds of each assumed range (same units as the parameter) and how it is
+            sampled.
+        """
         o = self.option
         if o.rate_reduction is not None:
             return {}
@@ -222,6 +359,22 @@ class Scaling(OptionEffect):
             f"halving every {h:g} years; mean over the cycle)")}
 
     def stages(self, site, space, index):
+        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
+
+        Parameters
+        ----------
+        site : riskrf.risk.slope_models.SlopeModels
+            The site's slope models (simulated runs, mass grid, exposed road).
+        space : object
+            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
+        index : int
+            The option's position in the study.
+
+        Returns
+        -------
+        list
+            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
+        """
         o = self.option
         if o.rate_reduction is not None:
             return [ReleaseStage(o.name, space.column(f"rate_reduction:{o.name}"))]
@@ -249,6 +402,22 @@ class _SlopeGeometry(OptionEffect):
         return TYPED_RETENTION if self.option.retention is not None else GEOMETRY
 
     def stages(self, site, space, index):
+        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
+
+        Parameters
+        ----------
+        site : riskrf.risk.slope_models.SlopeModels
+            The site's slope models (simulated runs, mass grid, exposed road).
+        space : object
+            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
+        index : int
+            The option's position in the study.
+
+        Returns
+        -------
+        list
+            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
+        """
         if self.option.retention is None:
             return []               # derived: simulated with the option's other geometry changes
         return [RetentionStage(self.option.name, space.column(f"retention:{self.option.name}"))]
@@ -265,6 +434,18 @@ class CatchDitch(_SlopeGeometry):
     """``ditch``: a catchment ditch dug into the profile."""
 
     def describe(self, currency=""):
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         o = self.option
         if o.retention is not None:
             return _typed_retention(o, "catchment ditch")
@@ -272,6 +453,13 @@ class CatchDitch(_SlopeGeometry):
                 "retention derived by simulation")
 
     def geometry_measure(self):
+        """The ditch to re-simulate, else None (typed retention).
+
+        Returns
+        -------
+        riskrf.risk.measures.Ditch or riskrf.risk.geometry_measures.SlopeMeasure or None
+            The geometry change to re-simulate; None when a typed retention replaces it.
+        """
         if self.option.retention is not None:
             return None
         o = self.option
@@ -283,6 +471,18 @@ class Bench(_SlopeGeometry):
     """``bench``: a catch bench cut into the slope."""
 
     def describe(self, currency=""):
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         o = self.option
         if o.retention is not None:
             return _typed_retention(o, "bench")
@@ -294,6 +494,18 @@ class Bund(_SlopeGeometry):
     """``bund``: an embankment on the ground."""
 
     def describe(self, currency=""):
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         o = self.option
         if o.retention is not None:
             return _typed_retention(o, "bund")
@@ -305,6 +517,18 @@ class Drape(_SlopeGeometry):
     """``drape``: a secured mesh; the surface of its zone takes an ASSUMED material."""
 
     def describe(self, currency=""):
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         o = self.option
         if o.retention is not None:
             return _typed_retention(o, "drape")
@@ -312,6 +536,19 @@ class Drape(_SlopeGeometry):
                 "an ASSUMED low-bounce, high-friction material; retention derived by simulation")
 
     def assumed_basis(self, n_components):
+        """(priority, text): the effect basis of an option with an assumed part of this kind.
+
+        Parameters
+        ----------
+        n_components : int
+            Number of components of the option whose basis is wanted.
+
+        Returns
+        -------
+        tuple or None
+            ``(priority, text)``: lower priority wins when several components have an assumed part; None when this kind
+            assumes nothing.
+        """
         return 0, ("derived by re-simulation of the draped surface, whose material is ASSUMED "
                    "(riskrf.risk.geometry_measures.DRAPE_MATERIAL)")
 
@@ -338,6 +575,18 @@ class Barrier(_Structure):
     needs_design_check = True
 
     def describe(self, currency=""):
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         o = self.option
         return (f"{o.kind} of {o.capacity_kj:,.0f} kJ (MEL), {o.height_m:g} m high"
                 + (f" at x = {o.x_m:g} m" if o.x_m is not None else " at the barrier line")
@@ -346,6 +595,22 @@ class Barrier(_Structure):
                 + f"; out of service {o.repair_days:g} days after an impact above MEL (assumption)")
 
     def stages(self, site, space, index):
+        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
+
+        Parameters
+        ----------
+        site : riskrf.risk.slope_models.SlopeModels
+            The site's slope models (simulated runs, mass grid, exposed road).
+        space : object
+            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
+        index : int
+            The option's position in the study.
+
+        Returns
+        -------
+        list
+            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
+        """
         return [self._stage(site, space, index, shed=False, coverage=1.0)]
 
 
@@ -355,12 +620,40 @@ class Shed(_Structure):
     order = SHED
 
     def describe(self, currency=""):
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         o = self.option
         return (f"rock shed of {o.capacity_kj:,.0f} kJ over "
                 + (f"{o.covered_length_m:g} m of road" if o.covered_length_m else "the exposed road")
                 + f"; out of service {o.repair_days:g} days after an impact above capacity (assumption)")
 
     def stages(self, site, space, index):
+        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
+
+        Parameters
+        ----------
+        site : riskrf.risk.slope_models.SlopeModels
+            The site's slope models (simulated runs, mass grid, exposed road).
+        space : object
+            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
+        index : int
+            The option's position in the study.
+
+        Returns
+        -------
+        list
+            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
+        """
         o = self.option
         coverage = min(o.covered_length_m / site.exposed_length_m, 1.0) if o.covered_length_m else 1.0
         return [self._stage(site, space, index, shed=True, coverage=coverage)]
@@ -372,6 +665,18 @@ class Realignment(OptionEffect):
     order = EXPOSURE
 
     def describe(self, currency=""):
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         o = self.option
         return (f"road moved to x = {o.road_x_m:g} m" if o.road_x_m is not None
                 else "road moved away from the slope (no exposure)")
@@ -381,6 +686,22 @@ class Realignment(OptionEffect):
         return "geometry: the road leaves the slope" if self.option.road_x_m is None else None
 
     def stages(self, site, space, index):
+        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
+
+        Parameters
+        ----------
+        site : riskrf.risk.slope_models.SlopeModels
+            The site's slope models (simulated runs, mass grid, exposed road).
+        space : object
+            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
+        index : int
+            The option's position in the study.
+
+        Returns
+        -------
+        list
+            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
+        """
         o = self.option
         if o.road_x_m is None:
             return [ExposureStage(o.name, np.zeros(len(site.models)))]
@@ -408,6 +729,18 @@ class Closure(OptionEffect):
         return super().typed or not self.option.has_closure_rule
 
     def describe(self, currency=""):
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         o = self.option
         if o.share_while_closed is None:
             return f"{o.rule_text()}; share and hours not yet computed (needs the site's rate model, [rates])"
@@ -425,6 +758,18 @@ class Closure(OptionEffect):
         return "computed: closure rule on the rate model and rainfall record"
 
     def check(self, source):
+        """Raise a MitigationError if the option cannot enter the engine yet.
+
+        Parameters
+        ----------
+        source : str
+            The file (or other source) the option came from, named in the error message.
+
+        Raises
+        ------
+        MitigationError
+            When the option cannot enter the engine yet.
+        """
         o = self.option
         if o.share_while_closed is None:
             raise MitigationError(
@@ -436,6 +781,22 @@ class Closure(OptionEffect):
         return [(f"closure_share:{self.option.name}", self.option.share_while_closed)]
 
     def stages(self, site, space, index):
+        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
+
+        Parameters
+        ----------
+        site : riskrf.risk.slope_models.SlopeModels
+            The site's slope models (simulated runs, mass grid, exposed road).
+        space : object
+            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
+        index : int
+            The option's position in the study.
+
+        Returns
+        -------
+        list
+            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
+        """
         return [ClosureStage(self.option.name, space.column(f"closure_share:{self.option.name}"))]
 
 
@@ -443,12 +804,43 @@ class Combined(OptionEffect):
     """``combined``: its components in series; costs and effects are theirs."""
 
     def describe(self, currency=""):
+        """What the option does, in words (money in ``currency``).
+
+        Parameters
+        ----------
+        currency : str, optional
+            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
+
+        Returns
+        -------
+        str
+            One-line description of the option, assumptions labelled ASSUMED.
+        """
         return "combination of " + " + ".join(self.option.options)
 
     def components(self, option_named):
+        """The options acting for this one: a combined option's components.
+
+        Parameters
+        ----------
+        option_named : callable
+            ``option_named(name)`` returns the study's option record of that name.
+
+        Returns
+        -------
+        list
+            The option records acting for this option.
+        """
         return [option_named(n) for n in self.option.options]
 
     def parameters(self):
+        """No parameters of its own: a combined option's costs and effects are its components'.
+
+        Returns
+        -------
+        list of tuple
+            ``(name, central value)`` pairs; costs in the study's currency, effects as shares [-], repair times [day].
+        """
         return []
 
 
@@ -459,18 +851,54 @@ KIND_CLASSES = {"none": DoNothing, "scaling": Scaling, "ditch": CatchDitch, "fen
 
 
 def effect_of(option) -> OptionEffect:
-    """The behaviour of ``option`` (its kind's class, wrapping it)."""
+    """The behaviour of ``option`` (its kind's class, wrapping it).
+
+    Parameters
+    ----------
+    option : riskrf.risk.mitigation_inputs.Option
+        The option record (its ``kind`` one of :data:`OPTION_KINDS`).
+
+    Returns
+    -------
+    OptionEffect
+        The instance of the kind's class (:data:`KIND_CLASSES`) wrapping ``option``.
+    """
     return KIND_CLASSES[option.kind](option)
 
 
 def scaling_effect(option) -> tuple:
-    """:meth:`Scaling.effect` of a scaling option."""
+    """:meth:`Scaling.effect` of a scaling option.
+
+    Parameters
+    ----------
+    option : riskrf.risk.mitigation_inputs.Option
+        A ``scaling`` option record.
+
+    Returns
+    -------
+    tuple
+        As :meth:`Scaling.effect`: initial effectiveness [-], its range [-], half-life [yr], cycle mean [-] and the
+        cycle means at the range's ends [-].
+    """
     return Scaling(option).effect()
 
 
 def effect_basis(option, components) -> str:
     """How the effect of ``option`` (made of ``components``) is known: typed (an ASSUMPTION), computed, derived,
-    or derived with an ASSUMED part, in words."""
+    or derived with an ASSUMED part, in words.
+
+    Parameters
+    ----------
+    option : riskrf.risk.mitigation_inputs.Option
+        The option whose effect basis is wanted.
+    components : list of riskrf.risk.mitigation_inputs.Option
+        The options acting for it (itself, or a combined option's components).
+
+    Returns
+    -------
+    str
+        The basis in words; a typed effectiveness starts with ``"ASSUMPTION"``.
+    """
     effects = [effect_of(c) for c in components]
     typed = [e.option.name for e in effects if e.typed]
     if typed:
@@ -487,7 +915,26 @@ def effect_basis(option, components) -> str:
 def option_chain(option, components, site, space, index_of: dict) -> OptionChain:
     """The engine's view of ``option``: the stages of its ``components`` in series (releases, typed retentions, the
     slope geometry changes re-simulated together, barriers, sheds, closures, realignments) and their costs.
-    ``index_of``: option name -> position in the study."""
+    ``index_of``: option name -> position in the study.
+
+    Parameters
+    ----------
+    option : riskrf.risk.mitigation_inputs.Option
+        The option.
+    components : list of riskrf.risk.mitigation_inputs.Option
+        The options acting for it, in any order (sorted here by the order in which they act).
+    site : riskrf.risk.slope_models.SlopeModels
+        The site's slope models.
+    space : object
+        The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
+    index_of : dict
+        Option name -> position in the study.
+
+    Returns
+    -------
+    riskrf.risk.loss_engine.OptionChain
+        The option's name, its stages in series and ``(option index, life [yr])`` of each component.
+    """
     effects = [effect_of(c) for c in components]
     stages = []
     for order in range(EXPOSURE + 1):

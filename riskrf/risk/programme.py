@@ -58,7 +58,14 @@ class Programme:
     gap: float = 0.0
 
     def summary(self) -> pd.DataFrame:
-        """The chosen sections and options, with their cost and benefit (one row per funded section)."""
+        """The chosen sections and options, with their cost and benefit (one row per funded section).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per funded section: section, option, cost (in the cost column's currency, e.g. [CHF]) and benefit
+            (deaths avoided [1/yr] or cost saving [currency]).
+        """
         return self.chosen.reset_index(drop=True)
 
     def __repr__(self) -> str:
@@ -77,7 +84,14 @@ class Frontier:
 
     def summary(self) -> pd.DataFrame:
         """One row per budget: budget, cost of the best programme, its benefit, the sections it funds and the
-        proven gap (the figure: :func:`riskrf.report.corridor_report.plot_frontier`)."""
+        proven gap (the figure: :func:`riskrf.report.corridor_report.plot_frontier`).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``budget`` and ``cost`` [currency], ``benefit`` (deaths avoided [1/yr] or cost saving [currency]),
+            ``sections`` and ``gap`` [-].
+        """
         return self.table.copy()
 
 
@@ -184,6 +198,33 @@ def efficient_frontier(options: pd.DataFrame, budgets=None, *, objective: str = 
     option to the cost of the programme that takes the best option of every section (beyond it more money buys
     nothing).  Between two budgets the best benefit is at least that of the lower one (a step curve).  Each point may
     take ``time_limit_s``; its proven gap is in the ``gap`` column (0: proven optimal).
+
+    Parameters
+    ----------
+    options : pandas.DataFrame
+        One row per (section, option) with the cost column [currency] and the objective's benefit column.
+    budgets : array_like, optional
+        Budgets to solve at [currency].
+    objective : str, optional
+        ``"risk"`` (deaths avoided per year [1/yr]) or ``"cost"`` (expected total cost saving [currency]).
+    cost_column : str, optional
+        The column of costs.
+    section_column : str, optional
+        The column naming the sections.
+    points : int, optional
+        Number of budgets of the default set.
+    time_limit_s : float, optional
+        Solver time limit per budget [s].
+
+    Returns
+    -------
+    Frontier
+        The best benefit at each budget.
+
+    Raises
+    ------
+    ValueError
+        When the objective is unknown or a column is missing or not numeric.
     """
     benefit = OBJECTIVES.get(objective)
     if benefit is None:

@@ -111,7 +111,18 @@ class RHRSError(RiskrfError, ValueError):
 
 def variant_problem(variant) -> str | None:
     """``None`` when :func:`rate` implements ``variant``, else what is wrong, as the end of an error message:
-    ``"must be one of ['fhwa'] (<why the variant asked for is not implemented>)"``."""
+    ``"must be one of ['fhwa'] (<why the variant asked for is not implemented>)"``.
+
+    Parameters
+    ----------
+    variant : object
+        The rating system asked for (a key of :data:`VARIANTS` when implemented).
+
+    Returns
+    -------
+    str or None
+        None when implemented, else the end of an error message saying why not.
+    """
     if isinstance(variant, str) and variant in VARIANTS:
         return None
     why = UNAVAILABLE_VARIANTS.get(variant) if isinstance(variant, str) else None
@@ -140,19 +151,86 @@ def _finite(value, name: str, *, lo: float | None = None, lo_open: bool = False)
 
 
 def score(x: float) -> float:
-    """Exponential RHRS score 3**x (x = 1, 2, 3, 4 give 3, 9, 27, 81 points)."""
+    """Exponential RHRS score 3**x (x = 1, 2, 3, 4 give 3, 9, 27, 81 points).
+
+    Parameters
+    ----------
+    x : float
+        Category level x [-].
+
+    Returns
+    -------
+    float
+        Score 3**x [points].
+
+    Raises
+    ------
+    RHRSError
+        When the input is not a finite number in range.
+
+    References
+    ----------
+    Pierson, L. A. and Van Vickle, R. (1993). Rockfall Hazard Rating System: participant's manual.
+    FHWA-SA-93-057, Federal Highway Administration.
+    """
     return 3.0 ** _finite(x, "x")
 
 
 def slope_height_x(height_m: float) -> float:
-    """x = H [ft] / 25 for the vertical slope height H (25 ft -> 3 points, 100 ft -> 81)."""
+    """x = H [ft] / 25 for the vertical slope height H (25 ft -> 3 points, 100 ft -> 81).
+
+    Parameters
+    ----------
+    height_m : float
+        Vertical slope height H [m], >= 0.
+
+    Returns
+    -------
+    x : float
+        Category level x [-] (score 3**x).
+
+    Raises
+    ------
+    RHRSError
+        When the input is not a finite number in range.
+
+    References
+    ----------
+    Pierson, L. A. and Van Vickle, R. (1993). Rockfall Hazard Rating System: participant's manual.
+    FHWA-SA-93-057, Federal Highway Administration.
+    """
     return _finite(height_m, "slope_height_m", lo=0) / FT_M / 25.0
 
 
 def average_vehicle_risk(adt_vehicles_per_day: float, slope_length_m: float, speed_kmh: float) -> float:
     """AVR [%] = ADT x slope length / 24 / posted speed x 100: the share of time a vehicle is below the slope
     (may exceed 100 %: more than one vehicle on average).  SI inputs: the length/speed ratio is unit-free,
-    so L [km] / V [km/h] equals L [mi] / V [mph]."""
+    so L [km] / V [km/h] equals L [mi] / V [mph].
+
+    Parameters
+    ----------
+    adt_vehicles_per_day : float
+        Average daily traffic ADT [vehicles/day], >= 0.
+    slope_length_m : float
+        Length of road below the slope [m], > 0.
+    speed_kmh : float
+        Posted speed [km/h], > 0.
+
+    Returns
+    -------
+    float
+        AVR [%].
+
+    Raises
+    ------
+    RHRSError
+        When an input is out of range.
+
+    References
+    ----------
+    Pierson, L. A. and Van Vickle, R. (1993). Rockfall Hazard Rating System: participant's manual.
+    FHWA-SA-93-057, Federal Highway Administration.
+    """
     adt = _finite(adt_vehicles_per_day, "adt_vehicles_per_day", lo=0)
     length_km = _finite(slope_length_m, "slope_length_m", lo=0, lo_open=True) / M_PER_KM
     v = _finite(speed_kmh, "speed_kmh", lo=0, lo_open=True)
@@ -160,39 +238,190 @@ def average_vehicle_risk(adt_vehicles_per_day: float, slope_length_m: float, spe
 
 
 def avr_x(avr_percent: float) -> float:
-    """x = AVR [%] / 25 (25 % -> 3 points, 100 % -> 81)."""
+    """x = AVR [%] / 25 (25 % -> 3 points, 100 % -> 81).
+
+    Parameters
+    ----------
+    avr_percent : float
+        Average vehicle risk AVR [%], >= 0.
+
+    Returns
+    -------
+    x : float
+        Category level x [-] (score 3**x).
+
+    Raises
+    ------
+    RHRSError
+        When the input is not a finite number in range.
+
+    References
+    ----------
+    Pierson, L. A. and Van Vickle, R. (1993). Rockfall Hazard Rating System: participant's manual.
+    FHWA-SA-93-057, Federal Highway Administration.
+    """
     return _finite(avr_percent, "avr_percent", lo=0) / 25.0
 
 
 def percent_decision_sight_distance(sight_distance_m: float, decision_sight_distance_m: float) -> float:
-    """%DSD = actual sight distance / decision sight distance x 100."""
+    """%DSD = actual sight distance / decision sight distance x 100.
+
+    Parameters
+    ----------
+    sight_distance_m : float
+        Actual sight distance [m], >= 0.
+    decision_sight_distance_m : float
+        Decision sight distance for the speed [m], > 0.
+
+    Returns
+    -------
+    float
+        %DSD [%].
+
+    Raises
+    ------
+    RHRSError
+        When an input is out of range.
+
+    References
+    ----------
+    Pierson, L. A. and Van Vickle, R. (1993). Rockfall Hazard Rating System: participant's manual.
+    FHWA-SA-93-057, Federal Highway Administration.
+    """
     return _finite(sight_distance_m, "sight_distance_m", lo=0) / _finite(
         decision_sight_distance_m, "decision_sight_distance_m", lo=0, lo_open=True) * 100.0
 
 
 def dsd_x(percent_dsd: float) -> float:
-    """x = (120 - %DSD) / 20 (100 % -> 3 points, 40 % -> 81)."""
+    """x = (120 - %DSD) / 20 (100 % -> 3 points, 40 % -> 81).
+
+    Parameters
+    ----------
+    percent_dsd : float
+        Percent decision sight distance %DSD [%], >= 0.
+
+    Returns
+    -------
+    x : float
+        Category level x [-] (score 3**x).
+
+    Raises
+    ------
+    RHRSError
+        When the input is not a finite number in range.
+
+    References
+    ----------
+    Pierson, L. A. and Van Vickle, R. (1993). Rockfall Hazard Rating System: participant's manual.
+    FHWA-SA-93-057, Federal Highway Administration.
+    """
     return (120.0 - _finite(percent_dsd, "percent_dsd", lo=0)) / 20.0
 
 
 def roadway_width_x(width_m: float) -> float:
-    """x = (52 - W [ft]) / 8 for the roadway width W including paved shoulders (44 ft -> 3 points, 20 ft -> 81)."""
+    """x = (52 - W [ft]) / 8 for the roadway width W including paved shoulders (44 ft -> 3 points, 20 ft -> 81).
+
+    Parameters
+    ----------
+    width_m : float
+        Roadway width W including paved shoulders [m], > 0.
+
+    Returns
+    -------
+    x : float
+        Category level x [-] (score 3**x).
+
+    Raises
+    ------
+    RHRSError
+        When the input is not a finite number in range.
+
+    References
+    ----------
+    Pierson, L. A. and Van Vickle, R. (1993). Rockfall Hazard Rating System: participant's manual.
+    FHWA-SA-93-057, Federal Highway Administration.
+    """
     return (52.0 - _finite(width_m, "roadway_width_m", lo=0, lo_open=True) / FT_M) / 8.0
 
 
 def block_size_x(size_m: float) -> float:
-    """x = block size [ft] (1 ft -> 3 points, 4 ft -> 81)."""
+    """x = block size [ft] (1 ft -> 3 points, 4 ft -> 81).
+
+    Parameters
+    ----------
+    size_m : float
+        Block size [m], > 0.
+
+    Returns
+    -------
+    x : float
+        Category level x [-] (score 3**x).
+
+    Raises
+    ------
+    RHRSError
+        When the input is not a finite number in range.
+
+    References
+    ----------
+    Pierson, L. A. and Van Vickle, R. (1993). Rockfall Hazard Rating System: participant's manual.
+    FHWA-SA-93-057, Federal Highway Administration.
+    """
     return _finite(size_m, "block_size_m", lo=0, lo_open=True) / FT_M
 
 
 def volume_x(volume_m3: float) -> float:
-    """x = volume per event [yd3] / 3 (3 yd3 -> 3 points, 12 yd3 -> 81)."""
+    """x = volume per event [yd3] / 3 (3 yd3 -> 3 points, 12 yd3 -> 81).
+
+    Parameters
+    ----------
+    volume_m3 : float
+        Volume per event [m3], > 0.
+
+    Returns
+    -------
+    x : float
+        Category level x [-] (score 3**x).
+
+    Raises
+    ------
+    RHRSError
+        When the input is not a finite number in range.
+
+    References
+    ----------
+    Pierson, L. A. and Van Vickle, R. (1993). Rockfall Hazard Rating System: participant's manual.
+    FHWA-SA-93-057, Federal Highway Administration.
+    """
     return _finite(volume_m3, "volume_m3", lo=0, lo_open=True) / YD3_M3 / 3.0
 
 
 def class_x(category: str, value) -> float:
     """Level x of a descriptive category: a class name of :data:`CLASSES` (or its first word), or a number in
-    [1, 4] (fractional allowed: between two classes)."""
+    [1, 4] (fractional allowed: between two classes).
+
+    Parameters
+    ----------
+    category : str
+        A descriptive category, a key of :data:`CLASSES`.
+    value : str or float
+        A class name of the category (or its first word), or a level in [1, 4] [-].
+
+    Returns
+    -------
+    float
+        Category level x [-] (score 3**x).
+
+    Raises
+    ------
+    RHRSError
+        When the category or class is unknown or the level lies outside [1, 4].
+
+    References
+    ----------
+    Pierson, L. A. and Van Vickle, R. (1993). Rockfall Hazard Rating System: participant's manual.
+    FHWA-SA-93-057, Federal Highway Administration.
+    """
     if category not in CLASSES:
         raise RHRSError(f"unknown RHRS category {category!r}; categories: {sorted(CLASSES)}")
     if isinstance(value, str):
@@ -247,11 +476,24 @@ class RHRSRating:
 
     def sheet(self) -> pd.DataFrame:
         """The rating sheet: one row per category with the rated value (SI, as given or derived), level x, score
-        and the whole-point score; last row the totals."""
+        and the whole-point score; last row the totals.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``category``, ``rated_value`` (SI units), ``x`` [-], ``score`` [points], ``points`` (whole points).
+        """
         return pd.DataFrame(self.sheet_rows())
 
     def sheet_rows(self) -> list:
-        """The rows of :meth:`sheet` as plain dicts (category, rated_value, x, score, points)."""
+        """The rows of :meth:`sheet` as plain dicts (category, rated_value, x, score, points).
+
+        Returns
+        -------
+        list of dict
+            One dict per category (keys ``category``, ``rated_value``, ``x``, ``score`` [points], ``points``), then the
+            totals.
+        """
         value_of = {"slope_height": "slope_height_m", "ditch_effectiveness": "ditch_effectiveness",
                     "average_vehicle_risk": "avr_percent", "percent_decision_sight_distance": "percent_dsd",
                     "roadway_width": "roadway_width_m", "structural_condition": ("structural_condition_case1",
@@ -272,7 +514,13 @@ class RHRSRating:
         return rows
 
     def summary(self) -> pd.DataFrame:
-        """One row per category: x, score (points); last row the total."""
+        """One row per category: x, score (points); last row the total.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``category``, ``x`` [-] and ``score`` [points]; last row the total.
+        """
         df = pd.DataFrame({"category": list(self.x), "x": list(self.x.values()),
                            "score": list(self.scores.values())})
         return pd.concat([df, pd.DataFrame({"category": ["total"], "x": [float("nan")], "score": [self.total]})],

@@ -59,11 +59,25 @@ class RoadRiskProfile:
     notes: tuple = ()
 
     def summary(self) -> pd.DataFrame:
-        """The per-bin table (a copy)."""
+        """The per-bin table (a copy).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per bin: ``start_m``, ``end_m`` [m], ``reach_share_per_m`` [1/m], ``falls_per_year_per_m``,
+            ``deaths_per_year_per_m``, ``injuries_per_year_per_m`` [1/(yr m)] and ``blocks``.
+        """
         return self.table.copy()
 
     def totals(self) -> dict:
-        """Whole-road figures: reach share, falls, deaths and injuries per year, and the worst metre."""
+        """Whole-road figures: reach share, falls, deaths and injuries per year, and the worst metre.
+
+        Returns
+        -------
+        dict
+            ``road``, ``length_m`` [m], ``reach_share`` [-], ``falls_per_year``, ``deaths_per_year``,
+            ``injuries_per_year`` [1/yr], ``worst_metre_start_m`` [m] and ``worst_deaths_per_year_per_m`` [1/(yr m)].
+        """
         t = self.table
         w = t["end_m"] - t["start_m"]
         worst = int(t["deaths_per_year_per_m"].to_numpy().argmax()) if len(t) else 0
@@ -77,7 +91,18 @@ class RoadRiskProfile:
                 else float("nan")}
 
     def plot(self, ax=None):
-        """Falls and deaths per year per metre along the road (matplotlib axes)."""
+        """Falls and deaths per year per metre along the road (matplotlib axes).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on (a new figure when None).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes of the falls (deaths on a twin axis).
+        """
         import matplotlib.pyplot as plt
         if ax is None:
             _, ax = plt.subplots(figsize=(8, 3.5))
@@ -100,7 +125,22 @@ class RoadRiskProfile:
 
 def block_weights_per_year(samples, mass_model, rate_per_year: float) -> np.ndarray:
     """Falls per year [1/yr] that each simulated block of a mass-coupled run stands for:
-    rate x P(M in its class) / blocks simulated in its class (see the module docstring)."""
+    rate x P(M in its class) / blocks simulated in its class (see the module docstring).
+
+    Parameters
+    ----------
+    samples : riskrf.hazard.mass_coupling.MassCoupledSamples
+        The mass-coupled run (masses [kg] and mass classes of every released block).
+    mass_model : object
+        The mass law [kg] of falls at the source (e.g. a truncated GutenbergRichterFit).
+    rate_per_year : float
+        Falls per year at the source [1/yr].
+
+    Returns
+    -------
+    numpy.ndarray
+        Weight of each block [1/yr].
+    """
     from ..hazard.impact_energy import mass_model as _wrap
     cls = samples.class_of(samples.mass_kg)
     counts = np.bincount(cls, minlength=samples.n_bins).astype(float)
@@ -193,7 +233,19 @@ def road_risk_along_line(samples, mass_model, rate_per_year: float, position_m, 
 
 def vulnerability_from_consequences(consequences) -> Vulnerability:
     """The site's vulnerabilities (:class:`riskrf.risk.mitigation_inputs.Consequences`: a number or
-    [[mass_kg, probability], ...] each) as a :class:`Vulnerability` (a number: the same at every mass)."""
+    [[mass_kg, probability], ...] each) as a :class:`Vulnerability` (a number: the same at every mass).
+
+    Parameters
+    ----------
+    consequences : riskrf.risk.mitigation_inputs.Consequences
+        The site's consequences (``vulnerability_moving_vehicle``, ``vulnerability_striking_rock``: a probability
+        [-] or pairs (mass [kg], probability [-])).
+
+    Returns
+    -------
+    riskrf.risk.road_users.Vulnerability
+        The vulnerability model.
+    """
     def table(v):
         return ((1.0, float(v)),) if np.ndim(v) == 0 else tuple(map(tuple, np.asarray(v, dtype=float).tolist()))
     return Vulnerability(direct=table(consequences.vulnerability_moving_vehicle),

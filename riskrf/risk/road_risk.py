@@ -73,6 +73,30 @@ def spatial_temporal_probability(vehicles_per_day, vehicle_length_m, speed_kmh):
     """P(S:T) = N_v L_v / (24 x 1000 x V_v): probability that a vehicle occupies the impact point.
 
     ``vehicles_per_day`` may be an array (uncertainty samples).
+
+    Parameters
+    ----------
+    vehicles_per_day : float or array_like
+        Traffic N_v [vehicles/day], > 0; an array of uncertainty samples is allowed.
+    vehicle_length_m : float
+        Vehicle length L_v [m].
+    speed_kmh : float
+        Speed V_v [km/h].
+
+    Returns
+    -------
+    float or numpy.ndarray
+        P(S:T) [-], shaped as ``vehicles_per_day``.
+
+    Raises
+    ------
+    ValueError
+        When an input is not positive or P(S:T) >= 1 (continuous traffic).
+
+    References
+    ----------
+    Bunce, C. M., Cruden, D. M. and Morgenstern, N. R. (1997). Assessment of the hazard from rock fall on a highway.
+    Canadian Geotechnical Journal 34, 344-356.
     """
     n = _positive_array(vehicles_per_day, "vehicles_per_day")
     length = check_positive(vehicle_length_m, "vehicle_length_m")
@@ -86,7 +110,24 @@ def spatial_temporal_probability(vehicles_per_day, vehicle_length_m, speed_kmh):
 
 
 def probability_at_least_one_hit(p_st, falls):
-    """P(S:H) = 1 - (1 - P(S:T))^N_r for N_r falls (AGS 2000, eq. E1)."""
+    """P(S:H) = 1 - (1 - P(S:T))^N_r for N_r falls (AGS 2000, eq. E1).
+
+    Parameters
+    ----------
+    p_st : float
+        P(S:T), probability that a vehicle occupies the impact point [-].
+    falls : float or array_like
+        Number of falls N_r reaching the road [-].
+
+    Returns
+    -------
+    numpy.ndarray
+        P(S:H) [-], shaped as ``falls``.
+
+    References
+    ----------
+    AGS (2000). Australian Geomechanics Society, landslide risk management concepts and guidelines, eq. E1.
+    """
     return -np.expm1(np.asarray(falls, dtype=float) * np.log1p(-float(p_st)))
 
 
@@ -95,6 +136,25 @@ def stationary_rock_strike_probability(vehicles_per_day, hours_on_road, p_cannot
 
     N_v vehicles/day pass in the ``hours_on_road`` the rock stays; each fails to stop
     with probability ``p_cannot_stop`` (sight distance shorter than stopping distance).
+
+    Parameters
+    ----------
+    vehicles_per_day : float or array_like
+        Traffic N_v [vehicles/day], > 0.
+    hours_on_road : float
+        Time t the rock lies on the road before removal [h].
+    p_cannot_stop : float
+        Probability that a vehicle fails to stop in time [-], in [0, 1].
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Probability that a vehicle strikes the rock [-], shaped as ``vehicles_per_day``.
+
+    References
+    ----------
+    Bunce, C. M., Cruden, D. M. and Morgenstern, N. R. (1997). Assessment of the hazard from rock fall on a highway.
+    Canadian Geotechnical Journal 34, 344-356.
     """
     n = _positive_array(vehicles_per_day, "vehicles_per_day")
     t = check_positive(hours_on_road, "hours_on_road")
@@ -105,27 +165,103 @@ def stationary_rock_strike_probability(vehicles_per_day, hours_on_road, p_cannot
 
 
 def commuter_passage_probability(trips_per_day, vehicle_length_m, speed_kmh):
-    """P(T:S) = trips x L_v / (24 x 1000 x V_v): a given commuter's car is at the impact point (AGS 2007)."""
+    """P(T:S) = trips x L_v / (24 x 1000 x V_v): a given commuter's car is at the impact point (AGS 2007).
+
+    Parameters
+    ----------
+    trips_per_day : float
+        Passes of the commuter through the exposed road [1/day].
+    vehicle_length_m : float
+        Vehicle length L_v [m].
+    speed_kmh : float
+        Speed V_v [km/h].
+
+    Returns
+    -------
+    float
+        P(T:S) [-].
+
+    References
+    ----------
+    AGS (2007). Australian Geomechanics Society, practice note guidelines for landslide risk management (AGS 2007c).
+    """
     return check_positive(trips_per_day, "trips_per_day") * check_positive(vehicle_length_m, "vehicle_length_m") \
         / (HOURS_PER_DAY * M_PER_KM * check_positive(speed_kmh, "speed_kmh"))
 
 
 def commuter_strike_probability(trips_per_day, hours_on_road, p_cannot_stop):
-    """P(a given commuter arrives while a rock lies on the road and cannot stop): 1 - exp(-trips t p / 24)."""
+    """P(a given commuter arrives while a rock lies on the road and cannot stop): 1 - exp(-trips t p / 24).
+
+    Parameters
+    ----------
+    trips_per_day : float
+        Passes of the commuter through the exposed road [1/day].
+    hours_on_road : float
+        Time t a rock lies on the road [h].
+    p_cannot_stop : float
+        Probability that the commuter fails to stop in time [-].
+
+    Returns
+    -------
+    float
+        Probability that the commuter strikes a lying rock, per fall [-].
+
+    References
+    ----------
+    Bunce, C. M., Cruden, D. M. and Morgenstern, N. R. (1997). Assessment of the hazard from rock fall on a highway.
+    Canadian Geotechnical Journal 34, 344-356.
+    """
     return float(-np.expm1(-check_positive(trips_per_day, "trips_per_day") * check_positive(hours_on_road,
                                                                                           "hours_on_road")
                            * float(p_cannot_stop) / HOURS_PER_DAY))
 
 
 def individual_risk(falls_per_year, trips_per_day, vehicle_length_m, speed_kmh, vulnerability):
-    """Annual probability of death of one commuter hit directly: lambda x P(T:S) x V(D:T) (AGS 2007)."""
+    """Annual probability of death of one commuter hit directly: lambda x P(T:S) x V(D:T) (AGS 2007).
+
+    Parameters
+    ----------
+    falls_per_year : float
+        Frequency lambda of falls reaching the road [1/yr].
+    trips_per_day : float
+        Passes of the commuter [1/day].
+    vehicle_length_m : float
+        Vehicle length L_v [m].
+    speed_kmh : float
+        Speed V_v [km/h].
+    vulnerability : float
+        Probability of death given a hit, V(D:T) [-].
+
+    Returns
+    -------
+    float
+        Annual probability of death of the commuter [1/yr].
+
+    References
+    ----------
+    AGS (2007). Australian Geomechanics Society, practice note guidelines for landslide risk management (AGS 2007c).
+    """
     return float(falls_per_year) * commuter_passage_probability(trips_per_day, vehicle_length_m, speed_kmh) \
         * float(vulnerability)
 
 
 def vulnerability_by_mass(mass_kg, table):
     """Probability of death for blocks of ``mass_kg`` from ``table``: a number (constant) or pairs
-    (mass_kg, vulnerability) interpolated linearly in log10(mass), constant beyond the ends."""
+    (mass_kg, vulnerability) interpolated linearly in log10(mass), constant beyond the ends.
+
+    Parameters
+    ----------
+    mass_kg : float or array_like
+        Block masses [kg].
+    table : float or sequence of (float, float)
+        A constant vulnerability [-], or pairs (mass [kg], vulnerability [-]) such as
+        :data:`VULNERABILITY_DIRECT_BY_MASS`.
+
+    Returns
+    -------
+    numpy.ndarray
+        Probability of death [-], shaped as ``mass_kg``.
+    """
     m = np.asarray(mass_kg, dtype=float)
     if isinstance(table, (int, float)):
         return np.full(m.shape, float(table))
@@ -140,6 +276,27 @@ def occupancy_distribution(mean_occupants: float, pmf: dict | None = None, max_o
     1 + Poisson(mean - 1) truncated at ``max_occupants`` (every vehicle has a driver;
     ASSUMPTION: passengers Poisson), renormalised, so the mean is ``mean_occupants`` up
     to the truncation.
+
+    Parameters
+    ----------
+    mean_occupants : float
+        Mean occupants per vehicle [persons], >= 1; ignored when ``pmf`` is given.
+    pmf : dict, optional
+        {occupants [persons]: probability [-]}, summing to 1.
+    max_occupants : int, optional
+        Largest number of occupants in the default distribution [persons].
+
+    Returns
+    -------
+    k : numpy.ndarray of int
+        Numbers of occupants [persons].
+    p : numpy.ndarray
+        P(K = k) [-], summing to 1.
+
+    Raises
+    ------
+    ValueError
+        When ``pmf`` is not a distribution over whole numbers >= 1, or ``mean_occupants`` < 1.
     """
     if pmf:
         k = np.array(sorted(int(x) for x in pmf), dtype=int)
@@ -162,6 +319,22 @@ def share_with_at_least(vulnerabilities, occupants_k, occupants_p, max_n: int | 
 
     Exact binomial sums, vectorised over any array of vulnerabilities: the pmf of Binomial(k, v) is built up one
     occupant at a time (pmf_k(i) = pmf_(k-1)(i) (1 - v) + pmf_(k-1)(i - 1) v), so no power is evaluated.
+
+    Parameters
+    ----------
+    vulnerabilities : array_like
+        Probability of death of each occupant v [-], any shape.
+    occupants_k : array_like of int
+        Numbers of occupants of a vehicle, K [persons].
+    occupants_p : array_like of float
+        P(K = k) for each entry of ``occupants_k`` [-], summing to 1.
+    max_n : int, optional
+        Largest number of deaths n [persons]; the largest K by default.
+
+    Returns
+    -------
+    numpy.ndarray
+        P(N >= n) [-] for n = 1 ... max_n, shape ``vulnerabilities.shape + (max_n,)``.
     """
     v_all = np.asarray(vulnerabilities, dtype=float)
     k_all = np.asarray(occupants_k, dtype=int)
@@ -194,6 +367,22 @@ def occupant_fn(frequencies, vulnerabilities, occupants_k, occupants_p) -> pd.Da
     vehicle (K ~ ``occupants_p`` over ``occupants_k``) dies independently with
     probability ``vulnerabilities[s]``: F(N) = sum_s f_s sum_k P(K = k) P(Binomial(k, V_s) >= N)
     for every N = 1 ... max k.  sum_N F(N) equals the expected deaths per year.
+
+    Parameters
+    ----------
+    frequencies : array_like
+        Frequency f_s of each scenario [1/yr].
+    vulnerabilities : array_like
+        Probability of death V_s of an occupant in each scenario [-].
+    occupants_k : array_like of int
+        Numbers of occupants of a vehicle, K [persons].
+    occupants_p : array_like of float
+        P(K = k) for each entry of ``occupants_k`` [-], summing to 1.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``N`` (deaths [persons]) and ``F`` (frequency of N or more deaths [1/yr]).
     """
     f = np.asarray(frequencies, dtype=float).ravel()
     v = np.asarray(vulnerabilities, dtype=float).ravel()
@@ -205,7 +394,24 @@ def occupant_fn(frequencies, vulnerabilities, occupants_k, occupants_p) -> pd.Da
 
 
 def fn_curve(scenarios) -> pd.DataFrame:
-    """F-N curve from scenarios ``[(frequency_per_year, fatalities), ...]``: F(N) = sum f_i for N_i >= N."""
+    """F-N curve from scenarios ``[(frequency_per_year, fatalities), ...]``: F(N) = sum f_i for N_i >= N.
+
+    Parameters
+    ----------
+    scenarios : array_like
+        Pairs (frequency [1/yr], fatalities [persons]), all >= 0.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``N`` (fatalities [persons]) and ``F`` (frequency of N or more [1/yr]); empty when no scenario
+        kills anyone.
+
+    Raises
+    ------
+    ValueError
+        When a frequency or number of fatalities is negative.
+    """
     arr = np.asarray(scenarios, dtype=float).reshape(-1, 2)
     if np.any(arr < 0):
         i = int(np.argmax(np.any(arr < 0, axis=1)))
@@ -219,7 +425,27 @@ def fn_curve(scenarios) -> pd.DataFrame:
 
 
 def vehicle_occupant_fn(hit_frequency, occupants, vulnerability) -> pd.DataFrame:
-    """F-N curve of vehicle hits with a fixed whole number of occupants: N ~ Binomial(occupants, vulnerability)."""
+    """F-N curve of vehicle hits with a fixed whole number of occupants: N ~ Binomial(occupants, vulnerability).
+
+    Parameters
+    ----------
+    hit_frequency : float
+        Frequency of vehicle hits [1/yr].
+    occupants : int
+        Occupants of the vehicle [persons], a whole number >= 1.
+    vulnerability : float
+        Probability of death of each occupant [-].
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``N`` (deaths [persons]) and ``F`` (frequency of N or more deaths [1/yr]).
+
+    Raises
+    ------
+    ValueError
+        When ``occupants`` is not a whole number >= 1.
+    """
     n_occ = int(occupants)
     if n_occ != occupants or n_occ < 1:
         raise ValueError(f"occupants = {occupants!r} must be a whole number >= 1; for a mean such as 1.4 use "
@@ -233,6 +459,24 @@ def fn_zone(fn: pd.DataFrame, lines: dict | None = None) -> str:
     "unacceptable": F(N) above the upper line C/N^k for some N <= 1,000, or any N > 5,000
     with F > 0; "intense scrutiny": F(N) >= 1e-9 for some 1,000 < N <= 5,000;
     "ALARP": above the lower line; else "broadly acceptable".
+
+    Parameters
+    ----------
+    fn : pandas.DataFrame
+        F-N curve with columns ``N`` [persons] and ``F`` [1/yr].
+    lines : dict, optional
+        ``{"unacceptable above": (C, k), "broadly acceptable below": (C, k)}`` criterion lines F = C / N^k
+        (C [1/yr]); :data:`HK_GEO_FN_LINES` by default.
+
+    Returns
+    -------
+    str
+        ``"unacceptable"``, ``"intense scrutiny"``, ``"ALARP"`` or ``"broadly acceptable"``.
+
+    References
+    ----------
+    ERM-Hong Kong (1998). Landslides and boulder falls from natural terrain: interim risk guidelines. GEO Report
+    No. 75, Geotechnical Engineering Office, Hong Kong.
     """
     lines = HK_GEO_FN_LINES if lines is None else lines
     (c_hi, k_hi), (c_lo, k_lo) = lines["unacceptable above"], lines["broadly acceptable below"]

@@ -97,6 +97,31 @@ def lanes_from_traffic(vehicles_per_day, speed_kmh: float, lanes: int = 2, direc
     traffic split ``directional_split`` : 1 - split between the directions and evenly between a direction's
     lanes.  ``fall_shares`` (one per lane, nearest the slope first; default even) say where falls land.
 
+    Parameters
+    ----------
+    vehicles_per_day : float
+        Two-way traffic [vehicles/day], > 0.
+    speed_kmh : float
+        Speed [km/h].
+    lanes : int, optional
+        Number of lanes, >= 1.
+    directional_split : float, optional
+        Share of the traffic towards the slope side [-], in [0, 1].
+    fall_shares : sequence of float, optional
+        Share of the falls reaching the road landing in each lane [-], nearest the slope first, summing to 1.
+
+    Returns
+    -------
+    tuple of Lane
+        The lanes, nearest the slope first.
+
+    Raises
+    ------
+    ValueError
+        When a number is out of range or ``fall_shares`` has the wrong length.
+
+    Examples
+    --------
     >>> [round(l.vehicles_per_day) for l in lanes_from_traffic(6000, 80)]
     [3000, 3000]
     """
@@ -140,6 +165,32 @@ def lane_hit_probability(lanes, vehicle_length_m: float, traffic_factor=1.0):
     (Bunce et al. 1997, per lane).  ``traffic_factor`` (a number or an array of samples) scales every lane's
     traffic.
 
+    Parameters
+    ----------
+    lanes : sequence of Lane
+        The road's lanes.
+    vehicle_length_m : float
+        Vehicle length L_v [m], > 0.
+    traffic_factor : float or array_like, optional
+        Factor on every lane's traffic [-] (an array of uncertainty samples allowed).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        P(hit) per fall reaching the road [-].
+
+    Raises
+    ------
+    ValueError
+        When the lane traffic is continuous (P >= 1) or an input is out of range.
+
+    References
+    ----------
+    Bunce, C. M., Cruden, D. M. and Morgenstern, N. R. (1997). Assessment of the hazard from rock fall on a highway.
+    Canadian Geotechnical Journal 34, 344-356.
+
+    Examples
+    --------
     >>> round(lane_hit_probability(lanes_from_traffic(6000, 80), 5.0), 7)   # 3000 x 5 / (24000 x 80)
     0.0078125
     """
@@ -159,6 +210,34 @@ def lane_strike_probability(lanes, hours_on_road: float, p_cannot_stop: float, t
     """P(a vehicle strikes a rock lying in its lane before it is removed) = sum_i q_i p (1 - exp(-N_i t / 24)):
     the first vehicle of the lane to arrive within ``hours_on_road`` fails to stop with probability ``p``.
 
+    Parameters
+    ----------
+    lanes : sequence of Lane
+        The road's lanes.
+    hours_on_road : float
+        Time t a rock lies on the road [h], > 0.
+    p_cannot_stop : float
+        Probability p that the arriving driver fails to stop [-], in [0, 1].
+    traffic_factor : float or array_like, optional
+        Factor on every lane's traffic [-] (an array of uncertainty samples allowed).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        P(strike) per fall reaching the road [-].
+
+    Raises
+    ------
+    ValueError
+        When an input is out of range.
+
+    References
+    ----------
+    Bunce, C. M., Cruden, D. M. and Morgenstern, N. R. (1997). Assessment of the hazard from rock fall on a highway.
+    Canadian Geotechnical Journal 34, 344-356.
+
+    Examples
+    --------
     >>> round(lane_strike_probability(lanes_from_traffic(6000, 80), 0.5, 0.002), 8)  # 0.002 (1 - exp(-3000*0.5/24))
     0.002
     """
@@ -188,14 +267,35 @@ class Vulnerability:
     basis: str = ""
 
     def probability(self, mass_kg, which: str = "direct", factor=1.0) -> np.ndarray:
-        """V(D:T) for blocks of ``mass_kg`` [kg]: ``which`` "direct" or "strike"; ``factor`` multiplies it."""
+        """V(D:T) for blocks of ``mass_kg`` [kg]: ``which`` "direct" or "strike"; ``factor`` multiplies it.
+
+        Parameters
+        ----------
+        mass_kg : float or array_like
+            Block masses [kg].
+        which : str, optional
+            ``"direct"`` (hit on a moving vehicle) or ``"strike"`` (vehicle strikes a lying rock).
+        factor : float or array_like, optional
+            Factor on the vulnerability [-]; the result is capped at 1.
+
+        Returns
+        -------
+        numpy.ndarray
+            Probability of death [-].
+        """
         table = np.asarray(self.direct if which == "direct" else self.strike, dtype=float)
         m = np.clip(np.asarray(mass_kg, dtype=float), 1e-12, None)
         v = np.interp(np.log10(m), np.log10(table[:, 0]), table[:, 1])
         return np.minimum(v * np.asarray(factor, dtype=float), 1.0)
 
     def summary(self) -> pd.DataFrame:
-        """The model's points, one row per mass, with the low and high ends of the stated range."""
+        """The model's points, one row per mass, with the low and high ends of the stated range.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``case``, ``mass_kg`` [kg], ``vulnerability``, ``low`` and ``high`` [-].
+        """
         lo, hi = self.factor_range
         rows = []
         for which, table in (("direct hit on a moving vehicle", self.direct),
@@ -249,7 +349,14 @@ class RoadUserRisk:
         return self.injuries_direct + self.injuries_strike
 
     def summary(self) -> pd.DataFrame:
-        """One row per way of being harmed, and the total."""
+        """One row per way of being harmed, and the total.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by ``case``; columns ``vehicles_involved``, ``deaths`` and ``injuries``, each per fall reaching the
+            road [-].
+        """
         return pd.DataFrame([
             {"case": "direct hit on a moving vehicle", "vehicles_involved": self.hit_probability,
              "deaths": self.deaths_direct, "injuries": self.injuries_direct},
@@ -269,6 +376,39 @@ def per_fall_risk(lanes, mass_kg, *, vehicle_length_m: float = 5.0, occupants: f
     deaths_direct = occupants x P(hit) x mean V_direct(m); deaths_strike = occupants x P(strike) x s x mean
     V_strike(m) with s = ``share_stopping_on_road`` (the share of falls that stop on the carriageway);
     injuries: occupants x P x mean (1 - V(m)) x injury_given_survival.
+
+    Parameters
+    ----------
+    lanes : sequence of Lane
+        The road's lanes.
+    mass_kg : float or array_like
+        Masses of the falls [kg], equally likely.
+    vehicle_length_m : float, optional
+        Vehicle length [m].
+    occupants : float, optional
+        Mean occupants per vehicle [persons].
+    hours_on_road : float, optional
+        Time a rock lies on the road [h].
+    p_cannot_stop : float, optional
+        Probability that the arriving driver fails to stop [-].
+    share_stopping_on_road : float, optional
+        Share of the falls that stop on the carriageway [-].
+    vulnerability : Vulnerability, optional
+        The vulnerability model.
+    factor : float, optional
+        Factor on the vulnerability [-].
+    injury_given_survival : float, optional
+        Probability that a survivor is injured [-]; the model's central value by default.
+
+    Returns
+    -------
+    RoadUserRisk
+        Vehicles involved, deaths and injuries per fall reaching the road [-].
+
+    References
+    ----------
+    Bunce, C. M., Cruden, D. M. and Morgenstern, N. R. (1997). Assessment of the hazard from rock fall on a highway.
+    Canadian Geotechnical Journal 34, 344-356.
     """
     m = np.atleast_1d(np.asarray(mass_kg, dtype=float))
     ph = lane_hit_probability(lanes, vehicle_length_m)

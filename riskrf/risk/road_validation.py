@@ -53,7 +53,24 @@ HONG_KONG_TRAFFIC = {"vehicles_per_day": (5000.0, 50000.0), "lanes": (2, 3, 4), 
 
 
 def poisson_interval(k: int, level: float = 0.95) -> tuple:
-    """Exact (Garwood 1936) two-sided interval of a Poisson mean given ``k`` events: chi2 quantiles / 2."""
+    """Exact (Garwood 1936) two-sided interval of a Poisson mean given ``k`` events: chi2 quantiles / 2.
+
+    Parameters
+    ----------
+    k : int
+        Number of events observed.
+    level : float, optional
+        Confidence level [-].
+
+    Returns
+    -------
+    tuple of float
+        (low, high) of the Poisson mean [events].
+
+    References
+    ----------
+    Garwood, F. (1936). Fiducial limits for the Poisson distribution. Biometrika 28, 437-442.
+    """
     a = 1.0 - level
     lo = 0.0 if k == 0 else stats.chi2.ppf(a / 2, 2 * k) / 2
     hi = stats.chi2.ppf(1 - a / 2, 2 * k + 2) / 2
@@ -93,6 +110,23 @@ def read_hong_kong_road_records(path) -> RoadRecords:
     """Rock-cut and soil/rock-cut incidents that affected a road, from the CEDD/GEO register CSV.
 
     Raises ValueError naming the file and the missing column.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The CEDD/GEO slope incident register (CSV).
+
+    Returns
+    -------
+    RoadRecords
+        One row per incident (``volume_m3`` [m3], deaths, injuries, vehicle involved, year) and the years covered.
+
+    Raises
+    ------
+    FileNotFoundError
+        When the file does not exist.
+    ValueError
+        Naming the file and a missing column, or the row and column of an unreadable count.
     """
     path = Path(path)
     if not path.exists():
@@ -142,7 +176,14 @@ class RoadValidation:
     def summary(self) -> pd.DataFrame:
         """One row per quantity: recorded count and rate per fall with its 95 % Poisson interval, predicted per
         fall (mean and 5-95 %), predicted count over the recorded falls, P(count <= recorded) and P(count >=
-        recorded) under the prediction, and whether the record lies inside the prediction's 95 % range."""
+        recorded) under the prediction, and whether the record lies inside the prediction's 95 % range.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by ``quantity``; counts, rates per fall [-] with their intervals, probabilities [-] and
+            ``consistent``.
+        """
         n = self.records.falls
         rec = {"vehicles involved": self.records.vehicles_involved, "deaths": self.records.deaths,
                "injuries": self.records.injuries}
@@ -172,6 +213,32 @@ def hong_kong_road_validation(path, *, vulnerability: Vulnerability = DEFAULT_VU
     averaged over the register's own incident sizes (mass = SCALE x 2,650 kg/m³; incidents without a size take
     the others' distribution).  ``two_way=True`` evaluates Bunce's formula with the two-way traffic in one lane
     (the form used before lanes were separated), to show what that does.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The CEDD/GEO slope incident register (CSV).
+    vulnerability : riskrf.risk.road_users.Vulnerability, optional
+        The vulnerability model.
+    traffic : dict, optional
+        Overrides of :data:`HONG_KONG_TRAFFIC` (traffic [vehicles/day], speed [km/h], occupants [persons], hours on
+        road [h], vehicle length [m]).
+    samples : int, optional
+        Number of samples S.
+    seed : int, optional
+        Random seed.
+    two_way : bool, optional
+        Put the two-way traffic in one lane.
+
+    Returns
+    -------
+    RoadValidation
+        Recorded and predicted (S samples) vehicles involved, deaths and injuries per fall reaching a road [-].
+
+    References
+    ----------
+    Bunce, C. M., Cruden, D. M. and Morgenstern, N. R. (1997). Assessment of the hazard from rock fall on a highway.
+    Canadian Geotechnical Journal 34, 344-356.
     """
     rec = read_hong_kong_road_records(path)
     tr = {**HONG_KONG_TRAFFIC, **(traffic or {})}

@@ -52,6 +52,27 @@ def check_rates(given, inventory: dict, path, error=ValueError) -> dict | None:
 
     Returns the merged ``[rates]`` table (defaults filled, the rainfall record read into ``"_rainfall"``,
     the warning list into ``"_warnings"``) or None.  Raises ``error`` naming the file, field and value.
+
+    Parameters
+    ----------
+    given : dict or None
+        The site file's ``[rates]`` table; None when absent.
+    inventory : dict
+        The site file's ``[inventory]`` table (its rate fields are checked and completed in place).
+    path : str or pathlib.Path
+        The site file; paths in the table are relative to its directory.
+    error : type, optional
+        Exception class raised on bad input.
+
+    Returns
+    -------
+    dict or None
+        The merged ``[rates]`` table, or None when ``given`` is None.
+
+    Raises
+    ------
+    Exception
+        ``error``, naming the file, field and value.
     """
     from .closure import read_rainstorm_warnings
     from ..io.rainfall import read_rainfall
@@ -182,7 +203,24 @@ def check_rates(given, inventory: dict, path, error=ValueError) -> dict | None:
 
 
 def check_closure_options(options, rates: dict | None, path, error=ValueError) -> None:
-    """Closure options given as rules need a daily ``[rates]`` model, and warning rules its warning list."""
+    """Closure options given as rules need a daily ``[rates]`` model, and warning rules its warning list.
+
+    Parameters
+    ----------
+    options : iterable of riskrf.risk.mitigation_inputs.Option
+        The study's options.
+    rates : dict or None
+        The checked ``[rates]`` table (:func:`check_rates`), or None.
+    path : str or pathlib.Path
+        The site file, named in errors.
+    error : type, optional
+        Exception class raised on bad input.
+
+    Raises
+    ------
+    Exception
+        ``error``, naming the file, option and field.
+    """
     for o in options:
         if o.kind != "closure" or not o.has_closure_rule:
             continue
@@ -249,7 +287,13 @@ class SiteRates:
     notes: tuple = field(default_factory=tuple)
 
     def rate_text(self) -> str:
-        """Where the hazard's rate comes from, in words, for rate_from = "rate_model"."""
+        """Where the hazard's rate comes from, in words, for rate_from = "rate_model".
+
+        Returns
+        -------
+        str
+            The sentence, rates in events per year [1/yr].
+        """
         every = {"day": "daily", "month": "monthly", "year": "yearly"}.get(self.period, self.period)
         text = (f"expected rate of the {self.preferred} {every} rate model of {Path(self.record).name} "
                 f"({self.start.year}-{self.end.year}) on the rainfall of {Path(self.rainfall).name}: "
@@ -261,14 +305,37 @@ class SiteRates:
         return text
 
     def hazard_factor(self, inventory) -> float:
-        """Factor on ``rate_scale`` making the inventory's rate the model's: climate_rate / (sized falls / duration)."""
+        """Factor on ``rate_scale`` making the inventory's rate the model's: climate_rate / (sized falls / duration).
+
+        Parameters
+        ----------
+        inventory : riskrf.frequency.inventory.Inventory
+            The site inventory (its sized falls ``masses`` and ``duration_years`` [yr]).
+
+        Returns
+        -------
+        float
+            The factor [-].
+
+        Raises
+        ------
+        ValueError
+            When the inventory has no sized falls.
+        """
         n = int(len(inventory.masses))
         if n == 0:
             raise ValueError(f"{inventory.source}: no sized falls; the rate model's rate cannot be split by size")
         return self.climate_rate / (n / inventory.duration_years)
 
     def summary(self) -> dict:
-        """Machine-readable figures (summary.json)."""
+        """Machine-readable figures (summary.json).
+
+        Returns
+        -------
+        dict
+            Record, rainfall, period, model, dates, rates [1/yr], change of climate, closures (share [-], hours per year
+            [h/yr], closures per year [1/yr], cost per hour [currency/h]) and notes.
+        """
         return {"record": self.record, "rainfall": self.rainfall, "period": self.period,
                 "preferred_model": self.preferred, "start": str(self.start.date()), "end": str(self.end.date()),
                 "observed_rate_per_year": self.observed_rate, "expected_rate_per_year": self.expected_rate,
@@ -284,7 +351,25 @@ class SiteRates:
 
 def evaluate_rates(rates: dict, base, inventory: dict, options=()) -> SiteRates:
     """Fit the rate model of a checked ``[rates]`` table (:func:`check_rates`) and compute the expected rates and
-    every closure rule among ``options``.  ``base`` is the directory paths are relative to."""
+    every closure rule among ``options``.  ``base`` is the directory paths are relative to.
+
+    Parameters
+    ----------
+    rates : dict
+        The checked ``[rates]`` table.
+    base : str or pathlib.Path
+        Directory the table's paths are relative to.
+    inventory : dict
+        The site file's ``[inventory]`` table (change of climate: ``rain_factor``, ``heavy_day_mm`` [mm],
+        ``heavy_day_change``).
+    options : iterable of riskrf.risk.mitigation_inputs.Option, optional
+        The study's options; closure rules among them are evaluated.
+
+    Returns
+    -------
+    SiteRates
+        Rates [1/yr] and closure rules of the fitted model.
+    """
     from .closure import closure_rule, warning_closure
     from ..frequency.inventory import READER_OPTIONS, read_inventory
     from ..frequency.rates import rate_model
@@ -334,7 +419,25 @@ def evaluate_rates(rates: dict, base, inventory: dict, options=()) -> SiteRates:
 
 def resolve_closures(options, site_rates: SiteRates | None) -> tuple:
     """The options with each closure rule's share and hours filled in from ``site_rates`` (costs added to the
-    annual maintenance, the rule and its source in ``closure_rule``); other options unchanged."""
+    annual maintenance, the rule and its source in ``closure_rule``); other options unchanged.
+
+    Parameters
+    ----------
+    options : iterable of riskrf.risk.mitigation_inputs.Option
+        The study's options.
+    site_rates : SiteRates or None
+        The evaluated rate model.
+
+    Returns
+    -------
+    tuple of riskrf.risk.mitigation_inputs.Option
+        The options, closure rules resolved (share [-], hours per year [h/yr]).
+
+    Raises
+    ------
+    ValueError
+        When a closure rule was not evaluated.
+    """
     out = []
     for o in options:
         if o.kind == "closure" and o.has_closure_rule:

@@ -53,7 +53,22 @@ def quantile_map(x, ref, var):
     F_var^-1(F_ref(x)), both empirical with plotting positions (i + 1/2) / n and linear between them; beyond
     ``ref``'s extremes scaled by the ratio of the extremes.  Values of ``x`` equal to a value held several times
     in ``ref`` (rolling blocks at h = 0) are spread evenly, in their order, over that value's probability range,
-    so that their share is kept.  Identity when ``var`` equals ``ref``; ``2 ref`` maps x to 2 x."""
+    so that their share is kept.  Identity when ``var`` equals ``ref``; ``2 ref`` maps x to 2 x.
+
+    Parameters
+    ----------
+    x : array_like
+        Values to map (units of the samples, e.g. bounce heights [m]).
+    ref : array_like
+        Sample of the law ``x`` follows.
+    var : array_like
+        Sample of the target law.
+
+    Returns
+    -------
+    numpy.ndarray
+        Mapped values, shaped as ``x``, in the samples' units.
+    """
     x = np.asarray(x, dtype=float)
     r, w = np.sort(np.asarray(ref, dtype=float)), np.sort(np.asarray(var, dtype=float))
     u = np.interp(x, r, (np.arange(r.size) + 0.5) / r.size)
@@ -96,7 +111,25 @@ class SlopeModels:
     _variant_classes: dict = field(default_factory=dict)
 
     def need_context(self, opt, fld):
-        """The simulation context, or a MitigationError naming the option and the field that needs it."""
+        """The simulation context, or a MitigationError naming the option and the field that needs it.
+
+        Parameters
+        ----------
+        opt : riskrf.risk.mitigation_inputs.Option
+            The option (named in error messages).
+        fld : str
+            The option's field that needs the scenario.
+
+        Returns
+        -------
+        riskrf.risk.measures.SimulationContext
+            The study's simulation context.
+
+        Raises
+        ------
+        MitigationError
+            When the study has no scenario.
+        """
         if self.context is None:
             raise MitigationError(f"{self.source}: option {opt.name!r}: {fld} needs the slope scenario to derive its "
                                   "effect (run with a scenario, or type an effectiveness as an assumption)")
@@ -106,7 +139,13 @@ class SlopeModels:
     @cached_property
     def models(self) -> list:
         """[0] the reference (the hazard's own simulation), then the joint material draws, then one low and one
-        high variant per uncertain material parameter (tornado)."""
+        high variant per uncertain material parameter (tornado).
+
+        Returns
+        -------
+        list of SlopeModel
+            The slope models, the reference first.
+        """
         models = [self._reference_model()]
         u = self.uncertainty
         ranges = self.material_ranges()
@@ -131,7 +170,14 @@ class SlopeModels:
         return models
 
     def material_ranges(self) -> dict:
-        """"material.field" -> (low, high, how) of the uncertain slope material parameters."""
+        """"material.field" -> (low, high, how) of the uncertain slope material parameters.
+
+        Returns
+        -------
+        dict
+            ``"material.field"`` -> (low, high, how): bounds in the field's units (restitution [-], angles [deg],
+            roughness [m]) and how they were obtained.
+        """
         u = self.uncertainty
         if u.calibration is not None:
             out = {}
@@ -166,7 +212,15 @@ class SlopeModels:
 
     @cached_property
     def arrays(self):
-        """Reach probability at the barrier line and P(road | barrier) per slope model."""
+        """Reach probability at the barrier line and P(road | barrier) per slope model.
+
+        Returns
+        -------
+        reach : numpy.ndarray
+            Probability of reaching the barrier line per slope model [-].
+        road_share : numpy.ndarray
+            P(road | barrier line) per slope model [-].
+        """
         ms = self.models
         reach = np.array([m.reach for m in ms])
         if self.by_mass is not None and len(ms) > 1:
@@ -178,7 +232,14 @@ class SlopeModels:
         return reach, np.array([m.road_share for m in ms])
 
     def table(self) -> pd.DataFrame:
-        """The slope models: material values, reach probability and road share of each."""
+        """The slope models: material values, reach probability and road share of each.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per slope model: ``model``, ``label``, material values, ``reach_probability`` [-] and ``road_share``
+            [-].
+        """
         return pd.DataFrame([{"model": i, "label": m.label, **m.values, "reach_probability": m.reach,
                               "road_share": m.road_share} for i, m in enumerate(self.models)])
 
@@ -187,7 +248,13 @@ class SlopeModels:
     def radius_m(self) -> np.ndarray:
         """Radius [m] of a block of each mass bin's representative mass: the scenario's block shape and density
         (its seeder) when there is a slope model, else a sphere of 2,650 kg/m3.  A block passes over a fence when
-        its underside (centre height - radius) clears the fence top, as in the simulator's barrier."""
+        its underside (centre height - radius) clears the fence top, as in the simulator's barrier.
+
+        Returns
+        -------
+        numpy.ndarray
+            Radius per mass bin (J,) [m].
+        """
         mid = self.grid.mid
         seeder = getattr(getattr(self.context, "scenario", None), "seeder", None)
         if seeder is not None:
@@ -206,6 +273,13 @@ class SlopeModels:
         masses; the hazard's own samples are another mass mixture): speeds by the ratio of the medians, bounce
         heights by quantile mapping (:func:`quantile_map`; a ratio of medians is 0 or unbounded when most blocks
         roll, h = 0), reach by the ratio of the mean reach probabilities (:attr:`arrays`).
+
+        Returns
+        -------
+        tuple or None
+            ``(class_of_bin, samples, profile)``: the mass class of each bin, class -> (speeds [m/s], bounce heights
+            [m]) of its arriving blocks, and per bin P(reach | class) over the mean reach [-]; None when the hazard is
+            not mass-coupled.
         """
         hz = self.hazard
         if not hz.mass_coupled:
@@ -227,7 +301,18 @@ class SlopeModels:
         One road share for all block sizes over-counts small falls at the road and under-counts large ones (large
         blocks run further); the blocks of each mass class of the hazard's mass-coupled run that crossed the barrier
         line and then the road line (``coupled_road_hits``) give each class its own share.  A class with fewer than
-        20 blocks at the barrier line keeps the overall share."""
+        20 blocks at the barrier line keeps the overall share.
+
+        Returns
+        -------
+        numpy.ndarray
+            Relative road share per mass bin (J,) [-].
+
+        Raises
+        ------
+        MitigationError
+            When ``coupled_road_hits`` does not match the hazard's mass-coupled run.
+        """
         mid = self.grid.mid
         ones = np.ones(mid.size)
         hits = self.coupled_road_hits
@@ -252,7 +337,25 @@ class SlopeModels:
     def barrier_damage(self, opt, *, shed: bool) -> tuple:
         """(passing, held above SEL, destroying) shares, each (models, J), of the falls meeting the fence or
         attenuator ``opt`` (at the barrier line or its own ``x_m``) or, ``shed``, the shed over the road, with
-        the damage states of :func:`riskrf.hazard.barriers.damage_state_shares` and E = 1/2 m v^2 [kJ]."""
+        the damage states of :func:`riskrf.hazard.barriers.damage_state_shares` and E = 1/2 m v^2 [kJ].
+
+        Parameters
+        ----------
+        opt : riskrf.risk.mitigation_inputs.Option
+            The option (named in error messages). Its ``capacity_kj`` [kJ], ``height_m`` [m] and ``x_m`` [m] are used.
+        shed : bool
+            A shed over the road (falls at the road line, none pass over) instead of a fence or attenuator.
+
+        Returns
+        -------
+        passing, held, destroying : numpy.ndarray
+            Shares of the falls [-], each (slope models, J).
+
+        Raises
+        ------
+        MitigationError
+            When bounce heights paired with speeds are missing.
+        """
         mid = self.grid.mid
         cap = opt.capacity_kj
         fence_lines = self.fence_samples_at(opt) if opt.x_m is not None and not shed else None
@@ -304,7 +407,23 @@ class SlopeModels:
         return tuple(shares)
 
     def fence_samples_at(self, opt) -> list:
-        """Per slope model: (effective speeds [m/s], bounce heights [m]) at the option's own line x_m."""
+        """Per slope model: (effective speeds [m/s], bounce heights [m]) at the option's own line x_m.
+
+        Parameters
+        ----------
+        opt : riskrf.risk.mitigation_inputs.Option
+            The option (named in error messages). Its ``x_m`` [m] is the line.
+
+        Returns
+        -------
+        list of tuple
+            Per slope model, (effective speeds [m/s], bounce heights [m]).
+
+        Raises
+        ------
+        MitigationError
+            When the study has no scenario or ``x_m`` lies outside the profile.
+        """
         import simulation.scenario as sc_mod
         ctx = self.need_context(opt, "x_m")
         prof = ctx.scenario.profile
@@ -318,23 +437,58 @@ class SlopeModels:
     # ---- the reference run (common random numbers) ---------------------------------------------------------
     @cached_property
     def reference_run(self):
-        """The unmodified scenario with the re-simulation blocks and seed (the common random numbers)."""
+        """The unmodified scenario with the re-simulation blocks and seed (the common random numbers).
+
+        Returns
+        -------
+        simulation.SimulationResult
+            The reference re-simulation.
+        """
         return self.context.run(self.context.scenario)
 
     @cached_property
     def reference_barrier(self):
-        """(effective speeds [m/s], bounce heights [m]) at the barrier line of :attr:`reference_run`."""
+        """(effective speeds [m/s], bounce heights [m]) at the barrier line of :attr:`reference_run`.
+
+        Returns
+        -------
+        speed : numpy.ndarray
+            Effective speeds [m/s].
+        height : numpy.ndarray
+            Bounce heights [m].
+        """
         return effective_samples(self.reference_run, self.context.barrier_collector)
 
     @cached_property
     def reference_road_blocks(self):
-        """Blocks of :attr:`reference_run` crossing the road line."""
+        """Blocks of :attr:`reference_run` crossing the road line.
+
+        Returns
+        -------
+        numpy.ndarray of int
+            Sorted block indices.
+        """
         return road_crossings(self.reference_run, self.context.road_collector)
 
     # ---- ditches, benches, bunds, drapes -------------------------------------------------------------------
     def geometry_retention(self, key: str, measures) -> tuple:
         """(overall retention of the reference model, its Beta law, overall retention per slope model, retention
-        by mass bin per slope model) of the slope changes ``measures`` simulated together; kept under ``key``."""
+        by mass bin per slope model) of the slope changes ``measures`` simulated together; kept under ``key``.
+
+        Parameters
+        ----------
+        key : str
+            Name under which the result is kept (the options' names joined by ``+``).
+        measures : list
+            The slope changes (:class:`riskrf.risk.measures.Ditch` or
+            :class:`riskrf.risk.geometry_measures.SlopeMeasure`).
+
+        Returns
+        -------
+        tuple
+            (retention of the reference model [-], its Beta law, retention per slope model [-], retention by mass bin
+            per slope model [-]).
+        """
         if key not in self.derived:
             per_model = self._ditch_retentions(measures)
             self.derived[key] = (per_model[0][0], per_model[0][1], np.array([r for r, _, _ in per_model]),

@@ -49,7 +49,18 @@ class FNLine:
     n_max: float = np.inf
 
     def frequency(self, n) -> np.ndarray:
-        """F on the line at N = ``n``."""
+        """F on the line at N = ``n``.
+
+        Parameters
+        ----------
+        n : float or array_like
+            Number of deaths N [persons].
+
+        Returns
+        -------
+        numpy.ndarray
+            F [1/yr], shaped as ``n``.
+        """
         return self.c / np.asarray(n, dtype=float) ** self.k
 
 
@@ -70,14 +81,61 @@ class CriteriaSet:
     evidence: str = "R"
 
     def individual_limit(self, slope: str = "existing") -> float:
-        """Tolerable individual risk [1/yr] for an ``existing`` or ``new`` slope."""
+        """Tolerable individual risk [1/yr] for an ``existing`` or ``new`` slope.
+
+        Parameters
+        ----------
+        slope : str, optional
+            ``"existing"`` or ``"new"``.
+
+        Returns
+        -------
+        float
+            The limit [1/yr].
+
+        Raises
+        ------
+        ValueError
+            When ``slope`` is not a key of the set.
+
+        References
+        ----------
+        ERM-Hong Kong (1998). Landslides and boulder falls from natural terrain: interim risk guidelines. GEO Report
+        No. 75, Geotechnical Engineering Office, Hong Kong.
+
+        AGS (2007). Australian Geomechanics Society, Practice note guidelines for landslide risk management. Australian
+        Geomechanics 42(1).
+
+        HSE (2001). Reducing risks, protecting people: HSE's decision-making process (R2P2). HSE Books.
+        """
         if slope not in self.individual_risk:
             raise ValueError(f"criteria {self.key!r}: slope = {slope!r} must be one of {sorted(self.individual_risk)}")
         return float(self.individual_risk[slope])
 
     def fn_zone(self, fn: pd.DataFrame) -> str:
         """Where an F-N curve (columns N, F) lies: "unacceptable", "intense scrutiny", "ALARP", "broadly
-        acceptable", or "no societal criterion" for a set without F-N lines."""
+        acceptable", or "no societal criterion" for a set without F-N lines.
+
+        Parameters
+        ----------
+        fn : pandas.DataFrame
+            F-N curve: columns ``N`` (deaths [persons]) and ``F`` (frequency of N or more [1/yr]).
+
+        Returns
+        -------
+        str
+            The zone.
+
+        References
+        ----------
+        ERM-Hong Kong (1998). Landslides and boulder falls from natural terrain: interim risk guidelines. GEO Report
+        No. 75, Geotechnical Engineering Office, Hong Kong.
+
+        AGS (2007). Australian Geomechanics Society, Practice note guidelines for landslide risk management. Australian
+        Geomechanics 42(1).
+
+        HSE (2001). Reducing risks, protecting people: HSE's decision-making process (R2P2). HSE Books.
+        """
         if self.fn_unacceptable is None:
             return "no societal criterion"
         if len(fn) == 0 or not np.any(fn["F"] > 0):
@@ -102,7 +160,20 @@ class CriteriaSet:
         return "ALARP"
 
     def fn_exceedance(self, F, N) -> np.ndarray:
-        """Largest ratio F(N) / line(N) over N (arrays ... x len(N)); > 1 means above the unacceptable line."""
+        """Largest ratio F(N) / line(N) over N (arrays ... x len(N)); > 1 means above the unacceptable line.
+
+        Parameters
+        ----------
+        F : array_like
+            Frequencies of N or more deaths [1/yr], last axis along ``N``.
+        N : array_like
+            Numbers of deaths [persons].
+
+        Returns
+        -------
+        numpy.ndarray
+            Largest ratio [-], shape ``F.shape[:-1]``; zeros for a set without F-N lines.
+        """
         if self.fn_unacceptable is None:
             return np.zeros(np.shape(F)[:-1])
         up = self.fn_unacceptable
@@ -112,12 +183,38 @@ class CriteriaSet:
         return ratio.max(axis=-1) if ratio.shape[-1] else np.zeros(np.shape(F)[:-1])
 
     def tolerable(self, individual_risk: float, fn: pd.DataFrame, slope: str = "existing") -> bool:
-        """Individual risk at or below the limit and the F-N curve outside the unacceptable region."""
+        """Individual risk at or below the limit and the F-N curve outside the unacceptable region.
+
+        Parameters
+        ----------
+        individual_risk : float
+            Individual risk of death of the person most at risk [1/yr].
+        fn : pandas.DataFrame
+            F-N curve: columns ``N`` (deaths [persons]) and ``F`` (frequency of N or more [1/yr]).
+        slope : str, optional
+            ``"existing"`` or ``"new"``.
+
+        Returns
+        -------
+        bool
+            True when both criteria are met.
+        """
         return bool(individual_risk <= self.individual_limit(slope)
                     and self.fn_zone(fn) not in ("unacceptable", "intense scrutiny"))
 
     def describe(self, slope: str = "existing") -> str:
-        """The criteria in one sentence."""
+        """The criteria in one sentence.
+
+        Parameters
+        ----------
+        slope : str, optional
+            ``"existing"`` or ``"new"``.
+
+        Returns
+        -------
+        str
+            Limits in [1/yr], marginal cost per life in the set's currency (e.g. [CHF]).
+        """
         parts = [f"individual risk <= {self.individual_limit(slope):.0e}/yr ({slope} slope)"]
         if self.fn_unacceptable is not None:
             up = self.fn_unacceptable
@@ -128,7 +225,13 @@ class CriteriaSet:
         return f"{self.name}: " + "; ".join(parts)
 
     def summary(self) -> pd.DataFrame:
-        """The set's numbers, one row each, with the source."""
+        """The set's numbers, one row each, with the source.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``criterion`` (with its unit), ``value``, ``source`` and ``evidence``.
+        """
         rows = [{"criterion": f"individual risk, {k} slope [1/yr]", "value": v} for k, v in self.individual_risk.items()]
         if self.individual_broadly_acceptable:
             rows.append({"criterion": "individual risk broadly acceptable [1/yr]",
@@ -172,7 +275,33 @@ def user_criteria(individual_risk_per_year: float, fn_c: float | None = None, fn
                   fn_acceptable_c: float | None = None, marginal_cost_per_life: float | None = None,
                   currency: str = "") -> CriteriaSet:
     """A criteria set of the user's own: an individual-risk limit, an optional F-N line F = fn_c / N^fn_k
-    (unacceptable above) and broadly-acceptable line (same slope), an optional marginal cost per life."""
+    (unacceptable above) and broadly-acceptable line (same slope), an optional marginal cost per life.
+
+    Parameters
+    ----------
+    individual_risk_per_year : float
+        Tolerable individual risk [1/yr], > 0.
+    fn_c : float, optional
+        C of the unacceptable line [1/yr] at N = 1.
+    fn_k : float, optional
+        Slope k of the F-N lines [-], in (0, 3].
+    fn_acceptable_c : float, optional
+        C of the broadly acceptable line [1/yr] at N = 1.
+    marginal_cost_per_life : float, optional
+        Marginal cost per statistical life saved [currency/life], e.g. [CHF].
+    currency : str, optional
+        Currency of the marginal cost.
+
+    Returns
+    -------
+    CriteriaSet
+        The set, key ``"user"``.
+
+    Raises
+    ------
+    ValueError
+        When a number is not > 0 or ``fn_k`` is out of range.
+    """
     for name, v in (("individual_risk_per_year", individual_risk_per_year), ("fn_c", fn_c),
                     ("fn_acceptable_c", fn_acceptable_c), ("marginal_cost_per_life", marginal_cost_per_life)):
         if v is not None and (isinstance(v, bool) or not np.isfinite(v) or v <= 0):
@@ -189,7 +318,24 @@ def user_criteria(individual_risk_per_year: float, fn_c: float | None = None, fn
 def cost_per_statistical_life_saved(extra_cost_pv, other_losses_saved_pv, deaths_avoided_per_year, horizon_years):
     """Cost per statistical life saved [currency/life] of a measure against a reference: (PV of its extra cost
     minus PV of the non-fatal losses it saves) / (deaths avoided per year x horizon).  inf when it saves no life;
-    <= 0 when it pays for itself."""
+    <= 0 when it pays for itself.
+
+    Parameters
+    ----------
+    extra_cost_pv : float or array_like
+        Present value of the measure's extra cost [currency], e.g. [CHF].
+    other_losses_saved_pv : float or array_like
+        Present value of the non-fatal losses it saves [currency].
+    deaths_avoided_per_year : float or array_like
+        Deaths avoided [1/yr].
+    horizon_years : float
+        Horizon [yr].
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Cost per statistical life saved [currency/life].
+    """
     lives = np.asarray(deaths_avoided_per_year, dtype=float) * float(horizon_years)
     net = np.asarray(extra_cost_pv, dtype=float) - np.asarray(other_losses_saved_pv, dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
