@@ -65,34 +65,11 @@ if __name__ == "__main__":
 
 
 # ---- numpydoc sections ---------------------------------------------------------------------------------------
-#: Modules whose public functions and methods are written in numpydoc form (issue 22, item 3): every module of
-#: these riskrf stage packages, the simulator's modules listed, less those another change is rewriting now.
-NUMPYDOC_PACKAGES = ("riskrf/core", "riskrf/io", "riskrf/frequency", "riskrf/hazard", "riskrf/report")
-NUMPYDOC_SIMULATION = ("engine", "result", "slope", "scenario", "units", "impact", "calibration",
-                       "profile_extraction", "terrain")
-NUMPYDOC_NOT_YET = ()
+#: Every public module of riskrf and simulation: its public functions and methods are written in numpydoc form.
 NUMPYDOC_MODULES = tuple(
-    [str(p.relative_to(ROOT)) for pkg in NUMPYDOC_PACKAGES for p in sorted((ROOT / pkg).glob("*.py"))
-     if str(p.relative_to(ROOT)) not in NUMPYDOC_NOT_YET and not p.name.startswith("_")]
-    + [f"simulation/{m}.py" for m in NUMPYDOC_SIMULATION])
-#: App, CLI and further simulator modules brought to numpydoc form (issue 22, item 3).
-NUMPYDOC_APP_SIM = ("simulation/contact.py", "simulation/engine3d.py", "riskrf/app/corridor.py", "riskrf/cli.py",
-                    "simulation/scenario3d.py", "simulation/sources.py", "simulation/materials.py",
-                    "simulation/plotting.py", "simulation/material_uncertainty.py", "simulation/precompile.py",
-                    "simulation/kernel.py", "simulation/kernel3d.py", "riskrf/app/background.py",
-                    "riskrf/app/hazard_map.py", "riskrf/app/preflight.py", "riskrf/app/site.py",
-                    "riskrf/app/site_design.py", "riskrf/app/assess3d.py", "riskrf/app/__init__.py")
-NUMPYDOC_MODULES += NUMPYDOC_APP_SIM
-# numpydoc sections added in the "docrest" pass (issue 22, Build item 3)
-NUMPYDOC_REST = ("riskrf/app/model_uncertainty.py", "riskrf/risk/model_decision.py", "simulation/pooled.py",
-                 "riskrf/app/assess.py", "riskrf/risk/mitigation.py")
-NUMPYDOC_MODULES = NUMPYDOC_MODULES + NUMPYDOC_REST
-#: The other riskrf.risk modules in numpydoc form (issue 22, item 3; mitigation and model_decision: NUMPYDOC_REST).
-NUMPYDOC_RISK = tuple(f"riskrf/risk/{m}.py" for m in (
-    "options", "road_risk", "rhrs", "decision_tree", "measures", "loss_engine", "slope_models", "tolerability",
-    "road_users", "site_rates", "mitigation_inputs", "closure", "geometry_measures", "road_profile",
-    "road_validation", "economics", "programme"))
-NUMPYDOC_MODULES += NUMPYDOC_RISK
+    str(p.relative_to(ROOT)) for pkg in PACKAGES for p in sorted((ROOT / pkg).rglob("*.py"))
+    if not any(part.startswith("_") and part != "__init__.py" for part in p.relative_to(ROOT).parts)
+    and "scenarios" not in p.relative_to(ROOT).parts)
 
 
 def _section(doc: str, title: str) -> bool:
