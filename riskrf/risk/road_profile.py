@@ -23,7 +23,8 @@ References
 ----------
 Bunce, C.M., Cruden, D.M. & Morgenstern, N.R. (1997). Assessment of the hazard from rock fall on a highway.
 Can. Geotech. J. 34: 344-356.
-Hantz, D. et al. (2021). Quantitative assessment of rockfall risk (mass-coupled frequency of arrivals).
+Hantz, D., Corominas, J., Crosta, G.B. & Jaboyedoff, M. (2021). Definitions and concepts for quantitative
+rockfall hazard and risk analysis. Geosciences 11(4): 158 (frequency of arrivals by block size).
 """
 from __future__ import annotations
 
