@@ -20,7 +20,9 @@ from .loss_engine import MASS_BINS, closure_cost_per_fall  # noqa: F401  (public
 from .options import (  # noqa: F401  (public names of this module)
     BARRIER_KINDS,
     DEFAULT_REPAIR_DAYS,
+    KIND_CLASSES,
     OPTION_KINDS,
+    OWN_FIELD_KINDS,
     SCALING_DEFAULT_CYCLE_YEARS,
     SCALING_EFFECTIVENESS,
     SCALING_EFFECTIVENESS_RANGE,
@@ -402,7 +404,8 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
     kind = spec.get("kind")
     if kind not in OPTION_KINDS:
         raise MitigationError(f"{source}: {where}: kind = {kind!r} is not one of {', '.join(OPTION_KINDS)}")
-    if "capital_cost" not in spec and kind != "combined":
+    kind_class = KIND_CLASSES[kind]
+    if "capital_cost" not in spec and kind_class.needs_capital_cost:
         raise MitigationError(f"{source}: {where}: missing field 'capital_cost' (use 0 for none)")
     for key in NUMBER_FIELDS:
         v = spec.get(key)
@@ -413,86 +416,31 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
         if key in spec:
             vals[key] = _range(spec[key], f"{source}: {where}: {key}",
                                share=key in ("retention_range", "rate_reduction_range", "effectiveness_range"))
-    rule_keys = ("threshold_mm", "window_days", "warning_levels")
-    typed_keys = ("share_while_closed", "closure_hours_per_year")
-    if kind == "closure":
-        if spec.get("warning_levels") is not None:
-            lv = spec["warning_levels"]
-            if not (isinstance(lv, list) and lv and all(isinstance(x, str) and x.strip() for x in lv)):
-                raise MitigationError(f"{source}: {where}: warning_levels = {lv!r} must be a list of warning levels, "
-                                      "e.g. [\"Red\", \"Black\"]")
-            vals["warning_levels"] = tuple(x.strip().capitalize() for x in lv)
-        rule = [k for k in rule_keys if spec.get(k) is not None]
-        typed = [k for k in typed_keys if spec.get(k) is not None]
-        if rule and typed:
-            raise MitigationError(f"{source}: {where}: give a closure rule ({', '.join(rule)}; its share and hours are "
-                                  f"computed from the site's rate model) or typed {', '.join(typed)} (an assumption), "
-                                  "not both")
-        if rule:
-            if spec.get("threshold_mm") is not None and spec.get("warning_levels") is not None:
-                raise MitigationError(f"{source}: {where}: give threshold_mm (a rainfall rule) or warning_levels (a "
-                                      "warning rule), not both")
-            if spec.get("window_days") is not None and spec.get("threshold_mm") is None:
-                raise MitigationError(f"{source}: {where}: window_days = {spec['window_days']!r} belongs to a rainfall "
-                                      "rule: give threshold_mm too")
-            if spec.get("threshold_mm") is not None and not spec["threshold_mm"] > 0:
-                raise MitigationError(f"{source}: {where}: threshold_mm = {spec['threshold_mm']!r} must be a rainfall "
-                                      "> 0 mm")
-            wd = spec.get("window_days")
-            if wd is not None and (isinstance(wd, bool) or int(wd) != wd or wd < 1):
-                raise MitigationError(f"{source}: {where}: window_days = {wd!r} must be a whole number of days >= 1")
-            if spec.get("threshold_mm") is not None and wd is None:
-                vals["window_days"] = 1.0
-        else:
-            for key in typed_keys:
-                if spec.get(key) is None:
-                    raise MitigationError(
-                        f"{source}: {where}: a closure needs a rule (threshold_mm [+ window_days], or warning_levels; "
-                        "computed from the site's [rates] model) or typed share_while_closed and "
-                        "closure_hours_per_year (an assumption; riskrf.risk.closure.closure_rule gives both: "
-                        f"ClosureRule.option_spec); {key} is missing")
-            if spec["closure_hours_per_year"] > 8766:
-                raise MitigationError(f"{source}: {where}: closure_hours_per_year = "
-                                      f"{spec['closure_hours_per_year']!r} exceeds the hours of a year (8766)")
-            vals["annual_maintenance"] = float(spec.get("annual_maintenance", 0.0)) + \
-                float(spec["closure_hours_per_year"]) * float(spec.get("cost_per_closure_hour", 0.0))
-    elif any(spec.get(k) is not None for k in typed_keys + rule_keys + ("cost_per_closure_hour",)):
-        raise MitigationError(f"{source}: {where}: share_while_closed, closure_hours_per_year, threshold_mm, "
-                              "window_days, warning_levels and cost_per_closure_hour are only for kind = 'closure'")
-    if kind != "scaling" and any(spec.get(k) is not None for k in ("effectiveness", "effectiveness_range",
-                                                                    "effectiveness_half_life_years")):
-        raise MitigationError(f"{source}: {where}: effectiveness, effectiveness_range and "
-                              "effectiveness_half_life_years are only for kind = 'scaling'")
+    at = f"{source}: {where}"
+    kind_class.read_spec(kind, spec, vals, at)
+    for owner in OWN_FIELD_KINDS:       # fields of one kind's own, named by another kind
+        own = KIND_CLASSES[owner].own_fields
+        if KIND_CLASSES[owner] is not kind_class and any(spec.get(k) is not None for k in own):
+            raise MitigationError(f"{at}: {', '.join(own[:-1])} and {own[-1]} are only for kind = {owner!r}")
     if spec.get("effectiveness_half_life_years") is not None and not spec["effectiveness_half_life_years"] > 0:
         raise MitigationError(f"{source}: {where}: effectiveness_half_life_years = "
                               f"{spec['effectiveness_half_life_years']!r} must be > 0 years")
     for key in ("rate_reduction", "retention", "share_while_closed", "effectiveness"):
         if spec.get(key) is not None and spec[key] > 1:
             raise MitigationError(f"{source}: {where}: {key} = {spec[key]!r} is a share and must lie in [0, 1]")
-    need = {"fence": ("capacity_kj", "height_m"), "attenuator": ("capacity_kj", "height_m"),
-            "shed": ("capacity_kj",)}.get(kind, ())
-    for key in need:
+    for key in kind_class.required_fields:
         if spec.get(key) is None:
-            raise MitigationError(f"{source}: {where}: a {kind} needs {key}")
+            raise MitigationError(f"{at}: a {kind} needs {key}")
         if spec[key] <= 0:      # a 0 kJ or 0 m barrier stops nothing: a typing mistake, never a design
             unit = "kJ" if key == "capacity_kj" else "m"
             raise MitigationError(f"{source}: options[{i}].{key} = {spec[key]!r} must be > 0 {unit} "
                                   f"({where}, a {kind})")
-    slope_need = {"bench": ("x_m", "width_m"), "bund": ("x_m", "width_m", "height_m"), "drape": ("zone_x_m",)}
-    if kind in slope_need and spec.get("retention") is None:
-        for key in slope_need[kind]:
+    if spec.get("retention") is None:
+        for key in kind_class.geometry_fields:
             if spec.get(key) is None:
-                raise MitigationError(f"{source}: {where}: a {kind} needs {key} (its geometry; its retention is "
+                raise MitigationError(f"{at}: a {kind} needs {key} (its geometry; its retention is "
                                       "derived by simulation) or a typed retention (an assumption)")
-    if kind == "ditch" and spec.get("retention") is None:
-        for key in ("x_m", "width_m", "depth_m"):
-            if spec.get(key) is None:
-                raise MitigationError(f"{source}: {where}: a ditch needs {key} (its geometry; its retention is "
-                                      "derived by simulation) or a typed retention (an assumption)")
-    if kind == "scaling" and spec.get("rate_reduction") is None and not any(
-            spec.get(k) is not None for k in ("min_mass_kg", "max_mass_kg", "zone_x_m")):
-        raise MitigationError(f"{source}: {where}: scaling needs the blocks it removes (min_mass_kg, max_mass_kg "
-                              "and/or zone_x_m) or a typed rate_reduction (an assumption)")
+    kind_class.check_effect_spec(kind, spec, at)
     if spec.get("min_mass_kg") is not None and spec.get("max_mass_kg") is not None \
             and spec["min_mass_kg"] > spec["max_mass_kg"]:
         raise MitigationError(f"{source}: {where}: min_mass_kg = {spec['min_mass_kg']!r} is greater than "
@@ -509,20 +457,7 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
                                   f"{list(rng)}")
     if spec.get("life_years") == 0:
         raise MitigationError(f"{source}: {where}: life_years must be > 0")
-    if kind == "combined":
-        comps = spec.get("options")
-        if not isinstance(comps, list) or len(comps) < 2 or not all(isinstance(c, str) for c in comps):
-            raise MitigationError(f"{source}: {where}: a combined option needs options = [\"name\", \"name\", ...] "
-                                  "(two or more)")
-        extra = {k for k in spec if k not in ("name", "kind", "options", "description")}
-        if extra:
-            raise MitigationError(f"{source}: {where}: a combined option takes its costs and effects from its "
-                                  f"components; remove {sorted(extra)}")
-        vals["options"] = tuple(comps)
-    elif "options" in spec:
-        raise MitigationError(f"{source}: {where}: options = ... is only for kind = 'combined'")
-    if kind in BARRIER_KINDS and vals.get("repair_days") is None:
-        vals["repair_days"] = DEFAULT_REPAIR_DAYS[kind]
+    kind_class.finish_spec(kind, spec, vals, at)
     return Option(**vals)
 
 

@@ -79,9 +79,84 @@ class OptionEffect:
 
     order = EXPOSURE
     needs_design_check = False
+    #: Fields of an ``[[options]]`` table that only this kind takes (any other kind naming one is an error).
+    own_fields = ()
+    #: Fields a table of this kind must give, each > 0 (a structure's capacity [kJ] and height [m]).
+    required_fields = ()
+    #: Geometry fields a table of this kind must give when it has no typed ``retention`` (positions, sizes [m]).
+    geometry_fields = ()
+    #: Does a table of this kind need ``capital_cost`` (a combined option takes its components' costs)?
+    needs_capital_cost = True
 
     def __init__(self, option):
         self.option = option
+
+    # ---- reading an ``[[options]]`` table (riskrf.risk.mitigation_inputs.parse_option) ------------------------
+    @classmethod
+    def read_spec(cls, kind: str, spec: dict, vals: dict, at: str) -> None:
+        """Check and read the fields of this kind's own rule (before the shared checks of shares and ranges).
+
+        Parameters
+        ----------
+        kind : str
+            The table's ``kind`` (one of :data:`OPTION_KINDS`).
+        spec : dict
+            The ``[[options]]`` table as read (costs in the study's currency, lengths [m], rainfall [mm]).
+        vals : dict
+            The values to build the option from; updated in place.
+        at : str
+            ``"<source>: option '<name>'"``, the start of every error message.
+
+        Returns
+        -------
+        None
+            Raises a MitigationError naming ``at``, the field and its value; nothing to read by default.
+        """
+        return None
+
+    @classmethod
+    def check_effect_spec(cls, kind: str, spec: dict, at: str) -> None:
+        """Check that a table of this kind says what the option does, beyond :attr:`required_fields` and
+        :attr:`geometry_fields` (e.g. the blocks scaling removes).
+
+        Parameters
+        ----------
+        kind : str
+            The table's ``kind`` (one of :data:`OPTION_KINDS`).
+        spec : dict
+            The ``[[options]]`` table as read.
+        at : str
+            ``"<source>: option '<name>'"``, the start of every error message.
+
+        Returns
+        -------
+        None
+            Raises a MitigationError naming ``at`` and the missing fields; nothing more is needed by default.
+        """
+        return None
+
+    @classmethod
+    def finish_spec(cls, kind: str, spec: dict, vals: dict, at: str) -> None:
+        """Last check and defaults of a table of this kind (after the shared checks).
+
+        Parameters
+        ----------
+        kind : str
+            The table's ``kind`` (one of :data:`OPTION_KINDS`).
+        spec : dict
+            The ``[[options]]`` table as read.
+        vals : dict
+            The values to build the option from; updated in place.
+        at : str
+            ``"<source>: option '<name>'"``, the start of every error message.
+
+        Returns
+        -------
+        None
+            Raises a MitigationError if the table lists component ``options`` (only a combined option has them).
+        """
+        if "options" in spec:
+            raise MitigationError(f"{at}: options = ... is only for kind = 'combined'")
 
     # ---- what it is and assumes --------------------------------------------------------------------------
     @property
@@ -269,6 +344,30 @@ class Scaling(OptionEffect):
     """``scaling``: scaling and bolting removes releases (of its zone and mass range, or a typed share)."""
 
     order = RELEASE
+    own_fields = ("effectiveness", "effectiveness_range", "effectiveness_half_life_years")
+
+    @classmethod
+    def check_effect_spec(cls, kind, spec, at):
+        """Check that scaling names the blocks it removes or a typed ``rate_reduction``.
+
+        Parameters
+        ----------
+        kind : str
+            The table's ``kind`` (``"scaling"``).
+        spec : dict
+            The ``[[options]]`` table as read (masses [kg], zone [m]).
+        at : str
+            ``"<source>: option '<name>'"``, the start of every error message.
+
+        Returns
+        -------
+        None
+            Raises a MitigationError when neither is given.
+        """
+        if spec.get("rate_reduction") is None and not any(
+                spec.get(k) is not None for k in ("min_mass_kg", "max_mass_kg", "zone_x_m")):
+            raise MitigationError(f"{at}: scaling needs the blocks it removes (min_mass_kg, max_mass_kg "
+                                  "and/or zone_x_m) or a typed rate_reduction (an assumption)")
 
     def effect(self) -> tuple:
         """Scaling and bolting by zone and mass: (initial effectiveness, its range, half-life [yr], mean over a
@@ -433,6 +532,8 @@ class _SlopeGeometry(OptionEffect):
 class CatchDitch(_SlopeGeometry):
     """``ditch``: a catchment ditch dug into the profile."""
 
+    geometry_fields = ("x_m", "width_m", "depth_m")
+
     def describe(self, currency=""):
         """What the option does, in words (money in ``currency``).
 
@@ -470,6 +571,8 @@ class CatchDitch(_SlopeGeometry):
 class Bench(_SlopeGeometry):
     """``bench``: a catch bench cut into the slope."""
 
+    geometry_fields = ("x_m", "width_m")
+
     def describe(self, currency=""):
         """What the option does, in words (money in ``currency``).
 
@@ -493,6 +596,8 @@ class Bench(_SlopeGeometry):
 class Bund(_SlopeGeometry):
     """``bund``: an embankment on the ground."""
 
+    geometry_fields = ("x_m", "width_m", "height_m")
+
     def describe(self, currency=""):
         """What the option does, in words (money in ``currency``).
 
@@ -515,6 +620,8 @@ class Bund(_SlopeGeometry):
 
 class Drape(_SlopeGeometry):
     """``drape``: a secured mesh; the surface of its zone takes an ASSUMED material."""
+
+    geometry_fields = ("zone_x_m",)
 
     def describe(self, currency=""):
         """What the option does, in words (money in ``currency``).
@@ -556,6 +663,30 @@ class Drape(_SlopeGeometry):
 class _Structure(OptionEffect):
     """A structure with damage states: out of service ``repair_days`` after a destructive impact."""
 
+    @classmethod
+    def finish_spec(cls, kind, spec, vals, at):
+        """Last check of the table, and the ASSUMED default ``repair_days`` of its kind (:data:`DEFAULT_REPAIR_DAYS`).
+
+        Parameters
+        ----------
+        kind : str
+            The table's ``kind`` (one of :data:`BARRIER_KINDS`).
+        spec : dict
+            The ``[[options]]`` table as read.
+        vals : dict
+            The values to build the option from; ``repair_days`` [day] set in place when not given.
+        at : str
+            ``"<source>: option '<name>'"``, the start of every error message.
+
+        Returns
+        -------
+        None
+            Raises a MitigationError as :meth:`OptionEffect.finish_spec` does.
+        """
+        super().finish_spec(kind, spec, vals, at)
+        if vals.get("repair_days") is None:
+            vals["repair_days"] = DEFAULT_REPAIR_DAYS[kind]
+
     def _own_parameters(self):
         o = self.option
         return [(f"repair_days:{o.name}", DEFAULT_REPAIR_DAYS[o.kind] if o.repair_days is None else o.repair_days)]
@@ -573,6 +704,7 @@ class Barrier(_Structure):
 
     order = BARRIER
     needs_design_check = True
+    required_fields = ("capacity_kj", "height_m")
 
     def describe(self, currency=""):
         """What the option does, in words (money in ``currency``).
@@ -618,6 +750,7 @@ class Shed(_Structure):
     """``shed``: a rock shed over ``covered_length_m`` of the exposed road, capacity ``capacity_kj``."""
 
     order = SHED
+    required_fields = ("capacity_kj",)
 
     def describe(self, currency=""):
         """What the option does, in words (money in ``currency``).
@@ -723,6 +856,74 @@ class Closure(OptionEffect):
     """``closure``: the road closed under a rainfall or warning rule (or a typed share of falls while closed)."""
 
     order = CLOSURE
+    #: A closure rule (computed from the site's rate model) ...
+    rule_fields = ("threshold_mm", "window_days", "warning_levels")
+    #: ... or a typed share of falls while closed and hours closed per year (an assumption).
+    typed_fields = ("share_while_closed", "closure_hours_per_year")
+    own_fields = typed_fields + rule_fields + ("cost_per_closure_hour",)
+
+    @classmethod
+    def read_spec(cls, kind, spec, vals, at):
+        """Check and read a closure's rule (rainfall or warning) or its typed share and hours; the cost of the
+        hours closed is added to ``annual_maintenance``.
+
+        Parameters
+        ----------
+        kind : str
+            The table's ``kind`` (``"closure"``).
+        spec : dict
+            The ``[[options]]`` table as read (rainfall [mm], window [day], hours [h/yr], cost per hour).
+        vals : dict
+            The values to build the option from; ``warning_levels``, ``window_days`` and ``annual_maintenance``
+            set in place.
+        at : str
+            ``"<source>: option '<name>'"``, the start of every error message.
+
+        Returns
+        -------
+        None
+            Raises a MitigationError naming ``at``, the field and its value.
+        """
+        if spec.get("warning_levels") is not None:
+            lv = spec["warning_levels"]
+            if not (isinstance(lv, list) and lv and all(isinstance(x, str) and x.strip() for x in lv)):
+                raise MitigationError(f"{at}: warning_levels = {lv!r} must be a list of warning levels, "
+                                      "e.g. [\"Red\", \"Black\"]")
+            vals["warning_levels"] = tuple(x.strip().capitalize() for x in lv)
+        rule = [k for k in cls.rule_fields if spec.get(k) is not None]
+        typed = [k for k in cls.typed_fields if spec.get(k) is not None]
+        if rule and typed:
+            raise MitigationError(f"{at}: give a closure rule ({', '.join(rule)}; its share and hours are "
+                                  f"computed from the site's rate model) or typed {', '.join(typed)} (an assumption), "
+                                  "not both")
+        if rule:
+            if spec.get("threshold_mm") is not None and spec.get("warning_levels") is not None:
+                raise MitigationError(f"{at}: give threshold_mm (a rainfall rule) or warning_levels (a "
+                                      "warning rule), not both")
+            if spec.get("window_days") is not None and spec.get("threshold_mm") is None:
+                raise MitigationError(f"{at}: window_days = {spec['window_days']!r} belongs to a rainfall "
+                                      "rule: give threshold_mm too")
+            if spec.get("threshold_mm") is not None and not spec["threshold_mm"] > 0:
+                raise MitigationError(f"{at}: threshold_mm = {spec['threshold_mm']!r} must be a rainfall "
+                                      "> 0 mm")
+            wd = spec.get("window_days")
+            if wd is not None and (isinstance(wd, bool) or int(wd) != wd or wd < 1):
+                raise MitigationError(f"{at}: window_days = {wd!r} must be a whole number of days >= 1")
+            if spec.get("threshold_mm") is not None and wd is None:
+                vals["window_days"] = 1.0
+        else:
+            for key in cls.typed_fields:
+                if spec.get(key) is None:
+                    raise MitigationError(
+                        f"{at}: a closure needs a rule (threshold_mm [+ window_days], or warning_levels; "
+                        "computed from the site's [rates] model) or typed share_while_closed and "
+                        "closure_hours_per_year (an assumption; riskrf.risk.closure.closure_rule gives both: "
+                        f"ClosureRule.option_spec); {key} is missing")
+            if spec["closure_hours_per_year"] > 8766:
+                raise MitigationError(f"{at}: closure_hours_per_year = "
+                                      f"{spec['closure_hours_per_year']!r} exceeds the hours of a year (8766)")
+            vals["annual_maintenance"] = float(spec.get("annual_maintenance", 0.0)) + \
+                float(spec["closure_hours_per_year"]) * float(spec.get("cost_per_closure_hour", 0.0))
 
     @property
     def typed(self):
@@ -803,6 +1004,38 @@ class Closure(OptionEffect):
 class Combined(OptionEffect):
     """``combined``: its components in series; costs and effects are theirs."""
 
+    needs_capital_cost = False
+
+    @classmethod
+    def finish_spec(cls, kind, spec, vals, at):
+        """Check and read the components ``options`` (two or more option names) and nothing else.
+
+        Parameters
+        ----------
+        kind : str
+            The table's ``kind`` (``"combined"``).
+        spec : dict
+            The ``[[options]]`` table as read.
+        vals : dict
+            The values to build the option from; ``options`` set in place to a tuple of names.
+        at : str
+            ``"<source>: option '<name>'"``, the start of every error message.
+
+        Returns
+        -------
+        None
+            Raises a MitigationError when the components are missing or other fields are given.
+        """
+        comps = spec.get("options")
+        if not isinstance(comps, list) or len(comps) < 2 or not all(isinstance(c, str) for c in comps):
+            raise MitigationError(f"{at}: a combined option needs options = [\"name\", \"name\", ...] "
+                                  "(two or more)")
+        extra = {k for k in spec if k not in ("name", "kind", "options", "description")}
+        if extra:
+            raise MitigationError(f"{at}: a combined option takes its costs and effects from its "
+                                  f"components; remove {sorted(extra)}")
+        vals["options"] = tuple(comps)
+
     def describe(self, currency=""):
         """What the option does, in words (money in ``currency``).
 
@@ -843,6 +1076,9 @@ class Combined(OptionEffect):
         """
         return []
 
+
+#: Kinds with fields no other kind takes (their classes' ``own_fields``), in the order a table is checked for them.
+OWN_FIELD_KINDS = ("closure", "scaling")
 
 #: The class of each option kind.
 KIND_CLASSES = {"none": DoNothing, "scaling": Scaling, "ditch": CatchDitch, "fence": Barrier, "attenuator": Barrier,
