@@ -689,15 +689,16 @@ class LossEngine:
             users = flow.users
             hits = x * (p_st * users)[:, None]
             strikes = x * (p_strike * users)[:, None]
+            n_hits, n_strikes = hits.sum(axis=1), strikes.sum(axis=1)
             deaths = occ * ((hits * vd_k).sum(axis=1) + (strikes * vs_k).sum(axis=1))
-            eal = deaths * P.value_of_statistical_life + (hits.sum(axis=1) + strikes.sum(axis=1)) \
-                * co.vehicle_damage + road * per_fall_cost
+            eal = deaths * P.value_of_statistical_life + (n_hits + n_strikes) * co.vehicle_damage \
+                + road * per_fall_cost
             ir = (x * (p_ts * vd_k + p_cs * vs_k)).sum(axis=1) * users
             pv_m = pvf * (maint + flow.repair_money)
             pv_l = pvf * eal
             for key, val in (("capital", capital), ("pv_renewals", renew), ("pv_maintenance", pv_m),
                              ("pv_expected_loss", pv_l), ("total", capital + renew + pv_m + pv_l), ("road", road),
-                             ("hits", hits.sum(axis=1)), ("strikes", strikes.sum(axis=1)), ("deaths", deaths),
+                             ("hits", n_hits), ("strikes", n_strikes), ("deaths", deaths),
                              ("eal", eal), ("ir", ir), ("repairs", flow.repairs),
                              ("replacements", flow.replacements), ("retention", stopped_by_structures)):
                 res[key][:, k] = val
