@@ -677,13 +677,12 @@ class LossEngine:
                 x, vd_k, vs_k = events_at_road(Fragments(frag.events * flow.ev_scale, frag.matrix,
                                                          frag.blocks * flow.g_prev), x, v_d, v_s)
             road = x.sum(axis=1)
-            if flow.before_structures is not None and any(s.stops_falls for s in chain.stages):
+            if flow.before_structures is not None and any(s.stops_falls for s in chain.stages) \
+                    and not any(s.moves_road for s in chain.stages):
                 passed = road if frag is None else x_blocks.sum(axis=1)     # share of the blocks stopped
                 with np.errstate(invalid="ignore", divide="ignore"):
                     stopped_by_structures = np.where(flow.before_structures > 0,
                                                      1.0 - passed / flow.before_structures, 0.0)
-                    if any(s.moves_road for s in chain.stages):
-                        stopped_by_structures = np.full(S, np.nan)
             else:
                 stopped_by_structures = np.full(S, np.nan)
             users = flow.users
