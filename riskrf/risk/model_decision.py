@@ -210,7 +210,9 @@ class ModelUncertainRanking(Displayed):
             raise DecisionValueError(f"costs must be a table of at least 2 draws x {len(self.options)} options "
                                      f"(at least 2); got shape {C.shape}")
         if not np.all(np.isfinite(C)):
-            raise DecisionValueError("costs hold values that are not finite numbers")
+            j, k = np.argwhere(~np.isfinite(C))[0]
+            raise DecisionValueError(f"costs[{j}, {k}] (draw {j}, option {self.options[k]!r}) = {float(C[j, k])}: "
+                                     "costs must be finite numbers")
         object.__setattr__(self, "costs", C)
         object.__setattr__(self, "weights", _weights(self.weights, C.shape[0]))
         if self.sample_costs is not None:
