@@ -34,7 +34,7 @@ from ..hazard.energy_study import (
 )
 from ..frequency.study import FrequencyAnalysis, analyse_inventory
 from ..frequency.inventory import Inventory, read_inventory
-from ..hazard.simulated import energy_hazard
+from ..hazard.simulated import simulate_energy_hazard
 from ..risk.mitigation import MitigationStudy
 from ..io.outputs import relative_paths, relative_paths_in_json_files, write_json
 from ..frequency.power_law import fit_gutenberg_richter
@@ -141,7 +141,6 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
         if mass_coupling not in ("simulated", "independent"):
             raise ValueError(f"mass_coupling = {mass_coupling!r} must be 'simulated' or 'independent'")
         if mass_coupling == "simulated" and not condition_on_mass:
-            from ..hazard.simulated import simulate_energy_hazard
             hazard, coupled = simulate_energy_hazard(gr, sc, collector, rate_per_year=rate, n=n, seed=seed,
                                                      design_masses_kg=design_masses_kg)
             if road_collector is not None and road_collector in [c.name for c in sc.collectors]:
