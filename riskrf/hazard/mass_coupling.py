@@ -405,8 +405,7 @@ class MassCoupledSamples(Displayed):
         float
             Speed [m/s].
         """
-        speeds = self._classes[int(self.class_of(mass_kg))][1]
-        return float(np.percentile(speeds, q)) if speeds.size else float("nan")
+        return self._class_percentile(q, mass_kg, 1)
 
     def height_percentile(self, q, mass_kg) -> float:
         """Bounce height [m] not exceeded by q % of the arriving blocks of the class of ``mass_kg``.
@@ -423,8 +422,13 @@ class MassCoupledSamples(Displayed):
         float
             Height of the block centre above the ground [m].
         """
-        h = self._classes[int(self.class_of(mass_kg))][2]
-        return float(np.percentile(h, q)) if h.size else float("nan")
+        return self._class_percentile(q, mass_kg, 2)
+
+    def _class_percentile(self, q, mass_kg, column: int) -> float:
+        """q-th percentile of column ``column`` (1: speed, 2: height) of the arrivals in the class of ``mass_kg``
+        (NaN when the class has none)."""
+        values = self._classes[int(self.class_of(mass_kg))][column]
+        return float(np.percentile(values, q)) if values.size else float("nan")
 
     def contains(self, mass_kg) -> bool:
         """Whether ``mass_kg`` lies inside the simulated mass range.
