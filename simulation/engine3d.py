@@ -24,7 +24,7 @@ from .units import J_PER_KJ, kinetic_energy_kj
 
 DEFAULT_CHUNK_3D = 20_000
 _KERNEL3D_MATERIALS = ("m_en_law", "m_en_mean", "m_en_std", "m_et_law", "m_et_mean", "m_et_std", "m_phi", "m_phi_std",
-                       "m_rough", "m_roll", "m_mu_ground", "m_gain")
+                       "m_rough", "m_roll", "m_mu_ground", "m_gain", "m_en_v0", "m_hop", "m_drag", "m_size_k")
 
 
 def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> dict:
@@ -113,6 +113,7 @@ def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_
                                                   ("x", "y", "z", "vx", "vy", "vz", "w", "mass", "radius",
                                                    "inertia_factor")),
             *grid, **mats, **cols, g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
+            sin_max_roll=st.sin_max_roll,
             max_events=st.max_events, key=key, n_path_blocks=n_paths, rec_pass=hazard,
             out_x=out["x"], out_y=out["y"], out_z=out["z"], out_reason=out["reason"], out_impacts=out["impacts"],
             out_t=out["t"], out_excess=out["excess"], out_events=out["events"],

@@ -24,20 +24,26 @@ Physics (shared with the 2-D kernel :mod:`simulation.kernel`)
 * Flight: exact parabola (no drag).
 * Impact: in the frame of the local 3-D normal of the bilinear surface, tilted by the material's
   roughness (two angles, along and across the direction of travel, each uniform in +-atan(roughness /
-  radius) as in 2-D), the normal and tangential restitution laws of :func:`simulation.impact.impact_body`
-  (the same compiled function the 2-D kernel calls) act on the normal speed, the tangential speed and the
-  spin.  Spin is carried as a scalar about the horizontal axis normal to the direction of travel; when
+  radius) as in 2-D), the normal and tangential restitution laws of :func:`simulation.contact.rebound`
+  (the same compiled function the 2-D kernel calls, with the Pfeiffer & Bowen velocity scaling of e_N) act on
+  the normal speed, the tangential speed and the spin.  Spin is carried as a scalar about the horizontal axis normal to the direction of travel; when
   the direction of travel turns, only the component of the spin about the new axis is kept (w cos of the
   turn), which never adds energy.
-* Ground contact (rolling or sliding, as the material says): the rebound normal speed below
-  ``v_contact`` turns the block into contact, with :func:`simulation.kernel.roll_on_speed` for the
+* Ground contact (rolling or sliding, as the material says): a rebound normal speed below the contact
+  speed of :func:`simulation.contact.contact_speed` (``v_contact``, or the speed of a hop as high as the
+  material's ``hop_height_m`` when that is larger) turns the block into contact, with :func:`simulation.kernel.roll_on_speed` for the
   transition to rolling; the block then moves along the surface in steps of at most half a cell with the
   gravity component in the tangent plane and the rolling-resistance (or sliding) friction of the 2-D
-  contact law, a = f (g_t - tan(phi_g) g cos(theta) v/|v|), f = 1 / (1 + k) rolling (5/7 for a sphere), 1
-  sliding.  The speed after each step comes from the work-energy balance over the step's 3-D path (drop
-  minus friction work), so no step can gain energy; the velocity is re-projected onto the new tangent
-  plane and its normal component lost (the 2-D rule at a slope change); where that normal component
-  points away from the ground and exceeds ``v_contact``, the block takes off.
+  contact law, a = f (g_t - mu_r g cos(theta) v/|v|) - c |v| v, f = 1 / (1 + k) rolling (5/7 for a sphere), 1
+  sliding, mu_r = tan(phi_g) + K roughness / r (:func:`simulation.contact.rolling_resistance`) and the
+  velocity-squared drag c = rolling_drag / r [1/m].  The speed after each step comes from the work-energy
+  balance over the step's 3-D path (drop minus friction work; with drag, the closed form of
+  :func:`simulation.contact.contact_speed_at` along the step), so no step can gain energy; the velocity is
+  re-projected onto the new tangent plane and its normal component lost (the 2-D rule at a slope change);
+  where that normal component points away from the ground and exceeds the contact speed, the block takes off.
+* Steep faces (``sin_max_roll`` < 1, the scenario's ``settings.max_rolling_slope_deg``): no rolling or sliding
+  in contact on a surface steeper than that; a block that would enter or stay in contact there leaves it
+  with its speed kept (:func:`simulation.contact.steep_face_launch`) and meets it again in impacts, as in 2-D.
 * Stop: slower than ``v_stop`` where the slope angle is within the ground friction angle; a block at
   momentary rest on a steeper slope restarts down the fall line, and one that comes to rest a second
   time within half a cell of its previous rest is held there (a pit or trough between flanks).
@@ -66,7 +72,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .contact import EN_WYLLIE, impact_body, roll_on_speed
+from .contact import (EN_WYLLIE, contact_speed, contact_speed_at, contact_stop_distance, rebound, roll_on_speed,
+                      rolling_resistance, steep_face_launch)
 from .kernel import (BARRIER_CAUGHT, BARRIER_THROUGH, CROSSED, OUTCOMES, _GOLDEN, _normal, _uniform,  # noqa: F401
                      barrier_outcome)
 
@@ -127,6 +134,48 @@ def _axis_cos(sx, sy, tx, ty):
     if ls < 1e-12 or lt < 1e-12:
         return 1.0
     return (sx * tx + sy * ty) / (ls * lt)
+
+
+@njit(cache=True)
+def _stop_fraction(u, u2sq, a_s, c, ds):
+    """Share of a contact step [-] after which a block of speed u [m/s] comes to rest: from the work-energy
+    balance u2sq = u^2 + 2 a_s ds (no drag), or from :func:`simulation.contact.contact_stop_distance` with
+    the drag c [1/m]."""
+    if c > 1e-12:
+        return min(contact_stop_distance(u, a_s, c) / ds, 1.0) if ds > 1e-12 else 0.0
+    return u * u / (u * u - u2sq) if u * u - u2sq > 0 else 0.0
+
+
+@njit(cache=True)
+def _leave_face(vx, vy, vz, x, y, z, nx0, ny0, nz0, v_sep):
+    """A block leaving a face too steep to roll on (3-D form of the 2-D rule).
+
+    The tangential speed is kept and turned away from the face until its outward normal share is ``v_sep``
+    (:func:`simulation.contact.steep_face_launch`; no energy is created).  A block at rest against the face
+    is moved 1e-6 m-scale horizontally away from it, z unchanged, so it falls onto the face from just above.
+
+    Returns
+    -------
+    tuple of float
+        (vx, vy, vz, x, y, z, tx, ty, tz): the new velocity [m/s], position [m] and travel direction.
+    """
+    vn = vx * nx0 + vy * ny0 + vz * nz0
+    tx, ty, tz = vx - vn * nx0, vy - vn * ny0, vz - vn * nz0
+    ut = math.sqrt(tx * tx + ty * ty + tz * tz)
+    if ut > 1e-12:
+        tx, ty, tz = tx / ut, ty / ut, tz / ut
+    else:                       # no tangential motion: down the fall line
+        tx, ty, tz = nz0 * nx0, nz0 * ny0, nz0 * nz0 - 1.0
+        tl = math.sqrt(tx * tx + ty * ty + tz * tz)
+        tx, ty, tz = (tx / tl, ty / tl, tz / tl) if tl > 1e-12 else (1.0, 0.0, 0.0)
+    vt_new, vn_new = steep_face_launch(ut, v_sep)
+    if vn_new <= 0.0:
+        hl = math.sqrt(nx0 * nx0 + ny0 * ny0)
+        if hl > 1e-12:
+            step = 1e-6 * (1.0 + abs(x) + abs(y))
+            x, y = x + step * nx0 / hl, y + step * ny0 / hl
+    return (vt_new * tx + vn_new * nx0, vt_new * ty + vn_new * ny0, vt_new * tz + vn_new * nz0, x, y, z + 1e-9,
+            tx, ty, tz)
 
 
 @njit(cache=True)
@@ -368,9 +417,9 @@ def _find_impact(zg, x0, y0, dx, dy, lip, x, y, z, vx, vy, vz, g):
 def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                zg, x0, y0, dx, dy, lip, mat_grid,
                m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
-               m_roll, m_mu_ground, m_gain,
+               m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k,
                c_ax, c_ay, c_bx, c_by, c_id, c_s0, c_cap, c_net,
-               g, v_contact, v_stop, max_events, key, n_path_blocks, rec_pass,
+               g, v_contact, v_stop, sin_max_roll, max_events, key, n_path_blocks, rec_pass,
                out_x, out_y, out_z, out_reason, out_impacts, out_t, out_excess, out_events,
                r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_out, r_count,
                p_block, p_cell, p_e, p_h, p_count,
@@ -427,6 +476,14 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
         Per material: rolling-resistance or sliding coefficient tan(phi_g) [-].
     m_gain : numpy.ndarray of bool
         Per material: energy gain allowed at impacts.
+    m_en_v0 : numpy.ndarray
+        Per material: velocity scale of e_N [m/s] (inf: none; :func:`simulation.contact.velocity_scaled`).
+    m_hop : numpy.ndarray
+        Per material: hop height [m] below which a rebound is ground contact (:func:`simulation.contact.contact_speed`).
+    m_drag : numpy.ndarray
+        Per material: rolling drag coefficient [-] (c = m_drag / r [1/m]).
+    m_size_k : numpy.ndarray
+        Per material: size term K of the rolling resistance [-] (:func:`simulation.contact.rolling_resistance`).
     c_ax, c_ay, c_bx, c_by : numpy.ndarray
         Ends of the collector segments in plan [m].
     c_id : numpy.ndarray of int
@@ -443,6 +500,8 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
         Numerical floor of the contact speed [m/s].
     v_stop : float
         Stop speed [m/s].
+    sin_max_roll : float
+        Sine of the steepest slope a block may roll or slide on in contact (1: any slope).
     max_events : int
         Largest number of events per block.
     key : numpy.uint64
@@ -652,15 +711,19 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                     tx, ty, tz = sx, sy, sz
                 w_eff = w * _axis_cos(sx, sy, tx, ty)      # spin about the axis normal to the travel
                 if vn < 0.0:
-                    vn2, vt2, w2, _ = impact_body(vn, vt, w_eff, r, m_en_law[mat], en, m_et_law[mat], et, mu, gain,
-                                                  k_in)
+                    vn2, vt2, w2, _ = rebound(vn, vt, w_eff, r, k_in, m_en_law[mat], en, m_en_v0[mat], m_et_law[mat],
+                                              et, mu, gain)
                 else:
                     vn2, vt2, w2 = 0.0, vt, w_eff
                 vx, vy, vz = vt2 * tx + vn2 * nnx, vt2 * ty + vn2 * nny, vt2 * tz + vn2 * nnz
                 w = w2
                 sx, sy, sz = tx, ty, tz
                 vn_true = vx * nx0 + vy * ny0 + vz * nz0
-                if vn_true < v_contact:
+                v_thr = contact_speed(v_contact, g, nz0, m_hop[mat])
+                if vn_true < v_thr and 1.0 - nz0 * nz0 > sin_max_roll * sin_max_roll:
+                    # a face too steep to roll on: the block leaves it again (speed kept), no ground contact
+                    vx, vy, vz, x, y, z, sx, sy, sz = _leave_face(vx, vy, vz, x, y, z, nx0, ny0, nz0, v_thr)
+                elif vn_true < v_thr:
                     contact = True
                     vx, vy, vz = vx - vn_true * nx0, vy - vn_true * ny0, vz - vn_true * nz0
                     u = math.sqrt(vx * vx + vy * vy + vz * vz)
@@ -696,9 +759,21 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                            min(max(int(round((x - x0) / dx)), 0), nx - 1)]
             nl = math.sqrt(gx * gx + gy * gy + 1.0)
             nx0, ny0, nz0 = -gx / nl, -gy / nl, 1.0 / nl
-            mu = m_mu_ground[mat]
+            if 1.0 - nz0 * nz0 > sin_max_roll * sin_max_roll:
+                # no rolling or sliding in contact on a face this steep: the block leaves it (speed kept)
+                vn_c = vx * nx0 + vy * ny0 + vz * nz0
+                vx, vy, vz = vx - vn_c * nx0, vy - vn_c * ny0, vz - vn_c * nz0
+                vx, vy, vz, x, y, z, sx, sy, sz = _leave_face(vx, vy, vz, x, y, z, nx0, ny0, nz0,
+                                                              contact_speed(v_contact, g, nz0, m_hop[mat]))
+                contact = False
+                if record:
+                    _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, t_abs, x, y, z,
+                                 math.sqrt(vx * vx + vy * vy + vz * vz), MODE_FLIGHT)
+                continue
+            mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r)
             roll = m_roll[mat]
             factor = 1.0 / (1.0 + k_in) if roll else 1.0
+            c_drag = m_drag[mat] / r if r > 0.0 else 0.0
             u = math.sqrt(vx * vx + vy * vy + vz * vz)
             if u < v_stop:
                 near = abs(x - last_rest_x) <= 0.5 * dx and abs(y - last_rest_y) <= 0.5 * dy
@@ -713,7 +788,7 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
             # tangential gravity g_t = g (n_z n - e_z) (down the fall line, magnitude g sin theta)
             gtx, gty, gtz = g * nz0 * nx0, g * nz0 * ny0, g * (nz0 * nz0 - 1.0)
             if u > 1e-12:
-                fr = factor * mu * g * nz0 / u
+                fr = factor * mu * g * nz0 / u + c_drag * u
                 ax_, ay_, az_ = factor * gtx - fr * vx, factor * gty - fr * vy, factor * gtz - fr * vz
             else:
                 ax_, ay_, az_ = factor * gtx, factor * gty, factor * gtz
@@ -732,12 +807,18 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
             ds = math.sqrt((xn - x) ** 2 + (yn - y) ** 2 + (zn - z) ** 2)
             nln = math.sqrt(gxn * gxn + gyn * gyn + 1.0)
             nz_avg = 0.5 * (nz0 + 1.0 / nln)
-            # work-energy balance over the step (per unit mass, rolling share f = 1/(1+k))
+            # work-energy balance over the step (per unit mass, rolling share f = 1/(1+k)); with drag, the
+            # closed form of dv/dt = a_s - c v^2 along the step (a_s: the constant-acceleration share)
             u2sq = u * u + 2.0 * factor * (g * (z - zn) - mu * g * nz_avg * ds)
+            a_s = 0.0
+            if c_drag > 1e-12:
+                a_s = factor * (g * (z - zn) - mu * g * nz_avg * ds) / ds if ds > 1e-12 else 0.0
+                d_stop = contact_stop_distance(u, a_s, c_drag)
+                u2sq = -1.0 if d_stop < ds else contact_speed_at(u, a_s, c_drag, ds) ** 2
             # collectors crossed on this step (height 0: in contact), up to where the block comes to rest
             if n_cseg > 0:
                 n_h = _collector_hits(c_ax, c_ay, c_bx, c_by, c_id, c_s0, x, y, xn, yn, s_hit, j_hit, lam_hit)
-                f_end = 1.0 if u2sq > 0.0 else (u * u / (u * u - u2sq) if u * u - u2sq > 0 else 0.0)
+                f_end = 1.0 if u2sq > 0.0 else _stop_fraction(u, u2sq, a_s, c_drag, ds)
                 cut = False
                 for q in range(n_h):
                     fq = s_hit[q]
@@ -751,9 +832,14 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                         zq, _, _ = _surface(zg, x0, y0, dx, dy, xq, yq)
                         dsq = math.sqrt((xq - x) ** 2 + (yq - y) ** 2 + (zq - z) ** 2)
                         uq = math.sqrt(max(u * u + 2.0 * factor * (g * (z - zq) - mu * g * nz_avg * dsq), 0.0))
+                        if c_drag > 1e-12 and dsq > 1e-12:
+                            uq = contact_speed_at(u, factor * (g * (z - zq) - mu * g * nz_avg * dsq) / dsq, c_drag,
+                                                  dsq)
                     else:
                         zq = z
                         uq = math.sqrt(max(u * u + fq * (u2sq - u * u), 0.0))
+                        if c_drag > 1e-12:
+                            uq = contact_speed_at(u, a_s, c_drag, fq * ds)
                     ul = max(math.sqrt(vx1 * vx1 + vy1 * vy1 + vz1 * vz1), 1e-300)
                     wq = uq / r if roll else 0.0
                     outcome, keep = _record_cross(
@@ -803,7 +889,7 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
             if u2sq <= 0.0:
                 # the block comes to rest within the step: where the balance reaches zero, if that point is
                 # not above what the energy allows; else it stays (a momentary rest decides next)
-                fz = u * u / (u * u - u2sq) if u * u - u2sq > 0 else 0.0
+                fz = _stop_fraction(u, u2sq, a_s, c_drag, ds)
                 xr, yr = x + fz * (xn - x), y + fz * (yn - y)
                 zr, _, _ = _surface(zg, x0, y0, dx, dy, xr, yr)
                 if zr == zr and zr <= z + u * u / (2.0 * factor * g):
@@ -828,7 +914,9 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
             t_abs += dt
             x, y, z = xn, yn, zn
             have_s, c_gx, c_gy = True, gxn, gyn
-            if dn * u2 >= v_contact:
+            mat_n = mat_grid[min(max(int(round((yn - y0) / dy)), 0), ny - 1),
+                             min(max(int(round((xn - x0) / dx)), 0), nx - 1)]
+            if dn * u2 >= contact_speed(v_contact, g, 1.0 / nln, m_hop[mat_n]):
                 # convex edge: the block leaves the ground with its velocity
                 contact = False
                 vx, vy, vz = u2 * dxv, u2 * dyv, u2 * dzv

@@ -411,6 +411,11 @@ class Settings:
     envelope_bins: int = 50
     max_rolling_slope_deg: float = 90.0
 
+    @property
+    def sin_max_roll(self) -> float:
+        """Sine of ``max_rolling_slope_deg`` as the kernels take it (exactly 1.0 at 90 deg: any slope)."""
+        return float(np.sin(np.radians(self.max_rolling_slope_deg))) if self.max_rolling_slope_deg < 90 else 1.0
+
 
 @dataclass(frozen=True, repr=False)
 class Scenario(Displayed):

@@ -42,7 +42,8 @@ collectors, read from TOML.
     height_m = 4.0
     capacity_kj = 2000
 
-    [settings]                       # gravity_ms2, contact_velocity_ms, stop_velocity_ms, max_events
+    [settings]                       # gravity_ms2, contact_velocity_ms, stop_velocity_ms, max_events,
+                                     # max_rolling_slope_deg (no rolling in contact on steeper faces)
 
 Every error names the file and the field; sources or collector vertices off the DEM (or on a nodata
 hole) and a material raster on another grid are refused before any simulation.
@@ -365,7 +366,8 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
         raise ScenarioError(f"{source}: collector names must be unique; got {cnames}")
 
     st = data.get("settings", {})
-    _check_keys(st, {"gravity_ms2", "contact_velocity_ms", "stop_velocity_ms", "max_events"}, "settings.", source)
+    _check_keys(st, {"gravity_ms2", "contact_velocity_ms", "stop_velocity_ms", "max_events", "max_rolling_slope_deg"},
+                "settings.", source)
     settings = Settings(
         gravity_ms2=_number(st.get("gravity_ms2", STANDARD_GRAVITY_MS2), "settings.gravity_ms2", source, lo=0.0,
                             lo_open=True),
@@ -373,7 +375,9 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
                                     lo=0.0, lo_open=True),
         stop_velocity_ms=_number(st.get("stop_velocity_ms", 0.05), "settings.stop_velocity_ms", source, lo=0.0),
         max_events=int(_number(st.get("max_events", DEFAULT_MAX_EVENTS_3D), "settings.max_events", source, lo=1)),
-        envelope_bins=0)
+        envelope_bins=0,
+        max_rolling_slope_deg=_number(st.get("max_rolling_slope_deg", 90.0), "settings.max_rolling_slope_deg",
+                                      source, lo=0.0, hi=90.0, lo_open=True))
     return TerrainScenario(name=str(data.get("name", Path(source).stem)), description=str(data.get("description", "")),
                            terrain=terrain, materials=materials, material_grid=grid, sources=sources,
                            collectors=tuple(collectors), settings=settings, source=source)

@@ -134,7 +134,12 @@ def _random_dem(seed):
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_energy_audit_on_random_dems(seed):
     dem = _random_dem(seed)
-    mats = {"rock": {"preset": "bedrock"}, "talus": {"preset": "talus"}, "soil": {"preset": "soil", "ground_motion": "slide"}}
+    mats = {"rock": {"preset": "bedrock"}, "talus": {"preset": "talus"}, "soil": {"preset": "soil", "ground_motion": "slide"},
+            # the contact model of simulation.contact (with no rolling on faces steeper than 40 deg, below)
+            "contact": {"preset": "talus", "contact_hop_height_m": 0.3, "rolling_size_coefficient": 1.0,
+                        "rolling_drag": 0.02,
+                        "normal_restitution": {"law": "constant", "mean": 0.35, "std": 0.05, "velocity_scale_ms": 9.0},
+                        "tangential": {"law": "coulomb", "mean": 0.55, "std": 0.12, "friction_angle_deg": 35.0}}}
     for name in mats:
         sc = _scenario(dem, mats, {"polygon": [[5, 10], [30, 10], [30, 110], [5, 110]], "height_m":
                                    {"dist": "uniform", "low": 0, "high": 5}, "mass_kg":
@@ -144,6 +149,8 @@ def test_energy_audit_on_random_dems(seed):
                         # a barrier that lets most blocks through (the energy above 50 kJ): no gain there either
                         collectors=[{"name": "net", "line": [[34, 0], [34, 120]], "height_m": 2.0,
                                      "capacity_kj": 20.0}])
+        if name == "contact":
+            sc = type(sc)(**{**sc.__dict__, "settings": type(sc.settings)(max_rolling_slope_deg=40.0)})
         r = run_terrain(sc, 300, seed=seed)
         assert (r.collector("net")["outcome"] == "through").sum() >= 10, name
         mass = r.blocks["mass"]
