@@ -34,6 +34,21 @@ def test_uni11211_factor_table_against_the_published_values():
         assert req.E_d_kj / req.E_k_kj == pytest.approx(combined, rel=1e-9)
 
 
+def test_etag027_energy_classes_and_sel_against_the_published_table():
+    # ETAG 027 energy levels 1-7 as tabulated in an Italian thesis on rock fall barrier certification, ch. I
+    # section 3.2.2.2 (123dok.org/article/certificazione-delle-barriere-paramassi-barriere-paramassi-elastiche.6qm0759y):
+    # "MEL [kJ] >= 100 250 500 1000 1500 2000 3000 4500 >4500", "SEL [kJ] - 85 170 330 500 660 1000 1500 >1500",
+    # "MEL ... deve essere pari a 3 volte l'energia del SEL" (a secondary source: the EAD itself was not read).
+    from riskrf.core.units import SEL_PER_MEL
+    from riskrf.hazard.design_basis import MEL_PRODUCT_CLASSES_KJ
+    mel = (100.0, 250.0, 500.0, 1000.0, 1500.0, 2000.0, 3000.0, 4500.0)
+    assert MEL_PRODUCT_CLASSES_KJ[:8] == mel
+    assert min(MEL_PRODUCT_CLASSES_KJ[8:]) > 4500.0                  # class 8: above 4,500 kJ
+    # the table's SEL are MEL / 3 rounded to a round number (85 for 83.3, 660 for 666.7): within 3 %
+    for m, sel in zip(mel[1:], (85.0, 170.0, 330.0, 500.0, 660.0, 1000.0, 1500.0)):
+        assert m * SEL_PER_MEL == pytest.approx(sel, rel=0.03), m
+
+
 def test_onr24810_distance_to_the_element_at_risk():
     # ONR 24810 constructive rules (trumerschutzbauten.com/standards/rockfall-standards/onr-24810/constructive/):
     # "1.2 times the maximum elongation as reported during the MEL test ... and shall not be less than one meter

@@ -2,6 +2,13 @@
 
     python simulation/scenarios/presets/derive_presets.py fit   [--n-per-release 50] [--seed 1]
     python simulation/scenarios/presets/derive_presets.py loo   [--n-per-release 50] [--seed 1]
+    python simulation/scenarios/presets/derive_presets.py loo --kernel 3d --out presets_loo_3d
+
+``--kernel 3d`` runs the Authume releases on the quarry's DEM with its zone raster (the 3-D kernel, the same
+contact model; simulation/scenarios/authume/authume_3d.toml) and compares **plan runouts** (horizontal
+distance of each stop from the release point: the surveyed stops lie 2.5-3.5 m above the terrain, so only plan
+positions are used); Evans & Hungr's reach stays the 2-D cliff-over-talus section.  It needs the raw quarry
+files (../shared/experiments-raw/authume-quarry) for the release points.
 
 The data sets (each cited in tests/data/<source>/README.md):
 
@@ -115,13 +122,34 @@ def _material(name: str) -> dict:
     return {"preset": name, **copy.deepcopy(MODEL["laws"].get(name, {}))}
 
 
+#: ``--kernel``: "2d" (the profile sections) or "3d" (the quarry DEM; see the module docstring).
+KERNEL = {"name": "2d"}
+
+
+def authume_scenario_3d(profile: str) -> dict:
+    """The Authume DEM scenario of release ``profile`` with its zone raster mapped to the presets (Blue = soil,
+    Gray = bedrock, Red = talus), each with the contact laws, and no rolling on faces steeper than 55 deg."""
+    sys.path.insert(0, str(AUTHUME))
+    from build_authume_3d import _raw_dir
+    from validate_authume_3d import scenario_data
+    data = scenario_data(profile, {k: _material(k) for k in ("soil", "bedrock", "talus")}, _raw_dir([]))
+    codes = {"vegetated_slope": "soil", "hard_ground": "bedrock", "rocky_slope": "talus"}
+    data["terrain"]["material_codes"] = {k: codes[v] for k, v in data["terrain"]["material_codes"].items()}
+    data["name"] = f"authume_3d_{profile.lower()}_presets"
+    data["settings"] = dict(SETTINGS)
+    return data
+
+
 def releases(profile: str, rows=None) -> list:
-    """Every observed block of ``profile`` (P1 or P2) as a release with its measured mass."""
-    key = (profile, bool(MODEL["laws"]))
+    """Every observed block of ``profile`` (P1 or P2) as a release with its measured mass: its stop x along the
+    2-D section, or (``--kernel 3d``) its plan runout on the DEM."""
+    three_d = KERNEL["name"] == "3d"
+    key = (profile, bool(MODEL["laws"]), three_d)
     if key not in _SCEN:
-        _SCEN[key] = authume_scenario(profile)
+        _SCEN[key] = authume_scenario_3d(profile) if three_d else authume_scenario(profile)
     obs = pd.read_csv(OBSERVED) if rows is None else rows
-    return [Release(name=f"{r.profile}-{r.block}", scenario=_SCEN[key], x_stop_m=[r.x_stop_m],
+    return [Release(name=f"{r.profile}-{r.block}", scenario=_SCEN[key],
+                    x_stop_m=[r.plan_runout_m if three_d else r.x_stop_m],
                     mass_kg=r.mass_kg, source=str(OBSERVED.relative_to(REPO)))
             for r in obs.itertuples() if r.profile == profile]
 
@@ -214,7 +242,7 @@ def release_row(dataset, model, per_release, rels):
             "pred_p90": qp[2], "median_error_pct": 100.0 * (qp[1] / qo[1] - 1.0),
             "ks_d": stats.ks_2samp(pred, obs).statistic, "w1": stats.wasserstein_distance(pred, obs),
             "beyond_p95": float(np.mean(obs > p95)), "beyond_p99": float(np.mean(obs > p99)),
-            "unit": "m (stop x)"}, (obs, pred)
+            "unit": "m (plan runout, 3-D)" if KERNEL["name"] == "3d" else "m (stop x)"}, (obs, pred)
 
 
 def constraint_row(model, cons, angles):
@@ -236,8 +264,11 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--draws", type=int, default=40)
     ap.add_argument("--model", choices=["contact", "contact-drag", "presets"], default="contact")
+    ap.add_argument("--kernel", choices=["2d", "3d"], default="2d",
+                    help="the Authume releases on their 2-D sections or on the quarry DEM (plan runouts)")
     ap.add_argument("--out", default="presets_loo", help="name of the LOO table and figure (docs/validation)")
     args = ap.parse_args()
+    KERNEL["name"] = args.kernel
     if args.model == "presets":
         MODEL["laws"] = {}
     MODEL["drag"] = args.model == "contact-drag"
@@ -248,7 +279,8 @@ def main():
         print(cal.summary()[["median", "mean", "sd", "q05", "q95", "sd_ratio"]].round(3).to_string())
         print(cal.correlations().round(2).to_string())
         print(cal.coverage().to_dict(), cal.constraint_table.round(2).to_string(), cal.notes)
-        write_priors(cal, REPO / "simulation" / "preset_priors.py", DATASETS, args)
+        if args.kernel == "2d":        # the shipped priors are the 2-D fit's; a 3-D fit is printed only
+            write_priors(cal, REPO / "simulation" / "preset_priors.py", DATASETS, args)
         return
     rows, curves = [], {}
     for held in DATASETS:
@@ -313,7 +345,7 @@ def main():
             ax.set_xlabel("shadow angle of the p99 stop [deg]")
             ax.set_ylabel("density over posterior draws")
         else:
-            ax.set_xlabel("stop position x [m]")
+            ax.set_xlabel("plan runout [m]" if KERNEL["name"] == "3d" else "stop position x [m]")
             ax.set_ylabel("fraction of blocks stopped before x")
         ax.set_title(f"{held} held out", fontsize="small")
         ax.legend(fontsize="x-small")
