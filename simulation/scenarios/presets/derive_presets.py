@@ -231,6 +231,26 @@ def predict_release_stops(rels, draws, n_each, seed0):
     return [np.concatenate(p) for p in per]
 
 
+def with_site_spread(draws, bounds, seed):
+    """Posterior draws with the ASSUMED site-to-site spread added: each fitted field moved by a uniform amount
+    within the half-width of :data:`simulation.material_uncertainty.ASSUMED_HALF_WIDTHS` for its preset and field
+    (0.15 for an e_T mean the preset's table does not list), kept inside the prior box.  A site the data sets
+    did not sample differs from them by more than the posterior's width (the two Authume profiles alone put
+    soil's phi_g 4 deg apart); this spread is independent of the held-out data."""
+    from simulation.material_uncertainty import ASSUMED_HALF_WIDTHS
+    rng = np.random.default_rng(seed)
+    out = []
+    for d in draws:
+        new = {}
+        for k, v in d.items():
+            _, preset, field = k.split(".", 2)
+            w = ASSUMED_HALF_WIDTHS.get(preset, {}).get(field, 0.15 if field == "tangential.mean" else 0.0)
+            lo, hi = bounds[k]
+            new[k] = float(np.clip(v + rng.uniform(-w, w), lo, hi))
+        out.append(new)
+    return out
+
+
 def release_row(dataset, model, per_release, rels):
     obs = np.array([r.x_stop_m[0] for r in rels])
     pred = np.concatenate(per_release)
@@ -264,6 +284,9 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--draws", type=int, default=40)
     ap.add_argument("--model", choices=["contact", "contact-drag", "presets"], default="contact")
+    ap.add_argument("--site-spread", choices=["none", "assumed"], default="none",
+                    help="add to every posterior draw the ASSUMED site-to-site spread of "
+                         "simulation.material_uncertainty (uniform, its half-widths) before predicting")
     ap.add_argument("--kernel", choices=["2d", "3d"], default="2d",
                     help="the Authume releases on their 2-D sections or on the quarry DEM (plan runouts)")
     ap.add_argument("--out", default="presets_loo", help="name of the LOO table and figure (docs/validation)")
@@ -290,31 +313,31 @@ def main():
         print(cal.summary()[["median", "q05", "q95", "sd_ratio"]].round(3).to_string(), cal.notes)
         draws = cal.posterior.sample(args.draws, random_state=args.seed).to_dict("records")
         label = "fitted on " + " + ".join(train)
-        if held == "evans_hungr_1993":
-            for model, ds in ((label, draws), ("published presets", [{}])):
-                laws = MODEL["laws"]
-                if ds is not draws:
-                    MODEL["laws"] = {}
+        variants = [(label, draws, True)]
+        if args.site_spread == "assumed":
+            variants.append((label + " + assumed site-to-site spread", with_site_spread(draws, cal.bounds, args.seed),
+                             True))
+        variants.append(("published presets", [{}], False))
+        for model, ds, fitted in variants:
+            laws = MODEL["laws"]
+            if not fitted:
+                MODEL["laws"] = {}
+            if held == "evans_hungr_1993":
                 c = evans_hungr()
                 cp = _ConstraintPool([c], _parameters())
                 MODEL["laws"] = laws
                 angs = []
                 for t, v in enumerate(ds):
-                    for rep in range(1 if ds is draws else args.draws):
+                    for rep in range(1 if fitted else args.draws):
                         angs.append(cp.far_angles(cp.simulate(v, 30_000 + 100 * t + rep))[0])
-                r, a = constraint_row(model, c, angs)
-                rows.append(r)
-                curves[(held, model)] = a
-        else:
-            for model, ds, n_each in ((label, draws, 10), ("published presets", [{}], 400)):
-                laws = MODEL["laws"]
-                if ds is not draws:
-                    MODEL["laws"] = {}
+                r, cv = constraint_row(model, c, angs)
+            else:
                 rels = releases(held.split("_")[1].upper())
                 MODEL["laws"] = laws
-                r, cv = release_row(held, model, predict_release_stops(rels, ds, n_each, 50_000), rels)
-                rows.append(r)
-                curves[(held, model)] = cv
+                r, cv = release_row(held, model, predict_release_stops(rels, ds, 10 if fitted else 400, 50_000),
+                                    rels)
+            rows.append(r)
+            curves[(held, model)] = cv
         print(pd.DataFrame(rows).round(3).to_string())
     table = pd.DataFrame(rows)
     out = REPO / "docs" / "validation"
@@ -329,12 +352,12 @@ def main():
         for (h, model), c in curves.items():
             if h != held:
                 continue
-            style = "C0" if model == "published presets" else "C3"
+            style = "C0" if model == "published presets" else ("C2" if "site-to-site" in model else "C3")
             if held == "evans_hungr_1993":
                 ax.hist(c, bins=15, alpha=0.5, color=style, label=model, density=True)
             else:
                 obs, pred = c
-                if model != "published presets":
+                if model != "published presets" and "site-to-site" not in model:
                     o = np.sort(obs)
                     ax.step(o, np.arange(1, o.size + 1) / o.size, where="post", color="k", lw=2,
                             label=f"observed ({o.size})")
