@@ -121,6 +121,58 @@ def assumed_spread(preset: str, table: dict) -> dict:
 PRESET_SPREAD_SOURCES: list = [assumed_spread]
 
 
+def site_spread_half_width(path: str) -> float:
+    """The ASSUMED site-to-site half-width of a dotted preset field ``materials.<preset>.<field>`` (in the field's
+    unit): :data:`ASSUMED_HALF_WIDTHS` of that preset and field, 0.15 for an e_T mean the preset's table does not
+    list (Wyllie 2014: e_T 0.3-0.8), 0 for a field with no stated spread.
+
+    Parameters
+    ----------
+    path : str
+        Dotted field, e.g. ``materials.soil.ground_friction_angle_deg``.
+
+    Returns
+    -------
+    float
+        Half-width [the field's unit].
+    """
+    _, preset, field = path.split(".", 2)
+    return ASSUMED_HALF_WIDTHS.get(preset, {}).get(field, 0.15 if field == "tangential.mean" else 0.0)
+
+
+def with_site_spread(sample: pd.DataFrame, bounds: dict, seed=1) -> pd.DataFrame:
+    """Posterior draws of preset fields for a site the calibration data did not sample.
+
+    Each value is moved by a uniform amount within :func:`site_spread_half_width` of its field and kept inside
+    the prior box ``bounds``.  A posterior fitted to a few sites measures what those sites share, not how much a
+    new site differs from them: the two Authume profiles alone put soil's rolling-resistance angle 4 deg apart
+    (11.8 and 16.0 deg) where each posterior is about 1.5 deg wide (docs/validation/trajectories.md).  The
+    half-widths are the ASSUMED ranges of :data:`ASSUMED_HALF_WIDTHS`.  In the leave-one-data-set-out check they
+    bring the share of Authume P2's stops beyond their release's predictive p99 from 25 % to 6 %.
+
+    Parameters
+    ----------
+    sample : pandas.DataFrame
+        Posterior draws, one column per dotted field (:func:`simulation.materials.preset_posterior`).
+    bounds : dict
+        Field -> (low, high) of its prior.
+    seed : int, optional
+        Random seed.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The draws with the site-to-site spread added (same shape and columns).
+    """
+    rng = np.random.default_rng(seed)
+    out = sample.copy()
+    for col in out.columns:
+        w = site_spread_half_width(col)
+        lo, hi = bounds[col]
+        out[col] = np.clip(out[col].to_numpy(float) + rng.uniform(-w, w, len(out)), lo, hi)
+    return out
+
+
 def _scenario_data(scenario) -> tuple[dict, str, Path | None]:
     from .calibration import scenario_dict
     data, src = scenario_dict(scenario)

@@ -65,6 +65,23 @@ def test_posterior_sample_matches_its_summary():
     assert list(preset_posterior(["talus"]).columns) == ["materials.talus.ground_friction_angle_deg"]
 
 
+def test_new_site_draws_add_the_assumed_site_to_site_spread():
+    from simulation.material_uncertainty import site_spread_half_width
+    base = preset_posterior()
+    new = preset_posterior(new_site=True, seed=3)
+    assert list(new.columns) == list(base.columns) and len(new) == len(base)
+    assert new.equals(preset_posterior(new_site=True, seed=3))                     # reproducible
+    assert site_spread_half_width("materials.soil.ground_friction_angle_deg") == 6.0
+    assert site_spread_half_width("materials.bedrock.tangential.mean") == 0.15
+    for k, st in preset_priors.SUMMARY.items():
+        w = site_spread_half_width(k)
+        shift = (new[k] - base[k]).abs()
+        lo, hi = st["bounds"]
+        assert new[k].between(lo, hi).all() and (shift <= w + 1e-12).all(), k
+        # a uniform shift of half-width w adds w^2 / 3 to the variance (inside the prior box)
+        assert new[k].var() == pytest.approx(base[k].var() + w * w / 3, rel=0.35), k
+
+
 def test_bad_preset_names_and_bases_are_named():
     with pytest.raises(PresetError, match=r"<preset_prior\(\)>: preset = 'tallus' is not a known material preset; "
                                           r"did you mean 'talus'\?"):

@@ -51,6 +51,7 @@ REPO = HERE.parents[2]
 sys.path.insert(0, str(REPO))
 
 from simulation.calibration import scenario_dict  # noqa: E402
+from simulation.material_uncertainty import with_site_spread  # noqa: E402
 from simulation.pooled import ReachConstraint, Release, _ConstraintPool, _Pool, calibrate_pooled  # noqa: E402
 
 AUTHUME = REPO / "simulation" / "scenarios" / "authume"
@@ -231,26 +232,6 @@ def predict_release_stops(rels, draws, n_each, seed0):
     return [np.concatenate(p) for p in per]
 
 
-def with_site_spread(draws, bounds, seed):
-    """Posterior draws with the ASSUMED site-to-site spread added: each fitted field moved by a uniform amount
-    within the half-width of :data:`simulation.material_uncertainty.ASSUMED_HALF_WIDTHS` for its preset and field
-    (0.15 for an e_T mean the preset's table does not list), kept inside the prior box.  A site the data sets
-    did not sample differs from them by more than the posterior's width (the two Authume profiles alone put
-    soil's phi_g 4 deg apart); this spread is independent of the held-out data."""
-    from simulation.material_uncertainty import ASSUMED_HALF_WIDTHS
-    rng = np.random.default_rng(seed)
-    out = []
-    for d in draws:
-        new = {}
-        for k, v in d.items():
-            _, preset, field = k.split(".", 2)
-            w = ASSUMED_HALF_WIDTHS.get(preset, {}).get(field, 0.15 if field == "tangential.mean" else 0.0)
-            lo, hi = bounds[k]
-            new[k] = float(np.clip(v + rng.uniform(-w, w), lo, hi))
-        out.append(new)
-    return out
-
-
 def release_row(dataset, model, per_release, rels):
     obs = np.array([r.x_stop_m[0] for r in rels])
     pred = np.concatenate(per_release)
@@ -315,8 +296,8 @@ def main():
         label = "fitted on " + " + ".join(train)
         variants = [(label, draws, True)]
         if args.site_spread == "assumed":
-            variants.append((label + " + assumed site-to-site spread", with_site_spread(draws, cal.bounds, args.seed),
-                             True))
+            spread = with_site_spread(pd.DataFrame(draws), cal.bounds, args.seed).to_dict("records")
+            variants.append((label + " + assumed site-to-site spread", spread, True))
         variants.append(("published presets", [{}], False))
         for model, ds, fitted in variants:
             laws = MODEL["laws"]
