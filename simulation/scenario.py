@@ -512,6 +512,67 @@ class Scenario(Displayed):
         return replace(self, collectors=tuple(cols))
 
 
+def parse_tables_and_materials(data: dict, required: tuple, optional: tuple, source: str) -> tuple:
+    """Check a scenario dictionary's top-level tables (``required`` must be there; ``name``, ``description`` and
+    ``optional`` may be) and parse its ``[materials]``: the part a profile and a terrain scenario share.
+
+    Parameters
+    ----------
+    data : dict
+        The parsed scenario TOML.
+    required, optional : tuple of str
+        Tables that must be present, and tables that may be.
+    source : str
+        Where the dictionary came from, for error messages.
+
+    Returns
+    -------
+    tuple of Material
+        The parsed materials, in the file's order.
+    """
+    _check_keys(data, {"name", "description", *required, *optional}, "", source)
+    for key in required:
+        if key not in data:
+            raise ScenarioError(f"{source}: missing [{key}] table")
+    mats = data["materials"]
+    if not isinstance(mats, dict) or not mats:
+        raise ScenarioError(f"{source}: [materials] must define at least one material table")
+    return tuple(Material.parse(name, spec, source) for name, spec in mats.items())
+
+
+def parse_settings(st: dict, source: str, *, max_events: int = 5000, envelopes: bool = True) -> Settings:
+    """The checked ``[settings]`` table of a scenario (:class:`Settings`; every field optional).
+
+    Parameters
+    ----------
+    st : dict
+        The ``[settings]`` table.
+    source : str
+        Where it came from, for error messages.
+    max_events : int, optional
+        Default event limit per block (the 3-D kernel takes a larger one).
+    envelopes : bool, optional
+        Whether ``envelope_bins`` may be given (2-D profiles only; 0 otherwise).
+
+    Returns
+    -------
+    Settings
+    """
+    _check_keys(st, set(Settings.__dataclass_fields__) - (set() if envelopes else {"envelope_bins"}), "settings.",
+                source)
+    return Settings(
+        gravity_ms2=_number(st.get("gravity_ms2", STANDARD_GRAVITY_MS2), "settings.gravity_ms2", source, lo=0.0,
+                            lo_open=True),
+        contact_velocity_ms=_number(st.get("contact_velocity_ms", 0.5), "settings.contact_velocity_ms", source,
+                                    lo=0.0, lo_open=True),
+        stop_velocity_ms=_number(st.get("stop_velocity_ms", 0.05), "settings.stop_velocity_ms", source, lo=0.0),
+        max_events=int(_number(st.get("max_events", max_events), "settings.max_events", source, lo=1)),
+        envelope_bins=int(_number(st.get("envelope_bins", 50), "settings.envelope_bins", source, lo=0, hi=10000))
+        if envelopes else 0,
+        max_rolling_slope_deg=_number(st.get("max_rolling_slope_deg", 90.0), "settings.max_rolling_slope_deg",
+                                      source, lo=0.0, hi=90.0, lo_open=True))
+
+
 def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None = None) -> Scenario:
     """Build and validate a :class:`Scenario` from a parsed TOML dictionary.
 
@@ -533,15 +594,8 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
     ScenarioError
         Naming the file, the field and the value.
     """
-    _check_keys(data, {"name", "description", "profile", "materials", "seeder", "collectors", "settings"}, "",
-                source)
-    for key in ("profile", "materials", "seeder"):
-        if key not in data:
-            raise ScenarioError(f"{source}: missing [{key}] table")
-    mats = data["materials"]
-    if not isinstance(mats, dict) or not mats:
-        raise ScenarioError(f"{source}: [materials] must define at least one material table")
-    materials = tuple(Material.parse(name, spec, source) for name, spec in mats.items())
+    materials = parse_tables_and_materials(data, ("profile", "materials", "seeder"), ("collectors", "settings"),
+                                           source)
     names = [m.name for m in materials]
 
     prof = data["profile"]
@@ -627,17 +681,7 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
     if len(set(cnames)) != len(cnames):
         raise ScenarioError(f"{source}: collector names must be unique; got {cnames}")
 
-    st = data.get("settings", {})
-    _check_keys(st, set(Settings.__dataclass_fields__), "settings.", source)
-    settings = Settings(
-        gravity_ms2=_number(st.get("gravity_ms2", STANDARD_GRAVITY_MS2), "settings.gravity_ms2", source, lo=0.0, lo_open=True),
-        contact_velocity_ms=_number(st.get("contact_velocity_ms", 0.5), "settings.contact_velocity_ms", source,
-                                    lo=0.0, lo_open=True),
-        stop_velocity_ms=_number(st.get("stop_velocity_ms", 0.05), "settings.stop_velocity_ms", source, lo=0.0),
-        max_events=int(_number(st.get("max_events", 5000), "settings.max_events", source, lo=1)),
-        envelope_bins=int(_number(st.get("envelope_bins", 50), "settings.envelope_bins", source, lo=0, hi=10000)),
-        max_rolling_slope_deg=_number(st.get("max_rolling_slope_deg", 90.0), "settings.max_rolling_slope_deg",
-                                      source, lo=0.0, hi=90.0, lo_open=True))
+    settings = parse_settings(data.get("settings", {}), source)
     return Scenario(name=str(data.get("name", Path(source).stem)), description=str(data.get("description", "")),
                     profile=profile, materials=materials, seeder=seeder, collectors=tuple(collectors),
                     settings=settings, source=source)

@@ -58,9 +58,10 @@ from pathlib import Path
 import numpy as np
 
 from ._display import Displayed, short_repr
-from .scenario import Distribution, Material, ScenarioError, Settings, _check_keys, _number
+from .scenario import (Distribution, ScenarioError, Settings, _check_keys, _number, parse_settings,
+                       parse_tables_and_materials)
 from .terrain import MaterialGrid, Terrain, TerrainError, read_dem, read_material_raster
-from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2, block_radius
+from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, block_radius
 
 #: Contact steps are events in 3-D (one per half cell rolled), so the default limit is higher than in 2-D.
 DEFAULT_MAX_EVENTS_3D = 200_000
@@ -241,15 +242,8 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
     TerrainScenario
         The checked scenario.
     """
-    _check_keys(data, {"name", "description", "terrain", "materials", "sources", "collectors", "settings"}, "",
-                source)
-    for key in ("terrain", "materials", "sources"):
-        if key not in data:
-            raise ScenarioError(f"{source}: missing [{key}] table")
-    mats = data["materials"]
-    if not isinstance(mats, dict) or not mats:
-        raise ScenarioError(f"{source}: [materials] must define at least one material table")
-    materials = tuple(Material.parse(name, spec, source) for name, spec in mats.items())
+    materials = parse_tables_and_materials(data, ("terrain", "materials", "sources"), ("collectors", "settings"),
+                                           source)
     names = [m.name for m in materials]
 
     tt = data["terrain"]
@@ -365,19 +359,7 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
     if len(set(cnames)) != len(cnames):
         raise ScenarioError(f"{source}: collector names must be unique; got {cnames}")
 
-    st = data.get("settings", {})
-    _check_keys(st, {"gravity_ms2", "contact_velocity_ms", "stop_velocity_ms", "max_events", "max_rolling_slope_deg"},
-                "settings.", source)
-    settings = Settings(
-        gravity_ms2=_number(st.get("gravity_ms2", STANDARD_GRAVITY_MS2), "settings.gravity_ms2", source, lo=0.0,
-                            lo_open=True),
-        contact_velocity_ms=_number(st.get("contact_velocity_ms", 0.5), "settings.contact_velocity_ms", source,
-                                    lo=0.0, lo_open=True),
-        stop_velocity_ms=_number(st.get("stop_velocity_ms", 0.05), "settings.stop_velocity_ms", source, lo=0.0),
-        max_events=int(_number(st.get("max_events", DEFAULT_MAX_EVENTS_3D), "settings.max_events", source, lo=1)),
-        envelope_bins=0,
-        max_rolling_slope_deg=_number(st.get("max_rolling_slope_deg", 90.0), "settings.max_rolling_slope_deg",
-                                      source, lo=0.0, hi=90.0, lo_open=True))
+    settings = parse_settings(data.get("settings", {}), source, max_events=DEFAULT_MAX_EVENTS_3D, envelopes=False)
     return TerrainScenario(name=str(data.get("name", Path(source).stem)), description=str(data.get("description", "")),
                            terrain=terrain, materials=materials, material_grid=grid, sources=sources,
                            collectors=tuple(collectors), settings=settings, source=source)
