@@ -615,6 +615,42 @@ def steep_face_launch(v_along, v_sep):
     return (vt if v_along >= 0.0 else -vt), vn
 
 
+#: A block that leaves faces too steep to roll on this many times in a row without moving more than
+#: :data:`STEEP_TRAP_RADIUS_M` (horizontally, along each axis) from where that run began is held there: it sits in a
+#: notch or pit whose flanks are all too steep to roll on, and would otherwise hop in place until its event limit.
+#: From rest on a plain steep face a block leaves the half metre within about ten launches.
+STEEP_TRAP_LAUNCHES = 100
+STEEP_TRAP_RADIUS_M = 0.5
+
+
+@njit(cache=True)
+def steep_trap(count, x_start, y_start, x, y):
+    """Count a launch from a steep face at (x, y) [m]; (count, x_start, y_start, trapped).
+
+    The run of launches restarts at (x, y) when the block is farther than :data:`STEEP_TRAP_RADIUS_M` from where
+    the run began; ``trapped`` is True once the run reaches :data:`STEEP_TRAP_LAUNCHES` (the block is then held).
+
+    Parameters
+    ----------
+    count : int
+        Launches so far in the run (0: none).
+    x_start, y_start : float
+        Where the run began [m].
+    x, y : float
+        Where the block leaves the face now [m] (y = 0 on a 2-D profile).
+
+    Returns
+    -------
+    tuple
+        (count, x_start, y_start, trapped).
+    """
+    if count > 0 and abs(x - x_start) <= STEEP_TRAP_RADIUS_M and abs(y - y_start) <= STEEP_TRAP_RADIUS_M:
+        count += 1
+    else:
+        count, x_start, y_start = 1, x, y
+    return count, x_start, y_start, count >= STEEP_TRAP_LAUNCHES
+
+
 # ---- ground contact with a velocity-squared drag: dv/dt = a - c v^2 along the motion ----------------------
 # A block rolling over asperities (talus boulders, tussocks) or ploughing soft ground loses at each asperity
 # a share of its kinetic energy, and meets more asperities per second the faster it goes: a resistance that

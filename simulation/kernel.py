@@ -23,7 +23,7 @@ from numba import njit
 from .contact import (EN_WYLLIE, contact_acceleration, contact_speed, contact_speed_at,  # noqa: F401
                       contact_stop_distance, contact_time, rebound, roll_on_speed, rolling_resistance,
                       roughness_tilt_max,
-                      steep_face_launch)
+                      steep_face_launch, steep_trap)
 from .units import J_PER_KJ
 
 # Stop reasons.
@@ -564,6 +564,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
         reason = RUNNING
         impacts = 0
         events = 0
+        trap_n, trap_x, trap_y = 0, 0.0, 0.0          # the run of launches from steep faces (steep_trap)
         while reason == RUNNING:
             events += 1
             if events > max_events:
@@ -664,7 +665,16 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 vn_true = -vx * math.sin(beta) + vz * math.cos(beta)
                 v_thr = contact_speed(v_contact, g, math.cos(beta), m_hop[mat])
                 if vn_true < v_thr and abs(math.sin(beta)) > sin_max_roll:
-                    # A face too steep to roll on: the block leaves it again (speed kept), no ground contact.
+                    # A face too steep to roll on: the block leaves it again (speed kept), no ground contact --
+                    # unless it has kept doing so in one place (a notch with flanks too steep to roll on).
+                    trap_n, trap_x, trap_y, trapped = steep_trap(trap_n, trap_x, trap_y, x, 0.0)
+                    if trapped:
+                        reason = STOPPED
+                        w = 0.0
+                        if record:
+                            _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, 0.0,
+                                         0.0, 0.0, MODE_STOP, EV_STOP)
+                        break
                     vt_true = vx * math.cos(beta) + vz * math.sin(beta)
                     vt_new, vn_new = steep_face_launch(vt_true, v_thr)
                     vx = vt_new * math.cos(beta) - vn_new * math.sin(beta)
@@ -701,7 +711,16 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r)
             roll = m_roll[mat]
             if abs(sinb) > sin_max_roll:
-                # No rolling or sliding in contact on a face this steep: the block leaves it (speed kept).
+                # No rolling or sliding in contact on a face this steep: the block leaves it (speed kept), unless
+                # it has kept doing so in one place (steep_trap).
+                trap_n, trap_x, trap_y, trapped = steep_trap(trap_n, trap_x, trap_y, x, 0.0)
+                if trapped:
+                    reason = STOPPED
+                    w = 0.0
+                    if record:
+                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, 0.0, 0.0,
+                                     0.0, MODE_STOP, EV_STOP)
+                    break
                 vt_new, vn_new = steep_face_launch(v_along, contact_speed(v_contact, g, cosb, m_hop[mat]))
                 vx = vt_new * cosb - vn_new * sinb
                 vz = vt_new * sinb + vn_new * cosb

@@ -43,7 +43,9 @@ Physics (shared with the 2-D kernel :mod:`simulation.kernel`)
   where that normal component points away from the ground and exceeds the contact speed, the block takes off.
 * Steep faces (``sin_max_roll`` < 1, the scenario's ``settings.max_rolling_slope_deg``): no rolling or sliding
   in contact on a surface steeper than that; a block that would enter or stay in contact there leaves it
-  with its speed kept (:func:`simulation.contact.steep_face_launch`) and meets it again in impacts, as in 2-D.
+  with its speed kept (:func:`simulation.contact.steep_face_launch`) and meets it again in impacts, as in 2-D;
+  one that keeps leaving steep faces in one place (a notch or pit with flanks too steep to roll on) is held
+  there (:func:`simulation.contact.steep_trap`).
 * Stop: slower than ``v_stop`` where the slope angle is within the ground friction angle; a block at
   momentary rest on a steeper slope restarts down the fall line, and one that comes to rest a second
   time within half a cell of its previous rest is held there (a pit or trough between flanks).
@@ -73,7 +75,7 @@ import numpy as np
 from numba import njit
 
 from .contact import (EN_WYLLIE, contact_speed, contact_speed_at, contact_stop_distance, rebound, roll_on_speed,
-                      rolling_resistance, steep_face_launch)
+                      rolling_resistance, steep_face_launch, steep_trap)
 from .kernel import (BARRIER_CAUGHT, BARRIER_THROUGH, CROSSED, OUTCOMES, _GOLDEN, _normal, _uniform,  # noqa: F401
                      barrier_outcome)
 
@@ -147,12 +149,15 @@ def _stop_fraction(u, u2sq, a_s, c, ds):
 
 
 @njit(cache=True)
-def _leave_face(vx, vy, vz, x, y, z, nx0, ny0, nz0, v_sep):
+def _leave_face(vx, vy, vz, x, y, z, nx0, ny0, nz0, v_sep, zg, x0, y0, dx, dy):
     """A block leaving a face too steep to roll on (3-D form of the 2-D rule).
 
     The tangential speed is kept and turned away from the face until its outward normal share is ``v_sep``
     (:func:`simulation.contact.steep_face_launch`; no energy is created).  A block at rest against the face
-    is moved 1e-6 m-scale horizontally away from it, z unchanged, so it falls onto the face from just above.
+    is moved 1e-6 m horizontally away from it, z unchanged, so it falls onto the face from just above -- only
+    where the surface there is not above the block (at the bottom of a notch it stays, and the run of launches
+    in one place ends it: :func:`simulation.contact.steep_trap`).  The step is a fixed length, not a share of
+    the coordinates, so a DEM in map coordinates (x ~ 2.6e6 m) behaves as one near the origin.
 
     Returns
     -------
@@ -172,8 +177,10 @@ def _leave_face(vx, vy, vz, x, y, z, nx0, ny0, nz0, v_sep):
     if vn_new <= 0.0:
         hl = math.sqrt(nx0 * nx0 + ny0 * ny0)
         if hl > 1e-12:
-            step = 1e-6 * (1.0 + abs(x) + abs(y))
-            x, y = x + step * nx0 / hl, y + step * ny0 / hl
+            x2, y2 = x + 1e-6 * nx0 / hl, y + 1e-6 * ny0 / hl
+            z2, _, _ = _surface(zg, x0, y0, dx, dy, x2, y2)
+            if z2 == z2 and z2 <= z:
+                x, y = x2, y2
     return (vt_new * tx + vn_new * nx0, vt_new * ty + vn_new * ny0, vt_new * tz + vn_new * nz0, x, y, z + 1e-9,
             tx, ty, tz)
 
@@ -608,6 +615,7 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
         impacts = 0
         events = 0
         last_rest_x, last_rest_y = math.inf, math.inf
+        trap_n, trap_x, trap_y = 0, 0.0, 0.0          # the run of launches from steep faces (steep_trap)
         have_s, c_gx, c_gy = False, 0.0, 0.0
         while reason == RUNNING:
             events += 1
@@ -721,8 +729,15 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                 vn_true = vx * nx0 + vy * ny0 + vz * nz0
                 v_thr = contact_speed(v_contact, g, nz0, m_hop[mat])
                 if vn_true < v_thr and 1.0 - nz0 * nz0 > sin_max_roll * sin_max_roll:
-                    # a face too steep to roll on: the block leaves it again (speed kept), no ground contact
-                    vx, vy, vz, x, y, z, sx, sy, sz = _leave_face(vx, vy, vz, x, y, z, nx0, ny0, nz0, v_thr)
+                    # a face too steep to roll on: the block leaves it again (speed kept), no ground contact --
+                    # unless it has kept doing so in one place (a notch or pit with flanks too steep to roll on)
+                    trap_n, trap_x, trap_y, trapped = steep_trap(trap_n, trap_x, trap_y, x, y)
+                    if trapped:
+                        reason = STOPPED
+                        vx, vy, vz, w = 0.0, 0.0, 0.0, 0.0
+                        break
+                    vx, vy, vz, x, y, z, sx, sy, sz = _leave_face(vx, vy, vz, x, y, z, nx0, ny0, nz0, v_thr, zg, x0,
+                                                                  y0, dx, dy)
                 elif vn_true < v_thr:
                     contact = True
                     vx, vy, vz = vx - vn_true * nx0, vy - vn_true * ny0, vz - vn_true * nz0
@@ -760,11 +775,18 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
             nl = math.sqrt(gx * gx + gy * gy + 1.0)
             nx0, ny0, nz0 = -gx / nl, -gy / nl, 1.0 / nl
             if 1.0 - nz0 * nz0 > sin_max_roll * sin_max_roll:
-                # no rolling or sliding in contact on a face this steep: the block leaves it (speed kept)
+                # no rolling or sliding in contact on a face this steep: the block leaves it (speed kept), unless
+                # it has kept doing so in one place (steep_trap)
+                trap_n, trap_x, trap_y, trapped = steep_trap(trap_n, trap_x, trap_y, x, y)
+                if trapped:
+                    reason = STOPPED
+                    vx, vy, vz, w = 0.0, 0.0, 0.0, 0.0
+                    break
                 vn_c = vx * nx0 + vy * ny0 + vz * nz0
                 vx, vy, vz = vx - vn_c * nx0, vy - vn_c * ny0, vz - vn_c * nz0
                 vx, vy, vz, x, y, z, sx, sy, sz = _leave_face(vx, vy, vz, x, y, z, nx0, ny0, nz0,
-                                                              contact_speed(v_contact, g, nz0, m_hop[mat]))
+                                                              contact_speed(v_contact, g, nz0, m_hop[mat]), zg, x0,
+                                                              y0, dx, dy)
                 contact = False
                 if record:
                     _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, t_abs, x, y, z,

@@ -125,3 +125,51 @@ def test_the_steep_face_setting_is_read_and_checked_in_3d():
     for bad in (0.0, 95.0, "steep"):
         with pytest.raises(ScenarioError, match="settings.max_rolling_slope_deg"):
             _scenario(CLIFF, mats, src, {"max_rolling_slope_deg": bad})
+
+
+def _notch(angle_deg, x_off=0.0, y_off=0.0):
+    """A V-notch along y with flanks at ``angle_deg`` (too steep to roll on with the 55 deg rule) and its axis at
+    x = 30 m, on a DEM whose origin may be moved (map coordinates)."""
+    t = np.tan(np.radians(angle_deg))
+    return Terrain.from_function(lambda x, y: 100 + np.minimum(t * np.abs(x - x_off - 30.0), 60) + 0 * y,
+                                 (x_off, x_off + 60), (y_off, y_off + 60), 1.0)
+
+
+def test_a_block_in_a_notch_too_steep_to_roll_on_is_held_not_bounced_forever():
+    """Found by review: with the steep-face rule a block at the bottom of a V whose 70 deg flanks it may not roll
+    on hopped in place until its event limit (19,999 impacts), in 2-D and 3-D.  It is now held there
+    (simulation.contact.steep_trap: 100 launches within 0.5 m)."""
+    from simulation.contact import STEEP_TRAP_LAUNCHES
+    mats = {"m": {"preset": "talus", "roughness_m": 0.0, "contact_hop_height_m": 0.3}}
+    st = {"max_rolling_slope_deg": 55.0, "max_events": 20_000}
+    x_rel = 30 + 20 / np.tan(np.radians(70.0))
+    sc3 = _scenario(_notch(70.0), mats, {"points": [[x_rel, 30.0]], "height_m": 0.0, "mass_kg": 1000,
+                                         "speed_ms": 0.0}, st)
+    r3 = run_terrain(sc3, 3, seed=1)
+    prof = profile_from_grid(_notch(70.0), [(0.0, 30.0), (60.0, 30.0)], spacing=1.0)
+    sc2 = simulation.scenario_from_dict({"profile": prof.to_dict(), "materials": mats, "settings": st,
+                                         "seeder": {"x": x_rel, "height_m": 0.0, "mass_kg": 1000, "vx_ms": 0.0}})
+    r2 = simulation.run(sc2, 3, seed=2)
+    for pb in (r3.per_block, r2.per_block):
+        assert np.all(pb["reason"] == kernel3d.STOPPED)
+        assert np.all(np.abs(pb["x"] - 30.0) < 1.0)                      # held at the bottom of the notch
+        assert np.all(pb["impacts"] < 3 * STEEP_TRAP_LAUNCHES)
+
+
+def test_a_steep_face_behaves_the_same_in_map_coordinates():
+    """Found by review: the step off a steep face was 1e-6 of the coordinates, 3.8 m at Swiss LV95 coordinates
+    (x ~ 2.6e6 m): the same face gave other stops when only the DEM's origin moved, and could put a block into
+    the opposite flank of a notch (energy created).  The step is now a fixed 1e-6 m."""
+    mats = {"m": {**CONTACT}}
+    st = {"max_rolling_slope_deg": 55.0}
+    stops = []
+    for xo, yo in ((0.0, 0.0), (2_600_000.0, 1_200_000.0)):
+        ter = Terrain.from_function(lambda x, y, xo=xo: _cliff_over_talus(x - xo, y), (xo, xo + 300), (yo, yo + 100),
+                                    1.0)
+        sc = _scenario(ter, mats, {"points": [[xo + 20.0, yo + 50.0]], "height_m": 0.0, "mass_kg": MASS,
+                                   "speed_ms": 0.0}, st)
+        r = run_terrain(sc, 200, seed=4)
+        assert np.all(r.energy_excess_j() <= r.blocks["mass"] * G * 1e-6)
+        stops.append(np.hypot(r.per_block["x"] - xo - 20.0, r.per_block["y"] - yo - 50.0))
+    # the same blocks stop at the same places (to rounding of the larger coordinates)
+    assert np.allclose(stops[0], stops[1], atol=0.05)
