@@ -26,13 +26,13 @@ Physics (shared with the 2-D kernel :mod:`simulation.kernel`)
   roughness (two angles, along and across the direction of travel, each uniform in +-atan(roughness /
   radius) as in 2-D), the normal and tangential restitution laws of :func:`simulation.contact.rebound`
   (the same compiled function the 2-D kernel calls, with the Pfeiffer & Bowen velocity scaling of e_N) act on
-  the normal speed, the tangential speed and the spin.  Spin is carried as a scalar about the horizontal axis normal to the direction of travel; when
-  the direction of travel turns, only the component of the spin about the new axis is kept (w cos of the
-  turn), which never adds energy.
+  the normal speed, the tangential speed and the spin.  Spin is carried as a scalar about the horizontal axis
+  normal to the direction of travel; when the direction of travel turns, only the component of the spin about
+  the new axis is kept (w cos of the turn), which never adds energy.
 * Ground contact (rolling or sliding, as the material says): a rebound normal speed below the contact
   speed of :func:`simulation.contact.contact_speed` (``v_contact``, or the speed of a hop as high as the
-  material's ``hop_height_m`` when that is larger) turns the block into contact, with :func:`simulation.kernel.roll_on_speed` for the
-  transition to rolling; the block then moves along the surface in steps of at most half a cell with the
+  material's ``hop_height_m`` when that is larger) turns the block into contact, with
+  :func:`simulation.kernel.roll_on_speed` for the transition to rolling; the block then moves along the surface in steps of at most half a cell with the
   gravity component in the tangent plane and the rolling-resistance (or sliding) friction of the 2-D
   contact law, a = f (g_t - mu_r g cos(theta) v/|v|) - c |v| v, f = 1 / (1 + k) rolling (5/7 for a sphere), 1
   sliding, mu_r = tan(phi_g) + K roughness / r (:func:`simulation.contact.rolling_resistance`) and the
