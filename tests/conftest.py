@@ -1,3 +1,4 @@
+import hashlib
 from pathlib import Path
 
 import pytest
@@ -5,11 +6,36 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).resolve().parent / "data"
 INVENTORIES = ROOT / "inventories"
+DEMO = ROOT / "riskrf" / "data"
+SCENARIO = ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml"
+LAUTER = DEMO / "lauterbrunnen_tls_2018.csv"
+
+
+def digest(directory: Path) -> dict:
+    """Content digest of every file under ``directory`` (inputs must be byte-identical after any command)."""
+    return {p.relative_to(directory): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(directory.rglob("*")) if p.is_file()}
 
 
 @pytest.fixture
 def data_dir():
     return DATA
+
+
+@pytest.fixture
+def no_work(monkeypatch):
+    """Every expensive stage fails loudly: a refusal must come before any of them runs (the bad-input tests)."""
+    import riskrf.app.assess
+    import riskrf.frequency.study
+    import simulation
+
+    def boom(*a, **k):
+        raise AssertionError("work started before the input was refused")
+    monkeypatch.setattr(riskrf.frequency.study, "analyse_inventory", boom)
+    monkeypatch.setattr(riskrf.app.assess, "energy_hazard_from_inputs", boom)
+    monkeypatch.setattr(riskrf.app.assess, "run_assessment", boom)
+    monkeypatch.setattr(simulation, "run", boom)
+    monkeypatch.setattr(simulation, "calibrate", boom)
 
 from hypothesis import settings  # noqa: E402
 

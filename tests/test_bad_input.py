@@ -6,7 +6,6 @@ no work started, and that no input file was modified.  Accepted cases assert the
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import os
@@ -26,39 +25,15 @@ from riskrf.frequency.inventory import read_inventory
 from riskrf.core.validation import RiskrfWarning
 from riskrf.io.velocities import read_velocities
 
-ROOT = Path(__file__).resolve().parents[1]
-DEMO = ROOT / "riskrf" / "data"
-SCENARIO = ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml"
-LAUTER = DEMO / "lauterbrunnen_tls_2018.csv"
+from .conftest import DEMO, LAUTER, ROOT, SCENARIO, digest
 
 
 # ---------------------------------------------------------------- helpers
-def snapshot(directory: Path) -> dict:
-    """Content digest of every file under ``directory`` (inputs must never change)."""
-    return {p.relative_to(directory): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(directory.rglob("*")) if p.is_file()}
-
-
 @pytest.fixture
 def inputs(tmp_path):
     d = tmp_path / "in"
     d.mkdir()
     return d
-
-
-@pytest.fixture
-def no_work(monkeypatch):
-    """Make every expensive stage fail loudly: a refusal must come before any of them runs."""
-    import riskrf.app.assess
-    import riskrf.frequency.study
-    import simulation
-
-    def boom(*a, **k):
-        raise AssertionError("work started before the input was refused")
-    monkeypatch.setattr(riskrf.frequency.study, "analyse_inventory", boom)
-    monkeypatch.setattr(riskrf.app.assess, "energy_hazard_from_inputs", boom)
-    monkeypatch.setattr(riskrf.app.assess, "run_assessment", boom)
-    monkeypatch.setattr(simulation, "run", boom)
 
 
 def write(path: Path, text: str, encoding="utf-8") -> Path:
@@ -140,10 +115,10 @@ SEMICOLON_COMMA = "Datum;Volumen [m3];Ort\n05.03.2019;1,192;Km 12,3\n31.12.2019;
 ])
 def test_inventory_exports_are_read(inputs, name, text, encoding, kwargs, volumes):
     f = write(inputs / "inv.csv", text, encoding)
-    before = snapshot(inputs)
+    before = digest(inputs)
     inv = read_inventory(f, start="2019-01-01", end="2020-12-31", density_kg_m3=2650, **kwargs)
     np.testing.assert_allclose(inv.volumes, volumes)
-    assert snapshot(inputs) == before
+    assert digest(inputs) == before
 
 
 def test_day_first_dotted_dates_are_read_day_first_throughout(inputs):
@@ -187,14 +162,14 @@ def test_excel_second_sheet_below_three_title_rows(inputs):
         title = pd.DataFrame([["Felssturzkataster"], ["Kanton Bern"], [""]])
         title.to_excel(xl, sheet_name="Ereignisse", index=False, header=False)
         body.to_excel(xl, sheet_name="Ereignisse", index=False, startrow=3)
-    before = snapshot(inputs)
+    before = digest(inputs)
     inv = read_inventory(f, sheet="Ereignisse", header_row=4, start="2019-01-01", end="2019-12-31",
                          density_kg_m3=2650)
     np.testing.assert_allclose(inv.volumes, [1.5, 2.25])
     assert inv.events["date"].iloc[0].strftime("%Y-%m-%d") == "2019-03-05"
     inv2 = read_inventory(f, sheet=2, header_row=4, start="2019-01-01", end="2019-12-31", density_kg_m3=2650)
     np.testing.assert_allclose(inv2.volumes, [1.5, 2.25])
-    assert snapshot(inputs) == before
+    assert digest(inputs) == before
     with pytest.raises(ValueError, match=r"export.xlsx.*sheet = 'Nope'.*Info.*Ereignisse"):
         read_inventory(f, sheet="Nope", duration_years=1)
     with pytest.raises(ValueError, match=r"export.xlsx.*no volume or mass column.*--header-row"):
@@ -218,11 +193,11 @@ def test_parquet_with_string_columns(inputs):
 ])
 def test_velocity_exports_are_read(inputs, text, kwargs, velocities, heights):
     f = write(inputs / "v.csv", text)
-    before = snapshot(inputs)
+    before = digest(inputs)
     df = read_velocities(f, **kwargs)
     np.testing.assert_allclose(df["velocity_ms"], velocities)
     np.testing.assert_allclose(df["height_m"], heights)
-    assert snapshot(inputs) == before
+    assert digest(inputs) == before
 
 
 def test_cli_fit_reads_a_european_export(inputs, tmp_path, capsys):
@@ -230,7 +205,7 @@ def test_cli_fit_reads_a_european_export(inputs, tmp_path, capsys):
     lines = [f"{1 + i % 12:02d}/{1 + (i * 5) % 12:02d}/{2019 + i // 12};{v:.3f}".replace(".", ",")
              for i, v in enumerate(np.exp(rng.normal(0, 1.5, 40)))]
     f = write(inputs / "kataster.csv", "Datum;Volumen [m³]\n" + "\n".join(lines) + "\n", "cp1252")
-    before = snapshot(inputs)
+    before = digest(inputs)
     rc = main(["fit", str(f), "--date-format", "%d/%m/%Y", "--density", "2650", "--bootstrap", "0",
                "--out", str(tmp_path / "o")])
     assert rc == 0, capsys.readouterr().err
@@ -238,7 +213,7 @@ def test_cli_fit_reads_a_european_export(inputs, tmp_path, capsys):
     assert "2019-01-01" in json.dumps(summary)      # 01/01/2019 .. ; day first as declared
     last = max(pd.Timestamp(int(x[6:10]), int(x[3:5]), int(x[0:2])) for x in lines)   # day first
     assert last.strftime("%Y-%m-%d") in json.dumps(summary)
-    assert snapshot(inputs) == before
+    assert digest(inputs) == before
 
 
 # ================================================================ 2. readers: refused, naming place and value
@@ -281,13 +256,13 @@ def test_bad_inventories_are_refused_naming_place_and_value(inputs, case, name, 
         pd.DataFrame({"volume_m3": [1.0]}).to_excel(f, index=False)
     else:
         write(f, text)
-    before = snapshot(inputs)
+    before = digest(inputs)
     kw = {"start": "2019-01-01", "end": "2019-12-31", "density_kg_m3": 2650}
     if "duration_years" in kwargs:
         kw = {"density_kg_m3": 2650}
     with pytest.raises(ValueError, match=match):
         read_inventory(f, **{**kw, **kwargs})
-    assert snapshot(inputs) == before
+    assert digest(inputs) == before
 
 
 def test_declared_units_accept_large_volumes_and_duplicates_can_be_dropped(inputs):
@@ -354,10 +329,10 @@ BAD_VELOCITIES = [
 @pytest.mark.parametrize("case,text,kwargs,match", BAD_VELOCITIES, ids=[c[0] for c in BAD_VELOCITIES])
 def test_bad_velocity_files_are_refused(inputs, case, text, kwargs, match):
     f = write(inputs / "v.csv", text)
-    before = snapshot(inputs)
+    before = digest(inputs)
     with pytest.raises(ValueError, match=match):
         read_velocities(f, **kwargs)
-    assert snapshot(inputs) == before
+    assert digest(inputs) == before
 
 
 # ================================================================ 3. impossible values refused before work
@@ -408,14 +383,14 @@ def test_energy_refuses_impossible_values_before_work(inputs, tmp_path, capsys, 
     if case.startswith("unknown collector"):
         i = args.index("--velocities")
         args[i:i + 2] = ["--scenario", str(SCENARIO)]
-    before = snapshot(inputs)
+    before = digest(inputs)
     rc = main(args)
     err = capsys.readouterr().err
     assert rc == 2, err
     assert err.startswith("riskrf energy: error:") and len(err.strip().splitlines()) == 1
     assert __import__("re").search(match, err), err
     assert not (tmp_path / "o").exists()
-    assert snapshot(inputs) == before
+    assert digest(inputs) == before
 
 
 RATES_REFUSALS = [
@@ -446,7 +421,7 @@ def test_rates_refuses_impossible_options_before_reading_files(inputs, tmp_path,
     monkeypatch.setattr(riskrf.cli, "_read", boom)
     inv = write(inputs / "falls.csv", "date,volume_m3\n2001-02-03,1.0\n")
     rain = write(inputs / "rain.csv", "date,rainfall_mm\n2001-02-03,1.0\n")
-    before = snapshot(inputs)
+    before = digest(inputs)
     rc = main(["rates", str(inv), "--rainfall", str(rain), "--out", str(tmp_path / "o"), *extra])
     err = capsys.readouterr().err
     assert rc == 2, err
@@ -454,7 +429,7 @@ def test_rates_refuses_impossible_options_before_reading_files(inputs, tmp_path,
     assert __import__("re").search(match, err), err
     assert "threshold_mm" not in err and "cost_per_hour" not in err
     assert not (tmp_path / "o").exists()
-    assert snapshot(inputs) == before
+    assert digest(inputs) == before
 
 
 def test_energy_with_fewer_than_one_fall_in_the_design_period_says_so(inputs, tmp_path, capsys):
@@ -506,13 +481,13 @@ SITE_REFUSALS = [
 def _assess_is_refused(site, inputs, tmp_path, capsys, match):
     """``riskrf assess site`` exits 2 with a one-line error naming site.toml and matching ``match``, before any
     work: no output folder, inputs untouched."""
-    before = snapshot(inputs)
+    before = digest(inputs)
     rc = main(["assess", str(site), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert rc == 2, err
     assert "site.toml" in err and __import__("re").search(match, err), err
     assert not (tmp_path / "o").exists()
-    assert snapshot(inputs) == before
+    assert digest(inputs) == before
 
 
 @pytest.mark.parametrize("case,fields,match", SITE_REFUSALS, ids=[c[0] for c in SITE_REFUSALS])
@@ -614,11 +589,11 @@ TREE_REFUSALS = [
 @pytest.mark.parametrize("case,text,match", TREE_REFUSALS, ids=[c[0] for c in TREE_REFUSALS])
 def test_decision_trees_with_impossible_numbers(inputs, tmp_path, capsys, case, text, match):
     f = write(inputs / "tree.json", text)
-    before = snapshot(inputs)
+    before = digest(inputs)
     rc = main(["decide", str(f), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert rc == 2 and __import__("re").search(match, err), err
-    assert not (tmp_path / "o").exists() and snapshot(inputs) == before
+    assert not (tmp_path / "o").exists() and digest(inputs) == before
 
 
 @pytest.mark.parametrize("value", ["0", "-5", "nan", "inf"])
@@ -808,11 +783,11 @@ def test_real_day_first_export_hong_kong_cedd():
 def test_site_with_a_bad_velocity_file_is_refused_before_the_fits(inputs, tmp_path, capsys, no_work):
     vel = write(inputs / "v.csv", "velocity_ms;height_m\n12,5;1\n14;-2\n")
     site = site_file(inputs, hazard={"scenario": None, "velocities": str(vel), "collector": None})
-    before = snapshot(inputs)
+    before = digest(inputs)
     rc = main(["assess", str(site), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert rc == 2 and "hazard.velocities" in err and "row 3, column 'height_m'" in err and "'-2'" in err, err
-    assert snapshot(inputs) == before and not (tmp_path / "o").exists()
+    assert digest(inputs) == before and not (tmp_path / "o").exists()
 
 
 HOSTILE = [
@@ -839,11 +814,11 @@ def test_hostile_files_give_one_line_errors(inputs, tmp_path, capsys, case, name
         f.mkdir()
     elif data is not False:
         f.write_bytes(data)
-    before = snapshot(inputs)
+    before = digest(inputs)
     rc = main(build(f, str(tmp_path / "o")))
     err = capsys.readouterr().err
     assert rc == 2 and len(err.strip().splitlines()) == 1 and needle in err and "Traceback" not in err, err
-    assert snapshot(inputs) == before and not (tmp_path / "o").exists()
+    assert digest(inputs) == before and not (tmp_path / "o").exists()
 
 
 def test_nan_probability_and_tonnes_given_as_kg(inputs):

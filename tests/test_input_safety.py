@@ -6,14 +6,12 @@ that the inputs are byte-identical afterwards.
 """
 from __future__ import annotations
 
-import hashlib
 import shutil
 import signal
 import subprocess
 import sys
 import textwrap
 import time
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -21,16 +19,7 @@ import pytest
 
 from riskrf.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
-DEMO = ROOT / "riskrf" / "data"
-SCENARIO = ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml"
-LAUTER = DEMO / "lauterbrunnen_tls_2018.csv"
-
-
-def digest(directory: Path) -> dict:
-    """Content digest of every file under ``directory``."""
-    return {p.relative_to(directory): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(directory.rglob("*")) if p.is_file()}
+from .conftest import DEMO, LAUTER, ROOT, SCENARIO, digest
 
 
 @pytest.fixture
@@ -61,22 +50,6 @@ def _without_closure(site: str) -> str:
     """The demo site without its rain-closure option (it needs the [rates] table removed here)."""
     blocks = site.split("[[options]]")
     return "[[options]]".join(b for b in blocks if 'kind = "closure"' not in b)
-
-
-@pytest.fixture
-def no_work(monkeypatch):
-    """Every expensive stage fails loudly: a refusal must come before any of them runs."""
-    import riskrf.app.assess
-    import riskrf.frequency.study
-    import simulation
-
-    def boom(*a, **k):
-        raise AssertionError("work started before the input was refused")
-    monkeypatch.setattr(riskrf.frequency.study, "analyse_inventory", boom)
-    monkeypatch.setattr(riskrf.app.assess, "energy_hazard_from_inputs", boom)
-    monkeypatch.setattr(riskrf.app.assess, "run_assessment", boom)
-    monkeypatch.setattr(simulation, "run", boom)
-    monkeypatch.setattr(simulation, "calibrate", boom)
 
 
 # ------------------------------------------------------------------ 1. outputs never touch inputs
