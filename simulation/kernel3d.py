@@ -936,9 +936,12 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
             t_abs += dt
             x, y, z = xn, yn, zn
             have_s, c_gx, c_gy = True, gxn, gyn
-            mat_n = mat_grid[min(max(int(round((yn - y0) / dy)), 0), ny - 1),
-                             min(max(int(round((xn - x0) / dx)), 0), nx - 1)]
-            if dn * u2 >= contact_speed(v_contact, g, 1.0 / nln, m_hop[mat_n]):
+            leaves = dn * u2 >= v_contact
+            if leaves:            # the hop height of the ground there can only raise the threshold
+                mat_n = mat_grid[min(max(int(round((yn - y0) / dy)), 0), ny - 1),
+                                 min(max(int(round((xn - x0) / dx)), 0), nx - 1)]
+                leaves = dn * u2 >= contact_speed(v_contact, g, 1.0 / nln, m_hop[mat_n])
+            if leaves:
                 # convex edge: the block leaves the ground with its velocity
                 contact = False
                 vx, vy, vz = u2 * dxv, u2 * dyv, u2 * dzv
