@@ -74,8 +74,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .contact import (EN_WYLLIE, contact_speed, contact_speed_at, contact_stop_distance, rebound, roll_on_speed,
-                      rolling_resistance, steep_face_launch, steep_trap)
+from .contact import (EN_WYLLIE, contact_speed, contact_speed_at, contact_stop_distance, contact_time, rebound,
+                      roll_on_speed, rolling_resistance, steep_face_launch, steep_trap)
 from .kernel import (BARRIER_CAUGHT, BARRIER_THROUGH, CROSSED, OUTCOMES, _GOLDEN, _normal, _uniform,  # noqa: F401
                      barrier_outcome)
 
@@ -146,6 +146,17 @@ def _stop_fraction(u, u2sq, a_s, c, ds):
     if c > 1e-12:
         return min(contact_stop_distance(u, a_s, c) / ds, 1.0) if ds > 1e-12 else 0.0
     return u * u / (u * u - u2sq) if u * u - u2sq > 0 else 0.0
+
+
+@njit(cache=True)
+def _contact_time(u, v, a_s, c, d, dt_euler):
+    """Time [s] a contact step takes to cover d [m] from speed u to v [m/s]: 2 d / (u + v), exact for the step's
+    constant acceleration, or :func:`simulation.contact.contact_time` with the drag c [1/m] (acceleration a_s);
+    the Euler step's ``dt_euler`` when the block does not move."""
+    if c > 1e-12:
+        t = contact_time(u, v, a_s, c, d)
+        return t if t >= 0.0 else dt_euler
+    return 2.0 * d / (u + v) if u + v > 1e-12 else dt_euler
 
 
 @njit(cache=True)
@@ -817,6 +828,12 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
             # at most about half a cell per step: u dt <= step and 1/2 |a| dt^2 <= step
             a_mag = math.sqrt(ax_ * ax_ + ay_ * ay_ + az_ * az_)
             dt = min(step_len / max(u, 1e-6), math.sqrt(2.0 * step_len / max(a_mag, 1e-3)))
+            if u > 1e-12:
+                # and not past the moment friction would bring the block to rest: a longer Euler step reverses
+                # the velocity and puts the end of the step behind the block (stops up to 10 % short)
+                a_par = (ax_ * vx + ay_ * vy + az_ * vz) / u
+                if a_par < 0.0:
+                    dt = min(dt, u / -a_par)
             vx1, vy1, vz1 = vx + ax_ * dt, vy + ay_ * dt, vz + az_ * dt
             xn = x + 0.5 * (vx + vx1) * dt
             yn = y + 0.5 * (vy + vy1) * dt
@@ -854,22 +871,25 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                         zq, _, _ = _surface(zg, x0, y0, dx, dy, xq, yq)
                         dsq = math.sqrt((xq - x) ** 2 + (yq - y) ** 2 + (zq - z) ** 2)
                         uq = math.sqrt(max(u * u + 2.0 * factor * (g * (z - zq) - mu * g * nz_avg * dsq), 0.0))
+                        dq, aq = dsq, 0.0
                         if c_drag > 1e-12 and dsq > 1e-12:
-                            uq = contact_speed_at(u, factor * (g * (z - zq) - mu * g * nz_avg * dsq) / dsq, c_drag,
-                                                  dsq)
+                            aq = factor * (g * (z - zq) - mu * g * nz_avg * dsq) / dsq
+                            uq = contact_speed_at(u, aq, c_drag, dsq)
                     else:
                         zq = z
                         uq = math.sqrt(max(u * u + fq * (u2sq - u * u), 0.0))
+                        dq, aq = fq * ds, a_s
                         if c_drag > 1e-12:
                             uq = contact_speed_at(u, a_s, c_drag, fq * ds)
+                    tq = _contact_time(u, uq, aq, c_drag, dq, fq * dt)
                     ul = max(math.sqrt(vx1 * vx1 + vy1 * vy1 + vz1 * vz1), 1e-300)
                     wq = uq / r if roll else 0.0
                     outcome, keep = _record_cross(
                         r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_out, r_count,
-                        bid, c_id[k], c_s0[k] + lam_hit[q] * seg_len, t_abs + fq * dt, xq, yq,
+                        bid, c_id[k], c_s0[k] + lam_hit[q] * seg_len, t_abs + tq, xq, yq,
                         vx1 / ul * uq, vy1 / ul * uq, vz1 / ul * uq, wq, 0.0, mass, inertia, r, c_cap[k], c_net[k])
                     if outcome == BARRIER_CAUGHT or outcome == BARRIER_THROUGH:
-                        t_abs += fq * dt
+                        t_abs += tq
                         x, y, z = xq, yq, zq
                         have_s = False
                         if outcome == BARRIER_CAUGHT:
@@ -916,7 +936,7 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                 zr, _, _ = _surface(zg, x0, y0, dx, dy, xr, yr)
                 if zr == zr and zr <= z + u * u / (2.0 * factor * g):
                     x, y, z = xr, yr, zr
-                t_abs += fz * dt
+                t_abs += _contact_time(u, 0.0, a_s, c_drag, fz * ds, fz * dt)
                 vx, vy, vz, w = 0.0, 0.0, 0.0, 0.0
                 if rec_pass:
                     _pass_add(acc, p_block, p_cell, p_e, p_h, p_count, bid,
@@ -933,7 +953,7 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                 ll = max(math.sqrt(dxv * dxv + dyv * dyv + dzv * dzv), 1e-300)
                 dxv, dyv, dzv = dxv / ll, dyv / ll, dzv / ll
             dn = dxv * nxn + dyv * nyn + dzv * nzn
-            t_abs += dt
+            t_abs += _contact_time(u, u2, a_s, c_drag, ds, dt)
             x, y, z = xn, yn, zn
             have_s, c_gx, c_gy = True, gxn, gyn
             leaves = dn * u2 >= v_contact

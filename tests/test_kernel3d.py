@@ -57,6 +57,24 @@ def test_deterministic_block_stops_where_the_2d_kernel_stops(motion, height):
     assert r3.per_block["y"][0] == pytest.approx(50.0, abs=1e-9)          # no lateral force on a plane
     assert r3.per_block["reason"][0] == kernel3d.STOPPED
     assert r3.per_block["impacts"][0] == r2.per_block["impacts"][0]
+    # travel time: each contact step takes 2 ds / (u + v), exact for its constant acceleration (it was the
+    # Euler step's dt, 0.4 % to 80 % off); the 2-D kernel's times are exact on straight segments
+    assert r3.per_block["t"][0] == pytest.approx(r2.per_block["t"][0], rel=0.01)
+
+
+@pytest.mark.parametrize("u0", [0.5, 3.0])
+def test_a_block_sliding_on_flat_ground_stops_where_and_when_friction_says(u0):
+    """Exact: sliding at u0 on flat ground with friction mu = tan 30 deg, the block stops after u0^2 / (2 mu g)
+    [m] and u0 / (mu g) [s] (0.5 m/s: 2.2 cm, 0.088 s -- the review's case of a stop within a fraction of a cell,
+    timed 0.98 s by the Euler steps before)."""
+    flat = Terrain.from_function(lambda x, y: 0 * x + 10.0, (0, 60), (0, 20), 1.0)
+    mats = {"m": {"normal_restitution": 0.3, "roughness_m": 0.0, "ground_motion": "slide",
+                  "ground_friction_angle_deg": 30.0}}
+    sc = _scenario(flat, mats, {"points": [[10.0, 10.0]], "height_m": 0.0, "mass_kg": 1000, "speed_ms": u0})
+    r = run_terrain(sc, 1, seed=1)
+    mu_g = np.tan(np.radians(30.0)) * 9.81
+    assert r.per_block["x"][0] - 10.0 == pytest.approx(u0 * u0 / (2 * mu_g), rel=1e-9)
+    assert r.per_block["t"][0] == pytest.approx(u0 / mu_g, rel=1e-6)
 
 
 def _quantile_se(a, b, q, rng, n_boot=300):

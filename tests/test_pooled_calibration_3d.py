@@ -40,15 +40,20 @@ def test_3d_calibration_recovers_a_known_rolling_resistance_on_a_plane_dem(dem):
     truth = _Pool([Release("truth", _data(dem, TRUE_PHI_DEG), [1.0])], {PHI: (5.0, 45.0)})
     observed = truth.simulate({}, 60, 999)[0]
     assert 50.0 < np.median(observed) < 80.0          # the blocks stop on the 10 deg plane (it starts at 40 m)
-    cal = calibrate_pooled([Release("synthetic", _data(dem), observed, source="synthetic plane")],
-                           {PHI: (10.0, 40.0), "materials.soil.tangential.mean": (0.3, 1.0)},
-                           n_per_release=400, n_initial=64, n_per_iteration=32, iterations=2, n_predictive=0,
-                           n_posterior=500, seed=2, obs_error_m=1.0)
-    lo, hi = cal.interval(PHI, 0.99)
-    # the known value lies in the 99 % interval (it does for 5 of the calibration seeds 1-6: the simulated
-    # likelihood's Monte Carlo noise is not in the posterior), and the interval is far narrower than the prior
-    assert lo <= TRUE_PHI_DEG <= hi
-    assert hi - lo < 3.0
+    inside, widths = 0, []
+    for seed in range(1, 9):                           # every calibration seed 1-8, none picked
+        cal = calibrate_pooled([Release("synthetic", _data(dem), observed, source="synthetic plane")],
+                               {PHI: (10.0, 40.0), "materials.soil.tangential.mean": (0.3, 1.0)},
+                               n_per_release=400, n_initial=64, n_per_iteration=32, iterations=2, n_predictive=0,
+                               n_posterior=500, seed=seed, obs_error_m=1.0)
+        lo, hi = cal.interval(PHI, 0.99)
+        inside += lo <= TRUE_PHI_DEG <= hi
+        widths.append(hi - lo)
+    # the known value lies in the 99 % interval for most seeds (7 of 8 when written: the simulated likelihood's
+    # Monte Carlo noise is not in the posterior, so the intervals are somewhat narrow -- documented in
+    # docs/validation/authume-3d.md), and every interval is far narrower than the 30 deg prior
+    assert inside >= 6, inside
+    assert max(widths) < 3.0, widths
 
 
 def test_a_3d_release_whose_source_is_outside_the_dem_is_refused_naming_release_and_field(dem):

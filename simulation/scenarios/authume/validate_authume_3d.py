@@ -139,15 +139,15 @@ circles: observed stops; star: release point.*
   some reach the DEM's edge).  The 2-D section forced blocks to stay on its line, and the fit compensated.
 * **P2 calibrated in 3-D (in-sample):** the 3-D fit raises the hard ground's rolling resistance to about
   12 deg (90 % interval 11-13 deg, against 8 deg in 2-D); blocks stay in the corridor (offset p90 14 m
-  instead of 79 m) and every distance falls: W1 of the runout 5.6 m (22 m with the 2-D parameters), energy
-  distance 1.9 m (17 m), and a real stop lies beyond the farthest of 100 simulated blocks 3.5 % of the time.
-  The runout distribution is still distinguishable from the observed one (KS p 2.5e-7: the simulated
+  instead of 79 m) and every distance falls: W1 of the runout 5.5 m (22 m with the 2-D parameters), energy
+  distance 1.8 m (17 m), and a real stop lies beyond the farthest of 100 simulated blocks 3.7 % of the time.
+  The runout distribution is still distinguishable from the observed one (KS p 4e-7: the simulated
   runouts lie short, median 53 m against 56 m observed), and 83 % of the observed runouts lie inside the 90 %
   posterior-predictive interval: the model with three fitted parameters does not fully describe this
   release.
-* **P1 calibrated in 3-D (in-sample):** the runout matches (KS p 0.47, W1 2.7 m), as with the 2-D parameters;
-  the lateral spread is again narrower than observed (offset KS p 0.02), which a runout likelihood cannot
-  fix.  P1 constrains the parameters weakly (posterior sd 0.5-0.8 of the prior's): its runouts are set by
+* **P1 calibrated in 3-D (in-sample):** the runout matches (KS p 0.51, W1 2.2 m), as with the 2-D parameters;
+  the lateral spread is again narrower than observed (offset KS p 0.01), which a runout likelihood cannot
+  fix.  P1 constrains the parameters weakly (posterior sd 0.4-0.6 of the prior's): its runouts are set by
   the bench geometry more than by the materials, so the P1 values (hard ground 29 deg, 2-D fit 42 deg) are
   one of many that fit.
 * **Transfer of the 3-D calibrations:** P1's parameters on P2 are far too short (W1 14 m, half of the real
@@ -160,7 +160,7 @@ circles: observed stops; star: release point.*
 * Parameters calibrated on one release do not transfer to the other, in 3-D as in 2-D.
 * The posterior intervals of the 3-D calibration come from a simulated likelihood with common random
   numbers; on a synthetic plane DEM (tests/test_pooled_calibration_3d.py) the known rolling resistance lay
-  inside the 99 % interval for 5 of 6 calibration seeds with 400 blocks per parameter set: read the
+  inside the 99 % interval for 7 of 8 calibration seeds (1-8) with 400 blocks per parameter set: read the
   intervals as somewhat too narrow.
 """
 
