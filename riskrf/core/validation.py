@@ -1,6 +1,7 @@
 """Argument checks shared by every module: each error names the argument and the value."""
 from __future__ import annotations
 
+import math
 import warnings
 
 import numpy as np
@@ -25,6 +26,22 @@ def warn(message: str) -> None:
         The warning's text (naming the file, field or argument it is about).
     """
     warnings.warn(message, RiskrfWarning, stacklevel=3)
+
+
+def is_finite_number(value) -> bool:
+    """True when ``value`` is a finite int or float as read from a file (a bool is not a number).
+
+    Parameters
+    ----------
+    value : object
+        The value as given (e.g. a TOML field), in any unit.
+
+    Returns
+    -------
+    bool
+        Whether ``value`` is an ``int`` or ``float``, not a ``bool``, and finite.
+    """
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def as_positive_array(values, name: str, *, allow_empty: bool = False) -> np.ndarray:

@@ -31,12 +31,13 @@ applied as given.
 """
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import pandas as pd
+
+from ..core.validation import is_finite_number
 
 #: Fields of ``[rates]`` and their defaults (those of ``riskrf rates``).
 RATES_FIELDS = {"record": None, "start": None, "end": None, "rainfall": None, "warnings": None, "period": "day",
@@ -74,16 +75,43 @@ def check_rates(given, inventory: dict, path, error=ValueError) -> dict | None:
     Exception
         ``error``, naming the file, field and value.
     """
-    from .closure import read_rainstorm_warnings
-    from ..io.rainfall import read_rainfall
-    from ..frequency.rates import _PERIODS, _SEASONS, _TRANSFORMS
-
     path = Path(path)
-    base = path.parent
+    src = _check_inventory_rate_fields(inventory, path, error)
+    if given is None:
+        if src == "rate_model":
+            raise error(f"{path}: inventory.rate_from = \"rate_model\" needs a [rates] table (record, rainfall) to "
+                        "fit the rate model")
+        return None
+    r = _merge_rates_table(given, inventory, path, error)
+    _check_rates_files(r, path, error)
+    _check_rates_model_fields(r, inventory.get("heavy_day_mm"), path, error)
+    _read_rates_inputs(r, inventory, path, error)
+    return r
 
-    def number(v):
-        return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
+def _check_inventory_rate_fields(inventory: dict, path: Path, error) -> str:
+    """Check the rate fields of ``[inventory]``: ``rate_from`` and the stated change of climate.
+
+    Parameters
+    ----------
+    inventory : dict
+        The site file's ``[inventory]`` table (``rate_from``, ``rain_factor`` [-], ``heavy_day_mm`` [mm/day],
+        ``heavy_day_change`` [-]).
+    path : pathlib.Path
+        The site file, named in errors.
+    error : type
+        Exception class raised on bad input.
+
+    Returns
+    -------
+    str
+        The rate source, one of :data:`RATE_SOURCES`.
+
+    Raises
+    ------
+    Exception
+        ``error``, naming the file, field and value.
+    """
     src = inventory.get("rate_from", "inventory")
     if src not in RATE_SOURCES:
         raise error(f"{path}: inventory.rate_from = {src!r} must be one of {list(RATE_SOURCES)} (the inventory's "
@@ -93,22 +121,45 @@ def check_rates(given, inventory: dict, path, error=ValueError) -> dict | None:
         raise error(f"{path}: inventory.{climate[0]} = {inventory[climate[0]]!r} states a change of climate for the "
                     "rate model's rate; it needs inventory.rate_from = \"rate_model\"")
     rf = inventory.get("rain_factor")
-    if rf is not None and (not number(rf) or rf <= 0):
+    if rf is not None and (not is_finite_number(rf) or rf <= 0):
         raise error(f"{path}: inventory.rain_factor = {rf!r} must be a number > 0 (1.1: every rainfall 10 % heavier)")
     hm, hc = inventory.get("heavy_day_mm"), inventory.get("heavy_day_change")
     if (hm is None) != (hc is None):
         raise error(f"{path}: inventory.heavy_day_mm = {hm!r} and inventory.heavy_day_change = {hc!r}: give both "
                     "(the daily rainfall of a heavy-rain day and the change of their frequency, 0.1 = +10 %)")
-    if hm is not None and (not number(hm) or hm <= 0):
+    if hm is not None and (not is_finite_number(hm) or hm <= 0):
         raise error(f"{path}: inventory.heavy_day_mm = {hm!r} must be a daily rainfall > 0 mm")
-    if hc is not None and (not number(hc) or hc <= -1):
+    if hc is not None and (not is_finite_number(hc) or hc <= -1):
         raise error(f"{path}: inventory.heavy_day_change = {hc!r} must be a number > -1 (0.1 = heavy days 10 % "
                     "more frequent)")
-    if given is None:
-        if src == "rate_model":
-            raise error(f"{path}: inventory.rate_from = \"rate_model\" needs a [rates] table (record, rainfall) to "
-                        "fit the rate model")
-        return None
+    return src
+
+
+def _merge_rates_table(given, inventory: dict, path: Path, error) -> dict:
+    """The ``[rates]`` table with its defaults filled in; the record defaults to the site inventory.
+
+    Parameters
+    ----------
+    given : object
+        The site file's ``[rates]`` table as read (checked to be a table).
+    inventory : dict
+        The site file's ``[inventory]`` table (``path``, ``start``, ``end`` stand in for a missing record).
+    path : pathlib.Path
+        The site file, named in errors.
+    error : type
+        Exception class raised on bad input.
+
+    Returns
+    -------
+    dict
+        Every field of :data:`RATES_FIELDS`, plus ``"defaults_used"`` (the defaults applied, as text) and
+        ``"record_is_inventory"``.
+
+    Raises
+    ------
+    Exception
+        ``error`` for a table that is not one, an unknown field (with a did-you-mean), no rainfall or no record.
+    """
     if not isinstance(given, dict):
         raise error(f"{path}: [rates] must be a table")
     import difflib
@@ -132,6 +183,27 @@ def check_rates(given, inventory: dict, path, error=ValueError) -> dict | None:
         r["defaults_used"].append(f"rates.record = {r['record']!r} (inventory.path)")
     else:
         r["record_is_inventory"] = False
+    return r
+
+
+def _check_rates_files(r: dict, path: Path, error) -> None:
+    """The files of a merged ``[rates]`` table (record, rainfall, warnings) exist; its start and end are dates.
+
+    Parameters
+    ----------
+    r : dict
+        The merged ``[rates]`` table (:func:`_merge_rates_table`).
+    path : pathlib.Path
+        The site file; the table's paths are relative to its directory.
+    error : type
+        Exception class raised on bad input.
+
+    Raises
+    ------
+    Exception
+        ``error``, naming the file, field and value (and the resolved path of a missing file).
+    """
+    base = path.parent
     for key in ("record", "rainfall", "warnings"):
         v = r[key]
         if v is None:
@@ -146,6 +218,31 @@ def check_rates(given, inventory: dict, path, error=ValueError) -> dict | None:
                 pd.Timestamp(str(r[key]))
             except ValueError:
                 raise error(f"{path}: rates.{key} = {r[key]!r} is not a date YYYY-MM-DD") from None
+
+
+def _check_rates_model_fields(r: dict, heavy_day_mm, path: Path, error) -> None:
+    """The model options of a merged ``[rates]`` table: period, windows, rainfall transform, season, trend.
+
+    ``r["season"]`` is normalised in place (``"none"`` becomes None).
+
+    Parameters
+    ----------
+    r : dict
+        The merged ``[rates]`` table (:func:`_merge_rates_table`).
+    heavy_day_mm : float or None
+        ``inventory.heavy_day_mm`` [mm/day]; when given the model must be daily with the day itself as first window.
+    path : pathlib.Path
+        The site file, named in errors.
+    error : type
+        Exception class raised on bad input.
+
+    Raises
+    ------
+    Exception
+        ``error``, naming the file, field and value.
+    """
+    from ..frequency.rates import _PERIODS, _SEASONS, _TRANSFORMS
+
     if r["period"] not in _PERIODS:
         raise error(f"{path}: rates.period = {r['period']!r} must be one of {list(_PERIODS)}")
     w = r["windows_days"]
@@ -161,10 +258,41 @@ def check_rates(given, inventory: dict, path, error=ValueError) -> dict | None:
     r["season"] = season
     if not isinstance(r["trend"], bool):
         raise error(f"{path}: rates.trend = {r['trend']!r} must be true or false")
-    if hm is not None and (r["period"] != "day" or r["windows_days"][0] != 1):
+    if heavy_day_mm is not None and (r["period"] != "day" or r["windows_days"][0] != 1):
         raise error(f"{path}: inventory.heavy_day_mm needs a daily rate model whose first window is the day itself "
                     f"(rates.period = 'day', windows_days starting with 1); got period {r['period']!r}, windows "
                     f"{r['windows_days']!r}")
+
+
+def _read_rates_inputs(r: dict, inventory: dict, path: Path, error) -> None:
+    """Read the rainfall, the record and the warning list of a checked ``[rates]`` table into it (in place).
+
+    The rainfall goes to ``r["_rainfall"]``, the record to ``r["_record"]`` (its period must be known and covered
+    by the rainfall, with the longest antecedent window of a daily model), the warning list to ``r["_warnings"]``
+    (None when not given).  The readers' warnings are silenced here: they come again when the model is fitted.
+
+    Parameters
+    ----------
+    r : dict
+        The checked ``[rates]`` table (files, dates and model options checked).
+    inventory : dict
+        The site file's ``[inventory]`` table (its reader options apply when the record is the inventory).
+    path : pathlib.Path
+        The site file; the table's paths are relative to its directory.
+    error : type
+        Exception class raised on bad input.
+
+    Raises
+    ------
+    Exception
+        ``error``, naming the file, field, value and the reader's message.
+    """
+    from .closure import read_rainstorm_warnings
+    from ..io.rainfall import read_rainfall
+    from ..frequency.inventory import READER_OPTIONS, read_inventory
+
+    base = path.parent
+    w = r["windows_days"]
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")       # gaps are reported again when the model is fitted
@@ -172,7 +300,6 @@ def check_rates(given, inventory: dict, path, error=ValueError) -> dict | None:
     except ValueError as exc:
         raise error(f"{path}: rates.rainfall = {r['rainfall']!r}: {exc}") from exc
     # the record and its period against the rainfall (gaps, coverage with the antecedent window), read now
-    from ..frequency.inventory import READER_OPTIONS, read_inventory
     reader = {k: inventory[k] for k in READER_OPTIONS if inventory.get(k) is not None} \
         if r["record_is_inventory"] else {}
     try:
@@ -199,7 +326,6 @@ def check_rates(given, inventory: dict, path, error=ValueError) -> dict | None:
             r["_warnings"] = read_rainstorm_warnings(base / r["warnings"])
         except ValueError as exc:
             raise error(f"{path}: rates.warnings = {r['warnings']!r}: {exc}") from exc
-    return r
 
 
 def check_closure_options(options, rates: dict | None, path, error=ValueError) -> None:
