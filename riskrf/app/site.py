@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import datetime
 import difflib
-import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..core import file_schemas as _fs
 from ..core.schema import check as _check_schema
-from ..core.validation import RiskrfError
+from ..core.validation import RiskrfError, is_finite_number
 from ..risk.mitigation import MitigationError, study_inputs
 from ..risk.site_rates import check_closure_options, check_rates
 
@@ -97,15 +96,88 @@ def load_site(path) -> Site:
         The checked site.
     """
     path = Path(path)
+    data = _read_site_toml(path)
+    tables, used = _merge_site_tables(data, path)
+    if tables["inventory"]["path"] is None:
+        raise SiteError(f"{path}: inventory.path is required (the rock fall inventory file)")
+    hz, inv = tables["hazard"], tables["inventory"]
+    _check_hazard(hz, path)
+    _check_inventory(inv, path)
+    _check_design_block(tables, path)
+    _check_design(tables, path)
+    _check_site_files(tables, path)
+    rates = check_rates(data.get("rates"), inv, path, error=SiteError)
+    if rates is not None:
+        used += rates.pop("defaults_used")
+    three_d, scenario = _check_scenario(data, hz, path, used)
+    _check_velocity_file(hz, path)
+    mitigation = _check_mitigation(data, path, rates, hz, scenario, three_d, used)
+    # every declared field against its type and range (shares and probabilities in [0, 1], rates, speeds,
+    # lengths and traffic > 0): the checks above keep their own messages, this catches the rest
+    _check_schema(data, _fs.SITE_SCHEMA, path, error=SiteError)
+    from .model_uncertainty import check_model_uncertainty
+    model_uncertainty, mu_used = check_model_uncertainty(data.get("model_uncertainty"), path, hz, error=SiteError)
+    used += mu_used
+    return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
+                description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
+                mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"], rates=rates,
+                design=tables["design"], report=tables["report"], three_d=three_d,
+                model_uncertainty=model_uncertainty)
+
+
+def _read_site_toml(path: Path) -> dict:
+    """The site file's content, read as TOML.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        Site TOML file.
+
+    Returns
+    -------
+    dict
+        The parsed file.
+
+    Raises
+    ------
+    FileNotFoundError
+        When there is no such file.
+    SiteError
+        When ``path`` is a directory or not valid TOML (a binary file included).
+    """
     if not path.exists():
         raise FileNotFoundError(f"site file not found: {path}")
     if path.is_dir():
         raise SiteError(f"{path} is a directory; give the site file (.toml) inside it")
     try:
         with open(path, "rb") as fh:
-            data = tomllib.load(fh)
+            return tomllib.load(fh)
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:   # a binary file: named, not a bare codec error
         raise SiteError(f"{path}: not valid TOML: {exc}") from exc
+
+
+def _merge_site_tables(data: dict, path: Path) -> tuple[dict, list]:
+    """The site file's own tables (:data:`SITE_FIELDS`) with their defaults filled in; unknown names refused.
+
+    Parameters
+    ----------
+    data : dict
+        The parsed site file.
+    path : pathlib.Path
+        The site file, named in errors.
+
+    Returns
+    -------
+    tables : dict
+        Table name -> {field: value}, every field of :data:`SITE_FIELDS` present.
+    used : list of str
+        The defaults applied, as ``"table.field = value"``.
+
+    Raises
+    ------
+    SiteError
+        For an unknown table or field (with a did-you-mean) or a table that is not one.
+    """
     allowed = set(SITE_FIELDS) | set(MITIGATION_TABLES) | set(OTHER_TABLES)
     for key in data:
         if key not in allowed:
@@ -128,9 +200,25 @@ def load_site(path) -> Site:
                 if default is not None:
                     used.append(f"{table}.{key} = {default!r}")
         tables[table] = merged
-    if tables["inventory"]["path"] is None:
-        raise SiteError(f"{path}: inventory.path is required (the rock fall inventory file)")
-    hz = tables["hazard"]
+    return tables, used
+
+
+def _check_hazard(hz: dict, path: Path) -> None:
+    """The [hazard] table's own fields: one source of speeds, block counts, fences, design period, reach, units.
+
+    Parameters
+    ----------
+    hz : dict
+        The merged [hazard] table (``fences_kj`` [kJ], ``fence_height_m``, ``free_board_m``, ``drop_height_m`` [m],
+        ``design_period_years`` [yr], ``reach_probability`` [-]).
+    path : pathlib.Path
+        The site file, named in errors.
+
+    Raises
+    ------
+    SiteError
+        Naming the file, field and value.
+    """
     if (hz["scenario"] is None) == (hz["velocities"] is None):
         raise SiteError(f"{path}: give exactly one of hazard.scenario (a slope scenario to simulate) or "
                         "hazard.velocities (a velocity file)")
@@ -148,24 +236,39 @@ def load_site(path) -> Site:
                             f"hazard.fences_kj ({len(hz['fences_kj'])})")
     elif isinstance(fh, bool) or not isinstance(fh, (int, float)) or fh <= 0:
         raise SiteError(f"{path}: hazard.fence_height_m = {fh!r} must be a number > 0 (or a list, one per fence)")
-    def number(v):
-        return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-    if not number(hz["free_board_m"]) or hz["free_board_m"] < 0:
+    if not is_finite_number(hz["free_board_m"]) or hz["free_board_m"] < 0:
         raise SiteError(f"{path}: hazard.free_board_m = {hz['free_board_m']!r} must be a number >= 0 m")
-    if not number(hz["design_period_years"]) or hz["design_period_years"] <= 1:
+    if not is_finite_number(hz["design_period_years"]) or hz["design_period_years"] <= 1:
         raise SiteError(f"{path}: hazard.design_period_years = {hz['design_period_years']!r} must be a number > 1 "
                         "year (a T-year event has annual probability 1/T)")
-    if not number(hz["reach_probability"]) or not 0 < hz["reach_probability"] <= 1:
+    if not is_finite_number(hz["reach_probability"]) or not 0 < hz["reach_probability"] <= 1:
         raise SiteError(f"{path}: hazard.reach_probability = {hz['reach_probability']!r} must be a probability in "
                         "(0, 1]")
     if hz["velocity_unit"] not in (None, "m/s", "km/h"):
         raise SiteError(f"{path}: hazard.velocity_unit = {hz['velocity_unit']!r} is not 'm/s' or 'km/h'")
-    if hz["drop_height_m"] is not None and (not number(hz["drop_height_m"]) or hz["drop_height_m"] <= 0):
+    if hz["drop_height_m"] is not None and (not is_finite_number(hz["drop_height_m"]) or hz["drop_height_m"] <= 0):
         raise SiteError(f"{path}: hazard.drop_height_m = {hz['drop_height_m']!r} must be a height > 0 m (release "
                         "to the barrier line, for the velocity plausibility check)")
-    inv = tables["inventory"]
+
+
+def _check_inventory(inv: dict, path: Path) -> None:
+    """The [inventory] table's numbers (masses, density, duration, rate scale) and its rate basis.
+
+    Parameters
+    ----------
+    inv : dict
+        The merged [inventory] table (``m_min_kg``, ``m_max_kg`` [kg], ``density_kg_m3`` [kg/m3],
+        ``duration_years`` [yr], ``rate_scale`` [-], ``rate_basis``).
+    path : pathlib.Path
+        The site file, named in errors.
+
+    Raises
+    ------
+    SiteError
+        Naming the file, field and value.
+    """
     for key in ("m_min_kg", "m_max_kg", "density_kg_m3", "duration_years"):
-        if inv[key] is not None and (not number(inv[key]) or inv[key] <= 0):
+        if inv[key] is not None and (not is_finite_number(inv[key]) or inv[key] <= 0):
             raise SiteError(f"{path}: inventory.{key} = {inv[key]!r} must be a number > 0")
     if inv["m_min_kg"] is not None and inv["m_max_kg"] is not None and inv["m_min_kg"] >= inv["m_max_kg"]:
         raise SiteError(f"{path}: inventory.m_min_kg = {inv['m_min_kg']!r} must be below inventory.m_max_kg = "
@@ -176,43 +279,136 @@ def load_site(path) -> Site:
         raise SiteError(f"{path}: inventory.rate_basis = {inv['rate_basis']!r} must be 'release' (the inventory "
                         "counts falls released from the slope) or 'road' (it counts falls that reached the road, "
                         "e.g. a patrol record)")
-    _check_design_block(tables, path)
-    _check_design(tables, path)
+
+
+def _check_site_files(tables: dict, path: Path) -> None:
+    """The files the site's own tables name (inventory, annual maxima, scenario, velocities, survey) exist.
+
+    Parameters
+    ----------
+    tables : dict
+        The merged site tables.
+    path : pathlib.Path
+        The site file; paths in it are relative to its folder.
+
+    Raises
+    ------
+    SiteError
+        Naming the field, the value and the resolved path of the missing file.
+    """
     for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
                        ("hazard", "velocities"), ("design_block", "survey")):
         rel = tables[table][key]
         if rel is not None and not (path.parent / rel).exists():
             raise SiteError(f"{path}: {table}.{key} = {rel!r}: file not found ({(path.parent / rel).resolve()})")
-    rates = check_rates(data.get("rates"), inv, path, error=SiteError)
-    if rates is not None:
-        used += rates.pop("defaults_used")
-    three_d = False
-    if hz["scenario"] is not None:
-        import simulation
-        if hz["collector"] is None:
-            hz["collector"] = "barrier"
-            used.append("hazard.collector = 'barrier'")
-        three_d = simulation.is_terrain_scenario_file(path.parent / hz["scenario"])
-        if three_d:
-            scenario = simulation.load_terrain_scenario(path.parent / hz["scenario"])
-            _check_terrain_site(data, hz, path)
-        else:
-            scenario = simulation.load_scenario(path.parent / hz["scenario"])
-            _fs.check_scenario_file(path.parent / hz["scenario"], error=SiteError)
-        names = [c.name for c in scenario.collectors]
-        if hz["collector"] not in names:
-            raise SiteError(f"{path}: hazard.collector = {hz['collector']!r}: scenario {hz['scenario']!r} has no "
-                            f"collector named {hz['collector']!r}; its collectors are {names}")
-        if hz["road_collector"] not in names and "road_collector" in data.get("hazard", {}):
-            raise SiteError(f"{path}: hazard.road_collector = {hz['road_collector']!r}: scenario {hz['scenario']!r} "
-                            f"has no such collector; its collectors are {names}")
-    if hz["velocities"] is not None:         # read now: a bad velocity file is found before the fits run
-        from ..io.velocities import read_velocities
-        try:
-            read_velocities(path.parent / hz["velocities"], collector=hz["collector"],
-                            velocity_unit=hz["velocity_unit"])
-        except ValueError as exc:
-            raise SiteError(f"{path}: hazard.velocities = {hz['velocities']!r}: {exc}") from exc
+
+
+def _check_scenario(data: dict, hz: dict, path: Path, used: list) -> tuple:
+    """Load hazard.scenario (2-D profile or 3-D terrain) and check the collectors the site names in it.
+
+    A missing ``hazard.collector`` defaults to ``"barrier"`` (set in ``hz`` and recorded in ``used``).
+
+    Parameters
+    ----------
+    data : dict
+        The parsed site file (a 3-D terrain site refuses the tables it does not use yet).
+    hz : dict
+        The checked [hazard] table.
+    path : pathlib.Path
+        The site file; the scenario is relative to its folder.
+    used : list of str
+        The defaults applied so far (appended to in place).
+
+    Returns
+    -------
+    three_d : bool
+        True for a 3-D terrain scenario (False also when there is no scenario).
+    scenario : object or None
+        The loaded scenario, None when the hazard comes from a velocity file.
+
+    Raises
+    ------
+    SiteError
+        For a collector the scenario does not have, a bad scenario file, or a table a 3-D site cannot use.
+    """
+    if hz["scenario"] is None:
+        return False, None
+    import simulation
+    if hz["collector"] is None:
+        hz["collector"] = "barrier"
+        used.append("hazard.collector = 'barrier'")
+    three_d = simulation.is_terrain_scenario_file(path.parent / hz["scenario"])
+    if three_d:
+        scenario = simulation.load_terrain_scenario(path.parent / hz["scenario"])
+        _check_terrain_site(data, hz, path)
+    else:
+        scenario = simulation.load_scenario(path.parent / hz["scenario"])
+        _fs.check_scenario_file(path.parent / hz["scenario"], error=SiteError)
+    names = [c.name for c in scenario.collectors]
+    if hz["collector"] not in names:
+        raise SiteError(f"{path}: hazard.collector = {hz['collector']!r}: scenario {hz['scenario']!r} has no "
+                        f"collector named {hz['collector']!r}; its collectors are {names}")
+    if hz["road_collector"] not in names and "road_collector" in data.get("hazard", {}):
+        raise SiteError(f"{path}: hazard.road_collector = {hz['road_collector']!r}: scenario {hz['scenario']!r} "
+                        f"has no such collector; its collectors are {names}")
+    return three_d, scenario
+
+
+def _check_velocity_file(hz: dict, path: Path) -> None:
+    """Read hazard.velocities now, so that a bad velocity file is found before the fits run.
+
+    Parameters
+    ----------
+    hz : dict
+        The checked [hazard] table (``velocities``, ``collector``, ``velocity_unit``).
+    path : pathlib.Path
+        The site file; the velocity file is relative to its folder.
+
+    Raises
+    ------
+    SiteError
+        Naming the field, the value and the reader's message.
+    """
+    if hz["velocities"] is None:
+        return
+    from ..io.velocities import read_velocities
+    try:
+        read_velocities(path.parent / hz["velocities"], collector=hz["collector"],
+                        velocity_unit=hz["velocity_unit"])
+    except ValueError as exc:
+        raise SiteError(f"{path}: hazard.velocities = {hz['velocities']!r}: {exc}") from exc
+
+
+def _check_mitigation(data: dict, path: Path, rates, hz: dict, scenario, three_d: bool, used: list) -> dict:
+    """The mitigation tables (:data:`MITIGATION_TABLES`), their closure rules and option geometry.
+
+    Parameters
+    ----------
+    data : dict
+        The parsed site file.
+    path : pathlib.Path
+        The site file, named in errors.
+    rates : dict or None
+        The checked [rates] table (closure rules need it).
+    hz : dict
+        The checked [hazard] table.
+    scenario : object or None
+        The loaded scenario (:func:`_check_scenario`).
+    three_d : bool
+        True for a 3-D terrain site (options are then neither required nor checked).
+    used : list of str
+        The defaults applied so far (the mitigation defaults are appended in place).
+
+    Returns
+    -------
+    dict
+        The checked study inputs (:func:`riskrf.risk.mitigation.study_inputs`), without ``defaults_used``.
+
+    Raises
+    ------
+    SiteError
+        With the message of the failed check.
+    """
     mit = {k: data[k] for k in MITIGATION_TABLES if k in data}
     try:
         mitigation = study_inputs(mit, str(path), require_options=not three_d)
@@ -223,17 +419,7 @@ def load_site(path) -> Site:
         check_closure_options(mitigation["options"], rates, path, error=SiteError)
     if hz["scenario"] is not None and not three_d:
         _check_option_geometry(mitigation["options"], scenario, hz, path, mitigation["uncertainty"])
-    # every declared field against its type and range (shares and probabilities in [0, 1], rates, speeds,
-    # lengths and traffic > 0): the checks above keep their own messages, this catches the rest
-    _check_schema(data, _fs.SITE_SCHEMA, path, error=SiteError)
-    from .model_uncertainty import check_model_uncertainty
-    model_uncertainty, mu_used = check_model_uncertainty(data.get("model_uncertainty"), path, hz, error=SiteError)
-    used += mu_used
-    return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
-                description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
-                mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"], rates=rates,
-                design=tables["design"], report=tables["report"], three_d=three_d,
-                model_uncertainty=model_uncertainty)
+    return mitigation
 
 
 def _check_terrain_site(data, hz, path):
@@ -258,8 +444,7 @@ def _check_design(tables, path):
     d = tables["design"]
     for key in ("positions_x_m", "mel_classes_kj"):
         v = d[key]
-        if v is not None and (not isinstance(v, list) or not v or not all(
-                isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)):
+        if v is not None and (not isinstance(v, list) or not v or not all(is_finite_number(x) for x in v)):
             raise SiteError(f"{path}: design.{key} = {v!r} must be a list of numbers")
     pb = d["position_blocks"]
     if pb is not None and (isinstance(pb, bool) or not isinstance(pb, int) or pb < 100):
