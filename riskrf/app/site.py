@@ -212,12 +212,12 @@ def _check_hazard(hz: dict, path: Path) -> None:
         The merged [hazard] table (``fences_kj`` [kJ], ``fence_height_m``, ``free_board_m``, ``drop_height_m`` [m],
         ``design_period_years`` [yr], ``reach_probability`` [-]).
     path : pathlib.Path
-        The site file, named in errors.
+        The site file, named in every message.
 
     Raises
     ------
     SiteError
-        Naming the file, field and value.
+        Naming the file, the hazard field and its value.
     """
     if (hz["scenario"] is None) == (hz["velocities"] is None):
         raise SiteError(f"{path}: give exactly one of hazard.scenario (a slope scenario to simulate) or "
@@ -385,7 +385,7 @@ def _check_mitigation(data: dict, path: Path, rates, hz: dict, scenario, three_d
     Parameters
     ----------
     data : dict
-        The parsed site file.
+        The parsed site file (its mitigation tables are taken from it).
     path : pathlib.Path
         The site file, named in errors.
     rates : dict or None

@@ -100,7 +100,7 @@ def _check_inventory_rate_fields(inventory: dict, path: Path, error) -> str:
     path : pathlib.Path
         The site file, named in errors.
     error : type
-        Exception class raised on bad input.
+        Exception class raised for a bad rate source or change of climate.
 
     Returns
     -------
@@ -278,9 +278,9 @@ def _read_rates_inputs(r: dict, inventory: dict, path: Path, error) -> None:
     inventory : dict
         The site file's ``[inventory]`` table (its reader options apply when the record is the inventory).
     path : pathlib.Path
-        The site file; the table's paths are relative to its directory.
+        The site file; the rainfall, record and warning files are relative to its directory.
     error : type
-        Exception class raised on bad input.
+        Exception class raised when a file cannot be read or the rainfall does not cover the record.
 
     Raises
     ------
