@@ -331,7 +331,9 @@ def resolve_material(spec: dict, where: str = "materials.?", source: str = "<dic
     """The material table ``spec`` with its ``preset`` (if any) expanded and its own fields applied on top.
 
     ``where`` names the table (e.g. ``"materials.apron"``) and ``source`` the file, for error messages.
-    A table without ``preset`` is returned unchanged (a copy).
+    A table without ``preset`` is returned unchanged (a copy).  ``preset_basis = "data"`` beside ``preset``
+    starts from the data-derived table (:func:`preset` with ``basis="data"``: the fitted contact laws and the
+    posterior medians) instead of the published values.
 
     Parameters
     ----------
@@ -357,9 +359,13 @@ def resolve_material(spec: dict, where: str = "materials.?", source: str = "<dic
     key = ALIASES.get(name, name)
     if key not in PRESETS:
         raise PresetError(_unknown(name, f"{where}.preset", source))
-    out = copy.deepcopy(PRESETS[key])
+    basis = spec.get("preset_basis", "published")
+    if basis not in ("published", "data"):
+        raise PresetError(f"{source}: {where}.preset_basis = {basis!r} must be 'published' (the preset's published "
+                          "values, the default) or 'data' (the data-derived table of preset(name, basis='data'))")
+    out = preset(key, basis=basis)
     for field, value in spec.items():
-        if field == "preset":
+        if field in ("preset", "preset_basis"):
             continue
         out[field] = _merge_table(out[field], value) if field in out else copy.deepcopy(value)
     return out

@@ -192,7 +192,8 @@ class Material:
     ``contact_velocity_ms`` alone decides, as before); ``rolling_drag`` kappa [-]: in ground contact the block
     also decelerates by (kappa / r) v^2 (rolling over asperities, ploughing; 0: none);
     ``rolling_size_coefficient`` K [-]: the rolling resistance is tan(phi_g) + K roughness / r, so small blocks
-    stop sooner (0: tan(phi_g) alone).
+    stop sooner (0: tan(phi_g) alone).  In a file, ``preset = NAME`` starts from a named material and
+    ``preset_basis = "data"`` beside it from its data-derived table (:func:`simulation.materials.preset`).
     See :mod:`simulation.contact`.
     """
 
@@ -235,9 +236,11 @@ class Material:
         where = f"materials.{name}."
         if not isinstance(spec, dict):
             raise ScenarioError(f"{source}: materials.{name} must be a table of material fields; got {spec!r}")
-        _check_keys(spec, {"preset", "normal_restitution", "tangential", "roughness_m", "ground_motion",
+        _check_keys(spec, {"preset", "preset_basis", "normal_restitution", "tangential", "roughness_m", "ground_motion",
                            "ground_friction_angle_deg", "rolling_resistance", "allow_energy_gain",
                            "contact_hop_height_m", "rolling_drag", "rolling_size_coefficient"}, where, source)
+        if "preset_basis" in spec and "preset" not in spec:
+            raise ScenarioError(f"{source}: {where}preset_basis = {spec['preset_basis']!r} needs a preset beside it")
         given = set(spec)
         if "preset" in spec:            # a named material from published ranges (simulation.materials)
             try:

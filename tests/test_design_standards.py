@@ -98,18 +98,26 @@ def test_odot_cut_retention_is_set_beside_the_ritchie_width(odot_study):
         row["simulated_percent"])
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "KNOWN DISAGREEMENT, reported in docs/validation/design-standards.md: on the 60 ft 0.25H:1V ODOT cut the "
-    "re-simulated 90 % retention width is about 17 m (600 blocks, seed 2: 17.6 m; 6,000 blocks: 17.3 m) against "
-    "8.16 m of the Modified Ritchie Criterion; only about 35 % of the blocks stop within 8.16 m.  The catchment "
-    "material of the scenario is a riskrf starting value, not back-analysed on the ODOT tests.  strict: the day "
-    "the model agrees this test passes and the marker must go."))
 def test_odot_cut_90_percent_width_agrees_with_the_modified_ritchie_criterion(odot_study):
     # Compared: the width retaining 90 % of the blocks that went over the face (the performance level Warren et al.
     # 2025 apply to catch benches) against W = 0.2 H + 4.5 m.  Tolerance +-35 %: the criterion is one straight line
     # in H that ignores rock size, face angle and catchment material, which Warren et al. found also govern
-    # rollout, and it was set from ditch and bench tests, not from one geometry.
+    # rollout, and it was set from ditch and bench tests, not from one geometry.  The scenario's materials are the
+    # data-derived presets (fitted to the Authume releases and Evans & Hungr's reach, not to any ditch): a
+    # prediction, 7.6 m against 8.16 m.  With the earlier riskrf starting values it was 17.3 m (a strict xfail).
     assert odot_study.widths[90.0] == pytest.approx(modified_ritchie_width_m(odot_study.cut_height_m), rel=0.35)
+
+
+@pytest.mark.parametrize("catchment", ["colluvium", "scree", "meadow"])
+def test_the_ritchie_agreement_does_not_hang_on_the_catchment_preset(catchment):
+    # the ditch floor of the ODOT tests is not described in what could be read: every data-derived soft-ground
+    # preset gives a 90 % width within the same tolerance (6,000 blocks, seed 5: colluvium 8.1 m, scree 9.2 m,
+    # meadow 7.6 m; soil, the scenario's, 7.6 m)
+    import tomllib
+    data = tomllib.loads(ODOT_CUT.read_text())
+    data["materials"]["catchment"] = {"preset": catchment, "preset_basis": "data"}
+    study = catchment_retention(simulation.scenario_from_dict(data, str(ODOT_CUT)), n=600, seed=2)
+    assert study.widths[90.0] == pytest.approx(modified_ritchie_width_m(study.cut_height_m), rel=0.35), catchment
 
 
 def _search():

@@ -160,3 +160,22 @@ def test_the_shipped_priors_were_made_with_the_generator_s_laws_and_data_sets():
     eh = simulation.scenario_from_dict(mod.evans_hungr_scenario())
     assert eh.profile.z[2] == mod.EH_APEX[1] and eh.profile.x[2] == mod.EH_APEX[0]
     assert mod.EH_SHADOW_ANGLE_DEG == 27.5            # Evans & Hungr (1993), abstract
+
+
+def test_a_scenario_file_can_start_a_material_from_the_data_derived_preset():
+    import simulation
+    from simulation.scenario import ScenarioError
+    base = {"profile": {"x": [0.0, 50.0], "z": [30.0, 0.0], "material": "m"},
+            "seeder": {"x": 1.0, "height_m": 1.0, "mass_kg": 500}}
+    sc = simulation.scenario_from_dict({**base, "materials": {"m": {"preset": "soil", "preset_basis": "data"}}})
+    data = preset("soil", basis="data")
+    assert sc.materials[0].ground_friction_deg == pytest.approx(data["ground_friction_angle_deg"])
+    assert sc.materials[0].hop_height_m == data["contact_hop_height_m"]
+    published = simulation.scenario_from_dict({**base, "materials": {"m": {"preset": "soil"}}})
+    assert published.materials[0].ground_friction_deg == PRESETS["soil"]["ground_friction_angle_deg"]
+    with pytest.raises(ScenarioError, match=r"x.toml: materials.m.preset_basis = 'fitted' must be 'published'"):
+        simulation.scenario_from_dict({**base, "materials": {"m": {"preset": "soil", "preset_basis": "fitted"}}},
+                                      "x.toml")
+    with pytest.raises(ScenarioError, match=r"materials.m.preset_basis = 'data' needs a preset beside it"):
+        simulation.scenario_from_dict({**base, "materials": {"m": {"preset_basis": "data", "roughness_m": 0.1}}},
+                                      "x.toml")
