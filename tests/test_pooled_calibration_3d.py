@@ -5,12 +5,14 @@ simulated with a known rolling-resistance angle; the calibration of two paramete
 its posterior interval.  Bad input: a 3-D release whose source lies outside the DEM, or that sets a 2-D-only
 release field, is refused before any simulation, naming the release and the field.
 """
+import warnings
+
 import numpy as np
 import pytest
 
 pytest.importorskip("rasterio")
 
-from simulation.pooled import Release, _Pool, calibrate_pooled  # noqa: E402
+from simulation.pooled import PooledCalibrationWarning, Release, _Pool, calibrate_pooled  # noqa: E402
 from simulation.terrain import Terrain  # noqa: E402
 
 T35, T10 = np.tan(np.radians(35.0)), np.tan(np.radians(10.0))
@@ -42,10 +44,12 @@ def test_3d_calibration_recovers_a_known_rolling_resistance_on_a_plane_dem(dem):
     assert 50.0 < np.median(observed) < 80.0          # the blocks stop on the 10 deg plane (it starts at 40 m)
     inside, widths = 0, []
     for seed in range(1, 9):                           # every calibration seed 1-8, none picked
-        cal = calibrate_pooled([Release("synthetic", _data(dem), observed, source="synthetic plane")],
-                               {PHI: (10.0, 40.0), "materials.soil.tangential.mean": (0.3, 1.0)},
-                               n_per_release=400, n_initial=64, n_per_iteration=32, iterations=2, n_predictive=0,
-                               n_posterior=500, seed=seed, obs_error_m=1.0)
+        with warnings.catch_warnings():                # small test budgets: some seeds warn of a low ESS (known)
+            warnings.simplefilter("ignore", PooledCalibrationWarning)
+            cal = calibrate_pooled([Release("synthetic", _data(dem), observed, source="synthetic plane")],
+                                   {PHI: (10.0, 40.0), "materials.soil.tangential.mean": (0.3, 1.0)},
+                                   n_per_release=400, n_initial=64, n_per_iteration=32, iterations=2,
+                                   n_predictive=0, n_posterior=500, seed=seed, obs_error_m=1.0)
         lo, hi = cal.interval(PHI, 0.99)
         inside += lo <= TRUE_PHI_DEG <= hi
         widths.append(hi - lo)
