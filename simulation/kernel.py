@@ -710,17 +710,12 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             cosb, sinb = cosb_raw / ls, sinb_raw / ls
             mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r)
             roll = m_roll[mat]
+            trapped = False
             if abs(sinb) > sin_max_roll:
                 # No rolling or sliding in contact on a face this steep: the block leaves it (speed kept), unless
-                # it has kept doing so in one place (steep_trap).
+                # it has kept doing so in one place (steep_trap: then it is held, below).
                 trap_n, trap_x, trap_y, trapped = steep_trap(trap_n, trap_x, trap_y, x, 0.0)
-                if trapped:
-                    reason = STOPPED
-                    w = 0.0
-                    if record:
-                        _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, 0.0, 0.0,
-                                     0.0, MODE_STOP, EV_STOP)
-                    break
+            if abs(sinb) > sin_max_roll and not trapped:
                 vt_new, vn_new = steep_face_launch(v_along, contact_speed(v_contact, g, cosb, m_hop[mat]))
                 vx = vt_new * cosb - vn_new * sinb
                 vz = vt_new * sinb + vn_new * cosb
@@ -731,8 +726,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
                                  MODE_FLIGHT, EV_TAKEOFF)
                 continue
-            if abs(v_along) < v_stop or v_along == 0.0:
-                if abs(sinb) <= mu * cosb or _at_trough(px, pz, k, x):
+            if trapped or abs(v_along) < v_stop or v_along == 0.0:
+                if trapped or abs(sinb) <= mu * cosb or _at_trough(px, pz, k, x):
                     reason = STOPPED
                     w = 0.0
                     if record:
