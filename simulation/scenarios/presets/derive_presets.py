@@ -29,6 +29,9 @@ Every scenario uses the presets as they are (their own laws) with ``settings.max
 four the data constrain: the rolling-resistance angles of soil, bedrock and talus and the tangential
 coefficient of soil.
 
+``loo`` (2-D) also predicts a data set none of the fits saw: the Modified Ritchie width of the ODOT 60 ft cut
+(simulation/scenarios/odot_catchment_cut.toml, W = 0.2 H + 4.5 m = 8.16 m), from the shipped priors.
+
 ``fit`` fits all data sets jointly and writes simulation/preset_priors.py (posterior summary and a 200-draw
 sample per fitted field); ``loo`` fits every data set's complement and predicts the held-out one, writing
 docs/validation/presets_loo.csv and docs/validation/figures/presets_loo.png.
@@ -246,6 +249,38 @@ def release_row(dataset, model, per_release, rels):
             "unit": "m (plan runout, 3-D)" if KERNEL["name"] == "3d" else "m (stop x)"}, (obs, pred)
 
 
+#: The ODOT 60 ft cut (simulation/scenarios/odot_catchment_cut.toml): its face and catchment are the data-derived
+#: bedrock and soil presets, so a posterior draw of those presets' fields is applied to the scenario's materials.
+ODOT_CUT = REPO / "simulation" / "scenarios" / "odot_catchment_cut.toml"
+ODOT_MATERIALS = {"bedrock": "rock", "soil": "catchment"}
+
+
+def ritchie_row(n_draws, seed):
+    """A data set none of the fits saw: the Modified Ritchie width of the ODOT 60 ft cut (W = 0.2 H + 4.5 m = 8.16 m,
+    Ryan & Pryor 2000), against the 90 % retention width predicted from the shipped priors (the fit on all three
+    data sets, :func:`simulation.materials.preset_posterior`), one re-simulation of 600 blocks per posterior draw."""
+    import simulation
+    from riskrf.hazard.catchment import catchment_retention, modified_ritchie_width_m
+    from simulation.calibration import apply_parameters
+    from simulation.materials import preset_posterior
+    data, _ = scenario_dict(ODOT_CUT)
+    draws = preset_posterior(list(ODOT_MATERIALS)).sample(n_draws, random_state=seed)
+    widths = []
+    for t, d in enumerate(draws.to_dict("records")):
+        vals = {".".join(["materials", ODOT_MATERIALS[k.split(".")[1]], *k.split(".")[2:]]): v for k, v in d.items()}
+        sc = simulation.scenario_from_dict(apply_parameters(data, vals), str(ODOT_CUT))
+        widths.append(catchment_retention(sc, n=600, seed=70_000 + t).widths[90.0])
+    w = np.asarray(widths)
+    obs = modified_ritchie_width_m(18.3)
+    q = np.quantile(w, [0.1, 0.5, 0.9])
+    return {"held_out": "odot_ritchie_rule", "model": "fitted on all three (the shipped priors)", "observations": 1,
+            "obs_p10": np.nan, "obs_p50": obs, "obs_p90": np.nan, "pred_p10": q[0], "pred_p50": q[1],
+            "pred_p90": q[2], "median_error_pct": 100.0 * (q[1] / obs - 1.0), "ks_d": np.nan,
+            "w1": float(np.mean(np.abs(w - obs))), "beyond_p95": float(obs > np.quantile(w, 0.95)),
+            "beyond_p99": float(obs > np.quantile(w, 0.99)),
+            "unit": "m (90 % retention width, 60 ft ODOT cut)"}, w
+
+
 def constraint_row(model, cons, angles):
     a = np.asarray(angles)
     q = np.quantile(a, [0.1, 0.5, 0.9])
@@ -320,6 +355,10 @@ def main():
             rows.append(r)
             curves[(held, model)] = cv
         print(pd.DataFrame(rows).round(3).to_string())
+    if args.kernel == "2d":
+        r, cv = ritchie_row(args.draws, args.seed)
+        rows.append(r)
+        curves[("odot_ritchie_rule", r["model"])] = cv
     table = pd.DataFrame(rows)
     out = REPO / "docs" / "validation"
     table.to_csv(out / f"{args.out}.csv", index=False, float_format="%.4g")
