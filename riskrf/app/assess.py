@@ -35,6 +35,7 @@ from ..hazard.energy_study import (
 from ..frequency.study import FrequencyAnalysis, analyse_inventory
 from ..frequency.inventory import Inventory, read_inventory
 from ..hazard.simulated import simulate_energy_hazard
+from ..risk.measures import road_crossings
 from ..risk.mitigation import MitigationStudy
 from ..io.outputs import relative_paths, relative_paths_in_json_files, write_json
 from ..frequency.power_law import fit_gutenberg_richter
@@ -121,58 +122,195 @@ def energy_hazard_from_inputs(inventory: Inventory, *, m_min=None, m_max=None, r
     ValueError
         Neither or both of ``scenario`` and ``velocities``, or an unknown ``mass_coupling``.
     """
-    import simulation
-
-    from ..io.velocities import read_velocities
-
     gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=m_min, m_max=m_max)
     rate = gr.rate_min * rate_scale
     if callable(design_masses_kg):
         design_masses_kg = design_masses_kg(gr, rate)
     if (scenario is None) == (velocities is None):
         raise ValueError("give exactly one of --scenario (simulate the velocities) or --velocities (a file)")
-    result = None
-    road_hits = None
     if scenario is not None:
-        sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
-        collector = collector or "barrier"
-        sc.collector_index(collector)
-        result = simulation.run(sc, n=n, seed=seed)
-        if mass_coupling not in ("simulated", "independent"):
-            raise ValueError(f"mass_coupling = {mass_coupling!r} must be 'simulated' or 'independent'")
-        if mass_coupling == "simulated" and not condition_on_mass:
-            hazard, coupled = simulate_energy_hazard(gr, sc, collector, rate_per_year=rate, n=n, seed=seed,
-                                                     design_masses_kg=design_masses_kg)
-            if road_collector is not None and road_collector in [c.name for c in sc.collectors]:
-                road_hits = np.zeros(coupled.n, dtype=bool)
-                road_hits[coupled.collector(road_collector, first_only=True)["block"].to_numpy()] = True
-        else:
-            hazard = EnergyHazard.from_simulation(gr, result, collector, rate_per_year=rate,
-                                                  condition_on_mass=condition_on_mass)
+        hazard, result, road_hits = _scenario_hazard(
+            gr, rate, scenario, collector, n=n, seed=seed, mass_coupling=mass_coupling,
+            condition_on_mass=condition_on_mass, design_masses_kg=design_masses_kg, road_collector=road_collector)
     else:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RiskrfWarning)      # kept in the hazard's notes below
-            df = read_velocities(velocities, collector=collector, velocity_unit=velocity_unit,
-                                 drop_height_m=drop_height_m, **(velocity_reader or {}))
-        v = df["velocity_ms"].to_numpy(dtype=float)
-        note = "; ".join([f"velocities: {len(df):,} samples from {velocities}", *df.attrs.get("warnings", [])])
-        if "angular_velocity_rads" in df and "radius_m" in df:
-            spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
-            v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
-            note += "; rotational energy included"
-        note += f"; reach probability {reach_probability:g} as given" + (
-            " (default: every fall assumed to reach the line)" if reach_probability == 1.0 else "")
-        hazard = EnergyHazard(mass=gr, velocity=v, rate_per_year=rate, reach_probability=reach_probability,
-                              heights_m=df["height_m"].to_numpy(dtype=float) if "height_m" in df else None,
-                              collector=collector or "", notes=(note,))
-    if rate_note is not None:
-        hazard = replace(hazard, notes=hazard.notes + (rate_note,))
-    elif rate_scale != 1.0:
-        hazard = replace(hazard, notes=hazard.notes + (
-            f"rate scaled by {rate_scale:g} (share of the inventoried source above this line)",))
+        result, road_hits = None, None
+        hazard = _velocity_file_hazard(gr, rate, velocities, collector, velocity_unit=velocity_unit,
+                                       drop_height_m=drop_height_m, velocity_reader=velocity_reader,
+                                       reach_probability=reach_probability)
+    hazard = with_rate_note(hazard, rate_scale, rate_note)
     if road_collector is not None:
         return gr, hazard, result, road_hits
     return gr, hazard, result
+
+
+def _scenario_hazard(gr, rate: float, scenario, collector: str | None, *, n: int, seed, mass_coupling: str,
+                     condition_on_mass: bool, design_masses_kg, road_collector: str | None) -> tuple:
+    """Energy hazard at the barrier line of a simulated slope (the scenario branch of
+    :func:`energy_hazard_from_inputs`).
+
+    The scenario's own seeder run is always made (figures, road share, mitigation); the hazard is the
+    mass-coupled :func:`~riskrf.hazard.simulated.simulate_energy_hazard` unless ``mass_coupling`` is
+    ``"independent"`` or ``condition_on_mass`` is set, then it is built from the seeder run's crossings.
+
+    Parameters
+    ----------
+    gr : GutenbergRichterFit
+        The power-law fit of the inventory: the law the mass-coupled run draws its block masses [kg] from.
+    rate : float
+        Falls per year at or above m_min [1/yr], ``rate_scale`` applied: the hazard's rate of falls.
+    scenario : str, pathlib.Path or simulation.Scenario
+        The slope to simulate.
+    collector : str or None
+        The barrier line (None: ``"barrier"``).
+    n : int
+        Simulated blocks.
+    seed : int
+        Seed of the simulation.
+    mass_coupling : {"simulated", "independent"}
+        How reach and speed depend on the mass.
+    condition_on_mass : bool
+        Use the seeder's own masses (the older form).
+    design_masses_kg : sequence of float
+        Masses [kg] the simulated mass range must cover.
+    road_collector : str or None
+        The road line, for the road crossings per block.
+
+    Returns
+    -------
+    hazard : EnergyHazard
+        Annual energy hazard at the barrier line (falls [1/yr], energies [kJ]).
+    result : simulation.SimulationResult
+        The scenario's seeder run.
+    road_hits : numpy.ndarray of bool or None
+        Per block of the mass-coupled run, did it cross the road line (None without that run or that line).
+
+    Raises
+    ------
+    KeyError
+        The scenario has no line named ``collector``.
+    ValueError
+        An unknown ``mass_coupling`` (checked after the seeder run).
+    """
+    import simulation
+
+    sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
+    collector = collector or "barrier"
+    sc.collector_index(collector)
+    result = simulation.run(sc, n=n, seed=seed)
+    if mass_coupling not in ("simulated", "independent"):
+        raise ValueError(f"mass_coupling = {mass_coupling!r} must be 'simulated' or 'independent'")
+    road_hits = None
+    if mass_coupling == "simulated" and not condition_on_mass:
+        hazard, coupled = simulate_energy_hazard(gr, sc, collector, rate_per_year=rate, n=n, seed=seed,
+                                                 design_masses_kg=design_masses_kg)
+        road_hits = _road_hits_per_block(coupled, sc, road_collector)
+    else:
+        hazard = EnergyHazard.from_simulation(gr, result, collector, rate_per_year=rate,
+                                              condition_on_mass=condition_on_mass)
+    return hazard, result, road_hits
+
+
+def _road_hits_per_block(coupled, scenario, road_collector: str | None):
+    """Whether each block of a run crossed the road line.
+
+    Parameters
+    ----------
+    coupled : simulation.SimulationResult
+        The mass-coupled run (anything with ``n`` and ``collector(name, first_only=True)``).
+    scenario : simulation.Scenario
+        The simulated slope (its collector names).
+    road_collector : str or None
+        The road line.
+
+    Returns
+    -------
+    numpy.ndarray of bool or None
+        One flag per block of ``coupled`` (None when ``road_collector`` is None or not a line of the scenario).
+    """
+    if road_collector is None or road_collector not in [c.name for c in scenario.collectors]:
+        return None
+    road_hits = np.zeros(coupled.n, dtype=bool)
+    road_hits[road_crossings(coupled, road_collector)] = True
+    return road_hits
+
+
+def _velocity_file_hazard(gr, rate: float, velocities, collector: str | None, *, velocity_unit: str | None,
+                          drop_height_m, velocity_reader, reach_probability: float) -> EnergyHazard:
+    """Energy hazard at the barrier line from a file of velocities (the velocity-file branch of
+    :func:`energy_hazard_from_inputs`).
+
+    The reader's plausibility warnings are not raised but kept in the hazard's note, together with the sample
+    count, whether rotational energy is included (when the file gives spin and radius) and the reach
+    probability as given.
+
+    Parameters
+    ----------
+    gr : GutenbergRichterFit
+        The power-law fit of the inventory: the mass law [kg] paired with the file's velocities.
+    rate : float
+        Falls per year at or above m_min [1/yr], ``rate_scale`` applied; ``reach_probability`` of them reach
+        the line.
+    velocities : str or pathlib.Path
+        The velocity file (:func:`riskrf.io.velocities.read_velocities`).
+    collector : str or None
+        The barrier line: the file is filtered to it when given.
+    velocity_unit : {"m/s", "km/h"} or None
+        Unit of the velocity column when its header does not say.
+    drop_height_m : float or None
+        Height drop to the line [m] for the plausibility limit.
+    velocity_reader : dict or None
+        Further keyword arguments of :func:`riskrf.io.velocities.read_velocities`.
+    reach_probability : float
+        P(a fall reaches the line) [-].
+
+    Returns
+    -------
+    EnergyHazard
+        Annual energy hazard at the line (falls [1/yr], effective speeds [m/s], energies [kJ]).
+    """
+    from ..io.velocities import read_velocities
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RiskrfWarning)      # kept in the hazard's notes below
+        df = read_velocities(velocities, collector=collector, velocity_unit=velocity_unit,
+                             drop_height_m=drop_height_m, **(velocity_reader or {}))
+    v = df["velocity_ms"].to_numpy(dtype=float)
+    note = "; ".join([f"velocities: {len(df):,} samples from {velocities}", *df.attrs.get("warnings", [])])
+    if "angular_velocity_rads" in df and "radius_m" in df:
+        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
+        v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
+        note += "; rotational energy included"
+    note += f"; reach probability {reach_probability:g} as given" + (
+        " (default: every fall assumed to reach the line)" if reach_probability == 1.0 else "")
+    return EnergyHazard(mass=gr, velocity=v, rate_per_year=rate, reach_probability=reach_probability,
+                        heights_m=df["height_m"].to_numpy(dtype=float) if "height_m" in df else None,
+                        collector=collector or "", notes=(note,))
+
+
+def with_rate_note(hazard: EnergyHazard, rate_scale: float, rate_note: str | None = None) -> EnergyHazard:
+    """The hazard with a note on where its rate came from appended.
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard.
+    rate_scale : float
+        Factor [-] applied to the inventory's rate (the share of the inventoried source above this line).
+    rate_note : str, optional
+        A note replacing the one on ``rate_scale`` (e.g. a rate from the site's rate model).
+
+    Returns
+    -------
+    EnergyHazard
+        ``hazard`` with ``rate_note`` appended to its notes, else with a note on ``rate_scale`` when it is not
+        1, else ``hazard`` itself.
+    """
+    if rate_note is not None:
+        return replace(hazard, notes=hazard.notes + (rate_note,))
+    if rate_scale != 1.0:
+        return replace(hazard, notes=hazard.notes + (
+            f"rate scaled by {rate_scale:g} (share of the inventoried source above this line)",))
+    return hazard
 
 
 def road_share(result, barrier: str, road: str | None) -> float:
