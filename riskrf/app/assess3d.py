@@ -186,10 +186,8 @@ def run_terrain_assessment(site: Site, *, seed: int | None = None, n_blocks: int
     scenario = simulation.load_terrain_scenario(site.resolve(hz_cfg["scenario"]))
     hazard, result = simulate_energy_hazard(gr, scenario, hz_cfg["collector"], rate_per_year=rate, n=n_blocks,
                                             seed=seed, workers=workers)
-    if inv_cfg["rate_scale"] != 1.0:
-        from dataclasses import replace
-        hazard = replace(hazard, notes=hazard.notes + (
-            f"rate scaled by {inv_cfg['rate_scale']:g} (share of the inventoried source above this line)",))
+    from .assess import with_rate_note
+    hazard = with_rate_note(hazard, inv_cfg["rate_scale"])
     timings["simulation"] = round(time.perf_counter() - t, 2)
 
     t = time.perf_counter()
