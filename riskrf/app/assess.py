@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..hazard.annual_hazard import EnergyHazard, inertia_factors
+from ..hazard.annual_hazard import EnergyHazard, effective_speeds
 from .background import InBackground
 from ..hazard.design_block import (design_block, design_block_candidates_kg, fragment_block_kg, read_block_survey,
                            resolve_sizes)
@@ -277,8 +277,7 @@ def _velocity_file_hazard(gr, rate: float, velocities, collector: str | None, *,
     v = df["velocity_ms"].to_numpy(dtype=float)
     note = "; ".join([f"velocities: {len(df):,} samples from {velocities}", *df.attrs.get("warnings", [])])
     if "angular_velocity_rads" in df and "radius_m" in df:
-        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
-        v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
+        v = effective_speeds(df)
         note += "; rotational energy included"
     note += f"; reach probability {reach_probability:g} as given" + (
         " (default: every fall assumed to reach the line)" if reach_probability == 1.0 else "")

@@ -45,6 +45,29 @@ def inertia_factors(df) -> np.ndarray:
     return df["inertia_factor"].to_numpy(dtype=float) if "inertia_factor" in df else np.full(len(df), SPHERE_INERTIA)
 
 
+def effective_speeds(df) -> np.ndarray:
+    """Speed [m/s] of each row of a collector (or velocity) table with its rotational energy put in:
+    v_eff = sqrt(v^2 + k (w r)^2), so that 1/2 m v_eff^2 is the translational plus rotational kinetic energy.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        Columns ``velocity_ms`` [m/s], ``angular_velocity_rads`` [rad/s], ``radius_m`` [m] and optionally
+        ``inertia_factor`` (:func:`inertia_factors`).
+
+    Returns
+    -------
+    numpy.ndarray
+        v_eff [m/s] per row.
+
+    References
+    ----------
+    Wyllie, D.C. (2014) Rock Fall Engineering, ch. 5 (rotational energy of a rolling block).
+    """
+    spin = df["angular_velocity_rads"].to_numpy(dtype=float) * df["radius_m"].to_numpy(dtype=float)
+    return np.sqrt(df["velocity_ms"].to_numpy(dtype=float) ** 2 + inertia_factors(df) * spin ** 2)
+
+
 _E_GRID = np.geomspace(1e-3, 1e12, 301)     # kJ: the grid on which hazard curves are inverted
 
 
@@ -121,10 +144,7 @@ class EnergyHazard(Displayed):
         if df.empty:
             raise ValueError(f"no simulated block reached collector {collector!r}: the hazard there is nil "
                              "for the simulated release; check the scenario")
-        v = df["velocity_ms"].to_numpy()
-        if rotational:
-            spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
-            v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
+        v = effective_speeds(df) if rotational else df["velocity_ms"].to_numpy()
         velocity = PairedSamples(v, df["mass_kg"].to_numpy()) if condition_on_mass else v
         notes = ("mass-independent form: one reach probability and one velocity law for all masses"
                  + (" (velocities classed by the seeder's masses)" if condition_on_mass else ""),

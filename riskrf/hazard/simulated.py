@@ -15,7 +15,7 @@ import simulation
 from ..core.format import sig
 from ..core.units import DESIGN_RETURN_PERIODS
 from ..core.validation import check_positive
-from .annual_hazard import EnergyHazard, inertia_factors
+from .annual_hazard import EnergyHazard, effective_speeds
 from .impact_energy import mass_model
 from .mass_coupling import MassCoupledSamples, NoArrivalsError, default_mass_range, stratified_log_uniform
 
@@ -115,7 +115,7 @@ def coupled_samples(result, collector: str, masses_kg, edges_kg, mass_model, *, 
 
     Each released block (``masses_kg``, in the order simulated) keeps its speed [m/s] and passing height [m] at its
     first crossing of ``collector`` (NaN when it never crossed); with ``rotational`` the speed is the effective one,
-    v_eff^2 = v^2 + k (omega r)^2 (:func:`~riskrf.hazard.annual_hazard.inertia_factors`), so that 1/2 m v_eff^2 is
+    v_eff^2 = v^2 + k (omega r)^2 (:func:`~riskrf.hazard.annual_hazard.effective_speeds`), so that 1/2 m v_eff^2 is
     the translational plus rotational energy.  ``edges_kg`` are the mass-class edges [kg]; the classes take their
     representative mass from ``mass_model``.
 
@@ -143,10 +143,7 @@ def coupled_samples(result, collector: str, masses_kg, edges_kg, mass_model, *, 
         return None
     speed = np.full(result.n, np.nan)
     height = np.full(result.n, np.nan)
-    v = df["velocity_ms"].to_numpy()
-    if rotational:
-        spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
-        v = np.sqrt(v ** 2 + inertia_factors(df) * spin ** 2)
+    v = effective_speeds(df) if rotational else df["velocity_ms"].to_numpy()
     blk = df["block"].to_numpy()
     speed[blk] = v
     height[blk] = df["height_m"].to_numpy()

@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..core.validation import RiskrfError
-from ..hazard.annual_hazard import inertia_factors
+from ..hazard.annual_hazard import effective_speeds
 
 #: Horizontal run per unit drop of the ditch wall on the slope side (steep, 0.25H:1V) and of the
 #: foreslope on the road side (1H:1V); defaults of :func:`ditch_profile` [assumption, ODOT-style shape].
@@ -427,7 +427,4 @@ def effective_samples(result, collector: str):
         Bounce height of each first crossing [m].
     """
     df = result.collector(collector, first_only=True)
-    v = df["velocity_ms"].to_numpy()
-    k = inertia_factors(df)
-    spin = df["angular_velocity_rads"].to_numpy() * df["radius_m"].to_numpy()
-    return np.sqrt(v ** 2 + k * spin ** 2), df["height_m"].to_numpy()
+    return effective_speeds(df), df["height_m"].to_numpy()
