@@ -253,6 +253,7 @@ def release_row(dataset, model, per_release, rels):
 #: bedrock and soil presets, so a posterior draw of those presets' fields is applied to the scenario's materials.
 ODOT_CUT = REPO / "simulation" / "scenarios" / "odot_catchment_cut.toml"
 ODOT_MATERIALS = {"bedrock": "rock", "soil": "catchment"}
+ODOT_CUT_HEIGHT_M = 18.3                                  # 60 ft
 
 
 def ritchie_row(n_draws, seed):
@@ -271,7 +272,7 @@ def ritchie_row(n_draws, seed):
         sc = simulation.scenario_from_dict(apply_parameters(data, vals), str(ODOT_CUT))
         widths.append(catchment_retention(sc, n=600, seed=70_000 + t).widths[90.0])
     w = np.asarray(widths)
-    obs = modified_ritchie_width_m(18.3)
+    obs = modified_ritchie_width_m(ODOT_CUT_HEIGHT_M)
     q = np.quantile(w, [0.1, 0.5, 0.9])
     return {"held_out": "odot_ritchie_rule", "model": "fitted on all three (the shipped priors)", "observations": 1,
             "obs_p10": np.nan, "obs_p50": obs, "obs_p90": np.nan, "pred_p10": q[0], "pred_p50": q[1],
@@ -367,13 +368,16 @@ def main():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
-    for ax, held in zip(axes, DATASETS):
+    panels = [*DATASETS, *(["odot_ritchie_rule"] if args.kernel == "2d" else [])]
+    fig, axes = plt.subplots(1, len(panels), figsize=(5 * len(panels), 4.2))
+    for ax, held in zip(axes, panels):
         for (h, model), c in curves.items():
             if h != held:
                 continue
             style = "C0" if model == "published presets" else ("C2" if "site-to-site" in model else "C3")
-            if held == "evans_hungr_1993":
+            if held == "odot_ritchie_rule":
+                ax.hist(c, bins=12, alpha=0.5, color=style, label=model, density=True)
+            elif held == "evans_hungr_1993":
                 ax.hist(c, bins=15, alpha=0.5, color=style, label=model, density=True)
             else:
                 obs, pred = c
@@ -383,7 +387,13 @@ def main():
                             label=f"observed ({o.size})")
                 p = np.sort(pred)
                 ax.plot(p, np.arange(1, p.size + 1) / p.size, color=style, label=model)
-        if held == "evans_hungr_1993":
+        if held == "odot_ritchie_rule":
+            from riskrf.hazard.catchment import modified_ritchie_width_m
+            w_mrc = modified_ritchie_width_m(ODOT_CUT_HEIGHT_M)
+            ax.axvline(w_mrc, color="k", lw=2, label=f"Modified Ritchie width {w_mrc:.2f} m")
+            ax.set_xlabel("90 % retention width, ODOT 60 ft cut [m]")
+            ax.set_ylabel("density over posterior draws")
+        elif held == "evans_hungr_1993":
             ax.axvline(EH_SHADOW_ANGLE_DEG, color="k", lw=2, label="Evans & Hungr 27.5 deg")
             ax.set_xlabel("shadow angle of the p99 stop [deg]")
             ax.set_ylabel("density over posterior draws")
