@@ -138,6 +138,17 @@ def _axis_cos(sx, sy, tx, ty):
     return (sx * tx + sy * ty) / (ls * lt)
 
 
+@njit(cache=True, inline="always")
+def _downhill(nx0, ny0, nz0):
+    """Unit vector down the fall line in the tangent plane of the surface with unit normal (nx0, ny0, nz0);
+    +x on flat ground."""
+    tx, ty, tz = nz0 * nx0, nz0 * ny0, nz0 * nz0 - 1.0
+    tl = math.sqrt(tx * tx + ty * ty + tz * tz)
+    if tl < 1e-12:
+        return 1.0, 0.0, 0.0
+    return tx / tl, ty / tl, tz / tl
+
+
 @njit(cache=True)
 def _stop_fraction(u, u2sq, a_s, c, ds):
     """Share of a contact step [-] after which a block of speed u [m/s] comes to rest: from the work-energy
@@ -181,9 +192,7 @@ def _leave_face(vx, vy, vz, x, y, z, nx0, ny0, nz0, v_sep, zg, x0, y0, dx, dy):
     if ut > 1e-12:
         tx, ty, tz = tx / ut, ty / ut, tz / ut
     else:                       # no tangential motion: down the fall line
-        tx, ty, tz = nz0 * nx0, nz0 * ny0, nz0 * nz0 - 1.0
-        tl = math.sqrt(tx * tx + ty * ty + tz * tz)
-        tx, ty, tz = (tx / tl, ty / tl, tz / tl) if tl > 1e-12 else (1.0, 0.0, 0.0)
+        tx, ty, tz = _downhill(nx0, ny0, nz0)
     vt_new, vn_new = steep_face_launch(ut, v_sep)
     if vn_new <= 0.0:
         hl = math.sqrt(nx0 * nx0 + ny0 * ny0)
@@ -693,11 +702,9 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                 t1x, t1y, t1z = vx - vn_t * nx0, vy - vn_t * ny0, vz - vn_t * nz0
                 tl = math.sqrt(t1x * t1x + t1y * t1y + t1z * t1z)
                 if tl < 1e-12:          # head-on: take the fall line (on flat ground, +x) as the travel direction
-                    t1x, t1y, t1z = nz0 * nx0, nz0 * ny0, nz0 * nz0 - 1.0
-                    tl = math.sqrt(t1x * t1x + t1y * t1y + t1z * t1z)
-                    if tl < 1e-12:
-                        t1x, t1y, t1z, tl = 1.0, 0.0, 0.0, 1.0
-                t1x, t1y, t1z = t1x / tl, t1y / tl, t1z / tl
+                    t1x, t1y, t1z = _downhill(nx0, ny0, nz0)
+                else:
+                    t1x, t1y, t1z = t1x / tl, t1y / tl, t1z / tl
                 t2x, t2y, t2z = ny0 * t1z - nz0 * t1y, nz0 * t1x - nx0 * t1z, nx0 * t1y - ny0 * t1x
                 theta_max = math.atan(m_rough[mat] / r) if r > 0 else 0.0
                 d1 = (2.0 * _uniform(state) - 1.0) * theta_max

@@ -136,7 +136,10 @@ def site_spread_half_width(path: str) -> float:
     float
         Half-width [the field's unit].
     """
-    _, preset, field = path.split(".", 2)
+    parts = str(path).split(".", 2)
+    if len(parts) != 3 or parts[0] != "materials":
+        raise ValueError(f"site spread: field {path!r} is not a dotted preset field 'materials.<preset>.<field>'")
+    _, preset, field = parts
     return ASSUMED_HALF_WIDTHS.get(preset, {}).get(field, 0.15 if field == "tangential.mean" else 0.0)
 
 
@@ -166,6 +169,9 @@ def with_site_spread(sample: pd.DataFrame, bounds: dict, seed=1) -> pd.DataFrame
     """
     rng = np.random.default_rng(seed)
     out = sample.copy()
+    missing = [c for c in out.columns if c not in bounds]
+    if missing:
+        raise ValueError(f"site spread: bounds = {sorted(bounds)!r} give no prior box for column(s) {missing!r}")
     for col in out.columns:
         w = site_spread_half_width(col)
         lo, hi = bounds[col]

@@ -115,12 +115,15 @@ def _numpydoc_gaps(rel: str, root: Path = ROOT) -> list[str]:
         if _returns_value(fn) and not (_section(doc, "Returns") or _section(doc, "Yields")):
             gaps.append(f"{rel}:{fn.lineno} {owner}{fn.name}: no Returns section")
 
+    classes = {n.name: n for n in tree.body if isinstance(n, ast.ClassDef)}
     for node in tree.body:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             check(node)
         elif isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
             for sub in node.body:
-                if isinstance(sub, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                # an override without its own docstring inherits the base's, which is checked where it is written
+                if isinstance(sub, (ast.FunctionDef, ast.AsyncFunctionDef)) and not (
+                        ast.get_docstring(sub) is None and _inherits_doc(node, sub.name, classes)):
                     check(sub, node.name + ".")
     return gaps
 

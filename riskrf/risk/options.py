@@ -321,18 +321,6 @@ class DoNothing(OptionEffect):
     """``none``: the site as it is."""
 
     def describe(self, currency=""):
-        """What the option does, in words (money in ``currency``).
-
-        Parameters
-        ----------
-        currency : str, optional
-            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
-
-        Returns
-        -------
-        str
-            One-line description of the option, assumptions labelled ASSUMED.
-        """
         return "the site as it is"
 
     @property
@@ -392,18 +380,6 @@ class Scaling(OptionEffect):
         return e0, tuple(rng), h, e0 * k, (rng[0] * k, rng[1] * k)
 
     def describe(self, currency=""):
-        """What the option does, in words (money in ``currency``).
-
-        Parameters
-        ----------
-        currency : str, optional
-            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
-
-        Returns
-        -------
-        str
-            One-line description of the option, assumptions labelled ASSUMED.
-        """
         o = self.option
         if o.rate_reduction is not None:
             return f"scaling and bolting; ASSUMED to prevent {o.rate_reduction:.0%} of falls (typed)"
@@ -439,14 +415,6 @@ class Scaling(OptionEffect):
         return [(f"scaling_effectiveness:{self.option.name}", self.effect()[3])]
 
     def assumed_ranges(self):
-        """name -> (low, high, how) of the option's assumed (not stated) ranges.
-
-        Returns
-        -------
-        dict
-            ``name -> (low, high, how)``: bounds of each assumed range (same units as the parameter) and how it is
-            sampled.
-        """
         o = self.option
         if o.rate_reduction is not None:
             return {}
@@ -458,22 +426,6 @@ class Scaling(OptionEffect):
             f"halving every {h:g} years; mean over the cycle)")}
 
     def stages(self, site, space, index):
-        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
-
-        Parameters
-        ----------
-        site : riskrf.risk.slope_models.SlopeModels
-            The site's slope models (simulated runs, mass grid, exposed road).
-        space : object
-            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
-        index : int
-            The option's position in the study.
-
-        Returns
-        -------
-        list
-            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
-        """
         o = self.option
         if o.rate_reduction is not None:
             return [ReleaseStage(o.name, space.column(f"rate_reduction:{o.name}"))]
@@ -501,22 +453,6 @@ class _SlopeGeometry(OptionEffect):
         return TYPED_RETENTION if self.option.retention is not None else GEOMETRY
 
     def stages(self, site, space, index):
-        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
-
-        Parameters
-        ----------
-        site : riskrf.risk.slope_models.SlopeModels
-            The site's slope models (simulated runs, mass grid, exposed road).
-        space : object
-            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
-        index : int
-            The option's position in the study.
-
-        Returns
-        -------
-        list
-            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
-        """
         if self.option.retention is None:
             return []               # derived: simulated with the option's other geometry changes
         return [RetentionStage(self.option.name, space.column(f"retention:{self.option.name}"))]
@@ -535,18 +471,6 @@ class CatchDitch(_SlopeGeometry):
     geometry_fields = ("x_m", "width_m", "depth_m")
 
     def describe(self, currency=""):
-        """What the option does, in words (money in ``currency``).
-
-        Parameters
-        ----------
-        currency : str, optional
-            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
-
-        Returns
-        -------
-        str
-            One-line description of the option, assumptions labelled ASSUMED.
-        """
         o = self.option
         if o.retention is not None:
             return _typed_retention(o, "catchment ditch")
@@ -574,18 +498,6 @@ class Bench(_SlopeGeometry):
     geometry_fields = ("x_m", "width_m")
 
     def describe(self, currency=""):
-        """What the option does, in words (money in ``currency``).
-
-        Parameters
-        ----------
-        currency : str, optional
-            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
-
-        Returns
-        -------
-        str
-            One-line description of the option, assumptions labelled ASSUMED.
-        """
         o = self.option
         if o.retention is not None:
             return _typed_retention(o, "bench")
@@ -599,18 +511,6 @@ class Bund(_SlopeGeometry):
     geometry_fields = ("x_m", "width_m", "height_m")
 
     def describe(self, currency=""):
-        """What the option does, in words (money in ``currency``).
-
-        Parameters
-        ----------
-        currency : str, optional
-            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
-
-        Returns
-        -------
-        str
-            One-line description of the option, assumptions labelled ASSUMED.
-        """
         o = self.option
         if o.retention is not None:
             return _typed_retention(o, "bund")
@@ -624,18 +524,6 @@ class Drape(_SlopeGeometry):
     geometry_fields = ("zone_x_m",)
 
     def describe(self, currency=""):
-        """What the option does, in words (money in ``currency``).
-
-        Parameters
-        ----------
-        currency : str, optional
-            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
-
-        Returns
-        -------
-        str
-            One-line description of the option, assumptions labelled ASSUMED.
-        """
         o = self.option
         if o.retention is not None:
             return _typed_retention(o, "drape")
@@ -707,18 +595,6 @@ class Barrier(_Structure):
     required_fields = ("capacity_kj", "height_m")
 
     def describe(self, currency=""):
-        """What the option does, in words (money in ``currency``).
-
-        Parameters
-        ----------
-        currency : str, optional
-            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
-
-        Returns
-        -------
-        str
-            One-line description of the option, assumptions labelled ASSUMED.
-        """
         o = self.option
         return (f"{o.kind} of {o.capacity_kj:,.0f} kJ (MEL), {o.height_m:g} m high"
                 + (f" at x = {o.x_m:g} m" if o.x_m is not None else " at the barrier line")
@@ -727,22 +603,6 @@ class Barrier(_Structure):
                 + f"; out of service {o.repair_days:g} days after an impact above MEL (assumption)")
 
     def stages(self, site, space, index):
-        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
-
-        Parameters
-        ----------
-        site : riskrf.risk.slope_models.SlopeModels
-            The site's slope models (simulated runs, mass grid, exposed road).
-        space : object
-            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
-        index : int
-            The option's position in the study.
-
-        Returns
-        -------
-        list
-            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
-        """
         return [self._stage(site, space, index, shed=False, coverage=1.0)]
 
 
@@ -753,40 +613,12 @@ class Shed(_Structure):
     required_fields = ("capacity_kj",)
 
     def describe(self, currency=""):
-        """What the option does, in words (money in ``currency``).
-
-        Parameters
-        ----------
-        currency : str, optional
-            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
-
-        Returns
-        -------
-        str
-            One-line description of the option, assumptions labelled ASSUMED.
-        """
         o = self.option
         return (f"rock shed of {o.capacity_kj:,.0f} kJ over "
                 + (f"{o.covered_length_m:g} m of road" if o.covered_length_m else "the exposed road")
                 + f"; out of service {o.repair_days:g} days after an impact above capacity (assumption)")
 
     def stages(self, site, space, index):
-        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
-
-        Parameters
-        ----------
-        site : riskrf.risk.slope_models.SlopeModels
-            The site's slope models (simulated runs, mass grid, exposed road).
-        space : object
-            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
-        index : int
-            The option's position in the study.
-
-        Returns
-        -------
-        list
-            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
-        """
         o = self.option
         coverage = min(o.covered_length_m / site.exposed_length_m, 1.0) if o.covered_length_m else 1.0
         return [self._stage(site, space, index, shed=True, coverage=coverage)]
@@ -798,18 +630,6 @@ class Realignment(OptionEffect):
     order = EXPOSURE
 
     def describe(self, currency=""):
-        """What the option does, in words (money in ``currency``).
-
-        Parameters
-        ----------
-        currency : str, optional
-            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
-
-        Returns
-        -------
-        str
-            One-line description of the option, assumptions labelled ASSUMED.
-        """
         o = self.option
         return (f"road moved to x = {o.road_x_m:g} m" if o.road_x_m is not None
                 else "road moved away from the slope (no exposure)")
@@ -819,22 +639,6 @@ class Realignment(OptionEffect):
         return "geometry: the road leaves the slope" if self.option.road_x_m is None else None
 
     def stages(self, site, space, index):
-        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
-
-        Parameters
-        ----------
-        site : riskrf.risk.slope_models.SlopeModels
-            The site's slope models (simulated runs, mass grid, exposed road).
-        space : object
-            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
-        index : int
-            The option's position in the study.
-
-        Returns
-        -------
-        list
-            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
-        """
         o = self.option
         if o.road_x_m is None:
             return [ExposureStage(o.name, np.zeros(len(site.models)))]
@@ -930,18 +734,6 @@ class Closure(OptionEffect):
         return super().typed or not self.option.has_closure_rule
 
     def describe(self, currency=""):
-        """What the option does, in words (money in ``currency``).
-
-        Parameters
-        ----------
-        currency : str, optional
-            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
-
-        Returns
-        -------
-        str
-            One-line description of the option, assumptions labelled ASSUMED.
-        """
         o = self.option
         if o.share_while_closed is None:
             return f"{o.rule_text()}; share and hours not yet computed (needs the site's rate model, [rates])"
@@ -959,18 +751,6 @@ class Closure(OptionEffect):
         return "computed: closure rule on the rate model and rainfall record"
 
     def check(self, source):
-        """Raise a MitigationError if the option cannot enter the engine yet.
-
-        Parameters
-        ----------
-        source : str
-            The file (or other source) the option came from, named in the error message.
-
-        Raises
-        ------
-        MitigationError
-            When the option cannot enter the engine yet.
-        """
         o = self.option
         if o.share_while_closed is None:
             raise MitigationError(
@@ -982,22 +762,6 @@ class Closure(OptionEffect):
         return [(f"closure_share:{self.option.name}", self.option.share_while_closed)]
 
     def stages(self, site, space, index):
-        """The option's typed stages for the engine (see :meth:`OptionEffect.stages`).
-
-        Parameters
-        ----------
-        site : riskrf.risk.slope_models.SlopeModels
-            The site's slope models (simulated runs, mass grid, exposed road).
-        space : object
-            The engine's parameter space; ``space.column(name)`` gives the sampled values of an effect parameter.
-        index : int
-            The option's position in the study.
-
-        Returns
-        -------
-        list
-            The option's stages (:mod:`riskrf.risk.loss_engine` stage objects), in the order they act.
-        """
         return [ClosureStage(self.option.name, space.column(f"closure_share:{self.option.name}"))]
 
 
@@ -1037,18 +801,6 @@ class Combined(OptionEffect):
         vals["options"] = tuple(comps)
 
     def describe(self, currency=""):
-        """What the option does, in words (money in ``currency``).
-
-        Parameters
-        ----------
-        currency : str, optional
-            Currency code printed after money amounts (e.g. ``"CHF"``); empty for none.
-
-        Returns
-        -------
-        str
-            One-line description of the option, assumptions labelled ASSUMED.
-        """
         return "combination of " + " + ".join(self.option.options)
 
     def components(self, option_named):
