@@ -409,7 +409,7 @@ def _envelope_contact(env_x, env_acc, xa, xb, x0, mass, inertia, r, contact_spee
 def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
              px, pz, tree, n_leaves, seg_mat, run_first, run_last,
              m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
-             m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k,
+             m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k, m_et_v0,
              c_x, c_cap, c_h, c_order, env_x, env_acc,
              g, v_contact, v_stop, sin_max_roll, max_events, key, n_path_blocks,
              out_x, out_z, out_reason, out_impacts, out_t,
@@ -477,6 +477,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
         Per material: rolling drag coefficient [-] (c = m_drag / r [1/m]).
     m_size_k : numpy.ndarray
         Per material: size coefficient of the rolling resistance [-].
+    m_et_v0 : numpy.ndarray
+        Per material: velocity scale of the tangential scaling [m/s] (inf: none; :func:`tangential_scaling`).
     c_x : numpy.ndarray
         Collector positions [m].
     c_cap : numpy.ndarray
@@ -657,7 +659,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 mu = math.tan(math.radians(min(max(phi, 0.0), 89.0)))
                 if vn < 0.0:
                     vn2, vt2, w, _ = rebound(vn, vt, w, r, k_in, m_en_law[mat], en, m_en_v0[mat], m_et_law[mat], et,
-                                             mu, gain)
+                                             mu, gain, m_et_v0[mat])
                 else:
                     vn2, vt2 = 0.0, vt
                 vx = vt2 * math.cos(bp) - vn2 * math.sin(bp)

@@ -444,7 +444,7 @@ def _find_impact(zg, x0, y0, dx, dy, lip, x, y, z, vx, vy, vz, g):
 def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                zg, x0, y0, dx, dy, lip, mat_grid,
                m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
-               m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k,
+               m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k, m_et_v0,
                c_ax, c_ay, c_bx, c_by, c_id, c_s0, c_cap, c_net,
                g, v_contact, v_stop, sin_max_roll, max_events, key, n_path_blocks, rec_pass,
                out_x, out_y, out_z, out_reason, out_impacts, out_t, out_excess, out_events,
@@ -511,6 +511,9 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
         Per material: rolling drag coefficient [-] (c = m_drag / r [1/m]).
     m_size_k : numpy.ndarray
         Per material: size term K of the rolling resistance [-] (:func:`simulation.contact.rolling_resistance`).
+    m_et_v0 : numpy.ndarray
+        Per material: velocity scale of the tangential scaling [m/s] (inf: none;
+        :func:`simulation.contact.tangential_scaling`).
     c_ax, c_ay, c_bx, c_by : numpy.ndarray
         Ends of the collector segments in plan [m].
     c_id : numpy.ndarray of int
@@ -738,7 +741,7 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                 w_eff = w * _axis_cos(sx, sy, tx, ty)      # spin about the axis normal to the travel
                 if vn < 0.0:
                     vn2, vt2, w2, _ = rebound(vn, vt, w_eff, r, k_in, m_en_law[mat], en, m_en_v0[mat], m_et_law[mat],
-                                              et, mu, gain)
+                                              et, mu, gain, m_et_v0[mat])
                 else:
                     vn2, vt2, w2 = 0.0, vt, w_eff
                 vx, vy, vz = vt2 * tx + vn2 * nnx, vt2 * ty + vn2 * nny, vt2 * tz + vn2 * nnz

@@ -192,7 +192,9 @@ class Material:
     ``contact_velocity_ms`` alone decides, as before); ``rolling_drag`` kappa [-]: in ground contact the block
     also decelerates by (kappa / r) v^2 (rolling over asperities, ploughing; 0: none);
     ``rolling_size_coefficient`` K [-]: the rolling resistance is tan(phi_g) + K roughness / r, so small blocks
-    stop sooner (0: tan(phi_g) alone).  In a file, ``preset = NAME`` starts from a named material and
+    stop sooner (0: tan(phi_g) alone); ``et_normal_scale_ms``: vt0 of the Pfeiffer & Bowen (1989) scaling of the
+    tangential energy by 1 / ((v_n / (vt0 e_N))^2 + 1) after a constant or Coulomb law (inf: none;
+    ``tangential.normal_scale_ms`` in a file, 76.2 m/s in CRSP).  In a file, ``preset = NAME`` starts from a named material and
     ``preset_basis = "data"`` beside it from its data-derived table (:func:`simulation.materials.preset`).
     See :mod:`simulation.contact`.
     """
@@ -214,6 +216,7 @@ class Material:
     hop_height_m: float = 0.0
     rolling_drag: float = 0.0
     rolling_size_coefficient: float = 0.0
+    et_normal_scale_ms: float = math.inf
 
     @classmethod
     def parse(cls, name: str, spec: dict, source: str) -> "Material":
@@ -281,7 +284,15 @@ class Material:
         et = spec.get("tangential", {"law": "friction", "friction_angle_deg": 30.0})
         if not isinstance(et, dict):
             raise ScenarioError(f"{source}: {where}tangential must be a table with 'law'")
-        _check_keys(et, {"law", "mean", "std", "friction_angle_deg", "std_deg"}, f"{where}tangential.", source)
+        _check_keys(et, {"law", "mean", "std", "friction_angle_deg", "std_deg", "normal_scale_ms"}, f"{where}tangential.",
+                    source)
+        et_v0 = math.inf
+        if "normal_scale_ms" in et:
+            if et.get("law", "friction") == "friction":
+                raise ScenarioError(f"{source}: {where}tangential.normal_scale_ms is not used by law 'friction' "
+                                    "(Stronge's impulse law); it scales the 'constant' and 'coulomb' laws")
+            et_v0 = _number(et["normal_scale_ms"], f"{where}tangential.normal_scale_ms", source, lo=0.0, hi=1e6,
+                            lo_open=True)
         if et.get("law", "friction") == "friction":
             et_law, et_mean, et_std = ET_FRICTION, 0.0, 0.0
             phi = _number(et.get("friction_angle_deg", 30.0), f"{where}tangential.friction_angle_deg", source,
@@ -320,7 +331,7 @@ class Material:
                    ground_friction_deg=_number(spec.get("ground_friction_angle_deg", 30.0 if motion == "slide"
                                                         else 15.0), f"{where}ground_friction_angle_deg", source,
                                                lo=0.0, hi=89.0),
-                   allow_energy_gain=gain, en_velocity_scale_ms=en_v0,
+                   allow_energy_gain=gain, en_velocity_scale_ms=en_v0, et_normal_scale_ms=et_v0,
                    hop_height_m=_number(spec.get("contact_hop_height_m", 0.0), f"{where}contact_hop_height_m",
                                         source, lo=0.0, hi=10.0),
                    rolling_drag=_number(spec.get("rolling_drag", 0.0), f"{where}rolling_drag", source, lo=0.0, hi=10.0),

@@ -19,7 +19,7 @@ from simulation.calibration import scenario_dict
 from simulation.contact import (EN_CONSTANT, EN_WYLLIE, ET_CONSTANT, ET_COULOMB, ET_FRICTION, contact_acceleration,
                                 contact_speed, contact_speed_at, contact_stop_distance, contact_time,
                                 coulomb_tangential, rebound, rolling_resistance, roughness_tilt_max,
-                                steep_face_launch, velocity_scaled)
+                                steep_face_launch, tangential_scaling, velocity_scaled)
 
 from .conftest import ROOT
 from .test_simulation_physics import G, scenario
@@ -76,15 +76,57 @@ def test_pfeiffer_bowen_velocity_scaling():
     assert en == pytest.approx(0.3 * 0.4554, abs=1e-4) and vn2 == pytest.approx(10.0 * en)
 
 
+def test_pfeiffer_bowen_tangential_scaling():
+    """The CRSP scaling factor SF = R_t / ((V_n / (76.2 R_n))^2 + 1) on the tangential energy (Pfeiffer & Bowen
+    1989; research/rockfall-simulation.md section 1.3, 76.2 m/s = 250 ft/s), here without its R_t (the law's
+    e_T), as a factor sqrt(SF / R_t) on the velocity."""
+    for vn, en in ((18.0, 0.25), (5.0, 0.25), (10.0, 0.4)):
+        sf_over_rt = 1.0 / ((vn / (76.2 * en)) ** 2 + 1.0)
+        assert tangential_scaling(-vn, en, 76.2) == pytest.approx(math.sqrt(sf_over_rt), rel=1e-12)
+    assert tangential_scaling(-18.0, 0.25, 76.2) == pytest.approx(0.7269, abs=1e-4)    # a free fall of 16.5 m
+    assert tangential_scaling(-5.0, 0.25, 76.2) == pytest.approx(0.9672, abs=1e-4)
+    assert tangential_scaling(-40.0, 0.25, math.inf) == 1.0
+    assert tangential_scaling(-10.0, 0.0, 76.2) == tangential_scaling(-10.0, 0.05, 76.2)     # e_N clipped
+    assert tangential_scaling(-10.0, 2.0, 76.2) == tangential_scaling(-10.0, 1.0, 76.2)
+    # in rebound: after the constant and Coulomb laws, on the tangential speed and spin only, with the normal
+    # law's e_N before its velocity scaling; Stronge's impulse law is left alone
+    f = tangential_scaling(-12.0, 0.3, 76.2)
+    base = rebound(-12.0, 6.0, 4.0, 0.5, 0.4, EN_CONSTANT, 0.3, 9.144, ET_CONSTANT, 0.5, 0.0, False)
+    scaled = rebound(-12.0, 6.0, 4.0, 0.5, 0.4, EN_CONSTANT, 0.3, 9.144, ET_CONSTANT, 0.5, 0.0, False, 76.2)
+    assert scaled[0] == base[0] and scaled[3] == base[3]
+    assert scaled[1] == pytest.approx(f * base[1], rel=1e-12) and scaled[2] == pytest.approx(f * base[2], rel=1e-12)
+    base = rebound(-12.0, 6.0, 4.0, 0.5, 0.4, EN_CONSTANT, 0.3, math.inf, ET_COULOMB, 0.5, 0.6, False)
+    scaled = rebound(-12.0, 6.0, 4.0, 0.5, 0.4, EN_CONSTANT, 0.3, math.inf, ET_COULOMB, 0.5, 0.6, False, 76.2)
+    assert scaled[1] == pytest.approx(f * base[1], rel=1e-12)
+    assert rebound(-12.0, 6.0, 4.0, 0.5, 0.4, EN_CONSTANT, 0.3, math.inf, ET_FRICTION, 0.5, 0.6, False, 76.2) == \
+        rebound(-12.0, 6.0, 4.0, 0.5, 0.4, EN_CONSTANT, 0.3, math.inf, ET_FRICTION, 0.5, 0.6, False)
+
+
+@pytest.mark.parametrize("h", [2.0, 20.0])
+def test_a_block_landing_on_a_bench_slides_the_distance_the_scaling_leaves(h):
+    """A block thrown horizontally at u = 6 m/s from h above flat ground, e_N = 0.1 (it stays in contact), e_T = 0.8,
+    sliding with phi_g = 30 deg: it stops at u sqrt(2 h / g) + (0.8 u s)^2 / (2 g tan 30 deg), s the tangential
+    scaling at v_n = sqrt(2 g h).  The higher fall lands harder and slides less far after landing."""
+    u, tan_g = 6.0, math.tan(math.radians(30.0))
+    sc = scenario([0, 200], [0, 0], material={"normal_restitution": {"law": "constant", "mean": 0.1},
+                                              "tangential": {"law": "constant", "mean": 0.8, "normal_scale_ms": 76.2},
+                                              "contact_hop_height_m": 1.0},
+                  seeder={"x": 10.0, "height_m": h, "vx_ms": u})
+    x = simulation.run(sc, n=1, seed=1).per_block["x"][0]
+    s = tangential_scaling(-math.sqrt(2 * G * h), 0.1, 76.2)
+    assert x == pytest.approx(10.0 + u * math.sqrt(2 * h / G) + (0.8 * u * s) ** 2 / (2 * G * tan_g), rel=1e-9)
+    assert s < (0.75 if h > 10 else 0.99)
+
+
 @settings(max_examples=300)
 @given(vn=st.floats(-40.0, -0.01), vt=st.floats(-30.0, 30.0), w=st.floats(-60.0, 60.0), r=st.floats(0.05, 3.0),
        k=st.sampled_from([0.4, 0.5]), en_law=st.sampled_from([EN_CONSTANT, EN_WYLLIE]), en=st.floats(0.0, 1.0),
        v0=st.sampled_from([math.inf, 9.144, 3.0]), et_law=st.sampled_from([ET_CONSTANT, ET_FRICTION, ET_COULOMB]),
-       et=st.floats(0.0, 1.0), mu=st.floats(0.0, 2.0))
-def test_no_impact_law_creates_energy(vn, vt, w, r, k, en_law, en, v0, et_law, et, mu):
+       et=st.floats(0.0, 1.0), mu=st.floats(0.0, 2.0), vt0=st.sampled_from([math.inf, 76.2, 5.0]))
+def test_no_impact_law_creates_energy(vn, vt, w, r, k, en_law, en, v0, et_law, et, mu, vt0):
     if en_law == EN_WYLLIE:
         en = en - 0.5                      # a deviation from the law's value
-    vn2, vt2, w2, _ = rebound(vn, vt, w, r, k, en_law, en, v0, et_law, et, mu, False)
+    vn2, vt2, w2, _ = rebound(vn, vt, w, r, k, en_law, en, v0, et_law, et, mu, False, vt0)
     e_in = vn * vn + vt * vt + k * r * r * w * w
     assert vn2 >= 0.0
     assert vn2 * vn2 + vt2 * vt2 + k * r * r * w2 * w2 <= e_in * (1 + 1e-12) + 1e-12
@@ -215,15 +257,18 @@ profiles = st.lists(st.floats(-75.0, 15.0), min_size=1, max_size=8).map(
 
 @settings(max_examples=30, deadline=None)
 @given(z=profiles, law=st.sampled_from(["constant", "wyllie"]), v0=st.sampled_from([None, 9.144]),
+       vt0=st.sampled_from([None, 76.2]),
        hop=st.floats(0.0, 0.5), drag=st.floats(0.0, 0.2), size_k=st.floats(0.0, 2.0), rough=st.floats(0.0, 0.3),
        steep=st.sampled_from([90.0, 55.0]), seed=st.integers(0, 1000), shape=st.sampled_from(["sphere", "disc"]))
-def test_energy_never_increases_with_the_new_contact_model(z, law, v0, hop, drag, size_k, rough, steep, seed, shape):
+def test_energy_never_increases_with_the_new_contact_model(z, law, v0, vt0, hop, drag, size_k, rough, steep, seed,
+                                                           shape):
     x = np.arange(z.size) * 10.0
     z = z - z.min() + 1.0
     nr = {"law": law} if law == "wyllie" else {"law": law, "mean": 0.3, "std": 0.05}
     if v0 is not None:
         nr["velocity_scale_ms"] = v0
-    sc = scenario(list(x), list(z), material={"normal_restitution": nr, "tangential": COULOMB, "roughness_m": rough,
+    tangential = COULOMB if vt0 is None else {**COULOMB, "normal_scale_ms": vt0}
+    sc = scenario(list(x), list(z), material={"normal_restitution": nr, "tangential": tangential, "roughness_m": rough,
                                               "ground_motion": "roll", "ground_friction_angle_deg": 25.0,
                                               "contact_hop_height_m": hop, "rolling_drag": drag,
                                               "rolling_size_coefficient": size_k},
@@ -283,6 +328,9 @@ def test_rolling_resistance_is_the_tangent_of_the_ground_friction_angle():
     ({"tangential": {"law": "constant", "mean": 0.5, "friction_angle_deg": 30.0}},
      "friction_angle_deg is not used by law 'constant'"),
     ({"tangential": {"law": "plough"}}, "is not 'friction', 'constant' or 'coulomb'"),
+    ({"tangential": {"law": "friction", "normal_scale_ms": 76.2}},
+     "test: materials.m.tangential.normal_scale_ms is not used by law 'friction'"),
+    ({"tangential": {"law": "coulomb", "mean": 0.5, "normal_scale_ms": -3}}, "normal_scale_ms = -3 is outside"),
     ({"contact_hop_height_m": -1.0}, "contact_hop_height_m = -1.0 is outside"),
     ({"rolling_drag": "a lot"}, "rolling_drag must be a number"),
 ])
