@@ -57,6 +57,24 @@ def test_a_dropped_block_bounces_as_the_velocity_law_and_the_hop_height_say(hop_
     assert flights == (1 if hop_m == 0.0 else 0)
 
 
+@pytest.mark.parametrize("h", [2.0, 20.0])
+def test_a_block_landing_on_flat_ground_slides_the_distance_the_tangential_scaling_leaves(h):
+    """The 2-D exact case of tests/test_contact.py on a DEM: thrown at u = 6 m/s along +x from h above flat ground
+    (e_N 0.1, e_T 0.8 scaled by Pfeiffer & Bowen's factor s at v_n = sqrt(2 g h), sliding with phi_g 30 deg), the
+    block stops at u sqrt(2 h / g) + (0.8 u s)^2 / (2 g tan 30 deg) from its source."""
+    from simulation.contact import tangential_scaling
+    flat = Terrain.from_function(lambda x, y: 0 * x + 10.0, (0, 60), (0, 40), 1.0)
+    mats = {"m": {"normal_restitution": {"law": "constant", "mean": 0.1}, "roughness_m": 0.0,
+                  "tangential": {"law": "constant", "mean": 0.8, "normal_scale_ms": 76.2},
+                  "ground_motion": "slide", "ground_friction_angle_deg": 30.0, "contact_hop_height_m": 1.0}}
+    sc = _scenario(flat, mats, {"points": [[10.0, 20.0]], "height_m": h, "mass_kg": 1000, "speed_ms": 6.0})
+    r = run_terrain(sc, 1, seed=1)
+    s = tangential_scaling(-math.sqrt(2 * G * h), 0.1, 76.2)
+    expected = 6.0 * math.sqrt(2 * h / G) + (0.8 * 6.0 * s) ** 2 / (2 * G * math.tan(math.radians(30.0)))
+    assert r.per_block["x"][0] - 10.0 == pytest.approx(expected, rel=1e-9)
+    assert r.per_block["y"][0] == pytest.approx(20.0, abs=1e-12)
+
+
 T70, T34 = np.tan(np.radians(70.0)), np.tan(np.radians(34.0))
 
 

@@ -142,9 +142,8 @@ class CatchmentStudy:
                     "source": "W = 0.2 H + 4.5 m, Ryan & Pryor (2000) after Ritchie (1963), quoted by Warren et al. "
                               "(2025, SSIM, doi 10.36487/ACG_repo/2535_04)",
                     "width_m": w_mrc, "simulated_retained_percent": 100.0 * float(self.retained_at(w_mrc)),
-                    "note": "a rule for a cut face above a flat catchment or bench; on the ODOT 60 ft cut the data-derived "
-                            "presets re-simulate a 90 % width of 7.6 m against its 8.16 m; with the earlier riskrf "
-                            "starting values it was 17.3 m (docs/validation/design-standards.md)"},
+                    "note": "a rule for a cut face above a flat catchment or bench; the ODOT 60 ft cut re-simulated "
+                            "with the data-derived presets is compared with it in docs/validation/design-standards.md"},
                 "width_for_retention_m": {f"{q:g}": (None if not np.isfinite(w) else w)
                                           for q, w in self.widths.items()},
                 "chart_source": self.chart_source or None,
