@@ -243,6 +243,254 @@ def _variant_text(name):
     return VARIANTS.get(name, name)
 
 
+#: Money columns of the ranked and budget-curve tables of the HTML report.
+_RANKED_MONEY_COLUMNS = ("best_option_capital", "best_option_total_cost", "expected_annual_cost_per_km", "spend",
+                         "cumulative_spend")
+
+
+def _caption_rows(caption: str, n: int, csv: str) -> str:
+    """A table caption that says when only the first :data:`HTML_ROWS` of ``n`` rows are shown.
+
+    Parameters
+    ----------
+    caption : str
+        The caption.
+    n : int
+        Rows of the whole table.
+    csv : str
+        The file that holds every row.
+
+    Returns
+    -------
+    str
+        The caption, with "(first ... of n; all in csv)" when ``n`` exceeds :data:`HTML_ROWS`.
+    """
+    return caption + (f" (first {HTML_ROWS} of {n}; all in {csv})" if n > HTML_ROWS else "")
+
+
+def _ranked_tables(s):
+    """The ranked summary as the report shows it, and the sections whose RHRS and risk ranks disagree.
+
+    Parameters
+    ----------
+    s : pandas.DataFrame
+        :meth:`CorridorResult.summary`.
+
+    Returns
+    -------
+    s : pandas.DataFrame
+        Whole-point RHRS total only; integer ranks, blank for a section without RHRS attributes.
+    disagree : pandas.DataFrame
+        Sections whose ranks differ by at least ``places``.
+    places : int
+        The rank difference that counts as a disagreement.
+    """
+    places = max(3, len(s) // 5)
+    disagree = s[(s["rank_difference"].abs() >= places).fillna(False).astype(bool)] \
+        if s["rank_rhrs"].notna().any() else s.iloc[0:0]
+    s = s.drop(columns=["rhrs_score"]) if "rhrs_total" in s and "rhrs_score" in s else s.copy()   # whole points
+    for col in ("rank_rhrs", "rank_difference"):           # integer ranks; a section without RHRS attributes: blank
+        s[col] = s[col].astype(object).where(s[col].notna(), "")
+    disagree = disagree.astype({"rank_rhrs": object, "rank_difference": object})
+    return s, disagree, places
+
+
+def _report_header(res) -> str:
+    """The title block of the corridor report: how the run went and the corridor's key figures.
+
+    Parameters
+    ----------
+    res : CorridorResult
+        The corridor's results.
+
+    Returns
+    -------
+    str
+        HTML: title, run line and the key-figures box (deaths per year, capital, rates, hazard, mass law).
+    """
+    c, t = res.corridor, res.table
+    return (f"<h1>{escape(c.name)}</h1>"
+            f"<p>{len(t)} sections assessed on {res.workers} dask worker(s) in {res.seconds:.1f} s, "
+            f"{res.n_blocks:,} simulated blocks per section, corridor seed {c.seed} (riskrf {__version__}).</p>"
+            "<div class='box'><ul>"
+            f"<li>Deaths per year, doing nothing: {cell(float(t['deaths_per_year'].sum()))}; with each section's "
+            f"best option: {cell(float(t['best_deaths_per_year'].sum()))}</li>"
+            f"<li>Capital of the best options: "
+            f"{cell(float(t['best_option_capital'].sum()), money_columns=True, currency=c.currency)}</li><li>Rates: "
+            + ("falls reaching the road (as recorded), release rate derived per section from the share reaching "
+               "the road averaged over the mass law" if c.rate_basis == "road" else "falls released (>= m_min)")
+            + "</li><li>Hazard at the barrier line mass-coupled as in riskrf assess (blocks simulated across the "
+              "mass law, reach and speed by mass class); the cut's own seeder only for the option effects"
+            + f"</li><li>{escape(c.mass_note)}</li></ul></div>")
+
+
+def _chainage_section(doc: Document, n: int, figure_png: Path) -> None:
+    """Add the section "Along the chainage" with the chainage figure.
+
+    Parameters
+    ----------
+    doc : Document
+        The report.
+    n : int
+        Number of sections (above :data:`AGGREGATE_ABOVE` the figure is binned).
+    figure_png : pathlib.Path
+        The chainage figure.
+    """
+    doc.section("Along the chainage")
+    doc.add(doc.figure(figure_png, "RHRS score, individual risk and deaths per year per km of each section, doing "
+                                   "nothing and with its best option"
+                       + (f" (binned: {n:,} sections in {CHAINAGE_BINS} bins of chainage)"
+                          if n > AGGREGATE_ABOVE else "")))
+
+
+def _map_section(doc: Document, c, figures: dict, funded: bool) -> None:
+    """Add the section "On the road" with the map of the sections on the centreline.
+
+    Parameters
+    ----------
+    doc : Document
+        The report.
+    c : Corridor
+        The corridor (its centreline and CRS).
+    figures : dict
+        Figures by name (the map under ``map``).
+    funded : bool
+        Whether the map marks the sections a programme funds.
+    """
+    doc.section("On the road")
+    doc.add(f"<p>Each section's line on the road centreline ({escape(c.centreline.source)}, {escape(c.crs)}); "
+            "the same lines with every column of sections.csv are in <code>sections.gpkg</code> for a GIS.</p>",
+            doc.figure(figures["map"], "Sections on the road, coloured by deaths per year per km of doing "
+                                       "nothing" + ("; wide black casing: funded by the programme" if funded else "")))
+
+
+def _programme_box(c, programme, budget_basis: str) -> str:
+    """What the budget caps, what the programme maximises and buys, and how capital and present value differ.
+
+    Parameters
+    ----------
+    c : Corridor
+        The corridor (currency, economics).
+    programme : Programme
+        The budget programme.
+    budget_basis : str
+        ``"total"`` or ``"year"``.
+
+    Returns
+    -------
+    str
+        HTML box.
+    """
+    cur = c.currency
+    caps = {"total": "the capital of the chosen options (money paid now)",
+            "year": "the equivalent annual cost of the chosen options (present value of capital, renewals and "
+                    "maintenance, spread as a level cost per year at the discount rate)"}[budget_basis]
+    buys = {"deaths_avoided_per_year": "the deaths avoided per year",
+            "expected_total_cost_saving": "the saving in expected total cost (capital + discounted "
+                                          "maintenance, renewals and expected losses) against doing nothing"}
+    e = c.study["economics"]
+    return (f"<div class='box'><p>Budget {cell(programme.budget, money_columns=True, currency=cur)} caps "
+            f"{caps}. The programme gives each section at most one option and maximises "
+            f"{buys[programme.benefit_column]}; it is solved as a mixed-integer programme, not by a greedy order, "
+            + ("and proven optimal. " if programme.gap == 0 else
+               f"which stopped at its time limit: the programme is within {programme.gap:.2g} (relative) of the "
+               "optimum. ")
+            + f"It funds {len(programme.chosen)} of {programme.n_sections} sections for "
+            f"{cell(programme.cost, money_columns=True, currency=cur)} and buys {cell(programme.benefit)}"
+            + (" deaths avoided per year" if programme.benefit_column == "deaths_avoided_per_year" else
+               f" {escape(cur)} of expected total cost saved") + ".</p>"
+            f"<p><b>Capital</b> is what the works cost when built. <b>Present value</b> adds renewals at the end "
+            f"of each option's life and yearly maintenance over {e.horizon_years:g} years, discounted at "
+            f"{e.discount_rate:.1%}. Per-metre costs are paid on each section's cut length.</p></div>")
+
+
+def _programme_section(doc: Document, res, programme, figures: dict, budget_basis: str) -> None:
+    """Add the section "Programme within the budget": its explanation, the funded sections and the frontier.
+
+    Parameters
+    ----------
+    doc : Document
+        The report.
+    res : CorridorResult
+        The corridor's results.
+    programme : Programme
+        The budget programme.
+    figures : dict
+        Figures by name (``frontier`` is shown when present).
+    budget_basis : str
+        ``"total"`` or ``"year"``.
+    """
+    box = _programme_box(res.corridor, programme, budget_basis)
+    doc.section("Programme within the budget")
+    doc.add(box)
+    pt = res.programme_table(programme)
+    funded = pt[pt["programme_option"] != ""]
+    doc.add(doc.table(funded.head(HTML_ROWS), _caption_rows("Sections the programme funds", len(funded),
+                                                            "programme.csv"),
+                      money_columns=("do_nothing_total_cost", "programme_capital", "programme_present_value",
+                                     "programme_equivalent_annual_cost", "programme_expected_total_cost"),
+                      currency=res.corridor.currency))
+    if "frontier" in figures:
+        doc.add(doc.figure(figures["frontier"], "Efficient frontier: what the best programme buys at each "
+                                                "budget (each point an exact programme; frontier.csv)"))
+
+
+def _ranking_sections(doc: Document, s, b, disagree, places: int, cur: str) -> None:
+    """Add the sections of the ranked table, the budget curve and, if any, the sections whose ranks disagree.
+
+    Parameters
+    ----------
+    doc : Document
+        The report.
+    s : pandas.DataFrame
+        The ranked summary as shown (:func:`_ranked_tables`).
+    b : pandas.DataFrame
+        :meth:`CorridorResult.budget_curve`.
+    disagree : pandas.DataFrame
+        Sections whose RHRS and risk ranks differ by at least ``places``.
+    places : int
+        That rank difference.
+    cur : str
+        Currency.
+    """
+    doc.section("Sections ranked by quantitative risk (RHRS rank beside)")
+    doc.add("<p>Whole-point RHRS category scores and totals of every section are in sections.csv; one rating sheet "
+            "per section is in <code>rating_sheets.html</code>.</p>",
+            doc.table(s.head(HTML_ROWS), _caption_rows("Sections ranked by risk", len(s), "corridor.csv"),
+                      money_columns=_RANKED_MONEY_COLUMNS, currency=cur))
+    doc.section("Budget curve")
+    doc.add("<p>Sections in order of deaths avoided per unit spent with their best option: what a budget buys when "
+            "sections are done in this order (a greedy order; the programme above is the exact choice). Spend is "
+            "the present value (capital + renewals + maintenance) above doing nothing.</p>",
+            doc.table(b.head(HTML_ROWS), _caption_rows("Budget curve", len(b), "budget_curve.csv"),
+                      money_columns=_RANKED_MONEY_COLUMNS, currency=cur))
+    if len(disagree):
+        doc.section("Where the RHRS and the risk ranking disagree")
+        doc.add(f"<p>Sections whose RHRS rank and risk rank differ by at least {places} places.</p>",
+                doc.table(disagree[["id", "rank_risk", "rank_rhrs", "rhrs_total" if "rhrs_total" in disagree else
+                                    "rhrs_score", "deaths_per_year", "individual_risk"]].head(HTML_ROWS),
+                          "RHRS and risk ranks that disagree"))
+
+
+def _closing_sections(doc: Document, res) -> None:
+    """Add the closing sections: rejected rows and failed sections (if any) and the inputs left at their defaults.
+
+    Parameters
+    ----------
+    doc : Document
+        The report.
+    res : CorridorResult
+        The corridor's results.
+    """
+    c = res.corridor
+    if c.errors or res.failures:
+        doc.section("Rejected rows and failed sections")
+        doc.add("<div class='warn'><ul>" + "".join(f"<li>{escape(e)}</li>" for e in list(c.errors) + list(res.failures))
+                + "</ul></div>")
+    doc.section("Inputs left at their defaults")
+    doc.add("<ul>" + "".join(f"<li>{escape(d)}</li>" for d in c.defaults_used) + "</ul>")
+
+
 def render_corridor_html(res, figure_png: Path, *, figures: dict | None = None, programme=None, frontier=None,
                          budget_basis: str = "total") -> str:
     """Self-contained HTML corridor report: key figures, chainage figure, map, the budget programme and its
@@ -271,98 +519,16 @@ def render_corridor_html(res, figure_png: Path, *, figures: dict | None = None, 
     """
     figures = figures or {}
     c = res.corridor
-    cur = c.currency
     s = res.summary()
     b = res.budget_curve()
-    t = res.table
-    money_cols = ("best_option_capital", "best_option_total_cost", "expected_annual_cost_per_km", "spend",
-                  "cumulative_spend")
-    disagree = s[(s["rank_difference"].abs() >= max(3, len(s) // 5)).fillna(False).astype(bool)] \
-        if s["rank_rhrs"].notna().any() else s.iloc[0:0]
-    s = s.drop(columns=["rhrs_score"]) if "rhrs_total" in s and "rhrs_score" in s else s.copy()   # whole points
-    for col in ("rank_rhrs", "rank_difference"):           # integer ranks; a section without RHRS attributes: blank
-        s[col] = s[col].astype(object).where(s[col].notna(), "")
-    disagree = disagree.astype({"rank_rhrs": object, "rank_difference": object})
+    s, disagree, places = _ranked_tables(s)
     doc = Document(title=c.name)
-    header = (f"<h1>{escape(c.name)}</h1>"
-              f"<p>{len(t)} sections assessed on {res.workers} dask worker(s) in {res.seconds:.1f} s, "
-              f"{res.n_blocks:,} simulated blocks per section, corridor seed {c.seed} (riskrf {__version__}).</p>"
-              "<div class='box'><ul>"
-              f"<li>Deaths per year, doing nothing: {cell(float(t['deaths_per_year'].sum()))}; with each section's "
-              f"best option: {cell(float(t['best_deaths_per_year'].sum()))}</li>"
-              f"<li>Capital of the best options: "
-              f"{cell(float(t['best_option_capital'].sum()), money_columns=True, currency=cur)}</li><li>Rates: "
-              + ("falls reaching the road (as recorded), release rate derived per section from the share reaching "
-                 "the road averaged over the mass law" if c.rate_basis == "road" else "falls released (>= m_min)")
-              + "</li><li>Hazard at the barrier line mass-coupled as in riskrf assess (blocks simulated across the "
-                "mass law, reach and speed by mass class); the cut's own seeder only for the option effects"
-              + f"</li><li>{escape(c.mass_note)}</li></ul></div>")
-    doc.section("Along the chainage")
-    doc.add(doc.figure(figure_png, "RHRS score, individual risk and deaths per year per km of each section, doing "
-                                   "nothing and with its best option"
-                       + (f" (binned: {len(t):,} sections in {CHAINAGE_BINS} bins of chainage)"
-                          if len(t) > AGGREGATE_ABOVE else "")))
+    header = _report_header(res)
+    _chainage_section(doc, len(res.table), figure_png)
     if "map" in figures:
-        doc.section("On the road")
-        doc.add(f"<p>Each section's line on the road centreline ({escape(c.centreline.source)}, {escape(c.crs)}); "
-                "the same lines with every column of sections.csv are in <code>sections.gpkg</code> for a GIS.</p>",
-                doc.figure(figures["map"], "Sections on the road, coloured by deaths per year per km of doing "
-                                           "nothing" + ("; wide black casing: funded by the programme"
-                                                        if programme is not None else "")))
+        _map_section(doc, c, figures, programme is not None)
     if programme is not None:
-        caps = {"total": "the capital of the chosen options (money paid now)",
-                "year": "the equivalent annual cost of the chosen options (present value of capital, renewals and "
-                        "maintenance, spread as a level cost per year at the discount rate)"}[budget_basis]
-        buys = {"deaths_avoided_per_year": "the deaths avoided per year",
-                "expected_total_cost_saving": "the saving in expected total cost (capital + discounted "
-                                              "maintenance, renewals and expected losses) against doing nothing"}
-        e = c.study["economics"]
-        doc.section("Programme within the budget")
-        doc.add(f"<div class='box'><p>Budget {cell(programme.budget, money_columns=True, currency=cur)} caps "
-                f"{caps}. The programme gives each section at most one option and maximises "
-                f"{buys[programme.benefit_column]}; it is solved as a mixed-integer programme, not by a greedy order, "
-                + ("and proven optimal. " if programme.gap == 0 else
-                   f"which stopped at its time limit: the programme is within {programme.gap:.2g} (relative) of the "
-                   "optimum. ")
-                + f"It funds {len(programme.chosen)} of {programme.n_sections} sections for "
-                f"{cell(programme.cost, money_columns=True, currency=cur)} and buys {cell(programme.benefit)}"
-                + (" deaths avoided per year" if programme.benefit_column == "deaths_avoided_per_year" else
-                   f" {escape(cur)} of expected total cost saved") + ".</p>"
-                f"<p><b>Capital</b> is what the works cost when built. <b>Present value</b> adds renewals at the end "
-                f"of each option's life and yearly maintenance over {e.horizon_years:g} years, discounted at "
-                f"{e.discount_rate:.1%}. Per-metre costs are paid on each section's cut length.</p></div>")
-        pt = res.programme_table(programme)
-        funded = pt[pt["programme_option"] != ""]
-        doc.add(doc.table(funded.head(HTML_ROWS), "Sections the programme funds" + (
-            f" (first {HTML_ROWS} of {len(funded)}; all in programme.csv)" if len(funded) > HTML_ROWS else ""),
-            money_columns=("do_nothing_total_cost", "programme_capital", "programme_present_value",
-                           "programme_equivalent_annual_cost", "programme_expected_total_cost"), currency=cur))
-        if "frontier" in figures:
-            doc.add(doc.figure(figures["frontier"], "Efficient frontier: what the best programme buys at each "
-                                                    "budget (each point an exact programme; frontier.csv)"))
-    doc.section("Sections ranked by quantitative risk (RHRS rank beside)")
-    doc.add("<p>Whole-point RHRS category scores and totals of every section are in sections.csv; one rating sheet "
-            "per section is in <code>rating_sheets.html</code>.</p>",
-            doc.table(s.head(HTML_ROWS), "Sections ranked by risk" + (
-                f" (first {HTML_ROWS} of {len(s)}; all in corridor.csv)" if len(s) > HTML_ROWS else ""),
-                money_columns=money_cols, currency=cur))
-    doc.section("Budget curve")
-    doc.add("<p>Sections in order of deaths avoided per unit spent with their best option: what a budget buys when "
-            "sections are done in this order (a greedy order; the programme above is the exact choice). Spend is "
-            "the present value (capital + renewals + maintenance) above doing nothing.</p>",
-            doc.table(b.head(HTML_ROWS), "Budget curve" + (f" (first {HTML_ROWS} of {len(b)}; all in "
-                                                           "budget_curve.csv)" if len(b) > HTML_ROWS else ""),
-                      money_columns=money_cols, currency=cur))
-    if len(disagree):
-        doc.section("Where the RHRS and the risk ranking disagree")
-        doc.add(f"<p>Sections whose RHRS rank and risk rank differ by at least {max(3, len(s) // 5)} places.</p>",
-                doc.table(disagree[["id", "rank_risk", "rank_rhrs", "rhrs_total" if "rhrs_total" in disagree else
-                                    "rhrs_score", "deaths_per_year", "individual_risk"]].head(HTML_ROWS),
-                          "RHRS and risk ranks that disagree"))
-    if c.errors or res.failures:
-        doc.section("Rejected rows and failed sections")
-        doc.add("<div class='warn'><ul>" + "".join(f"<li>{escape(e)}</li>" for e in list(c.errors) + list(res.failures))
-                + "</ul></div>")
-    doc.section("Inputs left at their defaults")
-    doc.add("<ul>" + "".join(f"<li>{escape(d)}</li>" for d in c.defaults_used) + "</ul>")
+        _programme_section(doc, res, programme, figures, budget_basis)
+    _ranking_sections(doc, s, b, disagree, places, c.currency)
+    _closing_sections(doc, res)
     return doc.render(header=header)
