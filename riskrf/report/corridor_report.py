@@ -253,12 +253,10 @@ def _caption_rows(caption: str, n: int, csv: str) -> str:
 
     Parameters
     ----------
-    caption : str
-        The caption.
+    caption, csv : str
+        The caption, and the file that holds every row.
     n : int
         Rows of the whole table.
-    csv : str
-        The file that holds every row.
 
     Returns
     -------
@@ -301,7 +299,7 @@ def _report_header(res) -> str:
     Parameters
     ----------
     res : CorridorResult
-        The corridor's results.
+        The corridor run: its corridor, table, workers, seconds and blocks per section.
 
     Returns
     -------
@@ -480,7 +478,7 @@ def _closing_sections(doc: Document, res) -> None:
     doc : Document
         The report.
     res : CorridorResult
-        The corridor's results.
+        The corridor run: its failures, and its corridor's rejected rows and defaults used.
     """
     c = res.corridor
     if c.errors or res.failures:
