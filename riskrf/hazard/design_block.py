@@ -642,8 +642,8 @@ def _chosen_row(alt: pd.DataFrame, hazard, coupled: bool, rule: str, pct: float,
         above = alt["mass_kg"] > m_max * (1 + 1e-12)
         alt.loc[above, "note"] = alt.loc[above, "note"] + "; ABOVE the stated maximum credible block m_max"
         if row["mass_kg"] > m_max * (1 + 1e-12):
-            raise ValueError(f"design block {row['mass_kg']:.6g} kg ({row['rule']}) exceeds the stated maximum credible "
-                             f"block m_max = {m_max:.6g} kg: revise m_max or the design-block rule")
+            raise ValueError(f"design block {row['mass_kg']:.6g} kg ({row['rule']}) exceeds the stated maximum "
+                             f"credible block m_max = {m_max:.6g} kg: revise m_max or the design-block rule")
     return row
 
 
