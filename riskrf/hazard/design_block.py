@@ -449,21 +449,71 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
     pct = check_percentile(percentile, "design_block.percentile")
     rho = check_positive(density_kg_m3, "density_kg_m3")
     T = check_positive(design_T, "design_T")
-    assumptions = []
-    survey, source = None, None
+    survey, source, assumptions = _block_sizes(survey_volumes_m3, survey_source, inventory, sizes, rule)
+    fragmenting, stated = _check_rule_arguments(rule, survey, fractal_dimension, iterations)
+    assumptions += stated
+    if sizes == "event_volumes":
+        assumptions.append("the inventory records event volumes; the return-period block treats a detached volume "
+                           "as one intact block (an upper bound)")
+    coupled = bool(getattr(hazard, "mass_coupled", False))
+    alt = _alternatives(hazard, coupled, survey, source, pct, T, rho,
+                        (fractal_dimension, iterations) if fragmenting else None)
+    row = _chosen_row(alt, hazard, coupled, rule, pct, T)
+    basis = _basis(rule, pct, T, source, fractal_dimension, iterations)
+    return DesignBlock(rule=rule, mass_kg=float(row["mass_kg"]), volume_m3=float(row["volume_m3"]),
+                       diameter_m=float(row["diameter_m"]), basis=basis, assumptions=tuple(assumptions),
+                       alternatives=alt, inputs=inputs)
+
+
+def _block_sizes(survey_volumes_m3, survey_source, inventory, sizes: str, rule: str):
+    """The block sizes the percentile rule reads: the block survey, else the inventory's own sizes.
+
+    Parameters
+    ----------
+    survey_volumes_m3, survey_source, inventory, sizes, rule
+        As in :func:`design_block`.
+
+    Returns
+    -------
+    tuple
+        (block volumes [m³] or None, their source in words or None, the list of assumptions the substitution
+        makes: the inventory's event volumes standing in for blocks under the percentile rule).
+    """
     if survey_volumes_m3 is not None:
-        survey = np.asarray(survey_volumes_m3, dtype=float)
-        source = f"block survey {survey_source or ''}".strip()
-    elif inventory is not None:
-        survey = inventory.masses / inventory.density_kg_m3
-        source = f"inventory {Path(str(inventory.source)).name} ({'event volumes' if sizes == 'event_volumes' else 'block sizes'})"
-        if sizes == "event_volumes" and rule == "percentile":
-            assumptions.append("ASSUMPTION: no block survey; the percentile is taken of the inventory's EVENT "
-                               "volumes, which overstate the blocks that reach a barrier (detachments break up)")
+        return np.asarray(survey_volumes_m3, dtype=float), f"block survey {survey_source or ''}".strip(), []
+    if inventory is None:
+        return None, None, []
+    volumes = inventory.masses / inventory.density_kg_m3
+    kind = "event volumes" if sizes == "event_volumes" else "block sizes"
+    source = f"inventory {Path(str(inventory.source)).name} ({kind})"
+    assumptions = []
+    if sizes == "event_volumes" and rule == "percentile":
+        assumptions.append("ASSUMPTION: no block survey; the percentile is taken of the inventory's EVENT "
+                           "volumes, which overstate the blocks that reach a barrier (detachments break up)")
+    return volumes, source, assumptions
+
+
+def _check_rule_arguments(rule: str, survey, fractal_dimension, iterations):
+    """Check, before any work, what the rule needs: both fragmentation parameters (valid) for the fragmentation
+    rule or whenever one is given, and block sizes (``survey``) for the percentile rule.
+
+    Parameters
+    ----------
+    rule, fractal_dimension, iterations
+        As in :func:`design_block`.
+    survey : numpy.ndarray or None
+        Block volumes [m³] (:func:`_block_sizes`).
+
+    Returns
+    -------
+    tuple
+        (True when fragmentation parameters are stated, the list of assumptions they make).
+    """
     fragmenting = fractal_dimension is not None or iterations is not None
     if rule == "fragmentation" and not fragmenting:
         raise ValueError("design_block.rule = 'fragmentation' needs design_block.fractal_dimension and "
                          "design_block.iterations (the user's stated fragmentation parameters)")
+    assumptions = []
     if fragmenting:
         fractal_fragments(1.0, fractal_dimension, iterations)        # checks both parameters before any work
         assumptions.append(f"ASSUMPTION: fragmentation parameters stated, not calibrated: fractal dimension "
@@ -471,40 +521,109 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
     if rule == "percentile" and survey is None:
         raise ValueError("design_block.rule = 'percentile' needs a block survey (design_block.survey) or an "
                          "inventory whose sizes stand in for one")
-    if sizes == "event_volumes":
-        assumptions.append("the inventory records event volumes; the return-period block treats a detached volume "
-                           "as one intact block (an upper bound)")
+    return fragmenting, assumptions
+
+
+def _alternative(hazard, coupled: bool, density_kg_m3: float, name: str, mass: float, note: str) -> dict:
+    """One row of the alternatives table: the candidate ``name`` of ``mass`` [kg].
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard (speeds of blocks of that mass).
+    coupled : bool
+        Whether the hazard is mass-coupled (a mass outside its simulated masses is labelled).
+    density_kg_m3 : float
+        Rock density [kg/m³].
+    name, note : str
+        The candidate and where it comes from.
+    mass : float
+        Mass [kg], NaN when undefined.
+
+    Returns
+    -------
+    dict
+        ``rule``, ``mass_kg``, ``volume_m3``, ``diameter_m`` (equivalent sphere), ``velocity_p95_ms``,
+        ``energy_at_v95_kj`` and ``note``.
+    """
+    v95 = hazard.velocity_percentile(95, mass_kg=mass) if np.isfinite(mass) else np.nan
+    if coupled and np.isfinite(mass) and not hazard.velocity.contains(mass):
+        note += "; outside the simulated masses (nearest class's speeds)"
+    volume = mass / density_kg_m3
+    return {"rule": name, "mass_kg": mass, "volume_m3": volume, "diameter_m": float(sphere_diameter_m(volume)),
+            "velocity_p95_ms": v95, "energy_at_v95_kj": kinetic_energy_kj(mass, v95), "note": note}
+
+
+def _alternatives(hazard, coupled: bool, survey, source, pct: float, T: float, rho: float,
+                  fragmentation) -> pd.DataFrame:
+    """The candidate design blocks side by side: the ONR 24810 percentile band of the block sizes (when there
+    are any), the T-year fall at the source and reaching the line, the fragments of the T-year fall (when
+    fragmentation is stated) and the maximum credible block (when stated).
+
+    Parameters
+    ----------
+    hazard : EnergyHazard
+        The hazard.
+    coupled : bool
+        Whether it is mass-coupled.
+    survey, source
+        Block volumes [m³] and their source (:func:`_block_sizes`), or None.
+    pct, T, rho : float
+        Percentile [%], return period [yr], rock density [kg/m³].
+    fragmentation : tuple or None
+        (fractal dimension D, generations) when stated.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One :func:`_alternative` row per candidate.
+    """
     rows = []
 
-    coupled = bool(getattr(hazard, "mass_coupled", False))
-
     def add(name, mass, note):
-        v95 = hazard.velocity_percentile(95, mass_kg=mass) if np.isfinite(mass) else np.nan
-        if coupled and np.isfinite(mass) and not hazard.velocity.contains(mass):
-            note += "; outside the simulated masses (nearest class's speeds)"
-        rows.append({"rule": name, "mass_kg": mass, "volume_m3": mass / rho, "diameter_m":
-                     float(sphere_diameter_m(mass / rho)), "velocity_p95_ms": v95,
-                     "energy_at_v95_kj": kinetic_energy_kj(mass, v95), "note": note})
+        rows.append(_alternative(hazard, coupled, rho, name, mass, note))
 
     if survey is not None:
-        band = sorted(set(ONR24810_PERCENTILES) | {pct})
-        for q in band:
+        for q in sorted(set(ONR24810_PERCENTILES) | {pct}):
             add(f"percentile p{q:g}", percentile_block(survey, q) * rho,
                 f"{source}; ONR 24810 band 95-98" + (" (chosen percentile)" if q == pct else ""))
     table = site_design_masses(hazard, [T], rho)
-    add(f"return period {T:g} yr at the source", float(table["source_mass_kg"].iloc[0]),
-        "site law: " + str(table["law"].iloc[0]))
+    source_kg = float(table["source_mass_kg"].iloc[0])
+    add(f"return period {T:g} yr at the source", source_kg, "site law: " + str(table["law"].iloc[0]))
     add(f"return period {T:g} yr reaching the line", float(table["line_mass_kg"].iloc[0]),
         "site law x reach probability by mass" if hazard.mass_coupled else "site law x one reach probability")
-    if fragmenting and np.isfinite(table["source_mass_kg"].iloc[0]):
-        mass, frags = _fragment_of(float(table["source_mass_kg"].iloc[0]), fractal_dimension, iterations, pct, rho)
+    if fragmentation is not None and np.isfinite(source_kg):
+        D, n = fragmentation
+        mass, frags = _fragment_of(source_kg, D, n, pct, rho)
         add(f"fragmentation of the {T:g}-yr event, p{pct:g}", mass,
-            f"fractal fragmentation (Perfect 1997), D = {sig(fractal_dimension)}, {iterations} generation(s): "
+            f"fractal fragmentation (Perfect 1997), D = {sig(D)}, {n} generation(s): "
             f"{sig(frags['count'].sum())} fragments; percentile by count")
     m_max = getattr(hazard.mass, "m_max", None)
     if m_max:
         add("maximum credible block m_max", float(m_max), "stated by the user (judgement); the upper bound")
-    alt = pd.DataFrame(rows)
+    return pd.DataFrame(rows)
+
+
+def _chosen_row(alt: pd.DataFrame, hazard, coupled: bool, rule: str, pct: float, T: float) -> pd.Series:
+    """Mark the block ``rule`` chooses (column ``chosen``) and label the alternatives above m_max, in ``alt``;
+    refuse a chosen block that is undefined, outside the simulated masses (mass-coupled hazard) or above m_max.
+
+    Parameters
+    ----------
+    alt : pandas.DataFrame
+        The alternatives (:func:`_alternatives`), changed in place.
+    hazard : EnergyHazard
+        The hazard (its simulated masses and m_max).
+    coupled : bool
+        Whether it is mass-coupled.
+    rule, pct, T
+        The rule, percentile [%] and return period [yr].
+
+    Returns
+    -------
+    pandas.Series
+        The chosen row.
+    """
     chosen = {"percentile": f"percentile p{pct:g}", "return_period": f"return period {T:g} yr at the source",
               "fragmentation": f"fragmentation of the {T:g}-yr event, p{pct:g}"}[rule]
     alt["chosen"] = alt["rule"] == chosen
@@ -518,24 +637,36 @@ def design_block(hazard, *, rule: str = "return_period", percentile: float = 97.
                          "Choose a design-block rule or parameters whose block lies in that range, or simulate a "
                          "range that includes it (energy_hazard(..., design_masses_kg=[mass]); riskrf energy and "
                          "riskrf assess include the design-block candidates, fragmentation too, by themselves)")
+    m_max = getattr(hazard.mass, "m_max", None)
     if m_max:
         above = alt["mass_kg"] > m_max * (1 + 1e-12)
         alt.loc[above, "note"] = alt.loc[above, "note"] + "; ABOVE the stated maximum credible block m_max"
         if row["mass_kg"] > m_max * (1 + 1e-12):
-            raise ValueError(f"design block {row['mass_kg']:.6g} kg ({row['rule']}) exceeds the stated maximum credible "
-                             f"block m_max = {m_max:.6g} kg: revise m_max or the design-block rule")
+            raise ValueError(f"design block {row['mass_kg']:.6g} kg ({row['rule']}) exceeds the stated maximum "
+                             f"credible block m_max = {m_max:.6g} kg: revise m_max or the design-block rule")
+    return row
+
+
+def _basis(rule: str, pct: float, T: float, source, fractal_dimension, iterations) -> str:
+    """How the design block was obtained, in words: the rule, the source of the sizes, the parameters.
+
+    Parameters
+    ----------
+    rule, pct, T, source, fractal_dimension, iterations
+        The rule, percentile [%], return period [yr], source of the block sizes and fragmentation parameters.
+
+    Returns
+    -------
+    str
+    """
     if rule == "percentile":
-        basis = (f"{pct:g}th percentile of the block sizes ({source}), after ONR 24810 (design block: 95th-98th "
-                 "percentile of the surveyed blocks)")
-    elif rule == "fragmentation":
-        basis = (f"{pct:g}th percentile (by count) of the fragments of the {T:g}-year event volume broken up by "
-                 f"fractal fragmentation (Perfect 1997; D = {sig(fractal_dimension)}, {iterations} generation(s))")
-    else:
-        basis = (f"{T:g}-year fall of the site's law (truncated at m_max, rate scaled to the source above the line), "
-                 "taken as one intact block")
-    return DesignBlock(rule=rule, mass_kg=float(row["mass_kg"]), volume_m3=float(row["volume_m3"]),
-                       diameter_m=float(row["diameter_m"]), basis=basis, assumptions=tuple(assumptions),
-                       alternatives=alt, inputs=inputs)
+        return (f"{pct:g}th percentile of the block sizes ({source}), after ONR 24810 (design block: 95th-98th "
+                "percentile of the surveyed blocks)")
+    if rule == "fragmentation":
+        return (f"{pct:g}th percentile (by count) of the fragments of the {T:g}-year event volume broken up by "
+                f"fractal fragmentation (Perfect 1997; D = {sig(fractal_dimension)}, {iterations} generation(s))")
+    return (f"{T:g}-year fall of the site's law (truncated at m_max, rate scaled to the source above the line), "
+            "taken as one intact block")
 
 
 def design_block_candidates_kg(*, rule, percentile, survey_volumes_m3, inventory, density_kg_m3) -> list:
