@@ -97,8 +97,11 @@ Normal-velocity scaling of e_T (constant and Coulomb laws)
 ----------------------------------------------------------
 With a finite ``vt0`` (``tangential.normal_scale_ms`` in a scenario) the tangential state after the law is
 scaled by sqrt(SF), SF = 1 / ((|v_n| / (vt0 e_N))^2 + 1): the scaling factor of Pfeiffer & Bowen (1989) on the
-tangential energy, vt0 = 76.2 m/s (250 ft/s) in CRSP, with e_N the normal law's value before any velocity
-scaling (clipped to [0.05, 1]).  A block landing hard (a high normal velocity, as after a free fall from a
+tangential energy, vt0 = 76.2 m/s (250 ft/s) in CRSP, with e_N the material's normal coefficient before any
+velocity scaling (CRSP's R_n: the constant, the velocity law's e_N, or -- an ASSUMPTION, CRSP has no angle law --
+Wyllie's angle-dependent value, about 0.2 at a steep impact where CRSP's R_n is typically 0.3-0.35, so the same
+vt0 takes more; clipped to [0.05, 1], an ASSUMPTION that keeps the factor finite and only matters at grazing
+angles, where it is about 1).  A block landing hard (a high normal velocity, as after a free fall from a
 wall onto a bench) keeps less of its tangential speed than one that grazes the ground; at |v_n| = 18 m/s and
 e_N = 0.25 it keeps 73 % of what the law leaves, at 5 m/s 97 %.  It only removes energy.
 """
@@ -357,7 +360,7 @@ def tangential_scaling(vn, e_n, vt0):
     vn : float
         Normal impact velocity [m/s].
     e_n : float
-        The normal law's e_N before any velocity scaling [-]; clipped to [0.05, 1].
+        The material's e_N before any velocity scaling [-] (CRSP's R_n); clipped to [0.05, 1].
     vt0 : float
         Velocity scale [m/s] (76.2 m/s = 250 ft/s in CRSP; inf: none).
 
@@ -445,6 +448,9 @@ def rebound(vn, vt, w, r, k, en_law, e_n, v0, et_law, e_t, mu, allow_energy_gain
     """
     en_law_value = normal_restitution(en_law, e_n, vn, vt)
     en = velocity_scaled(en_law_value, vn, v0)
+    # the tangential scaling takes the material's e_N before any velocity scaling (CRSP's R_n): the velocity
+    # law's own e_n, Wyllie's angle law with its deviation, or the constant
+    en_material = e_n if en_law == EN_VELOCITY else en_law_value
     if et_law == ET_FRICTION:
         vt2, w2, stuck = stronge_body(vn, vt, w, r, en, mu, k)
     elif et_law == ET_COULOMB:
@@ -453,7 +459,7 @@ def rebound(vn, vt, w, r, k, en_law, e_n, v0, et_law, e_t, mu, allow_energy_gain
         vt2 = e_t * vt
         w2 = e_t * w
     if et_law != ET_FRICTION and vn < 0.0:
-        s_t = tangential_scaling(vn, en_law_value, vt0)
+        s_t = tangential_scaling(vn, en_material, vt0)
         vt2 *= s_t
         w2 *= s_t
     vn2 = -en * vn

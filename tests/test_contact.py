@@ -16,8 +16,8 @@ from scipy.integrate import solve_ivp
 import simulation
 from simulation import ScenarioError
 from simulation.calibration import scenario_dict
-from simulation.contact import (EN_CONSTANT, EN_WYLLIE, ET_CONSTANT, ET_COULOMB, ET_FRICTION, contact_acceleration,
-                                contact_speed, contact_speed_at, contact_stop_distance, contact_time,
+from simulation.contact import (EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_COULOMB, ET_FRICTION,
+                                contact_acceleration, contact_speed, contact_speed_at, contact_stop_distance, contact_time,
                                 coulomb_tangential, rebound, rolling_resistance, roughness_tilt_max,
                                 steep_face_launch, tangential_scaling, velocity_scaled)
 
@@ -100,6 +100,12 @@ def test_pfeiffer_bowen_tangential_scaling():
     assert scaled[1] == pytest.approx(f * base[1], rel=1e-12)
     assert rebound(-12.0, 6.0, 4.0, 0.5, 0.4, EN_CONSTANT, 0.3, math.inf, ET_FRICTION, 0.5, 0.6, False, 76.2) == \
         rebound(-12.0, 6.0, 4.0, 0.5, 0.4, EN_CONSTANT, 0.3, math.inf, ET_FRICTION, 0.5, 0.6, False)
+    # CRSP's pairing, the velocity law for e_N (R_n = 0.35): SF takes R_n itself, not the velocity-reduced e_N
+    # (PlatRock's Pfeiffer model: SF = R_t / ((V_n / (76.2 R_n))^2 + 1) with the segment's R_n)
+    base = rebound(-18.0, 6.0, 0.0, 0.5, 0.4, EN_VELOCITY, 0.35, math.inf, ET_CONSTANT, 0.8, 0.0, False)
+    scaled = rebound(-18.0, 6.0, 0.0, 0.5, 0.4, EN_VELOCITY, 0.35, math.inf, ET_CONSTANT, 0.8, 0.0, False, 76.2)
+    assert scaled[1] / base[1] == pytest.approx(1.0 / math.sqrt((18.0 / (76.2 * 0.35)) ** 2 + 1.0), rel=1e-12)
+    assert scaled[1] / base[1] == pytest.approx(0.829, abs=1e-3)
 
 
 @pytest.mark.parametrize("h", [2.0, 20.0])
@@ -120,7 +126,8 @@ def test_a_block_landing_on_a_bench_slides_the_distance_the_scaling_leaves(h):
 
 @settings(max_examples=300)
 @given(vn=st.floats(-40.0, -0.01), vt=st.floats(-30.0, 30.0), w=st.floats(-60.0, 60.0), r=st.floats(0.05, 3.0),
-       k=st.sampled_from([0.4, 0.5]), en_law=st.sampled_from([EN_CONSTANT, EN_WYLLIE]), en=st.floats(0.0, 1.0),
+       k=st.sampled_from([0.4, 0.5]), en_law=st.sampled_from([EN_CONSTANT, EN_WYLLIE, EN_VELOCITY]),
+       en=st.floats(0.0, 1.0),
        v0=st.sampled_from([math.inf, 9.144, 3.0]), et_law=st.sampled_from([ET_CONSTANT, ET_FRICTION, ET_COULOMB]),
        et=st.floats(0.0, 1.0), mu=st.floats(0.0, 2.0), vt0=st.sampled_from([math.inf, 76.2, 5.0]))
 def test_no_impact_law_creates_energy(vn, vt, w, r, k, en_law, en, v0, et_law, et, mu, vt0):
