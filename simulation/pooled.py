@@ -990,20 +990,11 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
     PooledCalibration
     """
     releases = check_releases(releases)
-    for arg, v, lo in (("n_per_release", n_per_release, 10), ("iterations", iterations, 0),
-                       ("n_posterior", n_posterior, 10), ("n_predictive", n_predictive, 0)):
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
-            raise ValueError(f"{arg} must be a whole number >= {lo}; got {v!r}")
-    if not (isinstance(obs_error_m, (int, float)) and obs_error_m > 0):
-        raise ValueError(f"obs_error_m must be > 0 m; got {obs_error_m!r}")
-    if not isinstance(parameters, dict) or not parameters:
-        raise TypeError(f"parameters must be a non-empty dict of dotted material path -> (low, high); got "
-                        f"{parameters!r}")
+    _check_pooled_arguments(parameters, n_per_release, iterations, n_posterior, n_predictive, obs_error_m)
     constraints = _check_constraints(constraints)
     cpool = _ConstraintPool(constraints, parameters)
     pool = _Pool(releases, parameters, extra_materials={k.split(".")[1] for pl in cpool.pools for k in pl[1]})
     names = pool.names
-    d = len(names)
     lo = np.array([pool.bounds[k][0] for k in names])
     hi = np.array([pool.bounds[k][1] for k in names])
     lengths = pool.support_lengths()
@@ -1017,103 +1008,304 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
         ll = _log_likelihood(pool.simulate(values, n_per_release, sim_seed), releases, lengths, obs_error_m)
         return ll + (cpool.log_likelihood(cpool.simulate(values, sim_seed)) if constraints else 0.0)
 
+    u_all, ll_all, proposals = _adaptive_design(loglik, len(names), n_initial, n_per_iteration, iterations,
+                                                rng_design, rng_prop)
+    evaluations = pd.DataFrame(lo + u_all * (hi - lo), columns=names).assign(
+        log_likelihood=ll_all, weight=_importance_weights(u_all, ll_all, proposals))
+    fitted = _surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng_resample)
+    posterior, ess, notes = fitted or _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior,
+                                                     rng_resample)
+    notes += _bound_notes(posterior, pool.bounds, names)
+    coverage = _coverage(pool, releases, posterior, n_predictive, rng_pred)
+    ctable = _constraint_table(cpool, posterior, n_predictive, rng_pred)
+    return PooledCalibration(parameters={k: float(posterior[k].median()) for k in names}, bounds=dict(pool.bounds),
+                             posterior=posterior, evaluations=evaluations, coverage_table=coverage, ess=ess,
+                             n_per_release=int(n_per_release), seed=seed, releases=tuple(releases),
+                             notes=tuple(notes), constraint_table=ctable)
+
+
+def _check_pooled_arguments(parameters, n_per_release, iterations, n_posterior, n_predictive, obs_error_m):
+    """Refuse bad counts, kernel width or parameter table of :func:`calibrate_pooled` before any work.
+
+    Parameters
+    ----------
+    parameters : dict
+        Dotted material path -> (low, high).
+    n_per_release, iterations, n_posterior, n_predictive : int
+        The counts, checked in this order.
+    obs_error_m : float
+        Smallest kernel width [m].
+
+    Raises
+    ------
+    ValueError
+        A count that is not a whole number at or above its least value, or a width not > 0.
+    TypeError
+        ``parameters`` not a non-empty dict.
+    """
+    for arg, v, lo in (("n_per_release", n_per_release, 10), ("iterations", iterations, 0),
+                       ("n_posterior", n_posterior, 10), ("n_predictive", n_predictive, 0)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+            raise ValueError(f"{arg} must be a whole number >= {lo}; got {v!r}")
+    if not (isinstance(obs_error_m, (int, float)) and obs_error_m > 0):
+        raise ValueError(f"obs_error_m must be > 0 m; got {obs_error_m!r}")
+    if not isinstance(parameters, dict) or not parameters:
+        raise TypeError(f"parameters must be a non-empty dict of dotted material path -> (low, high); got "
+                        f"{parameters!r}")
+
+
+def _log_mixture(u, proposals):
+    """Log density of the defensive mixture of all proposals so far at the unit-cube points ``u``.
+
+    Parameters
+    ----------
+    u : numpy.ndarray
+        (n, d) points in the unit cube (the prior box scaled to [0, 1]).
+    proposals : list of tuple
+        (kind, number of points drawn, mean, covariance, truncation mass); kind "prior" is the uniform prior,
+        "t" a multivariate t truncated to the unit cube.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n,) log densities, each component weighted by its share of the points.
+    """
+    n_tot = sum(p[1] for p in proposals)
+    terms = []
+    for kind, n_k, mean, cov, z in proposals:
+        if kind == "prior":
+            terms.append(np.full(u.shape[0], math.log(n_k / n_tot)))
+        else:
+            terms.append(math.log(n_k / n_tot) + _t_logpdf(u, mean, cov) - math.log(z))
+    return np.logaddexp.reduce(np.vstack(terms), axis=0)
+
+
+def _importance_weights(u_all, ll_all, proposals):
+    """Normalised importance weights (likelihood x prior / proposal mixture) of the evaluated points.
+
+    Parameters
+    ----------
+    u_all : numpy.ndarray
+        (n, d) evaluated points in the unit cube.
+    ll_all : numpy.ndarray
+        (n,) their log-likelihoods.
+    proposals : list of tuple
+        The proposals they were drawn from, see :func:`_log_mixture`.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n,) weights summing to 1.
+    """
+    lw = ll_all - _log_mixture(u_all, proposals)
+    w = np.exp(lw - lw.max())
+    return w / w.sum()
+
+
+def _in_unit_box(draw, n, give_up=False):
+    """The first ``n`` points inside the unit cube from repeated batches ``draw()`` (rows in order).
+
+    Parameters
+    ----------
+    draw : callable
+        Returns an (m, d) batch of candidate points.
+    n : int
+        Points wanted.
+    give_up : bool
+        Return None when a non-empty batch leaves no point kept so far.
+
+    Returns
+    -------
+    numpy.ndarray or None
+        (n, d) points, or None (``give_up`` only).
+    """
+    kept = []
+    while len(kept) < n:
+        cand = draw()
+        kept.extend(cand[np.all((cand >= 0) & (cand <= 1), axis=1)].tolist())
+        if give_up and len(kept) == 0 and len(cand) > 0:
+            return None
+    return np.array(kept[:n])
+
+
+def _adaptive_design(loglik, d, n_initial, n_per_iteration, iterations, rng_design, rng_prop):
+    """The evaluated points: a scrambled Sobol design on the unit cube, then adaptive importance rounds.
+
+    Each round fits a multivariate t (4 degrees of freedom, twice the weighted covariance) to the importance
+    weights so far, draws ``n_per_iteration`` points from it inside the unit cube and evaluates them.
+
+    Parameters
+    ----------
+    loglik : callable
+        Log-likelihood of one unit-cube point.
+    d : int
+        Number of parameters.
+    n_initial, n_per_iteration : int or None
+        Points in the design (default the power of 2 at or above 64 d) and per round (default 32 d).
+    iterations : int
+        Adaptive rounds.
+    rng_design, rng_prop : numpy.random.Generator
+        Streams of the design and of the proposals.
+
+    Returns
+    -------
+    tuple
+        (points (n, d), log-likelihoods (n,), proposals as in :func:`_log_mixture`).
+    """
     n0 = n_initial or 2 ** int(math.ceil(math.log2(64 * d)))
     n_it = n_per_iteration or 32 * d
     u_all = stats.qmc.Sobol(d, scramble=True, seed=rng_design).random(n0)
     ll_all = np.array([loglik(u) for u in u_all])
-    # proposals: (weight in the mixture, mean, cov, truncation mass); the first is the prior (uniform on the box)
+    # proposals: (kind, weight in the mixture, mean, cov, truncation mass); the first is the prior (uniform on the box)
     proposals = [("prior", n0, None, None, 1.0)]
-
-    def log_mix(u):
-        n_tot = sum(p[1] for p in proposals)
-        terms = []
-        for kind, n_k, mean, cov, z in proposals:
-            if kind == "prior":
-                terms.append(np.full(u.shape[0], math.log(n_k / n_tot)))
-            else:
-                terms.append(math.log(n_k / n_tot) + _t_logpdf(u, mean, cov) - math.log(z))
-        return np.logaddexp.reduce(np.vstack(terms), axis=0)
-
-    def weights():
-        lw = ll_all - log_mix(u_all)
-        w = np.exp(lw - lw.max())
-        return w / w.sum()
-
     for _ in range(iterations):
-        w = weights()
+        w = _importance_weights(u_all, ll_all, proposals)
         mean = np.sum(w[:, None] * u_all, axis=0)
         diff = u_all - mean
         cov = (w[:, None] * diff).T @ diff / max(1.0 - np.sum(w * w), 1e-12)
         cov = 2.0 * cov + np.eye(d) * 1e-6                      # widened: heavier than the target
         test = _t_draw(rng_prop, mean, cov, 20000)
         z = max(float(np.mean(np.all((test >= 0) & (test <= 1), axis=1))), 1e-6)
-        new = []
-        while len(new) < n_it:
-            cand = _t_draw(rng_prop, mean, cov, 4 * n_it)
-            new.extend(cand[np.all((cand >= 0) & (cand <= 1), axis=1)].tolist())
-        new = np.array(new[:n_it])
+        new = _in_unit_box(lambda: _t_draw(rng_prop, mean, cov, 4 * n_it), n_it)
         proposals.append(("t", n_it, mean, cov, z))
         u_all = np.vstack([u_all, new])
         ll_all = np.concatenate([ll_all, [loglik(u) for u in new]])
-    w = weights()
-    ess = float(1.0 / np.sum(w * w))
-    theta_all = lo + u_all * (hi - lo)
-    evaluations = pd.DataFrame(theta_all, columns=names).assign(log_likelihood=ll_all, weight=w)
-    notes = []
+    return u_all, ll_all, proposals
+
+
+def _surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
+    """Posterior sample from the Gaussian a quadratic fit of the log-likelihood defines, truncated to the box.
+
+    The log-likelihood near its top is quadratic (smooth under common random numbers): sampling the Gaussian it
+    defines averages out the Monte Carlo noise that makes a few evaluated points dominate the importance weights.
+
+    Parameters
+    ----------
+    u_all, ll_all : numpy.ndarray
+        Evaluated unit-cube points (n, d) and their log-likelihoods (n,).
+    lo, hi : numpy.ndarray
+        Prior bounds of each parameter.
+    names : list of str
+        Parameter paths (the columns).
+    n_posterior : int
+        Size of the sample.
+    rng : numpy.random.Generator
+        The resampling stream.
+
+    Returns
+    -------
+    tuple or None
+        (posterior DataFrame, effective sample size, notes), or None when no concave quadratic fits or the
+        Gaussian puts no draw inside the box.
+    """
     surrogate = _quadratic_surrogate(u_all, ll_all)
-    if surrogate is not None:
-        # the log-likelihood near its top is quadratic (smooth under common random numbers): the posterior is the
-        # Gaussian it defines, truncated to the prior box; sampling it averages out the Monte Carlo noise that
-        # makes a few evaluated points dominate the importance weights
-        mean, cov, r2 = surrogate
-        draws = []
-        while len(draws) < n_posterior:
-            cand = rng_resample.multivariate_normal(mean, cov, size=4 * n_posterior)
-            draws.extend(cand[np.all((cand >= 0) & (cand <= 1), axis=1)].tolist())
-            if len(draws) == 0 and len(cand) > 0:
-                surrogate = None
-                break
-        if surrogate is not None:
-            posterior = pd.DataFrame(lo + np.array(draws[:n_posterior]) * (hi - lo), columns=names)
-            ess = float(n_posterior)
-            notes.append(f"posterior: Gaussian surrogate of the log-likelihood (R^2 {r2:.3f} over the evaluations "
-                         "near its top), truncated to the prior box")
     if surrogate is None:
-        # ABC rejection: the evaluated parameter sets whose log-likelihood is within chi2_d(0.999) of the best
-        # (twice the drop of the approximate 99.9 % likelihood region, Wilks: the best value of a noisy simulated
-        # likelihood is itself inflated by the noise), weighted by prior / proposal mixture
-        band = ll_all >= ll_all.max() - stats.chi2.ppf(0.999, d)
-        wb = np.where(band, np.exp(-log_mix(u_all)), 0.0)
-        wb /= wb.sum()
-        ess = float(1.0 / np.sum(wb * wb))
-        pos = (rng_resample.random() + np.arange(n_posterior)) / n_posterior     # systematic resampling
-        idx = np.minimum(np.searchsorted(np.cumsum(wb), pos), wb.size - 1)
-        posterior = pd.DataFrame(theta_all[idx], columns=names)
-        notes.append(f"posterior: ABC rejection of the {int(band.sum())} evaluations within chi2_d(0.999) of the "
-                     "best log-likelihood (no concave quadratic fits it near its top)")
-        if ess < 20:
-            msg = (f"effective sample size of the posterior sample is {ess:.0f} (< 20): the posterior is poorly "
-                   "resolved; raise n_per_iteration or iterations")
-            notes.append(msg)
-            warnings.warn(msg, PooledCalibrationWarning, stacklevel=2)
+        return None
+    mean, cov, r2 = surrogate
+    draws = _in_unit_box(lambda: rng.multivariate_normal(mean, cov, size=4 * n_posterior), n_posterior, give_up=True)
+    if draws is None:
+        return None
+    return (pd.DataFrame(lo + draws * (hi - lo), columns=names), float(n_posterior),
+            [f"posterior: Gaussian surrogate of the log-likelihood (R^2 {r2:.3f} over the evaluations near its top), "
+             "truncated to the prior box"])
+
+
+def _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng):
+    """Posterior sample by ABC rejection, when no Gaussian surrogate fits; warns when it is poorly resolved.
+
+    Keeps the evaluated points whose log-likelihood is within chi2_d(0.999) of the best (twice the drop of the
+    approximate 99.9 % likelihood region, Wilks: the best value of a noisy simulated likelihood is itself inflated
+    by the noise), weighted by prior / proposal mixture, and resamples them systematically.
+
+    Parameters
+    ----------
+    u_all, ll_all : numpy.ndarray
+        Evaluated unit-cube points (n, d) and their log-likelihoods (n,).
+    proposals : list of tuple
+        The proposals they were drawn from, see :func:`_log_mixture`.
+    lo, hi : numpy.ndarray
+        Prior bounds of each parameter.
+    names : list of str
+        Parameter paths (the columns).
+    n_posterior : int
+        Size of the sample.
+    rng : numpy.random.Generator
+        The resampling stream.
+
+    Returns
+    -------
+    tuple
+        (posterior DataFrame, effective sample size, notes).
+    """
+    band = ll_all >= ll_all.max() - stats.chi2.ppf(0.999, u_all.shape[1])
+    wb = np.where(band, np.exp(-_log_mixture(u_all, proposals)), 0.0)
+    wb /= wb.sum()
+    ess = float(1.0 / np.sum(wb * wb))
+    pos = (rng.random() + np.arange(n_posterior)) / n_posterior     # systematic resampling
+    idx = np.minimum(np.searchsorted(np.cumsum(wb), pos), wb.size - 1)
+    posterior = pd.DataFrame((lo + u_all * (hi - lo))[idx], columns=names)
+    notes = [f"posterior: ABC rejection of the {int(band.sum())} evaluations within chi2_d(0.999) of the best "
+             "log-likelihood (no concave quadratic fits it near its top)"]
+    if ess < 20:
+        notes.append(f"effective sample size of the posterior sample is {ess:.0f} (< 20): the posterior is poorly "
+                     "resolved; raise n_per_iteration or iterations")
+        warnings.warn(notes[-1], PooledCalibrationWarning, stacklevel=3)     # at the caller of calibrate_pooled
+    return posterior, ess, notes
+
+
+def _bound_notes(posterior, bounds, names):
+    """Notes (each also a warning) on parameters with over 10 % of the posterior within 1 % of a prior bound.
+
+    Parameters
+    ----------
+    posterior : pandas.DataFrame
+        The posterior sample.
+    bounds : dict
+        Parameter path -> (low, high).
+    names : list of str
+        Parameter paths, in the order of the notes.
+
+    Returns
+    -------
+    list of str
+        The notes.
+    """
+    notes = []
     for k in names:
-        b_lo, b_hi = pool.bounds[k]
+        b_lo, b_hi = bounds[k]
         at = np.mean(np.minimum(posterior[k] - b_lo, b_hi - posterior[k]) < 0.01 * (b_hi - b_lo))
         if at > 0.1:
             msg = (f"parameter {k!r}: {at:.0%} of the posterior lies within 1 % of a bound [{b_lo:g}, {b_hi:g}]; "
                    "the posterior is cut by the prior box")
             notes.append(msg)
-            warnings.warn(msg, PooledCalibrationWarning, stacklevel=2)
-    coverage = _coverage(pool, releases, posterior, n_predictive, rng_pred)
-    ctable = pd.DataFrame()
-    if constraints and n_predictive:
-        draws = posterior.iloc[rng_pred.choice(len(posterior), size=n_predictive, replace=False)]
-        ctable = cpool.table([cpool.far_angles(cpool.simulate(row.to_dict(), 20_000 + t))
-                              for t, (_, row) in enumerate(draws.iterrows())])
-    return PooledCalibration(parameters={k: float(posterior[k].median()) for k in names}, bounds=dict(pool.bounds),
-                             posterior=posterior, evaluations=evaluations, coverage_table=coverage, ess=ess,
-                             n_per_release=int(n_per_release), seed=seed, releases=tuple(releases),
-                             notes=tuple(notes), constraint_table=ctable)
+            warnings.warn(msg, PooledCalibrationWarning, stacklevel=3)        # at the caller of calibrate_pooled
+    return notes
+
+
+def _constraint_table(cpool, posterior, n_predictive, rng):
+    """Simulated far limits of the reach constraints for ``n_predictive`` posterior draws.
+
+    Parameters
+    ----------
+    cpool : _ConstraintPool
+        The constraints and their scenarios.
+    posterior : pandas.DataFrame
+        The posterior sample.
+    n_predictive : int
+        Posterior draws (0: none).
+    rng : numpy.random.Generator
+        The predictive stream (after the coverage draws).
+
+    Returns
+    -------
+    pandas.DataFrame
+        :meth:`_ConstraintPool.table`, empty without constraints or draws.
+    """
+    if not (cpool.constraints and n_predictive):
+        return pd.DataFrame()
+    draws = posterior.iloc[rng.choice(len(posterior), size=n_predictive, replace=False)]
+    return cpool.table([cpool.far_angles(cpool.simulate(row.to_dict(), 20_000 + t))
+                        for t, (_, row) in enumerate(draws.iterrows())])
 
 
 def _quadratic_surrogate(u, ll):
