@@ -1219,18 +1219,10 @@ def _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng):
 
     Parameters
     ----------
-    u_all, ll_all : numpy.ndarray
-        Evaluated unit-cube points (n, d) and their log-likelihoods (n,).
+    u_all, ll_all, lo, hi, names, n_posterior, rng
+        As in :func:`_surrogate_posterior`.
     proposals : list of tuple
-        The proposals they were drawn from, see :func:`_log_mixture`.
-    lo, hi : numpy.ndarray
-        Prior bounds of each parameter.
-    names : list of str
-        Parameter paths (the columns).
-    n_posterior : int
-        Size of the sample.
-    rng : numpy.random.Generator
-        The resampling stream.
+        The proposals the points were drawn from, see :func:`_log_mixture`.
 
     Returns
     -------

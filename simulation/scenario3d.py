@@ -245,8 +245,38 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
     materials = parse_tables_and_materials(data, ("terrain", "materials", "sources"), ("collectors", "settings"),
                                            source)
     names = [m.name for m in materials]
-
     tt = data["terrain"]
+    nodata_rule = _check_terrain_table(tt, source)
+    base = Path(base_dir) if base_dir is not None else Path(".")
+    try:
+        if terrain is None:
+            terrain = _read_terrain_dem(tt, base, crs, source)
+        grid = _material_grid(tt, terrain, base, names, source)
+    except TerrainError as exc:
+        raise ScenarioError(f"{source}: [terrain]: {exc}") from None
+    sources = _parse_sources(data["sources"], terrain, base, nodata_rule, source)
+    collectors = _parse_collectors(data.get("collectors", []), source)
+    settings = parse_settings(data.get("settings", {}), source, max_events=DEFAULT_MAX_EVENTS_3D, envelopes=False)
+    return TerrainScenario(name=str(data.get("name", Path(source).stem)), description=str(data.get("description", "")),
+                           terrain=terrain, materials=materials, material_grid=grid, sources=sources,
+                           collectors=collectors, settings=settings, source=source)
+
+
+def _check_terrain_table(tt: dict, source: str) -> str:
+    """Check the keys of the ``[terrain]`` table, its nodata rule and that one material map at most is given.
+
+    Parameters
+    ----------
+    tt : dict
+        The ``[terrain]`` table.
+    source : str
+        Where the scenario came from, for error messages.
+
+    Returns
+    -------
+    str
+        The nodata rule, "leave" or "error".
+    """
     _check_keys(tt, {"dem", "crs", "material", "material_raster", "material_codes", "material_polygons",
                      "material_field", "material_layer", "material_values", "nodata"}, "terrain.", source)
     nodata_rule = tt.get("nodata", "leave")
@@ -256,55 +286,153 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
                             "the sources meet a hole)")
     if "material_raster" in tt and "material_polygons" in tt:
         raise ScenarioError(f"{source}: give terrain.material_raster or terrain.material_polygons, not both")
-    base = Path(base_dir) if base_dir is not None else Path(".")
-    try:
-        if terrain is None:
-            if "dem" not in tt:
-                raise ScenarioError(f"{source}: terrain.dem (the DEM raster file) is required")
-            dem_path = base / str(tt["dem"])
-            if not dem_path.exists():
-                raise ScenarioError(f"{source}: terrain.dem = {tt['dem']!r}: file not found ({dem_path})")
-            terrain = read_dem(dem_path, crs=crs if crs is not None else tt.get("crs"))
-        if "material_raster" in tt:
-            if "material_codes" not in tt or not isinstance(tt["material_codes"], dict):
-                raise ScenarioError(f"{source}: terrain.material_raster needs terrain.material_codes = "
-                                    "{ code = \"material\", ... }")
-            codes = {}
-            for k, v in tt["material_codes"].items():
-                try:
-                    codes[int(k)] = str(v)
-                except ValueError:
-                    raise ScenarioError(f"{source}: terrain.material_codes key {k!r} is not an integer code") \
-                        from None
-            grid = read_material_raster(base / str(tt["material_raster"]), terrain, codes, names)
-        elif "material_polygons" in tt:
-            from .sources import read_material_polygons
-            if "material_field" not in tt:
-                raise ScenarioError(f"{source}: terrain.material_polygons needs terrain.material_field (the attribute "
-                                    "naming each polygon's material)")
-            mv = tt.get("material_values")
-            if mv is not None and not isinstance(mv, dict):
-                raise ScenarioError(f"{source}: terrain.material_values must be a table {{ value = \"material\" }}")
-            if "material" in tt and tt["material"] not in names:
-                raise ScenarioError(f"{source}: terrain.material = {tt['material']!r} is not a defined material "
-                                    f"({', '.join(names)})")
-            poly_path = base / str(tt["material_polygons"])
-            if not poly_path.exists():
-                raise ScenarioError(f"{source}: terrain.material_polygons = {tt['material_polygons']!r}: file not "
-                                    f"found ({poly_path})")
-            grid = read_material_polygons(poly_path, terrain, names, field_name=str(tt["material_field"]),
-                                          values=None if mv is None else {str(k): str(v) for k, v in mv.items()},
-                                          default=tt.get("material"), layer=tt.get("material_layer"))
-        else:
-            mname = tt.get("material", names[0])
-            if mname not in names:
-                raise ScenarioError(f"{source}: terrain.material = {mname!r} is not a defined material "
-                                    f"({', '.join(names)})")
-            grid = MaterialGrid(index=np.full(terrain.shape, names.index(mname), dtype=np.int64), names=tuple(names))
-    except TerrainError as exc:
-        raise ScenarioError(f"{source}: [terrain]: {exc}") from None
+    return nodata_rule
 
-    sd = data["sources"]
+
+def _read_terrain_dem(tt: dict, base: Path, crs, source: str) -> Terrain:
+    """Read the DEM named by ``terrain.dem`` (relative to ``base``); ``crs`` overrides ``terrain.crs``.
+
+    Parameters
+    ----------
+    tt : dict
+        The ``[terrain]`` table.
+    base : pathlib.Path
+        Directory of relative paths.
+    crs : str or rasterio.crs.CRS or None
+        The DEM's coordinate reference system when the file has none.
+    source : str
+        Where the scenario came from, for error messages.
+
+    Returns
+    -------
+    Terrain
+        The DEM.
+    """
+    if "dem" not in tt:
+        raise ScenarioError(f"{source}: terrain.dem (the DEM raster file) is required")
+    dem_path = base / str(tt["dem"])
+    if not dem_path.exists():
+        raise ScenarioError(f"{source}: terrain.dem = {tt['dem']!r}: file not found ({dem_path})")
+    return read_dem(dem_path, crs=crs if crs is not None else tt.get("crs"))
+
+
+def _check_material_name(name, names: list, source: str) -> None:
+    """Refuse a ``terrain.material`` that is not one of the scenario's materials ``names``."""
+    if name not in names:
+        raise ScenarioError(f"{source}: terrain.material = {name!r} is not a defined material ({', '.join(names)})")
+
+
+def _material_grid(tt: dict, terrain: Terrain, base: Path, names: list, source: str) -> MaterialGrid:
+    """The material of each DEM cell: from a coded raster, from polygons, or one material everywhere.
+
+    Parameters
+    ----------
+    tt : dict
+        The ``[terrain]`` table.
+    terrain : Terrain
+        The DEM.
+    base : pathlib.Path
+        Directory of relative paths.
+    names : list of str
+        The scenario's materials, in order.
+    source : str
+        Where the scenario came from, for error messages.
+
+    Returns
+    -------
+    MaterialGrid
+        Material index per cell.
+    """
+    if "material_raster" in tt:
+        codes = _material_codes(tt, source)
+        return read_material_raster(base / str(tt["material_raster"]), terrain, codes, names)
+    if "material_polygons" in tt:
+        return _material_polygon_grid(tt, terrain, base, names, source)
+    mname = tt.get("material", names[0])
+    _check_material_name(mname, names, source)
+    return MaterialGrid(index=np.full(terrain.shape, names.index(mname), dtype=np.int64), names=tuple(names))
+
+
+def _material_codes(tt: dict, source: str) -> dict:
+    """``terrain.material_codes`` as integer raster code -> material name.
+
+    Parameters
+    ----------
+    tt : dict
+        The ``[terrain]`` table with ``material_raster``; its ``material_codes`` must be a table of integer keys.
+    source : str
+        Named in the error messages.
+
+    Returns
+    -------
+    dict
+        int -> str.
+    """
+    if "material_codes" not in tt or not isinstance(tt["material_codes"], dict):
+        raise ScenarioError(f"{source}: terrain.material_raster needs terrain.material_codes = "
+                            "{ code = \"material\", ... }")
+    codes = {}
+    for k, v in tt["material_codes"].items():
+        try:
+            codes[int(k)] = str(v)
+        except ValueError:
+            raise ScenarioError(f"{source}: terrain.material_codes key {k!r} is not an integer code") from None
+    return codes
+
+
+def _material_polygon_grid(tt: dict, terrain: Terrain, base: Path, names: list, source: str) -> MaterialGrid:
+    """The material grid from ``terrain.material_polygons`` (see :func:`simulation.sources.read_material_polygons`).
+
+    Parameters
+    ----------
+    tt, terrain, base, names, source
+        As in :func:`_material_grid`; ``tt`` holds ``material_polygons`` and ``material_field``, optionally
+        ``material_values``, ``material`` (where no polygon lies) and ``material_layer``.
+
+    Returns
+    -------
+    MaterialGrid
+        Material index per cell.
+    """
+    from .sources import read_material_polygons
+    if "material_field" not in tt:
+        raise ScenarioError(f"{source}: terrain.material_polygons needs terrain.material_field (the attribute "
+                            "naming each polygon's material)")
+    mv = tt.get("material_values")
+    if mv is not None and not isinstance(mv, dict):
+        raise ScenarioError(f"{source}: terrain.material_values must be a table {{ value = \"material\" }}")
+    if "material" in tt:
+        _check_material_name(tt["material"], names, source)
+    poly_path = base / str(tt["material_polygons"])
+    if not poly_path.exists():
+        raise ScenarioError(f"{source}: terrain.material_polygons = {tt['material_polygons']!r}: file not "
+                            f"found ({poly_path})")
+    return read_material_polygons(poly_path, terrain, names, field_name=str(tt["material_field"]),
+                                  values=None if mv is None else {str(k): str(v) for k, v in mv.items()},
+                                  default=tt.get("material"), layer=tt.get("material_layer"))
+
+
+def _parse_sources(sd: dict, terrain: Terrain, base: Path, nodata_rule: str, source: str) -> Sources:
+    """The ``[sources]`` table: where blocks start (checked on the DEM) and their release state.
+
+    Parameters
+    ----------
+    sd : dict
+        The ``[sources]`` table (its keys are listed in the module docstring).
+    terrain : Terrain
+        The DEM the sources must lie on (off it or on a nodata hole: refused).
+    base : pathlib.Path
+        Directory against which ``sources.file`` is resolved.
+    nodata_rule : str
+        "error": refuse sources whose fall lines meet a nodata hole.
+    source : str
+        Where the scenario came from, for error messages.
+
+    Returns
+    -------
+    Sources
+        The checked sources.
+    """
     _check_keys(sd, {"points", "polygon", "line", "file", "layer", "slope_above_deg", "slope_units", "height_m",
                      "mass_kg", "density_kg_m3", "speed_ms", "vz_ms", "angular_velocity_rads", "shape"}, "sources.",
                 source)
@@ -325,7 +453,7 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
     shape = sd.get("shape", "sphere")
     if shape not in INERTIA_FACTORS:
         raise ScenarioError(f"{source}: sources.shape = {shape!r} is not one of {sorted(INERTIA_FACTORS)}")
-    sources = Sources(
+    return Sources(
         **places,
         height_m=Distribution.parse(sd.get("height_m", 1.0), "sources.height_m", source, lo=0.0, hi=1e4),
         mass_kg=Distribution.parse(sd["mass_kg"], "sources.mass_kg", source, lo=0.0, hi=1e9, lo_open=True),
@@ -337,32 +465,59 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
                                                  "sources.angular_velocity_rads", source, lo=-1e3, hi=1e3),
         shape=shape)
 
-    collectors = []
-    for i, c in enumerate(data.get("collectors", [])):
-        where = f"collectors[{i}]"
-        if not isinstance(c, dict):
-            raise ScenarioError(f"{source}: {where} must be a table with name and line")
-        _check_keys(c, {"name", "line", "height_m", "capacity_kj"}, f"{where}.", source)
-        if "name" not in c or "line" not in c:
-            raise ScenarioError(f"{source}: {where} needs a name and a line = [[x, y], ...]")
-        line = _plan_points(c["line"], f"{where}.line", source, min_points=2)
-        if np.any(np.hypot(*np.diff(line, axis=0).T) == 0):
-            raise ScenarioError(f"{source}: {where}.line ({c['name']!r}) has two coinciding vertices")
-        h = None if c.get("height_m") is None else _number(c["height_m"], f"{where}.height_m", source, lo=0.0,
-                                                           lo_open=True, hi=100.0)
-        cap = None if c.get("capacity_kj") is None else _number(c["capacity_kj"], f"{where}.capacity_kj", source,
-                                                                lo=0.0, lo_open=True)
-        if cap is not None and h is None:
-            raise ScenarioError(f"{source}: {where}.height_m is required for a barrier (capacity_kj given)")
-        collectors.append(PlanCollector(str(c["name"]), line, h, cap))
+
+def _parse_collectors(tables, source: str) -> tuple:
+    """The ``[[collectors]]`` tables: plan lines and barriers, with unique names.
+
+    Parameters
+    ----------
+    tables : list of dict
+        The ``[[collectors]]`` tables.
+    source : str
+        Where the scenario came from, for error messages.
+
+    Returns
+    -------
+    tuple of PlanCollector
+        In the order given.
+    """
+    collectors = tuple(_parse_collector(c, f"collectors[{i}]", source) for i, c in enumerate(tables))
     cnames = [c.name for c in collectors]
     if len(set(cnames)) != len(cnames):
         raise ScenarioError(f"{source}: collector names must be unique; got {cnames}")
+    return collectors
 
-    settings = parse_settings(data.get("settings", {}), source, max_events=DEFAULT_MAX_EVENTS_3D, envelopes=False)
-    return TerrainScenario(name=str(data.get("name", Path(source).stem)), description=str(data.get("description", "")),
-                           terrain=terrain, materials=materials, material_grid=grid, sources=sources,
-                           collectors=tuple(collectors), settings=settings, source=source)
+
+def _parse_collector(c, where: str, source: str) -> PlanCollector:
+    """One ``[[collectors]]`` table: a name, a plan line of distinct vertices and, for a barrier, its net.
+
+    Parameters
+    ----------
+    c : dict
+        The table, named ``where`` (e.g. ``collectors[0]``) in ``source`` by the error messages.
+    where, source : str
+        See ``c``.
+
+    Returns
+    -------
+    PlanCollector
+        The checked collector or barrier.
+    """
+    if not isinstance(c, dict):
+        raise ScenarioError(f"{source}: {where} must be a table with name and line")
+    _check_keys(c, {"name", "line", "height_m", "capacity_kj"}, f"{where}.", source)
+    if "name" not in c or "line" not in c:
+        raise ScenarioError(f"{source}: {where} needs a name and a line = [[x, y], ...]")
+    line = _plan_points(c["line"], f"{where}.line", source, min_points=2)
+    if np.any(np.hypot(*np.diff(line, axis=0).T) == 0):
+        raise ScenarioError(f"{source}: {where}.line ({c['name']!r}) has two coinciding vertices")
+    h = None if c.get("height_m") is None else _number(c["height_m"], f"{where}.height_m", source, lo=0.0,
+                                                       lo_open=True, hi=100.0)
+    cap = None if c.get("capacity_kj") is None else _number(c["capacity_kj"], f"{where}.capacity_kj", source,
+                                                            lo=0.0, lo_open=True)
+    if cap is not None and h is None:
+        raise ScenarioError(f"{source}: {where}.height_m is required for a barrier (capacity_kj given)")
+    return PlanCollector(str(c["name"]), line, h, cap)
 
 
 def is_terrain_scenario_file(path) -> bool:
