@@ -806,9 +806,17 @@ class PooledCalibration(Displayed):
         pandas.Series
             ``inside_90``, ``inside_99`` and ``beyond_p99`` (shares [-] of all observed stops, weighted by each
             release's number of stops) and ``observed_stops`` (count).
+
+        Raises
+        ------
+        ValueError
+            When no posterior-predictive check was run (``n_predictive=0``).
         """
         t = self.coverage_table
-        n = t["n_observed"].sum()
+        n = t["n_observed"].sum() if len(t) else 0
+        if n == 0:
+            raise ValueError("coverage: no posterior-predictive check was run (the calibration was called with "
+                             "n_predictive=0); calibrate with n_predictive > 0 to get it")
         return pd.Series({"inside_90": float((t["inside_90"] * t["n_observed"]).sum() / n),
                           "inside_99": float((t["inside_99"] * t["n_observed"]).sum() / n),
                           "beyond_p99": float((t["beyond_p99"] * t["n_observed"]).sum() / n),

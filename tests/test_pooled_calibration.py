@@ -199,3 +199,14 @@ def test_the_two_halves_of_the_authume_releases_give_overlapping_posteriors():
         assert a_lo <= b_hi and b_lo <= a_hi, (k, (a_lo, a_hi), (b_lo, b_hi))
     for cal in fits:
         assert cal.coverage()["beyond_p99"] <= 0.1          # at most 10 % of stops beyond their release's p99
+
+
+def test_coverage_without_a_predictive_check_says_so():
+    """A calibration run with n_predictive=0 has no posterior-predictive check: coverage() says why instead of
+    dividing by zero."""
+    fast = {**FAST, "n_predictive": 0, "n_initial": 32, "iterations": 1}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", simulation.PooledCalibrationWarning)
+        cal = calibrate_pooled(synthetic_releases(0, n_releases=4), BOUNDS, seed=1, **fast)
+    with pytest.raises(ValueError, match="n_predictive=0"):
+        cal.coverage()
