@@ -194,8 +194,8 @@ class Material:
     ``rolling_size_coefficient`` K [-]: the rolling resistance is tan(phi_g) + K roughness / r, so small blocks
     stop sooner (0: tan(phi_g) alone); ``et_normal_scale_ms``: vt0 of the Pfeiffer & Bowen (1989) scaling of the
     tangential energy by 1 / ((v_n / (vt0 e_N))^2 + 1) after a constant or Coulomb law (inf: none;
-    ``tangential.normal_scale_ms`` in a file, 76.2 m/s in CRSP).  In a file, ``preset = NAME`` starts from a named material and
-    ``preset_basis = "data"`` beside it from its data-derived table (:func:`simulation.materials.preset`).
+    ``tangential.normal_scale_ms`` in a file, 76.2 m/s in CRSP).  In a file, ``preset = NAME`` starts from a
+    named material and ``preset_basis = "data"`` beside it from its data-derived table (:func:`simulation.materials.preset`).
     See :mod:`simulation.contact`.
     """
 
@@ -284,8 +284,8 @@ class Material:
         et = spec.get("tangential", {"law": "friction", "friction_angle_deg": 30.0})
         if not isinstance(et, dict):
             raise ScenarioError(f"{source}: {where}tangential must be a table with 'law'")
-        _check_keys(et, {"law", "mean", "std", "friction_angle_deg", "std_deg", "normal_scale_ms"}, f"{where}tangential.",
-                    source)
+        _check_keys(et, {"law", "mean", "std", "friction_angle_deg", "std_deg", "normal_scale_ms"},
+                    f"{where}tangential.", source)
         et_v0 = math.inf
         if "normal_scale_ms" in et:
             if et.get("law", "friction") == "friction":

@@ -17,7 +17,8 @@ import simulation
 from simulation import ScenarioError
 from simulation.calibration import scenario_dict
 from simulation.contact import (EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_COULOMB, ET_FRICTION,
-                                contact_acceleration, contact_speed, contact_speed_at, contact_stop_distance, contact_time,
+                                contact_acceleration, contact_speed, contact_speed_at, contact_stop_distance,
+                                contact_time,
                                 coulomb_tangential, rebound, rolling_resistance, roughness_tilt_max,
                                 steep_face_launch, tangential_scaling, velocity_scaled)
 
