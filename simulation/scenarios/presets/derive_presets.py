@@ -198,7 +198,16 @@ def fit(datasets, n_per_release=50, seed=1, n_predictive=20):
 DRAG_PARAMETERS = {**CONTACT_PARAMETERS, "materials.soil.rolling_drag": (0.0, 0.05)}
 
 
+#: ``--model contact-sizedrag``: the soil's rolling resistance without a constant term (phi_g = 0), only the size
+#: term K roughness / r (K fitted, 0-4) and the v^2 drag kappa (fitted): resistance from asperities and from
+#: ploughing or vegetation, a variant tried for the transfer between the two Authume profiles.
+SIZEDRAG_PARAMETERS = {k: v for k, v in DRAG_PARAMETERS.items() if k != "materials.soil.ground_friction_angle_deg"}
+SIZEDRAG_PARAMETERS["materials.soil.rolling_size_coefficient"] = (0.0, 4.0)
+
+
 def _parameters() -> dict:
+    if MODEL.get("sizedrag"):
+        return SIZEDRAG_PARAMETERS
     if MODEL.get("drag"):
         return DRAG_PARAMETERS
     return CONTACT_PARAMETERS if MODEL["laws"] else PARAMETERS
@@ -317,7 +326,7 @@ def main():
     ap.add_argument("--n-per-release", type=int, default=50)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--draws", type=int, default=40)
-    ap.add_argument("--model", choices=["contact", "contact-drag", "presets"], default="contact")
+    ap.add_argument("--model", choices=["contact", "contact-drag", "contact-sizedrag", "presets"], default="contact")
     ap.add_argument("--site-spread", choices=["none", "assumed"], default="none",
                     help="add to every posterior draw the ASSUMED site-to-site spread of "
                          "simulation.material_uncertainty (uniform, its half-widths) before predicting")
@@ -329,6 +338,10 @@ def main():
     if args.model == "presets":
         MODEL["laws"] = {}
     MODEL["drag"] = args.model == "contact-drag"
+    MODEL["sizedrag"] = args.model == "contact-sizedrag"
+    if MODEL["sizedrag"]:
+        MODEL["laws"] = copy.deepcopy(MODEL["laws"])
+        MODEL["laws"]["soil"]["ground_friction_angle_deg"] = 0.0
     t0 = time.time()
     if args.mode == "fit":
         cal = fit(DATASETS, args.n_per_release, args.seed)
@@ -336,7 +349,7 @@ def main():
         print(cal.summary()[["median", "mean", "sd", "q05", "q95", "sd_ratio"]].round(3).to_string())
         print(cal.correlations().round(2).to_string())
         print(cal.coverage().to_dict(), cal.constraint_table.round(2).to_string(), cal.notes)
-        if args.kernel == "2d":        # the shipped priors are the 2-D fit's; a 3-D fit is printed only
+        if args.kernel == "2d" and args.model == "contact":    # the shipped priors; other fits are printed only
             write_priors(cal, REPO / "simulation" / "preset_priors.py", DATASETS, args)
         return
     rows, curves, folds = [], {}, []
