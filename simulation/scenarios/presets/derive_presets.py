@@ -2,7 +2,8 @@
 
     python simulation/scenarios/presets/derive_presets.py fit --n-per-release 200          # the shipped priors
     python simulation/scenarios/presets/derive_presets.py loo --n-per-release 200 --site-spread assumed
-    python simulation/scenarios/presets/derive_presets.py loo --kernel 3d --n-per-release 50 --out presets_loo_3d
+    python simulation/scenarios/presets/derive_presets.py loo --kernel 3d --n-per-release 50
+    python simulation/scenarios/presets/derive_presets.py loo --model contact-drag     # a variant: presets_loo_drag
 
 ``--kernel 3d`` runs the Authume releases on the quarry's DEM with its zone raster (the 3-D kernel, the same
 contact model; simulation/scenarios/authume/authume_3d.toml) and compares **plan runouts** (horizontal
@@ -332,8 +333,14 @@ def main():
                          "simulation.material_uncertainty (uniform, its half-widths) before predicting")
     ap.add_argument("--kernel", choices=["2d", "3d"], default="2d",
                     help="the Authume releases on their 2-D sections or on the quarry DEM (plan runouts)")
-    ap.add_argument("--out", default="presets_loo", help="name of the LOO table and figure (docs/validation)")
+    ap.add_argument("--out", default=None,
+                    help="name of the LOO table and figure in docs/validation (default: presets_loo, with _3d for "
+                         "--kernel 3d and _own_laws, _drag or _sizedrag for the other models, the names the "
+                         "validation page cites)")
     args = ap.parse_args()
+    if args.out is None:
+        suffix = {"contact": "", "presets": "_own_laws", "contact-drag": "_drag", "contact-sizedrag": "_sizedrag"}
+        args.out = "presets_loo" + suffix[args.model] + ("_3d" if args.kernel == "3d" else "")
     KERNEL["name"] = args.kernel
     if args.model == "presets":
         MODEL["laws"] = {}
