@@ -148,10 +148,11 @@ def with_site_spread(sample: pd.DataFrame, bounds: dict, seed=1) -> pd.DataFrame
 
     Each value is moved by a uniform amount within :func:`site_spread_half_width` of its field and kept inside
     the prior box ``bounds``.  A posterior fitted to a few sites measures what those sites share, not how much a
-    new site differs from them: the two Authume profiles alone put soil's rolling-resistance angle 4 deg apart
-    (11.8 and 16.0 deg) where each posterior is about 1.5 deg wide (docs/validation/trajectories.md).  The
+    new site differs from them: the two Authume profiles alone put soil's rolling-resistance angle 6.4 deg apart
+    (11.8 and 18.2 deg) where each posterior's 90 % interval is 2.5-4.9 deg wide
+    (docs/validation/trajectories.md, presets_loo_parameters.csv).  The
     half-widths are the ASSUMED ranges of :data:`ASSUMED_HALF_WIDTHS`.  In the leave-one-data-set-out check they
-    bring the share of Authume P2's stops beyond their release's predictive p99 from 25 % to 6 %.
+    bring the share of Authume P2's stops beyond their release's predictive p99 from 6.2 % to 0 %.
 
     Parameters
     ----------

@@ -179,8 +179,9 @@ def preset(name: str, basis: str = "published") -> dict:
         ``"published"`` (default): the values of :data:`PRESETS` (published ranges, the table above).
         ``"data"``: the table the data-derived priors were fitted with -- the preset's table with the contact laws
         of ``simulation.preset_priors.LAWS`` put over it (Coulomb-bounded e_T with Pfeiffer & Bowen's
-        normal-velocity scaling, hop heights, the size term of the rolling resistance) -- and every field fitted to real data (:func:`preset_prior`) replaced by its
-        posterior median; fields no data set constrains keep their published values.
+        normal-velocity scaling, hop heights, the size term of the rolling resistance) -- and every field fitted
+        to real data (:func:`preset_prior`) replaced by its posterior median; fields no data set constrains keep
+        their published values.
 
     Returns
     -------

@@ -195,7 +195,8 @@ class Material:
     stop sooner (0: tan(phi_g) alone); ``et_normal_scale_ms``: vt0 of the Pfeiffer & Bowen (1989) scaling of the
     tangential energy by 1 / ((v_n / (vt0 e_N))^2 + 1) after a constant or Coulomb law (inf: none;
     ``tangential.normal_scale_ms`` in a file, 76.2 m/s in CRSP).  In a file, ``preset = NAME`` starts from a
-    named material and ``preset_basis = "data"`` beside it from its data-derived table (:func:`simulation.materials.preset`).
+    named material and ``preset_basis = "data"`` beside it from its data-derived table
+    (:func:`simulation.materials.preset`).
     See :mod:`simulation.contact`.
     """
 
@@ -286,13 +287,6 @@ class Material:
             raise ScenarioError(f"{source}: {where}tangential must be a table with 'law'")
         _check_keys(et, {"law", "mean", "std", "friction_angle_deg", "std_deg", "normal_scale_ms"},
                     f"{where}tangential.", source)
-        et_v0 = math.inf
-        if "normal_scale_ms" in et:
-            if et.get("law", "friction") == "friction":
-                raise ScenarioError(f"{source}: {where}tangential.normal_scale_ms is not used by law 'friction' "
-                                    "(Stronge's impulse law); it scales the 'constant' and 'coulomb' laws")
-            et_v0 = _number(et["normal_scale_ms"], f"{where}tangential.normal_scale_ms", source, lo=0.0, hi=1e6,
-                            lo_open=True)
         if et.get("law", "friction") == "friction":
             et_law, et_mean, et_std = ET_FRICTION, 0.0, 0.0
             phi = _number(et.get("friction_angle_deg", 30.0), f"{where}tangential.friction_angle_deg", source,
@@ -315,6 +309,14 @@ class Material:
         else:
             raise ScenarioError(f"{source}: {where}tangential.law = {et['law']!r} is not 'friction', 'constant' "
                                 "or 'coulomb'")
+        et_v0 = math.inf
+        if "normal_scale_ms" in et:
+            if et_law == ET_FRICTION:
+                raise ScenarioError(f"{source}: {where}tangential.normal_scale_ms = {et['normal_scale_ms']!r} is not "
+                                    "used by law 'friction' (Stronge's impulse law); it scales the 'constant' and "
+                                    "'coulomb' laws")
+            et_v0 = _number(et["normal_scale_ms"], f"{where}tangential.normal_scale_ms", source, lo=0.0, hi=1e6,
+                            lo_open=True)
         motion = spec.get("ground_motion", "roll")
         if motion not in ("roll", "slide"):
             raise ScenarioError(f"{source}: {where}ground_motion = {motion!r} is not 'roll' or 'slide'")

@@ -337,7 +337,7 @@ def test_rolling_resistance_is_the_tangent_of_the_ground_friction_angle():
      "friction_angle_deg is not used by law 'constant'"),
     ({"tangential": {"law": "plough"}}, "is not 'friction', 'constant' or 'coulomb'"),
     ({"tangential": {"law": "friction", "normal_scale_ms": 76.2}},
-     "test: materials.m.tangential.normal_scale_ms is not used by law 'friction'"),
+     "test: materials.m.tangential.normal_scale_ms = 76.2 is not used by law 'friction'"),
     ({"tangential": {"law": "coulomb", "mean": 0.5, "normal_scale_ms": -3}}, "normal_scale_ms = -3 is outside"),
     ({"contact_hop_height_m": -1.0}, "contact_hop_height_m = -1.0 is outside"),
     ({"rolling_drag": "a lot"}, "rolling_drag must be a number"),

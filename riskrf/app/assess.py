@@ -189,16 +189,16 @@ def _scenario_hazard(gr, rate: float, scenario, collector: str | None, *, n: int
     KeyError
         The scenario has no line named ``collector``.
     ValueError
-        An unknown ``mass_coupling`` (checked after the seeder run).
+        An unknown ``mass_coupling`` (checked before the seeder run).
     """
     import simulation
 
     sc = scenario if isinstance(scenario, simulation.Scenario) else simulation.load_scenario(scenario)
     collector = collector or "barrier"
     sc.collector_index(collector)
-    result = simulation.run(sc, n=n, seed=seed)
     if mass_coupling not in ("simulated", "independent"):
         raise ValueError(f"mass_coupling = {mass_coupling!r} must be 'simulated' or 'independent'")
+    result = simulation.run(sc, n=n, seed=seed)
     road_hits = None
     if mass_coupling == "simulated" and not condition_on_mass:
         hazard, coupled = simulate_energy_hazard(gr, sc, collector, rate_per_year=rate, n=n, seed=seed,

@@ -84,7 +84,7 @@ CONTACT_LAWS = {
                              "std_deg": 3.0, "normal_scale_ms": CRSP_TANGENTIAL_SCALE_MS},
               "contact_hop_height_m": 0.3, "rolling_size_coefficient": 1.0},
 }
-MODEL = {"laws": CONTACT_LAWS}
+MODEL = {"laws": CONTACT_LAWS, "name": "contact"}
 
 #: The fitted preset fields and their uniform priors (wide: the published ranges sit inside them).
 PARAMETERS = {"materials.soil.ground_friction_angle_deg": (3.0, 45.0),
@@ -206,11 +206,15 @@ SIZEDRAG_PARAMETERS = {k: v for k, v in DRAG_PARAMETERS.items() if k != "materia
 SIZEDRAG_PARAMETERS["materials.soil.rolling_size_coefficient"] = (0.0, 4.0)
 
 
+#: ``--model`` -> (its own fitted fields, or None for those of the laws in use; the suffix of its LOO table's name).
+MODELS = {"contact": (None, ""), "presets": (None, "_own_laws"), "contact-drag": (DRAG_PARAMETERS, "_drag"),
+          "contact-sizedrag": (SIZEDRAG_PARAMETERS, "_sizedrag")}
+
+
 def _parameters() -> dict:
-    if MODEL.get("sizedrag"):
-        return SIZEDRAG_PARAMETERS
-    if MODEL.get("drag"):
-        return DRAG_PARAMETERS
+    own = MODELS[MODEL["name"]][0]
+    if own is not None:
+        return own
     return CONTACT_PARAMETERS if MODEL["laws"] else PARAMETERS
 
 
@@ -327,7 +331,7 @@ def main():
     ap.add_argument("--n-per-release", type=int, default=50)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--draws", type=int, default=40)
-    ap.add_argument("--model", choices=["contact", "contact-drag", "contact-sizedrag", "presets"], default="contact")
+    ap.add_argument("--model", choices=list(MODELS), default="contact")
     ap.add_argument("--site-spread", choices=["none", "assumed"], default="none",
                     help="add to every posterior draw the ASSUMED site-to-site spread of "
                          "simulation.material_uncertainty (uniform, its half-widths) before predicting")
@@ -339,14 +343,12 @@ def main():
                          "validation page cites)")
     args = ap.parse_args()
     if args.out is None:
-        suffix = {"contact": "", "presets": "_own_laws", "contact-drag": "_drag", "contact-sizedrag": "_sizedrag"}
-        args.out = "presets_loo" + suffix[args.model] + ("_3d" if args.kernel == "3d" else "")
+        args.out = "presets_loo" + MODELS[args.model][1] + ("_3d" if args.kernel == "3d" else "")
     KERNEL["name"] = args.kernel
+    MODEL["name"] = args.model
     if args.model == "presets":
         MODEL["laws"] = {}
-    MODEL["drag"] = args.model == "contact-drag"
-    MODEL["sizedrag"] = args.model == "contact-sizedrag"
-    if MODEL["sizedrag"]:
+    if args.model == "contact-sizedrag":
         MODEL["laws"] = copy.deepcopy(MODEL["laws"])
         MODEL["laws"]["soil"]["ground_friction_angle_deg"] = 0.0
     t0 = time.time()
