@@ -38,8 +38,11 @@ Method
   fitted to the log-likelihood of the evaluations near its top (a Gaussian surrogate; the fit region widens
   until the quadratic is concave) and the posterior sample is drawn from that Gaussian truncated to the box
   (Wood 2010, Nature 466:1102, for the Gaussian synthetic-likelihood idea; Wilkinson 2014, AISTATS, for
-  surrogates of ABC likelihoods).  When no concave quadratic fits, ABC rejection: the evaluations within
-  chi2_d(0.999) of the best log-likelihood, weighted by prior / proposal.  ``notes`` says which was used.
+  surrogates of ABC likelihoods).  When no concave quadratic fits (a flat, curved or cut direction), a
+  Gaussian process fitted to the best evaluations smooths the log-likelihood and the posterior is
+  importance-sampled from it (:mod:`simulation.surrogate`).  Only when that fails too (an effective sample
+  below ``GP_MIN_ESS``), ABC rejection: the evaluations within chi2_d(0.999) of the best log-likelihood,
+  weighted by prior / proposal.  ``notes`` says which was used.
 * **Posterior-predictive coverage.**  For ``n_predictive`` posterior draws every release is simulated again
   (another seed); the share of observed stops inside each release's central 90 % and 99 % predictive intervals
   should be near 0.90 and 0.99 when the model and its fitted parameters describe the data.
@@ -64,9 +67,9 @@ from .scenario import Distribution, Material, Scenario, ScenarioError, scenario_
 
 #: Share of the predictive density spread uniformly over the profile (the defensive mixture).
 DEFENSIVE_SHARE = 1e-3
-_RELEASE_FIELDS = ("x_m", "height_m", "vx_ms", "vz_ms", "downslope_speed_ms", "shape")
+_RELEASE_FIELDS = ("x_m", "height_m", "vx_ms", "vz_ms", "downslope_speed_ms", "shape", "aspect_ratio")
 #: Release fields a 3-D release may not set (its scenario's [sources] table gives them).
-_PROFILE_ONLY_FIELDS = ("x_m", "vx_ms", "vz_ms", "downslope_speed_ms", "shape", "radius_m")
+_PROFILE_ONLY_FIELDS = ("x_m", "vx_ms", "vz_ms", "downslope_speed_ms", "shape", "aspect_ratio", "radius_m")
 
 
 class PooledCalibrationWarning(UserWarning):
@@ -97,6 +100,9 @@ class Release(Displayed):
         the scenario's seeder values when None.
     shape : str, optional
         "sphere", "cylinder" or "disc".
+    aspect_ratio : float, optional
+        Length of a cylinder (or thickness of a disc) over its diameter [-]; the scenario's seeder value when None.
+        :func:`simulation.units.box_rolling_cylinder` gives radius and aspect ratio from a block's measured sizes.
     source : str
         The file (or other origin) the release was read from, named in errors.
     """
@@ -112,6 +118,7 @@ class Release(Displayed):
     vz_ms: float | None = None
     downslope_speed_ms: float | None = None
     shape: str | None = None
+    aspect_ratio: float | None = None
     source: str = "<releases>"
 
     def __repr__(self) -> str:
@@ -128,7 +135,7 @@ class Release(Displayed):
         pandas.DataFrame
             ``release``, ``scenario``, ``n_observed``, ``stop_min_m``/``stop_median_m``/``stop_max_m`` (stop
             positions, or plan runouts of a 3-D release [m]), ``mass_kg``, ``radius_m``, ``x_m``, ``height_m``,
-            ``vx_ms``, ``vz_ms``, ``downslope_speed_ms``, ``shape`` and ``source``.
+            ``vx_ms``, ``vz_ms``, ``downslope_speed_ms``, ``shape``, ``aspect_ratio`` and ``source``.
         """
         x = np.asarray(self.x_stop_m, dtype=float).ravel()
         ok = x[np.isfinite(x)]
@@ -138,7 +145,7 @@ class Release(Displayed):
                               "mass_kg": self.mass_kg, "radius_m": self.radius_m, "x_m": self.x_m,
                               "height_m": self.height_m, "vx_ms": self.vx_ms, "vz_ms": self.vz_ms,
                               "downslope_speed_ms": self.downslope_speed_ms, "shape": self.shape,
-                              "source": self.source}])
+                              "aspect_ratio": self.aspect_ratio, "source": self.source}])
 
 
 def _scenario_name(scenario) -> str:
@@ -313,8 +320,8 @@ def read_releases(path, scenarios: dict, *, release_column: str = "release") -> 
 
     Columns: ``release`` (name; rows sharing it form one release), ``scenario`` (a key of ``scenarios``, the
     mapping of names to scenario paths, dicts or Scenarios), ``x_stop_m`` [m]; optionally ``mass_kg``,
-    ``radius_m``, ``x_m``, ``height_m``, ``vx_ms``, ``vz_ms``, ``downslope_speed_ms``, ``shape`` -- one value
-    per release (rows of a release must agree).  A column given for some releases must be given for all.
+    ``radius_m``, ``x_m``, ``height_m``, ``vx_ms``, ``vz_ms``, ``downslope_speed_ms``, ``shape``,
+    ``aspect_ratio`` -- one value per release (rows of a release must agree).  A column given for some releases must be given for all.
     Errors name the file, the release (and line) and the field.
 
     Parameters
@@ -417,7 +424,7 @@ def check_releases(releases) -> list[Release]:
                              "release or for none (the scenario's seeder then decides)")
     for r in releases:
         where = f"{r.source}: release {r.name!r}"
-        for fld in ("mass_kg", "radius_m"):
+        for fld in ("mass_kg", "radius_m", "aspect_ratio"):
             v = getattr(r, fld)
             if v is not None and not (np.isfinite(v) and v > 0):
                 raise ValueError(f"{where}: {fld} = {v!r} must be a finite number > 0")
@@ -515,10 +522,12 @@ class _Pool:
                 raise ValueError(f"{where}: shape = {r.shape!r} is not 'sphere', 'cylinder' or 'disc'")
             if r.radius_m is not None:
                 shape = r.shape or sc.seeder.shape
-                rho = _density(r.mass_kg, r.radius_m, shape, sc.seeder.aspect_ratio)
+                aspect = r.aspect_ratio or sc.seeder.aspect_ratio
+                rho = _density(r.mass_kg, r.radius_m, shape, aspect)
+                body = shape if shape == "sphere" else f"{shape} of aspect ratio {aspect:g}"
                 if not 500.0 <= rho <= 6000.0:
                     raise ValueError(f"{where}: mass_kg = {r.mass_kg:g} and radius_m = {r.radius_m:g} give a "
-                                     f"density of {rho:,.0f} kg/m^3 for a {shape}, outside [500, 6000]")
+                                     f"density of {rho:,.0f} kg/m^3 for a {body}, outside [500, 6000]")
 
     def scenarios(self, values: dict) -> dict:
         """Scenario per base key with the parameter values put into its materials."""
@@ -630,8 +639,11 @@ def _with_release_state(sc: Scenario, r: Release) -> Scenario:
             kw[attr] = const(getattr(r, fld))
     if r.shape is not None:
         kw["shape"] = r.shape
+    if r.aspect_ratio is not None:
+        kw["aspect_ratio"] = float(r.aspect_ratio)
     if r.radius_m is not None:
-        kw["density_kg_m3"] = float(_density(r.mass_kg, r.radius_m, r.shape or sd.shape, sd.aspect_ratio))
+        kw["density_kg_m3"] = float(_density(r.mass_kg, r.radius_m, r.shape or sd.shape,
+                                             r.aspect_ratio or sd.aspect_ratio))
     return replace(sc, seeder=replace(sd, **kw)) if kw else sc
 
 
@@ -731,7 +743,8 @@ class PooledCalibration(Displayed):
     ``bounds``: the uniform prior; ``evaluations``: every parameter set simulated with its log-likelihood and
     importance weight; ``coverage_table``: per release, its observed stops and the share inside the 90 % and
     99 % posterior-predictive intervals; ``ess``: effective sample size of the posterior sample (its size when
-    drawn from the Gaussian surrogate; of the ABC-rejection weights otherwise).
+    drawn from the Gaussian surrogate; of the importance weights with the Gaussian-process surrogate; of the
+    ABC-rejection weights otherwise).
     """
 
     parameters: dict
@@ -1020,9 +1033,7 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
                                                 rng_design, rng_prop)
     evaluations = pd.DataFrame(lo + u_all * (hi - lo), columns=names).assign(
         log_likelihood=ll_all, weight=_importance_weights(u_all, ll_all, proposals))
-    fitted = _surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng_resample)
-    posterior, ess, notes = fitted or _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior,
-                                                     rng_resample)
+    posterior, ess, notes = _posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng_resample)
     notes += _bound_notes(posterior, pool.bounds, names)
     coverage = _coverage(pool, releases, posterior, n_predictive, rng_pred)
     ctable = _constraint_table(cpool, posterior, n_predictive, rng_pred)
@@ -1181,6 +1192,14 @@ def _adaptive_design(loglik, d, n_initial, n_per_iteration, iterations, rng_desi
     return u_all, ll_all, proposals
 
 
+def _posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng):
+    """The posterior sample, effective sample size and notes: from the Gaussian surrogate, else the
+    Gaussian-process surrogate, else ABC rejection (arguments as in :func:`_abc_posterior`)."""
+    return (_surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng)
+            or _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng)
+            or _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng))
+
+
 def _surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
     """Posterior sample from the Gaussian a quadratic fit of the log-likelihood defines, truncated to the box.
 
@@ -1218,8 +1237,44 @@ def _surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
              "truncated to the prior box"])
 
 
+#: Least effective sample of the Gaussian-process surrogate's importance weights for its posterior to be used.
+GP_MIN_ESS = 200
+
+
+def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
+    """Posterior sample from a Gaussian-process surrogate of the log-likelihood (:mod:`simulation.surrogate`),
+    when no concave quadratic fits it near its top.
+
+    Parameters
+    ----------
+    u_all, ll_all, lo, hi, names, n_posterior, rng
+        As in :func:`_surrogate_posterior`.
+
+    Returns
+    -------
+    tuple or None
+        (posterior DataFrame, effective sample size of the importance weights, notes), or None when the
+        surrogate cannot be fitted or its importance weights have an effective sample below :data:`GP_MIN_ESS`.
+    """
+    from .surrogate import gp_posterior_sample
+    d = u_all.shape[1]
+    if int(np.sum(ll_all >= ll_all.max() - 8.0 * stats.chi2.ppf(0.999, d))) < 10 * d:
+        return None
+    try:
+        draws, ess, gp = gp_posterior_sample(u_all, ll_all, n_posterior, rng)
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    if ess < GP_MIN_ESS:
+        return None
+    scales = ", ".join(f"{n.split('.', 1)[1]} {v:.2g}" for n, v in zip(names, gp.lengths))
+    return (pd.DataFrame(lo + draws * (hi - lo), columns=names), ess,
+            [f"posterior: Gaussian-process surrogate of the log-likelihood (no concave quadratic fits it near its "
+             f"top), fitted to the {gp.n_points} best evaluations (noise sd {gp.noise:.2f}; length scales on the "
+             f"unit prior box: {scales}), importance-sampled (effective sample {ess:,.0f})"])
+
+
 def _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng):
-    """Posterior sample by ABC rejection, when no Gaussian surrogate fits; warns when it is poorly resolved.
+    """Posterior sample by ABC rejection, when neither surrogate fits; warns when it is poorly resolved.
 
     Keeps the evaluated points whose log-likelihood is within chi2_d(0.999) of the best (twice the drop of the
     approximate 99.9 % likelihood region, Wilks: the best value of a noisy simulated likelihood is itself inflated

@@ -25,6 +25,7 @@ CYLINDER_INERTIA = 0.5
 """I / (m r^2) of a solid cylinder or disc rolling on its curved face, 1/2."""
 
 INERTIA_FACTORS = {"sphere": SPHERE_INERTIA, "cylinder": CYLINDER_INERTIA, "disc": CYLINDER_INERTIA}
+"""I / (m r^2) by block shape (a disc or plate rolls on its rim like a short cylinder: 1/2)."""
 
 
 def block_radius(mass, density_kg_m3, shape="sphere", aspect_ratio=1.0):
@@ -52,7 +53,47 @@ def block_radius(mass, density_kg_m3, shape="sphere", aspect_ratio=1.0):
     if shape in ("cylinder", "disc"):
         return (np.asarray(mass) / (2.0 * np.pi * density_kg_m3 * aspect_ratio)) ** (1.0 / 3.0)
     return (3.0 * np.asarray(mass) / (4.0 * np.pi * density_kg_m3)) ** (1.0 / 3.0)
-"""I / (m r^2) by block shape (a disc or plate rolls on its rim like a short cylinder: 1/2)."""
+
+
+def box_rolling_cylinder(l1_m, l2_m, l3_m):
+    """The cylinder a block of measured bounding-box sizes rolls as: (radius [m], aspect ratio [-]).
+
+    A block rolls about its longest axis (the stable axis of an elongated body), so its rolling radius is the
+    mean half-width of its cross-section, r = (L2 + L3) / 4, and its length L1 = 2 r x aspect ratio.  ASSUMPTION:
+    the block is modelled as that cylinder (inertia factor 1/2, :data:`CYLINDER_INERTIA`); the cross-section of a
+    box rolls with its centre between L3 / 2 and half its diagonal above the ground, and this mean radius lies
+    between them.  Its consequence, that flat and elongated blocks meet a larger rolling resistance
+    (roughness / r) and stop sooner, is what full-scale releases show (Authume: stop distance rises with
+    L3 / L1 and L2 / L1, Spearman 0.39-0.69; ``docs/validation/trajectories.md``).
+
+    Parameters
+    ----------
+    l1_m, l2_m, l3_m : float
+        The block's three bounding-box sizes [m], in any order (each finite and > 0).
+
+    Returns
+    -------
+    tuple of float
+        (radius [m], length over diameter [-]).
+
+    Raises
+    ------
+    ValueError
+        A size that is not a finite number > 0 (the message names it and its value).
+    """
+    import math
+    sizes = []
+    for name, v in (("l1_m", l1_m), ("l2_m", l2_m), ("l3_m", l3_m)):
+        try:
+            v = float(v)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} = {v!r} must be a block size [m]") from None
+        if not (math.isfinite(v) and v > 0):
+            raise ValueError(f"{name} = {v!r} must be a finite block size > 0 m")
+        sizes.append(v)
+    long, mid, short = sorted(sizes, reverse=True)
+    radius = (mid + short) / 4.0
+    return radius, long / (2.0 * radius)
 
 
 def kinetic_energy_kj(mass_kg, speed_ms, angular_velocity_rads=0.0, radius_m=0.0, inertia_factor=SPHERE_INERTIA):

@@ -210,3 +210,55 @@ def test_coverage_without_a_predictive_check_says_so():
         cal = calibrate_pooled(synthetic_releases(0, n_releases=4), BOUNDS, seed=1, **fast)
     with pytest.raises(ValueError, match="n_predictive=0"):
         cal.coverage()
+
+
+def test_box_rolling_cylinder_from_measured_sizes():
+    from simulation.units import block_radius, box_rolling_cylinder
+    # a 1.0 x 0.8 x 0.6 m block rolls about its 1.0 m axis: r = (0.8 + 0.6) / 4, length 1.0 = 2 r x aspect
+    assert box_rolling_cylinder(1.0, 0.8, 0.6) == pytest.approx((0.35, 1.0 / 0.7), rel=1e-12)
+    assert box_rolling_cylinder(0.6, 1.0, 0.8) == box_rolling_cylinder(1.0, 0.8, 0.6)     # any order
+    r, a = box_rolling_cylinder(1.0, 1.0, 1.0)                                             # a cube: r = L / 2
+    assert (r, a) == (0.5, 1.0)
+    # the cylinder and the seeder's radius law agree: a cylinder of that r and aspect at 2,650 kg/m^3
+    mass = 2650.0 * np.pi * 0.35 ** 2 * 1.0
+    assert float(block_radius(mass, 2650.0, "cylinder", 1.0 / 0.7)) == pytest.approx(0.35, rel=1e-12)
+    for bad in (0.0, -1.0, float("nan"), "a"):
+        with pytest.raises(ValueError, match=r"l2_m = .* block size"):
+            box_rolling_cylinder(1.0, bad, 0.5)
+
+
+def test_release_shape_and_aspect_ratio_set_the_simulated_radius():
+    from simulation.pooled import _Pool, _with_release_state
+    from simulation.units import box_rolling_cylinder
+    r, a = box_rolling_cylinder(1.1, 0.8, 0.5)
+    rel = Release("r1", _profile("A"), [100.0], mass_kg=900.0, radius_m=r, shape="cylinder", aspect_ratio=a,
+                  source="site.csv")
+    pool = _Pool([rel], BOUNDS)
+    sc = _with_release_state(next(iter(pool.bases.values()))[2], rel)
+    assert sc.seeder.shape == "cylinder" and sc.seeder.aspect_ratio == pytest.approx(a)
+    assert float(sc.seeder.radius(900.0)) == pytest.approx(r, rel=1e-12)
+    assert sc.seeder.inertia_factor == 0.5
+    assert rel.summary()["aspect_ratio"].iloc[0] == pytest.approx(a)
+    # the density check uses the release's aspect ratio, and says so
+    bad = Release("r1", _profile("A"), [100.0], mass_kg=900.0, radius_m=0.2, shape="cylinder", aspect_ratio=0.5,
+                  source="site.csv")
+    with pytest.raises(ValueError, match=r"site.csv: release 'r1': mass_kg = 900 and radius_m = 0.2 give a density "
+                                         r"of 35,810 kg/m\^3 for a cylinder of aspect ratio 0.5, outside"):
+        calibrate_pooled([bad], BOUNDS)
+    bad = Release("r1", _profile("A"), [100.0], mass_kg=900.0, radius_m=r, shape="cylinder", aspect_ratio=-1.0,
+                  source="site.csv")
+    with pytest.raises(ValueError, match=r"site.csv: release 'r1': aspect_ratio = -1.0 must be a finite number > 0"):
+        calibrate_pooled([bad], BOUNDS)
+
+
+def test_releases_file_reads_shape_and_aspect_ratio(tmp_path):
+    p = tmp_path / "releases.csv"
+    p.write_text("release,scenario,x_stop_m,mass_kg,radius_m,shape,aspect_ratio\n"
+                 "r1,A,100,900,0.325,cylinder,1.6923\nr1,A,104,900,0.325,cylinder,1.6923\n"
+                 "r2,A,90,500,0.33,sphere,1\n")
+    rel = read_releases(p, {"A": _profile("A")})
+    assert (rel[0].shape, rel[0].aspect_ratio, rel[1].shape) == ("cylinder", 1.6923, "sphere")
+    p.write_text("release,scenario,x_stop_m,mass_kg,radius_m,shape,aspect_ratio\n"
+                 "r1,A,100,900,0.325,cylinder,1.6923\nr1,A,104,900,0.325,cylinder,2\n")
+    with pytest.raises(ValueError, match=r"release 'r1': field aspect_ratio differs between its rows"):
+        read_releases(p, {"A": _profile("A")})

@@ -69,6 +69,8 @@ def test_a_3d_release_whose_source_is_outside_the_dem_is_refused_naming_release_
 def test_a_3d_release_refuses_profile_fields_and_impossible_runouts(dem):
     with pytest.raises(ValueError, match=r"release 'A': field x_m = 3.0 applies to a 2-D profile only"):
         _Pool([Release("A", _data(dem), [10.0], x_m=3.0)], {PHI: (10.0, 40.0)})
+    with pytest.raises(ValueError, match=r"release 'A': field aspect_ratio = 1.5 applies to a 2-D profile only"):
+        _Pool([Release("A", _data(dem), [10.0], aspect_ratio=1.5)], {PHI: (10.0, 40.0)})
     with pytest.raises(ValueError, match=r"release 'B': x_stop_m = -1 m is not a plan runout"):
         _Pool([Release("B", _data(dem), [10.0, -1.0])], {PHI: (10.0, 40.0)})
 

@@ -1,0 +1,146 @@
+"""Gaussian-process surrogate of a noisy simulated log-likelihood, and a posterior sample drawn through it.
+
+Used by :func:`simulation.calibrate_pooled` when no concave quadratic fits the log-likelihood near its top (a
+likelihood with a flat, curved or cut direction), before it falls back to ABC rejection.  The simulated
+log-likelihood at the evaluated parameter sets is noisy (a bounce more or less moves a stop) and, under common
+random numbers, jagged; resampling the evaluated points by their own likelihoods lets a few lucky points carry
+the whole posterior (an effective sample of a few).  A Gaussian process smooths the evaluations into a surface
+and the posterior is drawn from that surface by importance sampling, as in Gaussian-process emulation of
+simulators (Kennedy & O'Hagan 2001, J. R. Stat. Soc. B 63:425) and its use for likelihood-free inference
+(Wilkinson 2014, AISTATS, "Accelerating ABC methods using Gaussian processes"; Gutmann & Corander 2016,
+J. Mach. Learn. Res. 17(125), section 4).
+
+Model (Rasmussen & Williams 2006, *Gaussian Processes for Machine Learning*, MIT Press, eqs. 2.25-2.26 and
+5.8): ll(u) = m0 + f(u) + noise, f a zero-mean GP with squared-exponential covariance with one length scale per
+parameter (automatic relevance determination), the noise independent Gaussian (the Monte Carlo error of the
+simulated log-likelihood).  The constant m0 sits one chi2 drop below the lowest point used, so regions the
+design never reached are not favoured.  Hyperparameters maximise the log marginal likelihood (eq. 5.8).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import linalg, optimize, stats
+
+#: Most evaluated points the surrogate is fitted to (the best ones): the fit costs O(n^3).
+MAX_POINTS = 600
+#: Draws of the importance sampler.
+N_PROPOSAL = 40_000
+
+
+def _kernel(a, b, scale2, lengths):
+    d2 = np.sum(((a[:, None, :] - b[None, :, :]) / lengths) ** 2, axis=2)
+    return scale2 * np.exp(-0.5 * d2)
+
+
+def _neg_log_marginal(theta, u, y):
+    """Minus the log marginal likelihood (Rasmussen & Williams eq. 5.8) and its gradient (eq. 5.9) at log
+    hyperparameters ``theta`` (log signal sd, log length scales, log noise sd)."""
+    d = u.shape[1]
+    scale2, lengths, noise2 = math.exp(2 * theta[0]), np.exp(theta[1:1 + d]), math.exp(2 * theta[-1])
+    sq = ((u[:, None, :] - u[None, :, :]) / lengths) ** 2          # (n, n, d) scaled squared differences
+    kf = scale2 * np.exp(-0.5 * np.sum(sq, axis=2))
+    try:
+        c = linalg.cho_factor(kf + noise2 * np.eye(u.shape[0]), lower=True, check_finite=False)
+    except linalg.LinAlgError:
+        return 1e300, np.zeros_like(theta)
+    alpha = linalg.cho_solve(c, y, check_finite=False)
+    value = 0.5 * float(y @ alpha) + float(np.sum(np.log(np.diag(c[0])))) + 0.5 * y.size * math.log(2 * math.pi)
+    inner = np.outer(alpha, alpha) - linalg.cho_solve(c, np.eye(y.size), check_finite=False)
+    grad = np.empty_like(theta)
+    grad[0] = -0.5 * np.sum(inner * 2.0 * kf)
+    grad[1:1 + d] = -0.5 * np.einsum("ij,ijk->k", inner * kf, sq)
+    grad[-1] = -0.5 * np.trace(inner) * 2.0 * noise2
+    return value, grad
+
+
+class GPSurrogate:
+    """A Gaussian process fitted to log-likelihoods ``ll`` at unit-cube points ``u`` (the best
+    :data:`MAX_POINTS` within ``8 chi2_d(0.999)`` of the maximum).
+
+    Attributes
+    ----------
+    m0 : float
+        The constant mean (one chi2 drop below the lowest point used).
+    scale, lengths, noise : float, numpy.ndarray, float
+        Signal sd [log-likelihood units], length scales per parameter [unit cube], noise sd [log-likelihood
+        units] of the fitted process.
+    n_points : int
+        Points it was fitted to.
+    """
+
+    def __init__(self, u, ll):
+        u = np.asarray(u, dtype=float)
+        ll = np.asarray(ll, dtype=float)
+        d = u.shape[1]
+        drop = stats.chi2.ppf(0.999, d)
+        order = np.argsort(ll)[::-1]
+        keep = order[ll[order] >= ll.max() - 8.0 * drop][:MAX_POINTS]
+        self.u, y = u[keep], ll[keep]
+        self.n_points = int(keep.size)
+        self.m0 = float(y.min() - drop)
+        self.y = y - self.m0
+        sd = float(np.std(self.y)) or 1.0
+        theta0 = np.concatenate([[math.log(sd)], np.full(d, math.log(0.2)), [math.log(0.1 * sd)]])
+        bounds = ([(math.log(0.01 * sd), math.log(100 * sd))] + [(math.log(0.01), math.log(10.0))] * d
+                  + [(math.log(1e-3 * sd), math.log(sd))])
+        best = optimize.minimize(_neg_log_marginal, theta0, args=(self.u, self.y), jac=True, method="L-BFGS-B",
+                                 bounds=bounds, options={"maxiter": 200})
+        th = best.x
+        self.scale, self.lengths, self.noise = math.exp(th[0]), np.exp(th[1:1 + d]), math.exp(th[-1])
+        k = _kernel(self.u, self.u, self.scale ** 2, self.lengths) + self.noise ** 2 * np.eye(self.n_points)
+        self._alpha = linalg.cho_solve(linalg.cho_factor(k, lower=True), self.y)
+
+    def mean(self, u) -> np.ndarray:
+        """The surrogate's log-likelihood at unit-cube points ``u`` (n, d), in chunks."""
+        u = np.atleast_2d(np.asarray(u, dtype=float))
+        out = np.empty(u.shape[0])
+        for s in range(0, u.shape[0], 4096):
+            out[s:s + 4096] = self.m0 + _kernel(u[s:s + 4096], self.u, self.scale ** 2, self.lengths) @ self._alpha
+        return out
+
+
+def gp_posterior_sample(u, ll, n_posterior: int, rng):
+    """A posterior sample on the unit cube from the Gaussian-process surrogate of ``ll`` (uniform prior).
+
+    Draws :data:`N_PROPOSAL` points from a multivariate t (4 degrees of freedom) centred on the surrogate's
+    best fitted point with twice the covariance of the points within chi2_d(0.999) of the maximum, truncated to
+    the cube, weights them by exp(surrogate) / proposal density and resamples them systematically.
+
+    Parameters
+    ----------
+    u, ll : numpy.ndarray
+        Evaluated unit-cube points (n, d) and their simulated log-likelihoods (n,).
+    n_posterior : int
+        Size of the sample.
+    rng : numpy.random.Generator
+        Stream of the proposal and the resampling.
+
+    Returns
+    -------
+    tuple
+        (sample (n_posterior, d), effective sample size of the importance weights, the surrogate).
+    """
+    gp = GPSurrogate(u, ll)
+    d = gp.u.shape[1]
+    band = gp.u[gp.y + gp.m0 >= ll.max() - stats.chi2.ppf(0.999, d)]
+    band = band if band.shape[0] > d else gp.u
+    cov = 2.0 * np.cov(band, rowvar=False).reshape(d, d) + np.eye(d) * 1e-4
+    centre = gp.u[int(np.argmax(gp.mean(gp.u)))]
+    draws, kept = [], 0
+    while kept < N_PROPOSAL:
+        z = rng.multivariate_normal(np.zeros(d), cov, size=N_PROPOSAL)
+        t = centre + z / np.sqrt(rng.chisquare(4.0, size=N_PROPOSAL) / 4.0)[:, None]
+        t = t[np.all((t >= 0) & (t <= 1), axis=1)]
+        draws.append(t)
+        kept += t.shape[0]
+    prop = np.vstack(draws)[:N_PROPOSAL]
+    log_q = stats.multivariate_t(loc=centre, shape=cov, df=4.0).logpdf(prop)
+    lw = gp.mean(prop) - log_q
+    w = np.exp(lw - lw.max())
+    w /= w.sum()
+    ess = float(1.0 / np.sum(w * w))
+    pos = (rng.random() + np.arange(n_posterior)) / n_posterior        # systematic resampling
+    idx = np.minimum(np.searchsorted(np.cumsum(w), pos), w.size - 1)
+    return prop[idx], ess, gp
