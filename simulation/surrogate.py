@@ -101,12 +101,30 @@ class GPSurrogate:
         return out
 
 
-def gp_posterior_sample(u, ll, n_posterior: int, rng):
+def _t_proposal(centre, cov, n, rng):
+    """``n`` draws of a multivariate t (4 degrees of freedom) inside the unit cube and their log densities
+    (untruncated: the truncation constant cancels in normalised weights)."""
+    d = centre.size
+    draws, kept = [], 0
+    while kept < n:
+        z = rng.multivariate_normal(np.zeros(d), cov, size=n)
+        t = centre + z / np.sqrt(rng.chisquare(4.0, size=n) / 4.0)[:, None]
+        t = t[np.all((t >= 0) & (t <= 1), axis=1)]
+        draws.append(t)
+        kept += t.shape[0]
+    prop = np.vstack(draws)[:n]
+    return prop, stats.multivariate_t(loc=centre, shape=cov, df=4.0).logpdf(prop)
+
+
+def gp_posterior_sample(u, ll, n_posterior: int, rng, rounds: int = 3):
     """A posterior sample on the unit cube from the Gaussian-process surrogate of ``ll`` (uniform prior).
 
-    Draws :data:`N_PROPOSAL` points from a multivariate t (4 degrees of freedom) centred on the surrogate's
-    best fitted point with twice the covariance of the points within chi2_d(0.999) of the maximum, truncated to
-    the cube, weights them by exp(surrogate) / proposal density and resamples them systematically.
+    Adaptive importance sampling of exp(surrogate) (Cappé et al. 2004, J. Comput. Graph. Stat. 13:907): the
+    first proposal is a multivariate t (4 degrees of freedom) centred on the surrogate's best fitted point with
+    twice the covariance of the points within chi2_d(0.999) of the maximum; each further round centres it on
+    the weighted mean of the last with twice its weighted covariance.  Each round draws :data:`N_PROPOSAL`
+    points inside the cube; the last round's are weighted by exp(surrogate) / proposal density and resampled
+    systematically.
 
     Parameters
     ----------
@@ -115,31 +133,29 @@ def gp_posterior_sample(u, ll, n_posterior: int, rng):
     n_posterior : int
         Size of the sample.
     rng : numpy.random.Generator
-        Stream of the proposal and the resampling.
+        Stream of the proposals and the resampling.
+    rounds : int
+        Importance-sampling rounds.
 
     Returns
     -------
     tuple
-        (sample (n_posterior, d), effective sample size of the importance weights, the surrogate).
+        (sample (n_posterior, d), effective sample size of the last round's importance weights, the surrogate).
     """
     gp = GPSurrogate(u, ll)
     d = gp.u.shape[1]
     band = gp.u[gp.y + gp.m0 >= ll.max() - stats.chi2.ppf(0.999, d)]
     band = band if band.shape[0] > d else gp.u
-    cov = 2.0 * np.cov(band, rowvar=False).reshape(d, d) + np.eye(d) * 1e-4
+    cov = 2.0 * np.cov(band, rowvar=False).reshape(d, d) + np.eye(d) * 1e-6
     centre = gp.u[int(np.argmax(gp.mean(gp.u)))]
-    draws, kept = [], 0
-    while kept < N_PROPOSAL:
-        z = rng.multivariate_normal(np.zeros(d), cov, size=N_PROPOSAL)
-        t = centre + z / np.sqrt(rng.chisquare(4.0, size=N_PROPOSAL) / 4.0)[:, None]
-        t = t[np.all((t >= 0) & (t <= 1), axis=1)]
-        draws.append(t)
-        kept += t.shape[0]
-    prop = np.vstack(draws)[:N_PROPOSAL]
-    log_q = stats.multivariate_t(loc=centre, shape=cov, df=4.0).logpdf(prop)
-    lw = gp.mean(prop) - log_q
-    w = np.exp(lw - lw.max())
-    w /= w.sum()
+    for _ in range(rounds):
+        prop, log_q = _t_proposal(centre, cov, N_PROPOSAL, rng)
+        lw = gp.mean(prop) - log_q
+        w = np.exp(lw - lw.max())
+        w /= w.sum()
+        centre = w @ prop
+        diff = prop - centre
+        cov = 2.0 * (w[:, None] * diff).T @ diff + np.eye(d) * 1e-6
     ess = float(1.0 / np.sum(w * w))
     pos = (rng.random() + np.arange(n_posterior)) / n_posterior        # systematic resampling
     idx = np.minimum(np.searchsorted(np.cumsum(w), pos), w.size - 1)
