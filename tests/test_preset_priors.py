@@ -159,6 +159,19 @@ def test_the_shipped_priors_were_made_with_the_generator_s_laws_and_data_sets():
     eh = simulation.scenario_from_dict(mod.evans_hungr_scenario())
     assert eh.profile.z[2] == mod.EH_APEX[1] and eh.profile.x[2] == mod.EH_APEX[0]
     assert mod.EH_SHADOW_ANGLE_DEG == 27.5            # Evans & Hungr (1993), abstract
+    # the shipped model: each Authume block the sphere of its measured mass
+    assert all(r.radius_m is None and r.shape is None for r in mod.releases("P1"))
+    # --model contact-measured: every block rolls as the cylinder its measured sizes give (P1-1: 1.00 x 0.85 x
+    # 0.50 m, 1,247 kg), except P1-3, whose mass and sizes disagree (688 kg in a 0.75 x 0.45 x 0.40 m box): the
+    # sphere of its mass
+    mod.MODEL["name"] = "contact-measured"
+    rel = {r.name: r for r in mod.releases("P1")}
+    assert len(rel) == 41
+    assert (rel["P1-1"].shape, rel["P1-1"].radius_m, rel["P1-1"].aspect_ratio) == ("cylinder", 0.3375, 1.0 / 0.675)
+    assert rel["P1-1"].mass_kg == pytest.approx(1246.69)
+    assert rel["P1-3"].shape == "sphere"
+    assert rel["P1-3"].radius_m == pytest.approx((3 * 688.073 / (4 * math.pi * 2650.0)) ** (1 / 3))
+    assert sum(r.shape == "cylinder" for r in rel.values()) == 40
 
 
 def test_a_scenario_file_can_start_a_material_from_the_data_derived_preset():
