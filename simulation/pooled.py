@@ -64,6 +64,7 @@ from scipy import stats
 
 from ._display import Displayed, short_repr
 from .scenario import Distribution, Material, Scenario, ScenarioError, scenario_from_dict
+from .units import DENSITY_RANGE_KG_M3
 
 #: Share of the predictive density spread uniformly over the profile (the defensive mixture).
 DEFENSIVE_SHARE = 1e-3
@@ -321,8 +322,8 @@ def read_releases(path, scenarios: dict, *, release_column: str = "release") -> 
     Columns: ``release`` (name; rows sharing it form one release), ``scenario`` (a key of ``scenarios``, the
     mapping of names to scenario paths, dicts or Scenarios), ``x_stop_m`` [m]; optionally ``mass_kg``,
     ``radius_m``, ``x_m``, ``height_m``, ``vx_ms``, ``vz_ms``, ``downslope_speed_ms``, ``shape``,
-    ``aspect_ratio`` -- one value per release (rows of a release must agree).  A column given for some releases must be given for all.
-    Errors name the file, the release (and line) and the field.
+    ``aspect_ratio`` -- one value per release (rows of a release must agree).  A column given for some releases
+    must be given for all.  Errors name the file, the release (and line) and the field.
 
     Parameters
     ----------
@@ -525,9 +526,10 @@ class _Pool:
                 aspect = r.aspect_ratio or sc.seeder.aspect_ratio
                 rho = _density(r.mass_kg, r.radius_m, shape, aspect)
                 body = shape if shape == "sphere" else f"{shape} of aspect ratio {aspect:g}"
-                if not 500.0 <= rho <= 6000.0:
+                lo, hi = DENSITY_RANGE_KG_M3
+                if not lo <= rho <= hi:
                     raise ValueError(f"{where}: mass_kg = {r.mass_kg:g} and radius_m = {r.radius_m:g} give a "
-                                     f"density of {rho:,.0f} kg/m^3 for a {body}, outside [500, 6000]")
+                                     f"density of {rho:,.0f} kg/m^3 for a {body}, outside [{lo:g}, {hi:g}]")
 
     def scenarios(self, values: dict) -> dict:
         """Scenario per base key with the parameter values put into its materials."""

@@ -18,7 +18,7 @@ from .materials import PresetError, resolve_material
 from .contact import CRSP_VELOCITY_SCALE_MS, EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_COULOMB, ET_FRICTION
 from .slope import Profile
 from ._display import Displayed, short_repr
-from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2, block_radius
+from .units import DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2, block_radius
 
 
 class ScenarioError(ValueError):
@@ -666,7 +666,8 @@ def scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Path | None
         x_low=x_low, x_high=x_high,
         height_m=Distribution.parse(sd.get("height_m", 1.0), "seeder.height_m", source, lo=0.0, hi=1e4),
         mass_kg=Distribution.parse(sd["mass_kg"], "seeder.mass_kg", source, lo=0.0, hi=1e9, lo_open=True),
-        density_kg_m3=_number(sd.get("density_kg_m3", DEFAULT_DENSITY_KG_M3), "seeder.density_kg_m3", source, lo=500, hi=6000),
+        density_kg_m3=_number(sd.get("density_kg_m3", DEFAULT_DENSITY_KG_M3), "seeder.density_kg_m3", source,
+                              lo=DENSITY_RANGE_KG_M3[0], hi=DENSITY_RANGE_KG_M3[1]),
         vx_ms=Distribution.parse(sd.get("vx_ms", 0.0), "seeder.vx_ms", source, lo=-200, hi=200),
         vz_ms=Distribution.parse(sd.get("vz_ms", 0.0), "seeder.vz_ms", source, lo=-200, hi=200),
         angular_velocity_rads=Distribution.parse(sd.get("angular_velocity_rads", 0.0),

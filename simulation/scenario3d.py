@@ -61,7 +61,7 @@ from ._display import Displayed, short_repr
 from .scenario import (Distribution, ScenarioError, Settings, _check_keys, _number, parse_settings,
                        parse_tables_and_materials)
 from .terrain import MaterialGrid, Terrain, TerrainError, read_dem, read_material_raster
-from .units import DEFAULT_DENSITY_KG_M3, INERTIA_FACTORS, block_radius
+from .units import DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3, INERTIA_FACTORS, block_radius
 
 #: Contact steps are events in 3-D (one per half cell rolled), so the default limit is higher than in 2-D.
 DEFAULT_MAX_EVENTS_3D = 200_000
@@ -458,7 +458,7 @@ def _parse_sources(sd: dict, terrain: Terrain, base: Path, nodata_rule: str, sou
         height_m=Distribution.parse(sd.get("height_m", 1.0), "sources.height_m", source, lo=0.0, hi=1e4),
         mass_kg=Distribution.parse(sd["mass_kg"], "sources.mass_kg", source, lo=0.0, hi=1e9, lo_open=True),
         density_kg_m3=_number(sd.get("density_kg_m3", DEFAULT_DENSITY_KG_M3), "sources.density_kg_m3", source,
-                              lo=500, hi=6000),
+                              lo=DENSITY_RANGE_KG_M3[0], hi=DENSITY_RANGE_KG_M3[1]),
         speed_ms=Distribution.parse(sd.get("speed_ms", 0.0), "sources.speed_ms", source, lo=0.0, hi=200),
         vz_ms=Distribution.parse(sd.get("vz_ms", 0.0), "sources.vz_ms", source, lo=-200, hi=200),
         angular_velocity_rads=Distribution.parse(sd.get("angular_velocity_rads", 0.0),

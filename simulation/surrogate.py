@@ -93,7 +93,18 @@ class GPSurrogate:
         self._alpha = linalg.cho_solve(linalg.cho_factor(k, lower=True), self.y)
 
     def mean(self, u) -> np.ndarray:
-        """The surrogate's log-likelihood at unit-cube points ``u`` (n, d), in chunks."""
+        """The surrogate's log-likelihood at unit-cube points (the posterior mean of the process, in chunks).
+
+        Parameters
+        ----------
+        u : array_like
+            (n, d) points in the unit cube (the prior box scaled to [0, 1]).
+
+        Returns
+        -------
+        numpy.ndarray
+            (n,) log-likelihoods [the simulated log-likelihood's units].
+        """
         u = np.atleast_2d(np.asarray(u, dtype=float))
         out = np.empty(u.shape[0])
         for s in range(0, u.shape[0], 4096):

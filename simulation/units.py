@@ -18,6 +18,12 @@ DEFAULT_DENSITY_KG_M3 = 2650.0
 """Default rock density [kg/m^3] (quartz-rich rock; Wyllie 2014, table 1.1 gives 2,500-2,800 for
 most rock types).  Used when an inventory or scenario gives none, and always reported as a default."""
 
+#: Bulk densities of rock [kg/m³] accepted everywhere.  Rocks span about 1,000 (pumice, porous tuff) to 3,300
+#: (peridotite), massive ores up to about 5,200 (magnetite) (Schön 2015, Physical Properties of Rocks, 2nd ed.,
+#: chapter 2, tables 2.1-2.4); the bounds leave a margin on both sides.  A value such as 2.65 is g/cm³ typed
+#: for kg/m³, and 2,650,000 is g/m³: both would make every mass 1,000 times wrong.
+DENSITY_RANGE_KG_M3 = (500.0, 6000.0)
+
 SPHERE_INERTIA = 0.4
 """I / (m r^2) of a solid sphere, 2/5."""
 

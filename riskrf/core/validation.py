@@ -6,6 +6,8 @@ import warnings
 
 import numpy as np
 
+from simulation.units import DENSITY_RANGE_KG_M3  # noqa: F401  (its home; riskrf modules import it from here)
+
 
 class RiskrfError(Exception):
     """Base of every riskrf input error (site, corridor, mitigation, measures, decision tree, nil hazard), so that
@@ -108,13 +110,6 @@ def check_positive(value, name: str) -> float:
     if not np.isfinite(v) or v <= 0:
         raise ValueError(f"{name} must be finite and > 0; got {value!r}")
     return v
-
-
-#: Bulk densities of rock [kg/m³] riskrf accepts.  Rocks span about 1,000 (pumice, porous tuff) to 3,300
-#: (peridotite), massive ores up to about 5,200 (magnetite) (Schön 2015, Physical Properties of Rocks, 2nd ed.,
-#: chapter 2, tables 2.1-2.4); the bounds leave a margin on both sides.  A value such as 2.65 is g/cm³ typed
-#: for kg/m³, and 2,650,000 is g/m³: both would make every mass 1,000 times wrong.
-DENSITY_RANGE_KG_M3 = (500.0, 6000.0)
 
 
 def check_density(value, name: str = "density_kg_m3") -> float:

@@ -63,9 +63,9 @@ sys.path.insert(0, str(REPO))
 from simulation.calibration import scenario_dict  # noqa: E402
 from simulation.contact import CRSP_TANGENTIAL_SCALE_MS  # noqa: E402
 from simulation.material_uncertainty import with_site_spread  # noqa: E402
-from simulation.pooled import _density  # noqa: E402
-from simulation.units import DEFAULT_DENSITY_KG_M3, block_radius, box_rolling_cylinder  # noqa: E402
-from simulation.pooled import ReachConstraint, Release, _ConstraintPool, _Pool, calibrate_pooled  # noqa: E402
+from simulation.pooled import ReachConstraint, Release, _ConstraintPool, _density, _Pool, calibrate_pooled  # noqa: E402
+from simulation.units import (DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3, block_radius,  # noqa: E402
+                              box_rolling_cylinder)
 
 AUTHUME = REPO / "simulation" / "scenarios" / "authume"
 OBSERVED = REPO / "tests" / "data" / "authume" / "observed_runout.csv"
@@ -173,7 +173,8 @@ def releases(profile: str, rows=None) -> list:
         if MODEL["name"] == "contact-measured" and not three_d:
             radius, aspect = box_rolling_cylinder(r.l1_m, r.l2_m, r.l3_m)
             body = {"radius_m": radius, "shape": "cylinder", "aspect_ratio": aspect}
-            if not 500.0 <= _density(r.mass_kg, radius, "cylinder", aspect) <= 6000.0:
+            lo, hi = DENSITY_RANGE_KG_M3
+            if not lo <= _density(r.mass_kg, radius, "cylinder", aspect) <= hi:
                 # mass and sizes disagree (P1-3: 688 kg in a 0.75 x 0.45 x 0.40 m box, 5,097 kg/m^3): the
                 # equivalent sphere of the measured mass at the presets' density
                 body = {"radius_m": float(block_radius(r.mass_kg, DEFAULT_DENSITY_KG_M3)), "shape": "sphere",
@@ -225,10 +226,11 @@ SIZEDRAG_PARAMETERS = {k: v for k, v in DRAG_PARAMETERS.items() if k != "materia
 SIZEDRAG_PARAMETERS["materials.soil.rolling_size_coefficient"] = (0.0, 4.0)
 
 
-#: ``--model contact-vscale``: the soil's Pfeiffer & Bowen velocity scale vt0 fitted as well (instead of CRSP's
-#: 76.2 m/s): how much of its tangential speed a block keeps after a hard landing on soft ground, a variant tried
-#: for the transfer between the two Authume profiles (P1's blocks land on their bench after a free fall).
-VSCALE_PARAMETERS = {**CONTACT_PARAMETERS, "materials.soil.tangential.normal_scale_ms": (3.0, 80.0)}
+#: ``--model contact-vscale``: the rock's Pfeiffer & Bowen velocity scale vt0 fitted as well (instead of CRSP's
+#: 76.2 m/s): how much of its tangential speed a block keeps after a hard landing on rock, a variant tried for the
+#: transfer between the two Authume profiles (P1's blocks land on their rock bench after a 16 m free fall, P2's
+#: reach theirs down a rocky step at a shallower angle).
+VSCALE_PARAMETERS = {**CONTACT_PARAMETERS, "materials.bedrock.tangential.normal_scale_ms": (3.0, 80.0)}
 
 
 #: ``--model contact-measured``: the contact model with every Authume block rolling as the cylinder of its measured
@@ -278,8 +280,15 @@ def write_priors(cal, path: Path, datasets, args):
     path.write_text("\n".join(lines) + "\n")
 
 
+def _drawn(draws) -> dict:
+    """The fitted fields the posterior ``draws`` set (none for the published presets' single empty draw), with
+    their prior bounds: a field only some laws take (``tangential.normal_scale_ms``) is not set over the presets'
+    own laws."""
+    return {k: b for k, b in _parameters().items() if any(k in d for d in draws)}
+
+
 def predict_release_stops(rels, draws, n_each, seed0):
-    P = _parameters()
+    P = _drawn(draws)
     pool = _Pool(rels, {k: P[k] for k in P if k.split(".")[1] in rels[0].scenario["materials"]})
     per = [[] for _ in rels]
     for t, values in enumerate(draws):
@@ -308,9 +317,10 @@ def release_row(dataset, model, per_release, rels):
 ODOT_CUT = REPO / "simulation" / "scenarios" / "odot_catchment_cut.toml"
 ODOT_MATERIALS = {"bedrock": "rock", "soil": "catchment"}
 ODOT_CUT_HEIGHT_M = 18.3                                  # 60 ft
-#: The models whose laws are the shipped ones (those the scenario's ``preset_basis = "data"`` materials carry): the
-#: ODOT row is predicted for them, from the shipped priors or the model's own fit on all three data sets.
-ODOT_MODELS = ("contact", "contact-measured")
+#: The models whose laws are the shipped ones (those the scenario's ``preset_basis = "data"`` materials carry; the
+#: fitted fields are set over them): the ODOT row is predicted for them, from the shipped priors or the model's own
+#: fit on all three data sets.
+ODOT_MODELS = ("contact", "contact-measured", "contact-vscale")
 
 
 def ritchie_row(posterior, model, n_draws, seed):
@@ -417,7 +427,7 @@ def main():
                 MODEL["laws"] = {}
             if held == "evans_hungr_1993":
                 c = evans_hungr()
-                cp = _ConstraintPool([c], _parameters())
+                cp = _ConstraintPool([c], _drawn(ds))
                 MODEL["laws"] = laws
                 angs = []
                 for t, v in enumerate(ds):
