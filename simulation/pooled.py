@@ -1033,9 +1033,11 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
 
     u_all, ll_all, proposals = _adaptive_design(loglik, len(names), n_initial, n_per_iteration, iterations,
                                                 rng_design, rng_prop)
+    (posterior, ess, notes), u_all, ll_all, proposals = _posterior(
+        u_all, ll_all, proposals, lo, hi, names, n_posterior, rng_resample,
+        refine=(loglik, n_per_iteration or 32 * len(names), rng_prop))
     evaluations = pd.DataFrame(lo + u_all * (hi - lo), columns=names).assign(
         log_likelihood=ll_all, weight=_importance_weights(u_all, ll_all, proposals))
-    posterior, ess, notes = _posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng_resample)
     notes += _bound_notes(posterior, pool.bounds, names)
     coverage = _coverage(pool, releases, posterior, n_predictive, rng_pred)
     ctable = _constraint_table(cpool, posterior, n_predictive, rng_pred)
@@ -1194,12 +1196,32 @@ def _adaptive_design(loglik, d, n_initial, n_per_iteration, iterations, rng_desi
     return u_all, ll_all, proposals
 
 
-def _posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng):
-    """The posterior sample, effective sample size and notes: from the Gaussian surrogate, else the
-    Gaussian-process surrogate, else ABC rejection (arguments as in :func:`_abc_posterior`)."""
-    return (_surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng)
-            or _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng)
-            or _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng))
+def _posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng, refine=None):
+    """The posterior: from the Gaussian surrogate when a concave quadratic fits the evaluations; else from the
+    Gaussian-process surrogate, after simulating where its posterior lies while it extrapolates
+    (:func:`_refine_gp`, with ``refine``); else by ABC rejection.
+
+    Parameters
+    ----------
+    u_all, ll_all, proposals, lo, hi, names, n_posterior, rng
+        As in :func:`_abc_posterior`.
+    refine : tuple, optional
+        (log-likelihood of a unit-cube point, points per round, random stream) for :func:`_refine_gp`; None:
+        no new simulations.
+
+    Returns
+    -------
+    tuple
+        ((posterior DataFrame, effective sample size, notes), points, log-likelihoods, proposals), the last three
+        with any refinement rounds' evaluations appended.
+    """
+    fitted = _surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng)
+    if fitted is None:
+        if refine is not None:
+            u_all, ll_all, proposals = _refine_gp(refine[0], u_all, ll_all, proposals, refine[1], refine[2])
+        fitted = (_gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng)
+                  or _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng))
+    return fitted, u_all, ll_all, proposals
 
 
 def _surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
@@ -1241,6 +1263,63 @@ def _surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
 
 #: Least effective sample of the Gaussian-process surrogate's importance weights for its posterior to be used.
 GP_MIN_ESS = 200
+#: Most rounds of simulations drawn where the Gaussian-process posterior lies (``n_per_iteration`` points each).
+GP_REFINE_ROUNDS = 3
+
+
+def _gp_overreach(gp, draws, u_all) -> float:
+    """How far [log-likelihood units] the surrogate rises over its own posterior draws above its highest value at
+    a simulated point, beyond 1 (a likelihood ratio of e): > 0 when the posterior rests on extrapolation."""
+    return float(gp.mean(draws).max() - gp.mean(u_all).max() - 1.0)
+
+
+def _refine_gp(loglik, u_all, ll_all, proposals, n_it, rng):
+    """Simulate where the Gaussian-process posterior lies until the surrogate claims no log-likelihood the
+    simulations have not shown (at most :data:`GP_REFINE_ROUNDS` rounds).
+
+    A Gaussian process extrapolates: fitted to a likelihood that rises toward an unexplored corner of the prior
+    box, its mean can put the posterior where nothing was simulated.  Each round draws ``n_it`` points from a
+    multivariate t (4 degrees of freedom) with the mean and twice the covariance of the surrogate's posterior
+    sample, truncated to the cube (a proposal of the importance mixture, like the adaptive design's), and
+    simulates them; the next fit then knows the likelihood there (the acquisition of Gutmann & Corander 2016,
+    J. Mach. Learn. Res. 17(125), with the posterior itself as the acquisition density).
+
+    Parameters
+    ----------
+    loglik : callable
+        Log-likelihood of one unit-cube point.
+    u_all, ll_all : numpy.ndarray
+        Evaluated points (n, d) and their log-likelihoods (n,).
+    proposals : list of tuple
+        The proposals the points were drawn from (:func:`_log_mixture`); extended in place.
+    n_it : int
+        Points per round.
+    rng : numpy.random.Generator
+        Stream of the surrogate's sampling and of the new points.
+
+    Returns
+    -------
+    tuple
+        (points, log-likelihoods, proposals), with the rounds' points appended.
+    """
+    from .surrogate import gp_posterior_sample
+    d = u_all.shape[1]
+    for _ in range(GP_REFINE_ROUNDS):
+        try:
+            draws, _, gp = gp_posterior_sample(u_all, ll_all, 2000, rng)
+        except (np.linalg.LinAlgError, ValueError):
+            break
+        if _gp_overreach(gp, draws, u_all) <= 0.0:
+            break
+        mean = draws.mean(axis=0)
+        cov = 2.0 * np.cov(draws, rowvar=False).reshape(d, d) + np.eye(d) * 1e-6
+        test = _t_draw(rng, mean, cov, 20000)
+        z = max(float(np.mean(np.all((test >= 0) & (test <= 1), axis=1))), 1e-6)
+        new = _in_unit_box(lambda: _t_draw(rng, mean, cov, 4 * n_it), n_it)
+        proposals.append(("t", n_it, mean, cov, z))
+        u_all = np.vstack([u_all, new])
+        ll_all = np.concatenate([ll_all, [loglik(u) for u in new]])
+    return u_all, ll_all, proposals
 
 
 def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
@@ -1269,10 +1348,16 @@ def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
     if ess < GP_MIN_ESS:
         return None
     scales = ", ".join(f"{n.split('.', 1)[1]} {v:.2g}" for n, v in zip(names, gp.lengths))
-    return (pd.DataFrame(lo + draws * (hi - lo), columns=names), ess,
-            [f"posterior: Gaussian-process surrogate of the log-likelihood (no concave quadratic fits it near its "
+    notes = [f"posterior: Gaussian-process surrogate of the log-likelihood (no concave quadratic fits it near its "
              f"top), fitted to the {gp.n_points} best evaluations (noise sd {gp.noise:.2f}; length scales on the "
-             f"unit prior box: {scales}), importance-sampled (effective sample {ess:,.0f})"])
+             f"unit prior box: {scales}), importance-sampled (effective sample {ess:,.0f})"]
+    over = _gp_overreach(gp, draws, u_all)
+    if over > 0.0:
+        notes.append(f"the Gaussian-process posterior rests on extrapolation: the surrogate rises {over + 1.0:.1f} "
+                     "above its value at every simulated point where nothing was simulated; raise iterations or "
+                     "n_per_iteration")
+        warnings.warn(notes[-1], PooledCalibrationWarning, stacklevel=4)     # at the caller of calibrate_pooled
+    return pd.DataFrame(lo + draws * (hi - lo), columns=names), ess, notes
 
 
 def _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng):
@@ -1368,7 +1453,9 @@ def _constraint_table(cpool, posterior, n_predictive, rng):
 def _quadratic_surrogate(u, ll):
     """Gaussian (mean, covariance, R^2) from a quadratic fitted to the log-likelihood ``ll`` at the points ``u``
     (unit cube) within k chi2_d(0.999) of its maximum, k = 1, 2, 4, 8: the first concave fit (a jagged
-    likelihood gets a wider, smoother fit); None when no fit is concave or there are too few points."""
+    likelihood gets a wider, smoother fit) whose 99.9 % region holds one of the five best evaluations (a
+    quadratic forced over a kinked or skewed likelihood can put its peak away from where the simulations were
+    best); None when no fit qualifies or there are too few points."""
     d = u.shape[1]
     n_coef = 1 + d + d * (d + 1) // 2
     drop = stats.chi2.ppf(0.999, d)
@@ -1390,6 +1477,9 @@ def _quadratic_surrogate(u, ll):
         except np.linalg.LinAlgError:
             continue
         cov = np.linalg.inv(prec)
+        top = u[np.argsort(ll)[-5:]] - cov @ b                 # the five best evaluations, from the fitted peak
+        if np.einsum("ij,jk,ik->i", top, prec, top).min() > drop:
+            continue                                          # a quadratic that puts its peak away from the best
         resid = ys - design @ coef
         r2 = 1.0 - float(np.sum(resid ** 2) / max(np.sum((ys - ys.mean()) ** 2), 1e-300))
         return cov @ b, cov, r2
