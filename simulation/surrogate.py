@@ -71,9 +71,12 @@ class GPSurrogate:
     """
 
     def __init__(self, u, ll):
-        u = np.asarray(u, dtype=float)
-        ll = np.asarray(ll, dtype=float)
+        ok = np.isfinite(np.asarray(ll, dtype=float))
+        u = np.asarray(u, dtype=float)[ok]
+        ll = np.asarray(ll, dtype=float)[ok]
         d = u.shape[1]
+        if ll.size < d + 2:
+            raise ValueError(f"{ll.size} finite log-likelihoods: too few for a surrogate in {d} parameters")
         drop = stats.chi2.ppf(0.999, d)
         order = np.argsort(ll)[::-1]
         keep = order[ll[order] >= ll.max() - 8.0 * drop][:MAX_POINTS]
@@ -81,7 +84,7 @@ class GPSurrogate:
         self.n_points = int(keep.size)
         self.m0 = float(y.min() - drop)
         self.y = y - self.m0
-        sd = float(np.std(self.y)) or 1.0
+        sd = max(float(np.std(self.y)), 1e-3)
         theta0 = np.concatenate([[math.log(sd)], np.full(d, math.log(0.2)), [math.log(0.1 * sd)]])
         bounds = ([(math.log(0.01 * sd), math.log(100 * sd))] + [(math.log(0.01), math.log(10.0))] * d
                   + [(math.log(1e-3 * sd), math.log(sd))])
@@ -117,12 +120,16 @@ def _t_proposal(centre, cov, n, rng):
     (untruncated: the truncation constant cancels in normalised weights)."""
     d = centre.size
     draws, kept = [], 0
-    while kept < n:
+    for _ in range(1000):
+        if kept >= n:
+            break
         z = rng.multivariate_normal(np.zeros(d), cov, size=n)
         t = centre + z / np.sqrt(rng.chisquare(4.0, size=n) / 4.0)[:, None]
         t = t[np.all((t >= 0) & (t <= 1), axis=1)]
         draws.append(t)
         kept += t.shape[0]
+    if kept < n:
+        raise ValueError("the proposal puts almost no mass inside the prior box")
     prop = np.vstack(draws)[:n]
     return prop, stats.multivariate_t(loc=centre, shape=cov, df=4.0).logpdf(prop)
 
@@ -155,7 +162,7 @@ def gp_posterior_sample(u, ll, n_posterior: int, rng, rounds: int = 3):
     """
     gp = GPSurrogate(u, ll)
     d = gp.u.shape[1]
-    band = gp.u[gp.y + gp.m0 >= ll.max() - stats.chi2.ppf(0.999, d)]
+    band = gp.u[gp.y >= gp.y.max() - stats.chi2.ppf(0.999, d)]           # within one drop of the best
     band = band if band.shape[0] > d else gp.u
     cov = 2.0 * np.cov(band, rowvar=False).reshape(d, d) + np.eye(d) * 1e-6
     centre = gp.u[int(np.argmax(gp.mean(gp.u)))]

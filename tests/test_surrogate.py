@@ -101,3 +101,16 @@ def test_simulations_follow_the_surrogate_where_it_extrapolates():
     w = np.exp(np.where(g < 0.6, 20 * g + 40 * g ** 2, 26.4 - 200 * (g - 0.6)))
     exact = float((w * g).sum() / w.sum())
     assert post["materials.a.x"].mean() == pytest.approx(exact, abs=0.03), notes
+
+
+def test_failed_simulations_are_left_out_and_too_few_are_refused():
+    """NaN or -inf log-likelihoods (a simulation that failed) are left out of the surrogate; with none finite it
+    is refused with a ValueError (calibrate_pooled then falls back to ABC rejection)."""
+    rng = np.random.default_rng(0)
+    u = stats.qmc.Sobol(2, seed=1).random(256)
+    ll = -0.5 * (((u - 0.5) / 0.1) ** 2).sum(1) + rng.normal(0.0, 0.3, 256)
+    ll[:5], ll[5:10] = np.nan, -np.inf
+    draws, _, _ = gp_posterior_sample(u, ll, 1000, np.random.default_rng(1))
+    assert draws.std(0) == pytest.approx([0.1, 0.1], rel=0.15)
+    with pytest.raises(ValueError, match="0 finite log-likelihoods"):
+        gp_posterior_sample(u, np.full(256, np.nan), 100, np.random.default_rng(1))
