@@ -1187,13 +1187,40 @@ def _adaptive_design(loglik, d, n_initial, n_per_iteration, iterations, rng_desi
         diff = u_all - mean
         cov = (w[:, None] * diff).T @ diff / max(1.0 - np.sum(w * w), 1e-12)
         cov = 2.0 * cov + np.eye(d) * 1e-6                      # widened: heavier than the target
-        test = _t_draw(rng_prop, mean, cov, 20000)
-        z = max(float(np.mean(np.all((test >= 0) & (test <= 1), axis=1))), 1e-6)
-        new = _in_unit_box(lambda: _t_draw(rng_prop, mean, cov, 4 * n_it), n_it)
-        proposals.append(("t", n_it, mean, cov, z))
-        u_all = np.vstack([u_all, new])
-        ll_all = np.concatenate([ll_all, [loglik(u) for u in new]])
+        u_all, ll_all = _simulate_round(loglik, u_all, ll_all, proposals, mean, cov, n_it, rng_prop)
     return u_all, ll_all, proposals
+
+
+def _simulate_round(loglik, u_all, ll_all, proposals, mean, cov, n_it, rng):
+    """One round of new evaluations: ``n_it`` points from a multivariate t (4 degrees of freedom, ``mean``,
+    ``cov``) truncated to the unit cube, appended to ``proposals`` (with the truncation mass, estimated from
+    20,000 draws) and simulated.
+
+    Parameters
+    ----------
+    loglik : callable
+        Log-likelihood of one unit-cube point.
+    u_all, ll_all : numpy.ndarray
+        The points (n, d) and log-likelihoods (n,) so far.
+    proposals : list of tuple
+        See :func:`_log_mixture`; extended in place.
+    mean, cov : numpy.ndarray
+        Centre (d,) and scale matrix (d, d) of the t.
+    n_it : int
+        Points to draw.
+    rng : numpy.random.Generator
+        Stream of the draws.
+
+    Returns
+    -------
+    tuple
+        (points, log-likelihoods) with the round's appended.
+    """
+    test = _t_draw(rng, mean, cov, 20000)
+    z = max(float(np.mean(np.all((test >= 0) & (test <= 1), axis=1))), 1e-6)
+    new = _in_unit_box(lambda: _t_draw(rng, mean, cov, 4 * n_it), n_it)
+    proposals.append(("t", n_it, mean, cov, z))
+    return np.vstack([u_all, new]), np.concatenate([ll_all, [loglik(u) for u in new]])
 
 
 def _posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng, refine=None):
@@ -1313,12 +1340,7 @@ def _refine_gp(loglik, u_all, ll_all, proposals, n_it, rng):
             break
         mean = draws.mean(axis=0)
         cov = 2.0 * np.cov(draws, rowvar=False).reshape(d, d) + np.eye(d) * 1e-6
-        test = _t_draw(rng, mean, cov, 20000)
-        z = max(float(np.mean(np.all((test >= 0) & (test <= 1), axis=1))), 1e-6)
-        new = _in_unit_box(lambda: _t_draw(rng, mean, cov, 4 * n_it), n_it)
-        proposals.append(("t", n_it, mean, cov, z))
-        u_all = np.vstack([u_all, new])
-        ll_all = np.concatenate([ll_all, [loglik(u) for u in new]])
+        u_all, ll_all = _simulate_round(loglik, u_all, ll_all, proposals, mean, cov, n_it, rng)
     return u_all, ll_all, proposals
 
 
