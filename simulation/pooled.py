@@ -64,6 +64,7 @@ from scipy import stats
 
 from ._display import Displayed, short_repr
 from .scenario import Distribution, Material, Scenario, ScenarioError, scenario_from_dict
+from .surrogate import _in_unit_box, _t_draw, _t_logpdf, gp_posterior_sample
 from .units import DENSITY_RANGE_KG_M3
 
 #: Share of the predictive density spread uniformly over the profile (the defensive mixture).
@@ -959,23 +960,6 @@ def _set_in(spec, keys, value):
 
 
 # ---- the fit ----------------------------------------------------------------------------------------------------------
-def _t_logpdf(u, mean, cov, dof=4.0):
-    d = u.shape[1]
-    diff = u - mean
-    inv = np.linalg.inv(cov)
-    m = np.einsum("ij,jk,ik->i", diff, inv, diff)
-    _, logdet = np.linalg.slogdet(cov)
-    return (math.lgamma((dof + d) / 2) - math.lgamma(dof / 2) - 0.5 * d * math.log(dof * math.pi) - 0.5 * logdet
-            - 0.5 * (dof + d) * np.log1p(m / dof))
-
-
-def _t_draw(rng, mean, cov, n, dof=4.0):
-    d = mean.size
-    z = rng.multivariate_normal(np.zeros(d), cov, size=n)
-    g = rng.chisquare(dof, size=n) / dof
-    return mean + z / np.sqrt(g)[:, None]
-
-
 def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, seed=1, n_initial: int | None = None,
                      n_per_iteration: int | None = None, iterations: int = 3, n_posterior: int = 2000,
                      n_predictive: int = 40, obs_error_m: float = 0.5, constraints=()) -> PooledCalibration:
@@ -1125,32 +1109,6 @@ def _importance_weights(u_all, ll_all, proposals):
     return w / w.sum()
 
 
-def _in_unit_box(draw, n, give_up=False):
-    """The first ``n`` points inside the unit cube from repeated batches ``draw()`` (rows in order).
-
-    Parameters
-    ----------
-    draw : callable
-        Returns an (m, d) batch of candidate points.
-    n : int
-        Points wanted.
-    give_up : bool
-        Return None when a non-empty batch leaves no point kept so far.
-
-    Returns
-    -------
-    numpy.ndarray or None
-        (n, d) points, or None (``give_up`` only).
-    """
-    kept = []
-    while len(kept) < n:
-        cand = draw()
-        kept.extend(cand[np.all((cand >= 0) & (cand <= 1), axis=1)].tolist())
-        if give_up and len(kept) == 0 and len(cand) > 0:
-            return None
-    return np.array(kept[:n])
-
-
 def _adaptive_design(loglik, d, n_initial, n_per_iteration, iterations, rng_design, rng_prop):
     """The evaluated points: a scrambled Sobol design on the unit cube, then adaptive importance rounds.
 
@@ -1244,9 +1202,10 @@ def _posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng, refine
     """
     fitted = _surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng)
     if fitted is None:
+        gp = None
         if refine is not None:
-            u_all, ll_all, proposals = _refine_gp(refine[0], u_all, ll_all, proposals, refine[1], refine[2])
-        fitted = (_gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng)
+            u_all, ll_all, proposals, gp = _refine_gp(refine[0], u_all, ll_all, proposals, refine[1], refine[2])
+        fitted = (_gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=gp)
                   or _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng))
     return fitted, u_all, ll_all, proposals
 
@@ -1327,24 +1286,24 @@ def _refine_gp(loglik, u_all, ll_all, proposals, n_it, rng):
     Returns
     -------
     tuple
-        (points, log-likelihoods, proposals), with the rounds' points appended.
+        (points, log-likelihoods, proposals, surrogate): the rounds' points appended, and the surrogate fitted to
+        the final points (None when the last fit failed or points were added after it).
     """
-    from .surrogate import gp_posterior_sample
     d = u_all.shape[1]
     for _ in range(GP_REFINE_ROUNDS):
         try:
             draws, _, gp = gp_posterior_sample(u_all, ll_all, 2000, rng)
         except (np.linalg.LinAlgError, ValueError):
-            break
+            return u_all, ll_all, proposals, None
         if _gp_overreach(gp, draws, u_all) <= 0.0:
-            break
+            return u_all, ll_all, proposals, gp
         mean = draws.mean(axis=0)
         cov = 2.0 * np.cov(draws, rowvar=False).reshape(d, d) + np.eye(d) * 1e-6
         u_all, ll_all = _simulate_round(loglik, u_all, ll_all, proposals, mean, cov, n_it, rng)
-    return u_all, ll_all, proposals
+    return u_all, ll_all, proposals, None
 
 
-def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
+def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=None):
     """Posterior sample from a Gaussian-process surrogate of the log-likelihood (:mod:`simulation.surrogate`),
     when no concave quadratic fits it near its top.
 
@@ -1352,6 +1311,8 @@ def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
     ----------
     u_all, ll_all, lo, hi, names, n_posterior, rng
         As in :func:`_surrogate_posterior`.
+    gp : simulation.surrogate.GPSurrogate, optional
+        The surrogate already fitted to these points (:func:`_refine_gp`); fitted here when None.
 
     Returns
     -------
@@ -1359,12 +1320,11 @@ def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
         (posterior DataFrame, effective sample size of the importance weights, notes), or None when the
         surrogate cannot be fitted or its importance weights have an effective sample below :data:`GP_MIN_ESS`.
     """
-    from .surrogate import gp_posterior_sample
     d = u_all.shape[1]
     if int(np.sum(ll_all >= ll_all.max() - 8.0 * stats.chi2.ppf(0.999, d))) < 10 * d:
         return None
     try:
-        draws, ess, gp = gp_posterior_sample(u_all, ll_all, n_posterior, rng)
+        draws, ess, gp = gp_posterior_sample(u_all, ll_all, n_posterior, rng, gp=gp)
     except (np.linalg.LinAlgError, ValueError):
         return None
     if ess < GP_MIN_ESS:

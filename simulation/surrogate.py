@@ -55,6 +55,63 @@ def _neg_log_marginal(theta, u, y):
     return value, grad
 
 
+def _t_logpdf(u, mean, cov, dof=4.0):
+    """Log density of a multivariate t (``dof`` degrees of freedom, centre ``mean``, scale ``cov``) at the rows
+    of ``u`` (untruncated)."""
+    d = u.shape[1]
+    diff = u - mean
+    inv = np.linalg.inv(cov)
+    m = np.einsum("ij,jk,ik->i", diff, inv, diff)
+    _, logdet = np.linalg.slogdet(cov)
+    return (math.lgamma((dof + d) / 2) - math.lgamma(dof / 2) - 0.5 * d * math.log(dof * math.pi) - 0.5 * logdet
+            - 0.5 * (dof + d) * np.log1p(m / dof))
+
+
+def _t_draw(rng, mean, cov, n, dof=4.0):
+    """``n`` draws of a multivariate t (``dof`` degrees of freedom, centre ``mean``, scale ``cov``)."""
+    d = mean.size
+    z = rng.multivariate_normal(np.zeros(d), cov, size=n)
+    g = rng.chisquare(dof, size=n) / dof
+    return mean + z / np.sqrt(g)[:, None]
+
+
+def _in_unit_box(draw, n, give_up=False, max_batches=None):
+    """The first ``n`` points inside the unit cube from repeated batches ``draw()`` (rows in order).
+
+    Parameters
+    ----------
+    draw : callable
+        Returns an (m, d) batch of candidate points.
+    n : int
+        Points wanted.
+    give_up : bool
+        Return None when a non-empty batch leaves no point kept so far.
+    max_batches : int, optional
+        Most batches drawn (None: no limit).
+
+    Returns
+    -------
+    numpy.ndarray or None
+        (n, d) points, or None (``give_up`` only).
+
+    Raises
+    ------
+    ValueError
+        Fewer than ``n`` points inside the cube after ``max_batches`` batches.
+    """
+    kept, batches = [], 0
+    while len(kept) < n:
+        if max_batches is not None and batches >= max_batches:
+            raise ValueError(f"{len(kept)} of {n} proposal draws inside the prior box after {batches} batches: "
+                             "the proposal puts almost no mass inside it")
+        cand = draw()
+        batches += 1
+        kept.extend(cand[np.all((cand >= 0) & (cand <= 1), axis=1)].tolist())
+        if give_up and len(kept) == 0 and len(cand) > 0:
+            return None
+    return np.array(kept[:n])
+
+
 class GPSurrogate:
     """A Gaussian process fitted to log-likelihoods ``ll`` at unit-cube points ``u`` (the best
     :data:`MAX_POINTS` within ``8 chi2_d(0.999)`` of the maximum).
@@ -118,23 +175,11 @@ class GPSurrogate:
 def _t_proposal(centre, cov, n, rng):
     """``n`` draws of a multivariate t (4 degrees of freedom) inside the unit cube and their log densities
     (untruncated: the truncation constant cancels in normalised weights)."""
-    d = centre.size
-    draws, kept = [], 0
-    for _ in range(1000):
-        if kept >= n:
-            break
-        z = rng.multivariate_normal(np.zeros(d), cov, size=n)
-        t = centre + z / np.sqrt(rng.chisquare(4.0, size=n) / 4.0)[:, None]
-        t = t[np.all((t >= 0) & (t <= 1), axis=1)]
-        draws.append(t)
-        kept += t.shape[0]
-    if kept < n:
-        raise ValueError("the proposal puts almost no mass inside the prior box")
-    prop = np.vstack(draws)[:n]
-    return prop, stats.multivariate_t(loc=centre, shape=cov, df=4.0).logpdf(prop)
+    prop = _in_unit_box(lambda: _t_draw(rng, centre, cov, n), n, max_batches=1000)
+    return prop, _t_logpdf(prop, centre, cov)
 
 
-def gp_posterior_sample(u, ll, n_posterior: int, rng, rounds: int = 3):
+def gp_posterior_sample(u, ll, n_posterior: int, rng, rounds: int = 3, gp=None):
     """A posterior sample on the unit cube from the Gaussian-process surrogate of ``ll`` (uniform prior).
 
     Adaptive importance sampling of exp(surrogate) (Cappé et al. 2004, J. Comput. Graph. Stat. 13:907): the
@@ -154,13 +199,15 @@ def gp_posterior_sample(u, ll, n_posterior: int, rng, rounds: int = 3):
         Stream of the proposals and the resampling.
     rounds : int
         Importance-sampling rounds.
+    gp : GPSurrogate, optional
+        The surrogate already fitted to ``u`` and ``ll`` (fitted here when None).
 
     Returns
     -------
     tuple
         (sample (n_posterior, d), effective sample size of the last round's importance weights, the surrogate).
     """
-    gp = GPSurrogate(u, ll)
+    gp = GPSurrogate(u, ll) if gp is None else gp
     d = gp.u.shape[1]
     band = gp.u[gp.y >= gp.y.max() - stats.chi2.ppf(0.999, d)]           # within one drop of the best
     band = band if band.shape[0] > d else gp.u
