@@ -64,7 +64,7 @@ from scipy import stats
 
 from ._display import Displayed, short_repr
 from .scenario import Distribution, Material, Scenario, ScenarioError, scenario_from_dict
-from .surrogate import _in_unit_box, _t_draw, _t_logpdf, gp_posterior_sample
+from .surrogate import _in_unit_box, _t_draw, _t_logpdf, gp_posterior_sample, replicate_noise
 from .units import DENSITY_RANGE_KG_M3
 
 #: Share of the predictive density spread uniformly over the profile (the defensive mixture).
@@ -1008,18 +1008,18 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
     seed = int(np.random.SeedSequence().entropy % (2 ** 31)) if seed is None else seed
     ss = np.random.SeedSequence(seed)
     rng_design, rng_prop, rng_resample, rng_pred = (np.random.default_rng(c) for c in ss.spawn(4))
-    sim_seed = int(ss.generate_state(1)[0] % (2 ** 31))
+    sim_seed, *replicate_seeds = (int(v % (2 ** 31)) for v in ss.generate_state(3))
 
-    def loglik(u):
+    def loglik(u, seed=sim_seed):
         values = dict(zip(names, lo + u * (hi - lo)))
-        ll = _log_likelihood(pool.simulate(values, n_per_release, sim_seed), releases, lengths, obs_error_m)
-        return ll + (cpool.log_likelihood(cpool.simulate(values, sim_seed)) if constraints else 0.0)
+        ll = _log_likelihood(pool.simulate(values, n_per_release, seed), releases, lengths, obs_error_m)
+        return ll + (cpool.log_likelihood(cpool.simulate(values, seed)) if constraints else 0.0)
 
     u_all, ll_all, proposals = _adaptive_design(loglik, len(names), n_initial, n_per_iteration, iterations,
                                                 rng_design, rng_prop)
     (posterior, ess, notes), u_all, ll_all, proposals = _posterior(
         u_all, ll_all, proposals, lo, hi, names, n_posterior, rng_resample,
-        refine=(loglik, n_per_iteration or 32 * len(names), rng_prop))
+        refine=(loglik, n_per_iteration or 32 * len(names), rng_prop, tuple(replicate_seeds)))
     evaluations = pd.DataFrame(lo + u_all * (hi - lo), columns=names).assign(
         log_likelihood=ll_all, weight=_importance_weights(u_all, ll_all, proposals))
     notes += _bound_notes(posterior, pool.bounds, names)
@@ -1191,8 +1191,9 @@ def _posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng, refine
     u_all, ll_all, proposals, lo, hi, names, n_posterior, rng
         As in :func:`_abc_posterior`.
     refine : tuple, optional
-        (log-likelihood of a unit-cube point, points per round, random stream) for :func:`_refine_gp`; None:
-        no new simulations.
+        (log-likelihood ``f(point, seed=...)`` of a unit-cube point, points per round, random stream, two seeds
+        independent of the evaluations') for the noise floor (:func:`simulation.surrogate.replicate_noise` at the
+        :data:`N_REPLICATE` best points) and :func:`_refine_gp`; None: no new simulations and no noise floor.
 
     Returns
     -------
@@ -1202,10 +1203,13 @@ def _posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng, refine
     """
     fitted = _surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng)
     if fitted is None:
-        gp = None
+        gp, noise_floor = None, 0.0
         if refine is not None:
-            u_all, ll_all, proposals, gp = _refine_gp(refine[0], u_all, ll_all, proposals, refine[1], refine[2])
-        fitted = (_gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=gp)
+            loglik, n_it, rng_sim, seeds = refine
+            best = u_all[np.argsort(np.where(np.isfinite(ll_all), ll_all, -np.inf))[::-1][:N_REPLICATE]]
+            noise_floor = replicate_noise(lambda p, s: loglik(p, seed=s), best, seeds)
+            u_all, ll_all, proposals, gp = _refine_gp(loglik, u_all, ll_all, proposals, n_it, rng_sim, noise_floor)
+        fitted = (_gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=gp, noise_floor=noise_floor)
                   or _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng))
     return fitted, u_all, ll_all, proposals
 
@@ -1251,6 +1255,11 @@ def _surrogate_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng):
 GP_MIN_ESS = 200
 #: Most rounds of simulations drawn where the Gaussian-process posterior lies (``n_per_iteration`` points each).
 GP_REFINE_ROUNDS = 3
+#: Most share of the surrogate's leave-one-out standardised residuals beyond 3 before its posterior is flagged
+#: (0.3 % for a normal; the margin allows the heavier tails of a simulated log-likelihood).
+LOO_MAX_BEYOND_3 = 0.02
+#: Best evaluated points re-simulated with two independent seeds for the surrogate's noise floor.
+N_REPLICATE = 16
 
 
 def _gp_overreach(gp, draws, u_all) -> float:
@@ -1259,7 +1268,7 @@ def _gp_overreach(gp, draws, u_all) -> float:
     return float(gp.mean(draws).max() - gp.mean(u_all).max() - 1.0)
 
 
-def _refine_gp(loglik, u_all, ll_all, proposals, n_it, rng):
+def _refine_gp(loglik, u_all, ll_all, proposals, n_it, rng, noise_floor=0.0):
     """Simulate where the Gaussian-process posterior lies until the surrogate claims no log-likelihood the
     simulations have not shown (at most :data:`GP_REFINE_ROUNDS` rounds).
 
@@ -1282,6 +1291,8 @@ def _refine_gp(loglik, u_all, ll_all, proposals, n_it, rng):
         Points per round.
     rng : numpy.random.Generator
         Stream of the surrogate's sampling and of the new points.
+    noise_floor : float
+        Least noise sd of the surrogate (:class:`simulation.surrogate.GPSurrogate`).
 
     Returns
     -------
@@ -1292,7 +1303,7 @@ def _refine_gp(loglik, u_all, ll_all, proposals, n_it, rng):
     d = u_all.shape[1]
     for _ in range(GP_REFINE_ROUNDS):
         try:
-            draws, _, gp = gp_posterior_sample(u_all, ll_all, 2000, rng)
+            draws, _, gp = gp_posterior_sample(u_all, ll_all, 2000, rng, noise_floor=noise_floor)
         except (np.linalg.LinAlgError, ValueError):
             return u_all, ll_all, proposals, None
         if _gp_overreach(gp, draws, u_all) <= 0.0:
@@ -1303,7 +1314,7 @@ def _refine_gp(loglik, u_all, ll_all, proposals, n_it, rng):
     return u_all, ll_all, proposals, None
 
 
-def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=None):
+def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=None, noise_floor=0.0):
     """Posterior sample from a Gaussian-process surrogate of the log-likelihood (:mod:`simulation.surrogate`),
     when no concave quadratic fits it near its top.
 
@@ -1313,6 +1324,8 @@ def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=None):
         As in :func:`_surrogate_posterior`.
     gp : simulation.surrogate.GPSurrogate, optional
         The surrogate already fitted to these points (:func:`_refine_gp`); fitted here when None.
+    noise_floor : float
+        Least noise sd of a surrogate fitted here.
 
     Returns
     -------
@@ -1324,15 +1337,23 @@ def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=None):
     if int(np.sum(ll_all >= ll_all.max() - 8.0 * stats.chi2.ppf(0.999, d))) < 10 * d:
         return None
     try:
-        draws, ess, gp = gp_posterior_sample(u_all, ll_all, n_posterior, rng, gp=gp)
+        draws, ess, gp = gp_posterior_sample(u_all, ll_all, n_posterior, rng, gp=gp, noise_floor=noise_floor)
     except (np.linalg.LinAlgError, ValueError):
         return None
     if ess < GP_MIN_ESS:
         return None
     scales = ", ".join(f"{n.split('.', 1)[1]} {v:.2g}" for n, v in zip(names, gp.lengths))
+    beyond = float(np.mean(np.abs(gp.loo_z) > 3.0))
     notes = [f"posterior: Gaussian-process surrogate of the log-likelihood (no concave quadratic fits it near its "
-             f"top), fitted to the {gp.n_points} best evaluations (noise sd {gp.noise:.2f}; length scales on the "
-             f"unit prior box: {scales}), importance-sampled (effective sample {ess:,.0f})"]
+             f"top), fitted to {gp.n_points} evaluations near the top (noise sd {gp.noise:.2f}, the spread between "
+             f"independent seeds {gp.noise_floor:.2f}; length scales on the unit prior box: {scales}; "
+             f"leave-one-out standardised residuals sd {np.std(gp.loo_z):.2f}, {beyond:.1%} beyond 3), "
+             f"importance-sampled (effective sample {ess:,.0f})"]
+    if beyond > LOO_MAX_BEYOND_3:
+        notes.append(f"the Gaussian-process surrogate misfits its evaluations: {beyond:.1%} of their leave-one-out "
+                     f"standardised residuals lie beyond 3 (at most {LOO_MAX_BEYOND_3:.0%} expected); its posterior "
+                     "is approximate")
+        warnings.warn(notes[-1], PooledCalibrationWarning, stacklevel=4)     # at the caller of calibrate_pooled
     over = _gp_overreach(gp, draws, u_all)
     if over > 0.0:
         notes.append(f"the Gaussian-process posterior rests on extrapolation: the surrogate rises {over + 1.0:.1f} "

@@ -14,7 +14,12 @@ Model (Rasmussen & Williams 2006, *Gaussian Processes for Machine Learning*, MIT
 5.8): ll(u) = m0 + f(u) + noise, f a zero-mean GP with squared-exponential covariance with one length scale per
 parameter (automatic relevance determination), the noise independent Gaussian (the Monte Carlo error of the
 simulated log-likelihood).  The constant m0 sits one chi2 drop below the lowest point used, so regions the
-design never reached are not favoured.  Hyperparameters maximise the log marginal likelihood (eq. 5.8).
+design never reached are not favoured.  Hyperparameters maximise the log marginal likelihood (eq. 5.8), from
+several starts (one start can stop at a poor optimum that calls a constrained parameter irrelevant), with a floor
+on the length scales and on the noise (the spread between independent seeds): under common random numbers the
+simulated surface is jagged, and a process free to follow the jags as signal gives intervals too narrow.  When
+many points lie near the top, the fit uses the best few and a random draw of the rest, not the best of all
+(which would be the luckiest).
 """
 from __future__ import annotations
 
@@ -23,26 +28,40 @@ import math
 import numpy as np
 from scipy import linalg, optimize, stats
 
-#: Most evaluated points the surrogate is fitted to (the best ones): the fit costs O(n^3).
+#: Most evaluated points the surrogate is fitted to: the fit costs O(n^3).
 MAX_POINTS = 600
+#: Of those, how many are the best evaluations (the peak); the rest are drawn at random from the others near the
+#: top, so the fit does not select on the Monte Carlo noise (the best of many noisy values are the lucky ones).
+N_TOP = 100
+#: Least length scale on the unit prior box: a surface that changes faster than this is Monte Carlo jaggedness
+#: (common random numbers: a bounce more or less moves a stop), not a likelihood.
+LENGTH_FLOOR = 0.1
+#: Starting length scales of the marginal-likelihood fits (the best of the fits is kept).
+LENGTH_STARTS = (0.15, 0.4, 1.5)
 #: Draws of the importance sampler.
 N_PROPOSAL = 40_000
 
 
+def _sq_dist(a, b, lengths):
+    """Squared scaled distances between the rows of ``a`` and ``b`` (an (n, m) array, without an (n, m, d) one)."""
+    a, b = a / lengths, b / lengths
+    return np.maximum(np.sum(a * a, 1)[:, None] + np.sum(b * b, 1)[None, :] - 2.0 * a @ b.T, 0.0)
+
+
 def _kernel(a, b, scale2, lengths):
-    d2 = np.sum(((a[:, None, :] - b[None, :, :]) / lengths) ** 2, axis=2)
-    return scale2 * np.exp(-0.5 * d2)
+    return scale2 * np.exp(-0.5 * _sq_dist(a, b, lengths))
 
 
-def _neg_log_marginal(theta, u, y):
+def _neg_log_marginal(theta, diff2, y):
     """Minus the log marginal likelihood (Rasmussen & Williams eq. 5.8) and its gradient (eq. 5.9) at log
-    hyperparameters ``theta`` (log signal sd, log length scales, log noise sd)."""
-    d = u.shape[1]
+    hyperparameters ``theta`` (log signal sd, log length scales, log noise sd); ``diff2`` is the (n, n, d) array
+    of squared coordinate differences of the points."""
+    d = diff2.shape[2]
     scale2, lengths, noise2 = math.exp(2 * theta[0]), np.exp(theta[1:1 + d]), math.exp(2 * theta[-1])
-    sq = ((u[:, None, :] - u[None, :, :]) / lengths) ** 2          # (n, n, d) scaled squared differences
+    sq = diff2 / lengths ** 2                                         # (n, n, d) scaled squared differences
     kf = scale2 * np.exp(-0.5 * np.sum(sq, axis=2))
     try:
-        c = linalg.cho_factor(kf + noise2 * np.eye(u.shape[0]), lower=True, check_finite=False)
+        c = linalg.cho_factor(kf + noise2 * np.eye(y.size), lower=True, check_finite=False)
     except linalg.LinAlgError:
         return 1e300, np.zeros_like(theta)
     alpha = linalg.cho_solve(c, y, check_finite=False)
@@ -113,8 +132,23 @@ def _in_unit_box(draw, n, give_up=False, max_batches=None):
 
 
 class GPSurrogate:
-    """A Gaussian process fitted to log-likelihoods ``ll`` at unit-cube points ``u`` (the best
-    :data:`MAX_POINTS` within ``8 chi2_d(0.999)`` of the maximum).
+    """A Gaussian process fitted to log-likelihoods ``ll`` at unit-cube points ``u``.
+
+    The points used are those within ``8 chi2_d(0.999)`` of the maximum: all of them up to :data:`MAX_POINTS`,
+    else the :data:`N_TOP` best and a random draw (fixed seed) of the others.  The hyperparameters are the best of
+    maximum-marginal-likelihood fits from each start in :data:`LENGTH_STARTS`, with length scales at or above
+    :data:`LENGTH_FLOOR` and the noise sd at or above ``noise_floor``.
+
+    Parameters
+    ----------
+    u : array_like
+        (n, d) points in the unit cube.
+    ll : array_like
+        (n,) their log-likelihoods; NaN and -inf (failed simulations) are left out.
+    noise_floor : float
+        Least noise sd [log-likelihood units]: the spread of the log-likelihood between independent seeds at one
+        point (:func:`replicate_noise`).  Under common random numbers the simulated surface is jagged on that
+        scale, and a process allowed less noise follows the jags as signal (intervals too narrow).
 
     Attributes
     ----------
@@ -125,9 +159,14 @@ class GPSurrogate:
         units] of the fitted process.
     n_points : int
         Points it was fitted to.
+    noise_floor : float
+        The ``noise_floor`` it was given.
+    loo_z : numpy.ndarray
+        Leave-one-out standardised residuals of the points (Rasmussen & Williams eqs. 5.10-5.12): about N(0, 1)
+        when the process describes the evaluations.
     """
 
-    def __init__(self, u, ll):
+    def __init__(self, u, ll, noise_floor: float = 0.0):
         ok = np.isfinite(np.asarray(ll, dtype=float))
         u = np.asarray(u, dtype=float)[ok]
         ll = np.asarray(ll, dtype=float)[ok]
@@ -135,22 +174,33 @@ class GPSurrogate:
         if ll.size < d + 2:
             raise ValueError(f"{ll.size} finite log-likelihoods: too few for a surrogate in {d} parameters")
         drop = stats.chi2.ppf(0.999, d)
-        order = np.argsort(ll)[::-1]
-        keep = order[ll[order] >= ll.max() - 8.0 * drop][:MAX_POINTS]
-        self.u, y = u[keep], ll[keep]
-        self.n_points = int(keep.size)
+        band = np.flatnonzero(ll >= ll.max() - 8.0 * drop)
+        if band.size > MAX_POINTS:
+            order = band[np.argsort(ll[band])[::-1]]
+            rest = np.random.default_rng(0).choice(order[N_TOP:], MAX_POINTS - N_TOP, replace=False)
+            band = np.sort(np.concatenate([order[:N_TOP], rest]))
+        self.u, y = u[band], ll[band]
+        self.n_points = int(band.size)
         self.m0 = float(y.min() - drop)
         self.y = y - self.m0
         sd = max(float(np.std(self.y)), 1e-3)
-        theta0 = np.concatenate([[math.log(sd)], np.full(d, math.log(0.2)), [math.log(0.1 * sd)]])
-        bounds = ([(math.log(0.01 * sd), math.log(100 * sd))] + [(math.log(0.01), math.log(10.0))] * d
-                  + [(math.log(1e-3 * sd), math.log(sd))])
-        best = optimize.minimize(_neg_log_marginal, theta0, args=(self.u, self.y), jac=True, method="L-BFGS-B",
-                                 bounds=bounds, options={"maxiter": 200})
-        th = best.x
+        self.noise_floor = float(noise_floor)
+        nf = max(self.noise_floor, 1e-3 * sd)
+        bounds = ([(math.log(0.01 * sd), math.log(100 * sd))] + [(math.log(LENGTH_FLOOR), math.log(10.0))] * d
+                  + [(math.log(nf), math.log(max(sd, 2.0 * nf)))])
+        diff2 = (self.u[:, None, :] - self.u[None, :, :]) ** 2
+        fits = []
+        for start in LENGTH_STARTS:
+            theta0 = np.concatenate([[math.log(sd)], np.full(d, math.log(start)), [math.log(max(0.1 * sd, nf))]])
+            theta0 = np.clip(theta0, [b[0] for b in bounds], [b[1] for b in bounds])
+            fits.append(optimize.minimize(_neg_log_marginal, theta0, args=(diff2, self.y), jac=True,
+                                          method="L-BFGS-B", bounds=bounds, options={"maxiter": 200}))
+        th = min(fits, key=lambda f: f.fun).x
         self.scale, self.lengths, self.noise = math.exp(th[0]), np.exp(th[1:1 + d]), math.exp(th[-1])
         k = _kernel(self.u, self.u, self.scale ** 2, self.lengths) + self.noise ** 2 * np.eye(self.n_points)
-        self._alpha = linalg.cho_solve(linalg.cho_factor(k, lower=True), self.y)
+        c = linalg.cho_factor(k, lower=True)
+        self._alpha = linalg.cho_solve(c, self.y)
+        self.loo_z = self._alpha / np.sqrt(np.diag(linalg.cho_solve(c, np.eye(self.n_points))))
 
     def mean(self, u) -> np.ndarray:
         """The surrogate's log-likelihood at unit-cube points (the posterior mean of the process, in chunks).
@@ -172,6 +222,31 @@ class GPSurrogate:
         return out
 
 
+def replicate_noise(loglik, u, seeds) -> float:
+    """The noise sd of a simulated log-likelihood: its spread between two independent seeds at the same points.
+
+    Parameters
+    ----------
+    loglik : callable
+        ``loglik(point, seed)``: the log-likelihood of one unit-cube point simulated with ``seed``.
+    u : numpy.ndarray
+        (k, d) points (e.g. the best evaluated ones).
+    seeds : tuple of int
+        Two seeds, both independent of the one the evaluations used (else selecting the best points would
+        select on their noise).
+
+    Returns
+    -------
+    float
+        sqrt(mean((ll_a - ll_b)^2) / 2) over the points where both are finite [log-likelihood units]; 0 when
+        none is.
+    """
+    a = np.array([loglik(p, seeds[0]) for p in u])
+    b = np.array([loglik(p, seeds[1]) for p in u])
+    ok = np.isfinite(a) & np.isfinite(b)
+    return float(np.sqrt(np.mean((a[ok] - b[ok]) ** 2) / 2.0)) if ok.any() else 0.0
+
+
 def _t_proposal(centre, cov, n, rng):
     """``n`` draws of a multivariate t (4 degrees of freedom) inside the unit cube and their log densities
     (untruncated: the truncation constant cancels in normalised weights)."""
@@ -179,7 +254,7 @@ def _t_proposal(centre, cov, n, rng):
     return prop, _t_logpdf(prop, centre, cov)
 
 
-def gp_posterior_sample(u, ll, n_posterior: int, rng, rounds: int = 3, gp=None):
+def gp_posterior_sample(u, ll, n_posterior: int, rng, rounds: int = 3, gp=None, noise_floor: float = 0.0):
     """A posterior sample on the unit cube from the Gaussian-process surrogate of ``ll`` (uniform prior).
 
     Adaptive importance sampling of exp(surrogate) (Cappé et al. 2004, J. Comput. Graph. Stat. 13:907): the
@@ -201,13 +276,15 @@ def gp_posterior_sample(u, ll, n_posterior: int, rng, rounds: int = 3, gp=None):
         Importance-sampling rounds.
     gp : GPSurrogate, optional
         The surrogate already fitted to ``u`` and ``ll`` (fitted here when None).
+    noise_floor : float
+        Least noise sd of the surrogate fitted here (see :class:`GPSurrogate`).
 
     Returns
     -------
     tuple
         (sample (n_posterior, d), effective sample size of the last round's importance weights, the surrogate).
     """
-    gp = GPSurrogate(u, ll) if gp is None else gp
+    gp = GPSurrogate(u, ll, noise_floor) if gp is None else gp
     d = gp.u.shape[1]
     band = gp.u[gp.y >= gp.y.max() - stats.chi2.ppf(0.999, d)]           # within one drop of the best
     band = band if band.shape[0] > d else gp.u
