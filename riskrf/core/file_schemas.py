@@ -8,6 +8,7 @@ the mitigation dataclasses' defaults to :data:`TRAFFIC` and the others).  Shares
 from __future__ import annotations
 
 from .schema import REQUIRED, Field, FileSchema, Table
+from .validation import DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3
 
 
 def _num(name, unit="", doc="", default=None, **bounds):
@@ -62,7 +63,8 @@ INVENTORY = Table("inventory", (
     Field("start", "date", "", "start of the record period (else the sidecar, else the first date)"),
     Field("end", "date", "", "end of the record period"),
     _pos("duration_years", "yr", "length of the record, for undated inventories"),
-    _num("density_kg_m3", "kg/m3", "rock density (default: the sidecar, else 2,650, reported)", low=500, high=6000),
+    _num("density_kg_m3", "kg/m3", "rock density (default: the sidecar, else 2,650, reported)",
+         low=DENSITY_RANGE_KG_M3[0], high=DENSITY_RANGE_KG_M3[1]),
     _pos("m_min_kg", "kg", "completeness threshold of the power law (default: Clauset et al. 2009)"),
     _pos("m_max_kg", "kg", "maximum credible block (upper truncation)"),
     _num("rate_scale", "", "share of the inventoried rock face above this road (0.05 = 5 %)", default=1.0,
@@ -343,7 +345,8 @@ SCENARIO_SCHEMA = FileSchema("Slope scenario (simulation TOML)", (
     Table("seeder", (
         _text("type", "where blocks start", default="line"),
         Field("x", "any", "m", "release point or zone [from, to] along the profile"),
-        _num("density_kg_m3", "kg/m3", "block density", default=2650.0, low=500, high=6000),
+        _num("density_kg_m3", "kg/m3", "block density", default=DEFAULT_DENSITY_KG_M3, low=DENSITY_RANGE_KG_M3[0],
+             high=DENSITY_RANGE_KG_M3[1]),
     ), "Where and how blocks are released; mass_kg, height_m and velocities are numbers or distributions."),
     Table("collectors", (
         _text("name", "collector name", default=REQUIRED),

@@ -6,7 +6,7 @@ import warnings
 
 import numpy as np
 
-from simulation.units import DENSITY_RANGE_KG_M3  # noqa: F401  (its home; riskrf modules import it from here)
+from simulation.units import DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3  # noqa: F401  (their home; riskrf modules import them from here)
 
 
 class RiskrfError(Exception):

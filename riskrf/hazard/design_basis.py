@@ -49,6 +49,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.format import sig
+from ..core.validation import DEFAULT_DENSITY_KG_M3
 from ..core.units import SEL_PER_MEL, kinetic_energy_kj
 
 BASES = ("ONR 24810", "UNI 11211-4", "return period")
@@ -605,7 +606,7 @@ def barrier_shares(hazard, mel_kj: float, height_m: float, *, block_top_m: float
             "through": through}
 
 
-def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3: float = 2650.0,
+def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
                        x_m: float = float("nan"), clearance_m: float | None = None,
                        candidates=()) -> DesignRequirement:
     """The barrier the chosen basis requires at one line (see the module notes), with candidate checks.
@@ -818,7 +819,7 @@ def default_positions(scenario, barrier_x: float, road_x: float | None, k: int =
     return sorted(x for x in xs if start < x < end + 2.0)
 
 
-def position_search(hazard, scenario, basis: DesignBasis, *, block=None, density_kg_m3: float = 2650.0,
+def position_search(hazard, scenario, basis: DesignBasis, *, block=None, density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
                     positions_m=None, road_collector: str | None = "road", barrier_x: float | None = None,
                     n: int = 10_000, seed=1) -> PositionSearch:
     """:func:`design_requirement` at several positions along the profile from one simulation.

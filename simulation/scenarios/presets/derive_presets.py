@@ -127,7 +127,7 @@ def evans_hungr_scenario() -> dict:
             "seeder": {"type": "line", "x": [10.2, 12.0], "height_m": 0.0,
                        "downslope_speed_ms": {"dist": "uniform", "low": 0.5, "high": 3.0},
                        "mass_kg": {"dist": "lognormal", "median": 2000, "sigma": 1.0, "max": 100000},
-                       "density_kg_m3": 2650},
+                       "density_kg_m3": DEFAULT_DENSITY_KG_M3},
             "settings": {"envelope_bins": 0, **SETTINGS}}
 
 
