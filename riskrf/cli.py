@@ -634,19 +634,7 @@ def cmd_calibrate(args) -> int:
     from .io.outputs import atomic_output_dir, write_json
     from .report.files import save_figure
 
-    parameters = {}
-    for item in args.parameter or []:
-        name, sep, rng = item.partition("=")
-        low, sep2, high = rng.partition(":")
-        if not (sep and sep2 and name):
-            raise ValueError(f"--parameter {item!r}: use NAME=LOW:HIGH, e.g. "
-                             "materials.talus.ground_friction_angle_deg=15:40")
-        try:
-            parameters[name] = (float(low), float(high))
-        except ValueError:
-            raise ValueError(f"--parameter {item!r}: LOW and HIGH must be numbers; got {low!r} and {high!r}") from None
-    if not parameters:
-        raise ValueError("give at least one --parameter NAME=LOW:HIGH")
+    parameters = _parse_parameters(args.parameter)
     select = {}
     for item in args.select or []:
         key, sep, value = item.partition("=")
@@ -693,6 +681,117 @@ def cmd_calibrate(args) -> int:
         save_figure(cal.plot().figure, tmp / "runout_observed_vs_simulated.png")
     print(f"\nWrote the calibrated scenario, parameters.csv, comparison.csv, bootstrap.csv, evaluations.csv, "
           f"calibration.json and runout_observed_vs_simulated.png to {out}/")
+    return 0
+
+
+def _parse_parameters(items) -> dict:
+    """The ``--parameter NAME=LOW:HIGH`` options as {dotted path: (low, high)}.
+
+    Parameters
+    ----------
+    items : list of str or None
+        The options as given.
+
+    Returns
+    -------
+    dict
+        Dotted scenario path -> (low, high).
+
+    Raises
+    ------
+    ValueError
+        An option not of the form NAME=LOW:HIGH with numbers, or none given.
+    """
+    parameters = {}
+    for item in items or []:
+        name, sep, rng = item.partition("=")
+        low, sep2, high = rng.partition(":")
+        if not (sep and sep2 and name):
+            raise ValueError(f"--parameter {item!r}: use NAME=LOW:HIGH, e.g. "
+                             "materials.talus.ground_friction_angle_deg=15:40")
+        try:
+            parameters[name] = (float(low), float(high))
+        except ValueError:
+            raise ValueError(f"--parameter {item!r}: LOW and HIGH must be numbers; got {low!r} and {high!r}") from None
+    if not parameters:
+        raise ValueError("give at least one --parameter NAME=LOW:HIGH")
+    return parameters
+
+
+def cmd_calibrate_pooled(args) -> int:
+    """``riskrf calibrate-pooled RELEASES``: fit material parameters shared by many releases to all their observed
+    stops (:func:`simulation.calibrate_pooled`) and write the posterior sample with its diagnostics.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (see :func:`build_parser`).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
+    """
+    from simulation.pooled import calibrate_pooled, read_releases
+
+    from .app.preflight import check_out
+    from .core.file_schemas import check_scenario_file
+    from .io.outputs import atomic_output_dir, write_json
+    from .report.files import save_figure
+
+    parameters = _parse_parameters(args.parameter)
+    scenarios = {}
+    for item in args.scenario or []:
+        name, sep, path = item.partition("=")
+        if not (sep and name and path):
+            raise ValueError(f"--scenario {item!r}: use NAME=FILE, e.g. P1=authume_p1.toml (NAME as in the "
+                             f"{args.scenario_column!r} column)")
+        if not Path(path).is_file():
+            raise FileNotFoundError(f"--scenario {item!r}: scenario file not found: {path}")
+        check_scenario_file(path)
+        scenarios[name] = path
+    if not scenarios:
+        raise ValueError(f"give at least one --scenario NAME=FILE (NAME as in the {args.scenario_column!r} column)")
+    out = check_out(args, f"{Path(args.releases).stem}-pooled-calibration",
+                    inputs={f"scenario {k}": v for k, v in scenarios.items()})
+    columns = [c.strip() for c in args.release_column.split(",")]
+    releases = read_releases(args.releases, scenarios, release_column=columns if len(columns) > 1 else columns[0],
+                             scenario_column=args.scenario_column)
+    print(f"riskrf calibrate-pooled: {len(releases)} releases from {args.releases}, "
+          f"{sum(len(r.x_stop_m) for r in releases)} observed stops, {len(parameters)} parameters, "
+          f"{args.n_per_release} blocks per release and parameter set (seed {args.seed})")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        cal = calibrate_pooled(releases, parameters, n_per_release=args.n_per_release, seed=args.seed,
+                               iterations=args.iterations, n_posterior=args.posterior, n_predictive=args.predictive)
+    for w in caught:
+        if str(w.message) not in cal.notes:
+            print(f"warning: {w.message}")
+    summary = cal.summary()
+    print(summary.to_string(float_format=lambda v: f"{v:.4g}"))
+    if args.predictive:
+        cov = cal.coverage()
+        print(f"\nPredictive check: {cov['inside_90']:.0%} of the observed stops inside their release's central 90 % "
+              f"interval, {cov['inside_99']:.0%} inside its 99 % (nominal 90 % and 99 %)")
+    for note in cal.notes:
+        print(f"note: {note}")
+    with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
+        cal.write(tmp / "posterior.csv")
+        summary.to_csv(tmp / "parameters.csv")
+        cal.correlations().to_csv(tmp / "correlations.csv")
+        cal.evaluations.to_csv(tmp / "evaluations.csv", index=False)
+        files = ["posterior.csv", "parameters.csv", "correlations.csv", "evaluations.csv", "calibration.json",
+                 "posterior_pairs.png"]
+        if args.predictive:
+            cal.coverage_table.to_csv(tmp / "coverage.csv", index=False)
+            save_figure(cal.plot("coverage").figure, tmp / "coverage.png")
+            files[4:4] = ["coverage.csv"]
+            files.append("coverage.png")
+        write_json({"parameters": cal.parameters, "bounds": cal.bounds, "n_per_release": cal.n_per_release,
+                    "seed": cal.seed, "effective_sample": cal.ess, "releases": args.releases,
+                    "scenarios": scenarios, "notes": list(cal.notes)}, tmp / "calibration.json")
+        save_figure(cal.plot("pairs").figure, tmp / "posterior_pairs.png")
+    print(f"\nWrote {', '.join(files)} to {out}/")
     return 0
 
 
@@ -1072,6 +1171,47 @@ def _add_calibrate_parser(sub) -> None:
     p.set_defaults(func=cmd_calibrate)
 
 
+def _add_calibrate_pooled_parser(sub) -> None:
+    """Add the sub-command calibrate-pooled: fit material parameters shared by many releases, with a posterior.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command registry of :func:`build_parser`.
+    """
+    p = sub.add_parser(
+        "calibrate-pooled", help="fit material parameters shared by many releases to all their stops (posterior)",
+        description="Fit material parameters (dotted paths, uniform priors within bounds) shared by many "
+        "releases, each on its own scenario with its own block, to all their observed stops: kernel likelihood "
+        "of each stop under its release's simulated stops, common random numbers, a Sobol design and adaptive "
+        "importance rounds, the posterior from a quadratic or Gaussian-process surrogate of the log-likelihood "
+        "(ABC rejection as the last resort; the notes say which), and a predictive check per release.  Writes "
+        "the posterior sample (read back by simulation.read_posterior and the model-uncertainty inputs), "
+        "its summary, correlations, the evaluations, the predictive coverage and figures.  See the docs: "
+        "Trajectories and simulation, 'Pooled calibration'.", epilog=EPILOG)
+    p.add_argument("releases", help="CSV, one row per observed block: release name, scenario name, x_stop_m [m], "
+                   "optionally mass_kg, radius_m, shape, aspect_ratio, x_m, height_m, vx_ms, vz_ms, "
+                   "downslope_speed_ms (one value per release)")
+    p.add_argument("--scenario", action="append", metavar="NAME=FILE",
+                   help="scenario TOML of the releases whose scenario column says NAME; repeat for each")
+    p.add_argument("--parameter", action="append", metavar="NAME=LOW:HIGH",
+                   help="dotted material path and its uniform prior's bounds; repeat for several")
+    p.add_argument("--release-column", default="release", metavar="COL[,COL]",
+                   help="column naming the release, or several (comma-separated) that together name it "
+                        "(default release)")
+    p.add_argument("--scenario-column", default="scenario", metavar="COL",
+                   help="column holding the scenario name (default scenario)")
+    p.add_argument("--n-per-release", type=int, default=200,
+                   help="simulated blocks per release and parameter set (default 200)")
+    p.add_argument("--iterations", type=int, default=3, help="adaptive importance rounds (default 3)")
+    p.add_argument("--posterior", type=int, default=2000, help="size of the posterior sample (default 2,000)")
+    p.add_argument("--predictive", type=int, default=40,
+                   help="posterior draws simulated for the predictive check (default 40; 0 to skip)")
+    p.add_argument("--seed", type=int, default=1, help="seed of the simulations, design and sampling (default 1)")
+    _add_out_dir(p, "<releases>-pooled-calibration")
+    p.set_defaults(func=cmd_calibrate_pooled)
+
+
 def _add_rates_parser(sub) -> None:
     """Add the sub-command rates: rate regressions on rainfall, season and trend, and closure rules.
 
@@ -1231,6 +1371,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_assess_parser(sub)
     _add_demo_parser(sub)
     _add_calibrate_parser(sub)
+    _add_calibrate_pooled_parser(sub)
     _add_rates_parser(sub)
     _add_corridor_parser(sub)
     _add_hazard_map_parser(sub)

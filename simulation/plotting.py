@@ -274,8 +274,8 @@ def plot_pooled_coverage(calibration, ax=None):
     cov = calibration.coverage()
     ax.set_yticks(y, list(t.index))
     ax.invert_yaxis()
-    ax.set_xlabel("stop position (plan runout of a 3-D release) [m]")
-    ax.set_title(f"{cov['inside_90']:.0%} of {cov['observed_stops']} stops inside their 90 % interval, "
+    ax.set_xlabel("stop x along the profile [m] (plan runout from the release for a 3-D release)")
+    ax.set_title(f"{cov['inside_90']:.0%} of {int(cov['observed_stops'])} stops inside their 90 % interval, "
                  f"{cov['inside_99']:.0%} inside the 99 %", fontsize="small")
     ax.legend(fontsize="small")
     return ax

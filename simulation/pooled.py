@@ -317,7 +317,7 @@ class _ConstraintPool:
 
 
 # ---- reading and checking releases ----------------------------------------------------------------------------------
-def read_releases(path, scenarios: dict, *, release_column: str = "release") -> list[Release]:
+def read_releases(path, scenarios: dict, *, release_column="release", scenario_column: str = "scenario") -> list[Release]:
     """Releases from a CSV file: one row per observed block.
 
     Columns: ``release`` (name; rows sharing it form one release), ``scenario`` (a key of ``scenarios``, the
@@ -332,8 +332,11 @@ def read_releases(path, scenarios: dict, *, release_column: str = "release") -> 
         The CSV file of observed stops.
     scenarios : dict
         Scenario name (as in the ``scenario`` column) -> scenario path, dict or :class:`Scenario`.
-    release_column : str, optional
-        Name of the column that names the release (default ``"release"``).
+    release_column : str or list of str, optional
+        Column that names the release (default ``"release"``), or several whose values together name it (joined
+        by "-", e.g. ``["profile", "block"]`` gives "P1-3").
+    scenario_column : str, optional
+        Column that holds the scenario name (default ``"scenario"``).
 
     Returns
     -------
@@ -353,17 +356,20 @@ def read_releases(path, scenarios: dict, *, release_column: str = "release") -> 
         raise FileNotFoundError(f"releases file not found: {path}")
     df = pd.read_csv(path)
     df.index = df.index + 2                       # CSV line numbers (line 1 is the header)
-    for col in (release_column, "scenario", "x_stop_m"):
+    name_cols = [release_column] if isinstance(release_column, str) else list(release_column)
+    for col in name_cols + [scenario_column, "x_stop_m"]:
         if col not in df.columns:
             raise ValueError(f"{path}: no column {col!r} (columns: {list(df.columns)})")
+    names = df[name_cols].astype(str).agg("-".join, axis=1)
     out = []
-    for name, rows in df.groupby(release_column, sort=False):
-        key = rows["scenario"].iloc[0]
-        if (rows["scenario"] != key).any():
-            raise ValueError(f"{path}: release {name!r} names several scenarios {sorted(set(rows['scenario']))}")
+    for name, rows in df.groupby(names, sort=False):
+        key = rows[scenario_column].iloc[0]
+        if (rows[scenario_column] != key).any():
+            raise ValueError(f"{path}: release {name!r} names several scenarios "
+                             f"{sorted(set(rows[scenario_column]))}")
         if key not in scenarios:
-            raise ValueError(f"{path}: release {name!r} (line {rows.index[0]}): scenario = {key!r} is not one of "
-                             f"{sorted(scenarios)}")
+            raise ValueError(f"{path}: release {name!r} (line {rows.index[0]}): {scenario_column} = {key!r} is not "
+                             f"one of {sorted(scenarios)}")
         kw = {}
         for col in ("mass_kg", "radius_m") + _RELEASE_FIELDS:
             if col not in rows.columns:
@@ -1008,7 +1014,7 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
     seed = int(np.random.SeedSequence().entropy % (2 ** 31)) if seed is None else seed
     ss = np.random.SeedSequence(seed)
     rng_design, rng_prop, rng_resample, rng_pred = (np.random.default_rng(c) for c in ss.spawn(4))
-    sim_seed, *replicate_seeds = (int(v % (2 ** 31)) for v in ss.generate_state(3))
+    sim_seed, *replicate_seeds = (int(v % (2 ** 31)) for v in ss.generate_state(1 + N_REPLICATE_SEEDS))
 
     def loglik(u, seed=sim_seed):
         values = dict(zip(names, lo + u * (hi - lo)))
@@ -1191,7 +1197,7 @@ def _posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng, refine
     u_all, ll_all, proposals, lo, hi, names, n_posterior, rng
         As in :func:`_abc_posterior`.
     refine : tuple, optional
-        (log-likelihood ``f(point, seed=...)`` of a unit-cube point, points per round, random stream, two seeds
+        (log-likelihood ``f(point, seed=...)`` of a unit-cube point, points per round, random stream, seeds
         independent of the evaluations') for the noise floor (:func:`simulation.surrogate.replicate_noise` at the
         :data:`N_REPLICATE` best points) and :func:`_refine_gp`; None: no new simulations and no noise floor.
 
@@ -1258,8 +1264,10 @@ GP_REFINE_ROUNDS = 3
 #: Most share of the surrogate's leave-one-out standardised residuals beyond 3 before its posterior is flagged
 #: (0.3 % for a normal; the margin allows the heavier tails of a simulated log-likelihood).
 LOO_MAX_BEYOND_3 = 0.02
-#: Best evaluated points re-simulated with two independent seeds for the surrogate's noise floor.
-N_REPLICATE = 16
+#: Best evaluated points re-simulated with :data:`N_REPLICATE_SEEDS` independent seeds for the surrogate's noise
+#: floor (32 extra simulations, only when the Gaussian-process path is taken).
+N_REPLICATE = 4
+N_REPLICATE_SEEDS = 8
 
 
 def _gp_overreach(gp, draws, u_all) -> float:

@@ -223,7 +223,11 @@ class GPSurrogate:
 
 
 def replicate_noise(loglik, u, seeds) -> float:
-    """The noise sd of a simulated log-likelihood: its spread between two independent seeds at the same points.
+    """The noise sd of a simulated log-likelihood: its spread between independent seeds at the same points.
+
+    Under common random numbers the evaluations' noise is shared by nearby points (one seed moves a whole
+    neighbourhood), so two seeds at many nearby points measure it about once; several seeds per point measure it
+    as often as there are seeds.
 
     Parameters
     ----------
@@ -231,20 +235,19 @@ def replicate_noise(loglik, u, seeds) -> float:
         ``loglik(point, seed)``: the log-likelihood of one unit-cube point simulated with ``seed``.
     u : numpy.ndarray
         (k, d) points (e.g. the best evaluated ones).
-    seeds : tuple of int
-        Two seeds, both independent of the one the evaluations used (else selecting the best points would
-        select on their noise).
+    seeds : sequence of int
+        At least two seeds, all independent of the one the evaluations used (else selecting the best points
+        would select on their noise).
 
     Returns
     -------
     float
-        sqrt(mean((ll_a - ll_b)^2) / 2) over the points where both are finite [log-likelihood units]; 0 when
-        none is.
+        The square root of the mean over the points of the sample variance (ddof 1) between seeds, counting only
+        finite values and points with two or more [log-likelihood units]; 0 when there is none.
     """
-    a = np.array([loglik(p, seeds[0]) for p in u])
-    b = np.array([loglik(p, seeds[1]) for p in u])
-    ok = np.isfinite(a) & np.isfinite(b)
-    return float(np.sqrt(np.mean((a[ok] - b[ok]) ** 2) / 2.0)) if ok.any() else 0.0
+    values = np.array([[loglik(p, s) for s in seeds] for p in u], dtype=float)
+    var = [np.var(v[np.isfinite(v)], ddof=1) for v in values if np.sum(np.isfinite(v)) >= 2]
+    return float(np.sqrt(np.mean(var))) if var else 0.0
 
 
 def _t_proposal(centre, cov, n, rng):

@@ -262,3 +262,27 @@ def test_releases_file_reads_shape_and_aspect_ratio(tmp_path):
                  "r1,A,100,900,0.325,cylinder,1.6923\nr1,A,104,900,0.325,cylinder,2\n")
     with pytest.raises(ValueError, match=r"release 'r1': field aspect_ratio differs between its rows"):
         read_releases(p, {"A": _profile("A")})
+
+
+def test_command_line_pooled_calibration(tmp_path, capsys):
+    """``riskrf calibrate-pooled`` on 12 real Authume blocks (each its own release, named by profile and block):
+    the posterior file reads back, the coverage table has one row per release; a scenario name without its
+    ``--scenario`` is an error naming the file, release, line, column and value, before any simulation."""
+    from riskrf.cli import main
+    stops = tmp_path / "stops.csv"
+    OBSERVED.groupby("profile").head(6).to_csv(stops, index=False)
+    common = [str(stops), "--release-column", "profile,block", "--scenario-column", "profile",
+              "--scenario", f"P1={AUTHUME / 'authume_p1.toml'}",
+              "--parameter", "materials.vegetated_slope.ground_friction_angle_deg=3:45"]
+    rc = main(["calibrate-pooled", *common, "--scenario", f"P2={AUTHUME / 'authume_p2.toml'}", "--n-per-release",
+               "10", "--iterations", "1", "--posterior", "200", "--predictive", "5", "--out", str(tmp_path / "out")])
+    assert rc == 0, capsys.readouterr().err
+    out = tmp_path / "out"
+    post = read_posterior(out / "posterior.csv")
+    assert len(post) == 200 and list(post.columns) == ["materials.vegetated_slope.ground_friction_angle_deg"]
+    assert len(pd.read_csv(out / "coverage.csv")) == 12 and (out / "posterior_pairs.png").is_file()
+    assert "Predictive check" in capsys.readouterr().out
+    rc = main(["calibrate-pooled", *common, "--out", str(tmp_path / "bad")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "release 'P2-1' (line 8): profile = 'P2' is not one of ['P1']" in err and "stops.csv" in err
+    assert not (tmp_path / "bad").exists()

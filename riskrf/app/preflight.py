@@ -152,7 +152,8 @@ def check_out(args, default, *, kind="dir", inputs=None) -> Path:
 INPUT_ARGUMENTS = {"inventory": "inventory", "scenario": "scenario", "velocities": "velocity file",
                    "options": "options file", "tree": "decision tree", "site": "site file",
                    "corridor": "corridor file", "rainfall": "rainfall file", "warnings": "warning list",
-                   "block_survey": "block survey", "observed": "observed stops", "drop_height": "scenario"}
+                   "block_survey": "block survey", "observed": "observed stops", "drop_height": "scenario",
+                   "releases": "releases file"}
 
 
 def command_inputs(args) -> dict:

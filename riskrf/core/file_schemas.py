@@ -356,7 +356,7 @@ SCENARIO_SCHEMA = FileSchema("Slope scenario (simulation TOML)", (
         _pos("contact_velocity_ms", "m/s", "below it a flight becomes a contact"),
         _pos("stop_velocity_ms", "m/s", "below it a block stops"),
         _count("max_events", "events per block"),
-        _count("envelope_bins", "bins of the envelopes"),
+        _count("envelope_bins", "bins of the envelopes (0 = off)", low=0),
     ), "Numerical settings of the simulator."),
 ), "A slope for the trajectory simulator; materials are presets or their parameters.")
 
