@@ -615,6 +615,24 @@ def cmd_demo(args) -> int:
         return cmd_assess(args)
 
 
+def _with_warnings_printed(func, *args, **kwargs):
+    """``func(*args, **kwargs)`` (a calibration), printing each warning it raised that its ``notes`` do not
+    already hold as ``warning: ...`` lines.
+
+    Returns
+    -------
+    object
+        What ``func`` returned.
+    """
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = func(*args, **kwargs)
+    for w in caught:
+        if str(w.message) not in result.notes:
+            print(f"warning: {w.message}")
+    return result
+
+
 def cmd_calibrate(args) -> int:
     """``riskrf calibrate``: fit scenario material parameters to observed stop points.
 
@@ -651,14 +669,9 @@ def cmd_calibrate(args) -> int:
         table = read_numeric_table(args.observed, what="observed stops", decimal=args.decimal, sheet=args.sheet,
                                    header_row=args.header_row, encoding=args.encoding, numeric=(args.column,))
     observed = read_observed(args.observed, column=args.column, select=select, table=table)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        cal = simulation.calibrate(args.scenario, observed, parameters, n=args.n, seed=args.seed,
-                                   distance=args.distance, collector=args.collector, maxiter=args.maxiter,
-                                   n_bootstrap=args.bootstrap)
-    for w in caught:
-        if str(w.message) not in cal.notes:
-            print(f"warning: {w.message}")
+    cal = _with_warnings_printed(simulation.calibrate, args.scenario, observed, parameters, n=args.n,
+                                 seed=args.seed, distance=args.distance, collector=args.collector,
+                                 maxiter=args.maxiter, n_bootstrap=args.bootstrap)
     print(f"Calibrated {args.scenario} to {observed.attrs['source']}"
           + (f" rows {select}" if select else "") + f": {cal.observed.size} observed stops, {args.n:,} simulated "
           f"blocks per evaluation (seed {args.seed}), {len(cal.evaluations)} evaluations, distance {cal.distance_name}")
@@ -760,13 +773,9 @@ def cmd_calibrate_pooled(args) -> int:
     print(f"riskrf calibrate-pooled: {len(releases)} releases from {args.releases}, "
           f"{sum(len(r.x_stop_m) for r in releases)} observed stops, {len(parameters)} parameters, "
           f"{args.n_per_release} blocks per release and parameter set (seed {args.seed})")
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        cal = calibrate_pooled(releases, parameters, n_per_release=args.n_per_release, seed=args.seed,
-                               iterations=args.iterations, n_posterior=args.posterior, n_predictive=args.predictive)
-    for w in caught:
-        if str(w.message) not in cal.notes:
-            print(f"warning: {w.message}")
+    cal = _with_warnings_printed(calibrate_pooled, releases, parameters, n_per_release=args.n_per_release,
+                                 seed=args.seed, iterations=args.iterations, n_posterior=args.posterior,
+                                 n_predictive=args.predictive)
     summary = cal.summary()
     print(summary.to_string(float_format=lambda v: f"{v:.4g}"))
     if args.predictive:
