@@ -615,6 +615,16 @@ def cmd_demo(args) -> int:
         return cmd_assess(args)
 
 
+def _toml_tables(path) -> set:
+    """The top-level keys of a TOML file (empty when it cannot be read: its reader reports that)."""
+    import tomllib
+    try:
+        with open(path, "rb") as fh:
+            return set(tomllib.load(fh))
+    except (OSError, tomllib.TOMLDecodeError):
+        return set()
+
+
 def _with_warnings_printed(func, *args, **kwargs):
     """``func(*args, **kwargs)`` (a calibration), printing each warning it raised that its ``notes`` do not
     already hold as ``warning: ...`` lines.
@@ -722,6 +732,8 @@ def _parse_parameters(items) -> dict:
         if not (sep and sep2 and name):
             raise ValueError(f"--parameter {item!r}: use NAME=LOW:HIGH, e.g. "
                              "materials.talus.ground_friction_angle_deg=15:40")
+        if name in parameters:
+            raise ValueError(f"--parameter {item!r}: {name} is already given as {parameters[name]}")
         try:
             parameters[name] = (float(low), float(high))
         except ValueError:
@@ -749,24 +761,27 @@ def cmd_calibrate_pooled(args) -> int:
 
     from .app.preflight import check_out
     from .core.file_schemas import check_scenario_file
-    from .io.outputs import atomic_output_dir, write_json
+    from .io.outputs import atomic_output_dir, files_named_in_toml, write_json
     from .report.files import save_figure
 
     parameters = _parse_parameters(args.parameter)
-    scenarios = {}
+    scenarios, inputs = {}, {}
     for item in args.scenario or []:
         name, sep, path = item.partition("=")
         if not (sep and name and path):
             raise ValueError(f"--scenario {item!r}: use NAME=FILE, e.g. P1=authume_p1.toml (NAME as in the "
                              f"{args.scenario_column!r} column)")
+        if name in scenarios:
+            raise ValueError(f"--scenario {item!r}: {name!r} is already given as {scenarios[name]!r}")
         if not Path(path).is_file():
             raise FileNotFoundError(f"--scenario {item!r}: scenario file not found: {path}")
-        check_scenario_file(path)
+        if "terrain" not in _toml_tables(path):             # a 3-D scenario is checked by its own reader
+            check_scenario_file(path)
         scenarios[name] = path
+        inputs |= files_named_in_toml(path, label=f"scenario {name}")      # the TOML and the DEM etc. it names
     if not scenarios:
         raise ValueError(f"give at least one --scenario NAME=FILE (NAME as in the {args.scenario_column!r} column)")
-    out = check_out(args, f"{Path(args.releases).stem}-pooled-calibration",
-                    inputs={f"scenario {k}": v for k, v in scenarios.items()})
+    out = check_out(args, f"{Path(args.releases).stem}-pooled-calibration", inputs=inputs)
     columns = [c.strip() for c in args.release_column.split(",")]
     releases = read_releases(args.releases, scenarios, release_column=columns if len(columns) > 1 else columns[0],
                              scenario_column=args.scenario_column)

@@ -354,13 +354,18 @@ def read_releases(path, scenarios: dict, *, release_column="release", scenario_c
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"releases file not found: {path}")
-    df = pd.read_csv(path)
-    df.index = df.index + 2                       # CSV line numbers (line 1 is the header)
     name_cols = [release_column] if isinstance(release_column, str) else list(release_column)
+    df = pd.read_csv(path, dtype={c: str for c in name_cols + [scenario_column]})     # names as written
+    df.index = df.index + 2                       # CSV line numbers (line 1 is the header)
     for col in name_cols + [scenario_column, "x_stop_m"]:
         if col not in df.columns:
             raise ValueError(f"{path}: no column {col!r} (columns: {list(df.columns)})")
-    names = df[name_cols].astype(str).agg("-".join, axis=1)
+    for col in name_cols + [scenario_column]:
+        empty = df[col].isna() | (df[col].str.strip() == "")
+        if empty.any():
+            raise ValueError(f"{path}: line {empty.idxmax()}: column {col!r} is empty (every row names its release "
+                             "and scenario)")
+    names = df[name_cols].agg("-".join, axis=1)
     out = []
     for name, rows in df.groupby(names, sort=False):
         key = rows[scenario_column].iloc[0]
@@ -1264,6 +1269,8 @@ GP_REFINE_ROUNDS = 3
 #: Most share of the surrogate's leave-one-out standardised residuals beyond 3 before its posterior is flagged
 #: (0.3 % for a normal; the margin allows the heavier tails of a simulated log-likelihood).
 LOO_MAX_BEYOND_3 = 0.02
+#: Least sd of those residuals before the surrogate is flagged as smoothing more than the evaluations scatter.
+LOO_MIN_SD = 0.5
 #: Best evaluated points re-simulated with :data:`N_REPLICATE_SEEDS` independent seeds for the surrogate's noise
 #: floor (32 extra simulations, only when the Gaussian-process path is taken).
 N_REPLICATE = 4
@@ -1352,11 +1359,17 @@ def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=None, noise
         return None
     scales = ", ".join(f"{n.split('.', 1)[1]} {v:.2g}" for n, v in zip(names, gp.lengths))
     beyond = float(np.mean(np.abs(gp.loo_z) > 3.0))
+    floor = f"{gp.noise_floor:.2f}" if gp.noise_floor > 0 else "not measured"
     notes = [f"posterior: Gaussian-process surrogate of the log-likelihood (no concave quadratic fits it near its "
              f"top), fitted to {gp.n_points} evaluations near the top (noise sd {gp.noise:.2f}, the spread between "
-             f"independent seeds {gp.noise_floor:.2f}; length scales on the unit prior box: {scales}; "
+             f"independent seeds {floor}; length scales on the unit prior box: {scales}; "
              f"leave-one-out standardised residuals sd {np.std(gp.loo_z):.2f}, {beyond:.1%} beyond 3), "
              f"importance-sampled (effective sample {ess:,.0f})"]
+    if np.std(gp.loo_z) < LOO_MIN_SD:
+        notes.append(f"the Gaussian-process surrogate smooths more than its evaluations scatter (leave-one-out "
+                     f"standardised residuals sd {np.std(gp.loo_z):.2f}; about 1 expected): its noise floor, the "
+                     f"spread between seeds ({floor}), may hide structure, and its posterior may be too wide")
+        warnings.warn(notes[-1], PooledCalibrationWarning, stacklevel=4)     # at the caller of calibrate_pooled
     if beyond > LOO_MAX_BEYOND_3:
         notes.append(f"the Gaussian-process surrogate misfits its evaluations: {beyond:.1%} of their leave-one-out "
                      f"standardised residuals lie beyond 3 (at most {LOO_MAX_BEYOND_3:.0%} expected); its posterior "

@@ -160,7 +160,7 @@ class GPSurrogate:
     n_points : int
         Points it was fitted to.
     noise_floor : float
-        The ``noise_floor`` it was given.
+        The ``noise_floor`` it was given (0 when that was not a finite number > 0: not measured).
     loo_z : numpy.ndarray
         Leave-one-out standardised residuals of the points (Rasmussen & Williams eqs. 5.10-5.12): about N(0, 1)
         when the process describes the evaluations.
@@ -184,7 +184,7 @@ class GPSurrogate:
         self.m0 = float(y.min() - drop)
         self.y = y - self.m0
         sd = max(float(np.std(self.y)), 1e-3)
-        self.noise_floor = float(noise_floor)
+        self.noise_floor = float(noise_floor) if np.isfinite(noise_floor) and noise_floor > 0 else 0.0
         nf = max(self.noise_floor, 1e-3 * sd)
         bounds = ([(math.log(0.01 * sd), math.log(100 * sd))] + [(math.log(LENGTH_FLOOR), math.log(10.0))] * d
                   + [(math.log(nf), math.log(max(sd, 2.0 * nf)))])
@@ -196,7 +196,8 @@ class GPSurrogate:
             fits.append(optimize.minimize(_neg_log_marginal, theta0, args=(diff2, self.y), jac=True,
                                           method="L-BFGS-B", bounds=bounds, options={"maxiter": 200}))
         th = min(fits, key=lambda f: f.fun).x
-        self.scale, self.lengths, self.noise = math.exp(th[0]), np.exp(th[1:1 + d]), math.exp(th[-1])
+        self.scale, self.lengths = math.exp(th[0]), np.exp(th[1:1 + d])
+        self.noise = max(math.exp(th[-1]), self.noise_floor)            # exp(log(x)) may fall one ulp below x
         k = _kernel(self.u, self.u, self.scale ** 2, self.lengths) + self.noise ** 2 * np.eye(self.n_points)
         c = linalg.cho_factor(k, lower=True)
         self._alpha = linalg.cho_solve(c, self.y)
@@ -243,11 +244,19 @@ def replicate_noise(loglik, u, seeds) -> float:
     -------
     float
         The square root of the mean over the points of the sample variance (ddof 1) between seeds, counting only
-        finite values and points with two or more [log-likelihood units]; 0 when there is none.
+        finite values and points with two or more [log-likelihood units]; NaN when there is none (not measured).
+
+    Raises
+    ------
+    ValueError
+        Fewer than two seeds.
     """
+    seeds = list(seeds)
+    if len(seeds) < 2:
+        raise ValueError(f"replicate_noise: {len(seeds)} seed(s) given; the spread between seeds needs two or more")
     values = np.array([[loglik(p, s) for s in seeds] for p in u], dtype=float)
     var = [np.var(v[np.isfinite(v)], ddof=1) for v in values if np.sum(np.isfinite(v)) >= 2]
-    return float(np.sqrt(np.mean(var))) if var else 0.0
+    return float(np.sqrt(np.mean(var))) if var else float("nan")
 
 
 def _t_proposal(centre, cov, n, rng):

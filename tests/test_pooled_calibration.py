@@ -17,7 +17,7 @@ import pytest
 import simulation
 from simulation.pooled import PooledCalibration, Release, calibrate_pooled, read_posterior, read_releases
 
-from .conftest import ROOT
+from .conftest import ROOT, digest
 
 AUTHUME = ROOT / "simulation" / "scenarios" / "authume"
 OBSERVED = pd.read_csv(ROOT / "tests" / "data" / "authume" / "observed_runout.csv")
@@ -158,6 +158,12 @@ def test_releases_file_errors_name_file_release_line_and_field(tmp_path):
     p.write_text("release,scenario,x_stop_m,mass_kg\nr1,A,100,500\nr2,B,110,600\n")
     rel = read_releases(p, {"A": _profile("A"), "B": _profile("B")})
     assert [r.name for r in rel] == ["r1", "r2"] and rel[1].mass_kg == 600.0
+    p.write_text("profile,block,sc,x_stop_m\nP1,1,1,100\nP1,,1,90\n")                   # an empty name cell
+    with pytest.raises(ValueError, match=r"releases.csv: line 3: column 'block' is empty"):
+        read_releases(p, {"1": _profile("A")}, release_column=["profile", "block"], scenario_column="sc")
+    p.write_text("profile,block,sc,x_stop_m\nP1,1,1,100\nP1,02,1,90\n")      # numeric names, as written
+    rel = read_releases(p, {"1": _profile("A")}, release_column=["profile", "block"], scenario_column="sc")
+    assert [r.name for r in rel] == ["P1-1", "P1-02"]
 
 
 def test_bad_parameters_are_named():
@@ -286,3 +292,14 @@ def test_command_line_pooled_calibration(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "release 'P2-1' (line 8): profile = 'P2' is not one of ['P1']" in err and "stops.csv" in err
     assert not (tmp_path / "bad").exists()
+    rc = main(["calibrate-pooled", *common, "--scenario", f"P1={AUTHUME / 'authume_p2.toml'}"])
+    assert rc == 2 and "--scenario 'P1=" in (err := capsys.readouterr().err) and "already given" in err
+    folder = tmp_path / "sc"                                 # a 3-D scenario and the rasters it names
+    folder.mkdir()
+    for f in ("authume_3d.toml", "authume_dem.tif", "authume_zones.tif"):
+        (folder / f).write_bytes((AUTHUME / f).read_bytes())
+    before = digest(folder)
+    rc = main(["calibrate-pooled", str(stops), "--release-column", "profile,block", "--scenario-column", "profile",
+               "--scenario", f"P1={folder / 'authume_3d.toml'}", "--parameter",
+               "materials.soil.ground_friction_angle_deg=3:40", "--out", str(folder), "--overwrite"])
+    assert rc == 2 and "would delete it" in capsys.readouterr().err and digest(folder) == before
