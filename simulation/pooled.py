@@ -1220,8 +1220,10 @@ def _posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng, refine
             best = u_all[np.argsort(np.where(np.isfinite(ll_all), ll_all, -np.inf))[::-1][:N_REPLICATE]]
             noise_floor = replicate_noise(lambda p, s: loglik(p, seed=s), best, seeds)
             u_all, ll_all, proposals, gp = _refine_gp(loglik, u_all, ll_all, proposals, n_it, rng_sim, noise_floor)
-        fitted = (_gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=gp, noise_floor=noise_floor)
-                  or _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng))
+        fitted = _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=gp, noise_floor=noise_floor)
+        if isinstance(fitted, str):                    # why the Gaussian process was not used
+            post, ess, notes = _abc_posterior(u_all, ll_all, proposals, lo, hi, names, n_posterior, rng)
+            fitted = post, ess, notes + [f"the Gaussian-process surrogate was not used: {fitted}"]
     return fitted, u_all, ll_all, proposals
 
 
@@ -1344,19 +1346,22 @@ def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=None, noise
 
     Returns
     -------
-    tuple or None
-        (posterior DataFrame, effective sample size of the importance weights, notes), or None when the
-        surrogate cannot be fitted or its importance weights have an effective sample below :data:`GP_MIN_ESS`.
+    tuple or str
+        (posterior DataFrame, effective sample size of the importance weights, notes), or why not (in words) when
+        too few evaluations lie near the top, the surrogate cannot be fitted or its importance weights have an
+        effective sample below :data:`GP_MIN_ESS`.
     """
     d = u_all.shape[1]
-    if int(np.sum(ll_all >= ll_all.max() - 8.0 * stats.chi2.ppf(0.999, d))) < 10 * d:
-        return None
+    near = int(np.sum(ll_all >= ll_all.max() - 8.0 * stats.chi2.ppf(0.999, d)))
+    if near < 10 * d:
+        return f"{near} evaluations near the top, fewer than {10 * d} (10 per parameter)"
     try:
         draws, ess, gp = gp_posterior_sample(u_all, ll_all, n_posterior, rng, gp=gp, noise_floor=noise_floor)
-    except (np.linalg.LinAlgError, ValueError):
-        return None
+    except (np.linalg.LinAlgError, ValueError) as err:
+        return f"its fit failed ({err})"
     if ess < GP_MIN_ESS:
-        return None
+        return (f"its importance weights have an effective sample of {ess:.0f} (< {GP_MIN_ESS}): the surrogate's "
+                "peak is narrower than its length-scale floor resolves, or it rests on a few points")
     scales = ", ".join(f"{n.split('.', 1)[1]} {v:.2g}" for n, v in zip(names, gp.lengths))
     beyond = float(np.mean(np.abs(gp.loo_z) > 3.0))
     floor = f"{gp.noise_floor:.2f}" if gp.noise_floor > 0 else "not measured"
