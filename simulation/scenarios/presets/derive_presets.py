@@ -195,6 +195,8 @@ def evans_hungr() -> ReachConstraint:
 
 
 DATASETS = ("authume_p1", "authume_p2", "evans_hungr_1993")
+#: Adaptive rounds of 256 parameter sets after the 1,024-point design (``--iterations``).
+DESIGN = {"iterations": 4}
 
 
 def fit(datasets, n_per_release=50, seed=1, n_predictive=20):
@@ -212,7 +214,8 @@ def fit(datasets, n_per_release=50, seed=1, n_predictive=20):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return calibrate_pooled(rel, params, seed=seed, n_per_release=n_per_release, n_initial=1024,
-                                n_per_iteration=256, iterations=4, n_predictive=n_predictive, obs_error_m=2.0,
+                                n_per_iteration=256, iterations=DESIGN["iterations"], n_predictive=n_predictive,
+                                obs_error_m=2.0,
                                 constraints=con)
 
 
@@ -426,7 +429,10 @@ def main():
     ap.add_argument("--with-ritchie", action="store_true",
                     help="add the Modified Ritchie width of the ODOT 60 ft cut as a fourth data set (a reach "
                          "constraint, ritchie_constraint; held out in its own fold) instead of a check no fit saw")
+    ap.add_argument("--iterations", type=int, default=4,
+                    help="adaptive rounds of 256 parameter sets after the 1,024-point Sobol design (default 4)")
     args = ap.parse_args()
+    DESIGN["iterations"] = args.iterations
     datasets = DATASETS + (("odot_ritchie_rule",) if args.with_ritchie else ())
     if args.out is None:
         args.out = ("presets_loo" + MODELS[args.model][1] + ("_3d" if args.kernel == "3d" else "")
