@@ -8,6 +8,7 @@ import math
 import os
 import shutil
 import sys
+import textwrap
 import traceback
 import warnings
 from pathlib import Path
@@ -1205,14 +1206,20 @@ def _add_calibrate_pooled_parser(sub) -> None:
     """
     p = sub.add_parser(
         "calibrate-pooled", help="fit material parameters shared by many releases to all their stops (posterior)",
-        description="Fit material parameters (dotted paths, uniform priors within bounds) shared by many "
+        description=textwrap.fill("Fit material parameters (dotted paths, uniform priors within bounds) shared by many "
         "releases, each on its own scenario with its own block, to all their observed stops: kernel likelihood "
         "of each stop under its release's simulated stops, common random numbers, a Sobol design and adaptive "
         "importance rounds, the posterior from a quadratic or Gaussian-process surrogate of the log-likelihood "
         "(ABC rejection as the last resort; the notes say which), and a predictive check per release.  Writes "
         "the posterior sample (read back by simulation.read_posterior and the model-uncertainty inputs), "
         "its summary, correlations, the evaluations, the predictive coverage and figures.  See the docs: "
-        "Trajectories and simulation, 'Pooled calibration'.", epilog=EPILOG)
+        "Trajectories and simulation, 'Pooled calibration'.", 100),
+        epilog="Example (the 89 Authume quarry blocks, each its own release on its profile's section):\n"
+        "  riskrf calibrate-pooled tests/data/authume/observed_runout.csv --release-column profile,block \\\n"
+        "    --scenario-column profile --scenario P1=simulation/scenarios/authume/authume_p1.toml \\\n"
+        "    --scenario P2=simulation/scenarios/authume/authume_p2.toml \\\n"
+        "    --parameter materials.vegetated_slope.ground_friction_angle_deg=3:45 --n-per-release 50\n" + EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("releases", help="CSV, one row per observed block: release name, scenario name, x_stop_m [m], "
                    "optionally mass_kg, radius_m, shape, aspect_ratio, x_m, height_m, vx_ms, vz_ms, "
                    "downslope_speed_ms (one value per release)")
