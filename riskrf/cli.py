@@ -766,6 +766,10 @@ def cmd_calibrate_pooled(args) -> int:
     from .report.files import save_figure
 
     parameters = _parse_parameters(args.parameter)
+    for option, value, least in (("--n-per-release", args.n_per_release, 10), ("--iterations", args.iterations, 0),
+                                 ("--posterior", args.posterior, 10), ("--predictive", args.predictive, 0)):
+        if value < least:
+            raise ValueError(f"{option} {value}: must be a whole number >= {least}")
     scenarios, inputs = {}, {}
     for item in args.scenario or []:
         name, sep, path = item.partition("=")

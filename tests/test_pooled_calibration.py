@@ -292,6 +292,8 @@ def test_command_line_pooled_calibration(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "release 'P2-1' (line 8): profile = 'P2' is not one of ['P1']" in err and "stops.csv" in err
     assert not (tmp_path / "bad").exists()
+    rc = main(["calibrate-pooled", *common, "--n-per-release", "5"])
+    assert rc == 2 and "--n-per-release 5: must be a whole number >= 10" in capsys.readouterr().err
     rc = main(["calibrate-pooled", *common, "--scenario", f"P1={AUTHUME / 'authume_p2.toml'}"])
     assert rc == 2 and "--scenario 'P1=" in (err := capsys.readouterr().err) and "already given" in err
     folder = tmp_path / "sc"                                 # a 3-D scenario and the rasters it names
