@@ -616,16 +616,6 @@ def cmd_demo(args) -> int:
         return cmd_assess(args)
 
 
-def _toml_tables(path) -> set:
-    """The top-level keys of a TOML file (empty when it cannot be read: its reader reports that)."""
-    import tomllib
-    try:
-        with open(path, "rb") as fh:
-            return set(tomllib.load(fh))
-    except (OSError, tomllib.TOMLDecodeError):
-        return set()
-
-
 def _with_warnings_printed(func, *args, **kwargs):
     """``func(*args, **kwargs)`` (a calibration), printing each warning it raised that its ``notes`` do not
     already hold as ``warning: ...`` lines.
@@ -780,8 +770,7 @@ def cmd_calibrate_pooled(args) -> int:
             raise ValueError(f"--scenario {item!r}: {name!r} is already given as {scenarios[name]!r}")
         if not Path(path).is_file():
             raise FileNotFoundError(f"--scenario {item!r}: scenario file not found: {path}")
-        if "terrain" not in _toml_tables(path):             # a 3-D scenario is checked by its own reader
-            check_scenario_file(path)
+        check_scenario_file(path)
         scenarios[name] = path
         inputs |= files_named_in_toml(path, label=f"scenario {name}")      # the TOML and the DEM etc. it names
     if not scenarios:

@@ -1363,29 +1363,29 @@ def _gp_posterior(u_all, ll_all, lo, hi, names, n_posterior, rng, gp=None, noise
         return (f"its importance weights have an effective sample of {ess:.0f} (< {GP_MIN_ESS}): the surrogate's "
                 "peak is narrower than its length-scale floor resolves, or it rests on a few points")
     scales = ", ".join(f"{n.split('.', 1)[1]} {v:.2g}" for n, v in zip(names, gp.lengths))
-    beyond = float(np.mean(np.abs(gp.loo_z) > 3.0))
+    beyond, loo_sd = float(np.mean(np.abs(gp.loo_z) > 3.0)), float(np.std(gp.loo_z))
     floor = f"{gp.noise_floor:.2f}" if gp.noise_floor > 0 else "not measured"
     notes = [f"posterior: Gaussian-process surrogate of the log-likelihood (no concave quadratic fits it near its "
              f"top), fitted to {gp.n_points} evaluations near the top (noise sd {gp.noise:.2f}, the spread between "
              f"independent seeds {floor}; length scales on the unit prior box: {scales}; "
-             f"leave-one-out standardised residuals sd {np.std(gp.loo_z):.2f}, {beyond:.1%} beyond 3), "
+             f"leave-one-out standardised residuals sd {loo_sd:.2f}, {beyond:.1%} beyond 3), "
              f"importance-sampled (effective sample {ess:,.0f})"]
-    if np.std(gp.loo_z) < LOO_MIN_SD:
-        notes.append(f"the Gaussian-process surrogate smooths more than its evaluations scatter (leave-one-out "
-                     f"standardised residuals sd {np.std(gp.loo_z):.2f}; about 1 expected): its noise floor, the "
-                     f"spread between seeds ({floor}), may hide structure, and its posterior may be too wide")
-        warnings.warn(notes[-1], PooledCalibrationWarning, stacklevel=4)     # at the caller of calibrate_pooled
-    if beyond > LOO_MAX_BEYOND_3:
-        notes.append(f"the Gaussian-process surrogate misfits its evaluations: {beyond:.1%} of their leave-one-out "
-                     f"standardised residuals lie beyond 3 (at most {LOO_MAX_BEYOND_3:.0%} expected); its posterior "
-                     "is approximate")
-        warnings.warn(notes[-1], PooledCalibrationWarning, stacklevel=4)     # at the caller of calibrate_pooled
     over = _gp_overreach(gp, draws, u_all)
-    if over > 0.0:
-        notes.append(f"the Gaussian-process posterior rests on extrapolation: the surrogate rises {over + 1.0:.1f} "
-                     "above its value at every simulated point where nothing was simulated; raise iterations or "
-                     "n_per_iteration")
-        warnings.warn(notes[-1], PooledCalibrationWarning, stacklevel=4)     # at the caller of calibrate_pooled
+    for flagged, message in (
+            (loo_sd < LOO_MIN_SD,
+             f"the Gaussian-process surrogate smooths more than its evaluations scatter (leave-one-out standardised "
+             f"residuals sd {loo_sd:.2f}; about 1 expected): its noise floor, the spread between seeds ({floor}), "
+             "may hide structure, and its posterior may be too wide"),
+            (beyond > LOO_MAX_BEYOND_3,
+             f"the Gaussian-process surrogate misfits its evaluations: {beyond:.1%} of their leave-one-out "
+             f"standardised residuals lie beyond 3 (at most {LOO_MAX_BEYOND_3:.0%} expected); its posterior is "
+             "approximate"),
+            (over > 0.0,
+             f"the Gaussian-process posterior rests on extrapolation: the surrogate rises {over + 1.0:.1f} above its "
+             "value at every simulated point where nothing was simulated; raise iterations or n_per_iteration")):
+        if flagged:
+            notes.append(message)
+            warnings.warn(message, PooledCalibrationWarning, stacklevel=4)     # at the caller of calibrate_pooled
     return pd.DataFrame(lo + draws * (hi - lo), columns=names), ess, notes
 
 

@@ -364,7 +364,8 @@ ALL_SCHEMAS = (SITE_SCHEMA, OPTIONS_SCHEMA, CORRIDOR_SCHEMA, SCENARIO_SCHEMA)
 
 
 def check_scenario_file(path, *, error=ValueError) -> None:
-    """Hold a scenario TOML against :data:`SCENARIO_SCHEMA` (the simulator's own reader runs after).
+    """Hold a 2-D scenario TOML against :data:`SCENARIO_SCHEMA` (the simulator's own reader runs after); a 3-D
+    scenario (a ``[terrain]`` table) is left to its own reader, :mod:`simulation.scenario3d`.
 
     Parameters
     ----------
@@ -386,6 +387,8 @@ def check_scenario_file(path, *, error=ValueError) -> None:
             data = tomllib.load(fh)
     except (OSError, tomllib.TOMLDecodeError):
         return                               # the simulator's reader names the problem
+    if "terrain" in data:
+        return
     check(data, SCENARIO_SCHEMA, path, error=error)
 
 

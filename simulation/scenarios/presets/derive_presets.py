@@ -195,11 +195,9 @@ def evans_hungr() -> ReachConstraint:
 
 
 DATASETS = ("authume_p1", "authume_p2", "evans_hungr_1993")
-#: Adaptive rounds of 256 parameter sets after the 1,024-point design (``--iterations``).
-DESIGN = {"iterations": 4}
 
 
-def fit(datasets, n_per_release=50, seed=1, n_predictive=20):
+def fit(datasets, n_per_release=50, seed=1, n_predictive=20, iterations=4):
     rel, con = [], []
     for d in datasets:
         if d == "evans_hungr_1993":
@@ -214,7 +212,7 @@ def fit(datasets, n_per_release=50, seed=1, n_predictive=20):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return calibrate_pooled(rel, params, seed=seed, n_per_release=n_per_release, n_initial=1024,
-                                n_per_iteration=256, iterations=DESIGN["iterations"], n_predictive=n_predictive,
+                                n_per_iteration=256, iterations=iterations, n_predictive=n_predictive,
                                 obs_error_m=2.0,
                                 constraints=con)
 
@@ -432,7 +430,6 @@ def main():
     ap.add_argument("--iterations", type=int, default=4,
                     help="adaptive rounds of 256 parameter sets after the 1,024-point Sobol design (default 4)")
     args = ap.parse_args()
-    DESIGN["iterations"] = args.iterations
     datasets = DATASETS + (("odot_ritchie_rule",) if args.with_ritchie else ())
     if args.out is None:
         args.out = ("presets_loo" + MODELS[args.model][1] + ("_3d" if args.kernel == "3d" else "")
@@ -446,7 +443,7 @@ def main():
         MODEL["laws"]["soil"]["ground_friction_angle_deg"] = 0.0
     t0 = time.time()
     if args.mode == "fit":
-        cal = fit(datasets, args.n_per_release, args.seed)
+        cal = fit(datasets, args.n_per_release, args.seed, iterations=args.iterations)
         print(f"fit {time.time() - t0:.0f} s")
         print(cal.summary()[["median", "mean", "sd", "q05", "q95", "sd_ratio"]].round(3).to_string())
         print(cal.correlations().round(2).to_string())
@@ -457,7 +454,7 @@ def main():
     rows, curves, folds = [], {}, []
     for held in datasets:
         train = [d for d in datasets if d != held]
-        cal = fit(train, args.n_per_release, args.seed, n_predictive=0)
+        cal = fit(train, args.n_per_release, args.seed, n_predictive=0, iterations=args.iterations)
         print(held, f"fitted on {train} {time.time() - t0:.0f} s")
         print(cal.summary()[["median", "q05", "q95", "sd_ratio"]].round(3).to_string(), cal.notes)
         folds.append(fold_parameters(held, train, cal))
@@ -497,7 +494,8 @@ def main():
             from simulation.materials import preset_posterior
             label, post = "fitted on all three (the shipped priors)", preset_posterior(list(ODOT_MATERIALS))
         else:
-            label, post = "fitted on all three", fit(DATASETS, args.n_per_release, args.seed, n_predictive=0).posterior
+            label, post = "fitted on all three", fit(DATASETS, args.n_per_release, args.seed, n_predictive=0,
+                                                   iterations=args.iterations).posterior
         r, cv = ritchie_row(post, label, args.draws, args.seed)
         rows.append(r)
         curves[("odot_ritchie_rule", label)] = cv
