@@ -6,6 +6,7 @@
     python simulation/scenarios/presets/derive_presets.py loo --model contact-drag     # a variant: presets_loo_drag
     python simulation/scenarios/presets/derive_presets.py loo --model contact-measured --n-per-release 200 \
         --site-spread assumed                                              # blocks as measured: presets_loo_measured
+    python simulation/scenarios/presets/derive_presets.py vt0 --n-per-release 5 --draws 20   # presets_vt0.csv
 
 ``--kernel 3d`` runs the Authume releases on the quarry's DEM with its zone raster (the 3-D kernel, the same
 contact model; simulation/scenarios/authume/authume_3d.toml) and compares **plan runouts** (horizontal
@@ -41,7 +42,9 @@ bedrock keeps Stronge's law, so its e_T is not fitted).  The shipped priors come
 ``fit`` fits all data sets jointly and writes simulation/preset_priors.py (posterior summary and a 200-draw
 sample per fitted field); ``loo`` fits every data set's complement and predicts the held-out one, writing
 docs/validation/presets_loo.csv, the folds' posteriors docs/validation/presets_loo_parameters.csv and
-docs/validation/figures/presets_loo.png.
+docs/validation/figures/presets_loo.png.  ``vt0`` predicts every data set in-sample from the shipped priors with
+one Pfeiffer & Bowen scale put on the hard ground or on every material instead of CRSP's (:func:`vt0_sensitivity`,
+docs/validation/presets_vt0.csv).
 """
 from __future__ import annotations
 
@@ -408,9 +411,96 @@ def fold_parameters(held, train, cal) -> pd.DataFrame:
     return s
 
 
+#: ``vt0`` mode: the Pfeiffer & Bowen scales [m/s] tried, and the materials each is put on (CRSP's 76.2 is the
+#: shipped value).
+VT0_VALUES_MS = (CRSP_TANGENTIAL_SCALE_MS, 50.0, 40.0, 30.0, 20.0)
+VT0_MATERIALS = {"rock and talus": ("bedrock", "talus"), "every material": ("bedrock", "talus", "soil")}
+#: The end of P1's first bench below its 16 m wall [m along the section]: 59 % of the observed blocks stop before
+#: it, on the bench or above it (tests/data/authume/observed_runout.csv, x_stop_m < 46).
+AUTHUME_P1_BENCH_END_M = 46.0
+
+
+def vt0_sensitivity(n_draws: int, n_each: int, seed: int) -> pd.DataFrame:
+    """In-sample: every data set predicted from the shipped priors with one Pfeiffer & Bowen scale vt0 put on the
+    hard ground (rock and talus) or on every material instead of CRSP's 76.2 m/s -- what a transferable hard-landing
+    loss would have to be, and which data set could tell it (``vt0`` mode; docs/validation/presets_vt0.csv).
+
+    ``n_draws`` joint draws of the shipped posterior (the same for every row), ``n_each`` blocks per Authume
+    release and draw; Evans & Hungr one 200-block run per draw; the ODOT cut one 600-block run per draw."""
+    from simulation.materials import preset_posterior
+    from simulation.pooled import _ConstraintPool
+    from riskrf.hazard.catchment import modified_ritchie_width_m
+    draws = preset_posterior().sample(n_draws, random_state=seed).to_dict("records")
+    shipped = copy.deepcopy(CONTACT_LAWS)
+    rows = []
+    for where, mats in VT0_MATERIALS.items():
+        for vt0 in VT0_VALUES_MS:
+            if vt0 == CRSP_TANGENTIAL_SCALE_MS and rows:
+                continue                                        # the shipped model: one row
+            CONTACT_LAWS.clear()
+            CONTACT_LAWS.update(copy.deepcopy(shipped))
+            for m in mats:
+                CONTACT_LAWS[m]["tangential"]["normal_scale_ms"] = vt0
+            _SCEN.clear()
+            row = {"vt0_ms": vt0, "on": "every material (shipped)" if vt0 == CRSP_TANGENTIAL_SCALE_MS else where}
+            for prof in ("P1", "P2"):
+                rels = releases(prof)
+                r, (_, pred) = release_row(prof, "", predict_release_stops(rels, draws, n_each, 50_000), rels)
+                row[f"{prof}_median_error_pct"] = r["median_error_pct"]
+                row[f"{prof}_beyond_p99_pct"] = 100.0 * r["beyond_p99"]
+                row[f"{prof}_w1_m"] = r["w1"]
+                if prof == "P1":
+                    row["P1_on_first_bench_pct"] = 100.0 * float(np.mean(pred < AUTHUME_P1_BENCH_END_M))
+            c = evans_hungr()
+            cp = _ConstraintPool([c], _drawn(draws))
+            angles = [cp.far_angles(cp.simulate(v, 30_000 + 100 * t))[0] for t, v in enumerate(draws)]
+            row["eh_p99_shadow_angle_deg"] = float(np.median(angles))
+            post = pd.DataFrame(draws)
+            for m in ("bedrock", "soil"):
+                if m in mats:
+                    post[f"materials.{m}.tangential.normal_scale_ms"] = vt0
+            r, _ = ritchie_row(post, "", n_draws, seed)
+            row["odot_width_m"] = r["pred_p50"]
+            row["odot_width_error_pct"] = 100.0 * (r["pred_p50"] / modified_ritchie_width_m(ODOT_CUT_HEIGHT_M) - 1.0)
+            rows.append(row)
+            print({k: (round(v, 2) if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
+    CONTACT_LAWS.clear()
+    CONTACT_LAWS.update(shipped)
+    _SCEN.clear()
+    return pd.DataFrame(rows)
+
+
+def plot_vt0(table: pd.DataFrame, path: Path):
+    """Each data set's in-sample error against vt0 (the ``vt0`` mode's figure), the targets shaded."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from riskrf.hazard.catchment import modified_ritchie_width_m
+    shipped = table[table["vt0_ms"] == CRSP_TANGENTIAL_SCALE_MS]
+    panels = [("P1_median_error_pct", "Authume P1: median error [%]", (-20, 20)),
+              ("P2_median_error_pct", "Authume P2: median error [%]", (-20, 20)),
+              ("eh_p99_shadow_angle_deg", "Evans & Hungr: p99 shadow angle [deg]",
+               (0.8 * EH_SHADOW_ANGLE_DEG, 1.2 * EH_SHADOW_ANGLE_DEG)),
+              ("odot_width_m", "ODOT 60 ft cut: 90 % width [m]",
+               (0.8 * modified_ritchie_width_m(ODOT_CUT_HEIGHT_M), 1.2 * modified_ritchie_width_m(ODOT_CUT_HEIGHT_M)))]
+    fig, axes = plt.subplots(1, 4, figsize=(18, 3.8))
+    for ax, (col, title, band) in zip(axes, panels):
+        ax.axhspan(*band, color="0.9", label="target (+-20 %)")
+        for (where, mats), colour in zip(VT0_MATERIALS.items(), ("C3", "C0")):
+            t = pd.concat([shipped, table[table["on"] == where]]).sort_values("vt0_ms")
+            ax.plot(t["vt0_ms"], t[col], "o-", color=colour, label=f"vt0 on {where}")
+        ax.set_xlabel("Pfeiffer & Bowen scale vt0 [m/s] (CRSP: 76.2)")
+        ax.set_title(title, fontsize="small")
+    axes[0].legend(fontsize="x-small")
+    fig.suptitle("In-sample, the shipped priors with one hard-landing scale (derive_presets.py vt0)", fontsize="small")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("mode", choices=["fit", "loo"])
+    ap.add_argument("mode", choices=["fit", "loo", "vt0"])
     ap.add_argument("--n-per-release", type=int, default=50)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--draws", type=int, default=40)
@@ -442,6 +532,13 @@ def main():
         MODEL["laws"] = copy.deepcopy(MODEL["laws"])
         MODEL["laws"]["soil"]["ground_friction_angle_deg"] = 0.0
     t0 = time.time()
+    if args.mode == "vt0":
+        table = vt0_sensitivity(args.draws, args.n_per_release, args.seed)
+        table.to_csv(REPO / "docs" / "validation" / "presets_vt0.csv", index=False, float_format="%.4g")
+        print(f"total {time.time() - t0:.0f} s")
+        print(table.round(1).to_string())
+        plot_vt0(table, REPO / "docs" / "validation" / "figures" / "presets_vt0.png")
+        return
     if args.mode == "fit":
         cal = fit(datasets, args.n_per_release, args.seed, iterations=args.iterations)
         print(f"fit {time.time() - t0:.0f} s")
