@@ -43,7 +43,7 @@ bedrock keeps Stronge's law, so its e_T is not fitted).  The shipped priors come
 sample per fitted field); ``loo`` fits every data set's complement and predicts the held-out one, writing
 docs/validation/presets_loo.csv, the folds' posteriors docs/validation/presets_loo_parameters.csv and
 docs/validation/figures/presets_loo.png.  ``vt0`` predicts every data set in-sample from the shipped priors with
-one Pfeiffer & Bowen scale put on the hard ground or on every material instead of CRSP's (:func:`vt0_sensitivity`,
+one Pfeiffer & Bowen scale put on some of the materials instead of CRSP's (:func:`vt0_sensitivity`,
 docs/validation/presets_vt0.csv).
 """
 from __future__ import annotations
@@ -414,16 +414,19 @@ def fold_parameters(held, train, cal) -> pd.DataFrame:
 #: ``vt0`` mode: the Pfeiffer & Bowen scales [m/s] tried, and the materials each is put on (CRSP's 76.2 is the
 #: shipped value).
 VT0_VALUES_MS = (CRSP_TANGENTIAL_SCALE_MS, 50.0, 40.0, 30.0, 20.0)
-VT0_MATERIALS = {"rock and talus": ("bedrock", "talus"), "every material": ("bedrock", "talus", "soil")}
-#: The end of P1's first bench below its 16 m wall [m along the section]: 59 % of the observed blocks stop before
-#: it, on the bench or above it (tests/data/authume/observed_runout.csv, x_stop_m < 46).
+VT0_MATERIALS = {"rock": ("bedrock",), "rock and talus": ("bedrock", "talus"), "soil": ("soil",),
+                 "every material": ("bedrock", "talus", "soil")}
+#: Where P1's stops on and above its first bench end [m along the section]: 24 of the 41 observed blocks stop
+#: before it (20 on the bench by their surveyed height, 2 above it, 2 at the foot of the second wall whose
+#: projection falls short of the bench's lip at 39.5 m; tests/data/authume/observed_runout.csv), none between
+#: 44.2 and 48.2 m.
 AUTHUME_P1_BENCH_END_M = 46.0
 
 
 def vt0_sensitivity(n_draws: int, n_each: int, seed: int) -> pd.DataFrame:
     """In-sample: every data set predicted from the shipped priors with one Pfeiffer & Bowen scale vt0 put on the
-    hard ground (rock and talus) or on every material instead of CRSP's 76.2 m/s -- what a transferable hard-landing
-    loss would have to be, and which data set could tell it (``vt0`` mode; docs/validation/presets_vt0.csv).
+    materials of each :data:`VT0_MATERIALS` entry instead of CRSP's 76.2 m/s -- what a transferable hard-landing
+    loss would have to be, and how each data set responds to it (``vt0`` mode; docs/validation/presets_vt0.csv).
 
     ``n_draws`` joint draws of the shipped posterior (the same for every row), ``n_each`` blocks per Authume
     release and draw; Evans & Hungr one 200-block run per draw; the ODOT cut one 600-block run per draw."""
@@ -486,7 +489,7 @@ def plot_vt0(table: pd.DataFrame, path: Path):
     fig, axes = plt.subplots(1, 4, figsize=(18, 3.8))
     for ax, (col, title, band) in zip(axes, panels):
         ax.axhspan(*band, color="0.9", label="target (+-20 %)")
-        for (where, mats), colour in zip(VT0_MATERIALS.items(), ("C3", "C0")):
+        for (where, mats), colour in zip(VT0_MATERIALS.items(), ("C1", "C3", "C2", "C0")):
             t = pd.concat([shipped, table[table["on"] == where]]).sort_values("vt0_ms")
             ax.plot(t["vt0_ms"], t[col], "o-", color=colour, label=f"vt0 on {where}")
         ax.set_xlabel("Pfeiffer & Bowen scale vt0 [m/s] (CRSP: 76.2)")
