@@ -453,7 +453,7 @@ def vt0_sensitivity(n_draws: int, n_each: int, seed: int) -> pd.DataFrame:
                 row[f"{prof}_beyond_p99_pct"] = 100.0 * r["beyond_p99"]
                 row[f"{prof}_w1_m"] = r["w1"]
                 if prof == "P1":
-                    row["P1_on_first_bench_pct"] = 100.0 * float(np.mean(pred < AUTHUME_P1_BENCH_END_M))
+                    row["P1_before_bench_end_pct"] = 100.0 * float(np.mean(pred < AUTHUME_P1_BENCH_END_M))
             c = evans_hungr()
             cp = _ConstraintPool([c], _drawn(draws))
             angles = [cp.far_angles(cp.simulate(v, 30_000 + 100 * t))[0] for t, v in enumerate(draws)]
@@ -480,22 +480,31 @@ def plot_vt0(table: pd.DataFrame, path: Path):
     import matplotlib.pyplot as plt
     from riskrf.hazard.catchment import modified_ritchie_width_m
     shipped = table[table["vt0_ms"] == CRSP_TANGENTIAL_SCALE_MS]
-    panels = [("P1_median_error_pct", "Authume P1: median error [%]", (-20, 20)),
-              ("P2_median_error_pct", "Authume P2: median error [%]", (-20, 20)),
+    obs = pd.read_csv(OBSERVED)
+    p1_before = 100.0 * float(np.mean(obs.loc[obs["profile"] == "P1", "x_stop_m"] < AUTHUME_P1_BENCH_END_M))
+    w_mrc = modified_ritchie_width_m(ODOT_CUT_HEIGHT_M)
+    # (column, title, shaded target band, observed value or None)
+    panels = [("P1_before_bench_end_pct", f"Authume P1: stops before x = {AUTHUME_P1_BENCH_END_M:g} m [%]", None,
+               p1_before),
+              ("P1_median_error_pct", "Authume P1: median error [%]", (-20, 20), None),
+              ("P2_w1_m", "Authume P2: W1 to the observed stops [m]", None, None),
               ("eh_p99_shadow_angle_deg", "Evans & Hungr: p99 shadow angle [deg]",
-               (0.8 * EH_SHADOW_ANGLE_DEG, 1.2 * EH_SHADOW_ANGLE_DEG)),
-              ("odot_width_m", "ODOT 60 ft cut: 90 % width [m]",
-               (0.8 * modified_ritchie_width_m(ODOT_CUT_HEIGHT_M), 1.2 * modified_ritchie_width_m(ODOT_CUT_HEIGHT_M)))]
-    fig, axes = plt.subplots(1, 4, figsize=(18, 3.8))
-    for ax, (col, title, band) in zip(axes, panels):
-        ax.axhspan(*band, color="0.9", label="target (+-20 %)")
+               (0.8 * EH_SHADOW_ANGLE_DEG, 1.2 * EH_SHADOW_ANGLE_DEG), EH_SHADOW_ANGLE_DEG),
+              ("odot_width_m", "ODOT 60 ft cut: 90 % width [m]", (0.8 * w_mrc, 1.2 * w_mrc), w_mrc)]
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 3.8))
+    for ax, (col, title, band, observed) in zip(axes, panels):
+        if band is not None:
+            ax.axhspan(*band, color="0.9", label="target (+-20 %)")
+        if observed is not None:
+            ax.axhline(observed, color="k", lw=1.5, label="observed / published")
         for (where, mats), colour in zip(VT0_MATERIALS.items(), ("C1", "C3", "C2", "C0")):
             t = pd.concat([shipped, table[table["on"] == where]]).sort_values("vt0_ms")
             ax.plot(t["vt0_ms"], t[col], "o-", color=colour, label=f"vt0 on {where}")
         ax.set_xlabel("Pfeiffer & Bowen scale vt0 [m/s] (CRSP: 76.2)")
         ax.set_title(title, fontsize="small")
     axes[0].legend(fontsize="x-small")
-    fig.suptitle("In-sample, the shipped priors with one hard-landing scale (derive_presets.py vt0)", fontsize="small")
+    fig.suptitle("In-sample, the shipped priors with one hard-landing scale vt0 (derive_presets.py vt0); lines that "
+                 "coincide hide each other (P1 has no talus; the ODOT blocks land on soil)", fontsize="small")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
