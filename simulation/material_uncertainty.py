@@ -32,6 +32,12 @@ tangential.mean              0.15 (e_T 0.40-0.70 about 0.55)                Wyll
 (constant law only)                                                         impact; the mean's range assumed
 tangential.friction_angle_deg 5 deg (bedrock, pavements)                    basic friction angle of rock
 (friction law only)                                                         25-35 deg (Barton & Choubey 1977)
+tangential.normal_scale_ms   from 30 m/s up to the value (bedrock whose     the Authume quarry's two profiles
+(the data-derived tables)    table carries the Pfeiffer & Bowen scale:      disagree on it: P1's bench landings
+                             ``preset(name, basis="data")``)                want about 30 m/s, the other profile
+                                                                            68 m/s, CRSP 76.2 m/s
+                                                                            (docs/validation/trajectories.md,
+                                                                            section 5)
 ============================ ============================================== ====================================
 
 **Plugging in data-derived spreads.**  :data:`PRESET_SPREAD_SOURCES` is the list of functions consulted, first to
@@ -82,6 +88,17 @@ ASSUMED_BASIS = {
 }
 
 
+#: Low end of the ASSUMED range of the rock's Pfeiffer & Bowen scale vt0 [m/s] (the high end is the table's value,
+#: CRSP's 76.2 m/s in the data-derived presets): in-sample, the vt0 under which Authume P1's blocks stop on and
+#: above the bench below its 16 m wall as often as observed (docs/validation/presets_vt0.csv: 57 % at 30 m/s,
+#: observed 59 %).
+ROCK_VT0_LOW_MS = 30.0
+ASSUMED_BASIS["tangential.normal_scale_ms"] = (
+    "ASSUMPTION: the rock's Pfeiffer & Bowen scale from {low:g} m/s to the value: how much speed a block keeps when "
+    "it lands on a bench; Authume P1's bench landings want about 30 m/s, the quarry's other profile 68 m/s, CRSP "
+    "76.2 m/s (docs/validation/trajectories.md, section 5)")
+
+
 def _get(table: dict, field: str):
     node = table
     for key in field.split("."):
@@ -114,6 +131,10 @@ def assumed_spread(preset: str, table: dict) -> dict:
         if v is None:               # the law in force does not use this field (e.g. e_N of Wyllie's law)
             continue
         out[field] = (max(float(v) - w, 0.0), float(v) + w, ASSUMED_BASIS[field].format(w=w))
+    vt0 = _get(table, "tangential.normal_scale_ms")
+    if ALIASES.get(preset, preset) == "bedrock" and vt0 is not None and ROCK_VT0_LOW_MS < vt0 < np.inf:
+        out["tangential.normal_scale_ms"] = (ROCK_VT0_LOW_MS, float(vt0),
+                                             ASSUMED_BASIS["tangential.normal_scale_ms"].format(low=ROCK_VT0_LOW_MS))
     return out
 
 

@@ -151,6 +151,22 @@ def test_preset_spread_is_labelled_and_latin_hypercube_draws_fill_every_slice():
     assert talus.ground_friction_deg == pytest.approx(d.iloc[0]["materials.talus.ground_friction_angle_deg"])
 
 
+def test_the_rocks_bench_landing_scale_is_spread_where_a_data_derived_table_carries_it():
+    # the data-derived bedrock carries CRSP's vt0 = 76.2 m/s; the validation (docs/validation/presets_vt0.csv) puts
+    # Authume P1's bench landings near 30 m/s, so the ASSUMED range runs from 30 m/s up to the table's value
+    odot = ROOT / "simulation" / "scenarios" / "odot_catchment_cut.toml"
+    spread = simulation.preset_spread(odot)
+    row = spread.loc["materials.rock.tangential.normal_scale_ms"]
+    assert (row["low"], row["high"]) == (30.0, pytest.approx(76.2)) and row["assumption"]
+    assert "bench" in row["basis"] and "materials.catchment.tangential.normal_scale_ms" not in spread.index
+    d = simulation.material_draws(odot, 4, seed=2)
+    assert d["materials.rock.tangential.normal_scale_ms"].between(30.0, 76.2).all()
+    rock = next(m for m in simulation.scenario_with_values(odot, d.iloc[0].to_dict()).materials if m.name == "rock")
+    assert rock.et_normal_scale_ms == pytest.approx(d.iloc[0]["materials.rock.tangential.normal_scale_ms"])
+    # the published bedrock (Stronge's law) has no vt0: nothing to spread
+    assert not simulation.preset_spread(SCENARIO).index.str.endswith("normal_scale_ms").any()
+
+
 def test_a_data_derived_spread_plugs_in_first(monkeypatch):
     from simulation import material_uncertainty as mu
 
