@@ -29,7 +29,8 @@ normal_restitution.mean      the published range of the preset's e_N        Rock
 (constant law only)          (scree, soil 0.03; meadow 0.02; colluvium      and CRSP colluvium, as quoted in
                              0.01)                                          :mod:`simulation.materials`
 tangential.mean              0.15 (e_T 0.40-0.70 about 0.55)                Wyllie (2014) e_T 0.3-0.8 per
-(constant law only)                                                         impact; the mean's range assumed
+(constant and Coulomb laws;                                                 impact; the mean's range assumed
+the data-derived bedrock)
 tangential.friction_angle_deg 5 deg (bedrock, pavements)                    basic friction angle of rock
 (friction law only)                                                         25-35 deg (Barton & Choubey 1977)
 tangential.normal_scale_ms   from 30 m/s up to the value (bedrock whose     the Authume quarry's two profiles
@@ -66,7 +67,7 @@ from .scenario import Scenario, ScenarioError, scenario_from_dict
 #: Half-widths of the ASSUMED ranges of each preset's parameters (see the module docstring): preset -> field ->
 #: half-width in the field's unit.  Only fields the preset's laws use are varied.
 ASSUMED_HALF_WIDTHS: dict[str, dict[str, float]] = {
-    "bedrock": {"ground_friction_angle_deg": 4.0, "tangential.friction_angle_deg": 5.0},
+    "bedrock": {"ground_friction_angle_deg": 4.0, "tangential.friction_angle_deg": 5.0, "tangential.mean": 0.15},
     "talus": {"ground_friction_angle_deg": 4.0, "tangential.mean": 0.15},
     "scree": {"ground_friction_angle_deg": 4.0, "normal_restitution.mean": 0.03, "tangential.mean": 0.15},
     "colluvium": {"ground_friction_angle_deg": 6.0, "normal_restitution.mean": 0.01, "tangential.mean": 0.15},

@@ -159,6 +159,8 @@ def test_the_rocks_bench_landing_scale_is_spread_where_a_data_derived_table_carr
     row = spread.loc["materials.rock.tangential.normal_scale_ms"]
     assert (row["low"], row["high"]) == (30.0, pytest.approx(76.2)) and row["assumption"]
     assert "bench" in row["basis"] and "materials.catchment.tangential.normal_scale_ms" not in spread.index
+    # and its fitted e_T (Coulomb law) by +-0.15 as the soil's, where the published bedrock (Stronge) has none
+    assert spread.loc["materials.rock.tangential.mean", ["low", "high"]].tolist() == pytest.approx([0.5975, 0.8975])
     d = simulation.material_draws(odot, 4, seed=2)
     assert d["materials.rock.tangential.normal_scale_ms"].between(30.0, 76.2).all()
     rock = next(m for m in simulation.scenario_with_values(odot, d.iloc[0].to_dict()).materials if m.name == "rock")
