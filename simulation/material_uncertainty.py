@@ -33,12 +33,13 @@ tangential.mean              0.15 (e_T 0.40-0.70 about 0.55)                Wyll
 the data-derived bedrock)
 tangential.friction_angle_deg 5 deg (bedrock, pavements)                    basic friction angle of rock
 (friction law only)                                                         25-35 deg (Barton & Choubey 1977)
-tangential.normal_scale_ms   from 30 m/s up to the value (bedrock whose     the Authume quarry's two profiles
-(the data-derived tables)    table carries the Pfeiffer & Bowen scale:      disagree on it: P1's bench landings
-                             ``preset(name, basis="data")``)                want about 30 m/s, the other profile
-                                                                            68 m/s, CRSP 76.2 m/s
-                                                                            (docs/validation/trajectories.md,
-                                                                            section 5)
+tangential.normal_scale_ms   from 30 m/s up to the value (a bedrock whose   Authume P1's bench landings want
+(bedrock only)               table carries a finite Pfeiffer & Bowen scale  about 30 m/s in-sample, the other
+                             above 30 m/s: the data-derived tables,         profile 68 m/s, CRSP 76.2 m/s
+                             ``preset(name, basis="data")``, carry 76.2;    (docs/validation/trajectories.md,
+                             the soil's, where catchments land, is not      section 5); no data set here says
+                             varied)                                        how an earth bench or catchment
+                                                                            differs from CRSP's
 ============================ ============================================== ====================================
 
 **Plugging in data-derived spreads.**  :data:`PRESET_SPREAD_SOURCES` is the list of functions consulted, first to
@@ -90,14 +91,16 @@ ASSUMED_BASIS = {
 
 
 #: Low end of the ASSUMED range of the rock's Pfeiffer & Bowen scale vt0 [m/s] (the high end is the table's value,
-#: CRSP's 76.2 m/s in the data-derived presets): in-sample, the vt0 under which Authume P1's blocks stop on and
-#: above the bench below its 16 m wall as often as observed (docs/validation/presets_vt0.csv: 57 % at 30 m/s,
+#: CRSP's 76.2 m/s in the data-derived presets): in-sample, the vt0 under which Authume P1's blocks stop before the
+#: end of the bench below its first wall as often as observed (docs/validation/presets_vt0.csv: 57 % at 30 m/s,
 #: observed 59 %).
 ROCK_VT0_LOW_MS = 30.0
 ASSUMED_BASIS["tangential.normal_scale_ms"] = (
-    "ASSUMPTION: the rock's Pfeiffer & Bowen scale from {low:g} m/s to the value: how much speed a block keeps when "
-    "it lands on a bench; Authume P1's bench landings want about 30 m/s, the quarry's other profile 68 m/s, CRSP "
-    "76.2 m/s (docs/validation/trajectories.md, section 5)")
+    "ASSUMPTION: the rock's Pfeiffer & Bowen scale from {low:g} m/s to the value ({high:g} m/s): how much speed a "
+    "block keeps when "
+    "it lands on a rock bench; Authume P1's bench landings want about 30 m/s, the quarry's other profile 68 m/s, "
+    "CRSP 76.2 m/s (docs/validation/trajectories.md, section 5); earth benches and catchments (the soil) are not "
+    "varied")
 
 
 def _get(table: dict, field: str):
@@ -112,7 +115,9 @@ def _get(table: dict, field: str):
 def assumed_spread(preset: str, table: dict) -> dict:
     """The ASSUMED range of each parameter of ``preset`` that ``table`` (the material's resolved table) uses:
     {field: (low, high, basis)}, centred on the table's value (see :data:`ASSUMED_HALF_WIDTHS`); bounds kept
-    >= 0 (restitution coefficients, angles).
+    >= 0 (restitution coefficients, angles).  One range is one-sided: a bedrock whose table carries a finite
+    Pfeiffer & Bowen scale above :data:`ROCK_VT0_LOW_MS` gets that scale from :data:`ROCK_VT0_LOW_MS` up to its
+    value (at or below it, or infinite, it is not varied).
 
     Parameters
     ----------
@@ -134,8 +139,8 @@ def assumed_spread(preset: str, table: dict) -> dict:
         out[field] = (max(float(v) - w, 0.0), float(v) + w, ASSUMED_BASIS[field].format(w=w))
     vt0 = _get(table, "tangential.normal_scale_ms")
     if ALIASES.get(preset, preset) == "bedrock" and vt0 is not None and ROCK_VT0_LOW_MS < vt0 < np.inf:
-        out["tangential.normal_scale_ms"] = (ROCK_VT0_LOW_MS, float(vt0),
-                                             ASSUMED_BASIS["tangential.normal_scale_ms"].format(low=ROCK_VT0_LOW_MS))
+        out["tangential.normal_scale_ms"] = (ROCK_VT0_LOW_MS, float(vt0), ASSUMED_BASIS["tangential.normal_scale_ms"]
+                                             .format(low=ROCK_VT0_LOW_MS, high=float(vt0)))
     return out
 
 

@@ -427,6 +427,29 @@ def test_bad_material_uncertainty_names_the_field():
         parse_mitigation({"uncertainty": {"materials": {"talus.roughness_m": [0.3, 0.1]}}, "options": []}, "s.toml")
 
 
+def test_the_pfeiffer_bowen_scale_is_a_material_parameter_of_the_uncertainty():
+    # the site file's [uncertainty.materials] may range a rock's vt0 (docs/user-guide/contact-model.md): it is read,
+    # set and acts on the trajectories; a Stronge-law material and vt0 <= 0 are refused by name
+    from riskrf.risk.measures import MeasureError, material_value, scenario_with_materials
+    uncertainty = parse_mitigation({"uncertainty": {"materials": {"rock.tangential.normal_scale_ms": [30.0, 76.2]}}},
+                                   "s.toml", require_options=False)[5]
+    assert list(uncertainty.materials) == ["rock.tangential.normal_scale_ms"]
+    odot = simulation.load_scenario(ROOT / "simulation" / "scenarios" / "odot_catchment_cut.toml")
+    assert material_value(odot, "rock.tangential.normal_scale_ms") == pytest.approx(76.2)
+    hard = scenario_with_materials(odot, {"rock.tangential.normal_scale_ms": 5.0,
+                                          "catchment.tangential.normal_scale_ms": 5.0})
+    assert material_value(hard, "catchment.tangential.normal_scale_ms") == 5.0
+    x0 = simulation.run(odot, n=300, seed=4).per_block["x"]
+    x1 = simulation.run(hard, n=300, seed=4).per_block["x"]
+    assert np.median(x1) < np.median(x0)                 # landings keep less tangential speed: shorter rollout
+    with pytest.raises(MeasureError, match=r"'bedrock.tangential.normal_scale_ms': material 'bedrock' uses "
+                                           r"Stronge's 'friction' law"):
+        scenario_with_materials(simulation.load_scenario(BARRIER), {"bedrock.tangential.normal_scale_ms": 30.0})
+    with pytest.raises(MeasureError, match=r"'rock.tangential.normal_scale_ms' = 0.0: the Pfeiffer & Bowen scale "
+                                           r"must be > 0 m/s"):
+        scenario_with_materials(odot, {"rock.tangential.normal_scale_ms": 0.0})
+
+
 def test_fence_at_another_position_and_realignment_are_derived_from_simulation():
     opts = (Option("nothing", "none"), Option("fence", "fence", 5e5, capacity_kj=2000, height_m=3.0, x_m=45.0,
                                                repair_days=30),

@@ -160,13 +160,19 @@ def test_the_rocks_bench_landing_scale_is_spread_where_a_data_derived_table_carr
     assert (row["low"], row["high"]) == (30.0, pytest.approx(76.2)) and row["assumption"]
     assert "bench" in row["basis"] and "materials.catchment.tangential.normal_scale_ms" not in spread.index
     # and its fitted e_T (Coulomb law) by +-0.15 as the soil's, where the published bedrock (Stronge) has none
-    assert spread.loc["materials.rock.tangential.mean", ["low", "high"]].tolist() == pytest.approx([0.5975, 0.8975])
+    e_t = spread.loc["materials.rock.tangential.mean"]
+    assert [e_t["low"], e_t["high"]] == pytest.approx([e_t["value"] - 0.15, e_t["value"] + 0.15])
     d = simulation.material_draws(odot, 4, seed=2)
     assert d["materials.rock.tangential.normal_scale_ms"].between(30.0, 76.2).all()
     rock = next(m for m in simulation.scenario_with_values(odot, d.iloc[0].to_dict()).materials if m.name == "rock")
     assert rock.et_normal_scale_ms == pytest.approx(d.iloc[0]["materials.rock.tangential.normal_scale_ms"])
-    # the published bedrock (Stronge's law) has no vt0: nothing to spread
+    # the published bedrock (Stronge's law) has no vt0: nothing to spread; nor has a bedrock whose vt0 is at or
+    # below the range's low end (one-sided: it only ever removes energy at a landing)
     assert not simulation.preset_spread(SCENARIO).index.str.endswith("normal_scale_ms").any()
+    from simulation.calibration import scenario_dict
+    low, _ = scenario_dict(odot)
+    low["materials"]["rock"]["tangential"] = {"normal_scale_ms": 25.0}
+    assert "materials.rock.tangential.normal_scale_ms" not in simulation.preset_spread(low).index
 
 
 def test_a_data_derived_spread_plugs_in_first(monkeypatch):

@@ -339,6 +339,7 @@ def runout_beyond(result, x_m: float) -> np.ndarray:
 #: Material parameters that can be uncertain, as written in a scenario file -> field of simulation.scenario.Material.
 MATERIAL_FIELDS = {"normal_restitution.mean": "en_mean", "normal_restitution.std": "en_std",
                    "tangential.mean": "et_mean", "tangential.friction_angle_deg": "friction_deg",
+                   "tangential.normal_scale_ms": "et_normal_scale_ms",
                    "roughness_m": "roughness_m", "ground_friction_angle_deg": "ground_friction_deg"}
 
 
@@ -350,6 +351,10 @@ def _material_path(scenario, path: str, where: str):
                            f"({', '.join(names)})")
     if fld not in MATERIAL_FIELDS:
         raise MeasureError(f"{where}: {path!r}: {fld!r} is not one of {', '.join(MATERIAL_FIELDS)}")
+    from simulation.contact import ET_FRICTION
+    if fld == "tangential.normal_scale_ms" and scenario.materials[names.index(name)].et_law == ET_FRICTION:
+        raise MeasureError(f"{where}: {path!r}: material {name!r} uses Stronge's 'friction' law, which the "
+                           "Pfeiffer & Bowen scale does not act on (it scales the 'constant' and 'coulomb' laws)")
     return names.index(name), MATERIAL_FIELDS[fld]
 
 
@@ -404,6 +409,8 @@ def scenario_with_materials(scenario, values: dict, where: str = "materials"):
     mats = list(scenario.materials)
     for path, v in values.items():
         i, attr = _material_path(scenario, path, where)
+        if attr == "et_normal_scale_ms" and not float(v) > 0.0:
+            raise MeasureError(f"{where}: {path!r} = {v!r}: the Pfeiffer & Bowen scale must be > 0 m/s")
         mats[i] = replace(mats[i], **{attr: float(v)})
     return replace(scenario, materials=tuple(mats))
 

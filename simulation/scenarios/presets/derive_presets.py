@@ -6,7 +6,7 @@
     python simulation/scenarios/presets/derive_presets.py loo --model contact-drag     # a variant: presets_loo_drag
     python simulation/scenarios/presets/derive_presets.py loo --model contact-measured --n-per-release 200 \
         --site-spread assumed                                              # blocks as measured: presets_loo_measured
-    python simulation/scenarios/presets/derive_presets.py vt0 --n-per-release 5 --draws 20   # presets_vt0.csv
+    python simulation/scenarios/presets/derive_presets.py vt0 --n-per-release 50 --draws 40  # presets_vt0.csv
 
 ``--kernel 3d`` runs the Authume releases on the quarry's DEM with its zone raster (the 3-D kernel, the same
 contact model; simulation/scenarios/authume/authume_3d.toml) and compares **plan runouts** (horizontal
@@ -417,9 +417,9 @@ VT0_VALUES_MS = (CRSP_TANGENTIAL_SCALE_MS, 50.0, 40.0, 30.0, 20.0)
 VT0_MATERIALS = {"rock": ("bedrock",), "rock and talus": ("bedrock", "talus"), "soil": ("soil",),
                  "every material": ("bedrock", "talus", "soil")}
 #: Where P1's stops on and above its first bench end [m along the section]: 24 of the 41 observed blocks stop
-#: before it (20 on the bench by their surveyed height, 2 above it, 2 at the foot of the second wall whose
-#: projection falls short of the bench's lip at 39.5 m; tests/data/authume/observed_runout.csv), none between
-#: 44.2 and 48.2 m.
+#: before it (20 on the bench by their surveyed height, 2 above it, 2 at the foot of the second wall that project
+#: to 41.6 and 43.2 m, short of that wall's foot at about 44.5 m; tests/data/authume/observed_runout.csv), none
+#: between 44.2 and 48.2 m.
 AUTHUME_P1_BENCH_END_M = 46.0
 
 
@@ -434,42 +434,45 @@ def vt0_sensitivity(n_draws: int, n_each: int, seed: int) -> pd.DataFrame:
     from simulation.pooled import _ConstraintPool
     from riskrf.hazard.catchment import modified_ritchie_width_m
     draws = preset_posterior().sample(n_draws, random_state=seed).to_dict("records")
+    w_mrc = modified_ritchie_width_m(ODOT_CUT_HEIGHT_M)
     shipped = copy.deepcopy(CONTACT_LAWS)
     rows = []
-    for where, mats in VT0_MATERIALS.items():
-        for vt0 in VT0_VALUES_MS:
-            if vt0 == CRSP_TANGENTIAL_SCALE_MS and rows:
-                continue                                        # the shipped model: one row
-            CONTACT_LAWS.clear()
-            CONTACT_LAWS.update(copy.deepcopy(shipped))
-            for m in mats:
-                CONTACT_LAWS[m]["tangential"]["normal_scale_ms"] = vt0
-            _SCEN.clear()
-            row = {"vt0_ms": vt0, "on": "every material (shipped)" if vt0 == CRSP_TANGENTIAL_SCALE_MS else where}
-            for prof in ("P1", "P2"):
-                rels = releases(prof)
-                r, (_, pred) = release_row(prof, "", predict_release_stops(rels, draws, n_each, 50_000), rels)
-                row[f"{prof}_median_error_pct"] = r["median_error_pct"]
-                row[f"{prof}_beyond_p99_pct"] = 100.0 * r["beyond_p99"]
-                row[f"{prof}_w1_m"] = r["w1"]
-                if prof == "P1":
-                    row["P1_before_bench_end_pct"] = 100.0 * float(np.mean(pred < AUTHUME_P1_BENCH_END_M))
-            c = evans_hungr()
-            cp = _ConstraintPool([c], _drawn(draws))
-            angles = [cp.far_angles(cp.simulate(v, 30_000 + 100 * t))[0] for t, v in enumerate(draws)]
-            row["eh_p99_shadow_angle_deg"] = float(np.median(angles))
-            post = pd.DataFrame(draws)
-            for m in ("bedrock", "soil"):
-                if m in mats:
-                    post[f"materials.{m}.tangential.normal_scale_ms"] = vt0
-            r, _ = ritchie_row(post, "", n_draws, seed)
-            row["odot_width_m"] = r["pred_p50"]
-            row["odot_width_error_pct"] = 100.0 * (r["pred_p50"] / modified_ritchie_width_m(ODOT_CUT_HEIGHT_M) - 1.0)
-            rows.append(row)
-            print({k: (round(v, 2) if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
-    CONTACT_LAWS.clear()
-    CONTACT_LAWS.update(shipped)
-    _SCEN.clear()
+    try:
+        for where, mats in VT0_MATERIALS.items():
+            for vt0 in VT0_VALUES_MS:
+                if vt0 == CRSP_TANGENTIAL_SCALE_MS and rows:
+                    continue                                        # the shipped model: one row
+                CONTACT_LAWS.clear()
+                CONTACT_LAWS.update(copy.deepcopy(shipped))
+                for m in mats:
+                    CONTACT_LAWS[m]["tangential"]["normal_scale_ms"] = vt0
+                _SCEN.clear()
+                row = {"vt0_ms": vt0, "on": "every material (shipped)" if vt0 == CRSP_TANGENTIAL_SCALE_MS else where}
+                for prof in ("P1", "P2"):
+                    rels = releases(prof)
+                    r, (_, pred) = release_row(prof, "", predict_release_stops(rels, draws, n_each, 50_000), rels)
+                    row[f"{prof}_median_error_pct"] = r["median_error_pct"]
+                    row[f"{prof}_beyond_p99_pct"] = 100.0 * r["beyond_p99"]
+                    row[f"{prof}_w1_m"] = r["w1"]
+                    if prof == "P1":
+                        row["P1_before_bench_end_pct"] = 100.0 * float(np.mean(pred < AUTHUME_P1_BENCH_END_M))
+                c = evans_hungr()
+                cp = _ConstraintPool([c], _drawn(draws))
+                angles = [cp.far_angles(cp.simulate(v, 30_000 + 100 * t))[0] for t, v in enumerate(draws)]
+                row["eh_p99_shadow_angle_deg"] = float(np.median(angles))
+                post = pd.DataFrame(draws)
+                for m in ("bedrock", "soil"):
+                    if m in mats:
+                        post[f"materials.{m}.tangential.normal_scale_ms"] = vt0
+                r, _ = ritchie_row(post, "", n_draws, seed)
+                row["odot_width_m"] = r["pred_p50"]
+                row["odot_width_error_pct"] = 100.0 * (r["pred_p50"] / w_mrc - 1.0)
+                rows.append(row)
+                print({k: (round(v, 2) if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
+    finally:
+        CONTACT_LAWS.clear()
+        CONTACT_LAWS.update(shipped)
+        _SCEN.clear()
     return pd.DataFrame(rows)
 
 
@@ -545,6 +548,9 @@ def main():
         MODEL["laws"]["soil"]["ground_friction_angle_deg"] = 0.0
     t0 = time.time()
     if args.mode == "vt0":
+        if (args.model, args.kernel, args.with_ritchie, args.out) != ("contact", "2d", False, "presets_loo"):
+            ap.error("vt0 uses the shipped model on the 2-D sections and writes presets_vt0.csv: --model, --kernel, "
+                     "--with-ritchie and --out do not apply")
         table = vt0_sensitivity(args.draws, args.n_per_release, args.seed)
         table.to_csv(REPO / "docs" / "validation" / "presets_vt0.csv", index=False, float_format="%.4g")
         print(f"total {time.time() - t0:.0f} s")
