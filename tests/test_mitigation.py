@@ -13,8 +13,7 @@ from riskrf.risk.mitigation import (Consequences, Economics, Exposure, Mitigatio
                                Uncertainty, parse_mitigation, parse_option)
 from riskrf.frequency.power_law import fit_gutenberg_richter
 from riskrf.risk.road_risk import (commuter_passage_probability, commuter_strike_probability, fn_zone,
-                              occupancy_distribution, spatial_temporal_probability,
-                              stationary_rock_strike_probability)
+                              occupancy_distribution, spatial_temporal_probability)
 
 from .conftest import INVENTORIES, ROOT
 from .test_simulation_run import BARRIER
