@@ -97,10 +97,9 @@ ASSUMED_BASIS = {
 ROCK_VT0_LOW_MS = 30.0
 ASSUMED_BASIS["tangential.normal_scale_ms"] = (
     "ASSUMPTION: the rock's Pfeiffer & Bowen scale from {low:g} m/s to the value ({high:g} m/s): how much speed a "
-    "block keeps when "
-    "it lands on a rock bench; Authume P1's bench landings want about 30 m/s, the quarry's other profile 68 m/s, "
-    "CRSP 76.2 m/s (docs/validation/trajectories.md, section 5); earth benches and catchments (the soil) are not "
-    "varied")
+    "block keeps when it lands on a rock bench; Authume P1's bench landings want about 30 m/s, the quarry's other "
+    "profile 68 m/s, CRSP 76.2 m/s (docs/validation/trajectories.md, section 5); earth benches and catchments (the "
+    "soil) are not varied")
 
 
 def _get(table: dict, field: str):
