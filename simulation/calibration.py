@@ -110,6 +110,45 @@ def _did_you_mean(key, options) -> str:
     return f"; did you mean {close[0]!r}?" if close else f"; available: {', '.join(map(str, options))}"
 
 
+def parameter_materials(name: str) -> tuple:
+    """The materials a dotted parameter ``materials.NAME.FIELD`` sets: ``(NAME,)``, or for a shared parameter
+    ``materials.A+B.FIELD`` (one value put into the same field of several materials) ``(A, B)``; ``()`` for a
+    name that is not a material field.
+
+    Parameters
+    ----------
+    name : str
+        The dotted parameter name.
+
+    Returns
+    -------
+    tuple of str
+    """
+    parts = str(name).split(".")
+    if len(parts) < 3 or parts[0] != "materials":
+        return ()
+    return tuple(parts[1].split("+"))
+
+
+def material_parameter(name: str, material: str) -> str:
+    """The single-material name of the shared parameter ``name`` for ``material`` (``materials.A+B.FIELD`` ->
+    ``materials.A.FIELD``).
+
+    Parameters
+    ----------
+    name : str
+        A dotted material parameter (:func:`parameter_materials`).
+    material : str
+        One of its materials.
+
+    Returns
+    -------
+    str
+    """
+    _, _, field = str(name).split(".", 2)
+    return f"materials.{material}.{field}"
+
+
 def set_parameter(data: dict, name: str, value: float, *, source: str | None = None) -> None:
     """Set the value at dotted path ``name`` in a scenario dictionary (in place).
 
@@ -117,6 +156,8 @@ def set_parameter(data: dict, name: str, value: float, *, source: str | None = N
     a missing last field (a default) or a missing law table (e.g.
     ``normal_restitution.mean`` where the file gives ``normal_restitution =
     0.35``) is created.  ``collectors.NAME.FIELD`` addresses a collector by name.
+    ``materials.A+B.FIELD`` is one value shared by several materials: it is set in each of A, B that the scenario
+    defines (at least one must be).
 
     Parameters
     ----------
@@ -134,6 +175,16 @@ def set_parameter(data: dict, name: str, value: float, *, source: str | None = N
     if len(parts) < 2 or any(not p for p in parts):
         raise ValueError(f"{where}parameter {name!r}: use a dotted path such as "
                          "'materials.talus.ground_friction_angle_deg'")
+    shared = parameter_materials(name)
+    if len(shared) > 1:
+        defined = data.get("materials") or {}
+        if any(not m for m in shared) or not any(m in defined for m in shared):
+            raise ValueError(f"{where}parameter {name!r}: the scenario defines none of the materials "
+                             f"{list(shared)} (materials: {sorted(defined)})")
+        for m in shared:
+            if m in defined:
+                set_parameter(data, material_parameter(name, m), value, source=source)
+        return
     node = data
     for depth, key in enumerate(parts[:-1]):
         if isinstance(node, list):          # [[collectors]]: address by name
@@ -577,8 +628,13 @@ def dump_toml(data: dict) -> str:
 
 
 def _current_value(data: dict, name: str):
-    """The value at dotted path ``name`` (material presets expanded), or nan when the scenario gives none."""
+    """The value at dotted path ``name`` (material presets expanded), or nan when the scenario gives none (a
+    shared ``materials.A+B.FIELD``: that of the first of its materials the scenario defines)."""
     from .materials import PresetError, resolve_materials
+    shared = parameter_materials(name)
+    if len(shared) > 1:
+        first = next((m for m in shared if m in (data.get("materials") or {})), shared[0])
+        name = material_parameter(name, first)
     try:
         node = resolve_materials(data)
     except PresetError:

@@ -63,6 +63,7 @@ import pandas as pd
 from scipy import stats
 
 from ._display import Displayed, short_repr
+from .calibration import material_parameter, parameter_materials
 from .scenario import Distribution, Material, Scenario, ScenarioError, scenario_from_dict
 from .surrogate import _in_unit_box, _t_draw, _t_logpdf, gp_posterior_sample, replicate_noise
 from .units import DENSITY_RANGE_KG_M3
@@ -272,7 +273,7 @@ class _ConstraintPool:
             from .calibration import scenario_dict
             data, _ = scenario_dict(c.scenario)
             mats = data.get("materials", {})
-            own = {k: b for k, b in parameters.items() if str(k).split(".")[1:2] and str(k).split(".")[1] in mats}
+            own = {k: b for k, b in parameters.items() if any(m in mats for m in parameter_materials(k))}
             self.pools.append((_Pool([c._release()], own) if own else None, own))
 
     def simulate(self, values: dict, seed) -> list:
@@ -469,15 +470,16 @@ class _Pool:
         self.names = list(parameters)
         self.bounds = {}
         for name, b in parameters.items():
-            parts = str(name).split(".")
-            if len(parts) < 3 or parts[0] != "materials":
+            mats = parameter_materials(name)
+            if not mats or not all(mats):
                 raise ValueError(f"parameter {name!r}: a pooled calibration fits material fields shared by the "
-                                 "releases: 'materials.NAME.FIELD' (e.g. 'materials.talus.ground_friction_angle_deg')")
-            if parts[1] not in extra_materials and not any(parts[1] in data.get("materials", {})
-                                                           for data, _, _ in self.bases.values()):
+                                 "releases: 'materials.NAME.FIELD' (e.g. 'materials.talus.ground_friction_angle_deg'; "
+                                 "'materials.A+B.FIELD' shares one value between materials A and B)")
+            if not any(m in extra_materials or any(m in data.get("materials", {}) for data, _, _ in
+                                                   self.bases.values()) for m in mats):
                 files = sorted({src for _, src, _ in self.bases.values()})
-                raise ValueError(f"parameter {name!r}: no release's scenario defines material {parts[1]!r} "
-                                 f"(scenarios: {files})")
+                raise ValueError(f"parameter {name!r}: no release's scenario defines material "
+                                 f"{' or '.join(repr(m) for m in mats)} (scenarios: {files})")
             try:
                 lo, hi = (float(v) for v in b)
             except (TypeError, ValueError):
@@ -552,11 +554,11 @@ class _Pool:
             names = [m.name for m in mats]
             touched = {}
             for pname, v in values.items():
-                mat = pname.split(".")[1]
-                if mat not in names:
-                    continue
-                spec = touched.setdefault(mat, {"materials": {mat: copy.deepcopy(data["materials"][mat])}})
-                set_parameter(spec, pname, v, source=src)
+                for mat in parameter_materials(pname):
+                    if mat not in names:
+                        continue
+                    spec = touched.setdefault(mat, {"materials": {mat: copy.deepcopy(data["materials"][mat])}})
+                    set_parameter(spec, material_parameter(pname, mat), v, source=src)
             for mat, spec in touched.items():
                 mats[names.index(mat)] = Material.parse(mat, spec["materials"][mat], src)
             out[key] = replace(sc, materials=tuple(mats)) if touched else sc
@@ -953,13 +955,16 @@ def read_posterior(path, scenario=None) -> pd.DataFrame:
         mats = data.get("materials", {})
         for col in df.columns:
             parts = col.split(".")
-            if len(parts) < 3 or parts[0] != "materials" or parts[1] not in mats:
-                raise ValueError(f"{path}: field {col!r} names material {parts[1] if len(parts) > 1 else col!r}, "
+            named = parameter_materials(col)
+            if not named or not any(m in mats for m in named):
+                raise ValueError(f"{path}: field {col!r} names material "
+                                 f"{' or '.join(repr(m) for m in named) if named else repr(col)}, "
                                  f"which {src} does not define (materials: {sorted(mats)})")
-            try:
-                Material.parse(parts[1], _set_in(mats[parts[1]], parts[2:], float(df[col].iloc[0])), src)
-            except (ScenarioError, ValueError) as exc:
-                raise ValueError(f"{path}: field {col!r} does not fit material {parts[1]!r} of {src}: {exc}") from None
+            for m in (m for m in named if m in mats):
+                try:
+                    Material.parse(m, _set_in(mats[m], parts[2:], float(df[col].iloc[0])), src)
+                except (ScenarioError, ValueError) as exc:
+                    raise ValueError(f"{path}: field {col!r} does not fit material {m!r} of {src}: {exc}") from None
     return df
 
 
@@ -1011,7 +1016,8 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
     _check_pooled_arguments(parameters, n_per_release, iterations, n_posterior, n_predictive, obs_error_m)
     constraints = _check_constraints(constraints)
     cpool = _ConstraintPool(constraints, parameters)
-    pool = _Pool(releases, parameters, extra_materials={k.split(".")[1] for pl in cpool.pools for k in pl[1]})
+    pool = _Pool(releases, parameters,
+                 extra_materials={m for pl in cpool.pools for k in pl[1] for m in parameter_materials(k)})
     names = pool.names
     lo = np.array([pool.bounds[k][0] for k in names])
     hi = np.array([pool.bounds[k][1] for k in names])

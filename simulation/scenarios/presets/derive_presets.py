@@ -63,7 +63,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[2]
 sys.path.insert(0, str(REPO))
 
-from simulation.calibration import scenario_dict  # noqa: E402
+from simulation.calibration import material_parameter, parameter_materials, scenario_dict  # noqa: E402
 from simulation.contact import CRSP_TANGENTIAL_SCALE_MS  # noqa: E402
 from simulation.material_uncertainty import with_site_spread  # noqa: E402
 from simulation.pooled import ReachConstraint, Release, _ConstraintPool, _density, _Pool, calibrate_pooled  # noqa: E402
@@ -210,8 +210,8 @@ def fit(datasets, n_per_release=50, seed=1, n_predictive=20, iterations=4):
         else:
             rel.extend(releases(d.split("_")[1].upper()))
     params = {k: v for k, v in _parameters().items()
-              if any(k.split(".")[1] in r.scenario["materials"] for r in rel)
-              or any(k.split(".")[1] in c.scenario["materials"] for c in con)}
+              if any(m in r.scenario["materials"] for r in rel for m in parameter_materials(k))
+              or any(m in c.scenario["materials"] for c in con for m in parameter_materials(k))}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return calibrate_pooled(rel, params, seed=seed, n_per_release=n_per_release, n_initial=1024,
@@ -239,6 +239,11 @@ SIZEDRAG_PARAMETERS["materials.soil.rolling_size_coefficient"] = (0.0, 4.0)
 VSCALE_PARAMETERS = {**CONTACT_PARAMETERS, "materials.bedrock.tangential.normal_scale_ms": (3.0, 80.0)}
 
 
+#: ``--model contact-vscale-tied``: one vt0 shared by the rock and the talus (``materials.bedrock+talus....``), so that
+#: the Evans & Hungr cliff's landings on its talus inform the rock's bench landings as well.
+VSCALE_TIED_PARAMETERS = {**CONTACT_PARAMETERS, "materials.bedrock+talus.tangential.normal_scale_ms": (3.0, 80.0)}
+
+
 #: ``--model contact-measured``: the contact model with every Authume block rolling as the cylinder of its measured
 #: sizes (:func:`simulation.units.box_rolling_cylinder`) instead of the sphere of its mass, a variant tried for the
 #: transfer between the two Authume profiles.  The rock's phi_g starts at 0: beside the size term roughness / r it
@@ -250,6 +255,7 @@ MEASURED_PARAMETERS = {**CONTACT_PARAMETERS, "materials.bedrock.ground_friction_
 #: ``--model`` -> (its own fitted fields, or None for those of the laws in use; the suffix of its LOO table's name).
 MODELS = {"contact": (None, ""), "presets": (None, "_own_laws"), "contact-drag": (DRAG_PARAMETERS, "_drag"),
           "contact-sizedrag": (SIZEDRAG_PARAMETERS, "_sizedrag"), "contact-vscale": (VSCALE_PARAMETERS, "_vscale"),
+          "contact-vscale-tied": (VSCALE_TIED_PARAMETERS, "_vscale_tied"),
           "contact-measured": (MEASURED_PARAMETERS, "_measured")}
 
 
@@ -295,7 +301,7 @@ def _drawn(draws) -> dict:
 
 def predict_release_stops(rels, draws, n_each, seed0):
     P = _drawn(draws)
-    pool = _Pool(rels, {k: P[k] for k in P if k.split(".")[1] in rels[0].scenario["materials"]})
+    pool = _Pool(rels, {k: P[k] for k in P if any(m in rels[0].scenario["materials"] for m in parameter_materials(k))})
     per = [[] for _ in rels]
     for t, values in enumerate(draws):
         vals = {k: v for k, v in values.items() if k in pool.bounds}
@@ -326,7 +332,7 @@ ODOT_CUT_HEIGHT_M = 18.3                                  # 60 ft
 #: The models whose laws are the shipped ones (those the scenario's ``preset_basis = "data"`` materials carry; the
 #: fitted fields are set over them): the ODOT row is predicted for them, from the shipped priors or the model's own
 #: fit on all three data sets.
-ODOT_MODELS = ("contact", "contact-measured", "contact-vscale")
+ODOT_MODELS = ("contact", "contact-measured", "contact-vscale", "contact-vscale-tied")
 
 
 def ritchie_row(posterior, model, n_draws, seed):
@@ -337,11 +343,12 @@ def ritchie_row(posterior, model, n_draws, seed):
     from riskrf.hazard.catchment import catchment_retention, modified_ritchie_width_m
     from simulation.calibration import apply_parameters
     data, _ = scenario_dict(ODOT_CUT)
-    cols = [k for k in posterior.columns if k.split(".")[1] in ODOT_MATERIALS]
+    cols = [k for k in posterior.columns if any(m in ODOT_MATERIALS for m in parameter_materials(k))]
     draws = posterior[cols].sample(n_draws, random_state=seed)
     widths = []
     for t, d in enumerate(draws.to_dict("records")):
-        vals = {".".join(["materials", ODOT_MATERIALS[k.split(".")[1]], *k.split(".")[2:]]): v for k, v in d.items()}
+        vals = {material_parameter(k, ODOT_MATERIALS[m]): v for k, v in d.items() for m in parameter_materials(k)
+                if m in ODOT_MATERIALS}
         sc = simulation.scenario_from_dict(apply_parameters(data, vals), str(ODOT_CUT))
         widths.append(catchment_retention(sc, n=600, seed=70_000 + t).widths[90.0])
     w = np.asarray(widths)
