@@ -176,6 +176,47 @@ def test_bad_parameters_are_named():
         calibrate_pooled(rel, {"materials.ground.tangential.mean": (0.2, 2.0)})
 
 
+def test_a_parameter_shared_by_two_materials(tmp_path):
+    """'materials.A+B.FIELD' puts one value into the same field of every listed material a scenario defines: profile
+    A's material is 'ground', profile B's 'meadow' (its file value 45 deg, the truth 30 deg); fitted as one shared
+    parameter, the posterior covers the truth, which it cannot if B's releases kept their file value."""
+    from simulation.calibration import set_parameter
+    from simulation.pooled import _Pool
+    scen = {"A": _profile("A"), "B": _profile("B")}
+    scen["B"]["materials"] = {"meadow": {**scen["B"]["materials"]["ground"], "ground_friction_angle_deg": 45.0}}
+    scen["B"]["profile"]["material"] = "meadow"
+    rels = []
+    for i in range(20):
+        k = "AB"[i % 2]
+        m = 300.0 + 100.0 * i
+        truth = simulation.scenario_from_dict({**scen[k], "materials": {
+            mat: {**spec, "ground_friction_angle_deg": 30.0} for mat, spec in scen[k]["materials"].items()}})
+        res = simulation.run(truth, seed=[7, i], masses_kg=[m], record_paths=0)
+        rels.append(Release(name=f"r{i}", scenario=scen[k], x_stop_m=res.per_block["x"].copy(), mass_kg=m))
+    name = "materials.ground+meadow.ground_friction_angle_deg"
+    pool = _Pool(rels, {name: (15.0, 45.0)})
+    for sc in pool.scenarios({name: 22.0}).values():
+        assert [m.ground_friction_deg for m in sc.materials] == [22.0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", simulation.PooledCalibrationWarning)
+        cal = calibrate_pooled(rels, {name: (15.0, 45.0)}, seed=3, **FAST)
+    q05, q95 = cal.posterior[name].quantile([0.05, 0.95])
+    assert q05 < 30.0 < q95 and q95 - q05 < 10.0
+    # the posterior applies to a scenario with either material, and is refused by one with neither
+    path = cal.write(tmp_path / "posterior.csv")
+    assert list(read_posterior(path, scen["B"]).columns) == [name]
+    other = _profile("A")
+    other["materials"] = {"rock": other["materials"]["ground"]}
+    other["profile"]["material"] = "rock"
+    with pytest.raises(ValueError, match=r"names material 'ground' or 'meadow', which <dict> does not define"):
+        read_posterior(path, other)
+    data = {"materials": {"ground": {"ground_friction_angle_deg": 30.0}}}
+    set_parameter(data, name, 25.0)
+    assert data == {"materials": {"ground": {"ground_friction_angle_deg": 25.0}}}
+    with pytest.raises(ValueError, match=r"defines none of the materials \['talus', 'scree'\]"):
+        set_parameter(data, "materials.talus+scree.roughness_m", 0.2)
+
+
 # ---- a real data set: the two halves of the Authume releases --------------------------------------------------------
 PARAMETERS = {"materials.vegetated_slope.ground_friction_angle_deg": (3.0, 45.0),
               "materials.vegetated_slope.tangential.mean": (0.2, 1.0),
