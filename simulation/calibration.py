@@ -149,6 +149,32 @@ def material_parameter(name: str, material: str) -> str:
     return f"materials.{material}.{field}"
 
 
+def check_material_names(names) -> None:
+    """Refuse a shared parameter with an empty material (``materials.a+.x``) and two parameters that set the same
+    field of the same material (``materials.a+b.x`` beside ``materials.a.x``: whichever was set last would win).
+
+    Parameters
+    ----------
+    names : iterable of str
+        Dotted parameter names.
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter(s).
+    """
+    seen = {}
+    for name in names:
+        mats = parameter_materials(name)
+        if mats and not all(mats):
+            raise ValueError(f"parameter {name!r}: an empty material name in {str(name).split('.')[1]!r} (use "
+                             "'materials.A+B.FIELD')")
+        for m in mats:
+            key = material_parameter(name, m)
+            if seen.setdefault(key, name) != name:
+                raise ValueError(f"parameters {seen[key]!r} and {name!r} both set {key!r}")
+
+
 def set_parameter(data: dict, name: str, value: float, *, source: str | None = None) -> None:
     """Set the value at dotted path ``name`` in a scenario dictionary (in place).
 
@@ -178,7 +204,8 @@ def set_parameter(data: dict, name: str, value: float, *, source: str | None = N
     shared = parameter_materials(name)
     if len(shared) > 1:
         defined = data.get("materials") or {}
-        if any(not m for m in shared) or not any(m in defined for m in shared):
+        check_material_names([name])
+        if not any(m in defined for m in shared):
             raise ValueError(f"{where}parameter {name!r}: the scenario defines none of the materials "
                              f"{list(shared)} (materials: {sorted(defined)})")
         for m in shared:
@@ -254,6 +281,12 @@ def _check_parameters(data: dict, parameters, source: str) -> dict:
             raise ValueError(f"parameter {name!r}: bounds reversed or empty: low = {lo:g} must be below "
                              f"high = {hi:g}")
         bounds[name] = (lo, hi)
+    check_material_names(bounds)
+    for name in bounds:                  # one scenario: every material a shared name lists must be in it
+        missing = [m for m in parameter_materials(name) if m not in (data.get("materials") or {})]
+        if len(parameter_materials(name)) > 1 and missing:
+            raise ValueError(f"{source}: parameter {name!r}: the scenario defines no material {missing[0]!r}"
+                             f"{_did_you_mean(missing[0], list(data.get('materials') or {}))}")
     # every path must exist and every bound give a valid scenario
     for name, (lo, hi) in bounds.items():
         for v in (lo, hi):

@@ -162,11 +162,14 @@ def site_spread_half_width(path: str) -> float:
     float
         Half-width [the field's unit].
     """
+    from .calibration import parameter_materials
     parts = str(path).split(".", 2)
     if len(parts) != 3 or parts[0] != "materials":
         raise ValueError(f"site spread: field {path!r} is not a dotted preset field 'materials.<preset>.<field>'")
-    _, preset, field = parts
-    return ASSUMED_HALF_WIDTHS.get(preset, {}).get(field, 0.15 if field == "tangential.mean" else 0.0)
+    field = parts[2]
+    # a field shared by several presets (materials.a+b.FIELD) takes the widest of their half-widths
+    return max(ASSUMED_HALF_WIDTHS.get(preset, {}).get(field, 0.15 if field == "tangential.mean" else 0.0)
+               for preset in parameter_materials(path))
 
 
 def with_site_spread(sample: pd.DataFrame, bounds: dict, seed=1) -> pd.DataFrame:

@@ -63,7 +63,7 @@ import pandas as pd
 from scipy import stats
 
 from ._display import Displayed, short_repr
-from .calibration import material_parameter, parameter_materials
+from .calibration import check_material_names, material_parameter, parameter_materials
 from .scenario import Distribution, Material, Scenario, ScenarioError, scenario_from_dict
 from .surrogate import _in_unit_box, _t_draw, _t_logpdf, gp_posterior_sample, replicate_noise
 from .units import DENSITY_RANGE_KG_M3
@@ -269,12 +269,16 @@ class _ConstraintPool:
     def __init__(self, constraints, parameters: dict):
         self.constraints = constraints
         self.pools = []
+        self.materials = set()          # every material the constraints' scenarios define
         for c in constraints:
             from .calibration import scenario_dict
             data, _ = scenario_dict(c.scenario)
             mats = data.get("materials", {})
+            self.materials.update(mats)
             own = {k: b for k, b in parameters.items() if any(m in mats for m in parameter_materials(k))}
-            self.pools.append((_Pool([c._release()], own) if own else None, own))
+            # a shared parameter needs only one of its materials here (calibrate_pooled checks all of them)
+            listed = {m for k in own for m in parameter_materials(k)}
+            self.pools.append((_Pool([c._release()], own, extra_materials=listed) if own else None, own))
 
     def simulate(self, values: dict, seed) -> list:
         """(x, z) of the simulated stops [m] per constraint."""
@@ -468,6 +472,7 @@ class _Pool:
             self.rel_key.append(key)
         self._check_geometry()
         self.names = list(parameters)
+        check_material_names(self.names)
         self.bounds = {}
         for name, b in parameters.items():
             mats = parameter_materials(name)
@@ -475,11 +480,12 @@ class _Pool:
                 raise ValueError(f"parameter {name!r}: a pooled calibration fits material fields shared by the "
                                  "releases: 'materials.NAME.FIELD' (e.g. 'materials.talus.ground_friction_angle_deg'; "
                                  "'materials.A+B.FIELD' shares one value between materials A and B)")
-            if not any(m in extra_materials or any(m in data.get("materials", {}) for data, _, _ in
-                                                   self.bases.values()) for m in mats):
-                files = sorted({src for _, src, _ in self.bases.values()})
-                raise ValueError(f"parameter {name!r}: no release's scenario defines material "
-                                 f"{' or '.join(repr(m) for m in mats)} (scenarios: {files})")
+            for m in mats:                   # every listed material, so a misspelt one is not dropped
+                if m not in extra_materials and not any(m in data.get("materials", {})
+                                                        for data, _, _ in self.bases.values()):
+                    files = sorted({src for _, src, _ in self.bases.values()})
+                    raise ValueError(f"parameter {name!r}: no release's scenario defines material {m!r} "
+                                     f"(scenarios: {files})")
             try:
                 lo, hi = (float(v) for v in b)
             except (TypeError, ValueError):
@@ -956,7 +962,7 @@ def read_posterior(path, scenario=None) -> pd.DataFrame:
         for col in df.columns:
             parts = col.split(".")
             named = parameter_materials(col)
-            if not named or not any(m in mats for m in named):
+            if not named or not all(named) or not any(m in mats for m in named):
                 raise ValueError(f"{path}: field {col!r} names material "
                                  f"{' or '.join(repr(m) for m in named) if named else repr(col)}, "
                                  f"which {src} does not define (materials: {sorted(mats)})")
@@ -1016,8 +1022,7 @@ def calibrate_pooled(releases, parameters: dict, *, n_per_release: int = 200, se
     _check_pooled_arguments(parameters, n_per_release, iterations, n_posterior, n_predictive, obs_error_m)
     constraints = _check_constraints(constraints)
     cpool = _ConstraintPool(constraints, parameters)
-    pool = _Pool(releases, parameters,
-                 extra_materials={m for pl in cpool.pools for k in pl[1] for m in parameter_materials(k)})
+    pool = _Pool(releases, parameters, extra_materials=cpool.materials)
     names = pool.names
     lo = np.array([pool.bounds[k][0] for k in names])
     hi = np.array([pool.bounds[k][1] for k in names])

@@ -215,6 +215,26 @@ def test_a_parameter_shared_by_two_materials(tmp_path):
     assert data == {"materials": {"ground": {"ground_friction_angle_deg": 25.0}}}
     with pytest.raises(ValueError, match=r"defines none of the materials \['talus', 'scree'\]"):
         set_parameter(data, "materials.talus+scree.roughness_m", 0.2)
+    # refused by name: a misspelt member (it would be dropped), a field set twice, an empty member
+    with pytest.raises(ValueError, match=r"'materials.ground\+medow.ground_friction_angle_deg': no release's scenario "
+                                         r"defines material 'medow'"):
+        _Pool(rels, {"materials.ground+medow.ground_friction_angle_deg": (15.0, 45.0)})
+    with pytest.raises(ValueError, match=r"parameters 'materials.ground\+meadow.ground_friction_angle_deg' and "
+                                         r"'materials.ground.ground_friction_angle_deg' both set"):
+        _Pool(rels, {name: (15.0, 45.0), "materials.ground.ground_friction_angle_deg": (15.0, 45.0)})
+    with pytest.raises(ValueError, match=r"an empty material name in 'ground\+'"):
+        _Pool(rels, {"materials.ground+.ground_friction_angle_deg": (15.0, 45.0)})
+    with pytest.raises(ValueError, match=r"parameter 'materials.ground\+meadow.ground_friction_angle_deg': the "
+                                         r"scenario defines no material 'meadow'"):
+        simulation.calibrate(scen["A"], pd.DataFrame({"x_stop_m": [60.0, 70.0]}), {name: (15.0, 45.0)}, n=50)
+    # a reach constraint on a scenario with one of the materials takes the shared parameter too
+    from simulation.pooled import ReachConstraint, _ConstraintPool
+    c = ReachConstraint(name="reach", scenario=scen["B"], apex_x_m=0.0, apex_z_m=70.0, shadow_angle_deg=30.0,
+                        sd_deg=2.0)
+    assert list(_ConstraintPool([c], {name: (15.0, 45.0)}).pools[0][1]) == [name]
+    # the assumed site-to-site spread of a shared field: the widest of its presets' (talus 4 deg, soil 6 deg)
+    from simulation.material_uncertainty import site_spread_half_width
+    assert site_spread_half_width("materials.talus+soil.ground_friction_angle_deg") == 6.0
 
 
 # ---- a real data set: the two halves of the Authume releases --------------------------------------------------------

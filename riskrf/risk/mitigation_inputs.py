@@ -530,10 +530,10 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
                 raise MitigationError(f"{w} = {v!r}: needs at least 2 bootstrap rows; got {len(df)}")
             for col in df.columns:
                 parts = col.split(".", 2)
-                if len(parts) != 3 or parts[0] != "materials" or parts[2] not in MATERIAL_FIELDS:
+                if len(parts) != 3 or parts[0] != "materials" or parts[2] not in MATERIAL_FIELDS or "+" in parts[1]:
                     raise MitigationError(f"{w} = {v!r}: column {col!r} is not a material parameter "
-                                          "(materials.NAME.FIELD with FIELD one of "
-                                          f"{', '.join(MATERIAL_FIELDS)})")
+                                          "(materials.NAME.FIELD with one material NAME, not a shared 'A+B', and "
+                                          f"FIELD one of {', '.join(MATERIAL_FIELDS)})")
                 if not np.all(np.isfinite(pd.to_numeric(df[col], errors="coerce"))):
                     raise MitigationError(f"{w} = {v!r}: column {col!r} has values that are not finite numbers")
             vals["calibration"] = df.astype(float)
