@@ -1520,7 +1520,7 @@ def main(argv=None) -> int:
             check_common(args)               # --seed and -n, before anything is read
             return args.func(args)
     except KeyboardInterrupt:
-        return _interrupted(args, terminated)
+        return _end_if_terminated(_interrupted(args, terminated), terminated)
     except (ValueError, TypeError, FileNotFoundError, KeyError) as exc:   # includes SiteError, ScenarioError
         if args.debug:
             traceback.print_exc()
@@ -1528,7 +1528,7 @@ def main(argv=None) -> int:
         return 2
     except Exception as exc:     # OSError, RecursionError, ...: one line, the traceback only with --debug
         if _caused_by_interrupt(exc):       # Ctrl-C inside compiled code surfaces as SystemError
-            return _interrupted(args, terminated)
+            return _end_if_terminated(_interrupted(args, terminated), terminated)
         if args.debug:
             traceback.print_exc()
         if isinstance(exc, OSError):           # a file system refusal names its file itself
@@ -1596,6 +1596,26 @@ def _on_main_thread() -> bool:
     """True in the main thread (the only one where a signal handler can be installed)."""
     import threading
     return threading.current_thread() is threading.main_thread()
+
+
+def _end_if_terminated(status: int, terminated) -> int:
+    """After SIGTERM, once the temporary outputs are removed (the context managers have unwound), end the process
+    at once with ``status`` (143), as SIGTERM's default action does: the exit functions run (child processes are
+    stopped, logs flushed) but not the interpreter's finalization, during which a worker thread still inside
+    compiled code could abort the process (exit -6 instead of 143, seen once in CI).  After Ctrl-C, or when no
+    signal arrived, ``status`` is returned to the caller."""
+    if not terminated:
+        return status
+    import atexit
+    try:
+        atexit._run_exitfuncs()
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        os._exit(status)
 
 
 def _interrupted(args, terminated=()) -> int:
