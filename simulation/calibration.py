@@ -282,11 +282,13 @@ def _check_parameters(data: dict, parameters, source: str) -> dict:
                              f"high = {hi:g}")
         bounds[name] = (lo, hi)
     check_material_names(bounds)
+    defined = list(data.get("materials") or {})
     for name in bounds:                  # one scenario: every material a shared name lists must be in it
-        missing = [m for m in parameter_materials(name) if m not in (data.get("materials") or {})]
-        if len(parameter_materials(name)) > 1 and missing:
+        mats = parameter_materials(name)
+        missing = [m for m in mats if m not in defined]
+        if len(mats) > 1 and missing:
             raise ValueError(f"{source}: parameter {name!r}: the scenario defines no material {missing[0]!r}"
-                             f"{_did_you_mean(missing[0], list(data.get('materials') or {}))}")
+                             f"{_did_you_mean(missing[0], defined)}")
     # every path must exist and every bound give a valid scenario
     for name, (lo, hi) in bounds.items():
         for v in (lo, hi):

@@ -78,6 +78,12 @@ ASSUMED_HALF_WIDTHS: dict[str, dict[str, float]] = {
     "concrete": {"ground_friction_angle_deg": 4.0, "tangential.friction_angle_deg": 5.0},
 }
 
+#: Low end of the ASSUMED range of the rock's Pfeiffer & Bowen scale vt0 [m/s] (the high end is the table's value,
+#: CRSP's 76.2 m/s in the data-derived presets): in-sample, the vt0 under which Authume P1's blocks stop before the
+#: end of the bench below its first wall as often as observed (docs/validation/presets_vt0.csv: 57 % at 30 m/s,
+#: observed 59 %).
+ROCK_VT0_LOW_MS = 30.0
+
 #: Words stated beside each assumed range.
 ASSUMED_BASIS = {
     "ground_friction_angle_deg": "ASSUMPTION: +-{w:g} deg about the value (talus angles of repose 30-38 deg, "
@@ -87,19 +93,12 @@ ASSUMED_BASIS = {
     "tangential.mean": "ASSUMPTION: +-{w:g} about the mean e_T (Wyllie 2014: 0.3-0.8 impact to impact)",
     "tangential.friction_angle_deg": "ASSUMPTION: +-{w:g} deg about the value (basic friction angle of rock "
                                      "25-35 deg, Barton & Choubey 1977)",
+    "tangential.normal_scale_ms": "ASSUMPTION: the rock's Pfeiffer & Bowen scale from {low:g} m/s to the value "
+                                  "({high:g} m/s): how much speed a block keeps when it lands on a rock bench; "
+                                  "Authume P1's bench landings want about 30 m/s, the quarry's other profile 68 m/s, "
+                                  "CRSP 76.2 m/s (docs/validation/trajectories.md, section 5); earth benches and "
+                                  "catchments (the soil) are not varied",
 }
-
-
-#: Low end of the ASSUMED range of the rock's Pfeiffer & Bowen scale vt0 [m/s] (the high end is the table's value,
-#: CRSP's 76.2 m/s in the data-derived presets): in-sample, the vt0 under which Authume P1's blocks stop before the
-#: end of the bench below its first wall as often as observed (docs/validation/presets_vt0.csv: 57 % at 30 m/s,
-#: observed 59 %).
-ROCK_VT0_LOW_MS = 30.0
-ASSUMED_BASIS["tangential.normal_scale_ms"] = (
-    "ASSUMPTION: the rock's Pfeiffer & Bowen scale from {low:g} m/s to the value ({high:g} m/s): how much speed a "
-    "block keeps when it lands on a rock bench; Authume P1's bench landings want about 30 m/s, the quarry's other "
-    "profile 68 m/s, CRSP 76.2 m/s (docs/validation/trajectories.md, section 5); earth benches and catchments (the "
-    "soil) are not varied")
 
 
 def _get(table: dict, field: str):

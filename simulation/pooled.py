@@ -63,7 +63,7 @@ import pandas as pd
 from scipy import stats
 
 from ._display import Displayed, short_repr
-from .calibration import check_material_names, material_parameter, parameter_materials
+from .calibration import check_material_names, material_parameter, parameter_materials, scenario_dict, set_parameter
 from .scenario import Distribution, Material, Scenario, ScenarioError, scenario_from_dict
 from .surrogate import _in_unit_box, _t_draw, _t_logpdf, gp_posterior_sample, replicate_noise
 from .units import DENSITY_RANGE_KG_M3
@@ -271,7 +271,6 @@ class _ConstraintPool:
         self.pools = []
         self.materials = set()          # every material the constraints' scenarios define
         for c in constraints:
-            from .calibration import scenario_dict
             data, _ = scenario_dict(c.scenario)
             mats = data.get("materials", {})
             self.materials.update(mats)
@@ -288,7 +287,6 @@ class _ConstraintPool:
             if pool is not None:
                 sc = pool.scenarios({k: v for k, v in values.items() if k in own})[pool.rel_key[0]]
             else:
-                from .calibration import scenario_dict
                 data, src = scenario_dict(c.scenario)
                 sc = scenario_from_dict(data, source=src)
             res = run(sc, n=int(c.n_blocks), seed=[int(seed), 7919, g], record_paths=0)
@@ -459,7 +457,6 @@ class _Pool:
     """Every release's scenario parsed once; new material values swapped in per parameter set."""
 
     def __init__(self, releases, parameters: dict, extra_materials=()):
-        from .calibration import scenario_dict
         self.releases = releases
         self.bases = {}          # key -> (data, source, Scenario)
         self.rel_key = []
@@ -476,7 +473,7 @@ class _Pool:
         self.bounds = {}
         for name, b in parameters.items():
             mats = parameter_materials(name)
-            if not mats or not all(mats):
+            if not mats:
                 raise ValueError(f"parameter {name!r}: a pooled calibration fits material fields shared by the "
                                  "releases: 'materials.NAME.FIELD' (e.g. 'materials.talus.ground_friction_angle_deg'; "
                                  "'materials.A+B.FIELD' shares one value between materials A and B)")
@@ -553,7 +550,6 @@ class _Pool:
 
     def scenarios(self, values: dict) -> dict:
         """Scenario per base key with the parameter values put into its materials."""
-        from .calibration import set_parameter
         out = {}
         for key, (data, src, sc) in self.bases.items():
             mats = list(sc.materials)
@@ -956,7 +952,6 @@ def read_posterior(path, scenario=None) -> pd.DataFrame:
         if not pd.api.types.is_numeric_dtype(df[col]):
             raise ValueError(f"{path}: column {col!r} is not numeric")
     if scenario is not None:
-        from .calibration import scenario_dict
         data, src = scenario_dict(scenario)
         mats = data.get("materials", {})
         for col in df.columns:
@@ -975,7 +970,6 @@ def read_posterior(path, scenario=None) -> pd.DataFrame:
 
 
 def _set_in(spec, keys, value):
-    from .calibration import set_parameter
     holder = {"materials": {"m": copy.deepcopy(spec)}}
     set_parameter(holder, ".".join(["materials", "m"] + list(keys)), value)
     return holder["materials"]["m"]

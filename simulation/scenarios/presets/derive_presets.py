@@ -438,10 +438,7 @@ def vt0_sensitivity(n_draws: int, n_each: int, seed: int) -> pd.DataFrame:
     ``n_draws`` joint draws of the shipped posterior (the same for every row), ``n_each`` blocks per Authume
     release and draw; Evans & Hungr one 200-block run per draw; the ODOT cut one 600-block run per draw."""
     from simulation.materials import preset_posterior
-    from simulation.pooled import _ConstraintPool
-    from riskrf.hazard.catchment import modified_ritchie_width_m
     draws = preset_posterior().sample(n_draws, random_state=seed).to_dict("records")
-    w_mrc = modified_ritchie_width_m(ODOT_CUT_HEIGHT_M)
     shipped = copy.deepcopy(CONTACT_LAWS)
     rows = []
     try:
@@ -468,12 +465,11 @@ def vt0_sensitivity(n_draws: int, n_each: int, seed: int) -> pd.DataFrame:
                 angles = [cp.far_angles(cp.simulate(v, 30_000 + 100 * t))[0] for t, v in enumerate(draws)]
                 row["eh_p99_shadow_angle_deg"] = float(np.median(angles))
                 post = pd.DataFrame(draws)
-                for m in ("bedrock", "soil"):
-                    if m in mats:
-                        post[f"materials.{m}.tangential.normal_scale_ms"] = vt0
+                for m in [m for m in ODOT_MATERIALS if m in mats]:    # the ODOT cut's face and floor take it too
+                    post[f"materials.{m}.tangential.normal_scale_ms"] = vt0
                 r, _ = ritchie_row(post, "", n_draws, seed)
                 row["odot_width_m"] = r["pred_p50"]
-                row["odot_width_error_pct"] = 100.0 * (r["pred_p50"] / w_mrc - 1.0)
+                row["odot_width_error_pct"] = r["median_error_pct"]
                 rows.append(row)
                 print({k: (round(v, 2) if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
     finally:
