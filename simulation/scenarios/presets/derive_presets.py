@@ -539,6 +539,7 @@ def main():
                     help="adaptive rounds of 256 parameter sets after the 1,024-point Sobol design (default 4)")
     args = ap.parse_args()
     datasets = DATASETS + (("odot_ritchie_rule",) if args.with_ritchie else ())
+    out_given = args.out
     if args.out is None:
         args.out = ("presets_loo" + MODELS[args.model][1] + ("_3d" if args.kernel == "3d" else "")
                     + ("_ritchie" if args.with_ritchie else ""))
@@ -551,9 +552,12 @@ def main():
         MODEL["laws"]["soil"]["ground_friction_angle_deg"] = 0.0
     t0 = time.time()
     if args.mode == "vt0":
-        if (args.model, args.kernel, args.with_ritchie, args.out) != ("contact", "2d", False, "presets_loo"):
-            ap.error("vt0 uses the shipped model on the 2-D sections and writes presets_vt0.csv: --model, --kernel, "
-                     "--with-ritchie and --out do not apply")
+        given = {"--model": (args.model, "contact"), "--kernel": (args.kernel, "2d"),
+                 "--with-ritchie": (args.with_ritchie, False), "--out": (out_given, None)}
+        wrong = [f"{k} {v!r}" for k, (v, default) in given.items() if v != default]
+        if wrong:
+            ap.error(f"vt0 uses the shipped model on the 2-D sections and writes presets_vt0.csv: {', '.join(wrong)} "
+                     "does not apply")
         table = vt0_sensitivity(args.draws, args.n_per_release, args.seed)
         table.to_csv(REPO / "docs" / "validation" / "presets_vt0.csv", index=False, float_format="%.4g")
         print(f"total {time.time() - t0:.0f} s")
