@@ -64,6 +64,7 @@ class Precompile:
             self._proc.wait(timeout)
         except subprocess.TimeoutExpired:
             self._proc.kill()
+            self._proc.wait()
             return False
         return self._proc.returncode == 0
 
@@ -136,6 +137,7 @@ def discard_early() -> None:
             _early._proc.wait(5)
         except subprocess.TimeoutExpired:
             _early._proc.kill()
+            _early._proc.wait()          # reaped: no zombie, and poll() tells it has ended
     _early = None
 
 
