@@ -54,6 +54,7 @@ import pandas as pd
 from scipy import optimize, stats
 
 from ._display import Displayed, short_repr
+from .materials import parameter_materials
 from .scenario import Scenario, ScenarioError, scenario_from_dict
 
 #: Fewer observed stops than this give a warning: the calibration is weak.
@@ -108,26 +109,6 @@ def scenario_dict(scenario) -> tuple[dict, str]:
 def _did_you_mean(key, options) -> str:
     close = difflib.get_close_matches(str(key), [str(o) for o in options], n=1)
     return f"; did you mean {close[0]!r}?" if close else f"; available: {', '.join(map(str, options))}"
-
-
-def parameter_materials(name: str) -> tuple:
-    """The materials a dotted parameter ``materials.NAME.FIELD`` sets: ``(NAME,)``, or for a shared parameter
-    ``materials.A+B.FIELD`` (one value put into the same field of several materials) ``(A, B)``; ``()`` for a
-    name that is not a material field.
-
-    Parameters
-    ----------
-    name : str
-        The dotted parameter name.
-
-    Returns
-    -------
-    tuple of str
-    """
-    parts = str(name).split(".")
-    if len(parts) < 3 or parts[0] != "materials":
-        return ()
-    return tuple(parts[1].split("+"))
 
 
 def material_parameter(name: str, material: str) -> str:

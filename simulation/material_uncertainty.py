@@ -161,7 +161,7 @@ def site_spread_half_width(path: str) -> float:
     float
         Half-width [the field's unit].
     """
-    from .calibration import parameter_materials
+    from .materials import parameter_materials
     parts = str(path).split(".", 2)
     if len(parts) != 3 or parts[0] != "materials":
         raise ValueError(f"site spread: field {path!r} is not a dotted preset field 'materials.<preset>.<field>'")

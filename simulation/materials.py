@@ -207,13 +207,35 @@ def preset(name: str, basis: str = "published") -> dict:
     return out
 
 
+def parameter_materials(name: str) -> tuple:
+    """The materials a dotted parameter ``materials.NAME.FIELD`` sets: ``(NAME,)``, or for a shared parameter
+    ``materials.A+B.FIELD`` (one value put into the same field of several materials) ``(A, B)``; ``()`` for a
+    name that is not a material field.
+
+    Parameters
+    ----------
+    name : str
+        The dotted parameter name.
+
+    Returns
+    -------
+    tuple of str
+    """
+    parts = str(name).split(".")
+    if len(parts) < 3 or parts[0] != "materials":
+        return ()
+    return tuple(parts[1].split("+"))
+
+
 def _data_priors() -> dict:
-    """preset -> {field (dotted, inside the material table): posterior summary} from simulation/preset_priors.py."""
+    """preset -> {field (dotted, inside the material table): posterior summary} from simulation/preset_priors.py;
+    a parameter shared by several presets (``materials.A+B.FIELD``) is a field of each of them."""
     from . import preset_priors
     out: dict = {}
     for path, stat in preset_priors.SUMMARY.items():
-        _, mat, *field = path.split(".")
-        out.setdefault(mat, {})[".".join(field)] = stat
+        field = path.split(".", 2)[2]
+        for mat in parameter_materials(path):
+            out.setdefault(mat, {})[field] = stat
     return out
 
 
@@ -294,6 +316,7 @@ def preset_posterior(presets=None, *, new_site: bool = False, seed=1):
     pandas.DataFrame
     """
     import pandas as pd
+
     from . import preset_priors
     df = pd.DataFrame(preset_priors.SAMPLE)
     if presets is not None:
@@ -303,7 +326,7 @@ def preset_posterior(presets=None, *, new_site: bool = False, seed=1):
             if k not in PRESETS:
                 raise PresetError(_unknown(n, "preset", "<preset_posterior()>"))
             keys.append(k)
-        df = df[[c for c in df.columns if c.split(".")[1] in keys]]
+        df = df[[c for c in df.columns if set(parameter_materials(c)) & set(keys)]]
     if new_site:
         from .material_uncertainty import with_site_spread
         df = with_site_spread(df, {k: v["bounds"] for k, v in preset_priors.SUMMARY.items()}, seed)

@@ -191,3 +191,22 @@ def test_a_scenario_file_can_start_a_material_from_the_data_derived_preset():
     with pytest.raises(ScenarioError, match=r"materials.m.preset_basis = 'data' needs a preset beside it"):
         simulation.scenario_from_dict({**base, "materials": {"m": {"preset_basis": "data", "roughness_m": 0.1}}},
                                       "x.toml")
+
+
+def test_a_parameter_shared_by_two_presets_is_a_field_of_each(monkeypatch):
+    """A generated preset_priors.py may hold a parameter shared by several presets (``materials.A+B.FIELD``,
+    derive_presets.py --model contact-vscale-tied): the data basis, the prior table and the posterior's
+    preset filter read it for each of them."""
+    shared = "materials.bedrock+talus.ground_friction_angle_deg"
+    summary = {k: v for k, v in preset_priors.SUMMARY.items() if k.split(".", 2)[2] != "ground_friction_angle_deg"}
+    summary[shared] = {"mean": 21.0, "sd": 2.0, "median": 20.5, "q05": 17.0, "q95": 24.0, "bounds": (3.0, 50.0)}
+    sample = {k: preset_priors.SAMPLE[k] for k in summary if k != shared} | {shared: [20.5] * 200}
+    monkeypatch.setattr(preset_priors, "SUMMARY", summary)
+    monkeypatch.setattr(preset_priors, "SAMPLE", sample)
+    for name in ("bedrock", "talus"):
+        assert preset(name, basis="data")["ground_friction_angle_deg"] == 20.5
+        row = preset_prior(name).loc["ground_friction_angle_deg"]
+        assert row["basis"] == "data" and row["median"] == 20.5
+    assert preset("soil", basis="data")["ground_friction_angle_deg"] == PRESETS["soil"]["ground_friction_angle_deg"]
+    assert shared in preset_posterior(["talus"]).columns and shared in preset_posterior(["bedrock"]).columns
+    assert shared not in preset_posterior(["soil"]).columns
