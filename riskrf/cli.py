@@ -1504,31 +1504,35 @@ def main(argv=None) -> int:
     # Figures are written to files: a non-interactive backend, unless the user chose one.
     os.environ.setdefault("MPLBACKEND", "Agg")
     # Library code logs its stages (logger "riskrf"); the command line shows them as plain lines.
-    handler = logging.StreamHandler(sys.stdout)
-    handler.setFormatter(logging.Formatter("%(message)s"))
     logger = logging.getLogger("riskrf")
     if not logger.handlers:
+        handler = _StdoutHandler()
+        handler.setFormatter(logging.Formatter("%(message)s"))
         logger.addHandler(handler)
     logger.setLevel(logging.INFO)
     parser = build_parser()
     args = parser.parse_args(argv)
-    terminated: list = []
+    signals: list = []
     try:
-        with warnings.catch_warnings(), _readable_numbers(), _terminate_as_interrupt() as terminated:
+        with warnings.catch_warnings(), _readable_numbers(), _terminate_as_interrupt() as signals:
             warnings.simplefilter("ignore")  # every warning is reported in the printed summary instead
             from .app.preflight import check_common
             check_common(args)               # --seed and -n, before anything is read
             return args.func(args)
     except KeyboardInterrupt:
-        return _end_if_terminated(_interrupted(args, terminated), terminated)
+        return _end_if_terminated(_interrupted(args, signals), signals)
     except (ValueError, TypeError, FileNotFoundError, KeyError) as exc:   # includes SiteError, ScenarioError
+        if signals:                          # a signal arrived: whatever failed after it, the run was interrupted
+            return _end_if_terminated(_interrupted(args, signals), signals)
         if args.debug:
             traceback.print_exc()
         print(f"riskrf {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except Exception as exc:     # OSError, RecursionError, ...: one line, the traceback only with --debug
-        if _caused_by_interrupt(exc):       # Ctrl-C inside compiled code surfaces as SystemError
-            return _end_if_terminated(_interrupted(args, terminated), terminated)
+        # Ctrl-C or SIGTERM inside compiled code surfaces as SystemError (numpy, numba's kernels) or RuntimeError
+        # (numba's compiler): after a signal, any failure is the interrupt's
+        if signals or _caused_by_interrupt(exc):
+            return _end_if_terminated(_interrupted(args, signals), signals)
         if args.debug:
             traceback.print_exc()
         if isinstance(exc, OSError):           # a file system refusal names its file itself
@@ -1571,25 +1575,49 @@ def _caused_by_interrupt(exc) -> bool:
     return False
 
 
+class _StdoutHandler(logging.StreamHandler):
+    """A logging handler that writes to ``sys.stdout`` as it is when a record is emitted, not as it was when the
+    handler was made: a caller that replaces ``sys.stdout`` between calls of :func:`main` (a notebook, a test's
+    capture) gets the log lines, and a stream closed since is never written to."""
+
+    @property
+    def stream(self):
+        return sys.stdout
+
+    @stream.setter
+    def stream(self, value):
+        pass
+
+
 @contextlib.contextmanager
 def _terminate_as_interrupt():
     """SIGTERM (what ``timeout``, batch schedulers and CI send) handled like Ctrl-C: it raises KeyboardInterrupt
     in the main thread, so the temporary outputs are removed and the cluster is shut down on the way out.
-    Yields a list that holds the signal number once one arrived; the previous handler is restored after."""
+
+    Yields a list that holds the number of each SIGTERM or SIGINT (Ctrl-C) that arrived, so that an interrupt
+    which compiled code turned into another exception (numba's compiler raises RuntimeError when Ctrl-C stops
+    a compilation) is still reported as one.  SIGINT keeps Python's own action (KeyboardInterrupt) and is
+    recorded only where that action is installed (not where it is ignored, as under ``nohup``).  The previous
+    handlers are restored after."""
     import signal
     got: list = []
+    previous: dict = {}
     if _on_main_thread():
-        def handler(signum, frame):
+        def on_term(signum, frame):
             got.append(signum)
             raise KeyboardInterrupt
-        previous = signal.signal(signal.SIGTERM, handler)
-    else:
-        previous = None
+
+        def on_int(signum, frame):
+            got.append(signum)
+            signal.default_int_handler(signum, frame)
+        previous[signal.SIGTERM] = signal.signal(signal.SIGTERM, on_term)
+        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+            previous[signal.SIGINT] = signal.signal(signal.SIGINT, on_int)
     try:
         yield got
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def _on_main_thread() -> bool:
@@ -1598,13 +1626,13 @@ def _on_main_thread() -> bool:
     return threading.current_thread() is threading.main_thread()
 
 
-def _end_if_terminated(status: int, terminated) -> int:
-    """After SIGTERM, once the temporary outputs are removed (the context managers have unwound), end the process
+def _end_if_terminated(status: int, signals) -> int:
+    """After SIGTERM (in ``signals``, the signal numbers that arrived), once the temporary outputs are removed (the context managers have unwound), end the process
     at once with ``status`` (143), as SIGTERM's default action does: the exit functions run (child processes are
     stopped, logs flushed) but not the interpreter's finalization, during which a worker thread still inside
     compiled code could abort the process (exit -6 instead of 143, seen once in CI).  After Ctrl-C, or when no
     signal arrived, ``status`` is returned to the caller."""
-    if not terminated:
+    if not _terminated(signals):
         return status
     import atexit
     try:
@@ -1618,7 +1646,14 @@ def _end_if_terminated(status: int, terminated) -> int:
         os._exit(status)
 
 
-def _interrupted(args, terminated=()) -> int:
+def _terminated(signals) -> bool:
+    """True when SIGTERM is among ``signals`` (the signal numbers that arrived)."""
+    import signal
+    return signal.SIGTERM in signals
+
+
+def _interrupted(args, signals=()) -> int:
+    terminated = _terminated(signals)
     why = "terminated (SIGTERM)" if terminated else "interrupted"
     print(f"riskrf {args.command}: {why}; nothing was written (outputs appear only when complete)",
           file=sys.stderr)

@@ -6,6 +6,7 @@ that the inputs are byte-identical afterwards.
 """
 from __future__ import annotations
 
+import os
 import shutil
 import signal
 import subprocess
@@ -160,6 +161,52 @@ def test_sigterm_cleans_up_like_ctrl_c(tmp_path):
     assert stderr.strip().splitlines()[-1] == ("riskrf demo: terminated (SIGTERM); nothing was written (outputs "
                                                "appear only when complete)")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("how", ["SIGTERM to riskrf", "Ctrl-C at the terminal"])
+def test_a_background_child_leaves_the_signal_to_riskrf(tmp_path, how):
+    """A background child forked during a run (figures, the rate model) inherits riskrf's SIGTERM handler; it
+    must not answer the signal itself: riskrf prints its one line and stops the child, which ends silently (no
+    'Process ForkProcess-1: Traceback ... KeyboardInterrupt' after riskrf's line).  Ctrl-C at a terminal
+    reaches the whole process group, the child included."""
+    started = tmp_path / "started"
+    code = textwrap.dedent(f"""
+        import pathlib, sys, time
+        from riskrf.app.background import InBackground
+        from riskrf.cli import _terminate_as_interrupt
+
+        def work():
+            pathlib.Path({str(started)!r}).write_text("")
+            time.sleep(60)
+
+        try:
+            with _terminate_as_interrupt():
+                child = InBackground(work)
+                assert child.proc is not None, "no child was forked"
+                time.sleep(60)
+        except KeyboardInterrupt:
+            print("riskrf: stopped", file=sys.stderr)
+            sys.exit(143)
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            text=True, cwd=tmp_path, start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        deadline = time.monotonic() + 120
+        while not started.exists():
+            assert proc.poll() is None, proc.stderr.read()
+            assert time.monotonic() < deadline, "the child never started"
+            time.sleep(0.05)
+        if how == "SIGTERM to riskrf":
+            proc.send_signal(signal.SIGTERM)
+        else:
+            os.killpg(proc.pid, signal.SIGINT)
+        _, stderr = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 143, stderr
+    assert stderr.strip().splitlines() == ["riskrf: stopped"], stderr
 
 
 # ------------------------------------------------------------------ 2. numbers read as the user meant
@@ -484,6 +531,33 @@ def test_a_failure_inside_the_computation_is_an_internal_error_naming_stage_and_
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize("signum,status,line", [
+    (signal.SIGINT, 130, "riskrf fit: interrupted; nothing was written (outputs appear only when complete)"),
+    (signal.SIGTERM, 143, "riskrf fit: terminated (SIGTERM); nothing was written (outputs appear only when "
+                          "complete)")])
+def test_an_interrupt_that_compiled_code_turned_into_another_error_is_still_an_interrupt(
+        tmp_path, capsys, monkeypatch, signum, status, line):
+    """Ctrl-C during a numba compilation surfaces as ``RuntimeError: no compiled object yet for <Library ...>``
+    (the compiler catches the KeyboardInterrupt): reported as the interrupt it is, not as an internal error."""
+    import riskrf.cli
+    import riskrf.frequency.study
+
+    def compiling(*a, **k):
+        stopped = False
+        try:
+            signal.raise_signal(signum)       # the handler runs before raise_signal returns
+        except KeyboardInterrupt:
+            stopped = True                    # swallowed; the compiler fails later, outside this handler
+        assert stopped, "the signal did not interrupt"
+        raise RuntimeError("no compiled object yet for <Library 'stronge_body'>")
+    monkeypatch.setattr(riskrf.frequency.study, "analyse_inventory", compiling)
+    ended = []
+    monkeypatch.setattr(riskrf.cli, "_end_if_terminated", lambda status, signals: ended.append(status) or status)
+    assert main(["fit", str(LAUTER), "--out", str(tmp_path / "o")]) == status
+    assert capsys.readouterr().err.strip().splitlines() == [line] and ended == [status]
+    assert not (tmp_path / "o").exists()
+
+
 def test_corridor_section_with_a_million_falls_a_year_refused(tmp_path, capsys):
     d = tmp_path / "c"
     shutil.copytree(ROOT / "tests" / "data" / "corridor", d)
@@ -491,3 +565,22 @@ def test_corridor_section_with_a_million_falls_a_year_refused(tmp_path, capsys):
     (d / "small_sections.csv").write_text(table)
     assert main(["corridor", str(d / "small.toml"), "--out", str(tmp_path / "o")]) == 2
     assert "row 2 (section 'A'): column 'falls_per_year' gives 1e+06 falls a year" in capsys.readouterr().err
+
+
+def test_the_command_lines_log_goes_to_stdout_as_it_is_when_a_line_is_written(monkeypatch, capsys):
+    """The 'riskrf' logger's handler, installed by the first :func:`main` of a process, writes to the current
+    ``sys.stdout``: a notebook or a test that replaces it later gets the lines, and a stream closed since (the
+    capture of an earlier test) is never written to."""
+    import io
+    import logging
+    logger = logging.getLogger("riskrf")
+    monkeypatch.setattr(logger, "handlers", [])
+    first, second = io.StringIO(), io.StringIO()
+    monkeypatch.setattr(sys, "stdout", first)
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    logger.info("stage 1")
+    first.close()
+    monkeypatch.setattr(sys, "stdout", second)
+    logger.info("stage 2")
+    assert second.getvalue() == "stage 2\n" and "Logging error" not in capsys.readouterr().err

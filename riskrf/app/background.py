@@ -92,6 +92,13 @@ def _quietly(work):
 
 
 def _send_result(work, conn):
+    """The child's body.  The signals are the parent's to answer: the child was forked with riskrf's SIGTERM
+    handler (which raises KeyboardInterrupt), and Ctrl-C at a terminal reaches the whole process group.  Here
+    SIGTERM ends the child at once, silently (the parent stops it so on the way out), and SIGINT is ignored;
+    otherwise the child would print its own traceback after the parent's one line."""
+    import signal
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         value = _quietly(work)
     except Exception as exc:          # noqa: BLE001  (sent back and raised in the parent)
