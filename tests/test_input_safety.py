@@ -553,7 +553,13 @@ def test_an_interrupt_that_compiled_code_turned_into_another_error_is_still_an_i
     monkeypatch.setattr(riskrf.frequency.study, "analyse_inventory", compiling)
     ended = []
     monkeypatch.setattr(riskrf.cli, "_end_if_terminated", lambda status, signals: ended.append(status) or status)
-    assert main(["fit", str(LAUTER), "--out", str(tmp_path / "o")]) == status
+    # Python's own Ctrl-C action, even where this test process started with SIGINT ignored (nohup, a background
+    # job): there riskrf, like Python, leaves SIGINT ignored
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        assert main(["fit", str(LAUTER), "--out", str(tmp_path / "o")]) == status
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert capsys.readouterr().err.strip().splitlines() == [line] and ended == [status]
     assert not (tmp_path / "o").exists()
 
