@@ -1582,11 +1582,15 @@ class _StdoutHandler(logging.StreamHandler):
 
     @property
     def stream(self):
-        return sys.stdout
+        return sys.stdout if sys.stdout is not None else sys.stderr     # no stdout (pythonw, a daemon): stderr
 
     @stream.setter
     def stream(self, value):
         pass
+
+    def setStream(self, stream):
+        """Not supported: the stream is always the current ``sys.stdout``; returns None (nothing replaced)."""
+        return None
 
 
 @contextlib.contextmanager

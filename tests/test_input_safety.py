@@ -163,21 +163,33 @@ def test_sigterm_cleans_up_like_ctrl_c(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("when", ["at work", "just forked"])
 @pytest.mark.parametrize("how", ["SIGTERM to riskrf", "Ctrl-C at the terminal"])
-def test_a_background_child_leaves_the_signal_to_riskrf(tmp_path, how):
+def test_a_background_child_leaves_the_signal_to_riskrf(tmp_path, how, when):
     """A background child forked during a run (figures, the rate model) inherits riskrf's SIGTERM handler; it
     must not answer the signal itself: riskrf prints its one line and stops the child, which ends silently (no
     'Process ForkProcess-1: Traceback ... KeyboardInterrupt' after riskrf's line).  Ctrl-C at a terminal
-    reaches the whole process group, the child included."""
+    reaches the whole process group, the child included.  "just forked": the signal comes while the child is
+    still in multiprocessing's start-up, before its own code has run (held there for a second)."""
     started = tmp_path / "started"
     code = textwrap.dedent(f"""
-        import pathlib, sys, time
+        import multiprocessing.util, pathlib, sys, time
         from riskrf.app.background import InBackground
         from riskrf.cli import _terminate_as_interrupt
+        STARTED = pathlib.Path({str(started)!r})
 
         def work():
-            pathlib.Path({str(started)!r}).write_text("")
+            STARTED.write_text("")
             time.sleep(60)
+
+        if {when == "just forked"!r}:             # the child's start-up, before the work, held for a second
+            close_stdin = multiprocessing.util._close_stdin
+
+            def held():
+                STARTED.write_text("")
+                time.sleep(1.0)
+                close_stdin()
+            multiprocessing.util._close_stdin = held
 
         try:
             with _terminate_as_interrupt():

@@ -1,11 +1,17 @@
 """Work done beside the main computation, in a forked child process on the other core."""
 from __future__ import annotations
 
+import signal
+
 
 #: Longest wait for a background child [s]; past it the child is stopped and the work runs in this process.
 #: A child forked from a process whose native threads held a lock can wait on that lock for ever; this
 #: bounds the cost of that rare case to a repeat of the work instead of a hung run.
 CHILD_TIMEOUT_S = 240.0
+
+
+#: The signals a background child leaves to its parent (riskrf ends a run on them and stops the child).
+_PARENTS_SIGNALS = frozenset({signal.SIGINT, signal.SIGTERM})
 
 
 class InBackground:
@@ -40,9 +46,13 @@ class InBackground:
                 freeze = gc.get_freeze_count() == 0 and os.environ.get("RISKRF_NO_GC_FREEZE", "0") in ("", "0")
                 if freeze:
                     gc.freeze()
+                # SIGINT and SIGTERM are blocked across the fork: the child starts with riskrf's handlers and
+                # must not run them before _send_result has set its own (the signals wait until then)
+                blocked = signal.pthread_sigmask(signal.SIG_BLOCK, _PARENTS_SIGNALS)
                 try:
                     self.proc.start()
                 finally:
+                    signal.pthread_sigmask(signal.SIG_SETMASK, blocked)   # a signal that came meanwhile acts now
                     if freeze:
                         gc.unfreeze()
                 child.close()
@@ -96,9 +106,9 @@ def _send_result(work, conn):
     handler (which raises KeyboardInterrupt), and Ctrl-C at a terminal reaches the whole process group.  Here
     SIGTERM ends the child at once, silently (the parent stops it so on the way out), and SIGINT is ignored;
     otherwise the child would print its own traceback after the parent's one line."""
-    import signal
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _PARENTS_SIGNALS)     # blocked by the parent across the fork
     try:
         value = _quietly(work)
     except Exception as exc:          # noqa: BLE001  (sent back and raised in the parent)
