@@ -1631,11 +1631,12 @@ def _on_main_thread() -> bool:
 
 
 def _end_if_terminated(status: int, signals) -> int:
-    """After SIGTERM (in ``signals``, the signal numbers that arrived), once the temporary outputs are removed (the context managers have unwound), end the process
-    at once with ``status`` (143), as SIGTERM's default action does: the exit functions run (child processes are
-    stopped, logs flushed) but not the interpreter's finalization, during which a worker thread still inside
-    compiled code could abort the process (exit -6 instead of 143, seen once in CI).  After Ctrl-C, or when no
-    signal arrived, ``status`` is returned to the caller."""
+    """After SIGTERM (in ``signals``, the signal numbers that arrived), once the temporary outputs are removed
+    (the context managers have unwound), end the process at once with ``status`` (143), as SIGTERM's default
+    action does: the exit functions run (child processes are stopped, logs flushed) but not the interpreter's
+    finalization, during which a worker thread still inside compiled code could abort the process (exit -6
+    instead of 143, seen once in CI).  After Ctrl-C, or when no signal arrived, ``status`` is returned to the
+    caller."""
     if not _terminated(signals):
         return status
     import atexit

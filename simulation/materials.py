@@ -316,7 +316,6 @@ def preset_posterior(presets=None, *, new_site: bool = False, seed=1):
     pandas.DataFrame
     """
     import pandas as pd
-
     from . import preset_priors
     df = pd.DataFrame(preset_priors.SAMPLE)
     if presets is not None:
