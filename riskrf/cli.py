@@ -7,6 +7,7 @@ import logging
 import math
 import os
 import shutil
+import signal
 import sys
 import textwrap
 import traceback
@@ -1603,7 +1604,6 @@ def _terminate_as_interrupt():
     a compilation) is still reported as one.  SIGINT keeps Python's own action (KeyboardInterrupt) and is
     recorded only where that action is installed (not where it is ignored, as under ``nohup``).  The previous
     handlers are restored after."""
-    import signal
     got: list = []
     previous: dict = {}
     if _on_main_thread():
@@ -1653,7 +1653,6 @@ def _end_if_terminated(status: int, signals) -> int:
 
 def _terminated(signals) -> bool:
     """True when SIGTERM is among ``signals`` (the signal numbers that arrived)."""
-    import signal
     return signal.SIGTERM in signals
 
 

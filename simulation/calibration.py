@@ -54,7 +54,7 @@ import pandas as pd
 from scipy import optimize, stats
 
 from ._display import Displayed, short_repr
-from .materials import parameter_materials
+from .materials import material_parameter, parameter_materials
 from .scenario import Scenario, ScenarioError, scenario_from_dict
 
 #: Fewer observed stops than this give a warning: the calibration is weak.
@@ -109,25 +109,6 @@ def scenario_dict(scenario) -> tuple[dict, str]:
 def _did_you_mean(key, options) -> str:
     close = difflib.get_close_matches(str(key), [str(o) for o in options], n=1)
     return f"; did you mean {close[0]!r}?" if close else f"; available: {', '.join(map(str, options))}"
-
-
-def material_parameter(name: str, material: str) -> str:
-    """The single-material name of the shared parameter ``name`` for ``material`` (``materials.A+B.FIELD`` ->
-    ``materials.A.FIELD``).
-
-    Parameters
-    ----------
-    name : str
-        A dotted material parameter (:func:`parameter_materials`).
-    material : str
-        One of its materials.
-
-    Returns
-    -------
-    str
-    """
-    _, _, field = str(name).split(".", 2)
-    return f"materials.{material}.{field}"
 
 
 def check_material_names(names) -> None:

@@ -227,6 +227,42 @@ def parameter_materials(name: str) -> tuple:
     return tuple(parts[1].split("+"))
 
 
+def material_parameter(name: str, material: str) -> str:
+    """The single-material name of the shared parameter ``name`` for ``material`` (``materials.A+B.FIELD`` ->
+    ``materials.A.FIELD``).
+
+    Parameters
+    ----------
+    name : str
+        A dotted material parameter (:func:`parameter_materials`).
+    material : str
+        One of its materials.
+
+    Returns
+    -------
+    str
+    """
+    _, _, field = str(name).split(".", 2)
+    return f"materials.{material}.{field}"
+
+
+def parameter_sets_any(name: str, materials) -> bool:
+    """True when the dotted parameter ``name`` sets a field of at least one of ``materials`` (names).
+
+    Parameters
+    ----------
+    name : str
+        A dotted parameter (:func:`parameter_materials`).
+    materials : collection of str
+        Material names (a scenario's ``materials`` table, a list, ...).
+
+    Returns
+    -------
+    bool
+    """
+    return any(m in materials for m in parameter_materials(name))
+
+
 def _data_priors() -> dict:
     """preset -> {field (dotted, inside the material table): posterior summary} from simulation/preset_priors.py;
     a parameter shared by several presets (``materials.A+B.FIELD``) is a field of each of them."""
@@ -325,7 +361,7 @@ def preset_posterior(presets=None, *, new_site: bool = False, seed=1):
             if k not in PRESETS:
                 raise PresetError(_unknown(n, "preset", "<preset_posterior()>"))
             keys.append(k)
-        df = df[[c for c in df.columns if set(parameter_materials(c)) & set(keys)]]
+        df = df[[c for c in df.columns if parameter_sets_any(c, keys)]]
     if new_site:
         from .material_uncertainty import with_site_spread
         df = with_site_spread(df, {k: v["bounds"] for k, v in preset_priors.SUMMARY.items()}, seed)

@@ -63,7 +63,8 @@ import pandas as pd
 from scipy import stats
 
 from ._display import Displayed, short_repr
-from .calibration import check_material_names, material_parameter, parameter_materials, scenario_dict, set_parameter
+from .calibration import check_material_names, scenario_dict, set_parameter
+from .materials import material_parameter, parameter_materials, parameter_sets_any
 from .scenario import Distribution, Material, Scenario, ScenarioError, scenario_from_dict
 from .surrogate import _in_unit_box, _t_draw, _t_logpdf, gp_posterior_sample, replicate_noise
 from .units import DENSITY_RANGE_KG_M3
@@ -274,7 +275,7 @@ class _ConstraintPool:
             data, _ = scenario_dict(c.scenario)
             mats = data.get("materials", {})
             self.materials.update(mats)
-            own = {k: b for k, b in parameters.items() if any(m in mats for m in parameter_materials(k))}
+            own = {k: b for k, b in parameters.items() if parameter_sets_any(k, mats)}
             # a shared parameter needs only one of its materials here (calibrate_pooled checks all of them)
             listed = {m for k in own for m in parameter_materials(k)}
             self.pools.append((_Pool([c._release()], own, extra_materials=listed) if own else None, own))
@@ -957,7 +958,7 @@ def read_posterior(path, scenario=None) -> pd.DataFrame:
         for col in df.columns:
             parts = col.split(".")
             named = parameter_materials(col)
-            if not named or not all(named) or not any(m in mats for m in named):
+            if not named or not all(named) or not parameter_sets_any(col, mats):
                 raise ValueError(f"{path}: field {col!r} names material "
                                  f"{' or '.join(repr(m) for m in named) if named else repr(col)}, "
                                  f"which {src} does not define (materials: {sorted(mats)})")

@@ -386,7 +386,7 @@ def energy_hazard_ensemble(mass, scenario, collector: str = "barrier", *, poster
     EnergyHazardEnsemble
     """
     import simulation
-    from simulation.calibration import parameter_materials
+    from simulation.materials import parameter_sets_any
     from .simulated import energy_hazard
 
     path = scenario if not isinstance(scenario, simulation.Scenario) else scenario.source
@@ -398,7 +398,7 @@ def energy_hazard_ensemble(mass, scenario, collector: str = "barrier", *, poster
         raise ModelUncertaintyError(str(exc)) from None
     materials = [m.name for m in simulation.load_scenario(path).materials]
     for col in table.columns:                     # a posterior given as a table: checked before any simulation
-        if not any(m in materials for m in parameter_materials(col)):
+        if not parameter_sets_any(col, materials):
             raise ModelUncertaintyError(f"posterior column {col!r}: not a parameter 'materials.NAME.FIELD' of a "
                                         f"material of {path} (materials: {materials})")
     for i, row in table.iterrows():

@@ -528,9 +528,9 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
             from .measures import MATERIAL_FIELDS
             if len(df) < 2:
                 raise MitigationError(f"{w} = {v!r}: needs at least 2 bootstrap rows; got {len(df)}")
+            from simulation.materials import parameter_materials
             for col in df.columns:
-                parts = col.split(".", 2)
-                if len(parts) != 3 or parts[0] != "materials" or parts[2] not in MATERIAL_FIELDS or "+" in parts[1]:
+                if len(parameter_materials(col)) != 1 or col.split(".", 2)[2] not in MATERIAL_FIELDS:
                     raise MitigationError(f"{w} = {v!r}: column {col!r} is not a material parameter "
                                           "(materials.NAME.FIELD with one material NAME, not a shared 'A+B', and "
                                           f"FIELD one of {', '.join(MATERIAL_FIELDS)})")

@@ -63,8 +63,9 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[2]
 sys.path.insert(0, str(REPO))
 
-from simulation.calibration import material_parameter, parameter_materials, scenario_dict  # noqa: E402
+from simulation.calibration import scenario_dict  # noqa: E402
 from simulation.contact import CRSP_TANGENTIAL_SCALE_MS  # noqa: E402
+from simulation.materials import material_parameter, parameter_materials, parameter_sets_any  # noqa: E402
 from simulation.material_uncertainty import with_site_spread  # noqa: E402
 from simulation.pooled import ReachConstraint, Release, _ConstraintPool, _density, _Pool, calibrate_pooled  # noqa: E402
 from simulation.units import (DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3, block_radius,  # noqa: E402
@@ -210,8 +211,8 @@ def fit(datasets, n_per_release=50, seed=1, n_predictive=20, iterations=4):
         else:
             rel.extend(releases(d.split("_")[1].upper()))
     params = {k: v for k, v in _parameters().items()
-              if any(m in r.scenario["materials"] for r in rel for m in parameter_materials(k))
-              or any(m in c.scenario["materials"] for c in con for m in parameter_materials(k))}
+              if any(parameter_sets_any(k, r.scenario["materials"]) for r in rel)
+              or any(parameter_sets_any(k, c.scenario["materials"]) for c in con)}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return calibrate_pooled(rel, params, seed=seed, n_per_release=n_per_release, n_initial=1024,
@@ -301,7 +302,7 @@ def _drawn(draws) -> dict:
 
 def predict_release_stops(rels, draws, n_each, seed0):
     P = _drawn(draws)
-    pool = _Pool(rels, {k: P[k] for k in P if any(m in rels[0].scenario["materials"] for m in parameter_materials(k))})
+    pool = _Pool(rels, {k: P[k] for k in P if parameter_sets_any(k, rels[0].scenario["materials"])})
     per = [[] for _ in rels]
     for t, values in enumerate(draws):
         vals = {k: v for k, v in values.items() if k in pool.bounds}
@@ -343,7 +344,7 @@ def ritchie_row(posterior, model, n_draws, seed):
     from riskrf.hazard.catchment import catchment_retention, modified_ritchie_width_m
     from simulation.calibration import apply_parameters
     data, _ = scenario_dict(ODOT_CUT)
-    cols = [k for k in posterior.columns if any(m in ODOT_MATERIALS for m in parameter_materials(k))]
+    cols = [k for k in posterior.columns if parameter_sets_any(k, ODOT_MATERIALS)]
     draws = posterior[cols].sample(n_draws, random_state=seed)
     widths = []
     for t, d in enumerate(draws.to_dict("records")):
