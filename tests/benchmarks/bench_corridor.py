@@ -172,7 +172,7 @@ def main() -> int:
                         os.kill(pids[victim], signal.SIGKILL)
                         killed.append(victim)
 
-                res = cr.run_corridor(sub, client=client, progress=kill_one)
+                res = cr.run_corridor(sub, client=client, progress=kill_one, keep_going=True)
             finally:
                 client.close()
                 cluster.close()
