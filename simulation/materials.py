@@ -168,6 +168,25 @@ def preset_names() -> list[str]:
     return sorted(PRESETS)
 
 
+def data_basis_presets() -> list[str]:
+    """Names of the presets that have a data-derived table (``basis = "data"``): those with fitted contact laws
+    or posterior fields in ``simulation/preset_priors.py``.
+
+    Returns
+    -------
+    list of str
+        Sorted preset names.
+    """
+    from . import preset_priors
+    return sorted(set(getattr(preset_priors, "LAWS", {})) | set(_data_priors()))
+
+
+def _no_data_table(name: str, where: str, source: str) -> str:
+    return (f"{source}: {where} = {name!r} has no data-derived table, so preset_basis = 'data' cannot apply to it "
+            f"(it would silently give the published values); presets with one: {', '.join(data_basis_presets())}. "
+            "Use preset_basis = 'published' for this material, or calibrate it to data (riskrf calibrate)")
+
+
 def preset(name: str, basis: str = "published") -> dict:
     """A deep copy of the material table of preset ``name`` (aliases accepted).
 
@@ -181,18 +200,26 @@ def preset(name: str, basis: str = "published") -> dict:
         of ``simulation.preset_priors.LAWS`` put over it (Coulomb-bounded e_T with Pfeiffer & Bowen's
         normal-velocity scaling, hop heights, the size term of the rolling resistance) -- and every field fitted
         to real data (:func:`preset_prior`) replaced by its posterior median; fields no data set constrains keep
-        their published values.
+        their published values.  A preset without a data-derived table (:func:`data_basis_presets`) is
+        refused under ``"data"``, never silently given its published values.
 
     Returns
     -------
     dict
         A scenario material table (point values).
+
+    Raises
+    ------
+    PresetError
+        An unknown name or basis, or ``basis="data"`` for a preset without a data-derived table.
     """
     key = ALIASES.get(name, name)
     if key not in PRESETS:
         raise PresetError(_unknown(name, "preset", "<preset()>"))
     if basis not in ("published", "data"):
         raise PresetError(f"<preset()>: basis = {basis!r} must be 'published' or 'data'")
+    if basis == "data" and key not in data_basis_presets():
+        raise PresetError(_no_data_table(name, "preset", "<preset()>"))
     out = copy.deepcopy(PRESETS[key])
     if basis == "data":
         from . import preset_priors
@@ -422,6 +449,8 @@ def resolve_material(spec: dict, where: str = "materials.?", source: str = "<dic
     if basis not in ("published", "data"):
         raise PresetError(f"{source}: {where}.preset_basis = {basis!r} must be 'published' (the preset's published "
                           "values, the default) or 'data' (the data-derived table of preset(name, basis='data'))")
+    if basis == "data" and key not in data_basis_presets():
+        raise PresetError(_no_data_table(name, f"{where}.preset", source))
     out = preset(key, basis=basis)
     for field, value in spec.items():
         if field in ("preset", "preset_basis"):

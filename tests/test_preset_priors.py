@@ -30,7 +30,6 @@ def test_default_presets_are_the_published_values_and_data_basis_swaps_in_poster
         assert table[field[-1]] == pytest.approx(st["median"])
     # fields no data set constrains keep their published values
     assert preset("soil", basis="data")["normal_restitution"] == PRESETS["soil"]["normal_restitution"]
-    assert preset("meadow", basis="data") == PRESETS["meadow"]
     # a data-based table is a valid material
     sc = simulation.scenario_from_dict({"profile": {"x": [0, 10, 40], "z": [10, 0, 0], "material": "a"},
                                         "materials": {"a": preset("talus", basis="data")},
@@ -210,3 +209,16 @@ def test_a_parameter_shared_by_two_presets_is_a_field_of_each(monkeypatch):
     assert preset("soil", basis="data")["ground_friction_angle_deg"] == PRESETS["soil"]["ground_friction_angle_deg"]
     assert shared in preset_posterior(["talus"]).columns and shared in preset_posterior(["bedrock"]).columns
     assert shared not in preset_posterior(["soil"]).columns
+
+
+def test_data_basis_without_a_data_derived_table_is_refused_not_silently_published():
+    from simulation.materials import data_basis_presets
+    from simulation.scenario import ScenarioError
+    assert data_basis_presets() == ["bedrock", "soil", "talus"]
+    for name in set(PRESETS) - set(data_basis_presets()):
+        with pytest.raises(PresetError, match=rf"preset = '{name}' has no data-derived table.*bedrock, soil, talus"):
+            preset(name, basis="data")
+    base = {"profile": {"x": [0, 10, 40], "z": [10, 0, 0], "material": "m"}, "seeder": {"x": 1.0, "mass_kg": 500.0}}
+    with pytest.raises(ScenarioError, match=r"site.toml: materials.m.preset = 'meadow' has no data-derived table"):
+        simulation.scenario_from_dict({**base, "materials": {"m": {"preset": "meadow", "preset_basis": "data"}}},
+                                      "site.toml")
