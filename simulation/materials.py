@@ -95,6 +95,8 @@ from __future__ import annotations
 import copy
 import difflib
 
+from .errors import RiskrfError
+
 #: Wyllie's tangential coefficient on natural ground: e_T = v_t'/v_t in 0.3-0.8 (Wyllie 2014, IJRMMS 67:170,
 #: "independent of the velocity and normal force") read as mean +- 2 standard deviations.
 WYLLIE_ET = {"law": "constant", "mean": 0.55, "std": 0.12}
@@ -153,7 +155,7 @@ SOURCES = {
 }
 
 
-class PresetError(ValueError):
+class PresetError(RiskrfError, ValueError):
     """An unknown preset or a preset given in a wrong form; the message names the file and material."""
 
 

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
+from .errors import RiskrfError
 from .materials import PresetError, resolve_material
 from .contact import CRSP_VELOCITY_SCALE_MS, EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_COULOMB, ET_FRICTION
 from .slope import Profile
@@ -21,7 +22,7 @@ from ._display import Displayed, short_repr
 from .units import DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2, block_radius
 
 
-class ScenarioError(ValueError):
+class ScenarioError(RiskrfError, ValueError):
     """A scenario file or dictionary is invalid; the message names the file and field."""
 
 

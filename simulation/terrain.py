@@ -24,10 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import RiskrfError
 from ._display import Displayed, axes, short_repr
 
 
-class TerrainError(ValueError):
+class TerrainError(RiskrfError, ValueError):
     """A DEM, material raster, source or path on the terrain is unusable; the message names file and value."""
 
 

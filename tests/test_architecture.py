@@ -111,3 +111,47 @@ def test_the_checker_sees_imports():
     corridor = _imports("riskrf.app.corridor", modules["riskrf.app.corridor"], known)
     assert "riskrf.risk.rhrs" in corridor                       # ``from ..risk import rhrs``
     assert "riskrf.report.corridor_report" in corridor          # imported inside a function
+
+
+def _installed_modules():
+    """Every module of both packages (``simulation.scenarios`` holds data and scripts, not library code)."""
+    for package in ("riskrf", "simulation"):
+        root = ROOT.parent / package
+        for path in sorted(root.rglob("*.py")):
+            parts = list(path.relative_to(ROOT.parent).with_suffix("").parts)
+            if parts[-1] == "__init__":
+                parts.pop()
+            if parts[:2] == ["simulation", "scenarios"] or parts[-1] == "_compat":
+                continue
+            yield ".".join(parts), path
+
+
+def test_every_error_of_both_packages_is_a_riskrf_error():
+    import importlib
+    import inspect
+    from riskrf import RiskrfError
+    bad = []
+    for name, _ in _installed_modules():
+        module = importlib.import_module(name)
+        for cls_name, cls in inspect.getmembers(module, inspect.isclass):
+            if (cls.__module__ == name and issubclass(cls, Exception) and not issubclass(cls, Warning)
+                    and not issubclass(cls, RiskrfError)):
+                bad.append(f"{name}.{cls_name}")
+    assert bad == [], f"errors that ``except riskrf.RiskrfError`` would miss: {bad}"
+    import simulation
+    assert issubclass(simulation.ScenarioError, RiskrfError) and issubclass(simulation.ScenarioError, ValueError)
+
+
+def test_no_backend_choice_outside_the_command_line():
+    """Only the command line chooses matplotlib's backend (MPLBACKEND); a library call never does, so a notebook's
+    inline figures keep working after it."""
+    bad = []
+    for name, path in _installed_modules():
+        if name == "riskrf.cli":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+            if (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+                    and node.func.attr in ("use", "switch_backend")
+                    and isinstance(node.func.value, ast.Name) and node.func.value.id in ("matplotlib", "plt")):
+                bad.append(f"{name}:{node.lineno}")
+    assert bad == [], f"backend chosen outside riskrf.cli: {bad}"

@@ -113,8 +113,6 @@ class TerrainAssessment:
         dict
             The summary, with paths relative to the site file's folder.
         """
-        import matplotlib
-        matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
         from ..report.files import write_energy_study

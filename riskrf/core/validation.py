@@ -6,13 +6,10 @@ import warnings
 
 import numpy as np
 
+from simulation.errors import RiskrfError  # noqa: F401  (its home is the lower package; exported by riskrf)
 from simulation.units import DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3  # noqa: F401  (their home; riskrf modules import them from here)
 
 
-class RiskrfError(Exception):
-    """Base of every riskrf input error (site, corridor, mitigation, measures, decision tree, nil hazard), so that
-    ``except riskrf.RiskrfError`` catches them all.  Each concrete error also derives from the built-in it was
-    before (:class:`ValueError`), so existing ``except ValueError`` code keeps working."""
 
 
 class RiskrfWarning(UserWarning):
