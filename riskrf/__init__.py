@@ -38,8 +38,4 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
-from . import _compat  # noqa: E402  (old flat module paths, deprecated: riskrf.inventory -> riskrf.frequency.inventory)
-
-_compat.install()
-
 _lazy_exports(__name__, _EXPORTS)

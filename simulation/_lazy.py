@@ -15,7 +15,6 @@ def lazy_exports(package: str, exports: dict) -> None:
     A public name that is also a submodule's name (``riskrf.rate_model``, the function in the module of that
     name) stays the public object: importing the submodule anywhere does not replace it with the module, as
     it would in a plain lazy package, where the import system sets the package attribute after the import.
-    (The module may sit at another path, as for an old module path answered by ``riskrf._compat``.)
     """
     module = sys.modules[package]
 

@@ -66,7 +66,7 @@ def graph():
 
 
 def test_every_module_sits_in_a_stage(graph):
-    loose = sorted(m for m in graph if m != "riskrf" and _stage(m) is None and m != "riskrf._compat")
+    loose = sorted(m for m in graph if m != "riskrf" and _stage(m) is None)
     assert loose == [], f"modules outside the stage packages: {loose}"
 
 
@@ -121,7 +121,7 @@ def _installed_modules():
             parts = list(path.relative_to(ROOT.parent).with_suffix("").parts)
             if parts[-1] == "__init__":
                 parts.pop()
-            if parts[:2] == ["simulation", "scenarios"] or parts[-1] == "_compat":
+            if parts[:2] == ["simulation", "scenarios"]:
                 continue
             yield ".".join(parts), path
 

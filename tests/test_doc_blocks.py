@@ -5,7 +5,7 @@ working directory that holds links to the repository's data folders (``inventori
 ``tests``, ``corridors``, ``riskrf``), so that the paths the documentation uses (``inventories/...``)
 resolve and whatever a block writes lands in the temporary directory, never in the repository.  Blocks
 that are not meant to run are fenced as something else (```text for output, ```toml, ```bash, ```json).
-A block that imports a deprecated module path (``riskrf.inventory`` for ``riskrf.frequency.inventory``) fails.
+A block that imports a module path that no longer exists (``riskrf.inventory`` for ``riskrf.frequency.inventory``) fails.
 A block made only of ``--8<--`` includes shows an example script, which ``tests/test_examples.py`` runs.
 """
 from __future__ import annotations

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 import simulation
 from simulation import ScenarioError, load_scenario
-from simulation.impact import EN_WYLLIE, ET_FRICTION, impact_body
+from simulation.contact import EN_WYLLIE, ET_FRICTION, impact_body
 
 from .conftest import ROOT
 from .test_simulation_physics import G, scenario

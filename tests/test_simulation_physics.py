@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import simulation
-from simulation.impact import (EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_FRICTION, impact,
+from simulation.contact import (EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_FRICTION, impact,
                                stronge_sphere, wyllie_normal_restitution)
 
 G = 9.81
@@ -210,6 +210,6 @@ def test_rolling_cylinder_accelerates_at_two_thirds_g_sin_psi():
 
 
 def test_stronge_stick_for_a_cylinder():
-    from simulation.impact import stronge_body
+    from simulation.contact import stronge_body
     vt2, w2, stuck = stronge_body(-10.0, 3.0, 2.0, 0.5, 0.3, 0.8, 0.5)
     assert stuck and vt2 == pytest.approx(2 / 3 * 3.0 + 1 / 3 * 0.5 * 2.0)

@@ -150,33 +150,14 @@ def test_compile_kernel_runs_on_no_blocks():
     assert out.stdout.strip() == "[]"
 
 
-def test_old_module_paths_still_import_with_a_deprecation_warning():
-    """The flat module paths of before the stage layout (``riskrf.assess``, ``riskrf.rate_model``, ...) import the
-    module at its new path, the same object, with a DeprecationWarning naming that path; the public function
-    ``riskrf.rate_model`` stays the function."""
-    code = ("import warnings, sys; warnings.simplefilter('error', DeprecationWarning)\n"
-            "import riskrf, riskrf.app.assess as new\n"
-            "try:\n    import riskrf.assess\nexcept DeprecationWarning as w:\n    print(w)\n"
-            "warnings.simplefilter('ignore', DeprecationWarning)\n"
-            "import riskrf.assess, riskrf.rate_model\n"
-            "from riskrf.inventory import read_inventory\n"
-            "print(sys.modules['riskrf.assess'] is new, new.__spec__.name, callable(riskrf.rate_model),\n"
-            "      sys.modules['riskrf.rate_model'].__name__, read_inventory is riskrf.read_inventory)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
-    assert "riskrf.assess is deprecated" in out[0] and "import riskrf.app.assess" in out[0]
-    assert out[1].split() == ["True", "riskrf.app.assess", "True", "riskrf.frequency.rates", "True"]
-
-
-def test_old_module_paths_cover_every_moved_module():
-    """Each old path of the alias table names a module that exists at its new path, and no file is left at it."""
-    import importlib.util
-    from pathlib import Path
-
-    from riskrf._compat import MOVED
-    root = Path(riskrf.__file__).parent
-    for old, new in MOVED.items():
-        assert importlib.util.find_spec(new) is not None, new
-        assert not (root / f"{old.split('.', 1)[1]}.py").exists(), old
+def test_the_flat_module_paths_of_before_the_stage_layout_are_gone():
+    """No alias layer: ``riskrf.assess`` (now ``riskrf.app.assess``) does not import, and the public function
+    ``riskrf.rate_model`` is the function, not a module."""
+    code = ("import riskrf\n"
+            "try:\n    import riskrf.assess\nexcept ModuleNotFoundError as e:\n    print(e.name)\n"
+            "print(callable(riskrf.rate_model), riskrf.rate_model.__module__)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["riskrf.assess", "True", "riskrf.frequency.rates"]
 
 
 def test_every_input_error_is_a_riskrf_error():

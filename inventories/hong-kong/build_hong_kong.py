@@ -9,10 +9,10 @@ repository; see PROVENANCE.md there):
 Writes beside this script:
 
 - ``hong_kong_rock_cuts_1984_2020.csv`` + ``.toml``: the 445 incidents on man-made rock cuts
-  (FEATTYPE "Rock Cut"/"Rock cut") through :func:`riskrf.records.read_cedd_incidents`;
+  (FEATTYPE "Rock Cut"/"Rock cut") through :func:`riskrf.io.records.read_cedd_incidents`;
 - ``hko_daily_rainfall_1983_2020.csv``: the Observatory's daily totals 1983-01-01 .. 2020-12-31
   in riskrf's generic rainfall format (``date,rainfall_mm,note``), read through
-  :func:`riskrf.rainfall.read_rainfall` ("Trace" = 0 mm, flagged in ``note``).
+  :func:`riskrf.io.rainfall.read_rainfall` ("Trace" = 0 mm, flagged in ``note``).
 
 Run from the repository root: ``python inventories/hong-kong/build_hong_kong.py [--raw DIR]``.
 Rerunning reproduces the files byte for byte.
@@ -26,8 +26,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1]))
 
-from riskrf.rainfall import read_rainfall  # noqa: E402
-from riskrf.records import read_cedd_incidents  # noqa: E402
+from riskrf.io.rainfall import read_rainfall  # noqa: E402
+from riskrf.io.records import read_cedd_incidents  # noqa: E402
 
 RAW = HERE.parents[2] / "shared" / "inventories-raw" / "hong-kong-cedd"
 RECORD_START, RECORD_END = "1984-01-01", "2020-12-31"

@@ -122,7 +122,7 @@ def check_energy_args(args, *, road_collector=None) -> None:
 
 def check_out(args, default, *, kind="dir", inputs=None) -> Path:
     """The output path of a command, refused up front when it would clobber something: an existing output
-    without ``--overwrite``, or (:func:`riskrf.outputs.check_output_spares_inputs`) an ``--out`` that is, holds
+    without ``--overwrite``, or (:func:`riskrf.io.outputs.check_output_spares_inputs`) an ``--out`` that is, holds
     or lies inside one of ``inputs`` (``{"what it is": path}``), and ``--out ''`` or ``.``.
 
     Parameters

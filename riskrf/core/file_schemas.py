@@ -1,7 +1,7 @@
 """The declarations of riskrf's four input files (site, mitigation options, corridor, slope scenario).
 
 One :class:`~riskrf.core.schema.Field` per field: type, unit, range, default, meaning.  The defaults here are
-the ones the readers apply (:data:`riskrf.site.SITE_FIELDS` is built from :data:`SITE_SCHEMA`; a test holds
+the ones the readers apply (:data:`riskrf.app.site.SITE_FIELDS` is built from :data:`SITE_SCHEMA`; a test holds
 the mitigation dataclasses' defaults to :data:`TRAFFIC` and the others).  Shares and probabilities lie in
 [0, 1]; rates, speeds, lengths and traffic are > 0.
 """

@@ -6,8 +6,8 @@ raises one message naming the file, the table, the field and the value (``site.t
 = 0 must be a number > 0 vehicles/day``); :func:`render_markdown` writes the same declarations as the
 file-format reference (``docs/reference/file-formats-generated.md``).
 
-The hand-written readers (:func:`riskrf.site.load_site`, :func:`riskrf.mitigation_inputs.parse_mitigation`,
-:func:`riskrf.corridor.load_corridor`, :func:`simulation.load_scenario`) keep what a flat declaration cannot
+The hand-written readers (:func:`riskrf.app.site.load_site`, :func:`riskrf.risk.mitigation_inputs.parse_mitigation`,
+:func:`riskrf.app.corridor.load_corridor`, :func:`simulation.load_scenario`) keep what a flat declaration cannot
 say (unknown fields with a did-you-mean, one field depending on another, files that must exist, option
 geometry inside the profile); they run after :func:`check`, so every type and range here is enforced first.
 

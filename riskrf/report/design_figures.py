@@ -24,7 +24,7 @@ def _profile_axes(ax, profile, title=None):
 def options_profile_figure(scenario, options, *, barrier_x=None, road_x=None, requirement=None):
     """The slope profile with each option's geometry: ditches dug into it, fences and attenuators at their height,
     a shed roof over the road, the scaling zone on the face, a realigned road; and the required barrier (dashed)
-    at the barrier line.  ``options``: :class:`~riskrf.mitigation_inputs.Option` objects; ``requirement``: a
+    at the barrier line.  ``options``: :class:`~riskrf.risk.mitigation_inputs.Option` objects; ``requirement``: a
     :class:`~riskrf.hazard.design_basis.DesignRequirement` or None.
 
     Parameters

@@ -2,7 +2,7 @@
 
 Each returns a copy of the scenario with a changed profile or surface; the mitigation study derives its effect
 (the share of the falls that would reach the road that it stops, by block mass) by re-simulating the scenario
-with common random numbers, exactly as for a ditch (:mod:`riskrf.measures`).  Lengths in m.
+with common random numbers, exactly as for a ditch (:mod:`riskrf.risk.measures`).  Lengths in m.
 
 * **catch bench** (``x_m``, ``width_m``): a flat bench cut into the slope at the elevation of the ground at
   ``x_m + width_m``; its back wall rises ``inner_slope_hv`` m horizontally per m (default 0.25H:1V) to the ground
@@ -212,7 +212,7 @@ def drape_scenario(scenario, zone_x_m, where="drape"):
 
 
 def scenario_with_measures(scenario, measures, where: str = "measures", road_collector: str | None = "road"):
-    """A copy of ``scenario`` carrying every ditch (:class:`~riskrf.measures.Ditch`) and slope measure
+    """A copy of ``scenario`` carrying every ditch (:class:`~riskrf.risk.measures.Ditch`) and slope measure
     (:class:`SlopeMeasure`) of ``measures``; spans must not overlap and must not cross the road line.
 
     Parameters

@@ -1221,7 +1221,7 @@ def check_mitigation_file(path):
     inputs = study_inputs(data, str(path))         # a site file works too
     rates = None
     if any(o.kind == "closure" and o.has_closure_rule for o in inputs["options"]):
-        # closure rules: share and hours from the file's [rates] model (riskrf.site_rates)
+        # closure rules: share and hours from the file's [rates] model (riskrf.risk.site_rates)
         from .site_rates import check_closure_options, check_rates
         inv = dict(raw.get("inventory", {})) if isinstance(raw.get("inventory"), dict) else {}
         rates = check_rates(raw.get("rates"), inv, path, error=MitigationError)
