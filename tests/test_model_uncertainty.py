@@ -384,3 +384,50 @@ def test_a_posterior_table_is_checked_before_any_simulation():
     steep = pd.DataFrame({"materials.talus.ground_friction_angle_deg": [20.0, 95.0]})
     with pytest.raises(ModelUncertaintyError, match="posterior draw 1: .*ground_friction_angle_deg"):
         energy_hazard_ensemble(None, SCENARIO, posterior=steep, draws=2)
+
+
+# ---- EVPI with its Monte Carlo error: two options, a normal prior, the closed form ----------------------------------
+# Option A costs 0, option B costs D ~ N(mu, sigma^2) with mu > 0, so A is chosen now; with perfect information B
+# is chosen when D < 0.  EVPI = E[max(-D, 0)] = sigma phi(mu / sigma) - mu Phi(-mu / sigma) (Raiffa & Schlaifer
+# 1961, ch. 4: the value of perfect information about a normal difference of two actions).
+def _normal_evpi(mu, sigma):
+    return sigma * stats.norm.pdf(mu / sigma) - mu * stats.norm.cdf(-mu / sigma)
+
+
+@pytest.mark.parametrize("mu, sigma", [(1.0, 2.0), (3.0, 1.5)])
+def test_evpi_estimate_recovers_the_closed_form_within_its_standard_error(mu, sigma):
+    from riskrf.risk.model_decision import evpi_estimate
+    exact = _normal_evpi(mu, sigma)                              # 0.396 and 0.0127
+    rng = np.random.default_rng(7)
+    J, seeds = 400, 300
+    D = mu + sigma * rng.standard_normal((seeds, J))
+    est = [evpi_estimate(np.column_stack([np.zeros(J), d])) for d in D]
+    values = np.array([e.value for e in est])
+    assert values.mean() == pytest.approx(exact, rel=0.05)       # unbiased at this size
+    assert np.mean([e.upper_bound >= exact for e in est]) > 0.95
+    z = np.array([(e.value - exact) / e.standard_error for e in est])
+    if mu / sigma < 1:          # a choice that many draws change: the stated error is the real spread
+        assert abs(z.mean()) < 0.25 and 0.8 < z.std() < 1.2 and np.mean(np.abs(z) <= 2) > 0.9
+    else:                       # 2.3 % of draws change it (about 9 of 400): the regret is skewed and its s.e.
+        assert z.std() > 1.5    # understates the spread (sd of z 2.6) -- why the bound, not 2 s.e., is reported
+    r = ModelUncertainRanking(("A", "B"), np.column_stack([np.zeros(J), D[0]]))
+    assert est[0].value == pytest.approx(r.evpi()) and r.evpi() > 0
+
+
+def test_an_evpi_of_zero_from_few_draws_is_reported_with_its_upper_bound():
+    """Eight draws of a case whose true EVPI is small but not 0: no draw changes the choice, the estimate is 0 with
+    a standard error of 0 -- the text gives an upper bound above the true value instead of a bare 0."""
+    from riskrf.risk.model_decision import evpi_estimate
+    mu, sigma = 3.0, 1.0                                         # P(B cheaper) = 0.13 %
+    d = mu + sigma * np.array([-1.2, -0.8, -0.3, 0.0, 0.2, 0.5, 0.9, 1.4])
+    costs = np.column_stack([np.zeros(8), d])
+    e = evpi_estimate(costs)
+    assert e.value == 0.0 and e.standard_error == 0.0
+    assert e.upper_bound > _normal_evpi(mu, sigma) > 0
+    text = e.text("CHF")
+    assert text.startswith("0 CHF (at most ") and "no draw of 8 changes the choice" in text
+    r = ModelUncertainRanking(("A", "B"), costs, currency="CHF")
+    assert "at most" in r.text()[-1]
+    v = r.calibration_value([np.full(20, 40.0 + j) for j in range(8)], n_releases=5, profile_range_m=(0, 100),
+                            n_datasets=20)
+    assert v.evsi == 0.0 and "0 CHF (at most " in v.verdict() and v.to_dict()["evpi_upper_bound_97_5"] > 0

@@ -197,6 +197,7 @@ class ModelUncertaintyStudy:
                "best_option_over_draws": self.ranking.best_now(),
                "ranking": rank.to_dict(orient="records"),
                "evpi_material_parameters": self.ranking.evpi(),
+               "evpi_material_parameters_estimate": self.ranking.evpi_estimate().to_dict(),
                "calibration": self.calibration.to_dict(),
                "verdict": self.verdict(),
                "notes": list(self.notes),
