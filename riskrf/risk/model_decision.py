@@ -262,14 +262,18 @@ class CalibrationValue:
         """
         cur = f" {self.currency}" if self.currency else ""
         evpi = EVPIEstimate(self.evpi, self.evpi_standard_error, self.evpi_upper_bound, self.n_draws)
-        if self.evsi <= 0.0 and np.isfinite(self.evpi_upper_bound):
-            value = (f"0{cur} (at most {money(self.evpi_upper_bound, sig=2)}{cur}, the EVPI's 97.5 % upper bound: "
-                     f"no synthetic calibration changed the choice")
+        lead = f"EVSI of a field calibration with {self.n_releases} released blocks: "
+        bounded = self.n_draws > 0 and np.isfinite(self.evpi_upper_bound)
+        if bounded and self.evsi <= 0.0 and self.evpi <= 0.0:
+            head = (f"{lead}0{cur}, as is the EVPI of the material parameters (no draw of {self.n_draws} changes the "
+                    f"choice; both at most {money(self.evpi_upper_bound, sig=2)}{cur}, the EVPI's 97.5 % upper bound)")
+        elif bounded and self.evsi <= 0.0:
+            head = (f"{lead}0{cur} (no synthetic calibration changed the choice; at most the EVPI of the material "
+                    f"parameters, {evpi.text(self.currency)})")
         else:
-            value = f"{money(self.evsi, sig=3)}{cur} (+- {money(2 * self.standard_error, sig=2)}{cur}, 2 s.e."
-        head = (f"EVSI of a field calibration with {self.n_releases} released blocks: {value}; EVPI of the material "
-                f"parameters " + (evpi.text(self.currency) if self.n_draws else f"{money(self.evpi, sig=3)}{cur}")
-                + ")")
+            head = (f"{lead}{money(self.evsi, sig=3)}{cur} (+- {money(2 * self.standard_error, sig=2)}{cur}, 2 s.e.; "
+                    "EVPI of the material parameters "
+                    + (evpi.text(self.currency) if bounded else f"{money(self.evpi, sig=3)}{cur}") + ")")
         if self.calibration_cost is None:
             return head + "; no calibration cost stated"
         cost = (f"{money(self.calibration_cost, sig=3)}{cur}"
