@@ -18,7 +18,7 @@ from numba import njit
 
 from . import kernel3d
 from .engine import _material_arrays, check_masses
-from .scenario3d import TerrainScenario, _lipschitz, fall_line, sample_sources
+from .scenario3d import TerrainScenario, _lipschitz, fall_line, sample_sources, source_point_index
 from ._display import Displayed
 from .units import J_PER_KJ, kinetic_energy_kj
 
@@ -30,7 +30,8 @@ _KERNEL3D_MATERIALS = ("m_en_law", "m_en_mean", "m_en_std", "m_et_law", "m_et_me
 
 def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> dict:
     """Initial state of n blocks: plan position and elevation [m], velocity [m/s] (``speed_ms`` horizontally
-    along the local fall line, ``vz_ms`` vertically), spin [rad/s], mass [kg], radius [m], I / (m r^2).
+    along the local fall line, ``vz_ms`` vertically, or each release point's ``velocity_ms``), spin [rad/s], mass
+    [kg] (or each point's), radius [m] (or each point's ``radius_m``), I / (m r^2).
 
     Parameters
     ----------
@@ -52,15 +53,31 @@ def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> d
     sd = scenario.sources
     ss = np.random.SeedSequence(seed)
     g_xy, g_h, g_m, g_v, g_vz, g_w = (np.random.default_rng(c) for c in ss.spawn(6))
-    xy = sample_sources(sd, scenario.terrain, g_xy, n)
+    per_point = any(v is not None for v in (sd.point_velocity, sd.point_mass, sd.point_radius))
+    if per_point:                          # the same draw as sample_sources makes for points
+        idx = source_point_index(sd, g_xy, n)
+        xy = sd.points[idx]
+    else:
+        xy = sample_sources(sd, scenario.terrain, g_xy, n)
     x, y = xy[:, 0].copy(), xy[:, 1].copy()
     h = sd.height_m.sample(g_h, n)
-    mass = sd.mass_kg.sample(g_m, n) if masses_kg is None else check_masses(masses_kg, n).copy()
-    speed = sd.speed_ms.sample(g_v, n)
-    ux, uy = fall_line(scenario.terrain, x, y)
-    return {"x": x, "y": y, "z": scenario.terrain.elevation(x, y) + h, "vx": speed * ux, "vy": speed * uy,
-            "vz": sd.vz_ms.sample(g_vz, n), "w": sd.angular_velocity_rads.sample(g_w, n), "mass": mass,
-            "radius": sd.radius(mass), "inertia_factor": np.full(n, sd.inertia_factor)}
+    if masses_kg is not None:
+        mass = check_masses(masses_kg, n).copy()
+    elif sd.point_mass is not None:
+        mass = sd.point_mass[idx]
+    else:
+        mass = sd.mass_kg.sample(g_m, n)
+    if sd.point_velocity is not None:
+        vx, vy, vz = sd.point_velocity[idx].T.copy()
+    else:
+        speed = sd.speed_ms.sample(g_v, n)
+        ux, uy = fall_line(scenario.terrain, x, y)
+        vx, vy, vz = speed * ux, speed * uy, sd.vz_ms.sample(g_vz, n)
+    # a per-point radius belongs to the point's own mass: masses given here take the radius from mass and density
+    radius = sd.point_radius[idx] if sd.point_radius is not None and masses_kg is None else sd.radius(mass)
+    return {"x": x, "y": y, "z": scenario.terrain.elevation(x, y) + h, "vx": vx, "vy": vy, "vz": vz,
+            "w": sd.angular_velocity_rads.sample(g_w, n), "mass": mass, "radius": radius,
+            "inertia_factor": np.full(n, sd.inertia_factor)}
 
 
 def _collector_segments(scenario: TerrainScenario):

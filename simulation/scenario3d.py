@@ -31,6 +31,9 @@ collectors, read from TOML.
     speed_ms = 0.5                   # initial horizontal speed along the local fall line [m/s]
     vz_ms = 0.0
     angular_velocity_rads = 0.0
+    # with points (given or from a file), each point's own release state instead (one entry per point, or one
+    # for all): velocity_ms = [[vx, vy, vz], ...] [m/s] (direction as well as speed; replaces speed_ms and
+    # vz_ms), mass_kg = [m1, m2, ...] [kg], radius_m = [r1, r2, ...] [m] (default: from mass, density, shape)
 
     [[collectors]]                   # polylines in plan: crossings are recorded (position along the line,
     name = "road"                    # velocity, height above ground, mass)
@@ -87,6 +90,11 @@ class Sources:
     cells: np.ndarray | None = field(repr=False, default=None)
     threshold: object = None
     basis: str = ""
+    #: Per release point (with ``points`` only; None: the distributions above): velocity (n, 3) [m/s], mass (n,)
+    #: [kg] and radius (n,) [m].
+    point_velocity: np.ndarray | None = field(repr=False, default=None)
+    point_mass: np.ndarray | None = field(repr=False, default=None)
+    point_radius: np.ndarray | None = field(repr=False, default=None)
 
     def radius(self, mass):
         """Radius [m] of spheres (or cylinders of aspect ratio 1) of the given masses [kg].
@@ -434,8 +442,8 @@ def _parse_sources(sd: dict, terrain: Terrain, base: Path, nodata_rule: str, sou
         The checked sources.
     """
     _check_keys(sd, {"points", "polygon", "line", "file", "layer", "slope_above_deg", "slope_units", "height_m",
-                     "mass_kg", "density_kg_m3", "speed_ms", "vz_ms", "angular_velocity_rads", "shape"}, "sources.",
-                source)
+                     "mass_kg", "density_kg_m3", "speed_ms", "vz_ms", "angular_velocity_rads", "shape",
+                     "velocity_ms", "radius_m"}, "sources.", source)
     geometry = [k for k in ("points", "polygon", "line", "file") if k in sd]
     slope_rule = "slope_above_deg" in sd
     if len(geometry) > 1 or (not geometry and not slope_rule):
@@ -453,10 +461,14 @@ def _parse_sources(sd: dict, terrain: Terrain, base: Path, nodata_rule: str, sou
     shape = sd.get("shape", "sphere")
     if shape not in INERTIA_FACTORS:
         raise ScenarioError(f"{source}: sources.shape = {shape!r} is not one of {sorted(INERTIA_FACTORS)}")
+    height = Distribution.parse(sd.get("height_m", 1.0), "sources.height_m", source, lo=0.0, hi=1e4)
+    per_point = _point_states(sd, places["points"], terrain, height, source)
     return Sources(
-        **places,
-        height_m=Distribution.parse(sd.get("height_m", 1.0), "sources.height_m", source, lo=0.0, hi=1e4),
-        mass_kg=Distribution.parse(sd["mass_kg"], "sources.mass_kg", source, lo=0.0, hi=1e9, lo_open=True),
+        **places, **per_point,
+        height_m=height,
+        mass_kg=(Distribution("constant", {"value": float(per_point["point_mass"].mean())})
+                 if per_point["point_mass"] is not None else
+                 Distribution.parse(sd["mass_kg"], "sources.mass_kg", source, lo=0.0, hi=1e9, lo_open=True)),
         density_kg_m3=_number(sd.get("density_kg_m3", DEFAULT_DENSITY_KG_M3), "sources.density_kg_m3", source,
                               lo=DENSITY_RANGE_KG_M3[0], hi=DENSITY_RANGE_KG_M3[1]),
         speed_ms=Distribution.parse(sd.get("speed_ms", 0.0), "sources.speed_ms", source, lo=0.0, hi=200),
@@ -464,6 +476,69 @@ def _parse_sources(sd: dict, terrain: Terrain, base: Path, nodata_rule: str, sou
         angular_velocity_rads=Distribution.parse(sd.get("angular_velocity_rads", 0.0),
                                                  "sources.angular_velocity_rads", source, lo=-1e3, hi=1e3),
         shape=shape)
+
+
+def _per_point(value, n: int, width: int, where: str, source: str, *, positive: bool) -> np.ndarray:
+    """A per-point field: one entry per release point, or a single entry for all; (n,) or (n, 3) floats."""
+    what = "numbers" if width == 1 else "[vx, vy, vz] triples [m/s]"
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"{source}: {where} must be {what}, one per release point or one for all; got "
+                            f"{value!r}") from None
+    one = a.ndim == (0 if width == 1 else 1)
+    if one:
+        a = np.broadcast_to(a, (n,) if width == 1 else (n, width)).copy()
+    if a.shape != ((n,) if width == 1 else (n, width)):
+        raise ScenarioError(f"{source}: {where} must be {what}, one per release point ({n}) or one for all; got "
+                            f"shape {np.shape(value)}")
+    bad = ~np.isfinite(a) if width == 1 else ~np.isfinite(a).all(axis=1)
+    if positive:
+        bad |= ~(a > 0)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ScenarioError(f"{source}: {where}[{i}] = {a[i].tolist()} must be a finite number"
+                            + (" > 0" if positive else "") + f" (release point {i + 1})")
+    return a
+
+
+def _point_states(sd: dict, points, terrain: Terrain, height: Distribution, source: str) -> dict:
+    """Per-point release states of ``[sources]`` (``velocity_ms`` triples, a ``mass_kg`` list, ``radius_m``),
+    checked before any work: one per release point (or one for all), radius > 0, and a velocity that does not
+    point into the ground where a block can start on it (release height 0)."""
+    out = {"point_velocity": None, "point_mass": None, "point_radius": None}
+    listed_mass = isinstance(sd.get("mass_kg"), (list, tuple))
+    wanted = [k for k, on in (("velocity_ms", "velocity_ms" in sd), ("mass_kg", listed_mass),
+                              ("radius_m", "radius_m" in sd)) if on]
+    if not wanted:
+        return out
+    if points is None:
+        raise ScenarioError(f"{source}: sources.{wanted[0]} gives each release point its own value: it needs "
+                            "sources.points (or a file of points), not a polygon, line or slope rule")
+    n = len(points)
+    if "velocity_ms" in sd:
+        clash = [k for k in ("speed_ms", "vz_ms") if k in sd]
+        if clash:
+            raise ScenarioError(f"{source}: sources.velocity_ms gives the whole release velocity; remove "
+                                f"sources.{clash[0]} (speed_ms and vz_ms are for releases along the fall line)")
+        v = _per_point(sd["velocity_ms"], n, 3, "sources.velocity_ms", source, positive=False)
+        gx, gy = terrain.gradient(points[:, 0], points[:, 1])
+        normal = (-gx * v[:, 0] - gy * v[:, 1] + v[:, 2]) / np.sqrt(1 + gx ** 2 + gy ** 2)
+        p = height.params
+        can_touch = (height.kind == "constant" and p["value"] == 0) or p.get("low", 1.0) == 0
+        into = (normal < -1e-9 * (1 + np.linalg.norm(v, axis=1))) & can_touch
+        if into.any():
+            i = int(np.flatnonzero(into)[0])
+            raise ScenarioError(f"{source}: sources.velocity_ms[{i}] = {v[i].tolist()} m/s points into the ground at "
+                                f"release point {i + 1} ({points[i, 0]:g}, {points[i, 1]:g}): its component along the "
+                                f"ground's normal is {normal[i]:.3g} m/s and the block can start on the ground "
+                                "(height_m 0). Check the sign of vz, or give height_m > 0 for a block thrown down")
+        out["point_velocity"] = v
+    if listed_mass:
+        out["point_mass"] = _per_point(sd["mass_kg"], n, 1, "sources.mass_kg", source, positive=True)
+    if "radius_m" in sd:
+        out["point_radius"] = _per_point(sd["radius_m"], n, 1, "sources.radius_m", source, positive=True)
+    return out
 
 
 def _parse_collectors(tables, source: str) -> tuple:
@@ -676,6 +751,25 @@ def _in_polygon(poly: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return inside
 
 
+def source_point_index(sources: Sources, rng: np.random.Generator, n: int) -> np.ndarray:
+    """Which release point each of n blocks starts from (uniform among ``sources.points``).
+
+    Parameters
+    ----------
+    sources : Sources
+        Sources given as points.
+    rng : numpy.random.Generator
+        Random generator (the one :func:`sample_sources` uses).
+    n : int
+        Number of blocks.
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (n,)
+    """
+    return rng.integers(0, len(sources.points), n)
+
+
 def sample_sources(sources: Sources, terrain: Terrain, rng: np.random.Generator, n: int) -> np.ndarray:
     """n plan release points (n, 2): uniform among ``points``, or uniform inside ``polygon`` (rejection
     sampling in its bounding box; points on nodata holes are rejected too).
@@ -697,7 +791,7 @@ def sample_sources(sources: Sources, terrain: Terrain, rng: np.random.Generator,
         Plan release points (x, y) [m], shape (n, 2).
     """
     if sources.points is not None:
-        return sources.points[rng.integers(0, len(sources.points), n)]
+        return sources.points[source_point_index(sources, rng, n)]
     if sources.lines is not None:
         segs = np.concatenate([np.stack([ln[:-1], ln[1:]], axis=1) for ln in sources.lines])
         length = np.hypot(*(segs[:, 1] - segs[:, 0]).T)

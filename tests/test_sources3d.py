@@ -137,3 +137,62 @@ def test_sources_from_vector_files(tmp_path):
         _sc({"file": "far.gpkg"}, base=tmp_path)
     with pytest.raises(ScenarioError, match="needs exactly one of points"):
         _sc({"file": "pts.gpkg", "points": [[10, 10]]}, base=tmp_path)
+
+
+# ---- each release point's own state: velocity vector, mass, radius ------------------------------------------------
+PLANE = Terrain.from_function(lambda x, y: 0.2 * (200 - x), (0, 200), (0, 200), 1.0)    # 11.3 deg, fall line +x
+SMOOTH = {"rock": {"normal_restitution": 0.3, "tangential": {"law": "constant", "mean": 0.8}, "roughness_m": 0.0,
+                   "ground_friction_angle_deg": 9.0}}
+
+
+def test_a_release_velocity_sets_the_direction_not_only_the_fall_line():
+    """On a plane whose fall line is +x, a block launched with a cross-slope velocity is carried to the side of its
+    release point; with speed_ms it goes straight down the fall line."""
+    import simulation
+    base = {"terrain": {}, "materials": SMOOTH, "collectors": []}
+    src = {"points": [[20.0, 100.0]], "height_m": 0.5, "mass_kg": 500}
+    down = terrain_scenario_from_dict({**base, "sources": {**src, "speed_ms": 4.0}}, terrain=PLANE)
+    side = terrain_scenario_from_dict({**base, "sources": {**src, "velocity_ms": [[2.0, 8.0, 0.0]]}}, terrain=PLANE)
+    b = seed_blocks_3d(side, 3, seed=1)
+    assert b["vx"].tolist() == [2.0] * 3 and b["vy"].tolist() == [8.0] * 3 and b["vz"].tolist() == [0.0] * 3
+    y_down = simulation.run_terrain(down, 20, seed=1).stops()["y_m"]
+    y_side = simulation.run_terrain(side, 20, seed=1).stops()["y_m"]
+    assert np.abs(y_down - 100).max() < 1.0
+    assert (y_side > 105).all()                                   # carried to +y: the direction is honoured
+
+
+def test_each_release_point_gets_its_own_mass_and_radius():
+    sc = _sc({"points": [[150.0, 20.0], [150.0, 80.0]], "mass_kg": [50.0, 2000.0], "radius_m": [0.2, 0.6]})
+    b = seed_blocks_3d(sc, 400, seed=3)
+    near = b["y"] < 50
+    assert set(b["mass"][near]) == {50.0} and set(b["mass"][~near]) == {2000.0}
+    assert set(b["radius"][near]) == {0.2} and set(b["radius"][~near]) == {0.6}
+    assert 150 < near.sum() < 250                                 # points chosen uniformly
+    # masses given by the caller (the mass coupling) keep the radius of their own mass
+    given = seed_blocks_3d(sc, 4, seed=3, masses_kg=np.full(4, 1000.0))
+    assert np.allclose(given["radius"], sc.sources.radius(1000.0))
+    # without per-point fields the draw is the one of before (same points for the same seed)
+    plain = _sc({"points": [[150.0, 20.0], [150.0, 80.0]]})
+    assert np.array_equal(seed_blocks_3d(plain, 400, seed=3)["y"], b["y"])
+
+
+@pytest.mark.parametrize("sources, message", [
+    ({"points": [[150.0, 20.0]], "radius_m": [0.0]}, r"x.toml: sources.radius_m\[0\] = 0.0 must be a finite number > 0"),
+    ({"points": [[150.0, 20.0]], "radius_m": -0.3}, r"sources.radius_m\[0\] = -0.3 must be a finite number > 0"),
+    ({"points": [[150.0, 20.0], [150.0, 50.0]], "mass_kg": [10.0, 20.0, 30.0]},
+     r"sources.mass_kg must be numbers, one per release point \(2\) or one for all; got shape \(3,\)"),
+    ({"points": [[150.0, 20.0]], "height_m": 0.0, "velocity_ms": [1.0, 0.0, -2.0]},
+     r"sources.velocity_ms\[0\] = \[1.0, 0.0, -2.0\] m/s points into the ground at release point 1 \(150, 20\)"),
+    ({"points": [[150.0, 20.0]], "velocity_ms": [[1.0, 0.0]]}, r"sources.velocity_ms must be \[vx, vy, vz\] triples"),
+    ({"points": [[150.0, 20.0]], "velocity_ms": [1.0, 0.0, 0.0], "speed_ms": 2.0}, r"remove sources.speed_ms"),
+    ({"polygon": [[130, 10], [160, 10], [160, 40]], "velocity_ms": [1.0, 0.0, 0.0]},
+     r"sources.velocity_ms gives each release point its own value: it needs sources.points"),
+])
+def test_bad_release_states_are_refused_with_file_and_field(sources, message):
+    with pytest.raises(ScenarioError, match=message):
+        terrain_scenario_from_dict({"terrain": {}, "materials": MATS, "sources": {"mass_kg": 500, **sources}},
+                                   "x.toml", terrain=CLIFF)
+    # a block thrown down from above the ground is allowed
+    terrain_scenario_from_dict({"terrain": {}, "materials": MATS, "sources": {
+        "mass_kg": 500, "points": [[150.0, 20.0]], "height_m": 2.0, "velocity_ms": [1.0, 0.0, -2.0]}},
+        "x.toml", terrain=CLIFF)
