@@ -840,6 +840,11 @@ def cmd_corridor(args) -> int:
         print(f"riskrf corridor: error: --budget = {args.budget:g} must be a finite amount >= 0 (in the corridor's "
               "currency)", file=sys.stderr)
         return 2
+    if args.gdf is not None and not (math.isfinite(args.gdf) and args.gdf >= 1):
+        print(f"riskrf corridor: error: --gdf = {args.gdf:g} must be a number >= 1 (the ALARP gross-disproportion "
+              "factor: a section is funded while its cost is at most GDF times what it is worth at the VSL; it "
+              "overrides [criteria] disproportion_factor of the corridor file)", file=sys.stderr)
+        return 2
     corridor = load_corridor(args.corridor, keep_going=args.keep_going, sheet=args.sheet,   # every row checked
                              header_row=args.header_row, decimal=args.decimal, encoding=args.encoding)
     for e in corridor.errors:
@@ -866,7 +871,7 @@ def cmd_corridor(args) -> int:
             print(f"finished sections are kept in {parts}; rerun with --resume to skip them", file=sys.stderr)
         return 2
     write_corridor(res, out, overwrite=args.overwrite, budget=args.budget, budget_basis=args.budget_basis,
-                   objective=args.objective)
+                   objective=args.objective, gdf=args.gdf)
     shutil.rmtree(parts, ignore_errors=True)        # the run is complete: its partitions are in sections.csv
     for f in res.failures:
         print(f"failed: {f}")
@@ -878,11 +883,18 @@ def cmd_corridor(args) -> int:
               f"best: {r['best_option']} ({r['best_option_capital']:,.0f} {corridor.currency})")
     if args.budget is not None:
         import json
-        p = json.loads((out / "summary.json").read_text(encoding="utf-8"))["programme"]
+        summ = json.loads((out / "summary.json").read_text(encoding="utf-8"))
         caps = "capital" if args.budget_basis == "total" else "equivalent annual cost"
-        print(f"Programme within {args.budget:,.0f} {corridor.currency} of {caps}: {p['sections_funded']} sections "
-              f"funded for {p['cost']:,.0f} {corridor.currency}, {p['maximised'].replace('_', ' ')} "
-              f"{p['benefit']:.4g} (programme.csv, frontier.png)")
+        for label, p in (("Programme", summ["programme"]), ("Beside it", summ["other_programme"])):
+            gdf = f", GDF {p['gross_disproportion_factor']:g}" if p["gross_disproportion_factor"] else ""
+            bc = p["median_benefit_cost_ratio"]
+            req = (f"; {len(p['required_by_tolerability'])} required by tolerability"
+                   if p["required_by_tolerability"] else "")
+            print(f"{label} ({p['objective']}{gdf}) within {args.budget:,.0f} {corridor.currency} of {caps}: "
+                  f"{p['sections_funded']} sections funded for {p['cost']:,.0f} {corridor.currency}"
+                  + (f", median benefit/cost {bc:.2g}" if bc is not None else "") + req
+                  + f", {p['maximised'].replace('_', ' ')} {p['benefit']:.4g}")
+        print(summ["programme"]["disagreement"] + " (programme.csv, frontier.png)")
     extra = ", sections.gpkg, map.png" if corridor.centreline is not None else ""
     print(f"Report: {(out / 'report.html').resolve()} (also corridor.csv, sections.csv{extra}, budget_curve.csv, "
           "chainage.png, rating_sheets.html, summary.json)")
@@ -1313,8 +1325,15 @@ def _add_corridor_parser(sub) -> None:
     p.add_argument("--budget-basis", choices=("total", "year"), default="total",
                    help="what --budget caps: 'total' the capital paid now (default), 'year' the equivalent annual "
                         "cost (present value of capital, renewals and maintenance as a level cost per year)")
-    p.add_argument("--objective", choices=("risk", "cost"), default="risk",
-                   help="'risk': maximise deaths avoided per year (default); 'cost': minimise the expected total cost")
+    p.add_argument("--objective", choices=("alarp", "risk", "cost"), default="alarp",
+                   help="'alarp' (default): fund the sections above the intolerable individual-risk line whatever "
+                        "they cost, then maximise the net benefit at the corridor's VSL with the gross-disproportion "
+                        "factor (--gdf); 'risk': maximise deaths avoided per year; 'cost': minimise the expected "
+                        "total cost.  The other objective's programme is reported beside it")
+    p.add_argument("--gdf", type=float, default=None, metavar="FACTOR",
+                   help="ALARP gross-disproportion factor (>= 1) of --objective alarp: fund a section while its cost "
+                        "is at most FACTOR times what it is worth at the VSL (default: [criteria] "
+                        "disproportion_factor of the corridor file, else 1)")
     _add_reader_arguments(p, "the sections table", "corridor.sections_")
     p.set_defaults(func=cmd_corridor)
 

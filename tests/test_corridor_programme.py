@@ -73,12 +73,12 @@ def test_programme_on_section_results_is_the_brute_force_best(result):
     caps = opts.set_index("id")["capital"]
     avoided = opts.set_index("id")["deaths_avoided_per_year"]
     for budget in (0.0, caps.min(), caps.sum() - caps.min(), caps.sum()):
-        p = result.programme(budget)
+        p = result.programme(budget, objective="risk")          # the old default, by name
         best = max((sum(avoided[list(s)]), -sum(caps[list(s)]))          # every subset of the three sections
                    for k in range(4) for s in __import__("itertools").combinations(caps.index, k)
                    if sum(caps[list(s)]) <= budget + 1e-9 and all(avoided[list(s)] > 0))
         assert p.benefit == pytest.approx(best[0], rel=1e-9, abs=1e-15) and p.cost == pytest.approx(-best[1])
-    yearly = result.programme(opts["equivalent_annual_cost"].sum(), basis="year")
+    yearly = result.programme(opts["equivalent_annual_cost"].sum(), basis="year", objective="risk")
     assert len(yearly.chosen) == (opts["deaths_avoided_per_year"] > 0).sum()
     with pytest.raises(ValueError, match="budget basis = 'month'"):
         result.programme(1.0, basis="month")
@@ -87,7 +87,7 @@ def test_programme_on_section_results_is_the_brute_force_best(result):
 def test_write_outputs_gpkg_and_csv_agree(result, tmp_path):
     out = tmp_path / "out"
     budget = float(result.options_table()["capital"].min())
-    cr.write_corridor(result, out, budget=budget)
+    cr.write_corridor(result, out, budget=budget, objective="risk")
     for f in ("report.html", "sections.csv", "sections.gpkg", "map.png", "programme.csv", "frontier.csv",
               "frontier.png", "rating_sheets.html", "chainage.png", "summary.json"):
         assert (out / f).exists(), f
@@ -106,8 +106,11 @@ def test_write_outputs_gpkg_and_csv_agree(result, tmp_path):
     np.testing.assert_allclose(xy[[0, -1]], [[220200, 6915000], [220300, 6915050]])
     prog = pd.read_csv(out / "programme.csv").fillna({"programme_option": ""})
     assert (prog["programme_option"] != "").sum() == 1 and prog["programme_capital"].sum() <= budget + 1e-6
-    s = json.loads((out / "summary.json").read_text())["programme"]
-    assert s["budget_caps"] == "capital" and s["sections_funded"] == 1
+    summ = json.loads((out / "summary.json").read_text())
+    s = summ["programme"]
+    assert s["budget_caps"] == "capital" and s["sections_funded"] == 1 and s["objective"] == "risk"
+    assert summ["other_programme"]["objective"] == "alarp" and s["disagreement"]
+    assert "other_programme_option_alarp" in prog.columns
     html = (out / "report.html").read_text()
     assert "Programme within the budget" in html and "<b>Capital</b>" in html and "sections.gpkg" in html
     sheets = (out / "rating_sheets.html").read_text()
@@ -177,3 +180,95 @@ def test_cli_refuses_a_bad_budget_before_any_work(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["corridor", str(DATA / "small.toml"), "--budget", "-5", "--out", str(out)]) == 2
     assert "--budget = -5 must be a finite amount >= 0" in capsys.readouterr().err and not out.exists()
+
+
+# ---- the default objective: tolerability first, then net benefit at the VSL with the GDF (issue 40 item 4) -----
+def _fake(result, rows):
+    """The small corridor's result with a made-up table: ``rows`` of (id, individual risk of doing nothing,
+    [(option, capital, deaths per year, individual risk, expected total cost)]); doing nothing costs 1e6 of
+    expected loss and kills 1e-4 a year on every section.  No simulation: the programme only reads the table."""
+    recs = []
+    for k, (sid, ir, opts) in enumerate(rows):
+        js = [{"option": "do nothing", "kind": "none", "capital": 0.0, "pv_renewals": 0.0, "pv_maintenance": 0.0,
+               "deaths_per_year": 1e-4, "individual_risk": ir, "expected_total_cost": 1e6, "meets_criteria": True}]
+        js += [{"option": o, "kind": "fence", "capital": c, "pv_renewals": 0.0, "pv_maintenance": 0.0,
+                "deaths_per_year": d, "individual_risk": i, "expected_total_cost": e, "meets_criteria": True}
+               for o, c, d, i, e in opts]
+        rec = result.table.iloc[k % len(result.table)].to_dict()      # every other column from a real row
+        rec.update({"id": sid, "chainage_from_m": 100.0 * k, "chainage_to_m": 100.0 * k + 100, "length_m": 100.0,
+                    "deaths_per_year": 1e-4, "individual_risk": ir, "do_nothing_total_cost": 1e6,
+                    "options_json": json.dumps(js)})
+        recs.append(rec)
+    return replace(result, table=pd.DataFrame(recs), corridor=replace(result.corridor, centreline=None))
+
+
+#: (id, IR now, options): loss avoided / cost = (1e6 - (etc - c)) / c for each option
+ROWS = [("P", 5e-4, [("cheap", 50_000.0, 9e-5, 4e-4, 1.01e6),        # does not reach the 1e-4 line
+                     ("safe", 900_000.0, 1e-6, 5e-6, 1.85e6)]),     # reaches it; worth 0.05 of its cost
+        ("Q", 1e-6, [("f", 200_000.0, 1e-5, 1e-7, 0.5e6)]),          # worth 3.5x its cost
+        ("R", 1e-6, [("f", 400_000.0, 1e-5, 1e-7, 1.2e6)]),          # worth 0.5 of its cost
+        ("S", 1e-6, [("f", 300_000.0, 1e-5, 1e-7, 1.05e6)])]         # worth 0.83 of its cost
+
+
+def test_default_programme_funds_the_intolerable_first_then_only_what_is_worth_it(result):
+    res = _fake(result, ROWS)
+    assert res.required_sections() == {"P": ["safe"]}                # HK GEO existing slope: 1e-4 /yr
+    for budget in (0.0, 1.0e6, 5.0e6):
+        for gdf in (1.0, 1.5, 2.5):
+            p = res.programme(budget, gdf=gdf)
+            ch = p.chosen.set_index("id")
+            assert ch.loc["P", "option"] == "safe" and bool(ch.loc["P", "required_by_tolerability"])
+            assert p.overrun == pytest.approx(max(0.0, p.cost - budget))
+            others = ch.drop(index="P")
+            assert (others["benefit_cost_ratio"] >= 1 / gdf).all()     # the Must-show, with the GDF
+            # brute force over Q, R, S with the money left: the best sum of gdf * B - C
+            left = max(budget - 900_000.0, 0.0)
+            best = max(sum(gdf * (1e6 - dict(zip("QRS", (0.5e6, 1.2e6, 1.05e6)))[s] + c) - c
+                           for s, c in zip("QRS", (2e5, 4e5, 3e5)) if s in sub)
+                       for k in range(4) for sub in __import__("itertools").combinations("QRS", k)
+                       if sum(dict(zip("QRS", (2e5, 4e5, 3e5)))[s] for s in sub) <= left
+                       and all(gdf * (1e6 - dict(zip("QRS", (0.5e6, 1.2e6, 1.05e6)))[s] + c) > c
+                               for s, c in zip("QRS", (2e5, 4e5, 3e5)) if s in sub)) if left > 0 else 0
+            assert others["alarp_net_benefit"].sum() == pytest.approx(best, abs=1e-6)
+    # at 0 budget only the required section, paid beyond the budget; at GDF 1.5 (1/GDF 0.67) with money S (worth
+    # 0.83 of its cost) but not R (0.5); at GDF 2.5 (0.4) R too
+    assert list(res.programme(0.0).chosen["id"]) == ["P"] and res.programme(0.0).overrun == 900_000.0
+    assert set(res.programme(5e6, gdf=1.5).chosen["id"]) == {"P", "Q", "S"}
+    assert set(res.programme(5e6, gdf=2.5).chosen["id"]) == {"P", "Q", "R", "S"}
+    assert set(res.programme(5e6, gdf=1.0).chosen["id"]) == {"P", "Q"}
+    # the old objective, by name: no tolerability step, deaths avoided (funds R and S too)
+    assert set(res.programme(5e6, objective="risk").chosen["id"]) == {"P", "Q", "R", "S"}
+    cmp = res.compare_programmes(res.programme(1.5e6), res.programme(1.5e6, objective="risk"))
+    assert cmp["only_other"] and "Where they disagree" in cmp["line"]
+
+
+def test_outputs_name_the_other_programme(result, tmp_path):
+    res = _fake(result, ROWS)
+    cr.write_corridor(res, tmp_path / "o", budget=1.5e6, gdf=2.5)
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    p, o = s["programme"], s["other_programme"]
+    assert p["objective"] == "alarp" and p["gross_disproportion_factor"] == 2.5 and o["objective"] == "risk"
+    assert p["required_by_tolerability"] == ["P"] and p["disagreement"].startswith("Where they disagree")
+    assert all(f["benefit_cost_ratio"] >= 1 / 2.5 or f["required_by_tolerability"] for f in p["funded"])
+    html = (tmp_path / "o" / "report.html").read_text()
+    assert "objective &#x27;risk&#x27;" in html or "objective 'risk'" in html
+    assert "intolerable individual-risk line" in html and "Where they disagree" in html
+    prog = pd.read_csv(tmp_path / "o" / "programme.csv")
+    assert set(prog.loc[prog["programme_required_by_tolerability"], "id"]) == {"P"}
+    assert "other_programme_option_risk" in prog.columns
+
+
+def test_gdf_below_one_is_refused_naming_file_field_and_argument(result, tmp_path, capsys):
+    toml = (DATA / "small.toml").read_text().replace('sections = "small_sections.csv"',
+                                                      f'sections = "{DATA / "small_sections.csv"}"')
+    (tmp_path / "g.toml").write_text(toml + "\n[criteria]\ndisproportion_factor = 0.5\n")
+    with pytest.raises(cr.CorridorError, match=r"g.toml: criteria.disproportion_factor = 0.5 must be a number >= 1"):
+        cr.load_corridor(tmp_path / "g.toml")
+    (tmp_path / "g3.toml").write_text(toml + "\n[criteria]\ndisproportion_factor = 3\n")
+    assert cr.load_corridor(tmp_path / "g3.toml").study["criteria"].disproportion_factor == 3
+    with pytest.raises(ValueError, match=r"gdf = 0.9 must be a number >= 1"):
+        _fake(result, ROWS).programme(1e6, gdf=0.9)
+    from riskrf.cli import main
+    out = tmp_path / "out"
+    assert main(["corridor", str(DATA / "small.toml"), "--budget", "1e6", "--gdf", "0.5", "--out", str(out)]) == 2
+    assert "--gdf = 0.5 must be a number >= 1" in capsys.readouterr().err and not out.exists()

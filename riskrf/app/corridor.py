@@ -1057,6 +1057,28 @@ def _cross_row_errors(sections: list, tsrc: str, errors: list, bad_rows: set) ->
     return ordered
 
 
+def _check_corridor_gdf(gdf, where: str) -> float:
+    """The programme's gross-disproportion factor (>= 1), or a :class:`CorridorError` naming ``where`` and the value.
+
+    Parameters
+    ----------
+    gdf : float
+        Gross-disproportion factor [-].
+    where : str
+        File and field (``corridor.toml: criteria.disproportion_factor``) or the CLI argument (``--gdf``).
+
+    Returns
+    -------
+    float
+        The factor.
+    """
+    from ..risk.programme import check_gdf
+    try:
+        return check_gdf(gdf, where)
+    except ValueError as exc:
+        raise CorridorError(str(exc)) from None
+
+
 def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int | None = None,
                   decimal: str | None = None, encoding: str | None = None) -> Corridor:
     """Read and check a corridor file and its sections table before any work.
@@ -1107,6 +1129,7 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     materials, settings, template_path = _materials_template(data.get("materials", {}), path, src)
     # study inputs: the mitigation tables, with per-metre costs set aside per option
     options, study, used = _corridor_options(data, src)
+    _check_corridor_gdf(study["criteria"].disproportion_factor, f"{src}: criteria.disproportion_factor")
 
     df, file_rows, tsrc = _read_sections_table((path.parent / cor["sections"]).resolve(), cs["reader"])
     default_seeder = {"dist": "lognormal", "median": float(gr.m_min) * 2, "sigma": 1.0,
@@ -1625,7 +1648,10 @@ class CorridorResult:
         Money in the corridor currency: ``capital`` (paid now), ``present_value`` (capital + renewals +
         maintenance discounted at the corridor's rate over its horizon), ``equivalent_annual_cost``
         (present_value / annuity factor (1 - (1 + r)^-n) / r: the same money as a level cost per year);
-        ``deaths_avoided_per_year`` and ``expected_total_cost_saving`` against the section's do-nothing option.
+        ``deaths_avoided_per_year`` and ``expected_total_cost_saving`` against the section's do-nothing option;
+        ``loss_avoided`` (present value of the expected losses avoided, deaths at the VSL included: saving +
+        present_value) and ``benefit_cost_ratio`` (loss_avoided / present_value [-],
+        :func:`riskrf.risk.programme.benefit_cost_ratio`).
 
         Returns
         -------
@@ -1650,15 +1676,57 @@ class CorridorResult:
         cols = ["id", "option", "kind", "capital", "present_value", "equivalent_annual_cost", "deaths_per_year",
                 "deaths_avoided_per_year", "expected_total_cost", "expected_total_cost_saving", "individual_risk",
                 "meets_criteria"]
-        return pd.DataFrame(rows, columns=cols)
+        t = pd.DataFrame(rows, columns=cols)
+        from ..risk.programme import benefit_cost_ratio
+        t["loss_avoided"] = t["expected_total_cost_saving"] + t["present_value"]
+        t["benefit_cost_ratio"] = benefit_cost_ratio(t["expected_total_cost_saving"], t["present_value"])
+        return t
 
-    def programme(self, budget: float, *, basis: str = "total", objective: str = "risk"):
+    @property
+    def gdf(self) -> float:
+        """The corridor's ALARP gross-disproportion factor [-] (``[criteria] disproportion_factor``, default 1)."""
+        return float(self.corridor.study["criteria"].disproportion_factor)
+
+    def required_sections(self) -> dict:
+        """Sections above the intolerable individual-risk line, and the options that bring each below it.
+
+        The line is the criteria's ``individual_risk_per_year`` (the limit in force, e.g. 1e-4 /yr for an existing
+        slope under Hong Kong GEO Report 75 (1998)).  A section whose do-nothing individual risk exceeds it must be
+        funded whatever it costs, by an option whose individual risk is at most the limit; where no option reaches
+        it, by the options of least individual risk (the best it can be made).
+
+        Returns
+        -------
+        dict
+            ``{section id: [option names]}``, by chainage.
+        """
+        lim = float(self.corridor.study["criteria"].individual_risk_per_year)
+        opts = self.options_table()
+        out = {}
+        for _, r in self.table.iterrows():
+            if not float(r.get("individual_risk", 0.0) or 0.0) > lim:
+                continue
+            o = opts[opts["id"] == r["id"]]
+            if not len(o):
+                continue
+            ok = o[o["individual_risk"] <= lim]
+            if not len(ok):
+                ok = o[o["individual_risk"] <= o["individual_risk"].min() * (1 + 1e-12)]
+            out[r["id"]] = list(ok["option"])
+        return out
+
+    def programme(self, budget: float, *, basis: str = "total", objective: str = "alarp", gdf: float | None = None):
         """The best programme within ``budget`` (:func:`riskrf.risk.programme.optimise_programme`, exact MILP).
 
         ``basis``: ``"total"`` -- the budget caps the summed capital of the chosen options (money paid now);
         ``"year"`` -- it caps their summed equivalent annual cost (present value of capital, renewals and
-        maintenance spread as a level yearly cost at the discount rate).  ``objective``: ``"risk"`` maximises
-        deaths avoided per year, ``"cost"`` minimises the corridor's expected total cost.
+        maintenance spread as a level yearly cost at the discount rate).
+
+        ``objective``: ``"alarp"`` (default) first funds the sections above the intolerable individual-risk line
+        whatever they cost (:meth:`required_sections`), then maximises the net benefit at the corridor's VSL with
+        the gross-disproportion factor ``gdf`` (:func:`riskrf.risk.programme.alarp_net_benefit`): every other
+        funded option is worth at least 1/GDF of its present value.  ``"risk"`` maximises deaths avoided per year
+        and ``"cost"`` minimises the corridor's expected total cost (both as before, without the tolerability step).
 
         Parameters
         ----------
@@ -1667,18 +1735,27 @@ class CorridorResult:
         basis : str, optional
             ``"total"`` (capital) or ``"year"`` (equivalent annual cost).
         objective : str, optional
-            ``"risk"`` or ``"cost"``.
+            ``"alarp"``, ``"risk"`` or ``"cost"``.
+        gdf : float, optional
+            Gross-disproportion factor [-], >= 1 (default: the corridor's, :attr:`gdf`).
 
         Returns
         -------
         Programme
             The chosen option of each funded section and the programme's cost and benefit.
+
+        References
+        ----------
+        HSE (2001) Reducing risks, protecting people. HSE Books, para 140 and Appendix 3.
         """
         from ..risk.programme import optimise_programme
+        gdf = self.gdf if gdf is None else _check_corridor_gdf(gdf, "gdf")
         return optimise_programme(self.options_table(), budget, objective=objective,
-                                  cost_column=BUDGET_BASES[basis] if basis in BUDGET_BASES else _bad_basis(basis))
+                                  cost_column=BUDGET_BASES[basis] if basis in BUDGET_BASES else _bad_basis(basis),
+                                  gdf=gdf, required=self.required_sections() if objective == "alarp" else None)
 
-    def frontier(self, *, basis: str = "total", objective: str = "risk", points: int = 25, budgets=None):
+    def frontier(self, *, basis: str = "total", objective: str = "alarp", points: int = 25, budgets=None,
+                 gdf: float | None = None):
         """Efficient frontier: the best programme's benefit at each budget (exact at every point).
 
         Parameters
@@ -1686,11 +1763,13 @@ class CorridorResult:
         basis : str, optional
             ``"total"`` (capital) or ``"year"`` (equivalent annual cost).
         objective : str, optional
-            ``"risk"`` or ``"cost"``.
+            ``"alarp"``, ``"risk"`` or ``"cost"`` (see :meth:`programme`).
         points : int, optional
             Number of budgets (when ``budgets`` is not given).
         budgets : sequence of float, optional
             Budgets to solve at, in the corridor currency.
+        gdf : float, optional
+            Gross-disproportion factor [-] of ``"alarp"`` (default: the corridor's).
 
         Returns
         -------
@@ -1698,8 +1777,57 @@ class CorridorResult:
             The best benefit at each budget.
         """
         from ..risk.programme import efficient_frontier
+        gdf = self.gdf if gdf is None else _check_corridor_gdf(gdf, "gdf")
         return efficient_frontier(self.options_table(), budgets, objective=objective, points=points,
-                                  cost_column=BUDGET_BASES[basis] if basis in BUDGET_BASES else _bad_basis(basis))
+                                  cost_column=BUDGET_BASES[basis] if basis in BUDGET_BASES else _bad_basis(basis),
+                                  gdf=gdf, required=self.required_sections() if objective == "alarp" else None)
+
+    def compare_programmes(self, programme, other) -> dict:
+        """Where two programmes of the same budget differ, in numbers and in one line.
+
+        Parameters
+        ----------
+        programme : Programme
+            The programme recommended (e.g. objective ``"alarp"``).
+        other : Programme
+            The other objective's programme.
+
+        Returns
+        -------
+        dict
+            ``only_programme``, ``only_other`` and ``other_option`` (section ids funded by one only, or by both
+            with different options), the median benefit/cost [-] of each programme's funded options, and
+            ``line``: one sentence saying where they disagree.
+        """
+        a = programme.chosen.set_index("id")["option"]
+        b = other.chosen.set_index("id")["option"]
+        only_a = [i for i in self.table["id"] if i in a.index and i not in b.index]
+        only_b = [i for i in self.table["id"] if i in b.index and i not in a.index]
+        diff = [i for i in self.table["id"] if i in a.index and i in b.index and a[i] != b[i]]
+        name = {"alarp": f"net benefit at the VSL (GDF {programme.gdf:g})", "risk": "deaths avoided",
+                "cost": "expected total cost"}
+
+        def median_bc(p):
+            v = p.chosen["benefit_cost_ratio"] if "benefit_cost_ratio" in p.chosen else pd.Series(dtype=float)
+            return float(np.nanmedian(v)) if len(v.dropna()) else float("nan")
+
+        def ids(x):
+            return ", ".join(x[:6]) + (f" and {len(x) - 6} more" if len(x) > 6 else "")
+        bc_b = other.chosen.set_index("id")["benefit_cost_ratio"] if "benefit_cost_ratio" in other.chosen else {}
+        parts = []
+        if only_b:
+            worth = np.nanmedian([bc_b[i] for i in only_b]) if len(bc_b) else float("nan")
+            parts.append(f"the {name[other.objective]} programme also funds {len(only_b)} section(s) ({ids(only_b)}) "
+                         f"worth a median {worth:.2g} of their cost")
+        if only_a:
+            parts.append(f"only the {name[programme.objective]} programme funds {ids(only_a)}")
+        if diff:
+            parts.append(f"they choose different options on {ids(diff)}")
+        line = ("The two programmes agree." if not parts else
+                f"Where they disagree: {'; '.join(parts)}.")
+        return {"only_programme": only_a, "only_other": only_b, "other_option": diff,
+                "median_benefit_cost": median_bc(programme), "other_median_benefit_cost": median_bc(other),
+                "line": line}
 
     def programme_table(self, programme) -> pd.DataFrame:
         """Every section with the programme's choice: ``programme_option`` ("" = not funded: do nothing), its
@@ -1725,6 +1853,11 @@ class CorridorResult:
                                           for i, d in zip(t["id"], t["deaths_per_year"])]
         t["programme_expected_total_cost"] = [float(ch.loc[i, "expected_total_cost"]) if i in ch.index else d
                                               for i, d in zip(t["id"], t["do_nothing_total_cost"])]
+        if "benefit_cost_ratio" in ch:
+            t["programme_benefit_cost_ratio"] = [float(ch.loc[i, "benefit_cost_ratio"]) if i in ch.index else np.nan
+                                                 for i in t["id"]]
+        req = set(getattr(programme, "required", ()))
+        t["programme_required_by_tolerability"] = [i in req for i in t["id"]]
         return t
 
     def sections_table(self, programme=None) -> pd.DataFrame:
@@ -1923,17 +2056,59 @@ def run_corridor(corridor: Corridor, *, client=None, scheduler: str | None = Non
                           seconds=time.perf_counter() - t0, n_blocks=int(n_blocks or corridor.n_blocks))
 
 
+#: The objective whose programme is reported beside a programme's (``other_objective``).
+OTHER_OBJECTIVE = {"alarp": "risk", "risk": "alarp", "cost": "alarp"}
+
+
+def programme_summary(res: CorridorResult, programme, budget_basis: str = "total") -> dict:
+    """A programme as summary.json gives it: budget, objective, GDF, cost, benefit, the funded sections with their
+    options and benefit/cost, the sections required by tolerability and the overrun they cause.
+
+    Parameters
+    ----------
+    res : CorridorResult
+        The corridor run.
+    programme : Programme
+        The programme.
+    budget_basis : str, optional
+        ``"total"`` or ``"year"``.
+
+    Returns
+    -------
+    dict
+        JSON-ready; money in the corridor currency, benefit/cost [-].
+    """
+    ch = programme.chosen
+    bc = ch["benefit_cost_ratio"] if "benefit_cost_ratio" in ch else pd.Series(np.nan, index=ch.index)
+    gdf = programme.gdf if programme.objective == "alarp" else None
+    return {"budget": programme.budget, "basis": budget_basis, "budget_caps": BUDGET_BASES[budget_basis],
+            "objective": programme.objective, "maximised": programme.benefit_column,
+            "gross_disproportion_factor": gdf, "cost": programme.cost, "benefit": programme.benefit,
+            "sections_funded": int(len(ch)),
+            "funded": [{"id": str(r["id"]), "option": str(r["option"]), "cost": float(r[programme.cost_column]),
+                        "benefit_cost_ratio": None if not np.isfinite(b) else float(b),
+                        "required_by_tolerability": bool(r.get("required_by_tolerability", False))}
+                       for (_, r), b in zip(ch.iterrows(), bc)],
+            "median_benefit_cost_ratio": float(np.nanmedian(bc)) if bc.notna().any() else None,
+            "required_by_tolerability": list(programme.required), "overrun": programme.overrun,
+            "gap": programme.gap}
+
+
 def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False, budget: float | None = None,
-                   budget_basis: str = "total", objective: str = "risk", programme=None, frontier=None) -> None:
+                   budget_basis: str = "total", objective: str = "alarp", programme=None, frontier=None,
+                   gdf: float | None = None, other=None) -> None:
     """Write the corridor's outputs into ``out`` (a directory that appears only when everything is written; an
     existing non-empty ``out`` is replaced whole only with ``overwrite``):
 
     report.html, corridor.csv (ranked), sections.csv (by chainage; with a centreline also sections.gpkg, the same
     columns on each section's line in the centreline's CRS, and map.png), budget_curve.csv, chainage.png,
     rating_sheets.html (one RHRS sheet per rated section), summary.json; with ``budget`` also programme.csv (every
-    section with the option the exact programme gives it, or none), frontier.csv and frontier.png.
-    ``programme`` and ``frontier``: already solved (:meth:`CorridorResult.programme` and ``frontier`` of the same
-    budget, basis and objective), written as they are instead of solved again.
+    section with the option the exact programme gives it, or none, and the option of the other objective's
+    programme beside it), frontier.csv and frontier.png.  The other objective's programme (:data:`OTHER_OBJECTIVE`:
+    deaths avoided beside the default ``"alarp"``, ``"alarp"`` beside the others) is solved at the same budget and
+    named in summary.json (``other_programme``, and ``programme.disagreement``: one line) and in the report.
+    ``programme``, ``frontier`` and ``other``: already solved (:meth:`CorridorResult.programme` and ``frontier`` of
+    the same budget, basis and objective), written as they are instead of solved again.
 
     Parameters
     ----------
@@ -1948,11 +2123,15 @@ def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False, b
     budget_basis : str, optional
         ``"total"`` or ``"year"``.
     objective : str, optional
-        ``"risk"`` or ``"cost"``.
+        ``"alarp"`` (default), ``"risk"`` or ``"cost"`` (see :meth:`CorridorResult.programme`).
     programme : Programme, optional
         Already solved programme.
     frontier : Frontier, optional
         Already solved frontier.
+    gdf : float, optional
+        Gross-disproportion factor [-] of ``"alarp"`` (default: the corridor's ``[criteria] disproportion_factor``).
+    other : Programme, optional
+        Already solved programme of the other objective.
     """
     from ..io.gis import write_lines_gpkg
     from ..io.outputs import atomic_output_dir, write_json
@@ -1962,12 +2141,18 @@ def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False, b
         _bad_basis(budget_basis)
     if budget is None and programme is not None:
         budget = programme.budget
+    if programme is not None:
+        objective = programme.objective
+        gdf = programme.gdf if objective == "alarp" else gdf
     if budget is not None and programme is None:
-        programme = res.programme(budget, basis=budget_basis, objective=objective)
+        programme = res.programme(budget, basis=budget_basis, objective=objective, gdf=gdf)
+    if budget is not None and other is None:
+        other = res.programme(budget, basis=budget_basis, objective=OTHER_OBJECTIVE[objective], gdf=gdf)
     if budget is not None and frontier is None:
         # every frontier point is a full programme solve: fewer points for a long corridor (see FRONTIER_POINTS)
-        frontier = res.frontier(basis=budget_basis, objective=objective,
+        frontier = res.frontier(basis=budget_basis, objective=objective, gdf=gdf,
                                 points=FRONTIER_POINTS[0] if len(res.table) <= FRONTIER_POINTS[2] else FRONTIER_POINTS[1])
+    compared = res.compare_programmes(programme, other) if programme is not None else None
     with atomic_output_dir(out, overwrite=overwrite) as tmp:
         res.summary().to_csv(tmp / "corridor.csv", index=False)
         sections = res.sections_table(programme)
@@ -1979,18 +2164,21 @@ def write_corridor(res: CorridorResult, out: Path, *, overwrite: bool = False, b
             write_lines_gpkg(tmp / "sections.gpkg", sections, lines, crs=res.corridor.crs)
             figures["map"] = save_figure(plot_map(res, lines, programme), tmp / "map.png")
         if programme is not None:
-            res.programme_table(programme).to_csv(tmp / "programme.csv", index=False)
+            pt = res.programme_table(programme)
+            och = other.chosen.set_index("id")["option"]
+            pt[f"other_programme_option_{other.objective}"] = [och[i] if i in och.index else "" for i in pt["id"]]
+            pt.to_csv(tmp / "programme.csv", index=False)
             frontier.summary().to_csv(tmp / "frontier.csv", index=False)
             figures["frontier"] = save_figure(plot_frontier(frontier, currency=res.corridor.currency,
                                                             chosen_budget=budget), tmp / "frontier.png")
         (tmp / "rating_sheets.html").write_text(render_rating_sheets(res), encoding="utf-8")
         (tmp / "report.html").write_text(render_corridor_html(res, figures["chainage"], figures=figures,
                                                               programme=programme, frontier=frontier,
-                                                              budget_basis=budget_basis), encoding="utf-8")
+                                                              budget_basis=budget_basis, other=other,
+                                                              compared=compared), encoding="utf-8")
         summary = res.to_json()
         if programme is not None:
-            summary["programme"] = {"budget": programme.budget, "basis": budget_basis,
-                                    "budget_caps": BUDGET_BASES[budget_basis], "objective": objective,
-                                    "maximised": programme.benefit_column, "cost": programme.cost,
-                                    "benefit": programme.benefit, "sections_funded": int(len(programme.chosen))}
+            summary["programme"] = programme_summary(res, programme, budget_basis)
+            summary["programme"]["disagreement"] = compared["line"]
+            summary["other_programme"] = programme_summary(res, other, budget_basis)
         write_json(summary, tmp / "summary.json")

@@ -187,7 +187,9 @@ def plot_frontier(frontier, ax=None, *, currency: str = "", chosen_budget: float
     what = {"capital": "capital paid now", "equivalent_annual_cost": "equivalent annual cost per year"}
     ax.set_xlabel(f"budget: {what.get(frontier.cost_column, frontier.cost_column)} [{unit}]")
     ax.set_ylabel({"deaths_avoided_per_year": "deaths avoided per year",
-                   "expected_total_cost_saving": f"expected total cost saved [{currency}]"}[frontier.benefit_column])
+                   "expected_total_cost_saving": f"expected total cost saved [{currency}]",
+                   "alarp_net_benefit": f"net benefit at the VSL, GDF x benefit - cost [{currency}]"}.get(
+        frontier.benefit_column, frontier.benefit_column))
     ax.set_title("Efficient frontier: the best programme at each budget (exact, one option per section)")
     ax.grid(alpha=0.3)
     return fig
@@ -385,24 +387,77 @@ def _programme_box(c, programme, budget_basis: str) -> str:
                     "maintenance, spread as a level cost per year at the discount rate)"}[budget_basis]
     buys = {"deaths_avoided_per_year": "the deaths avoided per year",
             "expected_total_cost_saving": "the saving in expected total cost (capital + discounted "
-                                          "maintenance, renewals and expected losses) against doing nothing"}
+                                          "maintenance, renewals and expected losses) against doing nothing",
+            "alarp_net_benefit": f"the net benefit at the value of a statistical life "
+                                 f"({cell(c.study['consequences'].value_of_statistical_life, money_columns=True, currency=cur)}"
+                                 f") with the gross-disproportion factor GDF = {programme.gdf:g}: GDF times the "
+                                 "expected losses an option avoids (present value, lives at the VSL) less its present "
+                                 "value, so that every option it funds is worth at least 1/GDF of its cost"}
+    got = {"deaths_avoided_per_year": " deaths avoided per year",
+           "expected_total_cost_saving": f" {escape(cur)} of expected total cost saved",
+           "alarp_net_benefit": f" {escape(cur)} of net benefit"}
     e = c.study["economics"]
+    lim = c.study["criteria"].individual_risk_per_year
+    req = getattr(programme, "required", ())
+    first = ""
+    if programme.objective == "alarp":
+        first = (f"First, the sections above the intolerable individual-risk line ({lim:.0e}/yr) are funded whatever "
+                 "they cost, with an option that brings them below it: "
+                 + (f"{len(req)} section(s), {escape(', '.join(req))}"
+                    + (f", taking {cell(programme.overrun, money_columns=True, currency=cur)} beyond the budget"
+                       if programme.overrun > 0 else "") if req else "none here") + ". Then ")
     return (f"<div class='box'><p>Budget {cell(programme.budget, money_columns=True, currency=cur)} caps "
-            f"{caps}. The programme gives each section at most one option and maximises "
-            f"{buys[programme.benefit_column]}; it is solved as a mixed-integer programme, not by a greedy order, "
+            f"{caps}. {first}The programme gives each section at most one option and maximises "
+            f"{buys.get(programme.benefit_column, programme.benefit_column)}; it is solved as a mixed-integer "
+            "programme, not by a greedy order, "
             + ("and proven optimal. " if programme.gap == 0 else
                f"which stopped at its time limit: the programme is within {programme.gap:.2g} (relative) of the "
                "optimum. ")
             + f"It funds {len(programme.chosen)} of {programme.n_sections} sections for "
             f"{cell(programme.cost, money_columns=True, currency=cur)} and buys {cell(programme.benefit)}"
-            + (" deaths avoided per year" if programme.benefit_column == "deaths_avoided_per_year" else
-               f" {escape(cur)} of expected total cost saved") + ".</p>"
+            + got.get(programme.benefit_column, "") + ".</p>"
             f"<p><b>Capital</b> is what the works cost when built. <b>Present value</b> adds renewals at the end "
             f"of each option's life and yearly maintenance over {e.horizon_years:g} years, discounted at "
-            f"{e.discount_rate:.1%}. Per-metre costs are paid on each section's cut length.</p></div>")
+            f"{e.discount_rate:.1%}. Per-metre costs are paid on each section's cut length. <b>Benefit/cost</b> is "
+            "the present value of the expected losses an option avoids (lives at the VSL, damage, closures, "
+            "clean-up) over its present value.</p></div>")
 
 
-def _programme_section(doc: Document, res, programme, figures: dict, budget_basis: str) -> None:
+def _other_box(c, programme, other, compared) -> str:
+    """The other objective's programme beside the recommended one, and one line on where they disagree.
+
+    Parameters
+    ----------
+    c : Corridor
+        The corridor (currency).
+    programme : Programme
+        The recommended programme.
+    other : Programme
+        The other objective's programme at the same budget.
+    compared : dict
+        :meth:`riskrf.app.corridor.CorridorResult.compare_programmes` of the two.
+
+    Returns
+    -------
+    str
+        HTML box.
+    """
+    cur = c.currency
+    name = {"alarp": f"net benefit at the VSL (GDF {other.gdf:g}, tolerability first)",
+            "risk": "deaths avoided per year", "cost": "expected total cost"}
+
+    def bc(x):
+        return "n/a" if x is None or x != x else f"{x:.2g}"
+    return (f"<div class='box'><p><b>Beside it, objective '{escape(other.objective)}'</b> "
+            f"({escape(name[other.objective])}) at the same budget funds {len(other.chosen)} of {other.n_sections} "
+            f"sections for {cell(other.cost, money_columns=True, currency=cur)} (median benefit/cost "
+            f"{bc(compared['other_median_benefit_cost'])}, against {bc(compared['median_benefit_cost'])} for the "
+            f"programme above; programme.csv column other_programme_option_{escape(other.objective)}).</p>"
+            f"<p>{escape(compared['line'])}</p></div>")
+
+
+def _programme_section(doc: Document, res, programme, figures: dict, budget_basis: str, other=None,
+                       compared=None) -> None:
     """Add the section "Programme within the budget": its explanation, the funded sections and the frontier.
 
     Parameters
@@ -417,10 +472,16 @@ def _programme_section(doc: Document, res, programme, figures: dict, budget_basi
         Figures by name (``frontier`` is shown when present).
     budget_basis : str
         ``"total"`` or ``"year"``.
+    other : Programme, optional
+        The other objective's programme at the same budget.
+    compared : dict, optional
+        Where the two differ (:meth:`riskrf.app.corridor.CorridorResult.compare_programmes`).
     """
     box = _programme_box(res.corridor, programme, budget_basis)
     doc.section("Programme within the budget")
     doc.add(box)
+    if other is not None and compared is not None:
+        doc.add(_other_box(res.corridor, programme, other, compared))
     pt = res.programme_table(programme)
     funded = pt[pt["programme_option"] != ""]
     doc.add(doc.table(funded.head(HTML_ROWS), _caption_rows("Sections the programme funds", len(funded),
@@ -490,7 +551,7 @@ def _closing_sections(doc: Document, res) -> None:
 
 
 def render_corridor_html(res, figure_png: Path, *, figures: dict | None = None, programme=None, frontier=None,
-                         budget_basis: str = "total") -> str:
+                         budget_basis: str = "total", other=None, compared=None) -> str:
     """Self-contained HTML corridor report: key figures, chainage figure, map, the budget programme and its
     efficient frontier, ranked table (first :data:`HTML_ROWS` rows), budget curve, where the RHRS and the
     quantitative ranking disagree, rejected rows, failures and assumptions.
@@ -509,6 +570,10 @@ def render_corridor_html(res, figure_png: Path, *, figures: dict | None = None, 
         Its efficient frontier.
     budget_basis : str
         What the budget counts: ``"total"`` (capital paid now) or ``"year"`` (equivalent annual cost).
+    other : Programme, optional
+        The other objective's programme at the same budget, shown beside ``programme``.
+    compared : dict, optional
+        Where the two differ (:meth:`riskrf.app.corridor.CorridorResult.compare_programmes`).
 
     Returns
     -------
@@ -526,7 +591,7 @@ def render_corridor_html(res, figure_png: Path, *, figures: dict | None = None, 
     if "map" in figures:
         _map_section(doc, c, figures, programme is not None)
     if programme is not None:
-        _programme_section(doc, res, programme, figures, budget_basis)
+        _programme_section(doc, res, programme, figures, budget_basis, other, compared)
     _ranking_sections(doc, s, b, disagree, places, c.currency)
     _closing_sections(doc, res)
     return doc.render(header=header)
