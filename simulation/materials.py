@@ -307,7 +307,7 @@ def _data_priors() -> dict:
 def preset_prior(name: str):
     """The spread of preset ``name``'s values: one row per field, data-derived where a data set constrains it.
 
-    Fields fitted jointly to real data (``simulation/scenarios/presets/derive_presets.py``: the Authume quarry
+    Fields fitted jointly to real data (``validation/presets/derive_presets.py``: the Authume quarry
     releases P1 and P2, Garcia et al. 2022, and the minimum shadow angle of talus slopes, Evans & Hungr 1993)
     carry their posterior mean, sd, median and 90 % interval (``basis = "data"``); the other numeric fields carry
     the published point value (``basis = "published"``) and, for e_N and e_T, the published spread as ``sd``

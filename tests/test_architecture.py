@@ -114,16 +114,36 @@ def test_the_checker_sees_imports():
 
 
 def _installed_modules():
-    """Every module of both packages (``simulation.scenarios`` holds data and scripts, not library code)."""
+    """Every module of both packages (scripts live in ``validation/``, which is not installed)."""
     for package in ("riskrf", "simulation"):
         root = ROOT.parent / package
         for path in sorted(root.rglob("*.py")):
             parts = list(path.relative_to(ROOT.parent).with_suffix("").parts)
             if parts[-1] == "__init__":
                 parts.pop()
-            if parts[:2] == ["simulation", "scenarios"]:
-                continue
             yield ".".join(parts), path
+
+
+def test_no_script_ships_in_the_packages():
+    """The validation studies and derivation scripts live in ``validation/``, outside the installed packages:
+    every ``.py`` file under ``riskrf/`` and ``simulation/`` is a module of a package (each directory down to it
+    has an ``__init__.py``), and the package data in ``pyproject.toml`` names no ``.py`` file."""
+    import tomllib
+    loose = []
+    for package in ("riskrf", "simulation"):
+        for path in sorted((ROOT.parent / package).rglob("*.py")):
+            folder = path.parent
+            while folder != ROOT.parent:
+                if not (folder / "__init__.py").exists():
+                    loose.append(str(path.relative_to(ROOT.parent)))
+                    break
+                folder = folder.parent
+    assert loose == [], f"scripts inside the installed packages (move them to validation/): {loose}"
+    with open(ROOT.parent / "pyproject.toml", "rb") as f:
+        setuptools = tomllib.load(f)["tool"]["setuptools"]
+    data = [g for globs in setuptools.get("package-data", {}).values() for g in globs if g.endswith(".py")]
+    assert data == [], f"package data that installs scripts: {data}"
+    assert not any(p.startswith("validation") for p in setuptools["packages"]["find"]["include"])
 
 
 def test_every_error_of_both_packages_is_a_riskrf_error():

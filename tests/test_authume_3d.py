@@ -19,6 +19,7 @@ pytest.importorskip("rasterio")
 import simulation  # noqa: E402
 
 HERE = Path(simulation.__file__).parent / "scenarios" / "authume"
+SCRIPTS = Path(__file__).resolve().parents[1] / "validation" / "authume"    # not installed: run from the checkout
 DATA = Path(__file__).parent / "data" / "authume" / "observed_runout.csv"
 
 
@@ -45,11 +46,11 @@ def test_a_priori_run_stops_every_block_without_energy_gain():
 def test_p1_calibration_transferred_to_3d_reproduces_the_observed_plan_runout():
     """The 2-D calibration on P1 applied unchanged to the 3-D kernel: the simulated plan runouts are not
     distinguishable from the 41 observed ones (KS) and their Wasserstein distance stays below 3 m."""
-    sys.path.insert(0, str(HERE))
+    sys.path.insert(0, str(SCRIPTS))
     try:
         from validate_authume_3d import APRIORI
     finally:
-        sys.path.remove(str(HERE))
+        sys.path.remove(str(SCRIPTS))
     with open(HERE / "authume_3d.toml", "rb") as f:
         data = tomllib.load(f)
     with open(HERE / "authume_p1_calibrated.toml", "rb") as f:
@@ -72,11 +73,11 @@ def test_p2_calibrated_on_the_3d_kernel_fits_better_than_the_2d_calibration():
     """The 3-D calibration on P2 (results_3d_parameters.csv, written by validate_authume_3d.py) against the 2-D
     one, both on the 3-D kernel: the observed P2 plan runouts (48 blocks) are much closer with the 3-D fit
     (W1 5.6 m against 22 m at n = 2,000 in docs/validation/authume-3d.md)."""
-    sys.path.insert(0, str(HERE))
+    sys.path.insert(0, str(SCRIPTS))
     try:
         from validate_authume_3d import APRIORI
     finally:
-        sys.path.remove(str(HERE))
+        sys.path.remove(str(SCRIPTS))
     from simulation.calibration import apply_parameters
     obs = pd.read_csv(DATA)
     p2 = obs.loc[obs["profile"] == "P2"]

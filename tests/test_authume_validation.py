@@ -2,7 +2,7 @@
 
 Observed stops: tests/data/authume/observed_runout.csv (Garcia et al. 2022, Engineering Geology 310:106855;
 data richefeu/AuthumeQuarryRockfalls_Data-in-Brief f695c933, see its README).  The calibrated scenarios are
-written by simulation/scenarios/authume/calibrate_authume.py (n 2,000, seed 1); these tests re-run them with
+written by validation/authume/calibrate_authume.py (n 2,000, seed 1); these tests re-run them with
 the same n and seed and check the figures quoted in the README and results.md.
 """
 from __future__ import annotations

@@ -14,6 +14,7 @@ from simulation.profile_extraction import profile_from_points, read_stl
 ROOT = Path(__file__).resolve().parents[1]
 AUTHUME_DATA = ROOT / "tests" / "data" / "authume"
 AUTHUME_SCEN = ROOT / "simulation" / "scenarios" / "authume"
+AUTHUME_SCRIPTS = ROOT / "validation" / "authume"
 
 
 def _shared_authume():
@@ -161,7 +162,7 @@ def test_authume_scenarios_load_and_cover_the_observed_stops(name, zones):
 def test_authume_build_is_reproducible(tmp_path):
     raw = _shared_authume()
     import importlib.util
-    spec = importlib.util.spec_from_file_location("build_authume", AUTHUME_SCEN / "build_authume.py")
+    spec = importlib.util.spec_from_file_location("build_authume", AUTHUME_SCRIPTS / "build_authume.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     df = mod.build(raw, out_dir=tmp_path, data_dir=tmp_path)

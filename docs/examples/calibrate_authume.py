@@ -9,7 +9,7 @@ here: two material values of the 2-D profile are searched within bounds so that 
 simulated stop positions [m] come closest (1-Wasserstein distance) to the observed ones.
 The presets put the simulated stops far short of the real ones; after calibration they
 match.  A small search (300 blocks per evaluation, 6 generations, 50 bootstrap replicates)
-keeps this example fast; the study in ``simulation/scenarios/authume/`` uses 2,000 blocks.
+keeps this example fast; the study (``validation/authume/calibrate_authume.py``) uses 2,000 blocks.
 Writes ``runout_cdf.png`` to the output directory (first argument, else a new temporary
 directory).
 

@@ -1,10 +1,10 @@
 """Build the Authume quarry 3-D terrain (a 1 m DEM and a substrate-zone raster) and its ``[terrain]`` scenario.
 
-    python simulation/scenarios/authume/build_authume_3d.py [RAW_DIR]
+    python validation/authume/build_authume_3d.py [RAW_DIR]
 
 RAW_DIR defaults as in ``build_authume.py`` (the files of Garcia et al. 2022 / the Data in Brief repository
-richefeu/AuthumeQuarryRockfalls_Data-in-Brief, commit f695c933; read its PROVENANCE.md).  Writes,
-deterministically:
+richefeu/AuthumeQuarryRockfalls_Data-in-Brief, commit f695c933; read its PROVENANCE.md).  Writes into
+``simulation/scenarios/authume/``, deterministically:
 
 * ``authume_dem.tif``: elevations [m] (the raw vertical axis Y) on a 1 m grid, the zoned TIN
   (``DTM_{Blue,Gray,Red}_zone.stl``, the same terrain as the vertices in ``Terrain.xyz``) interpolated
@@ -29,7 +29,8 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-REPO = HERE.parents[2]
+REPO = HERE.parents[1]
+DATA = REPO / "simulation" / "scenarios" / "authume"   # the quarry's scenarios, DEM and results
 sys.path.insert(0, str(REPO))
 
 from simulation.profile_extraction import _TriangleLocator, read_stl  # noqa: E402
@@ -90,7 +91,7 @@ def release_point(raw: Path, profile: str):
     return float(m[0]), float(m[2]), float(m[1])
 
 
-def build(raw: Path, out_dir: Path = HERE) -> None:
+def build(raw: Path, out_dir: Path = DATA) -> None:
     import rasterio
     z, zone, t = grid_terrain(raw)
     common = dict(driver="GTiff", height=z.shape[0], width=z.shape[1], count=1, crs=LOCAL_CRS_WKT, transform=t,

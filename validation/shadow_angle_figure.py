@@ -1,6 +1,6 @@
 """Shadow angles of the cliff_talus_runout scenario: stop points against the Evans & Hungr (1993) rule.
 
-    python simulation/scenarios/shadow_angle_figure.py [--n 4000] [--seed 1]
+    python validation/shadow_angle_figure.py [--n 4000] [--seed 1]
 
 Runs the shipped scenario (materials: the bedrock, talus and meadow presets), computes
 the shadow angle of every stopped block -- the angle below the horizontal from the top
@@ -8,11 +8,11 @@ of the talus (x = 15.58 m, z = 60 m) to the stop point (Evans & Hungr 1993, Can.
 Geotech. J. 30:620-636) -- prints its distribution and writes, deterministically for a
 given seed:
 
-* ``figures/cliff_talus_runout_shadow.png``: the profile, the stop points, 10 simulated
+* ``simulation/scenarios/figures/cliff_talus_runout_shadow.png``: the profile, the stop points, 10 simulated
   trajectories, the 27.5 deg shadow line (Wyllie 2014, figure 1.1) and the 22 and 30 deg
   lines bounding Evans & Hungr's minimum shadow angles; beside it the histogram of
   shadow angles;
-* ``figures/cliff_talus_runout_shadow.csv``: the distribution (quantiles, shares).
+* ``simulation/scenarios/figures/cliff_talus_runout_shadow.csv``: the distribution (quantiles, shares).
 """
 from __future__ import annotations
 
@@ -24,9 +24,12 @@ import numpy as np
 import pandas as pd
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parents[1]))
+REPO = HERE.parent
+sys.path.insert(0, str(REPO))
 
 import simulation  # noqa: E402
+
+SCENARIOS = REPO / "simulation" / "scenarios"
 
 TALUS_TOP = (15.58, 60.0)          # x, z [m]
 TALUS_TOE_X = 101.269              # m
@@ -54,12 +57,12 @@ def main():
     ap.add_argument("--n", type=int, default=4000)
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()
-    sc = simulation.load_scenario(HERE / "cliff_talus_runout.toml")
+    sc = simulation.load_scenario(SCENARIOS / "cliff_talus_runout.toml")
     res = simulation.run(sc, n=args.n, seed=args.seed, record_paths=10)
     angle, x, z = shadow_angles(res)
     dist = distribution(angle, x, args.n)
     print(dist.round(3).to_string())
-    out = HERE / "figures"
+    out = SCENARIOS / "figures"
     out.mkdir(exist_ok=True)
     dist.to_frame("value").to_csv(out / "cliff_talus_runout_shadow.csv")
 

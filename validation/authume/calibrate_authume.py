@@ -1,15 +1,15 @@
 """Calibrate the Authume profiles to their observed stops, and test transfer between the profiles.
 
-    python simulation/scenarios/authume/calibrate_authume.py [--n 2000] [--seed 1]
+    python validation/authume/calibrate_authume.py [--n 2000] [--seed 1]
 
 For each profile (P1: 41 blocks, P2: 48 blocks; tests/data/authume/observed_runout.csv)
 the same substrate parameters are fitted with :func:`simulation.calibrate`;
 then the values fitted on one profile are put into the other profile's
 scenario (same substrate names: ``hard_ground`` and ``vegetated_slope`` occur
 on both) and the other profile's observations are compared with that
-prediction.  Writes, deterministically for a given seed:
+prediction.  Writes into ``simulation/scenarios/authume/``, deterministically for a given seed:
 
-* ``authume_p1_calibrated.toml``, ``authume_p2_calibrated.toml`` (next to this script),
+* ``authume_p1_calibrated.toml``, ``authume_p2_calibrated.toml``,
 * ``results.csv`` (the README table) and ``results.md``,
 * ``figures/authume_runout_calibration.png`` (observed, a-priori, calibrated and transferred
   runout CDFs for both profiles) and ``figures/authume_profiles.png`` (profiles with the
@@ -27,7 +27,8 @@ import numpy as np
 import pandas as pd
 
 HERE = Path(__file__).resolve().parent
-REPO = HERE.parents[2]
+REPO = HERE.parents[1]
+DATA = REPO / "simulation" / "scenarios" / "authume"   # the quarry's scenarios, DEM and results
 sys.path.insert(0, str(REPO))
 
 import simulation  # noqa: E402
@@ -61,7 +62,7 @@ def main():
     obs_all = pd.read_csv(OBSERVED)
     cals, data, rows = {}, {}, []
     for prof in ("P1", "P2"):
-        path = HERE / f"authume_{prof.lower()}.toml"
+        path = DATA / f"authume_{prof.lower()}.toml"
         data[prof], _ = scenario_dict(path)
         obs = obs_all.loc[obs_all.profile == prof, "x_stop_m"].to_numpy()
         t0 = time.perf_counter()
@@ -75,7 +76,7 @@ def main():
         print(f"{prof}: {time.perf_counter() - t0:.1f} s, {len(cal.evaluations)} evaluations")
         print(cal.summary().round(3).to_string())
         print(cal.comparison().round(3).to_string())
-        (HERE / f"authume_{prof.lower()}_calibrated.toml").write_text(cal.to_toml())
+        (DATA / f"authume_{prof.lower()}_calibrated.toml").write_text(cal.to_toml())
         rows.append({"profile": prof, "observed": len(obs), **stats_row("observed", obs, obs)})
         rows.append({"profile": prof, "observed": len(obs), **stats_row("a priori", cal.simulated_initial, obs)})
         rows.append({"profile": prof, "observed": len(obs), **stats_row(f"calibrated on {prof}", cal.simulated, obs)})
@@ -85,7 +86,7 @@ def main():
         obs = obs_all.loc[obs_all.profile == prof, "x_stop_m"].to_numpy()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            seed_check[prof] = simulation.calibrate(HERE / f"authume_{prof.lower()}.toml", obs, PARAMETERS, n=args.n,
+            seed_check[prof] = simulation.calibrate(DATA / f"authume_{prof.lower()}.toml", obs, PARAMETERS, n=args.n,
                                                     seed=args.seed + 1, n_bootstrap=0).parameters
     transfers = {}
     for prof, other in (("P1", "P2"), ("P2", "P1")):
@@ -99,8 +100,8 @@ def main():
     table = pd.DataFrame(rows)
     params = pd.concat({p: c.summary() for p, c in cals.items()}, names=["profile"])
     params[f"value_seed{args.seed + 1}"] = [seed_check[p][k] for p, k in params.index]
-    table.to_csv(HERE / "results.csv", index=False)
-    params.to_csv(HERE / "results_parameters.csv")
+    table.to_csv(DATA / "results.csv", index=False)
+    params.to_csv(DATA / "results_parameters.csv")
     md = ["| profile | case | p10 [m] | p50 [m] | p90 [m] | W1 [m] | KS D | KS p |", "|---|---|---|---|---|---|---|---|"]
     for r in table.itertuples():
         md.append(f"| {r.profile} | {r.case} | {r.p10_m:.1f} | {r.p50_m:.1f} | {r.p90_m:.1f} | "
@@ -111,13 +112,13 @@ def main():
         md.append(f"| {p} | `{k}` | {r['initial']:.3g} | {r['value']:.3g} | {r['ci95_low']:.3g}-{r['ci95_high']:.3g} | "
                   f"{r[f'value_seed{args.seed + 1}']:.3g} | {r['bound_low']:.3g}-{r['bound_high']:.3g} |")
     md.append(f"\nn = {args.n} simulated blocks per evaluation, seed {args.seed}, {args.bootstrap} bootstrap replicates.")
-    (HERE / "results.md").write_text("\n".join(md) + "\n")
+    (DATA / "results.md").write_text("\n".join(md) + "\n")
     print("\n".join(md))
 
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig_dir = HERE / "figures"
+    fig_dir = DATA / "figures"
     fig_dir.mkdir(exist_ok=True)
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
     for ax, prof in zip(axes, ("P1", "P2")):

@@ -1,6 +1,6 @@
 """Build the Authume quarry scenarios and observed runouts from the raw experiment files.
 
-    python simulation/scenarios/authume/build_authume.py [RAW_DIR]
+    python validation/authume/build_authume.py [RAW_DIR]
 
 RAW_DIR defaults to ``<repo>/../shared/experiments-raw/authume-quarry`` (or
 ``<repo>/../../shared/...`` from a git worktree) (the
@@ -32,7 +32,8 @@ import numpy as np
 import pandas as pd
 
 HERE = Path(__file__).resolve().parent
-REPO = HERE.parents[2]
+REPO = HERE.parents[1]
+DATA = REPO / "simulation" / "scenarios" / "authume"   # the quarry's scenarios, DEM and results
 sys.path.insert(0, str(REPO))
 
 from simulation.profile_extraction import profile_from_points, read_stl  # noqa: E402
@@ -80,7 +81,7 @@ def load_terrain(raw: Path):
     return np.concatenate(tris), labels
 
 
-def build(raw: Path, out_dir: Path = HERE, data_dir: Path = REPO / "tests" / "data" / "authume"):
+def build(raw: Path, out_dir: Path = DATA, data_dir: Path = REPO / "tests" / "data" / "authume"):
     tri, labels = load_terrain(raw)
     rows = []
     for prof_name in ("P1", "P2"):

@@ -1,6 +1,6 @@
 """Leave-one-dataset-out check of the pooled calibration on the two Authume profiles.
 
-    python simulation/scenarios/authume/leave_one_out.py [--n-per-release 50] [--seed 1]
+    python validation/authume/leave_one_out.py [--n-per-release 50] [--seed 1]
 
 For each profile (P1: 41 blocks, P2: 48; tests/data/authume/observed_runout.csv) the shared parameters are fitted
 with :func:`simulation.calibrate_pooled` on the OTHER profile's releases (each block its own release with its
@@ -26,7 +26,8 @@ import pandas as pd
 from scipy import stats
 
 HERE = Path(__file__).resolve().parent
-REPO = HERE.parents[2]
+REPO = HERE.parents[1]
+DATA = REPO / "simulation" / "scenarios" / "authume"   # the quarry's scenarios, DEM and results
 sys.path.insert(0, str(REPO))
 
 from simulation.pooled import Release, _Pool, calibrate_pooled  # noqa: E402
@@ -39,7 +40,7 @@ OBSERVED = REPO / "tests" / "data" / "authume" / "observed_runout.csv"
 
 def releases(profile):
     obs = pd.read_csv(OBSERVED)
-    return [Release(name=f"{r.profile}-{r.block}", scenario=HERE / f"authume_{r.profile.lower()}.toml",
+    return [Release(name=f"{r.profile}-{r.block}", scenario=DATA / f"authume_{r.profile.lower()}.toml",
                     x_stop_m=[r.x_stop_m], mass_kg=r.mass_kg, source=str(OBSERVED))
             for r in obs.itertuples() if r.profile == profile]
 
