@@ -77,3 +77,46 @@ def test_bad_input_is_named():
         optimise_programme(_table(np.random.default_rng(0)), -1)
     with pytest.raises(ValueError, match="objective"):
         optimise_programme(_table(np.random.default_rng(0)), 1, objective="x")
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("gdf", [1.0, 3.0])
+def test_alarp_objective_equals_brute_force_and_every_choice_is_worth_1_over_gdf(seed, gdf):
+    from riskrf.risk.programme import alarp_net_benefit, benefit_cost_ratio
+    t = _table(np.random.default_rng(seed)).assign(present_value=lambda d: d["capital"] * 1.3)
+    t["alarp_net_benefit"] = alarp_net_benefit(t["expected_total_cost_saving"], t["present_value"], gdf)
+    for budget in (0.0, 1.5e6, 1e9):
+        p = optimise_programme(t.drop(columns="alarp_net_benefit"), budget, objective="alarp", gdf=gdf)
+        b, _ = _brute(t, budget, "alarp_net_benefit")
+        assert p.benefit == pytest.approx(max(b, 0.0), rel=1e-9, abs=1e-6) and p.gdf == gdf
+        ratio = benefit_cost_ratio(p.chosen["expected_total_cost_saving"], p.chosen["present_value"])
+        assert (ratio >= 1 / gdf).all()
+    at_one = optimise_programme(t, 1.5e6, objective="alarp", gdf=1.0)     # GDF 1 is the cost objective
+    assert at_one.benefit == pytest.approx(optimise_programme(t, 1.5e6, objective="cost").benefit, rel=1e-9)
+
+
+def test_required_sections_are_funded_whatever_they_cost():
+    t = pd.DataFrame({"id": ["A", "A", "B"], "option": ["cheap", "safe", "f"], "capital": [1e5, 8e5, 2e5],
+                      "present_value": [1e5, 8e5, 2e5], "deaths_avoided_per_year": [1e-5, 1e-4, 1e-5],
+                      "expected_total_cost_saving": [5e4, -6e5, 3e5]})
+    p = optimise_programme(t, 5e5, objective="alarp", required={"A": ["safe"]})   # over budget: A alone
+    assert list(p.chosen["option"]) == ["safe"] and p.overrun == pytest.approx(3e5) and p.required == ("A",)
+    assert bool(p.chosen["required_by_tolerability"].iloc[0])
+    q = optimise_programme(t, 1e6, objective="alarp", required={"A": ["safe"]})   # room left: B too
+    assert set(q.chosen["option"]) == {"safe", "f"} and q.overrun == 0
+    with pytest.raises(ValueError, match=r"required = \{'A': \['x'\]\}: none of these is an option of section 'A'"):
+        optimise_programme(t, 1e6, objective="alarp", required={"A": ["x"]})
+    with pytest.raises(ValueError, match=r"gdf = 0.5 must be a number >= 1"):
+        optimise_programme(t, 1e6, objective="alarp", gdf=0.5)
+
+
+def test_native_solver_output_goes_to_the_log(capfd, caplog):
+    import logging
+    import os
+
+    from riskrf.risk.programme import solver_output_to_log
+    with caplog.at_level(logging.DEBUG, logger="riskrf"):
+        with solver_output_to_log():
+            os.write(1, b"HighsMipSolverData::transformNewIntegerFeasibleSolution tmpSolver.run();\n")
+    assert "HighsMipSolverData" not in capfd.readouterr().out
+    assert any("HighsMipSolverData" in r.getMessage() and r.levelno == logging.DEBUG for r in caplog.records)

@@ -310,8 +310,9 @@ def _with_objective(options: pd.DataFrame, objective: str, gdf: float, cost: str
                          "the VSL with the gross-disproportion factor; 'risk': deaths avoided per year; 'cost': "
                          "expected total cost saving)")
     benefit = OBJECTIVES[objective]
-    if objective != "alarp" or benefit in options.columns:
+    if objective != "alarp":
         return _check(options, cost, benefit, section), benefit
+    # always from the saving and the present value at this GDF (a column of another GDF is not reused)
     gdf = check_gdf(gdf)
     t = _check(options, cost, "expected_total_cost_saving", section)
     if value_column != cost:
@@ -347,8 +348,8 @@ def optimise_programme(options: pd.DataFrame, budget: float, *, objective: str =
         One row per (section, option) that could be built: ``section_column``, ``option``, ``cost_column``
         (what the budget pays, >= 0, in the corridor currency) and the benefit column of ``objective``
         (:data:`OBJECTIVES`: ``deaths_avoided_per_year`` [1/yr] or ``expected_total_cost_saving`` [currency]; for
-        ``"alarp"`` ``expected_total_cost_saving`` and ``value_column`` give ``alarp_net_benefit`` unless the table
-        has it).  Options with a benefit <= 0 are never worth funding and are left out (but on a required section).
+        ``"alarp"`` ``expected_total_cost_saving`` and ``value_column``, from which ``alarp_net_benefit`` is
+        computed at ``gdf``).  Options with a benefit <= 0 are never worth funding and are left out (but on a required section).
     budget : float
         Upper limit of the summed ``cost_column`` of the chosen options (>= 0), in the corridor currency; raised to
         the least cost of the ``required`` sections where they need more (:attr:`Programme.overrun`).
@@ -400,8 +401,10 @@ def optimise_programme(options: pd.DataFrame, budget: float, *, objective: str =
     cap = max(float(budget), least * (1 + 1e-12))
     pick, gap = _solve(cand[cost_column].to_numpy(), cand[benefit].to_numpy(), codes, len(sections), cap,
                        time_limit_s, must=must)
-    got = cand.loc[pick, [section_column, "option"] + ([] if benefit in options.columns else [benefit])]
-    chosen = options.drop(columns=[c for c in ("required_by_tolerability",) if c in options]).merge(
+    got = cand.loc[pick, [section_column, "option"] + ([] if benefit in options.columns and objective != "alarp"
+                                                       else [benefit])]
+    chosen = options.drop(columns=[c for c in ("required_by_tolerability",) if c in options]
+                          + ([benefit] if objective == "alarp" and benefit in options else [])).merge(
         got, on=[section_column, "option"])
     chosen["required_by_tolerability"] = chosen[section_column].isin(req).to_numpy()
     spent = float(cand.loc[pick, cost_column].sum())
