@@ -562,7 +562,7 @@ def cmd_assess(args) -> int:
             print(f"  - {relative_paths(w, site.path.parent)}")        # paths relative to the site file
     print(f"Rate of falls from the {s['hazard']['rate_source']}.")
     print(f"Lowest expected total cost: {s['best_option']} (then {s['second_option']}).")
-    print(f"Recommendation: {s['recommendation']['option']} ({s['recommendation']['basis']}).")
+    print(f"Recommendation: {s['recommendation']['option'] or 'none'} ({s['recommendation']['basis']}).")
     if "resolution" in s["recommendation"]:
         print(f"Resolution: {s['recommendation']['resolution']['text']}")
     if assessment.model_uncertainty is not None:

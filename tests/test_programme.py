@@ -118,5 +118,8 @@ def test_native_solver_output_goes_to_the_log(capfd, caplog):
     with caplog.at_level(logging.DEBUG, logger="riskrf"):
         with solver_output_to_log():
             os.write(1, b"HighsMipSolverData::transformNewIntegerFeasibleSolution tmpSolver.run();\n")
-    assert "HighsMipSolverData" not in capfd.readouterr().out
+    # the raw printf line is gone from descriptor 1; a handler an earlier test left on the riskrf logger may echo
+    # the DEBUG record ("HiGHS: ...") to stdout, which is the log doing its job
+    raw = [line for line in capfd.readouterr().out.splitlines() if line.startswith("HighsMipSolverData")]
+    assert raw == []
     assert any("HighsMipSolverData" in r.getMessage() and r.levelno == logging.DEBUG for r in caplog.records)

@@ -549,6 +549,58 @@ def fence_design_checks(options, energy) -> dict:
     return out
 
 
+def required_barrier_for_site(site, mitigation: dict, energy, site_design) -> tuple:
+    """The options to rank with the required barrier among them, every fence's design verdict, and the required
+    barrier itself.
+
+    The verdicts are the fence checks of ``energy`` (:func:`fence_design_checks`), replaced by the governing design
+    basis's checks (:func:`riskrf.risk.required_barrier.basis_design_checks`) for the fences the basis checked;
+    those decide whether an option may be recommended.  The required barrier
+    (:func:`riskrf.risk.required_barrier.required_barrier`) is costed with the site's ``[required_barrier]``
+    table (or the ASSUMED default prices, scaled to the site's own priced fences) and appended to the options
+    when it can be placed and ``[required_barrier] include`` is true.
+
+    Parameters
+    ----------
+    site : Site
+        The checked site.
+    mitigation : dict
+        Its mitigation tables (options, traffic, consequences, ...).
+    energy : EnergyAnalysis
+        Design energies [kJ] and fence checks.
+    site_design : SiteDesign or None
+        The design basis's requirement at the barrier line and the position search.
+
+    Returns
+    -------
+    tuple
+        ``(mitigation, checks, required)``: the tables with the required barrier among the options, option name
+        -> design verdict, and the :class:`~riskrf.risk.required_barrier.RequiredBarrier` (None without a
+        requirement or when ``include`` is false).
+    """
+    from ..risk.required_barrier import basis_design_checks, cost_model_from_site, required_barrier
+    options = list(mitigation["options"])
+    checks = fence_design_checks(options, energy)
+    requirement = getattr(site_design, "requirement", None)
+    if requirement is None:
+        return mitigation, checks, None
+    checks.update(basis_design_checks(requirement))
+    exposed = mitigation["exposure"].exposed_length_m if "exposure" in mitigation else 100.0
+    fences = [(o.capacity_kj, o.height_m, o.capital_cost, exposed) for o in options
+              if o.kind in ("fence", "attenuator") and o.x_m is None]
+    model, include = cost_model_from_site(site.required_barrier, site_fences=fences, source=str(site.path))
+    if not include:
+        return mitigation, checks, None
+    currency = mitigation["consequences"].currency if "consequences" in mitigation else ""
+    required = required_barrier(requirement, getattr(site_design, "positions", None), model,
+                                exposed_length_m=model.length_m or exposed, currency=currency,
+                                source=str(site.path))
+    if required.placeable and required.option.name not in {o.name for o in options}:
+        mitigation = dict(mitigation, options=options + [required.option])
+        checks[required.option.name] = required.verdict
+    return mitigation, checks, required
+
+
 def sensitivity_inputs(site, rate_scale: float | None = None) -> tuple:
     """(m_max values [kg], rate shares [-]) for the design-energy sensitivity: low, stated and high values.
 
@@ -691,6 +743,8 @@ class Assessment:
             "ranking": ranking.to_dict(orient="records"),
             "options": self.decision["options"],
             "recommendation": self.decision["recommendation"],
+            "required_barrier_option": (self.study.required_barrier.to_dict()
+                                        if self.study.required_barrier is not None else None),
             "uncertainty": self.decision["uncertainty"],
             "best_option": ranking["option"].iloc[0],
             "second_option": ranking["option"].iloc[1],
@@ -1177,15 +1231,17 @@ def _decision_stage(site: Site, inventory, hazard, result, road_hits, rate_scale
         from ..risk.site_rates import resolve_closures
         site_rates = rates.result()
         mitigation = dict(mitigation, options=resolve_closures(mitigation["options"], site_rates))
+    mitigation, checks, required = required_barrier_for_site(site, mitigation, energy, site_design)
     study = MitigationStudy(hazard=hazard, road_share=share, source=str(site.path),
                             defaults_used=site.defaults_used,
                             **study_context(result, hz_cfg["collector"], hz_cfg["road_collector"],
                                             hz_cfg["option_blocks"], seed, inventory, hazard,
                                             rate_scale, road_hits),
                             **mitigation)
-    study = replace(study, design_checks=fence_design_checks(study.options, energy))
+    study = replace(study, design_checks=checks, required_barrier=required)
     decision = study_report(study)
-    site_design = with_recommended_run(site_design, site, result, decision["recommendation"]["option"], seed)
+    site_design = with_recommended_run(site_design, site, result, decision["recommendation"]["option"], seed,
+                                       options=mitigation["options"])
     return mitigation, site_rates, study, decision, site_design
 
 

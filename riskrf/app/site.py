@@ -30,8 +30,8 @@ SITE_FIELDS = {t.name: t.defaults() for t in (_fs.SITE, _fs.INVENTORY, _fs.HAZAR
                                               _fs.REPORT)}
 MITIGATION_TABLES = ("traffic", "consequences", "economics", "options", "uncertainty", "criteria")
 #: Optional tables checked by their own modules: [rates] (riskrf.risk.site_rates), [model_uncertainty]
-#: (riskrf.app.model_uncertainty).
-OTHER_TABLES = ("rates", "model_uncertainty")
+#: (riskrf.app.model_uncertainty), [required_barrier] (riskrf.risk.required_barrier).
+OTHER_TABLES = ("rates", "model_uncertainty", "required_barrier")
 
 
 @dataclass(frozen=True)
@@ -59,6 +59,8 @@ class Site:
     three_d: bool = False
     #: the checked [model_uncertainty] table (riskrf.app.model_uncertainty), None when absent (off)
     model_uncertainty: dict | None = None
+    #: the [required_barrier] table as given (its cost model, riskrf.risk.required_barrier), {} when absent
+    required_barrier: dict = field(default_factory=dict)
 
     def resolve(self, relative) -> Path:
         """A path given in the site file, resolved against the site file's folder.
@@ -118,11 +120,19 @@ def load_site(path) -> Site:
     from .model_uncertainty import check_model_uncertainty
     model_uncertainty, mu_used = check_model_uncertainty(data.get("model_uncertainty"), path, hz, error=SiteError)
     used += mu_used
+    required = data.get("required_barrier", {})
+    if not isinstance(required, dict):
+        raise SiteError(f"{path}: [required_barrier] must be a table")
+    from ..risk.required_barrier import cost_model_from_site
+    try:
+        cost_model_from_site(required, source=str(path))
+    except ValueError as exc:
+        raise SiteError(str(exc)) from exc
     return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
                 description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
                 mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"], rates=rates,
                 design=tables["design"], report=tables["report"], three_d=three_d,
-                model_uncertainty=model_uncertainty)
+                model_uncertainty=model_uncertainty, required_barrier=dict(required))
 
 
 def _read_site_toml(path: Path) -> dict:

@@ -105,7 +105,7 @@ class SiteDesign:
         return out
 
 
-def option_scenario(site, scenario, option_name: str):
+def option_scenario(site, scenario, option_name: str, options=None):
     """The scenario with the option ``option_name`` built into it (its ditches dug, its fences and attenuators
     standing as barriers at their lines), or None when the option does not change the slope (scaling, shed,
     closure, realignment, doing nothing).
@@ -118,6 +118,8 @@ def option_scenario(site, scenario, option_name: str):
         The site's slope scenario.
     option_name : str
         Name of a mitigation option of the site.
+    options : sequence of Option, optional
+        The options ranked (default: the site's own; the ranking adds the required barrier).
 
     Returns
     -------
@@ -127,7 +129,7 @@ def option_scenario(site, scenario, option_name: str):
     from dataclasses import replace
 
     from ..risk.measures import Ditch, scenario_with_ditches
-    opts = {o.name: o for o in site.mitigation["options"]}
+    opts = {o.name: o for o in (site.mitigation["options"] if options is None else options)}
     o = opts[option_name]
     parts = [opts[n] for n in o.options] if o.kind == "combined" else [o]
     ditches = [Ditch(p.x_m, p.width_m, p.depth_m, **{k: getattr(p, k) for k in ("inner_slope_hv", "outer_slope_hv")
@@ -151,7 +153,8 @@ def option_scenario(site, scenario, option_name: str):
     return sc
 
 
-def with_recommended_run(design: SiteDesign, site, result, option_name: str, seed) -> SiteDesign:
+def with_recommended_run(design: SiteDesign, site, result, option_name: str | None, seed,
+                         options=None) -> SiteDesign:
     """``design`` with the recommended option's slope simulated (``hazard.option_blocks`` blocks, the seeder's
     masses), for its trajectories and stop points; unchanged when the option leaves the slope as it is.
 
@@ -163,10 +166,12 @@ def with_recommended_run(design: SiteDesign, site, result, option_name: str, see
         The checked site.
     result : SimulationResult or None
         The site's simulation (None: no slope to re-run).
-    option_name : str
-        Name of the recommended option.
+    option_name : str or None
+        Name of the recommended option (None: no option is recommended, nothing is run).
     seed : int
         Random seed.
+    options : sequence of Option, optional
+        The options ranked (default: the site's own).
 
     Returns
     -------
@@ -176,9 +181,9 @@ def with_recommended_run(design: SiteDesign, site, result, option_name: str, see
     from dataclasses import replace
 
     import simulation
-    if result is None:
+    if result is None or option_name is None:
         return design
-    sc = option_scenario(site, result.scenario, option_name)
+    sc = option_scenario(site, result.scenario, option_name, options)
     if sc is None:
         return design
     res = simulation.run(sc, n=int(site.hazard["option_blocks"]), seed=seed)

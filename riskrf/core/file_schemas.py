@@ -135,6 +135,29 @@ DESIGN = Table("design", (
          high_open=True),
 ), "The design basis that governs the barrier design, its partial factors and the required-barrier search.")
 
+REQUIRED_BARRIER = Table("required_barrier", (
+    Field("include", "bool", "", "rank the barrier the design basis requires as an option", True),
+    Field("cost_classes_kj", "numbers", "kJ", "MEL classes of the unit prices (default: riskrf's ASSUMED price "
+          "table, riskrf.risk.required_barrier.DEFAULT_COST_PER_M, scaled to the site's own fence prices)", low=0,
+          low_open=True),
+    Field("cost_per_m", "numbers", "currency/m", "unit price per metre of barrier at reference_height_m, one per "
+          "class", low=0, low_open=True),
+    _pos("reference_height_m", "m", "net height the unit prices refer to", default=5.0),
+    _nonneg("height_exponent", "", "a price scales as (net height / reference_height_m)^height_exponent",
+            default=1.0),
+    _pos("length_m", "m", "barrier length (default: traffic.exposed_length_m)"),
+    _nonneg("fixed_cost", "currency", "access and mobilisation", default=0.0),
+    _nonneg("annual_maintenance_share", "1/yr", "yearly maintenance as a share of the capital cost", default=0.01),
+    _pos("life_years", "years", "renewal period", default=25.0),
+    _nonneg("repair_share", "", "repair of an impact held above SEL, as a share of the capital cost", default=0.05),
+    _nonneg("replacement_share", "", "rebuild after an impact above MEL, as a share of the capital cost",
+            default=0.3),
+    Field("cost_range", "range", "", "capital cost range as factors of the central cost", (0.7, 1.5), low=0,
+          low_open=True),
+    _pos("max_net_height_m", "m", "tallest catalogue net: a position needing more is not placeable", default=8.0),
+), "The barrier the design basis requires, costed and ranked (riskrf.risk.required_barrier); the defaults are "
+   "ASSUMED and labelled in every output.")
+
 REPORT = Table("report", (
     _text("project", "project name in the title block"),
     _text("location", "site location in the title block"),
@@ -281,7 +304,8 @@ MODEL_UNCERTAINTY = Table("model_uncertainty", (
    "field calibration (off when the table is absent).")
 
 SITE_SCHEMA = FileSchema("Site file (riskrf assess SITE.toml)",
-                         (SITE, INVENTORY, HAZARD, DESIGN_BLOCK, DESIGN, REPORT, RATES) + MITIGATION_TABLES
+                         (SITE, INVENTORY, HAZARD, DESIGN_BLOCK, DESIGN, REQUIRED_BARRIER, REPORT, RATES)
+                         + MITIGATION_TABLES
                          + (MODEL_UNCERTAINTY,),
                          "One assessment: inventory, slope, exposure, options and economics.")
 OPTIONS_SCHEMA = FileSchema("Mitigation options file (riskrf decide --options OPTIONS.toml)", MITIGATION_TABLES,

@@ -592,7 +592,7 @@ def _decision_section(doc, a, figs: Path) -> None:
     tornado = a.decision["tornado"]
     central_best = ranking.loc[ranking["cost_at_central_values"].idxmin()]
     doc.section("Mitigation decision (Wyllie 2014, 8.5.5)")
-    doc.add(f"<div class='box'><b>Recommendation: {_e(rec['option'])}</b> ({_e(rec['basis'])}).<br>"
+    doc.add(f"<div class='box'><b>Recommendation: {_e(rec['option'] or 'none')}</b> ({_e(rec['basis'])}).<br>"
             f"{_e(rec['reason'])}</div>",
             "<h3>The options</h3><p>Each option is a change of the site; its effect is derived (re-simulated "
             "profile, simulated heights and energies at the barrier line, the mass model) unless marked as a typed "

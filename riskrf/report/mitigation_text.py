@@ -89,7 +89,7 @@ def study_report(study) -> dict:
              "What each option is and assumes:"]
     for _, r in study.options_table().iterrows():
         lines.append(f"  {r['option']}: {r['what it is and assumes']} [{r['effect_basis']}]")
-    lines += ["", f"RECOMMENDATION: {rec['option']} ({rec['basis']}).", "  " + rec["reason"], "",
+    lines += ["", f"RECOMMENDATION: {rec['option'] or 'none'} ({rec['basis']}).", "  " + rec["reason"], "",
               "Uncertain inputs sampled jointly: " + "; ".join(f"{k} {lo:.4g}-{hi:.4g} ({how})"
                                                                 for k, (lo, hi, how) in ranges.items())]
     r0 = study._central_result

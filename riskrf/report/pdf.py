@@ -379,7 +379,7 @@ def _title_page(rep, a, tb):
         rep.text(req.text() + ".", size=10, style="B")
         rep.text(d.basis.text(), size=8.5)
     rec = a.decision["recommendation"]
-    rep.text(f"Recommended option by expected total cost and tolerability: {rec['option']} ({rec['basis']}).",
+    rep.text(f"Recommended option by expected total cost and tolerability: {rec['option'] or 'none'} ({rec['basis']}).",
              size=10)
     rep.text("Signature fields: author ____________________   checker ____________________", size=9.5)
 

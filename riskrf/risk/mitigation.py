@@ -150,6 +150,9 @@ class MitigationStudy(Displayed):
     uncertainty: Uncertainty = Uncertainty()
     criteria: Criteria = Criteria()
     design_checks: dict = field(default_factory=dict)   # option name -> verdict of its design checks (fences)
+    #: the barrier the governing design basis requires (:class:`~riskrf.risk.required_barrier.RequiredBarrier`):
+    #: ranked as an option when it can be placed; the recommendation says so when it cannot.  None: not computed.
+    required_barrier: object = None
     coupled_road_hits: np.ndarray | None = field(default=None, repr=False)   # per block of the mass-coupled run
 
     def __post_init__(self):
@@ -608,6 +611,7 @@ class MitigationStudy(Displayed):
                     / spend * 1e6, np.nan)
         df["meets_criteria"] = [self._meets(row) for _, row in df.iterrows()]
         df["design_check"] = [self._design_check(o) for o in self.options]
+        df["design_adequate"] = ~df["design_check"].str.contains("NOT ADEQUATE", regex=False)
         self._alarp(df)
         df = df.sort_values("expected_total_cost", kind="stable").reset_index(drop=True)
         df["rank"] = np.arange(1, len(df) + 1)
@@ -725,7 +729,12 @@ class MitigationStudy(Displayed):
 
     def recommendation(self, ranking: pd.DataFrame | None = None) -> dict:
         """The cheapest option meeting the tolerability criteria, else the one reducing risk most per unit cost,
-        with the reasoning in plain words.
+        among the options that pass their design checks, with the reasoning in plain words.
+
+        An option whose design checks fail ("NOT ADEQUATE" in ``design_check``) stays in the ranking, marked, and is
+        never recommended: the reason names each such option that would otherwise have been chosen, and says when
+        no adequate option exists.  The required barrier (``required_barrier``) is reported: where it is ranked, or
+        why none can be placed and what would work instead.
 
         Parameters
         ----------
@@ -735,12 +744,38 @@ class MitigationStudy(Displayed):
         Returns
         -------
         dict
-            ``option`` (name), ``basis`` (the rule that chose it), ``reason`` (plain words), ``resolution``
-            (:meth:`resolution`), ``expected_total_cost`` [study currency] and ``probability_best`` [-].
+            ``option`` (name; None when no option passes its design checks), ``basis`` (the rule that chose it),
+            ``reason`` (plain words), ``resolution`` (:meth:`resolution`), ``expected_total_cost`` [study currency],
+            ``probability_best`` [-], ``design_check`` (the chosen option's verdict), ``not_recommended`` (option
+            name -> its failed design checks) and ``required_barrier`` (its sentence, or None).
         """
-        t = self.ranking() if ranking is None else ranking
+        t_all = self.ranking() if ranking is None else ranking
         cur = self.currency
         lim = self.criteria.individual_risk_per_year
+        bad = t_all["design_check"].astype(str).str.contains("NOT ADEQUATE", regex=False) \
+            if "design_check" in t_all else pd.Series(False, index=t_all.index)
+        rejected = t_all[bad]
+        t = t_all[~bad]
+        rb = self.required_barrier
+        rb_text = rb.text(cur) if rb is not None else None
+        excluded = ""
+        if len(rejected):
+            tolerable_bad = rejected[rejected["meets_criteria"]]
+            excluded = (" Not recommended, whatever their cost, because they fail their design checks: "
+                        + "; ".join(f"{r['option']} ({r['design_check']})" for _, r in rejected.iterrows()) + ".")
+            best_ok = t.loc[t["meets_criteria"], "expected_total_cost"].min() if t["meets_criteria"].any() \
+                else np.inf
+            if len(tolerable_bad) and tolerable_bad["expected_total_cost"].iloc[0] < best_ok:
+                excluded += (f" {tolerable_bad['option'].iloc[0]} would be the cheapest tolerable option but is "
+                             "not adequate.")
+        if t.empty:
+            why = ("NO ADEQUATE OPTION: every option fails its design checks, so none is recommended."
+                   + excluded + (" " + rb_text if rb_text else ""))
+            res = self.resolution(t_all)
+            return {"option": None, "basis": "no option passes its design checks", "reason": why, "resolution": res,
+                    "expected_total_cost": float("nan"), "probability_best": float("nan"), "design_check": None,
+                    "not_recommended": dict(zip(rejected["option"], rejected["design_check"])),
+                    "required_barrier": rb_text}
         ok = t[t["meets_criteria"]]
         cheapest = t.iloc[0]
         if len(ok):
@@ -795,8 +830,22 @@ class MitigationStudy(Displayed):
                               f"{rec['deaths_avoided_per_million']:.3g} statistical lives saved over "
                               f"{self.economics.horizon_years:g} years per million {cur} spent; residual individual "
                               f"risk {probability(rec['individual_risk'])}/yr. It is not tolerable either.")
-        if "NOT ADEQUATE" in str(rec.get("design_check", "")):
-            why += f" Warning: it fails its design checks ({rec['design_check']})."
+        if not len(ok) and len(t) < len(t_all):
+            basis = basis.replace("no option is tolerable", "no adequate option is tolerable")
+        why += excluded
+        if rb is not None and rb.placeable and rb.option.name in list(t_all["option"]) \
+                and rb.option.name != rec["option"]:
+            row = t_all[t_all["option"] == rb.option.name].iloc[0]
+            why += (f" {rb_text} It is ranked {int(row['rank'])} of {len(t_all)} at "
+                    f"{money(row['expected_total_cost'], cur, sig=3)}"
+                    + ("" if row["meets_criteria"] else " and does not meet the tolerability criteria") + ".")
+        elif rb is not None and not rb.placeable:
+            why += " " + rb_text
+        check = str(rec.get("design_check", "-"))
+        if check.startswith("adequate") and "not checked" in check:
+            why += f" Its design check: {check}; complete it before signing."
+        elif check == "not checked":
+            why += " Its design checks were not run (no requirement at its line); check it before signing."
         if "ASSUMED" in str(rec["effect_basis"]):
             why += f" Note: its effect is partly assumed ({rec['effect_basis']})."
         elif "ASSUMPTION" in str(rec["effect_basis"]):
@@ -805,7 +854,9 @@ class MitigationStudy(Displayed):
         why += " " + res["text"][0].upper() + res["text"][1:]
         return {"option": str(rec["option"]), "basis": basis, "reason": why, "resolution": res,
                 "expected_total_cost": float(rec["expected_total_cost"]),
-                "probability_best": float(rec["probability_best"])}
+                "probability_best": float(rec["probability_best"]), "design_check": check,
+                "not_recommended": dict(zip(rejected["option"], rejected["design_check"])),
+                "required_barrier": rb_text}
 
     # ---- sensitivity ---------------------------------------------------------------------------
     def sensitivity_parameters(self) -> list:
