@@ -197,6 +197,14 @@ def test_options_recommendation_and_fence_heights_in_outputs(assessed):
             assert o.get("retention") is not None and 0.0 <= o["retention"] <= 1.0, o["name"]
     rec = s["recommendation"]
     assert rec["option"] in {o["name"] for o in s["options"]} and rec["reason"].strip()
+    # issue 39 item 1: the recommendation passes its design checks; the rejected fences are named; the required
+    # barrier is reported (on the demo the required MEL is above every certified class: none can be placed)
+    ranked = {r["option"]: r for r in s["ranking"]}
+    assert ranked[rec["option"]]["design_adequate"] and "NOT ADEQUATE" not in str(rec["design_check"])
+    assert set(rec["not_recommended"]) == {n for n, r in ranked.items() if not r["design_adequate"]} != set()
+    rb = s["required_barrier_option"]
+    assert rb["placeable"] is False and "above the largest certified class" in rb["reason"]
+    assert rb["alternatives"] and "No certified barrier meets" in rec["reason"]
     fences = [o for o in load_site(site).mitigation["options"] if o.kind == "fence" and o.x_m is None]
     assert len({o.height_m for o in fences}) > 1                  # the demo's fences differ in height
     checks = pd.read_csv(out / "fence_checks.csv")

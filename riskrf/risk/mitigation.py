@@ -699,6 +699,12 @@ class MitigationStudy(Displayed):
         t = self.ranking() if ranking is None else ranking
         u = self.uncertain
         names = u["names"]
+        if len(t) < 2:                        # e.g. the only option that passes its design checks
+            a = t["option"].iloc[0]
+            return {"first": a, "second": None, "difference": float("nan"), "difference_se": float("nan"),
+                    "probability_best": float(u["probability_best"][names.index(a)]),
+                    "probability_best_se": float("nan"), "distinguishable": True,
+                    "text": f"{a} is the only option left to compare."}
         a, b = t["option"].iloc[0], t["option"].iloc[1]
         d = u["total"][:, names.index(b)] - u["total"][:, names.index(a)]
         S = d.size
