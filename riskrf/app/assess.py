@@ -822,7 +822,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         hz_cfg = site.hazard
         compiling, beside, rates = _start_compilation_and_rates(site, log)
         t = stage(1, "reading the inventory and fitting magnitude-frequency models")
-        inventory, frequency, maxima_frequency = _fit_inventory(site, seed)
+        inventory, frequency, maxima_frequency = fit_site_inventory(site, seed)
         timings["fits"] = round(time.perf_counter() - t, 2)
         if figures is not None:
             pending.append(InBackground(partial(_frequency_outputs, frequency, maxima_frequency, figures),
@@ -904,8 +904,11 @@ def _start_compilation_and_rates(site: Site, log):
     return compiling, beside, rates
 
 
-def _fit_inventory(site: Site, seed):
-    """Read the site's inventory (and its annual maxima, if given) and fit the magnitude-frequency models.
+def fit_site_inventory(site: Site, seed):
+    """Read the site's inventory (and its annual maxima, if given) and fit the magnitude-frequency models: the
+    fits stage of both the 2-D (:func:`run_assessment`) and the 3-D assessment
+    (:func:`riskrf.app.assess3d.run_terrain_assessment`), so that both report the same fits (the site's m_min,
+    500 bootstrap replicates; the hazard's law applies m_max on top).
 
     Parameters
     ----------

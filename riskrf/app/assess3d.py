@@ -2,8 +2,9 @@
 
 The chain, from one site file (the same fields as a 2-D site; see docs/user-guide/terrain-3d.md):
 
-1. the inventory and its power law (:func:`riskrf.frequency.study.analyse_inventory`, the site's m_min and
-   m_max; the rate at the source is the law's rate above m_min times ``inventory.rate_scale``);
+1. the inventory and its fits, by the 2-D chain's own fits stage (:func:`riskrf.app.assess.fit_site_inventory`:
+   the site's m_min, the same bootstrap sizes, the annual maxima when given); the hazard's power law takes the
+   site's m_min and m_max, and the rate at the source is its rate above m_min times ``inventory.rate_scale``;
 2. the mass-coupled energy hazard at the barrier line ``hazard.collector`` (a plan polyline of the terrain
    scenario): ``hazard.n_blocks`` blocks with masses spread log-uniformly over the law's range run by the
    3-D kernel (:func:`riskrf.hazard.simulated.simulate_energy_hazard`), reach, speed and bounce height by mass;
@@ -31,8 +32,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..frequency.inventory import Inventory, read_inventory
-from ..frequency.study import analyse_inventory
+from ..frequency.inventory import Inventory
 from ..hazard.energy_study import analyse_energy
 from ..hazard.simulated import simulate_energy_hazard
 from ..io.outputs import relative_paths, write_json
@@ -165,13 +165,8 @@ def run_terrain_assessment(site: Site, *, seed: int | None = None, n_blocks: int
     timings = {}
     t = time.perf_counter()
     log("[1/4] reading the inventory and fitting the power law")
-    from ..frequency.inventory import READER_OPTIONS
-    reader = {k: inv_cfg[k] for k in READER_OPTIONS if inv_cfg.get(k) is not None}
-    inventory = read_inventory(site.resolve(inv_cfg["path"]), start=inv_cfg["start"], end=inv_cfg["end"],
-                               duration_years=inv_cfg["duration_years"], density_kg_m3=inv_cfg["density_kg_m3"],
-                               **reader)
-    frequency = analyse_inventory(inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], n_bootstrap=200,
-                                  seed=seed)
+    from .assess import fit_site_inventory
+    inventory, frequency, _maxima = fit_site_inventory(site, seed)     # the 2-D chain's fits stage
     from ..frequency.power_law import fit_gutenberg_richter
     gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=inv_cfg["m_min_kg"],
                                m_max=inv_cfg["m_max_kg"])
