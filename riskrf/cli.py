@@ -922,7 +922,8 @@ def cmd_hazard_map(args) -> int:
     if args.tile_m <= 0:
         raise ValueError(f"--tile-m {args.tile_m!r} must be a tile size > 0 m")
     hm = hazard_map(args.scenario, n=args.n, seed=args.seed, crs=args.crs, workers=args.workers,
-                    dask=args.dask or args.scheduler is not None, scheduler=args.scheduler, tile_m=args.tile_m)
+                    dask=args.dask or args.scheduler is not None, scheduler=args.scheduler, tile_m=args.tile_m,
+                    rate_per_year=args.rate_per_year)
     print(f"Scenario {hm.scenario.name} ({hm.scenario.source}): {hm.result.n:,} blocks, seed {args.seed}")
     print(hm.result.summary().to_string(index=False, header=False))
     hm.write(out, overwrite=args.overwrite)
@@ -1349,8 +1350,9 @@ def _add_hazard_map_parser(sub) -> None:
     p = sub.add_parser("hazard-map", help="3-D rock fall hazard rasters on a DEM (GeoTIFF, GeoPackage)",
                        description="Run a 3-D scenario (TOML with a [terrain] table: DEM raster, materials, "
                        "[sources] points or polygon, plan collectors) and write GeoTIFFs on the DEM's grid and CRS "
-                       "(passage count, reach probability, kinetic energy p50/p95/p99, jump height p95, deposition "
-                       "density), stop points and trajectories as GeoPackage layers and a hillshade figure.",
+                       "(passage count, reach probability, kinetic energy p50/p95/p99/max, jump height p95, "
+                       "deposition density; with --rate-per-year the energies at annual frequencies 1/30, 1/100, "
+                       "1/300), stop points and trajectories as GeoPackage layers and a hillshade figure.",
                        epilog=EPILOG)
     p.add_argument("scenario", help="3-D scenario TOML, e.g. simulation/scenarios/authume/authume_3d.toml")
     _add_release_arguments(p, 10_000)
@@ -1363,6 +1365,10 @@ def _add_hazard_map_parser(sub) -> None:
                    "(implies --dask)")
     p.add_argument("--tile-m", type=float, default=250.0, help="tile size: squares of release points [m] "
                    "(default 250; results do not depend on it)")
+    p.add_argument("--rate-per-year", type=float, default=None, metavar="R", help="annual rate of releases from "
+                   "the scenario's sources [1/year] the blocks stand for: adds the intensity-frequency layers "
+                   "energy_1in30_kj, energy_1in100_kj, energy_1in300_kj (energy reached or exceeded with annual "
+                   "frequency 1/30, 1/100, 1/300 per cell; nodata where too few blocks pass)")
     _add_out_dir(p, "<scenario>-hazard-map")
     p.set_defaults(func=cmd_hazard_map)
 

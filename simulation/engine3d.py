@@ -17,6 +17,7 @@ import pandas as pd
 from numba import njit
 
 from . import kernel3d
+from .hazard_grids import deposition_density, mask_holes
 from .engine import _material_arrays, check_masses
 from .scenario3d import TerrainScenario, _lipschitz, fall_line, sample_sources, source_point_index
 from ._display import Displayed
@@ -154,7 +155,7 @@ def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_
 
 def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, masses_kg=None,
                 chunk_size: int = DEFAULT_CHUNK_3D, workers: int = 1, hazard: bool = False,
-                record_paths: int = 20) -> "TerrainResult":
+                record_paths: int = 20, passage_sink=None) -> "TerrainResult":
     """Simulate ``n`` blocks released from the scenario's sources on its DEM.
 
     Parameters
@@ -176,11 +177,17 @@ def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, m
         pixel crossed).
     record_paths : int
         Keep the event sequence of the first ``record_paths`` blocks (plots, trajectory layers).
+    passage_sink : callable, optional
+        With ``hazard``: receives each chunk's pixel passages (a dict of arrays, whole blocks, in block order
+        of the chunks) as soon as the chunk is run, and the result keeps none (``passages`` None); e.g.
+        :meth:`simulation.hazard_grids.PassageAggregator.add`, so memory does not grow with the blocks.  At most
+        ``2 * workers`` chunks are in flight.
 
     Returns
     -------
     TerrainResult
-        Stops, collector crossings, recorded paths and (with ``hazard``) the pixel passages of the run.
+        Stops, collector crossings, recorded paths and (with ``hazard`` and no ``passage_sink``) the pixel
+        passages of the run.
     """
     if masses_kg is not None:
         masses_kg = check_masses(masses_kg, None if n is None else n)
@@ -212,16 +219,32 @@ def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, m
     hint = {}
     job = lambda c: _run_chunk(c[0], c[1], blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap,  # noqa: E731
                                hint)
+    sink = passage_sink if hazard else None
+
+    def keep(part):
+        if sink is None:
+            return part
+        sink(part[2])                          # the chunk's passages go to the sink, not into the result
+        return part[0], part[1], None, part[3]
     if workers == 1 or len(chunks) == 1:
-        parts = [job(c) for c in chunks]
+        parts = [keep(job(c)) for c in chunks]
     else:
-        parts = [job(chunks[0])]
+        parts = [keep(job(chunks[0]))]
         with ThreadPoolExecutor(max_workers=workers) as pool:
-            parts += list(pool.map(job, chunks[1:]))
+            if sink is None:
+                parts += list(pool.map(job, chunks[1:]))
+            else:                              # a bounded window of chunks in flight, handed over in order
+                pending, todo = [], iter(chunks[1:])
+                for c in todo:
+                    pending.append(pool.submit(job, c))
+                    if len(pending) >= 2 * workers:
+                        parts.append(keep(pending.pop(0).result()))
+                parts += [keep(f.result()) for f in pending]
     elapsed = time.perf_counter() - started
     cat = lambda i: {k: np.concatenate([p[i][k] for p in parts]) for k in parts[0][i]}  # noqa: E731
     return TerrainResult(scenario=scenario, n=n, seed=seed, blocks=blocks, per_block=cat(0), crossings=cat(1),
-                         passages=cat(2) if hazard else None, paths=cat(3), elapsed_s=elapsed, workers=workers)
+                         passages=cat(2) if hazard and sink is None else None, paths=cat(3), elapsed_s=elapsed,
+                         workers=workers)
 
 
 # ---- tiles: the same run split by source, for a distributed engine ----------------------------------------------
@@ -310,7 +333,8 @@ class TerrainRunPlan:
             return {k: v[order] for k, v in cat.items()}
         return TerrainResult(scenario=self.scenario, n=self.n, seed=self.seed, blocks=self.blocks,
                              per_block=per_block, crossings=in_block_order("crossings"),
-                             passages=in_block_order("passages") if self.hazard else None,
+                             passages=in_block_order("passages") if self.hazard and "passages" in outputs[0]
+                             else None,
                              paths=in_block_order("paths"), elapsed_s=elapsed_s, workers=workers)
 
 
@@ -663,8 +687,9 @@ class TerrainResult(Displayed):
 
     # ---- hazard rasters ----------------------------------------------------------------------------
     def hazard_grids(self) -> dict:
-        """Hazard rasters on the DEM's grid (internal order, NaN where no block passed), from the pixels each
-        block crossed (run with ``hazard=True``):
+        """Hazard rasters on the DEM's grid (internal order; NaN on the DEM's nodata holes, and in the
+        percentile layers where no block passed), from the pixels each block crossed (run with ``hazard=True``
+        and no ``passage_sink``; a streamed run aggregates with :class:`simulation.hazard_grids.PassageAggregator`):
 
         ``passage_count`` blocks that passed through the pixel (each counted once); ``reach_probability`` that
         count / n; ``energy_p50_kj``, ``energy_p95_kj``, ``energy_p99_kj`` percentiles over those blocks of each
@@ -689,13 +714,8 @@ class TerrainResult(Displayed):
         for name, row in (("energy_p50_kj", eq[0]), ("energy_p95_kj", eq[1]), ("energy_p99_kj", eq[2]),
                           ("jump_height_p95_m", hq)):
             out[name] = row.reshape(ny, nx)
-        pb = self.per_block
-        stopped = pb["reason"] == kernel3d.STOPPED
-        j = np.clip(np.floor((pb["x"][stopped] - ter.x0) / ter.dx + 0.5).astype(np.int64), 0, nx - 1)
-        i = np.clip(np.floor((pb["y"][stopped] - ter.y0) / ter.dy + 0.5).astype(np.int64), 0, ny - 1)
-        dep = np.bincount(i * nx + j, minlength=ncell).astype(float) / (self.n * ter.dx * ter.dy)
-        out["deposition_density"] = dep.reshape(ny, nx)
-        return out
+        out["deposition_density"] = deposition_density(ter, self.per_block, self.n)
+        return mask_holes(out, ter)
 
     def plot(self, ax=None, paths: bool = True):
         """Plan view: hillshade of the DEM, recorded paths, stop points and collectors (matplotlib axes).

@@ -341,7 +341,8 @@ class Terrain(Displayed):
             raise TerrainError(f"grid of shape {grid.shape} is not on the DEM's grid {self.z.shape}")
         return grid if self.south_up else grid[::-1]
 
-    def write_geotiff(self, path, grid, nodata=np.nan, dtype="float32") -> Path:
+    def write_geotiff(self, path, grid, nodata=np.nan, dtype="float32", *, description: str | None = None,
+                      unit: str | None = None, tags: dict | None = None) -> Path:
         """Write a (ny, nx) grid in internal order as a single-band GeoTIFF on the DEM's grid and CRS
         (written to a temporary name, then renamed: never half-written).
 
@@ -355,6 +356,12 @@ class Terrain(Displayed):
             The nodata value written.
         dtype : str
             Pixel type.
+        description : str, optional
+            The band's description (the quantity, e.g. "passing energy p95"); also band tag ``quantity``.
+        unit : str, optional
+            The band's unit (GDAL unit type, e.g. "kJ"); also band tag ``unit``.
+        tags : dict, optional
+            Dataset-level metadata tags (GDAL metadata items).
 
         Returns
         -------
@@ -368,6 +375,14 @@ class Terrain(Displayed):
                        crs=self.crs, transform=self.transform, nodata=nodata, compress="deflate")
         with rasterio.open(tmp, "w", **profile) as dst:
             dst.write(data, 1)
+            if description is not None:
+                dst.set_band_description(1, description)
+                dst.update_tags(1, quantity=description)
+            if unit is not None:
+                dst.set_band_unit(1, unit)
+                dst.update_tags(1, unit=unit)
+            if tags:
+                dst.update_tags(**{str(k): str(v) for k, v in tags.items()})
         tmp.replace(path)
         return path
 
