@@ -78,9 +78,50 @@ def test_return_period_basis_is_the_T_year_energy():
     req = design_requirement(hz, DesignBasis("return period", design_T=100.0), block=None, density_kg_m3=RHO)
     m_T = stats.lognorm(s=1.0, scale=3000.0).isf(1.0 / (100.0 * 2.0))
     assert req.E_d_kj == pytest.approx(0.5 * m_T * 20.0 ** 2 / 1000.0, rel=2e-3)
-    # the 30-year energy against SEL also bounds the MEL: MEL >= 3 E_30
+    # no standard sets "30-year energy <= SEL": off by default, the T-year energy alone sets the MEL
+    assert req.required_mel_kj == pytest.approx(req.E_d_kj)
+    assert "owner option" not in req.governs
+    # the owner option on: the 30-year energy against SEL also bounds the MEL: MEL >= 3 E_30
+    on = design_requirement(hz, DesignBasis("return period", design_T=100.0, frequent_events_sel=True), block=None,
+                            density_kg_m3=RHO)
     e30 = 0.5 * stats.lognorm(s=1.0, scale=3000.0).isf(1.0 / 60.0) * 400 / 1000
-    assert req.required_mel_kj == pytest.approx(max(req.E_d_kj, 3 * e30), rel=2e-3)
+    assert on.required_mel_kj == pytest.approx(max(on.E_d_kj, 3 * e30), rel=2e-3)
+    assert "owner option frequent_events_sel, not in return period" in on.governs
+
+
+def test_owner_option_frequent_events_sel_moves_the_uni_mel_and_is_labelled():
+    # UNI 11211-4 sets E_d gamma_E <= MEL (RocFall UNI 11211 design page, UNI 11211-4:2012); the 30-year energy vs
+    # SEL is an owner option: with it off the MEL is E_d x 1.2; on, max(E_d x 1.2, 3 E_30), labelled "not in UNI"
+    hz = _hazard(rate=5.0)                      # 150 falls in 30 years: the 30-year energy is defined
+    off = design_requirement(hz, DesignBasis("UNI 11211-4"), block=_block(), density_kg_m3=RHO)
+    assert off.required_mel_kj == pytest.approx(1.2 * off.E_d_kj)
+    assert off.governs == "E_d x gamma_E (1.2) <= MEL (UNI 11211-4)"
+    on = design_requirement(hz, DesignBasis("UNI 11211-4", frequent_events_sel=True), block=_block(),
+                            density_kg_m3=RHO)
+    e30 = on.frequent_energy_kj
+    assert 3 * e30 > 1.2 * on.E_d_kj             # the frequent rule governs here
+    assert on.required_mel_kj == pytest.approx(3 * e30)
+    assert on.governs.endswith("(frequent events; owner option frequent_events_sel, not in UNI 11211-4)")
+    assert "owner option frequent_events_sel, not in UNI 11211-4" in on.text()
+    summ = on.summary()["value"]
+    assert any("owner option frequent_events_sel ON" in k for k in summ.index)
+    assert any("owner option frequent_events_sel off" in k for k in off.summary()["value"].index)
+    # the basis text says which rule is from the standard and which are owner options
+    t = DesignBasis("UNI 11211-4").text()
+    assert "Rules from UNI 11211-4:" in t and "Owner options (not in UNI 11211-4):" in t
+    assert "30-year impact energy <= SEL = MEL/3 (frequent_events_sel) [off]" in t
+    rules = DesignBasis("UNI 11211-4", frequent_events_sel=True).rules().set_index("rule")
+    assert rules.loc["30-year impact energy <= SEL = MEL/3 (frequent_events_sel)", "source"] == \
+        "owner option, not in UNI 11211-4"
+    assert rules.loc["30-year impact energy <= SEL = MEL/3 (frequent_events_sel)", "in force"] == "yes"
+    # the frequent-events check of a candidate appears only with the option on
+    cands = [("f", 3000.0, 6.0)]
+    chk = lambda r: list(r.candidates["check"])  # noqa: E731
+    assert not any(c.startswith("frequent") for c in chk(design_requirement(hz, DesignBasis("UNI 11211-4"),
+                                                          block=_block(), density_kg_m3=RHO, candidates=cands)))
+    assert any(c.startswith("frequent") for c in chk(design_requirement(
+        hz, DesignBasis("UNI 11211-4", frequent_events_sel=True), block=_block(), density_kg_m3=RHO,
+        candidates=cands)))
 
 
 def test_candidate_checks_deflection_and_residual_category():
@@ -222,3 +263,106 @@ def test_return_period_basis_without_a_T_year_event_says_why():
     # with a design block the basis falls back to it for the height, but the energy is still undefined
     with pytest.raises(ValueError, match="fewer than one fall reaches the line in 100 years"):
         design_requirement(hz, DesignBasis("return period", design_T=100.0), block=_block())
+
+
+# ---- issue 39 items 2 and 3: ONR 24810 event-frequency fractiles and consequence classes, elongation, kits ----
+def test_onr24810_event_frequency_class_sets_the_design_block_fractile():
+    # Trumer Schutzbauten's summary of ONR 24810, "Design Block" table: EF4 n >= 10/yr V98, EF3 1 <= n < 10 V97,
+    # EF2 0.03 <= n < 1 V96, EF1 n < 0.03 V95 (a design-block SIZE fractile)
+    from riskrf.hazard.design_basis import onr24810_event_frequency_class as efc
+    assert [efc(n)[:2] for n in (1.0, 5.0, 12.0)] == [("EF3", 97.0), ("EF3", 97.0), ("EF4", 98.0)]
+    assert [efc(n)[:2] for n in (10.0, 9.99, 0.5, 0.03, 0.0299, 0.0)] == [
+        ("EF4", 98.0), ("EF3", 97.0), ("EF2", 96.0), ("EF2", 96.0), ("EF1", 95.0), ("EF1", 95.0)]
+    with pytest.raises(ValueError, match="falls_per_year"):
+        efc(-1.0)
+
+
+@pytest.mark.parametrize("rate, cls, q", [(1.0, "EF3", 97.0), (5.0, "EF3", 97.0), (12.0, "EF4", 98.0)])
+def test_onr24810_design_requirement_takes_the_fractile_of_the_event_frequency(rate, cls, q):
+    from riskrf.hazard.design_block import design_block
+    hz = _hazard(rate=rate)
+    sizes = np.linspace(0.1, 10.0, 100)                       # block survey [m3]
+    block = design_block(hz, rule="percentile", percentile=97.0, survey_volumes_m3=sizes, survey_source="survey",
+                         density_kg_m3=RHO)
+    basis = DesignBasis("ONR 24810", consequence_class="CC2")
+    req = design_requirement(hz, basis, block=block, density_kg_m3=RHO)
+    assert req.event_frequency_class == cls and req.design_block_fractile == q
+    assert req.block_mass_kg == pytest.approx(np.percentile(sizes, q) * RHO)
+    replaced = any("replacing design_block.percentile = 97" in n for n in req.notes)
+    assert replaced == (q != 97.0)
+    assert req.summary()["value"]["ONR 24810 event-frequency class (falls per year)"] == cls
+    # a block of another rule is kept, and the output says it is not the standard approach
+    other = design_requirement(hz, basis, block=_block(), density_kg_m3=RHO)
+    assert other.block_mass_kg == pytest.approx(2.0 * RHO)
+    assert any(f"asks for the V{q:g}" in n and "[confirm against the standard]" in n for n in other.notes)
+
+
+def test_onr24810_consequence_class_and_its_factors():
+    from riskrf.hazard.design_basis import ONR_CONSEQUENCE_CLASSES
+    assert set(ONR_CONSEQUENCE_CLASSES) == {"CC1", "CC2", "CC3"}
+    # no factor value could be read: not stated -> 1.0 in force and flagged "[confirm against the standard]"
+    plain = design_requirement(_hazard(), DesignBasis("ONR 24810", consequence_class="CC3"), block=_block(),
+                               density_kg_m3=RHO)
+    assert plain.E_d_kj == pytest.approx(1080.0)
+    assert any("consequence class CC3 were not read" in n and "[confirm against the standard]" in n
+               for n in plain.notes)
+    assert "consequence class CC3 (high consequence" in plain.basis.text()
+    assert "consequence class NOT STATED" in DesignBasis("ONR 24810").text()
+    assert any("consequence class not stated" in n
+               for n in design_requirement(_hazard(), DesignBasis("ONR 24810"), block=_block(),
+                                           density_kg_m3=RHO).notes)
+    # the class's factors, once stated, are applied: E_d = 1/2 (m gamma_m)(v gamma_v)^2 = 1080 x 1.1 x 1.2^2
+    stated = design_requirement(_hazard(), design_basis_from_site({"basis": "ONR 24810", "consequence_class": "CC3",
+                                                                   "gamma_m": 1.1, "gamma_v": 1.2}),
+                                block=_block(), density_kg_m3=RHO)
+    assert stated.E_d_kj == pytest.approx(1080.0 * 1.1 * 1.44)
+    assert not any("were not read" in n for n in stated.notes)
+    with pytest.raises(ValueError, match="design.consequence_class = 'CC4'"):
+        design_basis_from_site({"basis": "ONR 24810", "consequence_class": "CC4"})
+
+
+def test_elongation_in_either_documented_form_and_kits_in_the_checks():
+    # one number for every fence, or a table {fence name: metres} (docs/user-guide/design-basis.md)
+    one = design_basis_from_site({"elongation_m": 5.0})
+    table = design_basis_from_site({"elongation_m": {"fence 2000 kJ": 5.0, "fence 3000 kJ": 7.0}})
+    assert one.kit_elongation_m("any fence") == 5.0
+    assert table.kit_elongation_m("fence 3000 kJ") == 7.0 and table.kit_elongation_m("other") is None
+    for bad in ("five", -1.0, {"fence 2000 kJ": 0.0}, True):
+        with pytest.raises(ValueError, match="design.elongation_m"):
+            design_basis_from_site({"elongation_m": bad})
+    # a kit of the table gives its SEL, elongation at MEL and residual category to the checks
+    from riskrf.hazard.barrier_kits import get_kit
+    kit = get_kit("generic 2000 kJ")
+    req = design_requirement(_hazard(), DesignBasis("UNI 11211-4", residual_category="A"), block=_block(),
+                             density_kg_m3=RHO, clearance_m=7.0, candidates=[("f", None, None, kit.name)])
+    c = req.candidates.set_index("check")
+    elong = c[c.index.str.startswith("elongation")]
+    assert elong["demand"].iloc[0] == pytest.approx(kit.max_elongation_mel_m * 1.3)      # 6.0 m x 1.3 = 7.8 m
+    assert not elong["adequate"].iloc[0]                                                 # > 7 m of clearance
+    assert "GENERIC kit, not a product" in elong.index[0]
+    assert c[c.index.str.startswith("height")]["capacity"].iloc[0] == kit.nominal_height_m
+    assert bool(c[c.index.str.startswith("residual height")]["adequate"].iloc[0])
+
+
+def test_site_file_elongation_forms_and_kit_errors_name_file_and_field(tmp_path):
+    from riskrf.risk.mitigation_inputs import MitigationError
+    from .test_assess import _site_copy
+    anchor = 'residual_category = "A"'
+    for form, want in (("elongation_m = 5.0", 5.0), ('elongation_m = { "fence 2000 kJ" = 5.0, "fence 3000 kJ" = 7.0 }',
+                                                       {"fence 2000 kJ": 5.0, "fence 3000 kJ": 7.0})):
+        site = load_site(_site_copy(tmp_path, replace={anchor: f"{anchor}\n{form}"}))
+        assert design_basis_from_site(site.design).elongation_m == want
+    path = _site_copy(tmp_path, replace={anchor: f'{anchor}\nelongation_m = "five"'})
+    with pytest.raises(SiteError, match=r"site.toml: design.elongation_m = 'five' must be one number"):
+        load_site(path)
+    # a fence naming a kit takes its MEL and height; a kit not in the table is refused with the known kits
+    fence = 'capacity_kj = 2000\nheight_m = 5.0'
+    site = load_site(_site_copy(tmp_path, replace={fence: 'kit = "generic 2000 kJ"'}))
+    f = next(o for o in site.mitigation["options"] if o.name == "fence 2000 kJ")
+    assert (f.kit, f.capacity_kj, f.height_m) == ("generic 2000 kJ", 2000.0, 5.0)
+    path = _site_copy(tmp_path, replace={fence: 'kit = "RXI-200"'})
+    with pytest.raises((SiteError, MitigationError)) as err:
+        load_site(path)
+    msg = str(err.value)
+    assert "site.toml" in msg and "option 'fence 2000 kJ': kit = 'RXI-200' is not in the kit table" in msg
+    assert "known kits: 'generic 100 kJ'" in msg

@@ -227,7 +227,7 @@ def design_for_site(site, hazard, block, result, density_kg_m3: float, seed) -> 
         road_x = result.scenario.collectors[names.index(road)].x if road in names else None
     clearance = (road_x - barrier_x) if road_x is not None and barrier_x is not None else None
     fences = [o for o in site.mitigation["options"] if o.kind in ("fence", "attenuator") and o.x_m is None]
-    candidates = [(o.name, o.capacity_kj, o.height_m) for o in fences] or [
+    candidates = [(o.name, o.capacity_kj, o.height_m, getattr(o, "kit", None)) for o in fences] or [
         (f"candidate fence {c:g} kJ", c, h) for c, h in zip(*_fence_list(site))]
     try:
         req = design_requirement(hazard, basis, block=block, density_kg_m3=density_kg_m3,

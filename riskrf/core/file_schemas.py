@@ -118,13 +118,19 @@ DESIGN_BLOCK = Table("design_block", (
 DESIGN = Table("design", (
     _text("basis", "the standard that governs the barrier design (riskrf.hazard.design_basis)",
           default="UNI 11211-4"),
-    _pos("frequent_T_years", "years", "return period of the frequent event checked against SEL", default=30.0),
-    _text("residual_category", "residual-height category required (EAD 340059)", default="A",
-          choices=("A", "B", "C")),
+    _pos("frequent_T_years", "years", "return period of the frequent event: ONR 24810's frequent design block, and "
+         "the energy of the owner option frequent_events_sel", default=30.0),
+    Field("frequent_events_sel", "bool", "", "OWNER OPTION, not in UNI 11211-4 or ONR 24810: the frequent_T_years "
+          "impact energy must not exceed SEL = MEL/3", False),
+    _text("residual_category", "OWNER OPTION: residual-height category required of the kit (EAD 340059 categories)",
+          default="A", choices=("A", "B", "C")),
+    _text("consequence_class", "ONR 24810 consequence class (EN 1990); flagged in every output when not stated",
+          choices=("CC1", "CC2", "CC3")),
     _pos("clearance_m", "m", "clearance from the barrier to the road, for the elongation check"),
     Field("mel_classes_kj", "numbers", "kJ", "the product classes searched for the required MEL", low=0,
           low_open=True),
-    _pos("elongation_m", "m", "maximum elongation of the candidate kit"),
+    Field("elongation_m", "any", "m", "the kits' maximum elongation at MEL: one number for every fence, or a table "
+          "{fence name = metres}"),
     Field("positions_x_m", "numbers", "m", "barrier positions searched along the profile"),
     _count("position_blocks", "blocks simulated for the position search", low=100),
     *(_pos(g, "", f"partial factor {g} (default: the basis's value, flagged in every output)")
@@ -247,6 +253,8 @@ OPTIONS = Table("options", (
     _nonneg("x_m", "m", "position along the profile"),
     _pos("width_m", "m", "ditch width"),
     _pos("depth_m", "m", "ditch depth"),
+    _text("kit", "fence or attenuator: a kit of riskrf/data/barrier_kits.csv (its MEL, SEL, nominal height, "
+          "maximum elongation and residual category enter the design checks)"),
     _pos("capacity_kj", "kJ", "barrier capacity (MEL)"),
     _pos("height_m", "m", "barrier height"),
     _pos("min_mass_kg", "kg", "smallest block scaling removes"),

@@ -29,11 +29,26 @@ public source) and every output names it.
     E_d is the T-year impact energy at the line (``hazard.design_period_years``), checked against MEL without
     a factor.
 
-Every basis adds the serviceability check the standards ask for frequent events: the ``frequent_T_years``
-impact energy (default 30 years: the Swiss "high probability" class 1-30 years, BUWAL 1997 [R]) against
-SEL = MEL/3, so that frequent impacts need no repair.  The residual-height category after a MEL impact
-(EAD 340059-00-0106 / ETAG 027: A >= 50 %, B 30-50 %, C < 30 % of the nominal height [R]) is required as
-``[design] residual_category`` (default "A").
+Standards as written, owner choices as named options.  A rule that the governing standard does not set is an
+**owner option** of ``[design]``, off by default, and labelled "owner option, not in <standard>" wherever it
+governs (:data:`OWNER_OPTIONS`, :meth:`DesignBasis.rules`):
+
+``frequent_events_sel`` (default false)
+    the ``frequent_T_years`` impact energy at the line (default 30 years: the Swiss "high probability" class
+    1-30 years, BUWAL 1997 [R]) against SEL = MEL/3, so that frequent impacts need no repair.  UNI 11211-4 asks
+    for E_d <= MEL/gamma_E or E_d <= SEL/gamma_E (RocFall UNI 11211 design page [V]), not for a return-period
+    energy; ONR 24810's own frequent/rare distinction is on the design block (below), not on a 30-year energy.
+``residual_category`` (default "A")
+    the residual-height category required of the kit (EAD 340059-00-0106 / ETAG 027 categories: A >= 50 %,
+    B 30-50 %, C < 30 % of the nominal height [R]); EAD 340059 classifies kits, it requires none.
+
+ONR 24810 (as summarised by Trumer Schutzbauten, trumerschutzbauten.com/standards/rockfall-standards/onr-24810/,
+pages "Design Block" and "Consequence Class" [V]) sets the design-block SIZE fractile by the event-frequency
+class of the site (:data:`ONR_EVENT_FREQUENCY_CLASSES`: EF4 n >= 10/yr V98, EF3 1 <= n < 10 V97, EF2
+0.03 <= n < 1 V96, EF1 n < 0.03 V95) and borrows the consequence classes CC1-CC3 of EN 1990
+(:data:`ONR_CONSEQUENCE_CLASSES`), which set its partial factors; the factor values per class were not readable
+in any source reached, so every output says "[confirm against the standard]" until the site states
+``gamma_m`` and ``gamma_v``.
 
 :func:`design_requirement` gives the required MEL (and the smallest product class that meets it), the required
 net height, the elongation the road clearance permits and the checks of candidate fences;
@@ -65,6 +80,64 @@ RESIDUAL_CATEGORIES = {"A": 0.5, "B": 0.3, "C": 0.0}
 #: Net heights are chosen in steps of this [m] (kits come in 0.5 m or 1 m steps).
 HEIGHT_STEP_M = 0.5
 
+#: Rules no standard of :data:`BASES` sets: owner options of ``[design]`` with their default and meaning.  Each
+#: is labelled "owner option, not in <basis>" wherever it governs.
+OWNER_OPTIONS = {
+    "frequent_events_sel": (False, "the frequent_T_years impact energy at the line <= SEL = MEL/3 (frequent impacts "
+                                   "need no repair)"),
+    "residual_category": ("A", "the residual-height category required of the kit after a MEL impact (EAD 340059 "
+                               "classifies kits A/B/C, it requires none)"),
+}
+
+#: ONR 24810 event-frequency classes: (class, lowest n [falls/yr], design-block size fractile [%], name).  Table
+#: "Event Frequency Class / Occurrence Frequency n (1/a) / Design Block Size Fractile" of Trumer Schutzbauten's
+#: summary of ONR 24810, page "Design Block" (trumerschutzbauten.com/standards/rockfall-standards/onr-24810/
+#: design-block/) [V]: EF4 n >= 10 V98, EF3 1 <= n < 10 V97, EF2 0.03 <= n < 1 V96, EF1 n < 0.03 V95.
+ONR_EVENT_FREQUENCY_CLASSES = (("EF4", 10.0, 98.0, "very high"), ("EF3", 1.0, 97.0, "high"),
+                               ("EF2", 0.03, 96.0, "low"), ("EF1", 0.0, 95.0, "rare"))
+#: ONR 24810 consequence classes (from EN 1990:2002 Annex B), as summarised by Trumer Schutzbauten, page
+#: "Consequence Class" (trumerschutzbauten.com/standards/rockfall-standards/onr-24810/consequence-class/) [V].
+ONR_CONSEQUENCE_CLASSES = {
+    "CC1": "low consequence: e.g. agricultural buildings rarely occupied, forest roads, freight roads with low traffic",
+    "CC2": "medium consequence: e.g. residential and public buildings, regional and national roads with daily "
+           "traffic < 50,000 vehicles",
+    "CC3": "high consequence: high impact on human life, very large economic, social or environmental effects",
+}
+#: ONR 24810 partial factors on the design block's mass and speed by consequence class.  The standard's table was
+#: not readable in any source reached (the published summaries name the classes, not the numbers; Moelk & Stelzer
+#: 2013 only say the factors exist): no value is given, and every output says "[confirm against the standard]"
+#: until the site file states gamma_m and gamma_v.
+ONR_CONSEQUENCE_FACTORS: dict = {}
+CONFIRM = "[confirm against the standard]"
+
+
+def onr24810_event_frequency_class(falls_per_year: float) -> tuple:
+    """ONR 24810 event-frequency class and design-block size fractile of a site with ``falls_per_year`` events.
+
+    Parameters
+    ----------
+    falls_per_year : float
+        Occurrence frequency n of rock fall events [1/yr].
+
+    Returns
+    -------
+    tuple
+        (class "EF1"-"EF4", design-block size fractile [%], class name): EF4 n >= 10 -> 98, EF3 1 <= n < 10 -> 97,
+        EF2 0.03 <= n < 1 -> 96, EF1 n < 0.03 -> 95.
+
+    References
+    ----------
+    ONR 24810:2021, design block, as summarised by Trumer Schutzbauten, "Design Block" table
+    (trumerschutzbauten.com/standards/rockfall-standards/onr-24810/design-block/).
+    """
+    n = float(falls_per_year)
+    if not (np.isfinite(n) and n >= 0):
+        raise ValueError(f"falls_per_year = {falls_per_year!r} must be a number >= 0 [1/yr]")
+    for cls, lo, fractile, name in ONR_EVENT_FREQUENCY_CLASSES:
+        if n >= lo:
+            return cls, fractile, name
+    raise AssertionError("unreachable")  # pragma: no cover - EF1 starts at 0
+
 #: Default partial factors per basis; [V] seen in a source, [R] recalled (see the module notes).
 DEFAULT_FACTORS = {
     "UNI 11211-4": {"gamma_Tr": 1.10, "gamma_Dp": 1.10, "gamma_VolF": 1.10, "gamma_gamma": 1.0,
@@ -77,11 +150,12 @@ FACTOR_SOURCES = {
     "UNI 11211-4": ("gamma_Tr, gamma_Dp, gamma_VolF (1.02 / 1.10) and gamma_gamma (1.0): UNI 11211-4:2012 as quoted "
                     "by the RocFall UNI 11211 design page and Peila & Ronco (2009) [V]; gamma_E = 1.2 against MEL, "
                     "gamma_d = 1.3 at MEL and h_d = h_t gamma_Tr gamma_Dp [R: confirm against the standard]"),
-    "ONR 24810": ("design block 95th-98th percentile and characteristic percentiles 95/99 [V: Natural Hazards 2024, "
-                  "doi 10.1007/s11069-024-06432-4; Marchelli 2022]; distance to the element at risk >= max(1.2 D_MEL, "
+    "ONR 24810": ("design block: the block-size fractile of the event-frequency class, EF4 V98, EF3 V97, EF2 V96, "
+                  "EF1 V95 [V: Trumer Schutzbauten's ONR 24810 summary, 'Design Block']; characteristic speed "
+                  "percentile 95/99 [V: Marchelli 2022]; distance to the element at risk >= max(1.2 D_MEL, "
                   "D_MEL + 1 m) [V: ONR 24810 constructive rules as summarised by Trumer Schutzbauten]; gamma_m and "
-                  "gamma_v are riskrf defaults, NOT checked against the ONR 24810 tables: state them in [design] for "
-                  "a signed design"),
+                  "gamma_v are riskrf defaults, NOT checked against the ONR 24810 tables by consequence class: state "
+                  "them in [design] for a signed design"),
     "return period": "the T-year impact energy at the line against MEL, no partial factor",
 }
 
@@ -305,17 +379,51 @@ def onr24810_energy(mass_kg, velocity_ms, *, gamma_m, gamma_v):
     return kinetic_energy_kj(mass_kg * gamma_m, velocity_ms * gamma_v)
 
 
+def check_elongation(value, where: str = "design.elongation_m"):
+    """The maximum elongation at MEL of the candidate kits in either documented form: one number [m] for every
+    fence, or a table {fence name: metres}; a ValueError naming ``where`` otherwise.
+
+    Parameters
+    ----------
+    value : float or dict
+        One number > 0 [m], or {fence name: number > 0 [m]}.
+    where : str, optional
+        Name of the field, for the message.
+
+    Returns
+    -------
+    float or dict
+        The number [m], or the table {name: metres}.
+    """
+    def ok(v):
+        return (not isinstance(v, (bool, np.bool_)) and isinstance(v, (int, float, np.integer, np.floating))
+                and np.isfinite(float(v)) and float(v) > 0)
+    if isinstance(value, dict):
+        for name, d in value.items():
+            if not ok(d):
+                raise ValueError(f"{where}[{name!r}] = {d!r} must be a number > 0 m (the kit's maximum elongation "
+                                 "in the MEL test)")
+        return {str(k): float(v) for k, v in value.items()}
+    if ok(value):
+        return float(value)
+    raise ValueError(f"{where} = {value!r} must be one number > 0 m for every fence, or a table "
+                     "{fence name = metres} (the kits' maximum elongation in the MEL test)")
+
+
 @dataclass(frozen=True)
 class DesignBasis:
     """The chosen standard with its factors and limits (site file ``[design]``).
 
     basis : one of :data:`BASES`; factors : the partial factors in force (defaults of the basis, replaced by those
     the site states); stated : names of the factors the site file stated; frequent_T_years : return period [yr] of
-    the frequent event checked against SEL; residual_category : the required residual-height category;
-    clearance_m : distance [m] from the barrier to the road available for the net's elongation (None: from the
-    scenario, barrier line to road line); free_board_m : free board [m] above the design block's top;
-    mel_classes_kj : the product classes [kJ]; elongation_m : {fence name: maximum elongation at MEL [m]} of
-    candidate kits; design_T : return period [yr] of the return-period basis.
+    the frequent event (ONR 24810's frequent design block; the owner option below); frequent_events_sel : the
+    owner option "frequent_T_years energy <= SEL" (default False: no standard of :data:`BASES` sets it);
+    residual_category : the required residual-height category (an owner option, default "A");
+    consequence_class : ONR 24810 consequence class "CC1"-"CC3" (None: not stated, flagged); clearance_m :
+    distance [m] from the barrier to the road available for the net's elongation (None: from the scenario, barrier
+    line to road line); free_board_m : free board [m] above the design block's top; mel_classes_kj : the product
+    classes [kJ]; elongation_m : maximum elongation at MEL [m] of the candidate kits, one number for every fence or
+    {fence name: metres}; design_T : return period [yr] of the return-period basis.
     """
 
     basis: str = DEFAULT_BASIS
@@ -326,8 +434,10 @@ class DesignBasis:
     clearance_m: float | None = None
     free_board_m: float = 0.5
     mel_classes_kj: tuple = MEL_PRODUCT_CLASSES_KJ
-    elongation_m: dict = field(default_factory=dict)
+    elongation_m: dict | float = field(default_factory=dict)
     design_T: float = 100.0
+    frequent_events_sel: bool = False
+    consequence_class: str | None = None
 
     def __post_init__(self):
         check_basis(self.basis)
@@ -355,9 +465,83 @@ class DesignBasis:
         if c.size == 0 or np.any(~np.isfinite(c) | (c <= 0)):
             raise ValueError(f"design.mel_classes_kj = {list(self.mel_classes_kj)!r} must be positive energies [kJ]")
         object.__setattr__(self, "mel_classes_kj", tuple(sorted(float(x) for x in c)))
-        for name, d in self.elongation_m.items():
-            if not (np.isfinite(float(d)) and float(d) > 0):
-                raise ValueError(f"design.elongation_m[{name!r}] = {d!r} must be a number > 0 m")
+        object.__setattr__(self, "elongation_m", check_elongation(self.elongation_m))
+        if not isinstance(self.frequent_events_sel, (bool, np.bool_)):
+            raise ValueError(f"design.frequent_events_sel = {self.frequent_events_sel!r} must be true or false "
+                             "(an owner option, default false)")
+        if self.consequence_class is not None and self.consequence_class not in ONR_CONSEQUENCE_CLASSES:
+            raise ValueError(f"design.consequence_class = {self.consequence_class!r} is not one of "
+                             f"{', '.join(map(repr, ONR_CONSEQUENCE_CLASSES))} (ONR 24810)")
+
+    def kit_elongation_m(self, fence: str) -> float | None:
+        """The stated maximum elongation at MEL [m] of ``fence``: its entry of the table, or the one number given
+        for every fence; None when not stated.
+
+        Parameters
+        ----------
+        fence : str
+            Name of the candidate fence.
+
+        Returns
+        -------
+        float or None
+            Maximum elongation in the MEL test [m].
+        """
+        if isinstance(self.elongation_m, dict):
+            return self.elongation_m.get(fence)
+        return float(self.elongation_m)
+
+    def rules(self) -> pd.DataFrame:
+        """Every rule of the requirement, with where it comes from: the standard (and its source), an owner
+        option (on or off), or a riskrf default to confirm.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``rule``, ``source`` ("<basis>", "owner option, not in <basis>", "riskrf default, not checked
+            against <basis>"), ``in force`` ("yes"/"no") and ``reference``.
+        """
+        b = self.basis
+        rows = []
+
+        def add(rule, source, on, ref):
+            rows.append({"rule": rule, "source": source, "in force": "yes" if on else "no", "reference": ref})
+
+        if b == "UNI 11211-4":
+            f = self.factors
+            add(f"E_d = 1/2 (Vol rho gamma_VolF gamma_gamma)(v{f['velocity_percentile']:g} gamma_Tr gamma_Dp)^2 "
+                f"<= MEL / gamma_E", b, True, "RocFall UNI 11211 design page quoting UNI 11211-4:2012 [V]; gamma_E "
+                f"= {f['gamma_E']:g} {CONFIRM}")
+            add("net height >= h_d + f_min, f_min = max(0.5 m, block radius), h_d = h95 gamma_Tr gamma_Dp", b, True,
+                f"free border [V]; h_d factors {CONFIRM}")
+            add(f"elongation: D_MEL x gamma_d ({f['gamma_d']:g}) <= clearance D_A", b, True,
+                f"check D_A >= D_d [V]; gamma_d {CONFIRM}")
+        elif b == "ONR 24810":
+            add("design block: the block-size fractile of the event-frequency class (EF4 V98, EF3 V97, EF2 V96, "
+                "EF1 V95)", b, True, "Trumer Schutzbauten, ONR 24810 'Design Block' table [V]")
+            add("E_d = 1/2 (m gamma_m)(v gamma_v)^2 <= MEL (rare design block) or <= SEL = MEL/3 (frequent: "
+                f"the design block arrives at least once in {self.frequent_T_years:g} years)", b, True,
+                f"MEL/SEL by design event: {CONFIRM} (riskrf reads 'frequent' as more often than 1/"
+                f"{self.frequent_T_years:g} yr, the EF1/EF2 boundary 0.03/yr)")
+            cc = self.consequence_class or "not stated"
+            add(f"partial factors gamma_m, gamma_v of consequence class {cc}", b, True,
+                "stated in the site file" if not self.unverified else
+                f"riskrf default 1.0 {CONFIRM}: the factor table by consequence class was not read")
+            add("net height >= h95 + block radius + free board", "riskrf default, not checked against ONR 24810",
+                True, CONFIRM)
+            add("distance to the road >= max(1.2 D_MEL, D_MEL + 1 m)", b, True,
+                "Trumer Schutzbauten, ONR 24810 'Constructive Rules' [V]")
+        else:
+            add(f"{self.design_T:g}-year impact energy at the line <= MEL", "return period (an owner basis, not a "
+                "standard)", True, "riskrf")
+            add("net height >= h95 + block radius + free board", "return period (an owner basis, not a standard)",
+                True, "riskrf")
+        add(f"{self.frequent_T_years:g}-year impact energy <= SEL = MEL/3 (frequent_events_sel)",
+            f"owner option, not in {b}", self.frequent_events_sel,
+            "off by default" if not self.frequent_events_sel else "stated in the site file")
+        add(f"residual-height category {self.residual_category} required after a MEL impact (residual_category)",
+            f"owner option, not in {b}", True, "EAD 340059 categories A >= 50 %, B 30-50 %, C < 30 % [R]")
+        return pd.DataFrame(rows)
 
     @property
     def unverified(self) -> list:
@@ -376,9 +560,22 @@ class DesignBasis:
         """
         f = ", ".join(f"{k} {v:g}" for k, v in self.factors.items())
         s = f"design basis {self.basis} ({f}); {FACTOR_SOURCES[self.basis]}"
+        if self.basis == "ONR 24810":
+            cc = self.consequence_class
+            s += (f"; consequence class {cc} ({ONR_CONSEQUENCE_CLASSES[cc]})" if cc else
+                  "; consequence class NOT STATED (design.consequence_class: CC1, CC2 or CC3)")
         if self.unverified:
             s += (f"; NOT STATED in the site file, riskrf defaults in force: {', '.join(self.unverified)} "
-                  "(confirm against the standard before signing)")
+                  f"(confirm against the standard before signing) {CONFIRM}")
+        r = self.rules()
+        std = r[r["source"] == self.basis]["rule"].tolist()
+        own = r[r["source"].str.startswith("owner option")]
+        s += (f". Rules from {self.basis}: " + "; ".join(std) if std else "")
+        s += ". Owner options (not in " + self.basis + "): " + "; ".join(
+            f"{row['rule']} [{'ON' if row['in force'] == 'yes' else 'off'}]" for _, row in own.iterrows())
+        other = r[r["source"].str.startswith("riskrf default")]["rule"].tolist()
+        if other:
+            s += f". riskrf defaults not checked against {self.basis}: " + "; ".join(other) + f" {CONFIRM}"
         return s
 
 
@@ -417,8 +614,8 @@ def design_basis_from_site(cfg: dict | None, *, design_T: float = 100.0, free_bo
     keep = {k: v for k, v in cfg.items() if v is not None}
     if "mel_classes_kj" in keep:
         keep["mel_classes_kj"] = tuple(keep["mel_classes_kj"])
-    if "elongation_m" in keep and not isinstance(keep["elongation_m"], dict):
-        raise ValueError(f"design.elongation_m = {keep['elongation_m']!r} must be a table {{fence name = metres}}")
+    if "elongation_m" in keep:
+        keep["elongation_m"] = check_elongation(keep["elongation_m"])
     keep.setdefault("free_board_m", free_board_m)
     return DesignBasis(basis=basis, factors=factors, stated=tuple(factors), design_T=float(design_T), **keep)
 
@@ -462,6 +659,11 @@ class DesignRequirement:
     residual_category: str
     shares: dict = field(default_factory=dict)
     candidates: pd.DataFrame = field(default_factory=pd.DataFrame, repr=False)
+    #: ONR 24810: the event-frequency class of the site and its design-block size fractile [%] (else "" and NaN)
+    event_frequency_class: str = ""
+    design_block_fractile: float = float("nan")
+    #: statements about the requirement a checker must read (fractile replaced, factors not stated, ...)
+    notes: tuple = ()
 
     def summary(self) -> pd.DataFrame:
         """The requirement as a one-column table with plain-language row names and units.
@@ -480,7 +682,9 @@ class DesignRequirement:
             "characteristic energy E_k [kJ]": self.E_k_kj,
             "design energy E_d [kJ]": self.E_d_kj,
             "design event (kit level used)": "rare: MEL" if self.design_event == "rare" else "frequent: SEL = MEL/3",
-            f"{self.basis.frequent_T_years:g}-year energy (frequent event, against SEL) [kJ]": self.frequent_energy_kj,
+            (f"{self.basis.frequent_T_years:g}-year energy [kJ] (owner option frequent_events_sel "
+             f"{'ON: checked against SEL' if self.basis.frequent_events_sel else 'off: for information'}; "
+             f"not in {self.basis.basis})"): self.frequent_energy_kj,
             "required MEL [kJ]": self.required_mel_kj,
             "required product class MEL [kJ]": self.required_class_kj,
             "MEL set by": self.governs,
@@ -490,8 +694,15 @@ class DesignRequirement:
             "required net height (0.5 m steps) [m]": self.required_net_height_m,
             "clearance to the road D_A [m]": self.clearance_m,
             "permitted maximum elongation [m] (D_A / gamma_d; ONR 24810 also D_A - 1 m)": self.permitted_elongation_m,
-            "required residual-height category": self.residual_category,
+            f"required residual-height category (owner option, not in {self.basis.basis})": self.residual_category,
         }
+        if self.event_frequency_class:
+            rows["ONR 24810 event-frequency class (falls per year)"] = self.event_frequency_class
+            rows["ONR 24810 design-block size fractile [%]"] = self.design_block_fractile
+        if self.basis.basis == "ONR 24810":
+            rows["ONR 24810 consequence class"] = self.basis.consequence_class or f"not stated {CONFIRM}"
+        for i, n in enumerate(self.notes):
+            rows[f"note {i + 1}"] = n
         return pd.DataFrame({"value": pd.Series(rows, dtype=object)})
 
     def text(self) -> str:
@@ -505,7 +716,7 @@ class DesignRequirement:
         cls = (f"{self.required_class_kj:,.0f} kJ class" if np.isfinite(self.required_class_kj)
                else f"above the largest product class ({max(self.basis.mel_classes_kj):,.0f} kJ): no single kit")
         return (f"{self.basis.basis} governs: E_d = {self.E_d_kj:,.0f} kJ; required MEL {self.required_mel_kj:,.0f} kJ "
-                f"({cls}), required net height {self.required_net_height_m:g} m at x = {self.x_m:g} m"
+                f"({cls}; set by {self.governs}), required net height {self.required_net_height_m:g} m at x = {self.x_m:g} m"
                 + (f", maximum elongation {self.permitted_elongation_m:.2f} m" if self.permitted_elongation_m else "")
                 + f", residual-height category {self.residual_category}")
 
@@ -521,13 +732,18 @@ class DesignRequirement:
             "x_m", "block_mass_kg", "block_diameter_m", "block_rule", "v_k_ms", "v_d_ms", "E_k_kj", "E_d_kj",
             "frequent_energy_kj", "design_event", "required_mel_kj", "required_class_kj", "governs", "h_k_m",
             "h_d_m", "required_height_m", "required_net_height_m", "clearance_m", "permitted_elongation_m",
-            "residual_category")}
+            "residual_category", "event_frequency_class", "design_block_fractile")}
         out = {k: (None if isinstance(v, float) and not np.isfinite(v) else v) for k, v in out.items()}
         out["basis"] = self.basis.basis
         out["basis_text"] = self.basis.text()
         out["factors"] = dict(self.basis.factors)
         out["factors_not_stated"] = self.basis.unverified
         out["frequent_T_years"] = self.basis.frequent_T_years
+        out["owner_options"] = {"frequent_events_sel": bool(self.basis.frequent_events_sel),
+                                "residual_category": self.basis.residual_category}
+        out["consequence_class"] = self.basis.consequence_class
+        out["rules"] = self.basis.rules().to_dict(orient="records")
+        out["notes"] = list(self.notes)
         out["required_barrier_shares"] = dict(self.shares)
         out["candidates"] = self.candidates.to_dict(orient="records")
         return out
@@ -619,7 +835,9 @@ def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3:
     density_kg_m3 : rock density [kg/m3]
     x_m : position of the line [m] (for the outputs)
     clearance_m : distance [m] from the line to the road (``basis.clearance_m`` replaces it when stated)
-    candidates : sequence of (name, MEL [kJ], height [m]) fences to check against the requirement
+    candidates : sequence of (name, MEL [kJ], height [m]) or (name, MEL, height, kit) fences to check against the
+        requirement; a kit (:class:`~riskrf.hazard.barrier_kits.Kit` or a name of the kit table) gives its SEL,
+        maximum elongation at MEL and residual-height category (and the MEL and height where these are None)
 
     Returns
     -------
@@ -632,6 +850,17 @@ def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3:
     UNI 11211-4:2012 (rev. 2018); Peila & Ronco (2009), NHESS 9:1291-1298; ONR 24810:2021.
     """
     f = basis.factors
+    notes = []
+    ef_cls, ef_q = "", float("nan")
+    if basis.basis == "ONR 24810":
+        block, ef_cls, ef_q = _onr_design_block(hazard, block, notes)
+        if basis.consequence_class is None:
+            notes.append(f"ONR 24810 consequence class not stated (design.consequence_class = CC1, CC2 or CC3) "
+                         f"{CONFIRM}")
+        if basis.unverified:
+            notes.append(f"ONR 24810 partial factors {', '.join(basis.unverified)} = 1.0 are riskrf defaults; the "
+                         f"standard's factors for consequence class {basis.consequence_class or '(not stated)'} "
+                         f"were not read: state them in [design] {CONFIRM}")
     m, rule = _block_for_basis(hazard, basis, block, density_kg_m3)
     d = float((6.0 * m / density_kg_m3 / np.pi) ** (1.0 / 3.0))
     qv = f.get("velocity_percentile", 95.0)
@@ -643,7 +872,7 @@ def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3:
         E_d = uni11211_energy(m / density_kg_m3, density_kg_m3, v_k, gamma_Tr=f["gamma_Tr"], gamma_Dp=f["gamma_Dp"],
                               gamma_VolF=f["gamma_VolF"], gamma_gamma=f["gamma_gamma"])
         event, need = "rare", E_d * f["gamma_E"]
-        what = f"E_d x gamma_E ({f['gamma_E']:g}) <= MEL"
+        what = f"E_d x gamma_E ({f['gamma_E']:g}) <= MEL (UNI 11211-4)"
         h_factor = f["gamma_Tr"] * f["gamma_Dp"]
     elif basis.basis == "ONR 24810":
         v_d = v_k * f["gamma_v"]
@@ -655,8 +884,9 @@ def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3:
         T_block = 1.0 / rate_block if rate_block > 0 else float("inf")
         event = "frequent" if T_block < basis.frequent_T_years else "rare"
         need = E_d / SEL_PER_MEL if event == "frequent" else E_d
-        what = (f"E_d <= SEL = MEL/3 (design block arrives every {sig(T_block)} yr, frequent)" if event == "frequent"
-                else f"E_d <= MEL (design block arrives every {sig(T_block)} yr, rare)")
+        what = (f"E_d <= SEL = MEL/3 (ONR 24810; design block arrives every {sig(T_block)} yr, frequent: more often "
+                f"than every {basis.frequent_T_years:g} yr {CONFIRM})" if event == "frequent"
+                else f"E_d <= MEL (ONR 24810; design block arrives every {sig(T_block)} yr, rare)")
         h_factor = 1.0
     else:
         T = basis.design_T
@@ -666,11 +896,13 @@ def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3:
                              f"line in {T:g} years; choose another basis or return period")
         E_k, v_k, v_d = E_d, float("nan"), float("nan")
         event, need = "rare", E_d
-        what = f"{T:g}-year energy <= MEL"
+        what = f"{T:g}-year energy <= MEL (return-period basis, an owner basis)"
         h_factor = 1.0
     governs = what
-    if np.isfinite(e_freq) and e_freq / SEL_PER_MEL > need:
-        need, governs = e_freq / SEL_PER_MEL, f"{basis.frequent_T_years:g}-year energy <= SEL = MEL/3 (frequent events)"
+    frequent_rule = (f"{basis.frequent_T_years:g}-year energy <= SEL = MEL/3 (frequent events; owner option "
+                     f"frequent_events_sel, not in {basis.basis})")
+    if basis.frequent_events_sel and np.isfinite(e_freq) and e_freq / SEL_PER_MEL > need:
+        need, governs = e_freq / SEL_PER_MEL, frequent_rule
     cls = required_product_class(need, basis.mel_classes_kj)
     qh = f.get("height_percentile", 95.0)
     h_k = _class_value(hazard, "height", qh, m)
@@ -689,22 +921,38 @@ def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3:
     shares = barrier_shares(hazard, cls if np.isfinite(cls) else need, round_up(H), block_top_m=0.0) \
         if np.isfinite(H) else {}
     rows = []
-    for name, mel, height in candidates:
-        sel = mel * SEL_PER_MEL
-        rows.append({"fence": name, "check": f"energy: {governs}", "demand": need, "capacity": mel, "unit": "kJ",
+    for cand in candidates:
+        name, mel, height = cand[:3]
+        kit = _kit_of(cand[3] if len(cand) > 3 else None)
+        if kit is not None:
+            mel = kit.mel_kj if mel is None else mel
+            height = kit.nominal_height_m if height is None else height
+        sel = kit.sel_kj if kit is not None else mel * SEL_PER_MEL
+        of = f" [{kit.label()}]" if kit is not None else ""
+        rows.append({"fence": name, "check": f"energy: {governs}{of}", "demand": need, "capacity": mel, "unit": "kJ",
                      "adequate": bool(need <= mel * (1 + 1e-12))})
-        if np.isfinite(e_freq):
-            rows.append({"fence": name, "check": f"frequent events: {basis.frequent_T_years:g}-year energy vs SEL",
+        if basis.frequent_events_sel and np.isfinite(e_freq):
+            rows.append({"fence": name, "check": f"frequent events: {frequent_rule}{of}",
                          "demand": e_freq, "capacity": sel, "unit": "kJ", "adequate": bool(e_freq <= sel)})
-        rows.append({"fence": name, "check": f"height: {border_text}",
+        rows.append({"fence": name, "check": f"height: {border_text}{of}",
                      "demand": H, "capacity": height, "unit": "m",
                      "adequate": bool(H <= height) if np.isfinite(H) else None})   # no simulated heights
-        elong = basis.elongation_m.get(name)
+        elong = basis.kit_elongation_m(name)
+        elong_from = "stated in design.elongation_m"
+        if elong is None and kit is not None:
+            elong, elong_from = kit.max_elongation_mel_m, kit.label()
+        if kit is not None:
+            need_cat = basis.residual_category
+            rows.append({"fence": name, "check": f"residual height: category {kit.residual_category} vs required "
+                                                 f"{need_cat} (owner option, not in {basis.basis}){of}",
+                         "demand": float("nan"), "capacity": float("nan"), "unit": "",
+                         "adequate": bool(kit.residual_category <= need_cat)})   # A is the best, C the worst
         if elong is not None and clear is not None:
             need_d = required_distance_m(basis, elong)
-            rule = (f"max({f['gamma_d']:g} D_MEL, D_MEL + 1 m)" if basis.basis == "ONR 24810"
-                    else f"D_MEL x gamma_d ({f['gamma_d']:g})")
-            rows.append({"fence": name, "check": f"elongation: {rule} vs clearance",
+            rule_d = (f"max({f['gamma_d']:g} D_MEL, D_MEL + 1 m)" if basis.basis == "ONR 24810"
+                      else f"D_MEL x gamma_d ({f['gamma_d']:g})")
+            rows.append({"fence": name, "check": f"elongation: {rule_d} vs clearance (D_MEL {elong:g} m, "
+                                                 f"{elong_from})",
                          "demand": need_d, "capacity": clear, "unit": "m", "adequate": bool(need_d <= clear)})
         elif clear is not None:
             rows.append({"fence": name, "check": "elongation: the kit's maximum elongation at MEL must not exceed",
@@ -715,7 +963,47 @@ def design_requirement(hazard, basis: DesignBasis, *, block=None, density_kg_m3:
         required_mel_kj=float(need), required_class_kj=cls, governs=governs, h_k_m=h_k, h_d_m=h_d,
         required_height_m=float(H), required_net_height_m=round_up(H) if np.isfinite(H) else float("nan"),
         clearance_m=clear, permitted_elongation_m=permitted, residual_category=basis.residual_category,
-        shares=shares, candidates=pd.DataFrame(rows))
+        shares=shares, candidates=pd.DataFrame(rows), event_frequency_class=ef_cls, design_block_fractile=ef_q,
+        notes=tuple(notes))
+
+
+def _kit_of(kit):
+    """A :class:`~riskrf.hazard.barrier_kits.Kit` from a kit or its name (None stays None)."""
+    if kit is None:
+        return None
+    from .barrier_kits import Kit, get_kit
+    return kit if isinstance(kit, Kit) else get_kit(kit)
+
+
+def _onr_design_block(hazard, block, notes: list):
+    """ONR 24810's design block: the block-size fractile of the site's event-frequency class.
+
+    The class follows from the hazard's rate of falls (``hazard.rate_per_year`` [1/yr], the site's events).  A
+    percentile design block built from block sizes (``block.inputs``) is re-derived at the class's fractile when
+    its percentile differs; a block of another rule is kept and flagged.  Returns (block, class, fractile [%]).
+    """
+    n = float(hazard.rate_per_year)
+    cls, q, name = onr24810_event_frequency_class(n)
+    head = f"ONR 24810 event-frequency class {cls} ({name}; n = {sig(n)} falls/yr)"
+    if block is None:
+        return block, cls, q
+    if block.rule == "percentile" and block.inputs:
+        stated = float(block.inputs.get("percentile", q))
+        if abs(stated - q) > 1e-9:
+            from .design_block import design_block
+            block = design_block(hazard, **{**block.inputs, "percentile": q})
+            notes.append(f"{head}: the design block is the V{q:g} of the block sizes, replacing "
+                         f"design_block.percentile = {stated:g}")
+        else:
+            notes.append(f"{head}: design block V{q:g} of the block sizes")
+    elif block.rule == "percentile":
+        notes.append(f"{head} asks for the V{q:g} of the block sizes; the design block's percentile could not be "
+                     f"checked {CONFIRM}")
+    else:
+        notes.append(f"{head} asks for the V{q:g} of the block sizes (the standard approach); the design block is "
+                     f"the {block.rule!r} block (design_block.rule): not the standard approach, unless the simplified "
+                     f"approach applies (CC1, EF1-EF2 or < 100 jointed bodies) {CONFIRM}")
+    return block, cls, q
 
 
 def _mass_model(hazard):
@@ -914,7 +1202,9 @@ def position_search(hazard, scenario, basis: DesignBasis, *, block=None, density
     return PositionSearch(table=pd.DataFrame(rows), profile=(px, pz), basis=basis, n=int(n), road_x_m=road_x)
 
 
-__all__ = ["BASES", "DEFAULT_BASIS", "DEFAULT_FACTORS", "DesignBasis", "DesignRequirement", "MEL_PRODUCT_CLASSES_KJ",
+__all__ = ["BASES", "CONFIRM", "DEFAULT_BASIS", "DEFAULT_FACTORS", "DesignBasis", "OWNER_OPTIONS",
+           "ONR_CONSEQUENCE_CLASSES", "ONR_CONSEQUENCE_FACTORS", "ONR_EVENT_FREQUENCY_CLASSES", "check_elongation",
+           "onr24810_event_frequency_class", "DesignRequirement", "MEL_PRODUCT_CLASSES_KJ",
            "PositionSearch", "RESIDUAL_CATEGORIES", "barrier_shares", "check_basis", "default_positions",
            "design_basis_from_site", "design_requirement", "frequent_energy", "onr24810_energy", "onr24810_min_distance_m",
            "permitted_elongation_m", "position_search", "required_distance_m",

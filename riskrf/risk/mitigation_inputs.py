@@ -224,6 +224,7 @@ class Option:
     material: str | None = None
     capacity_kj: float | None = None
     height_m: float | None = None
+    kit: str | None = None                         # fence/attenuator: a kit of riskrf/data/barrier_kits.csv
     min_mass_kg: float | None = None
     max_mass_kg: float | None = None
     zone_x_m: tuple | None = None
@@ -362,6 +363,30 @@ def _vulnerability(v, where):
     return tuple(map(tuple, arr.tolist()))
 
 
+def _with_kit(spec: dict, kind: str, at: str) -> dict:
+    """``spec`` with the MEL [kJ] and nominal height [m] of the kit it names (``kit = "..."``, a kit of
+    :func:`riskrf.hazard.barrier_kits.known_kits`) where it gives none; a MitigationError naming ``at`` and the
+    field when the kit is unknown (the known kits listed), the kind is not a barrier, or a stated capacity or
+    height contradicts the kit."""
+    from ..hazard.barrier_kits import get_kit
+    if kind not in ("fence", "attenuator"):
+        raise MitigationError(f"{at}: kit = {spec['kit']!r} is only for kind = 'fence' or 'attenuator'")
+    try:
+        kit = get_kit(spec["kit"], f"{at}: kit")
+    except ValueError as exc:
+        raise MitigationError(str(exc)) from exc
+    out = dict(spec)
+    for key, value, unit in (("capacity_kj", kit.mel_kj, "kJ (its MEL)"), ("height_m", kit.nominal_height_m,
+                                                                             "m (its nominal height)")):
+        given = out.get(key)
+        if given is None:
+            out[key] = value
+        elif isinstance(given, (int, float)) and not isinstance(given, bool) and abs(float(given) - value) > 1e-9:
+            raise MitigationError(f"{at}: {key} = {given!r} contradicts kit {kit.name!r}: {value:g} {unit}; leave "
+                                  f"{key} out to take the kit's")
+    return out
+
+
 def parse_option(spec: dict, i: int, source: str) -> Option:
     """Check and read option ``i`` of a study (a dict from TOML) read from ``source``; an :class:`Option`.
 
@@ -405,6 +430,8 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
     if kind not in OPTION_KINDS:
         raise MitigationError(f"{source}: {where}: kind = {kind!r} is not one of {', '.join(OPTION_KINDS)}")
     kind_class = KIND_CLASSES[kind]
+    if spec.get("kit") is not None:
+        spec = _with_kit(spec, kind, f"{source}: {where}")
     if "capital_cost" not in spec and kind_class.needs_capital_cost:
         raise MitigationError(f"{source}: {where}: missing field 'capital_cost' (use 0 for none)")
     for key in NUMBER_FIELDS:
