@@ -374,3 +374,57 @@ def test_user_text_is_escaped(assessed):
     html = (out / "report.html").read_text()
     assert "&lt;script&gt;alert(1)&lt;/script&gt; &amp; road" in html
     assert "<script>alert(1)" not in html
+
+
+def _html_sections(page: str) -> dict:
+    """Heading -> flat text of each <h2> section of report.html (after the table of contents)."""
+    import html as _html
+    import re
+    body = page.split("</nav>", 1)[1]
+    parts = re.split(r"<h2[^>]*>(.*?)</h2>", body)[1:]
+    flat = lambda t: " ".join(_html.unescape(re.sub(r"<[^>]+>", " ", t)).split())   # noqa: E731
+    return {flat(h): flat(t) for h, t in zip(parts[::2], parts[1::2])}
+
+
+def _pdf_sections(path) -> dict:
+    """Heading -> flat text of each top-level outline entry of report.pdf (from its page to the next's)."""
+    from pypdf import PdfReader
+    reader = PdfReader(path)
+    tops = [o for o in reader.outline if not isinstance(o, list)]
+    starts = [reader.get_destination_page_number(o) for o in tops] + [len(reader.pages)]
+    pages = [p.extract_text() for p in reader.pages]
+    return {o.title: " ".join(" ".join(pages[a:max(b, a + 1)]).split())
+            for o, a, b in zip(tops, starts, starts[1:])}
+
+
+def test_html_and_pdf_carry_the_same_sections_and_tables(assessed):
+    """Issue 39 item 5: report.html and report.pdf have the same sections in the same order (the HTML headings are
+    the PDF's outline), and the same tables in the same section: road-user risk, Bunce per lane, the F-N chart, the
+    design checks of every option, the catchment widths beside the Modified Ritchie Criterion, and the
+    recommendation with the options not recommended because they fail their design checks and the required
+    barrier."""
+    from riskrf.report import sections as S
+    site, out = assessed
+    html = _html_sections((out / "report.html").read_text())
+    pdf = _pdf_sections(out / "report.pdf")
+    assert list(html) == list(pdf)
+    assert len(html) >= 15 and list(html)[-1] == "Appendix B. Run record"
+    for caption in (S.T_CANDIDATES, S.T_POSITIONS, S.T_CATCHMENT_WIDTHS, S.T_RITCHIE, S.T_BUNCE, S.T_RISK,
+                    S.T_DESIGN_CHECKS, S.T_RANKING, S.T_BREAK_EVEN, S.F_FN, S.F_CATCHMENT):
+        where = [h for h, text in html.items() if caption in text]
+        assert where, caption
+        assert caption in pdf[where[0]], (caption, where[0])
+    risk = next(h for h in html if h.split(". ", 1)[1].startswith("Risk to road users"))
+    decision = next(h for h in html if "Mitigation decision" in h)
+    catchment = next(h for h in html if "Catchment ditch" in h)
+    for doc in (html, pdf):
+        assert "P(S:T)" in doc[risk] and "towards slope side" in doc[risk]
+        assert "0.2 H + 4.5 m" in doc[catchment]
+        assert "NOT ADEQUATE" in doc[decision] and "design adequate" in doc[decision].lower()
+    s = json.loads((out / "summary.json").read_text())
+    rec = s["recommendation"]
+    assert rec["not_recommended"]                    # the demo's fences fail the governing basis
+    said = ["Not recommended, whatever their cost, because they fail their design checks",
+            " ".join(str(rec["required_barrier"]).split())[:60]]
+    for words in said:
+        assert words in html[decision] and words in pdf[decision], words

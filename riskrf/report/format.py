@@ -144,6 +144,7 @@ class Document:
     sections: list = field(default_factory=list)
     n_tables: int = 0
     n_figures: int = 0
+    n_sections: int = 0
 
     @property
     def next_table(self) -> str:
@@ -165,18 +166,23 @@ class Document:
         """
         self.parts.extend(f for f in fragments if f)
 
-    def section(self, title: str) -> None:
-        """Start numbered section ``title`` (listed in the table of contents).
+    def section(self, title: str, appendix: str | None = None) -> None:
+        """Start numbered section ``title``, or appendix ``appendix`` (listed in the table of contents).
 
         Parameters
         ----------
         title : str
             Plain text (escaped here).
+        appendix : str, optional
+            Appendix letter: the heading reads "Appendix A. title" and takes no number.
         """
-        number = len(self.sections) + 1
-        anchor = f"s{number}"
-        self.sections.append((anchor, f"{number}. {title}"))
-        self.parts.append(f"<h2 id='{anchor}'>{number}. {escape(title)}</h2>")
+        if appendix is None:
+            self.n_sections += 1
+            anchor, label = f"s{self.n_sections}", f"{self.n_sections}. {title}"
+        else:
+            anchor, label = f"app{appendix}", f"Appendix {appendix}. {title}"
+        self.sections.append((anchor, label))
+        self.parts.append(f"<h2 id='{anchor}'>{escape(label)}</h2>")
 
     def table(self, df: pd.DataFrame, caption: str, *, digits: int = 3, money_columns=(), currency: str = "",
               headers: dict | None = None, index: bool = False) -> str:

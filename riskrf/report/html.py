@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import re
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,9 @@ from ..hazard.impact_energy import PairedSamples
 from ..risk.road_risk import fn_zone
 from .format import Document, cell, human_header, money, probability, sig
 from .format import escape as _e
+from . import sections as S
+from .sections import SOFTWARE_METRICS  # noqa: F401  (re-exported: riskrf.report.html.SOFTWARE_METRICS)
+from .sections import render as render_sections
 
 
 def _name(path) -> str:
@@ -223,8 +227,8 @@ def _tornado_section(doc, tornado, figs: Path) -> None:
             doc.table(table, "One-way sensitivity of the design energies", digits=3))
 
 
-#: Rows of the simulation's summary that measure the software, not the slope: kept out of the engineering tables.
-SOFTWARE_METRICS = ("run time [s]", "impacts per second", "blocks per second")
+#: Body of each report section (riskrf.report.sections), called as fn(doc, a, figs, section).
+BODIES: dict = {}
 
 
 def render_report(a, figs: Path) -> str:
@@ -249,18 +253,8 @@ def render_report(a, figs: Path) -> str:
               f"&middot; generated {_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; method after Wyllie "
               f"(2014) <i>Rock Fall Engineering</i>, ch. 3-8</small></p>")
     header += _summary_box(a)
-    _site_and_data_section(doc, a)
-    _magnitude_frequency_section(doc, a, figs)
-    _annual_maxima_section(doc, a, figs)
-    _simulation_section(doc, a, figs)
-    _energy_section(doc, a, figs)
-    _fence_sections(doc, a, figs)
-    _risk_section(doc, a, figs)
-    _decision_section(doc, a, figs)
-    mu = getattr(a, "model_uncertainty", None)
-    if mu is not None:
-        _model_uncertainty_section(doc, mu, figs, a.study.currency)
-    _assumptions_section(doc, a)
+    bodies = {key: partial(fn, doc, a, figs) for key, fn in BODIES.items()}
+    render_sections(a, bodies, lambda s: doc.section(s.title, appendix=s.appendix))
     return _ABSOLUTE_DIRS.sub("", doc.render(header=header))
 
 
@@ -311,14 +305,14 @@ def _summary_box(a) -> str:
         summary.append(f"<li>Over the judgement inputs (m<sub>max</sub> {sig(sv['m_max_kg'].min())} - "
                        f"{sig(sv['m_max_kg'].max())} kg, rate share {sig(sv['rate_share'].min())} - "
                        f"{sig(sv['rate_share'].max())}) the {en.design_T:g}-year energy spans "
-                       f"{sig(sv['energy_kj'].min(), 2)} - {sig(sv['energy_kj'].max(), 2)} kJ (section 5).</li>")
+                       f"{sig(sv['energy_kj'].min(), 2)} - {sig(sv['energy_kj'].max(), 2)} kJ ({S.section_number(a, 'hazard')}).</li>")
     if en.tornado is not None and len(en.tornado.table):
         d = en.tornado.dominant()
         if len(d):
             r = d.iloc[0]
             summary.append(f"<li>The {_e(r['design_energy'])} is most sensitive to {_e(r['input'])} "
                            f"({sig(r['energy_low_kj'], 2)} - {sig(r['energy_high_kj'], 2)} kJ; tornado in "
-                           "section 5).</li>")
+                           f"{S.section_number(a, 'hazard')}).</li>")
     if en.design_block is not None:
         b = en.design_block
         summary.append(f"<li>Design block: <b>{sig(b.mass_kg)} kg ({sig(b.volume_m3)} m&sup3;, diameter "
@@ -352,42 +346,48 @@ def _summary_box(a) -> str:
     return "".join(summary)
 
 
-def _site_and_data_section(doc, a) -> None:
-    """Section 1: the inventory, its completeness and the rate model with its closure rules."""
-    inv, cur = a.inventory, a.study.currency
-    doc.section("Site and data")
+def _site_data_body(doc, a, figs: Path, s) -> None:
+    """The inventory, its completeness and (when fitted to the site's own record) the rate model."""
+    inv = a.inventory
     doc.add(doc.table(_item_table(inv.summary()), f"The inventory ({_e(_name(inv.source))})"),
             "<h3>Completeness</h3><p>Falls per year and the smallest recorded size show whether recording "
             "was consistent over the record.</p>",
             doc.table(inv.completeness().reset_index().head(60), "Completeness of the record by year"))
-    if a.rates is not None:
-        r = a.rates
-        closures = pd.DataFrame([{"option": k, **{c: v for c, v in d.items() if not c.startswith("evaluated")},
-                                  "evaluated over": f"{d['evaluated_from']} to {d['evaluated_to']}"}
-                                 for k, d in r.summary()["closures"].items()])
-        closures = closures.rename(columns={
-            "share_while_closed": "share of falls while closed (model)",
-            "recorded_share_while_closed": "share of recorded falls while closed",
-            "closure_hours_per_year": "closure hours [h/yr]", "closures_per_year": "closures [1/yr]",
-            "cost_per_hour": f"cost per closure hour [{cur}/h]"})
-        transferred = _name(r.record) != _name(inv.source)
-        doc.add(f"<h3>Rate model ({_e(_name(r.record))}, rainfall {_e(_name(r.rainfall))})</h3>"
-                "<p>Counts of the dated record against antecedent rainfall, season and trend (Poisson and negative "
-                "binomial regression; docs: Rates and rainfall). Closure options given as rules take their share of "
-                "falls while closed and their closure hours from this model."
-                + (" The record is not this site's inventory: its rates, and the closure shares and hours computed "
-                   "from it, are transferred to this site (an assumption; see the site description)."
-                   if transferred else "") + "</p>",
-                doc.table(_item_table(r.model_summary.map(lambda v: re.sub(
-                    r"-?\d+(?:\.\d+)?e[+-]\d+", lambda m: sig(float(m.group())), str(v)))), "Rate model"))
-        if len(closures):
-            doc.add(doc.table(closures, "Closure rules computed from the rate model"))
+    if a.rates is not None and not S.rates_transferred(a):
+        _rate_model(doc, a)
+    elif a.rates is not None:
+        doc.add(f"<p>The rate model is fitted to another site's record: see {S.section_number(a, 'other_sites')}.</p>")
 
 
-def _magnitude_frequency_section(doc, a, figs: Path) -> None:
-    """Section 2: the power law, its goodness of fit and the design masses of the site and of the whole wall."""
+def _rate_model(doc, a) -> None:
+    """The rate model with its closure rules."""
+    inv, cur = a.inventory, a.study.currency
+    r = a.rates
+    closures = pd.DataFrame([{"option": k, **{c: v for c, v in d.items() if not c.startswith("evaluated")},
+                              "evaluated over": f"{d['evaluated_from']} to {d['evaluated_to']}"}
+                             for k, d in r.summary()["closures"].items()])
+    closures = closures.rename(columns={
+        "share_while_closed": "share of falls while closed (model)",
+        "recorded_share_while_closed": "share of recorded falls while closed",
+        "closure_hours_per_year": "closure hours [h/yr]", "closures_per_year": "closures [1/yr]",
+        "cost_per_hour": f"cost per closure hour [{cur}/h]"})
+    transferred = _name(r.record) != _name(inv.source)
+    doc.add(f"<h3>Rate model ({_e(_name(r.record))}, rainfall {_e(_name(r.rainfall))})</h3>"
+            "<p>Counts of the dated record against antecedent rainfall, season and trend (Poisson and negative "
+            "binomial regression; docs: Rates and rainfall). Closure options given as rules take their share of "
+            "falls while closed and their closure hours from this model."
+            + (" The record is not this site's inventory: its rates, and the closure shares and hours computed "
+               "from it, are transferred to this site (an assumption; see the site description)."
+               if transferred else "") + "</p>",
+            doc.table(_item_table(r.model_summary.map(lambda v: re.sub(
+                r"-?\d+(?:\.\d+)?e[+-]\d+", lambda m: sig(float(m.group())), str(v)))), "Rate model"))
+    if len(closures):
+        doc.add(doc.table(closures, "Closure rules computed from the rate model"))
+
+
+def _magnitude_frequency_body(doc, a, figs: Path, s) -> None:
+    """The power law, its goodness of fit and the design masses of the site and of the whole wall."""
     fr, gr, en = a.frequency, a.frequency.power_law, a.energy
-    doc.section("Magnitude-frequency relation (Wyllie 2014, 8.4.1)")
     n_table = doc.next_table
     doc.add(f"<p>log<sub>10</sub> N(&ge;m) = a &minus; b log<sub>10</sub> m, N per year, m in kg; "
             f"{_e(gr.summary().loc['method', 'note'])}; completeness threshold m<sub>min</sub> by "
@@ -405,7 +405,8 @@ def _magnitude_frequency_section(doc, a, figs: Path) -> None:
             "and with the rate of the share of the source above the line. T-year fall at the source "
             "(rate &times; P(M &gt; m) = 1/T) and reaching the line (with the reach probability of each mass). "
             "Nothing exceeds m<sub>max</sub>; blank where fewer than one such fall is expected in T years. "
-            "These are event sizes; the design block (section 5) separates the block from the event.</p>",
+            f"These are event sizes; the design block ({S.section_number(a, 'hazard')}) separates the block from "
+            "the event.</p>",
             doc.table(en.site_masses.drop(columns="law"), "Design masses of the site's law: "
                       + str(en.site_masses["law"].iloc[0])) if en.site_masses is not None else "",
             "<h3>For reference: the whole monitored wall (regional fit, untruncated, rate not scaled)</h3>",
@@ -414,40 +415,65 @@ def _magnitude_frequency_section(doc, a, figs: Path) -> None:
             doc.table(fr.design_masses(), "Design masses of the whole wall's law (reference only)"))
 
 
-def _annual_maxima_section(doc, a, figs: Path) -> None:
-    """Section 3: Gumbel and GEV fits of the annual maxima (of the inventory or of a dated record)."""
+def _annual_maxima_body(doc, a, figs: Path, s) -> None:
+    """Gumbel and GEV fits of the annual maxima of the site's inventory (another record's: in the appendix)."""
     fr = a.frequency
-    mf = fr if fr.gumbel is not None else a.maxima_frequency
-    doc.section("Extreme values of annual maxima (Wyllie 2014, 8.4.2)")
-    if mf is None or mf.gumbel is None:
+    if fr.gumbel is not None:
+        _annual_maxima(doc, a, fr, figs)
+    elif a.maxima_frequency is not None and a.maxima_frequency.gumbel is not None:
+        doc.add("<p>Not fitted to this site's inventory (it has no dates). The dated record the site file names "
+                f"(inventory.annual_maxima) is fitted in {S.section_number(a, 'other_sites')}, with the data of "
+                "other sites: it does not enter the design values.</p>")
+    else:
         doc.add("<p>Not fitted: the inventory has no dates, so there are no annual maxima, and the site "
                 "file names no dated record (inventory.annual_maxima).</p>")
-    else:
-        sub = figs if mf is fr else figs / "annual_maxima"
-        d = mf.deviance or {}
-        pref = mf.preferred_model()
-        preferred = f"{pref['model']}</b>: {_e(pref['reason'])}<b>"
-        doc.add(f"<p>Record used: <code>{_e(_name(mf.inventory.source))}</code> &mdash; {_e(mf.inventory.site)}. "
-                f"{mf.gumbel.data.size:,} annual maxima in {mf.gumbel.n_years:,} years; years without a fall "
-                f"(p0 = {sig(mf.gumbel.p_zero, 2)}) enter through the mixed model. Location and scale are "
-                "masses in kg."
-                + (" The fits, the power law and the bootstrap p-value quoted in the preferred-model text below "
-                   "are of this record, not of the site's inventory in section 2." if mf is not fr else "")
-                + "</p>",
-                doc.table(mf.gumbel.summary().reset_index(), "Gumbel fit of the annual maxima"))
-        if mf.gev is not None:
-            doc.add(doc.table(mf.gev.summary().reset_index(), "GEV fit of the annual maxima"),
-                    f"<p>Deviance test Gumbel vs GEV: D = {sig(d.get('deviance', np.nan))}, p = "
-                    f"{sig(d.get('p_value', np.nan), 2)}. Preferred model: <b>{preferred}</b>.</p>")
-        doc.add(doc.figure(sub / "gumbel_plot.png", "Gumbel probability plot"),
-                doc.figure(sub / "return_levels.png",
-                           "Return levels of the annual maximum, with the law the power law implies"))
 
 
-def _simulation_section(doc, a, figs: Path) -> None:
-    """Section 4: the scenario, the simulation summary and its figures (or where the velocities come from)."""
+def _annual_maxima(doc, a, mf, figs: Path) -> None:
+    """Gumbel and GEV fits of the annual maxima of ``mf`` (the site's frequency study or a dated record's)."""
+    fr = a.frequency
+    sub = figs if mf is fr else figs / "annual_maxima"
+    d = mf.deviance or {}
+    pref = mf.preferred_model()
+    preferred = f"{pref['model']}</b>: {_e(pref['reason'])}<b>"
+    doc.add(f"<p>Record used: <code>{_e(_name(mf.inventory.source))}</code> &mdash; {_e(mf.inventory.site)}. "
+            f"{mf.gumbel.data.size:,} annual maxima in {mf.gumbel.n_years:,} years; years without a fall "
+            f"(p0 = {sig(mf.gumbel.p_zero, 2)}) enter through the mixed model. Location and scale are "
+            "masses in kg."
+            + (" The fits, the power law and the bootstrap p-value quoted in the preferred-model text below "
+               f"are of this record, not of the site's inventory in {S.section_number(a, 'magnitude_frequency')}."
+               if mf is not fr else "")
+            + "</p>",
+            doc.table(mf.gumbel.summary().reset_index(), "Gumbel fit of the annual maxima"))
+    if mf.gev is not None:
+        doc.add(doc.table(mf.gev.summary().reset_index(), "GEV fit of the annual maxima"),
+                f"<p>Deviance test Gumbel vs GEV: D = {sig(d.get('deviance', np.nan))}, p = "
+                f"{sig(d.get('p_value', np.nan), 2)}. Preferred model: <b>{preferred}</b>.</p>")
+    doc.add(doc.figure(sub / "gumbel_plot.png", "Gumbel probability plot"),
+            doc.figure(sub / "return_levels.png",
+                       "Return levels of the annual maximum, with the law the power law implies"))
+
+
+def _other_sites_body(doc, a, figs: Path, s) -> None:
+    """Appendix: the data of other sites (a regional record's annual maxima, a transferred rate model)."""
+    doc.add("<p>These records are not this site's: they show the methods (annual maxima, rainfall rate model) and "
+            "do not enter the design values.</p>")
+    mf = a.maxima_frequency
+    if mf is not None and mf.gumbel is not None:
+        doc.add("<h3>Annual maxima of the regional record</h3>")
+        _annual_maxima(doc, a, mf, figs)
+    if S.rates_transferred(a):
+        _rate_model(doc, a)
+
+
+def _run_record_body(doc, a, figs: Path, s) -> None:
+    """Appendix: the run record (version, seed, blocks, site file, outputs)."""
+    doc.add(doc.table(pd.DataFrame(S.run_record(a), columns=["item", "value"]), "Run record"))
+
+
+def _trajectories_body(doc, a, figs: Path, s) -> None:
+    """The scenario, the simulation summary and its figures (or where the velocities come from)."""
     hz = a.energy.hazard
-    doc.section("Trajectories at the barrier line (Wyllie 2014, ch. 3-7)")
     if a.result is not None:
         res = a.result
         sc = res.scenario
@@ -467,10 +493,9 @@ def _simulation_section(doc, a, figs: Path) -> None:
         doc.add(f"<p>{_e(hz.notes[0] if hz.notes else 'velocities from a file')}</p>")
 
 
-def _energy_section(doc, a, figs: Path) -> None:
-    """Section 5: the impact energy hazard, design energies, mass classes, sensitivity, design block and UNI."""
+def _hazard_body(doc, a, figs: Path, s) -> None:
+    """The impact energy hazard, design energies, mass classes, sensitivity, design block and UNI."""
     en, hz = a.energy, a.energy.hazard
-    doc.section("Impact energy hazard (Wyllie 2014, 8.1-8.3)")
     doc.add("<p>&lambda;(E &gt; e) = rate of falls &times; P(reach) &times; P(E &gt; e), with the mass "
             "distribution of the fitted power law and the simulated velocities (rotation included). "
             "Intervals: seeded parametric bootstrap over b, the rate and the finite simulation.</p>",
@@ -515,56 +540,94 @@ def _energy_section(doc, a, figs: Path) -> None:
                 f"{sig(u.design_energy_kj, 2)} kJ with factors {_e(cell(u.factors))}.</p>")
 
 
-def _fence_sections(doc, a, figs: Path) -> None:
-    """Section 6: the design basis (when given) and the fence checks against MEL and SEL."""
-    en = a.energy
-    if getattr(a, "design", None) is not None:
-        d = a.design
-        doc.section(f"Design basis: {d.basis.basis} governs")
-        doc.add(f"<p>{_e(d.basis.text())}</p>",
-                doc.table(d.summary().reset_index().rename(columns={"index": "quantity"}),
-                          "What the design basis requires at the barrier line"),
-                doc.table(d.requirement.candidates if d.requirement is not None else None,
-                          "Checks of the candidate fences against the design basis"))
-        if d.positions is not None:
-            doc.add(doc.table(d.positions.summary(), "Required MEL and net height by barrier position"),
-                    doc.figure(figs / "barrier_positions.png", "Barrier position search"))
-        doc.add(doc.figure(figs / "options_profile.png", "Every option's geometry on the slope profile"),
-                doc.figure(figs / "stop_points.png", "Stop points of the simulated blocks"))
-        if d.catchment is not None:
-            doc.add(doc.figure(figs / "catchment_retention.png", "Catchment retention against width from the toe"))
-    doc.section("Fence checks (ETAG 027 / EAD 340059: MEL, SEL = MEL/3; for comparison, the design basis governs)")
-    for name, table in en.fences.items():
+def _kv_table(doc, rows, caption: str) -> str:
+    """A two-column table (item, value) of text rows."""
+    return doc.table(pd.DataFrame(rows, columns=["item", "value"]), caption)
+
+
+def _design_values_body(doc, a, figs: Path, s) -> None:
+    """The design values sheet: design block, speeds, energies, bounce heights and the required barrier."""
+    from .pdf import design_values_rows
+    doc.add(_kv_table(doc, design_values_rows(a), "Design values at the barrier line"),
+            "<p>Energies in kJ, lengths in m.  The shares stopped / over / through take bounce height and energy "
+            "of the arriving falls (under the site's mass law) as independent.</p>")
+
+
+def _design_basis_body(doc, a, figs: Path, s) -> None:
+    """The design basis, its factors, what it requires at the barrier line and the candidate fences' checks."""
+    d = a.design
+    doc.add(f"<p>{_e(d.basis.text())}</p>")
+    if d.requirement is None:
+        doc.add(f"<p>{_e('; '.join(d.notes))}</p>")
+    doc.add(doc.table(pd.DataFrame({"factor": list(d.basis.factors), "value": list(d.basis.factors.values())}),
+                      "Partial factors of the design basis") if getattr(d.basis, "factors", None) else "",
+            doc.table(d.summary().reset_index().rename(columns={"index": "quantity"}),
+                      "What the design basis requires at the barrier line"),
+            doc.table(d.requirement.candidates if d.requirement is not None else None, S.T_CANDIDATES))
+
+
+def _positions_body(doc, a, figs: Path, s) -> None:
+    """The barrier-position search: the requirement at each searched position."""
+    doc.add(doc.table(a.design.positions.summary(), S.T_POSITIONS),
+            *(doc.figure(figs / name, cap) for name, cap in s.figures))
+
+
+def _slope_model_body(doc, a, figs: Path, s) -> None:
+    """The slope model: profile vertices with segment dips, materials with the source of their values."""
+    from .pdf import slope_tables
+    sc, vert, mats = slope_tables(a.site)
+    doc.add(f"<p>Scenario {_e(_name(a.site.hazard['scenario']))}: {_e(sc.description.strip())}</p>",
+            "<h3>Profile vertices and segment angles</h3>",
+            doc.table(pd.DataFrame(vert, columns=list(S.SLOPE_VERTEX_COLUMNS)), "Profile vertices and segment angles"),
+            "<h3>Materials and the source of their values</h3>",
+            doc.table(pd.DataFrame(mats, columns=list(S.SLOPE_MATERIAL_COLUMNS)),
+                      "Materials and the source of their values"))
+
+
+def _figures_body(doc, a, figs: Path, s) -> None:
+    """A section made of its figures (``s.figures``)."""
+    doc.add(*(doc.figure(figs / name, cap) for name, cap in s.figures))
+
+
+def _runout_body(doc, a, figs: Path, s) -> None:
+    """The stop points with their run-out statistics."""
+    from .pdf import runout_rows
+    doc.add(*(doc.figure(figs / name, cap) for name, cap in s.figures),
+            doc.figure(figs / "recommended_trajectories.png", "Trajectories on the slope with the recommended option"))
+    rows = runout_rows(getattr(a, "design", None))
+    if rows:
+        doc.add(_kv_table(doc, rows, "Run-out of the simulated blocks"))
+
+
+def _catchment_body(doc, a, figs: Path, s) -> None:
+    """The catchment ditch: widths for each retention beside the Modified Ritchie Criterion, the chart."""
+    c = a.design.catchment
+    widths, rule = S.catchment_tables(c)
+    doc.add(f"<p>{_e(S.catchment_text(c))}</p>",
+            doc.table(widths, S.T_CATCHMENT_WIDTHS),
+            doc.table(rule, S.T_RITCHIE),
+            f"<p>{_e(S.RITCHIE_CAVEAT)}</p>",
+            doc.table(c.chart, "Published chart against the re-simulation") if c.chart is not None else "",
+            *(doc.figure(figs / name, cap) for name, cap in s.figures))
+
+
+def _fence_checks_body(doc, a, figs: Path, s) -> None:
+    """The fence checks against MEL and SEL (for comparison; the design basis governs)."""
+    for name, table in a.energy.fences.items():
         doc.add(f"<h3>{_e(name)}</h3>", doc.table(table, f"Checks of {name}"))
 
 
-def _risk_section(doc, a, figs: Path) -> None:
-    """Section 7: individual and societal risk to road users by option."""
-    ranking = a.decision["ranking"]
-    ir_limit = a.study.criteria.individual_risk_per_year
-    risk = ranking[["option", "road_falls_per_year", "deaths_per_year", "individual_risk"]].copy()
-    risk[f"meets {probability(ir_limit)}/yr"] = risk["individual_risk"] <= ir_limit
-    risk["F(N≥1) [1/yr]"] = ranking["F_N1_per_year"]
-    risk[f"F-N zone ({a.study.criteria.fn_diagram})"] = ranking["fn_zone"]
-    risk = risk.rename(columns={"individual_risk": "individual risk [1/yr]", "deaths_per_year": "deaths [1/yr]",
-                                "road_falls_per_year": "falls reaching the road [1/yr]"})
-    doc.section("Risk to road users")
-    doc.add(f"<p>Bunce et al. (1997): P(S:T) = N<sub>v</sub> L<sub>v</sub> / (24 &times; 1000 &times; "
-            f"V<sub>v</sub>) for {a.study.exposure.vehicles_per_day:,.0f} vehicles a day of "
-            f"{sig(a.study.exposure.vehicle_length_m)} m at {sig(a.study.exposure.speed_kmh)} km/h; a vehicle "
-            "striking a rock on the road; individual risk of a commuter (AGS 2007). Both individual and societal "
-            "risk count direct hits and strikes on fallen rocks, falls of every size reaching the road (the power "
-            "law above m<sub>min</sub> and the inventory's smaller falls below it), a probability of death that "
-            "grows with block mass (an assumption anchored to AGS 2000 / Finlay et al. 1999, see the defaults) "
-            "and occupants per vehicle as a distribution. F-N zones on the Hong Kong diagram (ERM-Hong Kong, GEO "
-            "Report 75, 1998): lines F = 10<sup>-3</sup>/N and 10<sup>-5</sup>/N to N = 1,000, intense scrutiny "
-            "for N = 1,000-5,000, unacceptable beyond.</p>",
-            doc.table(risk, "Risk to road users by option", digits=2),
-            doc.figure(figs / "fn_curve.png", "F-N curves with Hong Kong GEO criteria"))
+def _road_risk_body(doc, a, figs: Path, s) -> None:
+    """Individual and societal risk to road users by option: Bunce per lane, the risk table, the F-N curves."""
+    doc.add(f"<p>{_e(S.road_risk_text(a))}</p>",
+            doc.table(S.bunce_table(a), S.T_BUNCE, digits=3),
+            doc.table(S.road_risk_table(a), S.T_RISK, digits=2),
+            *(doc.figure(figs / name, f"{cap} ({a.study.criteria.fn_diagram})") for name, cap in s.figures))
 
 
-def _decision_section(doc, a, figs: Path) -> None:
-    """Section 8: recommendation, options, costs, uncertain inputs, break-even, tornado and value of information."""
+def _decision_body(doc, a, figs: Path, s) -> None:
+    """Recommendation, design checks, options, costs, uncertain inputs, break-even, tornado and value of
+    information."""
     ranking, cur = a.decision["ranking"], a.study.currency
     money_cur, money_est = _money_formatters(cur)
     be = a.decision["break_even"]
@@ -583,6 +646,8 @@ def _decision_section(doc, a, figs: Path) -> None:
         "expected losses (PV, central)": ranking["pv_expected_loss"].map(money_est),
         "meets criteria": ranking["meets_criteria"].map(lambda v: "yes" if v else "no"),
         "meets them in (share of samples)": ranking["probability_meets_criteria"].map(lambda v: f"{v:.0%}"),
+        **({"design adequate": ranking["design_adequate"].map(lambda v: "yes" if v else "NO")}
+           if "design_adequate" in ranking else {}),
         **({"design check": ranking["design_check"]} if "design_check" in ranking else {}),
         **({"ALARP test": ranking["alarp"]} if "alarp" in ranking else {})})
     opts = a.decision["options_table"].copy()
@@ -591,9 +656,11 @@ def _decision_section(doc, a, figs: Path) -> None:
     opts = opts.rename(columns={"effectiveness": "falls kept off the road", "effect_basis": "effect from"})
     tornado = a.decision["tornado"]
     central_best = ranking.loc[ranking["cost_at_central_values"].idxmin()]
-    doc.section("Mitigation decision (Wyllie 2014, 8.5.5)")
-    doc.add(f"<div class='box'><b>Recommendation: {_e(rec['option'] or 'none')}</b> ({_e(rec['basis'])}).<br>"
-            f"{_e(rec['reason'])}</div>",
+    lines = S.recommendation_lines(a)
+    doc.add(f"<div class='box'><b>{_e(lines[0])}</b>" + "".join(f"<br>{_e(t)}" for t in lines[1:]) + "</div>",
+            "<h3>Design checks of the options</h3><p>An option whose design checks fail stays in the ranking, "
+            "marked NOT ADEQUATE, and is never recommended.</p>",
+            doc.table(S.design_checks_table(a), S.T_DESIGN_CHECKS),
             "<h3>The options</h3><p>Each option is a change of the site; its effect is derived (re-simulated "
             "profile, simulated heights and energies at the barrier line, the mass model) unless marked as a typed "
             "assumption. Retention: share of the falls that would reach the road which the structure stops.</p>",
@@ -607,7 +674,7 @@ def _decision_section(doc, a, figs: Path) -> None:
             "The columns marked central are at the central values of the inputs and add up to the cost at central "
             "values; the expected total cost is the mean over the samples and differs from it where the losses "
             "have a long tail or a stated range is not centred on the central value.</p>",
-            doc.table(costs, f"Expected total costs [{cur}]"),
+            doc.table(costs, f"{S.T_RANKING} [{cur}]"),
             "<h3>Uncertain inputs</h3>",
             doc.table(pd.DataFrame([{"input": k, "low": v["low"], "high": v["high"], "law": v["law"]}
                                     for k, v in unc["inputs"].items()]), "Uncertain inputs sampled jointly"),
@@ -624,9 +691,8 @@ def _decision_section(doc, a, figs: Path) -> None:
                f"{probability(central_best['individual_risk'])}/yr; met in "
                f"{central_best['probability_meets_criteria']:.0%} of the joint samples), so it is not the "
                "recommendation") + ". They compare costs only; the criteria are not applied.</p>",
-            doc.table(be[np.isfinite(be["break_even"])], "Break-even values of single inputs"),
-            doc.figure(figs / "tornado.png", "Tornado: the lowest cost at central values as each input moves over its "
-                                             "stated range (x0.5 / x2 where none is stated); the 15 inputs that "
+            doc.table(be[np.isfinite(be["break_even"])], S.T_BREAK_EVEN),
+            doc.figure(figs / "tornado.png", f"{S.F_TORNADO} (x0.5 / x2 where none is stated); the 15 inputs that "
                                              "change the best option or the order first, then by swing"),
             "<h3>Inputs that change the best option or the order</h3>",
             doc.table(tornado.loc[tornado["changes_order"], ["parameter", "low", "high", "range", "best_at_low",
@@ -642,11 +708,10 @@ def _decision_section(doc, a, figs: Path) -> None:
             "investigations settling them are worth.</p>")
 
 
-def _assumptions_section(doc, a) -> None:
-    """Section 9: assumptions, defaults and judgement inputs, and warnings."""
+def _assumptions_body(doc, a, figs: Path, s) -> None:
+    """Assumptions, defaults and judgement inputs, and warnings."""
     en, hz = a.energy, a.energy.hazard
     rate_scale = a.site.inventory["rate_scale"]
-    doc.section("Assumptions, defaults and warnings")
     classed = isinstance(hz.velocity, PairedSamples)
     items = [("Lumped-mass trajectories of round blocks; restitution and friction parameters are starting values "
               "to be calibrated on site (Wyllie 2014, ch. 7)."),
@@ -660,7 +725,7 @@ def _assumptions_section(doc, a) -> None:
               + (f" with the rate scaled by {sig(rate_scale)} (typed assumption)" if rate_scale != 1 else "") + "."),
              f"Rate of falls from the {a.rate_source}.",
              "Judgement inputs not in any interval: m_max and the rate share (see the sensitivity table and the "
-             "tornado of the design energies in section 5)."]
+             f"tornado of the design energies in {S.section_number(a, 'hazard')})."]
     if en.design_block is not None:
         items += [f"Design block ({en.design_block.rule} rule): {x}" for x in en.design_block.assumptions]
     doc.add("<div class='warn'><ul>" + "".join(f"<li>{_e(t)}</li>" for t in items) + "</ul></div>")
@@ -671,10 +736,10 @@ def _assumptions_section(doc, a) -> None:
                 + "".join(f"<li>{_e(w)}</li>" for w in a.warnings) + "</ul></div>")
 
 
-def _model_uncertainty_section(doc, mu, figs: Path, cur: str) -> None:
+def _model_uncertainty_body(doc, a, figs: Path, s) -> None:
     """The trajectory model's uncertainty: the design energies' split, the ranking over the draws, the EVPI and
     the EVSI of a field calibration (riskrf.app.model_uncertainty)."""
-    doc.section("Trajectory model uncertainty")
+    mu, cur = a.model_uncertainty, a.study.currency
     e = mu.energy.summary()
     e = e[["T_years", "energy_kj_reference", "energy_kj_mean", "combined_low_kj", "combined_high_kj",
            "model_low_kj", "model_high_kj", "statistical_low_kj", "statistical_high_kj",
@@ -697,3 +762,13 @@ def _model_uncertainty_section(doc, mu, figs: Path, cur: str) -> None:
             doc.figure(figs / "ranking_model_uncertainty.png", "Expected total cost of each option under each draw"),
             f"<div class='box'><b>{_e(mu.verdict())}</b></div>",
             "<div class='warn'><ul>" + "".join(f"<li>{_e(n)}</li>" for n in mu.notes) + "</ul></div>")
+
+
+BODIES.update({
+    "design_values": _design_values_body, "design_basis": _design_basis_body, "positions": _positions_body,
+    "slope_model": _slope_model_body, "options_profile": _figures_body, "runout": _runout_body,
+    "catchment": _catchment_body, "trajectories": _trajectories_body, "hazard": _hazard_body,
+    "fence_checks": _fence_checks_body, "road_risk": _road_risk_body, "decision": _decision_body,
+    "model_uncertainty": _model_uncertainty_body, "site_data": _site_data_body,
+    "magnitude_frequency": _magnitude_frequency_body, "annual_maxima": _annual_maxima_body,
+    "assumptions": _assumptions_body, "other_sites": _other_sites_body, "run_record": _run_record_body})

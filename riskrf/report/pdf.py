@@ -15,9 +15,14 @@ from __future__ import annotations
 import datetime
 import math
 import tomllib
+from functools import partial
 from pathlib import Path
 
 import numpy as np
+
+from . import sections as S
+from .format import cell, human_header
+from .sections import render as render_sections
 
 A4_TEXT_WIDTH_MM = 180.0
 
@@ -149,14 +154,42 @@ class _Report:
         self.fresh_page = False
         if appendix is None:
             self.section_no += 1
-            label = f"{self.section_no}  {title}"
+            label = f"{self.section_no}. {title}"
         else:
-            label = f"Appendix {appendix}  {title}"
+            label = f"Appendix {appendix}. {title}"
         pdf.start_section(label, level=0)
         pdf.set_font("DejaVu", "B", 13)
         pdf.multi_cell(0, 7, label, new_x="LMARGIN", new_y="NEXT")
         pdf.ln(1.5)
         pdf.set_font("DejaVu", "", 9.5)
+
+    def heading(self, title: str):
+        """A bold heading outside the outline (the title page's)."""
+        self.pdf.set_font("DejaVu", "B", 10.5)
+        self.pdf.multi_cell(0, 6, title, new_x="LMARGIN", new_y="NEXT")
+        self.pdf.set_font("DejaVu", "", 9.5)
+
+    def caption(self, text: str):
+        """The caption of the table that follows (the same words as the HTML table's caption)."""
+        pdf = self.pdf
+        if pdf.get_y() > pdf.h - 40:
+            pdf.add_page()
+        pdf.set_font("DejaVu", "I", 8)
+        pdf.multi_cell(0, 4, text, new_x="LMARGIN", new_y="NEXT")
+        pdf.set_font("DejaVu", "", 9.5)
+
+    def frame(self, df, caption: str, *, widths=None, size: float = 7.5, digits: int = 3, align=None):
+        """A DataFrame as a captioned table: column names as words with units, cells as in the HTML report."""
+        if df is None or len(df) == 0:
+            return
+        self.caption(caption)
+        rows = [[cell(v, digits=digits) for v in rec] for rec in df.itertuples(index=False)]
+        self.table([human_header(str(c)) for c in df.columns], rows, widths=widths, size=size, align=align)
+
+    def figures(self, figs, section, max_height: float = 110.0):
+        """The section's figures (:attr:`riskrf.report.sections.Section.figures`) that exist."""
+        for name, cap in section.figures:
+            self.figure(Path(figs) / name, cap, max_height=max_height)
 
     def sub(self, title: str):
         pdf = self.pdf
@@ -258,9 +291,21 @@ def title_block(site, now: datetime.date | None = None) -> dict:
             "client": str(r.get("client") or "not stated")}
 
 
-def _slope_tables(site):
-    """(vertex rows, material rows) of the site's scenario: vertices with the angle of the segment that follows,
-    materials with their laws and the source of their values."""
+def slope_tables(site):
+    """The site's scenario with its vertex rows and material rows (both formats print them).
+
+    Parameters
+    ----------
+    site : Site
+        The site; its ``hazard`` table names a scenario.
+
+    Returns
+    -------
+    (simulation.Scenario, list, list)
+        The scenario; vertices with the dip of the segment that follows and its material
+        (:data:`riskrf.report.sections.SLOPE_VERTEX_COLUMNS`); materials with their laws and the source of their
+        values (:data:`riskrf.report.sections.SLOPE_MATERIAL_COLUMNS`).
+    """
     import simulation
     from simulation.materials import ALIASES, SOURCES
     path = site.resolve(site.hazard["scenario"])
@@ -321,23 +366,8 @@ def write_pdf_report(a, path, figs) -> Path:
     pdf.insert_toc_placeholder(_toc, pages=1)       # it starts the next page itself
     rep.fresh_page = True
 
-    d = a.design
-    if d is not None and d.requirement is not None:
-        _design_values_sheet(rep, a)
-        _design_checks(rep, d)
-        if d.positions is not None:
-            _barrier_positions(rep, d, figs)
-    if a.site.hazard.get("scenario"):
-        _slope_model(rep, a.site)
-    _options_and_runout(rep, d, figs)
-    if d is not None and d.catchment is not None:
-        _catchment(rep, d.catchment, figs)
-    _hazard(rep, a, figs)
-    _ranking(rep, a, figs)
-    if getattr(a, "model_uncertainty", None) is not None:
-        _model_uncertainty(rep, a.model_uncertainty, a.study.currency, figs)
-    _inventory_and_assumptions(rep, a, figs)
-    _appendices(rep, a, figs)
+    render_sections(a, {key: partial(fn, rep, a, figs) for key, fn in BODIES.items()},
+                    lambda sec: rep.section(sec.title, appendix=sec.appendix))
     path = Path(path)
     tmp = path.with_suffix(".pdf.part")
     pdf.output(str(tmp))
@@ -372,10 +402,10 @@ def _title_page(rep, a, tb):
             ("software", f"riskrf {_version()}"),
             ("seed; simulated blocks", f"{a.seed}; {a.n_blocks:,}")], size=9.5)
     if d is not None and req is None:
-        rep.sub("Design statement")
+        rep.heading("Design statement")
         rep.text(f"{d.basis.basis}: " + "; ".join(d.notes), size=10, style="B")
     if req is not None:
-        rep.sub("Design statement")
+        rep.heading("Design statement")
         rep.text(req.text() + ".", size=10, style="B")
         rep.text(d.basis.text(), size=8.5)
     rec = a.decision["recommendation"]
@@ -384,20 +414,22 @@ def _title_page(rep, a, tb):
     rep.text("Signature fields: author ____________________   checker ____________________", size=9.5)
 
 
-def _design_values_sheet(rep, a):
-    """Write the design values sheet: design block, speeds, energies, bounce heights and the required barrier.
+def design_values_rows(a) -> list:
+    """(item, value) rows of the design values sheet: design block, speeds, energies, bounce heights and the
+    required barrier (both formats print them).
 
     Parameters
     ----------
-    rep : _Report
-        The document being written.
     a : Assessment
         The finished assessment; its ``design.requirement`` is not None.
+
+    Returns
+    -------
+    list of (str, str)
     """
     d = a.design
     req = d.requirement
     hz = a.energy.hazard
-    rep.section("Design values sheet")
     blk = a.energy.design_block
     m = req.block_mass_kg
     v95, v99 = (hz.velocity_percentile(q, mass_kg=m) for q in (95, 99))
@@ -434,31 +466,61 @@ def _design_values_sheet(rep, a):
     ]
     if d.runout:
         rows.append(("simulated blocks reaching the road (run-out)", pct(d.runout.get("share_reaching_road"))))
-    rep.kv(rows, widths=(2, 3))
+    return rows
+
+
+
+
+def _design_values_sheet(rep, a, figs, s):
+    """Write the design values sheet (:func:`design_values_rows`).
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment; its ``design.requirement`` is not None.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
+    """
+    rep.kv(design_values_rows(a), widths=(2, 3))
     rep.text("Energies in kJ, lengths in m.  The shares stopped / over / through take bounce height and energy "
              "of the arriving falls (under the site's mass law) as independent.", size=8)
 
 
-def _design_checks(rep, d):
+def _design_checks(rep, a, figs, s):
     """Write the design basis, its factors, the requirement at the barrier line and the candidate fences' checks.
 
     Parameters
     ----------
     rep : _Report
         The document being written.
-    d : SiteDesign
-        The assessment's design; its ``requirement`` is not None.
+    a : Assessment
+        The finished assessment; its ``design`` is not None.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
     """
+    d = a.design
     req = d.requirement
-    rep.section("Design basis and checks")
     rep.text(d.basis.text())
+    if req is None:
+        rep.text("; ".join(d.notes), size=9)
+    rep.caption("Partial factors of the design basis")
     rep.table(["factor", "value"], [[k, fmt(v, 3)] for k, v in d.basis.factors.items()], widths=[2, 1])
+    if req is None:
+        return
     rep.sub("Requirement at the barrier line")
+    rep.caption("What the design basis requires at the barrier line")
     rep.table(["quantity", "value"], [[k, fmt(v) if not isinstance(v, str) else v]
                                       for k, v in req.summary()["value"].items()], widths=[3, 2],
               align=["LEFT", "RIGHT"])
     if len(req.candidates):
         rep.sub("Checks of the candidate fences")
+        rep.caption(S.T_CANDIDATES)
         rep.table(["fence", "check", "demand", "capacity", "unit", "adequate"],
                   [[r["fence"], r["check"], fmt(r["demand"]), fmt(r["capacity"]), r["unit"],
                     "not given" if r["adequate"] is None or (isinstance(r["adequate"], float)
@@ -470,22 +532,25 @@ def _design_checks(rep, d):
                  "road divided by gamma_d (ONR 24810: also at most the clearance less 1 m).", size=8)
 
 
-def _barrier_positions(rep, d, figs):
+def _barrier_positions(rep, a, figs, s):
     """Write the barrier-position search: the requirement at each searched position and the cheapest one.
 
     Parameters
     ----------
     rep : _Report
         The document being written.
-    d : SiteDesign
-        The assessment's design; its ``positions`` is not None.
+    a : Assessment
+        The finished assessment; its ``design.positions`` is not None.
     figs : pathlib.Path
         Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
     """
-    rep.section("Barrier position along the profile")
+    d = a.design
     t = d.positions.table
     rep.text(f"The requirement of {d.basis.basis} repeated at {len(t)} positions from one simulation of "
              f"{d.positions.n:,} blocks across the site's mass range.")
+    rep.caption(S.T_POSITIONS)
     rep.table(["x [m]", "ground z [m]", "reaching [%]", "arrivals per year", "E_d [kJ]",
                "required MEL [kJ]", "product class [kJ]", "net height [m]", "to road [m]"],
               [[fmt(r["x_m"], 4), fmt(r["ground_z_m"], 3), f"{100 * r['reach_share']:.1f}",
@@ -498,105 +563,163 @@ def _barrier_positions(rep, d, figs):
                  f"{fmt(best['required_net_height_m'])} m.")
     else:
         rep.text("No searched position can be protected by a single certified kit of the listed classes.")
-    rep.figure(figs / "barrier_positions.png", "Required MEL and net height by barrier position.",
-               max_height=150)
+    rep.figures(figs, s, max_height=150)
 
 
-def _slope_model(rep, site):
+def _slope_model(rep, a, figs, s):
     """Write the slope model: the scenario's profile vertices with segment angles and its materials' sources.
 
     Parameters
     ----------
     rep : _Report
         The document being written.
-    site : Site
-        The site; its ``hazard`` table names a scenario.
+    a : Assessment
+        The finished assessment; its site's ``hazard`` table names a scenario.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
     """
-    sc, vert, mats = _slope_tables(site)
-    rep.section("Slope model")
+    site = a.site
+    sc, vert, mats = slope_tables(site)
     rep.text(f"Scenario {Path(str(site.hazard['scenario'])).name}: {sc.description.strip()}", size=8.5)
     rep.sub("Profile vertices and segment angles")
-    rep.table(["vertex", "x [m]", "z [m]", "dip of the segment to the next vertex [°]",
-               "material of that segment"], vert, widths=[0.8, 1, 1, 2, 2])
+    rep.table(list(S.SLOPE_VERTEX_COLUMNS), vert, widths=[0.8, 1, 1, 2, 2])
     rep.sub("Materials and the source of their values")
-    rep.table(["material", "normal restitution e_N", "tangential: e_T or friction", "rough-ness [m]",
-               "ground motion", "ground friction φ_g [°]", "source or calibration"], mats,
+    rep.table(list(S.SLOPE_MATERIAL_COLUMNS), mats,
               widths=[1.1, 1.6, 1.6, 1.0, 1.0, 1.0, 4.3], size=7,
               align=["LEFT", "LEFT", "LEFT", "RIGHT", "LEFT", "RIGHT", "LEFT"])
 
 
-def _options_and_runout(rep, d, figs):
-    """Write the options on the profile, the trajectories and the stop points with their run-out statistics.
+def _options_profile(rep, a, figs, s):
+    """Write every option drawn on the profile.
 
     Parameters
     ----------
     rep : _Report
         The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
+    """
+    rep.figures(figs, s, max_height=110)
+
+
+def runout_rows(d) -> list:
+    """(item, value) rows of the run-out statistics of the simulated blocks, with the recommended option's where it
+    changes the slope (both formats print them).
+
+    Parameters
+    ----------
     d : SiteDesign or None
-        The assessment's design (run-out statistics when it has them).
-    figs : pathlib.Path
-        Directory of the assessment's figures.
+        The assessment's design.
+
+    Returns
+    -------
+    list of (str, str)
+        Empty without a design or run-out statistics.
     """
-    rep.section("Mitigation options on the profile")
-    rep.figure(figs / "options_profile.png", "Every option's geometry on the slope profile, and the barrier the "
-                                             "design basis requires (dashed).", max_height=110)
-    rep.figure(figs / "profile_trajectories.png", "Simulated trajectories on the existing profile.",
-               max_height=110)
-    rep.section("Stop points and run-out")
-    rep.figure(figs / "stop_points.png", "Where the simulated blocks stopped, on the existing slope and with the "
-                                         "recommended option where it changes the slope.", max_height=120)
-    rep.figure(figs / "recommended_trajectories.png", "Trajectories on the slope with the recommended option.",
-               max_height=100)
-    if d is not None and d.runout:
-        r = d.runout
-        rep.kv([("blocks simulated (scenario seeder masses)", f"{r['blocks']:,}"),
-                ("stop point p50 / p95 / p99", f"{fmt(r['stop_x_p50_m'], 4)} / {fmt(r['stop_x_p95_m'], 4)} / "
-                                               f"{fmt(r['stop_x_p99_m'], 4)} m"),
-                ("share reaching the barrier line", pct(r.get("share_reaching_barrier_line"))),
-                ("share reaching the road", pct(r.get("share_reaching_road")))])
-        rr = d.recommended_runout()
-        if rr is not None:
-            rep.kv([(f"with {rr['option']}: blocks simulated", f"{rr['blocks']:,}"),
-                    (f"with {rr['option']}: stop point p50 / p95", f"{fmt(rr['stop_x_p50_m'], 4)} / "
-                                                                  f"{fmt(rr['stop_x_p95_m'], 4)} m"),
-                    (f"with {rr['option']}: share reaching the road", pct(rr.get("share_reaching_road")))])
+    if d is None or not d.runout:
+        return []
+    r = d.runout
+    rows = [("blocks simulated (scenario seeder masses)", f"{r['blocks']:,}"),
+            ("stop point p50 / p95 / p99", f"{fmt(r['stop_x_p50_m'], 4)} / {fmt(r['stop_x_p95_m'], 4)} / "
+                                           f"{fmt(r['stop_x_p99_m'], 4)} m"),
+            ("share reaching the barrier line", pct(r.get("share_reaching_barrier_line"))),
+            ("share reaching the road", pct(r.get("share_reaching_road")))]
+    rr = d.recommended_runout()
+    if rr is not None:
+        rows += [(f"with {rr['option']}: blocks simulated", f"{rr['blocks']:,}"),
+                 (f"with {rr['option']}: stop point p50 / p95", f"{fmt(rr['stop_x_p50_m'], 4)} / "
+                                                               f"{fmt(rr['stop_x_p95_m'], 4)} m"),
+                 (f"with {rr['option']}: share reaching the road", pct(rr.get("share_reaching_road")))]
+    return rows
 
 
-def _catchment(rep, c, figs):
-    """Write the catchment ditch: widths needed for each retention, the Modified Ritchie Criterion, the chart.
+def _runout(rep, a, figs, s):
+    """Write the stop points with their run-out statistics.
 
     Parameters
     ----------
     rep : _Report
         The document being written.
-    c : CatchmentStudy
-        The design's catchment study.
+    a : Assessment
+        The finished assessment.
     figs : pathlib.Path
         Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
     """
-    rep.section("Catchment ditch at the toe of the cut")
-    applies = c.to_dict()["odot_chart_geometry"]
-    rep.text(f"Retention against catchment width beyond the toe of the cut (x = {fmt(c.toe_x_m, 4)} m; cut "
-             f"{fmt(c.cut_height_m, 3)} m high at {fmt(c.face_angle_deg, 3)}°), re-simulated with the site's "
-             f"slope model.  Pierson, Gullixson & Chassie (2001, FHWA-OR-RD-02-04) charts: {applies}.")
-    rep.table(["retention", "catchment width needed [m]"],
-              [[f"{q:g} %", fmt(w, 3) if np.isfinite(w) else "not reached on the profile"]
-               for q, w in c.widths.items()], widths=[1, 2])
-    mrc = c.to_dict()["modified_ritchie_criterion"]
-    rep.text(f"Published width rule beside it: the Modified Ritchie Criterion W = 0.2 H + 4.5 m (Ryan & Pryor "
-             f"2000, after Ritchie 1963) gives {fmt(mrc['width_m'], 3)} m for this cut, within which the "
-             f"re-simulation retains {fmt(mrc['simulated_retained_percent'], 3)} % of the blocks that went over "
-             "the face.  The rule is for a cut face above a flat catchment; on the ODOT test cut the "
-             "re-simulation retains fewer blocks than the rule implies (validation: design standards and "
-             "ditch charts).", size=8)
+    rep.figures(figs, s, max_height=120)
+    rep.figure(figs / "recommended_trajectories.png", "Trajectories on the slope with the recommended option",
+               max_height=100)
+    rows = runout_rows(getattr(a, "design", None))
+    if rows:
+        rep.caption("Run-out of the simulated blocks")
+        rep.kv(rows)
+
+
+def _catchment(rep, a, figs, s):
+    """Write the catchment ditch: widths needed for each retention beside the Modified Ritchie Criterion, the chart.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment; its ``design.catchment`` is not None.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
+    """
+    c = a.design.catchment
+    widths, rule = S.catchment_tables(c)
+    rep.text(S.catchment_text(c))
+    rep.frame(widths, S.T_CATCHMENT_WIDTHS, widths=[1, 2])
+    rep.frame(rule, S.T_RITCHIE, widths=[2, 3], align=["LEFT", "LEFT"])
+    rep.text(S.RITCHIE_CAVEAT, size=8)
     if c.chart is not None:
-        rep.table(["width [m]", "chart retained [%]", "simulated [%]", "difference [points]"],
-                  [[fmt(r["width_m"]), fmt(r["retained_percent"]), fmt(r["simulated_percent"]),
-                    fmt(r["difference_points"])] for _, r in c.chart.iterrows()])
-    rep.figure(figs / "catchment_retention.png", "Retention against catchment width.", max_height=100)
+        rep.frame(c.chart, "Published chart against the re-simulation")
+    rep.figures(figs, s, max_height=100)
 
 
-def _hazard(rep, a, figs):
+def _trajectories(rep, a, figs, s):
+    """Write the trajectories at the barrier line: the scenario, the simulation summary and its figures.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
+    """
+    hz = a.energy.hazard
+    if a.result is None:
+        rep.text(hz.notes[0] if hz.notes else "velocities from a file")
+        return
+    res = a.result
+    rep.text(f"Scenario {res.scenario.name}: {res.scenario.description.strip()}", size=8.5)
+    rep.text("The speeds, heights and energies of this table are of the scenario seeder's own masses: they describe "
+             "how the slope behaves, they design nothing (the design basis designs with the site's mass law).",
+             size=8.5)
+    summ = res.summary().drop(index=list(S.SOFTWARE_METRICS), errors="ignore")
+    rep.caption("Simulation summary")
+    rep.table(["item", "value"], [[str(k), " ".join(cell(v) for v in row.values)] for k, row in summ.iterrows()],
+              widths=[3, 2])
+    rep.figures(figs, s, max_height=110)
+    rep.figure(figs / "collector_distributions.png",
+               "Speed, bounce height and energy at the barrier line (of the simulated blocks)", max_height=110)
+
+
+def _hazard(rep, a, figs, s):
     """Write the impact-energy hazard at the barrier line: rates, return-period energies, the design block.
 
     Parameters
@@ -607,12 +730,14 @@ def _hazard(rep, a, figs):
         The finished assessment.
     figs : pathlib.Path
         Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
     """
     hz = a.energy.hazard
-    rep.section("Impact-energy hazard at the barrier line")
     rep.text(f"Falls per year at the source {fmt(hz.rate_per_year)}; reach probability {fmt(hz.reach_probability)}; "
              f"arrivals per year {fmt(hz.arrival_rate)}.  Rate: {a.rate_source}.")
     de = a.energy.design
+    rep.caption("Design energies by return period")
     rep.table(["return period [years]", "annual exceedance", "energy [kJ]", "95 % interval [kJ]",
                "probability in 50 years"],
               [[year(r["T_years"]), fmt(r["annual_exceedance"]), fmt(r["energy_kj"]),
@@ -627,12 +752,11 @@ def _hazard(rep, a, figs):
                    for _, r in alt.iterrows()], widths=[3, 1, 1, 1, 1, 1.2, 0.7])
         rep.text("Which value designs: the governing basis above; the p95 energy of arriving falls under the site's "
                  "law and the return-period energies are shown for comparison only.", size=8)
-    rep.figure(figs / "energy_exceedance.png", "Annual frequency of impacts above an energy at the barrier line.",
-               max_height=110)
+    rep.figures(figs, s, max_height=110)
 
 
-def _ranking(rep, a, figs):
-    """Write the mitigation options ranked by expected total cost, the recommendation and the tornado chart.
+def _fence_checks(rep, a, figs, s):
+    """Write the fence checks against MEL and SEL (for comparison; the design basis governs).
 
     Parameters
     ----------
@@ -642,36 +766,107 @@ def _ranking(rep, a, figs):
         The finished assessment.
     figs : pathlib.Path
         Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
+    """
+    for name, table in a.energy.fences.items():
+        rep.sub(name)
+        rep.frame(table, f"Checks of {name}", size=7)
+
+
+def _road_risk(rep, a, figs, s):
+    """Write the risk to road users: Bunce et al. (1997) per lane, individual and societal risk, the F-N curves.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
+    """
+    rep.text(S.road_risk_text(a), size=8.5)
+    rep.frame(S.bunce_table(a), S.T_BUNCE, widths=[3.2, 1, 1, 1.1, 1.1, 1.3], size=7.2)
+    rep.frame(S.road_risk_table(a), S.T_RISK, digits=2, widths=[2.2, 1, 1, 1, 1, 1, 1.3], size=7.2)
+    for name, cap in s.figures:
+        rep.figure(figs / name, f"{cap} ({a.study.criteria.fn_diagram})", max_height=110)
+
+
+def _decision(rep, a, figs, s):
+    """Write the mitigation decision: the recommendation, the design checks of every option, the ranking by expected
+    total cost, the break-even values and the tornado chart.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
     """
     rank = a.decision["ranking"]
-    rec = a.decision["recommendation"]
     cur = a.study.currency
-    rep.section("Mitigation options ranked")
+    lines = S.recommendation_lines(a)
+    rep.text(lines[0], size=10, style="B")
+    for line in lines[1:]:
+        rep.text(line, size=8.5)
+    rep.sub("Design checks of the options")
+    rep.text("An option whose design checks fail stays in the ranking, marked NOT ADEQUATE, and is never "
+             "recommended.", size=8.5)
+    rep.frame(S.design_checks_table(a), S.T_DESIGN_CHECKS, widths=[0.8, 2.2, 1.3, 5.6, 1.5], size=7,
+              align=["RIGHT", "LEFT", "LEFT", "LEFT", "LEFT"])
+    rep.sub("Costs")
+    rep.caption(f"{S.T_RANKING} [{cur}]")
+    adequate = rank["design_adequate"] if "design_adequate" in rank else [True] * len(rank)
     rep.table(["option", f"capital [{cur}]", f"expected total cost [{cur}]", "5-95 % [" + cur + "]",
-               "road falls per year", "individual risk per year", "societal risk", "meets criteria"],
+               "P(cheapest)", "road falls per year", "individual risk per year", "societal risk",
+               "tolerable", "adequate"],
               [[r["option"], fmt(r["capital"]), fmt(r["expected_total_cost"]),
-                f"{fmt(r['cost_p05'])} - {fmt(r['cost_p95'])}", fmt(r["road_falls_per_year"]),
-                fmt(r["individual_risk"]), str(r["fn_zone"]), "yes" if r["meets_criteria"] else "no"]
-               for _, r in rank.iterrows()], widths=[2.2, 1.2, 1.3, 1.9, 1, 1.1, 1.2, 0.9], size=7.2)
-    rep.text(f"Recommendation: {rec['reason']}", size=8.5)
-    rep.figure(figs / "tornado.png", "One-way sensitivity of the expected total cost.", max_height=100)
+                f"{fmt(r['cost_p05'])} - {fmt(r['cost_p95'])}", f"{r['probability_best']:.0%}",
+                fmt(r["road_falls_per_year"]), fmt(r["individual_risk"]), str(r["fn_zone"]),
+                "yes" if r["meets_criteria"] else "no", "yes" if ok else "NO"]
+               for (_, r), ok in zip(rank.iterrows(), adequate)],
+              widths=[2.2, 1.1, 1.2, 1.9, 1.1, 1, 1.1, 1.2, 1.1, 1.1], size=7)
+    rep.text("Tolerable: meets the tolerability criteria (individual and societal risk); adequate: passes its "
+             "design checks (see the table above).  An option that is not adequate is never recommended.", size=8)
+    ec = a.study.economics
+    rep.text(f"Expected total cost = capital + present value of renewals, maintenance, repairs and replacements + "
+             f"present value of expected losses, over {ec.horizon_years:g} years at {ec.discount_rate:.1%}; mean "
+             f"and 5-95 % over {a.decision['uncertainty']['samples']:,} joint samples of the uncertain inputs.",
+             size=8)
+    be = a.decision["break_even"]
+    be = be[np.isfinite(be["break_even"])]
+    if len(be):
+        rep.sub("Break-even: input values at which the two cheapest options at central values tie")
+        rep.frame(be, S.T_BREAK_EVEN, size=7)
+    rep.figures(figs, s, max_height=100)
+    voi = a.decision["value_of_information"]
+    rep.text(f"Value of perfect information about the rate of falls: {fmt(voi['evpi'])} {cur}; about all sampled "
+             f"inputs at once: {fmt(voi['evpi_all_sampled_inputs'])} {cur} (the most that investigations settling "
+             "them are worth).", size=8.5)
 
 
-def _model_uncertainty(rep, mu, cur, figs):
+def _model_uncertainty(rep, a, figs, s):
     """Write the trajectory model uncertainty: design energy and ranking over draws of the material parameters.
 
     Parameters
     ----------
     rep : _Report
         The document being written.
-    mu : ModelUncertaintyStudy
-        The assessment's model-uncertainty study.
-    cur : str
-        Currency of the costs.
+    a : Assessment
+        The finished assessment; its ``model_uncertainty`` is not None.
     figs : pathlib.Path
         Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
     """
-    rep.section("Trajectory model uncertainty")
+    mu, cur = a.model_uncertainty, a.study.currency
     rep.text(f"The slope re-simulated for {mu.ranking.n_draws} draws of its material parameters ({mu.basis}).",
              size=8.5)
     for line in mu.energy.text(mu.design_T):
@@ -688,8 +883,8 @@ def _model_uncertainty(rep, mu, cur, figs):
                f"The {mu.design_T:g}-year energy of each draw with its bootstrap interval.", max_height=90)
 
 
-def _inventory_and_assumptions(rep, a, figs):
-    """Write the inventory with its magnitude-frequency law, then the assumptions, defaults and warnings.
+def _site_data(rep, a, figs, s):
+    """Write the site's inventory and the completeness of its record.
 
     Parameters
     ----------
@@ -699,26 +894,103 @@ def _inventory_and_assumptions(rep, a, figs):
         The finished assessment.
     figs : pathlib.Path
         Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
+    """
+    inv = a.inventory
+    rep.kv([("inventory", Path(str(inv.source)).name), ("recorded falls", f"{inv.n_events:,}"),
+            ("record length", f"{fmt(inv.duration_years)} years")])
+    comp = inv.completeness().reset_index().head(60)
+    rep.sub("Completeness")
+    rep.frame(comp, "Completeness of the record by year", size=7)
+    if a.rates is not None and not S.rates_transferred(a):
+        rep.text("Rate model: " + a.rates.rate_text(), size=8.5)
+    elif a.rates is not None:
+        rep.text(f"The rate model is fitted to another site's record: see {S.section_number(a, 'other_sites')}.",
+                 size=8.5)
+
+
+def _magnitude_frequency(rep, a, figs, s):
+    """Write the magnitude-frequency law of the inventory.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
+    """
+    gr = a.frequency.power_law
+    rep.kv([("power-law exponent b", f"{fmt(gr.b)} ± {fmt(gr.b_stderr, 2)}"), ("m_min", f"{fmt(gr.m_min)} kg"),
+            ("falls per year at or above m_min", fmt(gr.rate_min))])
+    if a.energy.site_masses is not None:
+        rep.frame(a.energy.site_masses.drop(columns="law"),
+                  "Design masses of the site's law: " + str(a.energy.site_masses["law"].iloc[0]), size=7)
+    rep.figures(figs, s, max_height=110)
+
+
+def _annual_maxima_of(rep, mf, sub):
+    """Write the Gumbel fit of a frequency study's annual maxima and its plot."""
+    rep.kv([("record", Path(str(mf.inventory.source)).name), ("events", f"{mf.inventory.n_events:,}"),
+            ("years", f"{year(mf.inventory.duration_years)}")])
+    rep.frame(mf.gumbel.summary().reset_index(), "Gumbel fit of the annual maxima", size=7.5)
+    rep.figure(sub / "gumbel_plot.png", "Gumbel probability plot", max_height=100)
+
+
+def _annual_maxima(rep, a, figs, s):
+    """Write the extreme values of the site's annual maxima, or where they are (another record) or why not.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
+    """
+    if a.frequency.gumbel is not None:
+        _annual_maxima_of(rep, a.frequency, figs)
+    elif a.maxima_frequency is not None and a.maxima_frequency.gumbel is not None:
+        rep.text("Not fitted to this site's inventory (it has no dates). The dated record the site file names "
+                 f"(inventory.annual_maxima) is fitted in {S.section_number(a, 'other_sites')}, with the data of "
+                 "other sites: it does not enter the design values.")
+    else:
+        rep.text("Not fitted: the inventory has no dates, so there are no annual maxima, and the site file names no "
+                 "dated record (inventory.annual_maxima).")
+
+
+def _assumptions(rep, a, figs, s):
+    """Write the assumptions, defaults and warnings.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
     """
     from ..io.outputs import relative_paths
-    rep.section("Inventory and magnitude-frequency law")
-    gr = a.frequency.power_law
-    rep.kv([("inventory", Path(str(a.inventory.source)).name), ("recorded falls", f"{a.inventory.n_events:,}"),
-            ("record length", f"{fmt(a.inventory.duration_years)} years"),
-            ("power-law exponent b", f"{fmt(gr.b)} ± {fmt(gr.b_stderr, 2)}"), ("m_min", f"{fmt(gr.m_min)} kg"),
-            ("falls per year at or above m_min", fmt(gr.rate_min))])
-    rep.figure(figs / "magnitude_frequency.png", "Magnitude-frequency of the inventory.", max_height=110)
-
-    rep.section("Assumptions, defaults and warnings")
     for w in a.warnings:
         rep.text("• " + str(relative_paths(str(w), a.site.path.parent)), size=8.5)
     if a.site.defaults_used:
         rep.sub("Defaults applied (not stated in the site file)")
-        rep.text("; ".join(a.site.defaults_used), size=8)
+        for entry in a.site.defaults_used:
+            rep.text("• " + str(entry), size=8)
 
 
-def _appendices(rep, a, figs):
-    """Write appendix A (data from other sites, when the assessment has them) and appendix B (the run record).
+def _other_sites(rep, a, figs, s):
+    """Write the data of other sites: a regional record's annual maxima, a transferred rate model.
 
     Parameters
     ----------
@@ -728,22 +1000,45 @@ def _appendices(rep, a, figs):
         The finished assessment.
     figs : pathlib.Path
         Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
     """
-    if a.maxima_frequency is not None or a.rates is not None:
-        rep.section("Data from other sites (reference only)", appendix="A")
-        rep.text("These records are not this site's: they show the methods (annual maxima, rainfall rate model) and "
-                 "do not enter the design values above.", size=9)
-        if a.maxima_frequency is not None:
-            mf = a.maxima_frequency
-            rep.kv([("record", Path(str(mf.inventory.source)).name), ("events", f"{mf.inventory.n_events:,}"),
-                    ("years", f"{year(mf.inventory.duration_years)}")])
-            rep.figure(figs / "annual_maxima" / "gumbel_plot.png", "Annual maxima of the regional record.",
-                       max_height=100)
-        if a.rates is not None:
-            rep.text("Rate model: " + a.rates.rate_text(), size=8.5)
-    rep.section("Run record", appendix="B")
-    rep.kv([("riskrf version", str(_version())), ("seed", str(a.seed)), ("simulated blocks", f"{a.n_blocks:,}"),
-            ("site file", a.site.path.name), ("outputs", "report.html, summary.json, CSV tables, figures/")])
+    rep.text("These records are not this site's: they show the methods (annual maxima, rainfall rate model) and "
+             "do not enter the design values.", size=9)
+    mf = a.maxima_frequency
+    if mf is not None and mf.gumbel is not None:
+        rep.sub("Annual maxima of the regional record")
+        _annual_maxima_of(rep, mf, figs / "annual_maxima")
+    if S.rates_transferred(a):
+        rep.text("Rate model: " + a.rates.rate_text(), size=8.5)
+
+
+def _run_record(rep, a, figs, s):
+    """Write the run record.
+
+    Parameters
+    ----------
+    rep : _Report
+        The document being written.
+    a : Assessment
+        The finished assessment.
+    figs : pathlib.Path
+        Directory of the assessment's figures.
+    s : riskrf.report.sections.Section
+        The section.
+    """
+    rep.caption("Run record")
+    rep.kv(S.run_record(a))
+
+
+#: Body of each report section (riskrf.report.sections), called as fn(rep, a, figs, section).
+BODIES = {
+    "design_values": _design_values_sheet, "design_basis": _design_checks, "positions": _barrier_positions,
+    "slope_model": _slope_model, "options_profile": _options_profile, "runout": _runout, "catchment": _catchment,
+    "trajectories": _trajectories, "hazard": _hazard, "fence_checks": _fence_checks, "road_risk": _road_risk,
+    "decision": _decision, "model_uncertainty": _model_uncertainty, "site_data": _site_data,
+    "magnitude_frequency": _magnitude_frequency, "annual_maxima": _annual_maxima, "assumptions": _assumptions,
+    "other_sites": _other_sites, "run_record": _run_record}
 
 
 def _version():
