@@ -181,7 +181,7 @@ def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, m
         With ``hazard``: receives each chunk's pixel passages (a dict of arrays, whole blocks, in block order
         of the chunks) as soon as the chunk is run, and the result keeps none (``passages`` None); e.g.
         :meth:`simulation.hazard_grids.PassageAggregator.add`, so memory does not grow with the blocks.  At most
-        ``2 * workers`` chunks are in flight.
+        ``workers`` chunks run while one is handed over.
 
     Returns
     -------
@@ -237,7 +237,7 @@ def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, m
                 pending, todo = [], iter(chunks[1:])
                 for c in todo:
                     pending.append(pool.submit(job, c))
-                    if len(pending) >= 2 * workers:
+                    if len(pending) >= workers:
                         parts.append(keep(pending.pop(0).result()))
                 parts += [keep(f.result()) for f in pending]
     elapsed = time.perf_counter() - started

@@ -100,10 +100,12 @@ def check_rate(rate_per_year, name: str = "rate_per_year") -> float:
 
 
 @njit(cache=True)
-def _reduce_chunk(block, cell, e, h, mark, pos, count, e_max, h_max):
-    """One record per (block, pixel) of a chunk's passages (largest energy and height), updating the running
-    count and maxima per pixel.  ``mark[c]`` holds the last block seen at pixel c (blocks are never seen in two
-    chunks), ``pos[c]`` its record; returns the records' pixel, energy, height and how many there are."""
+def _reduce_chunk(block, cell, e, h, mark, pos, count, e_max, h_max, nx, tnx, tile_size, n_tiles, rec_c, rec_e,
+                  rec_h):
+    """One record per (block, pixel) of some blocks' passages (largest energy and height), grouped by tile into
+    ``rec_c`` (pixel within its tile), ``rec_e``, ``rec_h``; updates the running count and maxima per pixel.
+    ``mark[c]`` holds the last block seen at pixel c (a block is never seen in two calls), ``pos[c]`` its
+    record.  Returns the records per tile (their slices follow each other in tile order) and their number."""
     m = cell.shape[0]
     oc = np.empty(m, np.int64)
     oe = np.empty(m, np.float32)
@@ -124,6 +126,7 @@ def _reduce_chunk(block, cell, e, h, mark, pos, count, e_max, h_max):
             oe[k] = e[i]
             oh[k] = h[i]
             k += 1
+    per_tile = np.zeros(n_tiles, np.int64)
     for j in range(k):
         c = oc[j]
         count[c] += 1
@@ -131,7 +134,21 @@ def _reduce_chunk(block, cell, e, h, mark, pos, count, e_max, h_max):
             e_max[c] = oe[j]
         if oh[j] > h_max[c]:
             h_max[c] = oh[j]
-    return oc, oe, oh, k
+        r, q = c // nx, c % nx
+        per_tile[(r // tile_size) * tnx + q // tile_size] += 1
+    fill = np.zeros(n_tiles, np.int64)
+    for t in range(1, n_tiles):
+        fill[t] = fill[t - 1] + per_tile[t - 1]
+    for j in range(k):
+        c = oc[j]
+        r, q = c // nx, c % nx
+        t = (r // tile_size) * tnx + q // tile_size
+        f = fill[t]
+        rec_c[f] = (r % tile_size) * tile_size + q % tile_size
+        rec_e[f] = oe[j]
+        rec_h[f] = oh[j]
+        fill[t] = f + 1
+    return per_tile, k
 
 
 @njit(cache=True)
@@ -224,12 +241,11 @@ class PassageAggregator:
         self.count = np.zeros(ncell, np.int64)
         self.e_max = np.full(ncell, -np.inf, np.float32)
         self.h_max = np.full(ncell, -np.inf, np.float32)
-        self._mark = np.full(ncell, -1, np.int64)
+        self._mark = np.full(ncell, -1, np.int64)       # the last block seen at each pixel
         self._pos = np.zeros(ncell, np.int64)
         self.tny, self.tnx = -(-self.ny // TILE), -(-self.nx // TILE)
         self._records = np.zeros(self.tny * self.tnx, np.int64)
         self._dir = Path(tempfile.mkdtemp(prefix="riskrf-hazard-", dir=scratch_dir))
-        self.blocks_added = 0
 
     def __enter__(self):
         return self
@@ -263,23 +279,18 @@ class PassageAggregator:
         if cell.size == 0:
             return
         block = np.asarray(passages["block"])
-        oc, oe, oh, k = _reduce_chunk(block, cell, np.asarray(passages["e"], np.float32),
-                                      np.asarray(passages["h"], np.float32), self._mark, self._pos, self.count,
-                                      self.e_max, self.h_max)
-        oc, oe, oh = oc[:k], oe[:k], oh[:k]
-        row, col = np.divmod(oc, self.nx)
-        tile = (row // TILE) * self.tnx + col // TILE
-        rec = np.empty(k, _REC)
-        rec["c"] = (row % TILE) * TILE + col % TILE
-        rec["e"], rec["h"] = oe, oh
-        order = np.argsort(tile, kind="stable")
-        rec, tile = rec[order], tile[order]
-        cuts = np.flatnonzero(np.diff(tile)) + 1
-        for a, b in zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [k]])):
-            t = int(tile[a])
+        rec = np.empty(cell.size, _REC)          # at most one record per passage
+        per_tile, k = _reduce_chunk(block, cell, np.asarray(passages["e"], np.float32),
+                                    np.asarray(passages["h"], np.float32), self._mark, self._pos, self.count,
+                                    self.e_max, self.h_max, self.nx, self.tnx, TILE, self._records.size,
+                                    rec["c"], rec["e"], rec["h"])
+        a = 0
+        for t in np.flatnonzero(per_tile):
+            b = a + int(per_tile[t])
             with open(self._dir / f"{t}.bin", "ab") as f:
-                f.write(rec[a:b].tobytes())
-            self._records[t] += b - a
+                rec[a:b].tofile(f)
+            a = b
+        self._records += per_tile
 
     def rasters(self, n: int, *, rate_per_year: float | None = None, frequencies=()) -> dict:
         """Per-pixel statistics (internal order, (ny, nx) float arrays; NaN where no block passed) and the scratch

@@ -227,7 +227,7 @@ def write_geopackage(result, path) -> Path:
 
 
 def hazard_map(scenario, n: int = 10_000, seed=1, *, crs=None, workers: int = 1, record_paths: int = 50,
-               masses_kg=None, chunk_size: int = 5_000, dask: bool = False, client=None, scheduler: str | None = None,
+               masses_kg=None, chunk_size: int = 2_000, dask: bool = False, client=None, scheduler: str | None = None,
                tile_m: float = 250.0, max_tile_blocks: int = 50_000, rate_per_year: float | None = None,
                scratch_dir=None, log=None) -> HazardMap:
     """Run a 3-D scenario for hazard rasters, aggregating the pixel passages chunk by chunk.
@@ -249,8 +249,8 @@ def hazard_map(scenario, n: int = 10_000, seed=1, *, crs=None, workers: int = 1,
     masses_kg : array, optional
         Block masses [kg] instead of the sources' distribution.
     chunk_size : int
-        Blocks per kernel call (the unit of work of a thread, and of the aggregation: at most ``2 * workers``
-        chunks' passages are in memory; results do not depend on it).
+        Blocks per kernel call (the unit of work of a thread and of the aggregation: about ``workers + 1``
+        chunks' pixel passages are in memory at a time, 16 bytes per pixel crossed; results do not depend on it).
     dask : bool
         Run tiles by source on a dask.distributed cluster (see the module docstring): ``client`` (used as is),
         else ``scheduler`` (an address, or DASK_SCHEDULER_ADDRESS), else a LocalCluster of ``workers`` processes.
