@@ -162,37 +162,6 @@ class _BootstrapBar:
         self.stream.flush()
 
 
-def write_table(df, path: Path, suffix: str | None = None) -> None:
-    """Write a DataFrame as Parquet or CSV by the file suffix, atomically (temporary name, then rename).
-
-    Parameters
-    ----------
-    df : pandas.DataFrame
-        The table.
-    path : pathlib.Path
-        Output file (``.parquet`` or ``.csv``).
-    suffix : str, optional
-        Format to use instead of the file's suffix.
-    """
-    import os
-    import tempfile
-    suffix = (suffix or path.suffix).lower()
-    if suffix not in (".parquet", ".csv"):
-        raise ValueError(f"--out {path}: use a .parquet or .csv file name")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    os.close(fd)
-    try:
-        if suffix == ".parquet":
-            df.to_parquet(tmp, index=False)
-        else:
-            df.to_csv(tmp, index=False)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def cmd_simulate(args) -> int:
     """``riskrf simulate``: run a scenario, print its summary, write the crossings table and figures.
 
@@ -210,13 +179,24 @@ def cmd_simulate(args) -> int:
 
     import simulation
 
-    from .io.outputs import atomic_outputs, check_output, check_output_spares_inputs
+    from .io.outputs import atomic_outputs, check_output, check_output_spares_inputs, require_pyarrow, write_table
     from .app.preflight import command_inputs
-    out = Path(f"{Path(args.scenario).stem}-crossings.parquet") if args.out is None else \
-        check_output_spares_inputs(args.out, command_inputs(args))
-    check_output(out, overwrite=args.overwrite, kind="file")
+    out = Path(f"{Path(args.scenario).stem}-crossings.{'parquet' if args.format == 'parquet' else 'csv'}") \
+        if args.out is None else check_output_spares_inputs(args.out, command_inputs(args))
     if out.suffix.lower() not in (".parquet", ".csv"):
         raise ValueError(f"--out {out}: use a .parquet or .csv file name")
+    fmt = args.format or out.suffix.lower()[1:]
+    if fmt not in ("both", out.suffix.lower()[1:]):
+        raise ValueError(f"--out {out} is a {out.suffix} file but --format {fmt}: name a .{fmt} file, or pass "
+                         "--format both for a .csv and a .parquet side by side")
+    suffixes = (".csv", ".parquet") if fmt == "both" else (out.suffix.lower(),)
+    if ".parquet" in suffixes:
+        require_pyarrow(f"--format {fmt}" if args.format else f"--out {out}",
+                        instead="or use --format csv" if args.format else "or name a .csv file")
+    outs = [out] + [out.with_suffix(s) for s in suffixes if s != out.suffix.lower()]
+    for path in outs:
+        check_output_spares_inputs(path, command_inputs(args))
+        check_output(path, overwrite=args.overwrite, kind="file")
     figures = out.with_name(f"{out.stem}-figures") if args.figures is None else Path(args.figures)
     check_output_spares_inputs(figures, command_inputs(args), option="--figures")
     check_output(figures, overwrite=args.overwrite, kind="dir", option="--figures")
@@ -232,13 +212,18 @@ def cmd_simulate(args) -> int:
     if "outcome" in crossings:
         crossings["outcome"] = crossings["outcome"].astype(str)
     from .report import files as report_files
-    with atomic_outputs([(out, "file"), (figures, "dir")], overwrite=args.overwrite) as (tmp_out, tmp):
-        write_table(crossings, tmp_out, suffix=out.suffix)       # table and figures appear together or not at all
+    targets = [(path, "file") for path in outs] + [(figures, "dir")]
+    with atomic_outputs(targets, overwrite=args.overwrite) as tmps:    # tables and figures appear together or not
+        *tmp_outs, tmp = tmps
+        for path, tmp_out in zip(outs, tmp_outs):
+            write_table(crossings, tmp_out, suffix=path.suffix)
         report_files.write_simulation_figures(result, tmp, [c.name for c in scenario.collectors])
-        result.runout.to_csv(tmp / "runout.csv", index=False)
-        result.envelopes.to_csv(tmp / "envelopes.csv", index=False)
-    print(f"\nWrote {len(crossings):,} collector crossings to {out} and figures, runout.csv and "
-          f"envelopes.csv to {figures}/")
+        for suffix in suffixes:
+            write_table(result.runout, tmp / f"runout{suffix}", option="--format")
+            write_table(result.envelopes, tmp / f"envelopes{suffix}", option="--format")
+    names = " and ".join(f"runout{s}, envelopes{s}" for s in suffixes)
+    print(f"\nWrote {len(crossings):,} collector crossings to {' and '.join(map(str, outs))} and figures, "
+          f"{names} to {figures}/")
     return 0
 
 
@@ -1050,8 +1035,15 @@ def _add_simulate_parser(sub) -> None:
     p.add_argument("scenario", help="scenario TOML file, e.g. simulation/scenarios/road_cut_barrier.toml")
     _add_release_arguments(p, 100_000)
     p.add_argument("--out", default=None, metavar="FILE",
-                   help="crossings table, .parquet or .csv (default <scenario>-crossings.parquet)")
-    p.add_argument("--figures", default=None, metavar="DIR", help="figure directory (default <out>-figures)")
+                   help="crossings table, .csv or .parquet (default <scenario>-crossings.csv, .parquet with "
+                   "--format parquet)")
+    p.add_argument("--format", choices=("csv", "parquet", "both"), default=None,
+                   help="format of the crossings table and of runout and envelopes: csv (cells a spreadsheet "
+                   "would run as a formula are prefixed with '), parquet (columnar, smaller and faster to read; "
+                   "needs pyarrow: pip install 'riskrf[parquet]') or both side by side (default: the --out "
+                   "suffix, else csv)")
+    p.add_argument("--figures", default=None, metavar="DIR",
+                   help="directory of the figures, runout and envelopes (default <out>-figures)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="show a progress bar (default: on for 200,000 blocks or more on a terminal)")
     p.set_defaults(func=cmd_simulate)

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import io
 import json
 import math
 import os
@@ -13,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from ..core.validation import RiskrfError
 
 
 def _umask() -> int:
@@ -191,8 +194,57 @@ def _neutralise_cell(cell: str) -> str:
     return cell
 
 
+#: Files written by :func:`write_csv`, whose cells are already safe: ``(st_dev, st_ino)`` ->
+#: ``(st_size, st_mtime_ns, st_ctime_ns)`` right after writing (a rename keeps all of them; any later change
+#: to the file changes one, and then :func:`_finish` neutralises it again).
+_NEUTRALISED: dict[tuple[int, int], tuple[int, int, int]] = {}
+
+
+def _stat_key(path) -> tuple[tuple[int, int], tuple[int, int, int]]:
+    st = os.stat(path)
+    return (st.st_dev, st.st_ino), (st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+
+
+def _already_neutralised(path) -> bool:
+    key, sig = _stat_key(path)
+    return _NEUTRALISED.pop(key, None) == sig
+
+
+#: Where a spreadsheet cell could start: the start of the file, or after a comma or a line end.  ``"`` opens a
+#: quoted cell; the captured rest runs to the next comma, quote or line end, and the character after it is
+#: captured to tell an ordinary cell from a quoted or odd one.
+_CELL_START = re.compile(r'(?:\A|(?<=[,\n\r]))([=+\-@\t\r"])([^,\n\r"]*)(.?)', re.S)
+
+
+def _needs_neutralising(text: str) -> bool:
+    """Whether ``text`` (a whole CSV file) may hold a cell :func:`neutralise_csv` would change.
+
+    ``False`` only when every place a cell could start with ``=``, ``+``, ``-``, ``@``, tab or carriage return
+    holds an unquoted number (``-1.5``, ``+3e-2``): such a file is left exactly as it is by the full
+    rewrite, so it can be skipped.  ``True`` sends the file to the exact cell-by-cell check (quoted cells and
+    every other case).
+    """
+    for m in _CELL_START.finditer(text):
+        first, rest, after = m.groups()
+        if first == '"':                      # a quoted cell: unsafe when its text starts like a formula
+            if (rest[:1] or after) in _FORMULA_START and (rest or after):
+                return True
+            continue
+        if after not in ("", ",", "\n", "\r"):
+            return True
+        try:
+            float(first + rest)
+        except ValueError:
+            return True
+    return False
+
+
 def neutralise_csv(path) -> None:
     """Prefix with ``'`` every text cell that a spreadsheet would execute as a formula (=, +, -, @).
+
+    A cell that starts with one of ``= + - @``, tab or carriage return and is not a number (``-1.5`` stays)
+    gets the prefix.  A file whose possible formula cells are all unquoted numbers is recognised from its
+    text in one pass and not rewritten; any other file is read and checked cell by cell.
 
     Parameters
     ----------
@@ -205,7 +257,11 @@ def neutralise_csv(path) -> None:
     """
     path = Path(path)
     with open(path, newline="", encoding="utf-8", errors="surrogateescape") as fh:
-        rows = list(csv.reader(fh))
+        text = fh.read()
+    if not _needs_neutralising(text):
+        return
+    rows = list(csv.reader(io.StringIO(text, newline="")))
+    del text
     changed = False
     for row in rows:
         for j, cell in enumerate(row):
@@ -218,6 +274,226 @@ def neutralise_csv(path) -> None:
             csv.writer(fh, lineterminator="\n").writerows(rows)
 
 
+def _neutralise_strings(values: pd.Series) -> pd.Series:
+    """``values`` (text or missing) with every cell :func:`_neutralise_cell` would change changed; vectorised:
+    only the cells starting with a formula character are looked at one by one."""
+    start = values.str.startswith(_FORMULA_START, na=False).to_numpy()
+    if not start.any():
+        return values
+    where = np.flatnonzero(start)
+    values = values.astype(object)
+    values.iloc[where] = [_neutralise_cell(v) for v in values.iloc[where]]
+    return values
+
+
+#: Characters that make the csv module quote a cell (comma, quote, line ends) or may (other control
+#: characters); cells holding one are written through the csv module itself, so the quoting is its own.
+_MAY_QUOTE = r'[\x00-\x1f",]'
+
+
+def _csv_cells(values) -> list[str]:
+    """One row of cells as the csv module writes it (QUOTE_MINIMAL, ``\n``), split back into cells' text."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    out = []
+    for v in values:
+        buf.seek(0)
+        buf.truncate()
+        w.writerow([v, ""])                   # two cells: a lone empty cell would be written as ""
+        out.append(buf.getvalue()[:-2])
+    return out
+
+
+#: Text the csv module writes but does not read back as written (an unquoted carriage return ends the row; a
+#: NUL byte is refused): such tables go through pandas and the cell-by-cell check, as before.
+_UNREADABLE = r"[\r\x00]"
+
+
+def _is_text_column(col: pd.Series) -> bool:
+    if isinstance(col.dtype, pd.CategoricalDtype):
+        return _is_text_column(pd.Series(col.cat.categories, dtype=object))
+    if isinstance(col.dtype, pd.StringDtype):
+        return True
+    return col.dtype == object and pd.api.types.infer_dtype(col, skipna=True) in ("string", "empty")
+
+
+def _fast_csv_ok(df: pd.DataFrame) -> bool:
+    """Whether :func:`write_csv` can format ``df`` itself: flat text column labels, two or more columns and rows,
+    and every column float, integer or bool (NumPy) or text (also categories of text) with missing values (no
+    carriage return or NUL)."""
+    if len(df.columns) < 2 or len(df) == 0 or isinstance(df.columns, pd.MultiIndex):
+        return False
+    if not all(isinstance(c, str) for c in df.columns) or df.columns.has_duplicates:
+        return False
+    for _, col in df.items():
+        dt = col.dtype
+        if isinstance(dt, np.dtype) and dt.kind in "fiub":
+            continue
+        text = pd.Series(col.cat.categories, dtype=object) if isinstance(dt, pd.CategoricalDtype) else col
+        if not _is_text_column(col) or text.str.contains(_UNREADABLE, regex=True, na=False).any():
+            return False
+    return True
+
+
+def _column_text(col: pd.Series) -> list[str]:
+    """The cells of one column as pandas' ``to_csv`` writes them, already neutralised and quoted."""
+    dt = col.dtype
+    if isinstance(dt, np.dtype) and dt.kind in "fiub":
+        arr = col.to_numpy()
+        if dt == np.float64:
+            text = list(map(float.__repr__, arr.tolist()))     # what NumPy's astype(str) gives, faster
+        elif dt.kind == "f":
+            text = arr.astype(str).tolist()                     # float32/16: their own shortest repr
+        else:
+            text = list(map(str, arr.tolist()))
+        if dt.kind == "f":
+            for i in np.flatnonzero(np.isnan(arr)):
+                text[i] = ""
+        return text
+    if isinstance(dt, pd.CategoricalDtype):            # each category formatted once, then taken by code
+        cats = _column_text(pd.Series(col.cat.categories, dtype=object)) + [""]
+        return np.array(cats, dtype=object)[col.cat.codes.to_numpy()].tolist()
+    values = _neutralise_strings(col)
+    special = values.str.contains(_MAY_QUOTE, regex=True, na=False).to_numpy()
+    missing = values.isna().to_numpy()
+    text = values.astype(object).tolist()
+    for i in np.flatnonzero(missing):
+        text[i] = ""
+    for i, cell in zip(np.flatnonzero(special), _csv_cells(values.iloc[np.flatnonzero(special)])):
+        text[i] = cell
+    return text
+
+
+#: Rows formatted and written at a time by :func:`write_csv` (bounds the memory of the text).
+CSV_CHUNK_ROWS = 100_000
+
+
+def write_csv(df: pd.DataFrame, path, *, index: bool = False) -> None:
+    """Write ``df`` as CSV with every text cell a spreadsheet would run as a formula prefixed with ``'``.
+
+    The file is byte for byte what ``df.to_csv(path, index=index)`` followed by :func:`neutralise_csv` writes
+    (UTF-8, ``,``, ``"`` quoting where needed, ``\n`` line ends, missing values empty, floats in their
+    shortest round-trip form), but only text columns and labels are checked, in memory and vectorised;
+    numeric columns never need it.  Tables of NumPy float, integer, bool and text (or categorical text)
+    columns are formatted here, :data:`CSV_CHUNK_ROWS` rows at a time; any other table (dates, mixed object
+    columns, an index) goes through pandas and the file check.  :func:`atomic_outputs` does not check
+    the file again.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        The table.
+    path : str or path
+        The file written (replaced if it exists; write into :func:`atomic_outputs`' temporary names for an
+        all-or-nothing output).
+    index : bool
+        Whether to write the index as the first column(s), as pandas does.
+    """
+    path = Path(path)
+    if index or not _fast_csv_ok(df):
+        df.to_csv(path, index=index)
+        neutralise_csv(path)
+    else:
+        header = _csv_cells(_neutralise_strings(pd.Series(list(df.columns), dtype=object)))
+        with open(path, "w", newline="", encoding="utf-8") as fh:
+            fh.write(",".join(header) + "\n")
+            for start in range(0, len(df), CSV_CHUNK_ROWS):
+                part = df.iloc[start:start + CSV_CHUNK_ROWS]
+                cells = [_column_text(col) for _, col in part.items()]
+                fh.write("\n".join(map(",".join, zip(*cells))))
+                fh.write("\n")
+    key, sig = _stat_key(path)
+    _NEUTRALISED[key] = sig
+
+
+class MissingDependencyError(RiskrfError, ImportError, ValueError):
+    """An optional package a chosen option needs is not installed (the message names the option and the
+    install command).  Also an :class:`ImportError`, and a :class:`ValueError` so that the command line
+    reports it in one line."""
+
+
+def require_pyarrow(option: str, *, instead: str = ""):
+    """Import pyarrow for ``option``, or say which extra installs it.
+
+    Parameters
+    ----------
+    option : str
+        What needs Parquet, for the message (e.g. ``"--format parquet"``).
+    instead : str
+        An alternative offered in the message (e.g. ``"or use --format csv"``).
+
+    Returns
+    -------
+    module
+        :mod:`pyarrow`.
+
+    Raises
+    ------
+    MissingDependencyError
+        pyarrow is not installed.
+    """
+    try:
+        import pyarrow
+    except ImportError:
+        raise MissingDependencyError(
+            f"{option} writes Parquet, which needs pyarrow, and pyarrow is not installed: "
+            f"pip install 'riskrf[parquet]' (or pip install pyarrow){', ' + instead if instead else ''}") from None
+    return pyarrow
+
+
+def write_parquet(df: pd.DataFrame, path, *, option: str = "Parquet output") -> None:
+    """Write ``df`` as Parquet (pyarrow, no index); the values as they are (no cell is prefixed).
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        The table.
+    path : str or path
+        The file written.
+    option : str
+        What asked for Parquet, for the message when pyarrow is missing.
+
+    Raises
+    ------
+    MissingDependencyError
+        pyarrow is not installed (``pip install 'riskrf[parquet]'``).
+    """
+    require_pyarrow(option)
+    df.to_parquet(path, index=False)
+
+
+def write_table(df: pd.DataFrame, path, *, suffix: str | None = None, option: str = "--out") -> None:
+    """Write ``df`` as Parquet or CSV by ``suffix`` (default: the file's), with :func:`write_parquet` or
+    :func:`write_csv`.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        The table.
+    path : str or path
+        The file written (inside :func:`atomic_outputs` for an all-or-nothing output).
+    suffix : {".csv", ".parquet"}, optional
+        The format, when the file name does not give it (a temporary name).
+    option : str
+        The option that named the file, for messages.
+
+    Raises
+    ------
+    ValueError
+        Another suffix.
+    MissingDependencyError
+        Parquet without pyarrow.
+    """
+    path = Path(path)
+    suffix = (suffix or path.suffix).lower()
+    if suffix == ".parquet":
+        write_parquet(df, path, option=option)
+    elif suffix == ".csv":
+        write_csv(df, path)
+    else:
+        raise ValueError(f"{option} {path}: use a .parquet or .csv file name")
+
+
 def _finish(tmp: Path) -> None:
     """Permissions by the user's umask (temporary names are created private) and safe CSV cells."""
     mode_dir, mode_file = 0o777 & ~_umask(), 0o666 & ~_umask()
@@ -227,7 +503,7 @@ def _finish(tmp: Path) -> None:
             os.chmod(item, mode_dir)
         elif item.is_file():
             os.chmod(item, mode_file)
-            if item.suffix.lower() == ".csv":
+            if item.suffix.lower() == ".csv" and not _already_neutralised(item):
                 neutralise_csv(item)
 
 
