@@ -256,13 +256,14 @@ class _Report:
 
 def _toc(pdf, outline):
     pdf.set_font("DejaVu", "B", 13)
-    pdf.cell(0, 8, "Contents", new_x="LMARGIN", new_y="NEXT")
+    pdf.set_x(pdf.l_margin)
+    pdf.cell(A4_TEXT_WIDTH_MM, 8, "Contents", new_x="LMARGIN", new_y="NEXT")
     pdf.ln(2)
     for s in outline:
         pdf.set_font("DejaVu", "" if s.level else "B", 9.5 if s.level == 0 else 8.5)
         indent = 6 * s.level
         pdf.set_x(pdf.l_margin + indent)
-        name = s.name if len(s.name) < 95 else s.name[:92] + "..."
+        name = s.name if len(s.name) < 86 else s.name[:83] + "..."
         pdf.cell(A4_TEXT_WIDTH_MM - indent - 15, 5.2, name, link=pdf.add_link(page=s.page_number))
         pdf.cell(15, 5.2, str(s.page_number), align="R", new_x="LMARGIN", new_y="NEXT")
 
@@ -832,7 +833,7 @@ def _decision(rep, a, figs, s):
                 fmt(r["road_falls_per_year"]), fmt(r["individual_risk"]), str(r["fn_zone"]),
                 "yes" if r["meets_criteria"] else "no", "yes" if ok else "NO"]
                for (_, r), ok in zip(rank.iterrows(), adequate)],
-              widths=[2.2, 1.1, 1.2, 1.9, 1.1, 1, 1.1, 1.2, 1.1, 1.1], size=7)
+              widths=[1.9, 1.3, 1.3, 1.8, 1.4, 1, 1.1, 1.2, 1.1, 1.3], size=6.8)
     rep.text("Tolerable: meets the tolerability criteria (individual and societal risk); adequate: passes its "
              "design checks (see the table above).  An option that is not adequate is never recommended.", size=8)
     ec = a.study.economics
@@ -844,7 +845,8 @@ def _decision(rep, a, figs, s):
     be = be[np.isfinite(be["break_even"])]
     if len(be):
         rep.sub("Break-even: input values at which the two cheapest options at central values tie")
-        rep.frame(be, S.T_BREAK_EVEN, size=7)
+        rep.frame(be, S.T_BREAK_EVEN, size=7, widths=[2.2] + [1] * (be.shape[1] - 2) + [3.2],
+                  align=["LEFT"] + ["RIGHT"] * (be.shape[1] - 2) + ["LEFT"])
     rep.figures(figs, s, max_height=100)
     voi = a.decision["value_of_information"]
     rep.text(f"Value of perfect information about the rate of falls: {fmt(voi['evpi'])} {cur}; about all sampled "
