@@ -179,3 +179,15 @@ def test_bad_rate_is_refused_before_work_naming_the_option(slope, tmp_path, caps
         assert "--rate-per-year" in err and "> 0 [1/year]" in err and not out.exists()
     with pytest.raises(HazardGridError, match=r"rate_per_year .*got 'two'"):
         hazard_map(slope / "slope.toml", n=10, rate_per_year="two")
+
+
+def test_streamed_dask_tiles_give_the_same_rasters(slope):
+    """Tiles by source on dask, each tile's passages aggregated as it arrives: the unchunked rasters exactly."""
+    distributed = pytest.importorskip("distributed")
+    sc = simulation.load_terrain_scenario(slope / "slope.toml")
+    ref = simulation.run_terrain(sc, 240, seed=9, hazard=True).hazard_grids()
+    with distributed.Client(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as client:
+        hm = hazard_map(sc, n=240, seed=9, client=client, tile_m=4.0, max_tile_blocks=30, record_paths=3)
+    assert hm.result.passages is None and hm.result.workers == 2
+    for k, g in ref.items():
+        np.testing.assert_array_equal(hm.grids[k], g, err_msg=k)
