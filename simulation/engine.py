@@ -36,6 +36,34 @@ def _material_arrays(scenario: Scenario):
         m_drag=f("rolling_drag"), m_size_k=f("rolling_size_coefficient"), m_et_v0=f("et_normal_scale_ms"))
 
 
+def kernel_features(scenario: Scenario) -> tuple[bool, bool]:
+    """Which optional contact features a scenario uses: (rolling drag, steep-face rule).
+
+    :func:`run` passes ``m_drag`` = None to :func:`simulation.kernel.simulate` when no material has a rolling
+    drag, and ``sin_max_roll`` = None when no segment of the profile is steeper than ``max_rolling_slope_deg``
+    (less a margin of 1e-9 in the sine, so rounding never hides one); numba then compiles a specialisation of
+    the kernel with that feature's code pruned, and the features cost nothing where they are not used.  The
+    results are the same either way: with no drag the contact steps take c = 0 in both, and the steep-face
+    tests are false on every segment.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario about to be simulated.
+
+    Returns
+    -------
+    tuple of bool
+        (some material has ``rolling_drag`` > 0, some segment is steeper than ``max_rolling_slope_deg``).
+    """
+    drag = any(m.rolling_drag > 0.0 for m in scenario.materials)
+    sin_max = scenario.settings.sin_max_roll
+    prof = scenario.profile
+    dx, dz = np.diff(prof.x), np.diff(prof.z)
+    steep = sin_max < 1.0 and bool(np.any(np.abs(dz) / np.hypot(dx, dz) > sin_max - 1e-9))
+    return drag, steep
+
+
 def check_masses(masses_kg, n=None) -> np.ndarray:
     """Block masses [kg] given to :func:`run`: a 1-d array of finite values > 0 (n of them when n is given).
 
@@ -173,6 +201,10 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
     prof = scenario.profile
     st = scenario.settings
     mats = _material_arrays(scenario)
+    uses_drag, uses_steep = kernel_features(scenario)
+    if not uses_drag:
+        mats["m_drag"] = None            # the kernel's specialisation without rolling drag (kernel_features)
+    sin_max_roll = st.sin_max_roll if uses_steep else None
     cols = scenario.collectors
     c_x = np.array([c.x for c in cols], dtype=float)
     c_cap = np.array([np.nan if c.capacity_kj is None else c.capacity_kj for c in cols], dtype=float)
@@ -216,7 +248,7 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
                 prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.material_index, prof.run_first, prof.run_last,
                 **mats, c_x=c_x, c_cap=c_cap, c_h=c_h, c_order=c_order, env_x=env_x, env_acc=env_chunk,
                 g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
-                sin_max_roll=st.sin_max_roll,
+                sin_max_roll=sin_max_roll,
                 max_events=st.max_events, key=key, n_path_blocks=n_paths,
                 out_x=per_block["x"][lo:hi], out_z=per_block["z"][lo:hi], out_reason=per_block["reason"][lo:hi],
                 out_impacts=per_block["impacts"][lo:hi], out_t=per_block["t"][lo:hi],

@@ -473,8 +473,10 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
         Per material: velocity scale of e_N [m/s] (inf: none).
     m_hop : numpy.ndarray
         Per material: hop height [m].
-    m_drag : numpy.ndarray
-        Per material: rolling drag coefficient [-] (c = m_drag / r [1/m]).
+    m_drag : numpy.ndarray or None
+        Per material: rolling drag coefficient [-] (c = m_drag / r [1/m]).  None where no material has one: numba
+        then compiles a version without the drag terms (c = 0 in every contact step, the same numbers as an
+        array of zeros; :func:`simulation.engine.kernel_features`).
     m_size_k : numpy.ndarray
         Per material: size coefficient of the rolling resistance [-].
     m_et_v0 : numpy.ndarray
@@ -497,8 +499,9 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
         Numerical floor of the contact speed [m/s].
     v_stop : float
         Stop speed [m/s].
-    sin_max_roll : float
-        Sine of the steepest slope a block may roll or slide on [-].
+    sin_max_roll : float or None
+        Sine of the steepest slope a block may roll or slide on [-].  None where no segment is steeper: the
+        version compiled for it has no steep-face tests (they would all be false).
     max_events : int
         Largest number of events per block.
     key : numpy.uint64
@@ -537,6 +540,23 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
     state = np.empty(1, np.uint64)
     cross_t = np.empty(n_coll)
     stack = np.empty((3, 128), np.int64)
+    # Per segment, once per chunk, by the very expressions the event loop used to evaluate at every event (so
+    # the numbers are the same): sine and cosine of the slope angle atan2(dz, dx) (impacts) and the direction
+    # cosines dx / l, dz / l (ground contact).
+    n_arr = max(n_seg, 0)                          # a call on no profile (the precompile's) has none
+    seg_beta, seg_sin_beta, seg_cos_beta = np.empty(n_arr), np.empty(n_arr), np.empty(n_arr)
+    seg_cos, seg_sin = np.empty(n_arr), np.empty(n_arr)
+    for k in range(n_seg):
+        beta = math.atan2(pz[k + 1] - pz[k], px[k + 1] - px[k])
+        seg_beta[k], seg_sin_beta[k], seg_cos_beta[k] = beta, math.sin(beta), math.cos(beta)
+        cosb_raw = px[k + 1] - px[k]
+        sinb_raw = pz[k + 1] - pz[k]
+        ls = math.sqrt(cosb_raw * cosb_raw + sinb_raw * sinb_raw)
+        seg_cos[k], seg_sin[k] = cosb_raw / ls, sinb_raw / ls
+    # Per material: the impact friction coefficient where it has no spread (the loop's expression with phi + 0.0).
+    mat_mu = np.empty(m_phi.shape[0])
+    for m in range(m_phi.shape[0]):
+        mat_mu[m] = math.tan(math.radians(min(max(m_phi[m] + 0.0, 0.0), 89.0)))
     for b in range(block_ids.shape[0]):
         bid = block_ids[b]
         state[0] = key ^ (np.uint64(bid + 1) * _GOLDEN)
@@ -567,6 +587,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
         impacts = 0
         events = 0
         trap_n, trap_x, trap_y = 0, 0.0, 0.0          # the run of launches from steep faces (steep_trap)
+        theta_mat, theta_max = -1, 0.0                 # roughness tilt of this block on material theta_mat
         while reason == RUNNING:
             events += 1
             if events > max_events:
@@ -637,15 +658,17 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                 # Impact on segment k.
                 impacts += 1
                 mat = seg_mat[k]
-                beta = math.atan2(pz[k + 1] - pz[k], px[k + 1] - px[k])
-                theta_max = roughness_tilt_max(m_rough[mat], r)
+                sin_beta, cos_beta = seg_sin_beta[k], seg_cos_beta[k]
+                if mat != theta_mat:
+                    theta_mat, theta_max = mat, roughness_tilt_max(m_rough[mat], r)
                 delta = (2.0 * _uniform(state) - 1.0) * theta_max
-                bp = beta + delta
-                vn = -vx * math.sin(bp) + vz * math.cos(bp)
+                bp = seg_beta[k] + delta
+                sin_bp, cos_bp = math.sin(bp), math.cos(bp)
+                vn = -vx * sin_bp + vz * cos_bp
                 if vn >= 0.0:
-                    bp = beta
-                    vn = -vx * math.sin(bp) + vz * math.cos(bp)
-                vt = vx * math.cos(bp) + vz * math.sin(bp)
+                    sin_bp, cos_bp = sin_beta, cos_beta
+                    vn = -vx * sin_bp + vz * cos_bp
+                vt = vx * cos_bp + vz * sin_bp
                 gain = m_gain[mat]
                 cap = 10.0 if gain else 1.0
                 if m_en_law[mat] == EN_WYLLIE:       # the law gives the value; the spread is a deviation
@@ -655,18 +678,21 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                         if m_en_std[mat] > 0 else m_en_mean[mat]
                 et = min(max(m_et_mean[mat] + m_et_std[mat] * _normal(state), 0.0), cap) \
                     if m_et_std[mat] > 0 else m_et_mean[mat]
-                phi = m_phi[mat] + (m_phi_std[mat] * _normal(state) if m_phi_std[mat] > 0 else 0.0)
-                mu = math.tan(math.radians(min(max(phi, 0.0), 89.0)))
+                if m_phi_std[mat] > 0:
+                    phi = m_phi[mat] + m_phi_std[mat] * _normal(state)
+                    mu = math.tan(math.radians(min(max(phi, 0.0), 89.0)))
+                else:
+                    mu = mat_mu[mat]
                 if vn < 0.0:
                     vn2, vt2, w, _ = rebound(vn, vt, w, r, k_in, m_en_law[mat], en, m_en_v0[mat], m_et_law[mat], et,
                                              mu, gain, m_et_v0[mat])
                 else:
                     vn2, vt2 = 0.0, vt
-                vx = vt2 * math.cos(bp) - vn2 * math.sin(bp)
-                vz = vt2 * math.sin(bp) + vn2 * math.cos(bp)
-                vn_true = -vx * math.sin(beta) + vz * math.cos(beta)
-                v_thr = contact_speed(v_contact, g, math.cos(beta), m_hop[mat])
-                if vn_true < v_thr and abs(math.sin(beta)) > sin_max_roll:
+                vx = vt2 * cos_bp - vn2 * sin_bp
+                vz = vt2 * sin_bp + vn2 * cos_bp
+                vn_true = -vx * sin_beta + vz * cos_beta
+                v_thr = contact_speed(v_contact, g, cos_beta, m_hop[mat])
+                if sin_max_roll is not None and vn_true < v_thr and abs(sin_beta) > sin_max_roll:
                     # A face too steep to roll on: the block leaves it again (speed kept), no ground contact --
                     # unless it has kept doing so in one place (a notch with flanks too steep to roll on).
                     trap_n, trap_x, trap_y, trapped = steep_trap(trap_n, trap_x, trap_y, x, 0.0)
@@ -677,27 +703,27 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                             _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, 0.0,
                                          0.0, 0.0, MODE_STOP, EV_STOP)
                         break
-                    vt_true = vx * math.cos(beta) + vz * math.sin(beta)
+                    vt_true = vx * cos_beta + vz * sin_beta
                     vt_new, vn_new = steep_face_launch(vt_true, v_thr)
-                    vx = vt_new * math.cos(beta) - vn_new * math.sin(beta)
-                    vz = vt_new * math.sin(beta) + vn_new * math.cos(beta)
+                    vx = vt_new * cos_beta - vn_new * sin_beta
+                    vz = vt_new * sin_beta + vn_new * cos_beta
                     vn_true = vn_new
                     if vn_new <= 0.0:            # at rest against the face: step off it horizontally
-                        x = _step_off(px, k, x, math.sin(beta))
+                        x = _step_off(px, k, x, sin_beta)
                 if record:
                     _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
                                  MODE_FLIGHT, EV_IMPACT)
-                if vn_true < v_thr and not abs(math.sin(beta)) > sin_max_roll:
+                if vn_true < v_thr and (sin_max_roll is None or not abs(sin_beta) > sin_max_roll):
                     # Ground contact: the normal component is lost; a rolling material makes the block roll
                     # without slip, conserving angular momentum about the contact point.
                     contact = True
-                    v_along = vx * math.cos(beta) + vz * math.sin(beta)
+                    v_along = vx * cos_beta + vz * sin_beta
                     if m_roll[mat]:
                         v_along = roll_on_speed(v_along, w, r, k_in)
                         w = v_along / r
                     else:
                         w = 0.0
-                    vx, vz = v_along * math.cos(beta), v_along * math.sin(beta)
+                    vx, vz = v_along * cos_beta, v_along * sin_beta
                     if record:
                         _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vx, vz, w,
                                      MODE_CONTACT, EV_CONTACT)
@@ -706,18 +732,15 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             # ---- ground contact on segment `seg`: roll or slide with constant acceleration ----
             k = seg
             mat = seg_mat[k]
-            cosb_raw = px[k + 1] - px[k]
-            sinb_raw = pz[k + 1] - pz[k]
-            ls = math.sqrt(cosb_raw * cosb_raw + sinb_raw * sinb_raw)
-            cosb, sinb = cosb_raw / ls, sinb_raw / ls
+            cosb, sinb = seg_cos[k], seg_sin[k]
             mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r)
             roll = m_roll[mat]
             trapped = False
-            if abs(sinb) > sin_max_roll:
+            if sin_max_roll is not None and abs(sinb) > sin_max_roll:
                 # No rolling or sliding in contact on a face this steep: the block leaves it (speed kept), unless
                 # it has kept doing so in one place (steep_trap: then it is held, below).
                 trap_n, trap_x, trap_y, trapped = steep_trap(trap_n, trap_x, trap_y, x, 0.0)
-            if abs(sinb) > sin_max_roll and not trapped:
+            if sin_max_roll is not None and abs(sinb) > sin_max_roll and not trapped:
                 vt_new, vn_new = steep_face_launch(v_along, contact_speed(v_contact, g, cosb, m_hop[mat]))
                 vx = vt_new * cosb - vn_new * sinb
                 vz = vt_new * sinb + vn_new * cosb
@@ -741,7 +764,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             else:
                 direction = 1.0 if v_along > 0 else -1.0
             a_dir = contact_acceleration(g, sinb, cosb, direction, mu, k_in, roll)   # along the motion
-            drag = m_drag[mat] / r if r > 0.0 else 0.0
+            drag = 0.0 if m_drag is None else (m_drag[mat] / r if r > 0.0 else 0.0)
             u = abs(v_along)
             # Collinear segments of the same material are crossed in one step.
             if direction > 0:
@@ -828,9 +851,7 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
                     _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, bid, t_abs, x, z, vxe, vze, w,
                                  MODE_STOP, EV_LEFT)
                 break
-            c2x, c2z = px[k2 + 1] - px[k2], pz[k2 + 1] - pz[k2]
-            l2 = math.sqrt(c2x * c2x + c2z * c2z)
-            cos2, sin2 = c2x / l2, c2z / l2
+            cos2, sin2 = seg_cos[k2], seg_sin[k2]
             # A convex edge launches the block when its speed away from the next segment reaches the
             # contact velocity; below it the block stays in contact (as a landing below it would), so a
             # finely kinked terrain profile is not turned into thousands of micro-flights and impacts.

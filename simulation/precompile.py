@@ -167,8 +167,10 @@ def empty_kernel_arguments() -> dict:
             "out_reason", "out_impacts", "r_block", "r_coll", "r_outcome", "r_count", "pb", "pmode", "pev",
             "pcount"}
     bools = {"m_roll", "m_gain"}
-    scalars = {"g": 9.81, "v_contact": 0.5, "v_stop": 0.1, "sin_max_roll": 1.0, "max_events": 1, "n_leaves": 1, "n_path_blocks": 0,
-               "key": np.uint64(1)}
+    # m_drag and sin_max_roll None: the specialisation of scenarios without rolling drag or steep faces
+    # (simulation.engine.kernel_features), the one the demo and most sites run
+    scalars = {"g": 9.81, "v_contact": 0.5, "v_stop": 0.1, "sin_max_roll": None, "max_events": 1, "n_leaves": 1,
+               "n_path_blocks": 0, "key": np.uint64(1), "m_drag": None}
     out = {}
     for name in inspect.signature(getattr(kernel.simulate, "py_func", kernel.simulate)).parameters:
         if name in scalars:
