@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 import riskrf
-from riskrf.frequency.power_law import GRID_CANDIDATES, LARGE_SAMPLE, _candidates
+from riskrf.frequency.power_law import GRID_CANDIDATES, LARGE_SAMPLE
+from riskrf.frequency.power_law.threshold import _candidates
 
 
 def _sample(n, seed=3, b=0.8):

@@ -167,7 +167,7 @@ def test_ci_coverage_of_b_from_simulated_data():
 @settings(max_examples=40, deadline=None)
 @given(b=st.floats(0.2, 2.0), p=st.floats(1e-9, 1.0), m_max=st.one_of(st.none(), st.floats(1e3, 1e8)))
 def test_sf_isf_round_trip(b, p, m_max):
-    from riskrf.frequency.power_law import _truncated_isf, _truncated_sf
+    from riskrf.frequency.power_law.law import _truncated_isf, _truncated_sf
     m = _truncated_isf(p, b, 1.0, m_max)
     assert _truncated_sf(m, b, 1.0, m_max) == pytest.approx(p, rel=1e-7, abs=1e-12)
 

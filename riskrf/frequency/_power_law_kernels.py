@@ -14,7 +14,7 @@ def tail_ks(logx, first, last, k, b):
     """KS distance of the tail from index k to the power law F(x) = 1 - (x / x_k)^-b, over every point.
 
     The empirical CDF is compared on both sides of each jump: ``last``/``first`` index arrays give the
-    step heights (see :func:`riskrf.frequency.power_law._tail_arrays`).
+    step heights (see :func:`riskrf.frequency.power_law.threshold._tail_arrays`).
     """
     return _ks_over(logx, first, last, k, b, k, logx.shape[0], 0.0)
 
