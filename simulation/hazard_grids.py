@@ -264,6 +264,11 @@ class PassageAggregator:
         """Bytes written to the scratch files so far."""
         return int(self._records.sum()) * _REC.itemsize
 
+    @property
+    def largest_tile_bytes(self) -> int:
+        """Bytes of the largest tile's scratch file (what :meth:`rasters` reads at once)."""
+        return int(self._records.max(initial=0)) * _REC.itemsize
+
     def add(self, passages: dict) -> None:
         """Take the pixel passages of some blocks (every passage of each: ``block``, ``cell``, ``e`` [kJ],
         ``h`` [m], as the kernel records them); they may be dropped afterwards.
@@ -334,7 +339,7 @@ class PassageAggregator:
                 rec = np.fromfile(self._dir / f"{t}.bin", dtype=_REC)
                 r0, c0 = (t // self.tnx) * TILE, (t % self.tnx) * TILE
                 r1, c1 = min(r0 + TILE, ny), min(c0 + TILE, nx)
-                teq, thq, ter = tile_statistics(rec["c"].astype(np.int64), rec["e"], rec["h"], TILE * TILE, qs,
+                teq, thq, ter = tile_statistics(rec["c"], rec["e"], rec["h"], TILE * TILE, qs,
                                                 HEIGHT_QUANTILE, ranks)
                 del rec
                 h, w = r1 - r0, c1 - c0

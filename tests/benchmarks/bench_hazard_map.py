@@ -45,18 +45,18 @@ def child(n: int, mode: str, workers: int, write: bool) -> dict:
     simulation.run_terrain(sc, 20, seed=0, hazard=True).hazard_grids()
     before = _rss_mb()
     t0 = time.perf_counter()
-    scratch = None
+    scratch = largest = None
     if mode == "streamed":
         from simulation import hazard_grids
         seen = []
         orig = hazard_grids.PassageAggregator.rasters
 
         def spy(self, *a, **k):                                      # the scratch bytes, read before cleanup
-            seen.append(self.scratch_bytes)
+            seen.append((self.scratch_bytes, self.largest_tile_bytes))
             return orig(self, *a, **k)
         hazard_grids.PassageAggregator.rasters = spy
         hm = hazard_map(sc, n=n, seed=1, workers=workers, chunk_size=2_000, record_paths=50)
-        scratch = seen[0]
+        scratch, largest = seen[0]
         passages = None
     else:
         res = simulation.run_terrain(sc, n, seed=1, workers=workers, chunk_size=5_000, hazard=True, record_paths=50)
@@ -66,7 +66,8 @@ def child(n: int, mode: str, workers: int, write: bool) -> dict:
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     out = {"n": n, "mode": mode, "before_mb": before, "peak_mb": peak, "wall_s": wall,
            "passages_per_block": None if passages is None else passages / n,
-           "scratch_mb": None if scratch is None else scratch / 2 ** 20}
+           "scratch_mb": None if scratch is None else scratch / 2 ** 20,
+           "largest_tile_mb": None if largest is None else largest / 2 ** 20}
     if write:
         with tempfile.TemporaryDirectory() as d:
             t1 = time.perf_counter()
@@ -98,7 +99,7 @@ def main() -> None:
             r = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout.splitlines()[-1])
             peaks[mode, n] = r["peak_mb"]
             extra = (f", {r['passages_per_block']:.0f} pixel passages per block" if r["passages_per_block"] else
-                     f", scratch files {r['scratch_mb']:,.0f} MB")
+                     f", scratch files {r['scratch_mb']:,.0f} MB (largest tile {r['largest_tile_mb']:.1f} MB)")
             if args.write:
                 extra += f"; written in {r['write_s']:.1f} s, peak after writing {r['peak_after_write_mb']:,.0f} MB"
             print(f"{mode:8s} {n:>9,} blocks: peak RSS {r['peak_mb']:7,.0f} MB (before the run {r['before_mb']:,.0f} MB,"
