@@ -211,16 +211,22 @@ def cmd_simulate(args) -> int:
     crossings = pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
     if "outcome" in crossings:
         crossings["outcome"] = crossings["outcome"].astype(str)
+    from functools import partial
+
+    from .app.background import InBackground
     from .report import files as report_files
+    report_files.prepare_drawing()
     targets = [(path, "file") for path in outs] + [(figures, "dir")]
     with atomic_outputs(targets, overwrite=args.overwrite) as tmps:    # tables and figures appear together or not
         *tmp_outs, tmp = tmps
+        drawn = InBackground(partial(report_files.write_simulation_figures, result, tmp,   # on the other core
+                                     [c.name for c in scenario.collectors]))                 # while tables are written
         for path, tmp_out in zip(outs, tmp_outs):
             write_table(crossings, tmp_out, suffix=path.suffix)
-        report_files.write_simulation_figures(result, tmp, [c.name for c in scenario.collectors])
         for suffix in suffixes:
             write_table(result.runout, tmp / f"runout{suffix}", option="--format")
             write_table(result.envelopes, tmp / f"envelopes{suffix}", option="--format")
+        drawn.result()
     names = " and ".join(f"runout{s}, envelopes{s}" for s in suffixes)
     print(f"\nWrote {len(crossings):,} collector crossings to {' and '.join(map(str, outs))} and figures, "
           f"{names} to {figures}/")
