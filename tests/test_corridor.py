@@ -11,6 +11,9 @@ import pytest
 distributed = pytest.importorskip("distributed")
 
 from riskrf.app import corridor as cr  # noqa: E402
+from riskrf.app.corridor import run as corridor_run  # noqa: E402  (the module whose globals the tasks use)
+from riskrf.app.corridor.cut import CREST_M, VERGE_M  # noqa: E402
+from riskrf.app.corridor.model import _section_seed  # noqa: E402
 from riskrf.cli import main  # noqa: E402
 
 DATA = Path(__file__).resolve().parent / "data" / "corridor"
@@ -77,8 +80,8 @@ def test_rates_and_ranking(runs, corridor):
 
 
 def test_seed_depends_on_id_not_order(corridor):
-    a = cr._section_seed(7, "A")
-    assert a == cr._section_seed(7, "A") and a != cr._section_seed(7, "B") and a != cr._section_seed(8, "A")
+    a = _section_seed(7, "A")
+    assert a == _section_seed(7, "A") and a != _section_seed(7, "B") and a != _section_seed(8, "A")
     # the child SeedSequence(seed).spawn would give at key crc32(id)
     import zlib
     child = np.random.SeedSequence(7, spawn_key=(zlib.crc32(b"A"),))
@@ -88,9 +91,9 @@ def test_seed_depends_on_id_not_order(corridor):
 def test_generated_cut_geometry(corridor):
     sec = corridor.section("A")                    # 25 m at 60 deg, ditch 3 x 1 m, 1 m shoulder, 7 m road
     p = sec.scenario.profile
-    toe = cr.CREST_M + 25 / np.tan(np.radians(60))
+    toe = CREST_M + 25 / np.tan(np.radians(60))
     assert p.z[0] == 25 and p.z.min() == pytest.approx(-1.0)
-    assert p.x[-1] == pytest.approx(toe + 3 + 1 + 7 + cr.VERGE_M)
+    assert p.x[-1] == pytest.approx(toe + 3 + 1 + 7 + VERGE_M)
     road = {c.name: c.x for c in sec.scenario.collectors}
     assert road["road"] == pytest.approx(toe + 3 + 1 + 0.01) and road["barrier"] == pytest.approx(toe + 3 + 0.5)
 
@@ -146,12 +149,11 @@ def test_unreachable_scheduler_fails_fast_and_writes_nothing(tmp_path, capsys):
     out = tmp_path / "out"
     real = cr.connect
     import functools
-    import riskrf.app.corridor
-    riskrf.app.corridor.connect = functools.partial(real, timeout_s=1)
+    corridor_run.connect = functools.partial(real, timeout_s=1)
     try:
         rc = main(["corridor", str(DATA / "small.toml"), "--scheduler", "tcp://127.0.0.1:9", "--out", str(out)])
     finally:
-        riskrf.app.corridor.connect = real
+        corridor_run.connect = real
     assert rc == 2 and "cannot reach the dask scheduler" in capsys.readouterr().err
     assert not out.exists() and not any(tmp_path.iterdir())
 
@@ -168,21 +170,21 @@ def test_failure_reported_with_keep_going_and_resume(corridor, tmp_path, monkeyp
         return real(section, cor, n_blocks, seed)
 
     try:
-        monkeypatch.setattr(cr, "assess_section", flaky)
+        monkeypatch.setattr(corridor_run, "assess_section", flaky)
         parts = tmp_path / "parts"
         with pytest.raises(RuntimeError, match="section 'B' failed"):
             cr.run_corridor(corridor, client=client, n_blocks=N, partitions=parts, retries=0)
         res = cr.run_corridor(corridor, client=client, n_blocks=N, partitions=parts, keep_going=True, retries=0)
         assert list(res.table["id"]) == ["A", "C"] and "section 'B'" in res.failures[0]
         assert len(list(parts.glob("*.parquet"))) == 2 and not list(parts.glob("*.partial"))
-        monkeypatch.setattr(cr, "assess_section", real)
+        monkeypatch.setattr(corridor_run, "assess_section", real)
         calls.clear()
         seen = []
         res2 = cr.run_corridor(corridor, client=client, n_blocks=N, partitions=parts, resume=True,
                                progress=lambda d, t, s: seen.append(s))
         assert seen == ["B"] and list(res2.table["id"]) == ["A", "B", "C"]
     finally:
-        monkeypatch.setattr(cr, "assess_section", real)
+        monkeypatch.setattr(corridor_run, "assess_section", real)
 
 
 def test_duplicate_chainage_is_an_overlap(tmp_path):
@@ -216,11 +218,11 @@ def test_worker_dying_mid_run_is_rescheduled_and_nothing_half_written(corridor, 
         return real(section, cor, n_blocks, seed)
 
     try:
-        monkeypatch.setattr(cr, "assess_section", dying)
+        monkeypatch.setattr(corridor_run, "assess_section", dying)
         parts = tmp_path / "parts"
         res = cr.run_corridor(corridor, client=client, n_blocks=N, partitions=parts, retries=0)
     finally:
-        monkeypatch.setattr(cr, "assess_section", real)
+        monkeypatch.setattr(corridor_run, "assess_section", real)
         client.close()
         cluster.close()
     assert len(died) == 1 and res.failures == ()
@@ -243,7 +245,7 @@ class _Borrowed:
 
 def test_cli_writes_outputs(tmp_path, monkeypatch, runs, clients):
     # the CLI path on the shared threaded 1-worker cluster (a LocalCluster of processes is the default)
-    monkeypatch.setattr(cr, "connect", lambda scheduler=None, n_workers=None, **k: (_Borrowed(clients[1]), None))
+    monkeypatch.setattr(corridor_run, "connect", lambda scheduler=None, n_workers=None, **k: (_Borrowed(clients[1]), None))
     out = tmp_path / "run"
     assert main(["corridor", str(DATA / "small.toml"), "-n", str(N), "--out", str(out)]) == 0
     for f in ("report.html", "corridor.csv", "sections.csv", "budget_curve.csv", "chainage.png", "summary.json"):
@@ -448,8 +450,8 @@ def test_bench_in_generated_cut(tmp_path):
     c = cr.load_corridor(_write(tmp_path, rows))
     p = c.section("A").scenario.profile
     run = 1 / np.tan(np.radians(60))
-    x_upper = cr.CREST_M + 15 * run
-    np.testing.assert_allclose(p.x[:5], [0, cr.CREST_M, x_upper, x_upper + 2, x_upper + 2 + 10 * run])
+    x_upper = CREST_M + 15 * run
+    np.testing.assert_allclose(p.x[:5], [0, CREST_M, x_upper, x_upper + 2, x_upper + 2 + 10 * run])
     np.testing.assert_allclose(p.z[:5], [25, 25, 10, 10, 0])
     assert p.material_names[p.material_index[2]] == "soil"         # the bench surface: the ditch material
     seeder_x = c.section("A").scenario.seeder
@@ -461,7 +463,7 @@ def test_bench_in_generated_cut(tmp_path):
 def test_dask_scheduler_address_env_unreachable(tmp_path, monkeypatch, capsys):
     import functools
     monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", "tcp://127.0.0.1:9")
-    monkeypatch.setattr(cr, "connect", functools.partial(cr.connect, timeout_s=1))
+    monkeypatch.setattr(corridor_run, "connect", functools.partial(cr.connect, timeout_s=1))
     out = tmp_path / "out"
     rc = main(["corridor", str(DATA / "small.toml"), "--out", str(out)])
     assert rc == 2

@@ -13,6 +13,7 @@ import pytest
 pyogrio = pytest.importorskip("pyogrio")
 
 from riskrf.app import corridor as cr  # noqa: E402
+from riskrf.app.corridor.result import _pv  # noqa: E402
 from riskrf.io import gis  # noqa: E402
 from riskrf.risk.programme import optimise_programme  # noqa: E402
 
@@ -69,7 +70,7 @@ def test_per_metre_costs_on_the_works_length(result, tmp_path):
 def test_programme_on_section_results_is_the_brute_force_best(result):
     opts = result.options_table()
     assert set(opts["kind"]) == {"fence"} and len(opts) == 3
-    np.testing.assert_allclose(opts["present_value"], opts["equivalent_annual_cost"] * cr._pv(result.corridor))
+    np.testing.assert_allclose(opts["present_value"], opts["equivalent_annual_cost"] * _pv(result.corridor))
     caps = opts.set_index("id")["capital"]
     avoided = opts.set_index("id")["deaths_avoided_per_year"]
     for budget in (0.0, caps.min(), caps.sum() - caps.min(), caps.sum()):

@@ -89,6 +89,7 @@ def main() -> int:
     ap.add_argument("--kill", action="store_true")
     args = ap.parse_args()
     from riskrf.app import corridor as cr
+    from riskrf.app.corridor.outputs import FRONTIER_POINTS
     with tempfile.TemporaryDirectory() as d:
         path = make_corridor(Path(d), args.sections, args.blocks)
         t0 = time.perf_counter()
@@ -132,7 +133,7 @@ def main() -> int:
         t0 = time.perf_counter()
         prog = full.programme(budget)
         t_prog = time.perf_counter() - t0
-        pts = cr.FRONTIER_POINTS[0] if args.sections <= cr.FRONTIER_POINTS[2] else cr.FRONTIER_POINTS[1]
+        pts = FRONTIER_POINTS[0] if args.sections <= FRONTIER_POINTS[2] else FRONTIER_POINTS[1]
         t0 = time.perf_counter()
         front = full.frontier(points=pts)
         t_front = time.perf_counter() - t0
