@@ -13,9 +13,10 @@ chunk of blocks at a time (``run_terrain(..., passage_sink=agg.add)``), and afte
 The chunk is then dropped.  :meth:`PassageAggregator.rasters` reads one tile file at a time and computes each
 pixel's percentiles exactly (the values are the float32 values :func:`aggregate_passages` sorts; same
 interpolation), so the rasters are *identical* to the unchunked ones for the same seed, whatever the chunk
-size, the threads, or the order chunks arrive in.  Peak memory is the DEM-sized arrays (about 60 bytes a
-pixel), the chunks in flight and the largest tile's records (10 bytes per block passing each of its 4,096
-pixels); the scratch files take 10 bytes per block and pixel crossed on disk (about 7 MB per 1,000 blocks on
+size, the threads, or the order chunks arrive in.  Peak memory is the DEM-sized arrays (about 32 bytes a
+pixel while running, and the rasters at the end), the chunks in flight and the largest tile's records, read
+at once (10 bytes per block passing each of its 4,096 pixels: the only part that grows with the blocks, slowly);
+the scratch files take 10 bytes per block and pixel crossed on disk (about 7 MB per 1,000 blocks on
 a 1 km^2, 1 m DEM) and are removed when the rasters are made or the aggregator is closed.
 
 Intensity-frequency layers: with the annual rate ``R`` [1/year] of releases the ``n`` simulated blocks stand
