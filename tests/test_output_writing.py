@@ -128,7 +128,7 @@ def test_parquet_round_trips_the_table(tmp_path):
 
 def test_missing_pyarrow_names_the_option_and_the_install(tmp_path, monkeypatch, capsys):
     monkeypatch.setitem(sys.modules, "pyarrow", None)                    # import pyarrow -> ImportError
-    with pytest.raises(MissingDependencyError, match=r"--format parquet .*pip install 'riskrf\[parquet\]'"):
+    with pytest.raises(MissingDependencyError, match=r"--format parquet: .*pip install 'riskrf\[parquet\]'"):
         require_pyarrow("--format parquet")
     with pytest.raises(ImportError):
         write_table(pd.DataFrame({"a": [1]}), tmp_path / "t.parquet")
@@ -137,6 +137,15 @@ def test_missing_pyarrow_names_the_option_and_the_install(tmp_path, monkeypatch,
     err = capsys.readouterr().err
     assert "--out" in err and "pip install 'riskrf[parquet]'" in err and "name a .csv file" in err
     assert not out.exists() and not (tmp_path / "run-figures").exists()     # refused before any work
+
+
+def test_reading_parquet_without_pyarrow_names_the_file(tmp_path, monkeypatch):
+    pytest.importorskip("pyarrow", reason="writing the Parquet file to read needs pyarrow")
+    from riskrf.io.tables import read_table
+    pd.DataFrame({"date": ["2020-01-01"], "volume_m3": [1.5]}).to_parquet(tmp_path / "inv.parquet")
+    monkeypatch.setitem(sys.modules, "pyarrow", None)
+    with pytest.raises(MissingDependencyError, match=r"inv\.parquet: Parquet needs pyarrow.*riskrf\[parquet\]"):
+        read_table(tmp_path / "inv.parquet")
 
 
 def test_simulate_format_both(tmp_path, capsys):

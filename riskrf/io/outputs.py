@@ -418,7 +418,7 @@ def require_pyarrow(option: str, *, instead: str = ""):
     Parameters
     ----------
     option : str
-        What needs Parquet, for the message (e.g. ``"--format parquet"``).
+        What needs Parquet, for the message (e.g. ``"--format parquet"``, or the file read).
     instead : str
         An alternative offered in the message (e.g. ``"or use --format csv"``).
 
@@ -436,7 +436,7 @@ def require_pyarrow(option: str, *, instead: str = ""):
         import pyarrow
     except ImportError:
         raise MissingDependencyError(
-            f"{option} writes Parquet, which needs pyarrow, and pyarrow is not installed: "
+            f"{option}: Parquet needs pyarrow, which is not installed: "
             f"pip install 'riskrf[parquet]' (or pip install pyarrow){', ' + instead if instead else ''}") from None
     return pyarrow
 

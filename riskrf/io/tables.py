@@ -218,6 +218,8 @@ def read_table(path, *, sheet=None, header_row: int | None = None, encoding: str
     elif suffix == ".parquet":
         if sheet is not None or header_row is not None:
             raise ValueError(f"{path}: sheet and header_row apply to Excel and text tables, not Parquet")
+        from .outputs import require_pyarrow
+        require_pyarrow(str(path), instead="or save the table as .csv or .xlsx")
         try:
             table = pd.read_parquet(path)
         except Exception as exc:      # pyarrow raises its own classes for corrupt files
