@@ -345,15 +345,18 @@ def test_a_road_record_is_reproduced_in_every_draw(tmp_path):
 
 
 def test_report_section_and_figures(carried, tmp_path):
+    from types import SimpleNamespace
+
     from riskrf.report.format import Document
-    from riskrf.report.html import _model_uncertainty_section
+    from riskrf.report.html import _model_uncertainty_body
     mu = carried.model_uncertainty
     figs = mu.figures(tmp_path)
     assert all(f.exists() and f.stat().st_size > 1000 for f in figs)
     doc = Document(title="t")
-    _model_uncertainty_section(doc, mu, tmp_path, "CHF")
+    _model_uncertainty_body(doc, SimpleNamespace(model_uncertainty=mu, study=SimpleNamespace(currency="CHF")),
+                            tmp_path, None)
     html = doc.render()
-    assert "Trajectory model uncertainty" in html and "share of the variance from the trajectory model" in html
+    assert "share of the variance from the trajectory model" in html     # (the title is the section list's)
     assert mu.verdict().split(":")[0] in html and html.count("data:image/png;base64,") == 2
 
 

@@ -743,6 +743,7 @@ class Assessment:
             "ranking": ranking.to_dict(orient="records"),
             "options": self.decision["options"],
             "recommendation": self.decision["recommendation"],
+            "effort": self.decision.get("effort"),
             "required_barrier_option": (self.study.required_barrier.to_dict()
                                         if self.study.required_barrier is not None else None),
             "uncertainty": self.decision["uncertainty"],
@@ -850,9 +851,11 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             pending.append(InBackground(partial(write_energy_study, energy, figures)))
 
         t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
+        replicate = partial(draw_evaluator, site, inventory, rate_scale=rate_scale / release_factor,
+                            rate_note=rate_note, design_masses=design_masses)
         mitigation, site_rates, study, decision, site_design = _decision_stage(
             site, inventory, hazard, result, road_hits, rate_scale, energy, rates, site_rates, site_design, seed,
-            study_report)
+            study_report, replicate=replicate if hz_cfg["scenario"] else None, n_blocks=n_blocks)
         timings["decision"] = round(time.perf_counter() - t, 2)
         model_uncertainty = _model_uncertainty_stage(
             site, inventory, hazard, energy, rate_scale, release_factor, rate_note, mitigation, design_masses, log,
@@ -1190,7 +1193,7 @@ def _energy_stage(site: Site, inventory, gr, hazard, result, survey, m_max_value
 
 
 def _decision_stage(site: Site, inventory, hazard, result, road_hits, rate_scale: float, energy, rates, site_rates,
-                    site_design, seed, study_report):
+                    site_design, seed, study_report, replicate=None, n_blocks: int | None = None):
     """Rank the mitigation options and re-run the recommended one on the site.
 
     Parameters
@@ -1219,6 +1222,11 @@ def _decision_stage(site: Site, inventory, hazard, result, road_hits, rate_scale
         Seed of the option runs.
     study_report : callable
         :func:`riskrf.report.mitigation_text.study_report`.
+    replicate : callable, optional
+        :func:`draw_evaluator` with the assessment's rate and design masses bound: the study repeated with
+        independent trajectory ensembles for the error budget (:func:`ensemble_replicates`); None: not repeated.
+    n_blocks : int, optional
+        Blocks of the site's simulation (default ``hazard.n_blocks``).
 
     Returns
     -------
@@ -1241,11 +1249,72 @@ def _decision_stage(site: Site, inventory, hazard, result, road_hits, rate_scale
                                             hz_cfg["option_blocks"], seed, inventory, hazard,
                                             rate_scale, road_hits),
                             **mitigation)
-    study = replace(study, design_checks=checks, required_barrier=required)
+    ensemble = ensemble_replicates(site, result, seed, replicate, mitigation, study.uncertainty,
+                                   n_blocks=n_blocks) if replicate is not None else None
+    study = replace(study, design_checks=checks, required_barrier=required, ensemble=ensemble)
+    from ..risk.error_budget import adapt_effort
+    study, effort = adapt_effort(study, log=logger.info)
     decision = study_report(study)
+    decision["effort"] = effort.to_dict()
+    decision["recommendation"]["reason"] += " " + effort.text()
     site_design = with_recommended_run(site_design, site, result, decision["recommendation"]["option"], seed,
                                        options=mitigation["options"])
     return mitigation, site_rates, study, decision, site_design
+
+
+def ensemble_replicates(site: Site, result, seed, replicate, mitigation: dict, uncertainty, *,
+                        n_blocks: int | None = None):
+    """The mitigation study repeated with independent trajectory ensembles, for the error budget
+    (:class:`riskrf.risk.error_budget.EnsembleReplicates`).
+
+    Each of ``[uncertainty] ensemble_replicates`` replicates re-runs the chain (:func:`draw_evaluator`: the energy
+    hazard's simulation, the road share, every option's re-simulation and the material re-simulations) with its
+    own simulation seed and ``ensemble_effort`` of the blocks, and the same joint samples of the inputs (common
+    random numbers), so that the between-replicate variance is that of the trajectory ensembles alone; it is
+    multiplied by the effort (a variance falling as 1 / blocks).
+
+    Parameters
+    ----------
+    site : Site
+        The checked site.
+    result : simulation.SimulationResult or None
+        The site's simulation (None: no trajectory ensemble, nothing to repeat).
+    seed : int
+        The assessment's simulation seed; the replicates' seeds are derived from it.
+    replicate : callable
+        ``replicate(scenario, n_blocks, option_blocks, seed, uncertainty, mitigation=...)`` ->
+        (hazard, study, result, share), :func:`draw_evaluator` with the assessment's rate bound.
+    mitigation : dict
+        The mitigation tables the study ranks (with the required barrier).
+    uncertainty : riskrf.risk.mitigation_inputs.Uncertainty
+        The study's uncertain inputs (``ensemble_replicates``, ``ensemble_effort``).
+    n_blocks : int, optional
+        Blocks of the site's simulation (default ``hazard.n_blocks``).
+
+    Returns
+    -------
+    EnsembleReplicates or None
+        Expected costs [currency] and P(best) [-] per replicate and option; None when off (fewer than 2
+        replicates) or without a simulation.
+    """
+    from ..risk.error_budget import EnsembleReplicates
+    R = int(uncertainty.ensemble_replicates)
+    if R < 2 or result is None:
+        return None
+    n_full = int(site.hazard["n_blocks"] if n_blocks is None else n_blocks)
+    effort = float(uncertainty.ensemble_effort)
+    n = max(int(round(n_full * effort)), 1)
+    option_blocks = max(int(round(site.hazard["option_blocks"] * effort)), 1)
+    seeds = tuple(int(x) for x in np.random.SeedSequence([int(seed or 0), 40]).generate_state(R))
+    means, best, names = [], [], None
+    for s in seeds:
+        _, st, _, _ = replicate(result.scenario, n, option_blocks, s, uncertainty, mitigation=mitigation)
+        u = st.uncertain
+        names = tuple(u["names"])
+        means.append(u["mean"])
+        best.append(u["probability_best"])
+    return EnsembleReplicates(names=names, mean=np.array(means), probability_best=np.array(best),
+                              effort=min(n / n_full, 1.0), seeds=seeds)
 
 
 def _model_uncertainty_stage(site: Site, inventory, hazard, energy, rate_scale: float, release_factor: float,

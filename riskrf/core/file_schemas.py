@@ -289,6 +289,15 @@ UNCERTAINTY = Table("uncertainty", (
     _count("material_draws", "re-simulations with drawn material parameters", default=8),
     Field("sample_power_law", "bool", "", "sample b and the rate from their posteriors", True),
     Field("sample_retention", "bool", "", "sample derived retentions", True),
+    _count("ensemble_replicates", "repeated trajectory ensembles of the error budget (0: off; else >= 2)",
+           default=4, low=0),
+    Field("ensemble_effort", "number", "", "share of the blocks each repeated ensemble simulates", 0.25, low=0,
+          high=1, low_open=True),
+    Field("precision_target", "number", "", "adaptive effort: stop once every option's expected cost is known "
+          "within +- this share (2 SE)", 0.05, low=0, high=1, low_open=True),
+    _count("max_samples", "adaptive effort: budget of joint samples (default max(4000, samples))", low=2),
+    _count("max_material_draws", "adaptive effort: budget of material re-simulations (default max(32, "
+           "material_draws))", low=2),
 ), "Epistemic uncertainty, sampled jointly.")
 
 MITIGATION_TABLES = (TRAFFIC, CONSEQUENCES, ECONOMICS, CRITERIA, OPTIONS, UNCERTAINTY)

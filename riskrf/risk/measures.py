@@ -260,7 +260,7 @@ class SimulationContext:
 
     threads: int = 0              # simulations run at once by run_many (0: one per core); corridor workers use 1
 
-    def run(self, scenario):
+    def run(self, scenario, seed: int | None = None):
         """Simulate ``scenario`` with this context's number of blocks and seed (no recorded paths); a
         :class:`simulation.SimulationResult`.
 
@@ -268,6 +268,8 @@ class SimulationContext:
         ----------
         scenario : simulation.scenario.Scenario
             The slope scenario.
+        seed : int, optional
+            Seed of this run (default the context's ``seed``: common random numbers).
 
         Returns
         -------
@@ -275,9 +277,10 @@ class SimulationContext:
             The simulated run of ``n_blocks`` blocks with ``seed``.
         """
         import simulation
-        return simulation.run(scenario, n=self.n_blocks, seed=self.seed, record_paths=0)
+        return simulation.run(scenario, n=self.n_blocks, seed=self.seed if seed is None else seed,
+                              record_paths=0)
 
-    def run_many(self, scenarios) -> list:
+    def run_many(self, scenarios, seeds=None) -> list:
         """:meth:`run` for each scenario, several at once on threads (the kernel releases the GIL); the results
         are those of one-by-one runs, in order.
 
@@ -285,6 +288,8 @@ class SimulationContext:
         ----------
         scenarios : iterable of simulation.scenario.Scenario
             The scenarios to simulate.
+        seeds : sequence of int or None, optional
+            One seed per scenario (None entries, or no sequence: the context's seed).
 
         Returns
         -------
@@ -292,11 +297,12 @@ class SimulationContext:
             One result per scenario, in order.
         """
         scenarios = list(scenarios)
+        seeds = [None] * len(scenarios) if seeds is None else list(seeds)
         threads = min(self.threads or os.cpu_count() or 1, len(scenarios))
         if threads <= 1:
-            return [self.run(sc) for sc in scenarios]
+            return [self.run(sc, s) for sc, s in zip(scenarios, seeds)]
         with ThreadPoolExecutor(threads) as pool:
-            return list(pool.map(self.run, scenarios))
+            return list(pool.map(self.run, scenarios, seeds))
 
 
 def road_crossings(result, road: str) -> np.ndarray:

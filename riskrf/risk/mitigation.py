@@ -43,6 +43,7 @@ from ..core.format import money, probability
 from ..hazard.annual_hazard import EnergyHazard
 from ..hazard.impact_energy import mass_model
 from .economics import pv_factor
+from .error_budget import clustered_se, combined_se, sources_text
 from .loss_engine import LossEngine, LossResult, ParameterSpace, fragment_matrix, mass_grid, mass_pmf
 from .measures import SimulationContext, material_value
 from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.risk.mitigation)
@@ -154,6 +155,10 @@ class MitigationStudy(Displayed):
     #: ranked as an option when it can be placed; the recommendation says so when it cannot.  None: not computed.
     required_barrier: object = None
     coupled_road_hits: np.ndarray | None = field(default=None, repr=False)   # per block of the mass-coupled run
+    #: the study repeated with independent trajectory ensembles
+    #: (:class:`~riskrf.risk.error_budget.EnsembleReplicates`): their variance enters every reported standard
+    #: error; None: the ensembles are held fixed and the outputs say their error is not included
+    ensemble: object = field(default=None, repr=False)
 
     def __post_init__(self):
         _check_combinations(self.options, self.source)
@@ -479,7 +484,10 @@ class MitigationStudy(Displayed):
             ``names`` (options), ``total`` (S, K) total cost per joint sample and option [study currency, present
             value], per option ``mean``, ``p05`` and ``p95`` [study currency], ``probability_best``,
             ``expected_regret`` [study currency], ``probability_meets_individual_risk`` and
-            ``probability_meets_criteria`` [-]; ``evpi`` of all sampled inputs [study currency] and ``samples`` (S).
+            ``probability_meets_criteria`` [-]; ``evpi`` of all sampled inputs [study currency], ``samples`` (S),
+            ``clusters`` (the material re-simulation of each sample, or None), ``best`` (index of the cheapest
+            option per sample) and ``se`` (per option, the standard error of ``mean`` over every Monte Carlo
+            source, :mod:`riskrf.risk.error_budget`) with ``error_sources`` (which, in words).
 
         References
         ----------
@@ -496,7 +504,13 @@ class MitigationStudy(Displayed):
         regret = (total - total.min(axis=1, keepdims=True)).mean(axis=0)
         ir_ok = r.ir <= self.criteria.individual_risk_per_year
         fn_ok = self._fn_tolerable(r)
-        return {"names": r.names, "total": total, "mean": total.mean(axis=0),
+        clusters = P.get("material_draw")
+        ens = self.ensemble
+        se = combined_se(clustered_se(total, clusters),
+                         None if ens is None else np.array([ens.cost_variance(n) for n in r.names]))
+        return {"names": r.names, "total": total, "mean": total.mean(axis=0), "clusters": clusters, "best": best,
+                "se": se, "error_sources": sources_text(total.shape[0], 0 if clusters is None else
+                                                        len(np.unique(clusters)), ens),
                 "probability_meets_criteria": (ir_ok & fn_ok).mean(axis=0),
                 "p05": np.percentile(total, 5, axis=0), "p95": np.percentile(total, 95, axis=0),
                 "probability_best": p_best, "expected_regret": regret,
@@ -584,7 +598,8 @@ class MitigationStudy(Displayed):
                 "capital": r.capital[0, k], "pv_renewals": r.pv_renewals[0, k],
                 "pv_maintenance": r.pv_maintenance[0, k], "pv_expected_loss": r.pv_expected_loss[0, k],
                 "cost_at_central_values": r.total[0, k],
-                "expected_total_cost": u["mean"][k], "cost_p05": u["p05"][k], "cost_p95": u["p95"][k],
+                "expected_total_cost": u["mean"][k], "expected_total_cost_se": u["se"][k],
+                "cost_p05": u["p05"][k], "cost_p95": u["p95"][k],
                 "probability_best": u["probability_best"][k], "expected_regret": u["expected_regret"][k],
                 "road_falls_per_year": r.road[0, k], "retention": None if np.isnan(ret) else float(ret),
                 "effectiveness": r.effectiveness[0, k],
@@ -679,11 +694,13 @@ class MitigationStudy(Displayed):
     def resolution(self, ranking: pd.DataFrame | None = None) -> dict:
         """Can the joint samples tell the two cheapest options apart?
 
-        Paired over the joint samples: the difference of their total costs, its Monte Carlo standard error
-        sd / sqrt(S), and the standard error of P(best) of the cheapest, sqrt(p (1 - p) / S).  They are
-        "distinguishable" when the mean difference exceeds twice its standard error and P(best) is known within
-        +-0.03 (two standard errors).  The slope re-simulations (``material_draws``) add an error these samples do
-        not show; more draws and samples (``[uncertainty]``) narrow both.
+        Paired over the joint samples: the difference of their total costs and P(best) of the cheapest, each with
+        its standard error over every Monte Carlo source (:mod:`riskrf.risk.error_budget`): the joint samples
+        clustered by the material re-simulation they share (``material_draws``), and the trajectory ensembles'
+        variance from repeated ensembles (``ensemble``; without them the text says it is not included).  They are
+        "distinguishable" (the ranking is resolved) when the lead, the mean difference, exceeds twice its standard
+        error; P(best) is stated with its two standard errors.  More draws and samples (``[uncertainty]``, or the
+        adaptive effort of :func:`riskrf.risk.error_budget.adapt_effort`) narrow both.
 
         Parameters
         ----------
@@ -707,21 +724,22 @@ class MitigationStudy(Displayed):
                     "text": f"{a} is the only option left to compare."}
         a, b = t["option"].iloc[0], t["option"].iloc[1]
         d = u["total"][:, names.index(b)] - u["total"][:, names.index(a)]
-        S = d.size
-        se = float(d.std(ddof=1) / np.sqrt(S)) if S > 1 else np.inf
+        ens = self.ensemble
+        g = u["clusters"]
+        se = combined_se(clustered_se(d, g), None if ens is None else ens.difference_variance(a, b))
         p = float(u["probability_best"][names.index(a)])
-        se_p = float(np.sqrt(p * (1 - p) / S))
-        ok = bool(abs(d.mean()) > 2 * se and 2 * se_p <= 0.03)
-        draws = self.uncertainty.material_draws if any(k.startswith("material:") for k in self.parameter_ranges()) \
-            else 0
-        text = (f"{a} and {b} {'are' if ok else 'are NOT'} distinguishable at the stated effort ({S:,} joint samples"
-                + (f", {draws} slope re-simulations" if draws else "") + f"): {b} costs "
+        se_p = combined_se(clustered_se((u["best"] == names.index(a)).astype(float), g),
+                           None if ens is None else ens.probability_variance(a))
+        ok = bool(abs(d.mean()) > 2 * se)
+        text = (f"{a} and {b} {'are' if ok else 'are NOT'} distinguishable at the stated effort ({u['error_sources']}"
+                + f"): {b} costs "
                 f"{money(d.mean(), self.currency, sig=3)} more in expectation (+- {money(2 * se, sig=2)}, two "
                 f"standard errors); P({a} cheapest) = {p:.2f} +- {2 * se_p:.2f}")
         if not ok:
             text += "; more samples and re-simulations, or better information, are needed to separate them"
         return {"first": a, "second": b, "difference": float(d.mean()), "difference_se": se,
-                "probability_best": p, "probability_best_se": se_p, "distinguishable": ok, "text": text + "."}
+                "probability_best": p, "probability_best_se": se_p, "distinguishable": ok,
+                "error_sources": u["error_sources"], "text": text + "."}
 
     def best(self) -> str:
         """Name of the first option of :meth:`ranking` (the lowest expected total cost over the joint samples).

@@ -193,6 +193,16 @@ class Uncertainty:
     calibration_source: str = ""
     fractal_dimension: tuple | None = None   # (low, high): event volumes break up by fractal fragmentation
     fragmentation_iterations: int = 3         # generations of that fragmentation (Perfect 1997)
+    #: repeated trajectory ensembles for the error budget (0: off, the outputs say the ensembles' error is not
+    #: included; else at least 2) and the share of the blocks each uses (riskrf.risk.error_budget)
+    ensemble_replicates: int = 4
+    ensemble_effort: float = 0.25
+    #: adaptive effort (riskrf.risk.error_budget.adapt_effort): joint samples and material re-simulations are
+    #: doubled until the ranking is resolved, every option's expected cost is known within +-precision_target
+    #: (2 SE, a share of the cost), or the budget is used
+    precision_target: float = 0.05
+    max_samples: int = 4000
+    max_material_draws: int = 32
 
 
 @dataclass(frozen=True)
@@ -527,7 +537,26 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
     vals = {}
     for key, v in data.items():
         w = f"{source}: uncertainty.{key}"
-        if key in ("samples", "seed", "material_draws", "fragmentation_iterations"):
+        if key == "ensemble_replicates":
+            if isinstance(v, bool) or not isinstance(v, int) or v < 0 or v == 1:
+                raise MitigationError(f"{w} = {v!r} must be 0 (off) or a whole number >= 2 (a variance needs two "
+                                      "replicates)")
+            vals[key] = v
+        elif key == "precision_target":
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v <= 1:
+                raise MitigationError(f"{w} = {v!r} must be a share of the expected cost > 0 and <= 1 (0.05: "
+                                      "+-5 % at 2 standard errors)")
+            vals[key] = float(v)
+        elif key in ("max_samples", "max_material_draws"):
+            if isinstance(v, bool) or not isinstance(v, int) or v < 2:
+                raise MitigationError(f"{w} = {v!r} must be a whole number >= 2 (a standard error needs at least "
+                                      "two)")
+            vals[key] = v
+        elif key == "ensemble_effort":
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v <= 1:
+                raise MitigationError(f"{w} = {v!r} must be a share of the blocks > 0 and <= 1")
+            vals[key] = float(v)
+        elif key in ("samples", "seed", "material_draws", "fragmentation_iterations"):
             if isinstance(v, bool) or not isinstance(v, int) or v < (0 if key == "seed" else 1):
                 raise MitigationError(f"{w} = {v!r} must be a whole number {'>= 0' if key == 'seed' else '>= 1'}")
             if key == "fragmentation_iterations" and v > 12:
@@ -582,11 +611,19 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
             vals[key] = (lo, hi)
     if vals.get("calibration") is not None and vals.get("materials"):
         raise MitigationError(f"{source}: give uncertainty.materials or uncertainty.calibration_bootstrap, not both")
+    d = Uncertainty()
+    for budget, start in (("max_samples", "samples"), ("max_material_draws", "material_draws")):
+        first = vals.get(start, getattr(d, start))
+        if budget not in vals:
+            vals[budget] = max(getattr(d, budget), first)
+        elif vals[budget] < first:
+            raise MitigationError(f"{source}: uncertainty.{budget} = {vals[budget]!r} is below uncertainty.{start} "
+                                  f"= {first!r}: the budget must allow at least the effort the study starts with")
     for f in fields(Uncertainty):
         if f.name in ("calibration", "calibration_source"):
             continue
-        if f.name not in vals:
-            used.append(f"uncertainty.{f.name} = {getattr(Uncertainty(), f.name)!r} (default)")
+        if f.name not in data and f.name not in ("calibration_bootstrap",):
+            used.append(f"uncertainty.{f.name} = {vals.get(f.name, getattr(d, f.name))!r} (default)")
     return Uncertainty(**vals)
 
 

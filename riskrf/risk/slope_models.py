@@ -36,7 +36,10 @@ from .options import MitigationError
 class SlopeModel:
     """One slope model: its ``label`` and material ``values``, (effective speeds [m/s], bounce heights [m]) at the
     barrier line (``barrier``) and at the road (``road``, or None), the probability of reaching the barrier line
-    ``reach``, P(road | barrier line) ``road_share``, its scenario and simulation result (None without)."""
+    ``reach``, P(road | barrier line) ``road_share``, its scenario and simulation result (None without), and the
+    ``seed`` of its simulation (None: the context's, the common random numbers of the reference and the tornado
+    variants; a joint material draw has its own, so that the draws are independent ensembles).  The re-simulations
+    of a model's changed slopes (ditches, fences elsewhere) use its seed."""
 
     label: str
     values: dict
@@ -46,6 +49,7 @@ class SlopeModel:
     scenario: object = None
     result: object = None
     road: tuple | None = None
+    seed: int | None = None
 
 
 def quantile_map(x, ref, var):
@@ -165,8 +169,13 @@ class SlopeModels:
                                                                                  ("high", ranges[n][1]))]
             scenarios = [scenario_with_materials(ctx.scenario, vals, where=f"{self.source}: uncertainty.materials")
                          for vals, _ in variants]
-            for (vals, label), sc, res in zip(variants, scenarios, ctx.run_many(scenarios)):
-                models.append(self._simulated_model(vals, label, sc, res))
+            # each joint draw an independent ensemble (its own seed): the samples' clusters then carry the
+            # trajectory noise too (riskrf.risk.error_budget); the tornado's low/high variants keep the context's
+            draw_seeds = [int(x) for x in np.random.SeedSequence([int(ctx.seed), int(u.seed), 17]).generate_state(
+                len(draws))]
+            seeds = draw_seeds + [None] * (len(variants) - len(draws))
+            for (vals, label), sc, res, seed in zip(variants, scenarios, ctx.run_many(scenarios, seeds), seeds):
+                models.append(self._simulated_model(vals, label, sc, res, seed))
         return models
 
     def material_ranges(self) -> dict:
@@ -202,13 +211,13 @@ class SlopeModels:
                           float(self.hazard.reach_probability), float(self.road_share),
                           None if ctx is None else ctx.scenario, self.reference, road)
 
-    def _simulated_model(self, values: dict, label: str, sc, res) -> SlopeModel:
+    def _simulated_model(self, values: dict, label: str, sc, res, seed=None) -> SlopeModel:
         ctx = self.context
         v, h = effective_samples(res, ctx.barrier_collector)
         reach = max(v.size, 1) / res.n
         road = effective_samples(res, ctx.road_collector)
         share = min(road[0].size / v.size, 1.0) if v.size else 1.0
-        return SlopeModel(label, values, (v, h), reach, share, sc, res, road)
+        return SlopeModel(label, values, (v, h), reach, share, sc, res, road, seed)
 
     @cached_property
     def arrays(self):
@@ -431,7 +440,8 @@ class SlopeModels:
             raise MitigationError(f"{self.source}: option {opt.name!r}: x_m = {opt.x_m:g} m is outside the profile "
                                   f"({prof.x[0]:g}, {prof.x[-1]:g}) m")
         col = sc_mod.Collector(f"{opt.name} line", float(opt.x_m))
-        runs = ctx.run_many(replace(m.scenario, collectors=m.scenario.collectors + (col,)) for m in self.models)
+        runs = ctx.run_many((replace(m.scenario, collectors=m.scenario.collectors + (col,)) for m in self.models),
+                            [m.seed for m in self.models])
         return [effective_samples(res, col.name) for res in runs]
 
     # ---- the reference run (common random numbers) ---------------------------------------------------------
@@ -511,7 +521,7 @@ class SlopeModels:
         except (MeasureError, ValueError) as exc:
             raise MitigationError(str(exc)) from exc
         return [self._ditch_retention(m, i, res) for i, (m, res) in
-                enumerate(zip(self.models, ctx.run_many(scenarios)))]
+                enumerate(zip(self.models, ctx.run_many(scenarios, [m.seed for m in self.models])))]
 
     def _ditch_retention(self, model: SlopeModel, index: int, ditched):
         """Share of the falls that would reach the road that the ditches stop (common random numbers): overall,
