@@ -48,9 +48,12 @@ def _table():
                          "outcome": pd.Categorical(rng.choice(["held", "=over", None, "a,b"], size=n))})
 
 
-def test_csv_is_byte_for_byte_the_previous_writers(tmp_path):
+@pytest.mark.parametrize("arrow", [True, False], ids=["arrow", "no-pyarrow"])
+def test_csv_is_byte_for_byte_the_previous_writers(tmp_path, monkeypatch, arrow):
     df = _table()
     previous_writer(df, tmp_path / "old.csv")
+    if not arrow:
+        monkeypatch.setitem(sys.modules, "pyarrow", None)        # the pure-Python formatting
     write_csv(df, tmp_path / "new.csv")
     assert (tmp_path / "new.csv").read_bytes() == (tmp_path / "old.csv").read_bytes()
     back = pd.read_csv(tmp_path / "new.csv", keep_default_na=False, dtype=str)
@@ -97,6 +100,9 @@ _cells = st.one_of(st.none(), st.text(alphabet=st.sampled_from(list("=+-@\t\r\n\
 def test_any_text_gives_the_previous_writers_bytes(tmp_path_factory, rows):
     folder = tmp_path_factory.mktemp("csv")
     df = pd.DataFrame(rows, columns=["a", "b", "c"])
+    df["d"] = np.arange(len(df)) * -7
+    df["e"] = df["b"].isna()
+    df["f"] = np.trunc(df["b"].to_numpy())                      # whole numbers of every size
     for col in ("a", "c"):
         df[col] = df[col].astype(object)
     previous_writer(df, folder / "old.csv")

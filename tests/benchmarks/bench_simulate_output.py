@@ -1,0 +1,167 @@
+"""Where the time of ``riskrf simulate`` goes, and what writing its tables costs (issue 37, build item 5).
+
+Run from the repository root::
+
+    python tests/benchmarks/bench_simulate_output.py [-n 1000000] [--cli] [--before DIR]
+
+In one process it times the stages of ``riskrf simulate`` on the shipped barrier scenario: the kernel
+(``simulation.run``), building the crossings table, drawing the figures, then writing the three tables
+(crossings, ``runout``, ``envelopes``) three ways: the previous writer (pandas ``to_csv``, then every cell
+read back and checked one by one, timed apart), :func:`riskrf.io.outputs.write_csv`, and Parquet when pyarrow
+is installed.  It prints each stage's seconds and the share of writing in the run (kernel + table + figures +
+writing).  Stage times are wall seconds of one process; the machine's other jobs move them.
+
+With ``--cli`` it also runs the whole command in a child process (``--format csv`` and ``--format parquet``)
+and prints its wall time and peak memory (the child's maximum resident set).  ``--before DIR`` runs the same
+command from another source tree beside it (e.g. ``git archive COMMIT | tar -x -C DIR``), whose numba cache is
+warmed by a small run first.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENARIO = ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml"
+
+
+def previous_neutralise(path) -> None:
+    """The cell-by-cell check of every CSV before issue 37 item 5 (read whole, rewrite when a cell changed)."""
+    from riskrf.io.outputs import _neutralise_cell
+    with open(path, newline="", encoding="utf-8", errors="surrogateescape") as fh:
+        rows = list(csv.reader(fh))
+    changed = False
+    for row in rows:
+        for j, cell in enumerate(row):
+            new = _neutralise_cell(cell)
+            if new is not cell:
+                row[j] = new
+                changed = True
+    if changed:
+        with open(path, "w", newline="", encoding="utf-8", errors="surrogateescape") as fh:
+            csv.writer(fh, lineterminator="\n").writerows(rows)
+
+
+def _timed(fn, *args, **kwargs) -> float:
+    t0 = time.perf_counter()
+    fn(*args, **kwargs)
+    return time.perf_counter() - t0
+
+
+def stages(n: int, seed: int, folder: Path) -> None:
+    """Time the stages of ``riskrf simulate`` in this process and print them."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import pandas as pd
+
+    import simulation
+    from riskrf.io.outputs import write_csv, write_parquet
+    from riskrf.report import files as report_files
+
+    sc = simulation.load_scenario(SCENARIO)
+    simulation.run(sc, n=1000, seed=seed)                       # compilation (cached on disk) out of the timing
+    t0 = time.perf_counter()
+    result = simulation.run(sc, n=n, seed=seed)
+    kernel = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    crossings = pd.concat([result.collector(c.name).assign(collector=c.name) for c in sc.collectors],
+                          ignore_index=True)
+    crossings["outcome"] = crossings["outcome"].astype(str)
+    runout, envelopes = result.runout, result.envelopes
+    build = time.perf_counter() - t0
+    figures = _timed(report_files.write_simulation_figures, result, folder, [c.name for c in sc.collectors])
+    tables = {"crossings": crossings, "runout": runout, "envelopes": envelopes}
+
+    rows = []
+    for name, table in tables.items():
+        old = folder / f"{name}-previous.csv"
+        to_csv = _timed(table.to_csv, old, index=False)
+        neutral = _timed(previous_neutralise, old)
+        new = _timed(write_csv, table, folder / f"{name}.csv")
+        same = (folder / f"{name}.csv").read_bytes() == old.read_bytes()
+        try:
+            parquet = _timed(write_parquet, table, folder / f"{name}.parquet")
+            mb_parquet = (folder / f"{name}.parquet").stat().st_size / 1e6
+        except ImportError:
+            parquet, mb_parquet = float("nan"), float("nan")
+        rows.append((name, len(table), to_csv, neutral, new, parquet, old.stat().st_size / 1e6, mb_parquet, same))
+
+    prev = sum(r[2] + r[3] for r in rows)
+    now = sum(r[4] for r in rows)
+    pq = sum(r[5] for r in rows)
+    base = kernel + build + figures
+    print(f"riskrf simulate stages, {n:,} blocks of {SCENARIO.name}, seed {seed} (wall s, one process)")
+    print(f"  kernel (simulation.run)      {kernel:8.2f}")
+    print(f"  table build (crossings)      {build:8.2f}")
+    print(f"  figures (4 PNG)              {figures:8.2f}")
+    print(f"  {'table':<12}{'rows':>10}{'to_csv':>9}{'neutral.':>10}{'previous':>10}{'write_csv':>11}"
+          f"{'parquet':>9}{'CSV MB':>8}{'PQ MB':>7}  identical")
+    for name, nrows, to_csv, neutral, new, parquet, mb, mbp, same in rows:
+        print(f"  {name:<12}{nrows:>10,}{to_csv:>9.2f}{neutral:>10.2f}{to_csv + neutral:>10.2f}{new:>11.2f}"
+              f"{parquet:>9.2f}{mb:>8.1f}{mbp:>7.1f}  {'yes' if same else 'NO'}")
+    neutral = sum(r[3] for r in rows)
+    print(f"  writing, previous: {prev:.2f} s = {prev / (base + prev):.0%} of the run "
+          f"(neutralising {neutral:.2f} s = {neutral / (base + prev):.0%})")
+    print(f"  writing, CSV now:  {now:.2f} s = {now / (base + now):.0%} of the run "
+          f"({'PASS' if now / (base + now) <= 0.20 else 'FAIL'}: target <= 20 %)")
+    if pq == pq:
+        print(f"  writing, Parquet:  {pq:.2f} s = {pq / (base + pq):.0%} of the run")
+
+
+def _child(cmd, cwd, env) -> tuple[float, float, int]:
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode != 0:
+        sys.exit(f"{' '.join(map(str, cmd))} failed: {proc.stderr.read().decode()}")
+    return wall, usage.ru_maxrss / 1024, proc.returncode          # ru_maxrss is in KiB on Linux
+
+
+def whole_command(n: int, seed: int, folder: Path, trees: dict) -> None:
+    """Run ``riskrf simulate`` in child processes from each source tree; print wall time and peak memory."""
+    print(f"\nwhole command: python -m riskrf.cli simulate {SCENARIO.relative_to(ROOT)} -n {n} --seed {seed} "
+          "--no-progress --out run.<csv|parquet> (child process)")
+    for label, tree in trees.items():
+        env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(tree))
+        base = [sys.executable, "-m", "riskrf.cli", "simulate", str(SCENARIO), "--seed", str(seed),
+                "--no-progress"]
+        warm = folder / f"warm-{label}"
+        _child(base + ["-n", "1000", "--out", str(warm / "w.csv")], folder, env)      # numba cache of this tree
+        for fmt in ("csv", "parquet"):
+            out = folder / f"{label}-{fmt}"
+            wall, peak, _ = _child(base + ["-n", str(n), "--out", str(out / f"run.{fmt}")], folder, env)
+            size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file()) / 1e6
+            print(f"  {label:<8} {fmt:<8} {wall:7.2f} s  peak {peak:7.0f} MiB  outputs {size:6.1f} MB")
+            shutil.rmtree(out, ignore_errors=True)
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("-n", type=int, default=1_000_000, help="blocks (default 10^6)")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--cli", action="store_true", help="also run the whole command in child processes")
+    ap.add_argument("--before", default=None, metavar="DIR",
+                    help="with --cli: a source tree of an earlier commit, run beside this one")
+    args = ap.parse_args(argv)
+    with tempfile.TemporaryDirectory(prefix="bench-simulate-output-") as tmp:
+        folder = Path(tmp)
+        stages(args.n, args.seed, folder)
+        if args.cli:
+            trees = {"now": ROOT}
+            if args.before:
+                trees = {"before": Path(args.before).resolve(), **trees}
+            whole_command(args.n, args.seed, folder, trees)
+    print(f"\nload average {os.getloadavg()[0]:.1f}")
+
+
+if __name__ == "__main__":
+    main()
