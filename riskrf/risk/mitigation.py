@@ -44,6 +44,7 @@ from ..hazard.annual_hazard import EnergyHazard
 from ..hazard.impact_energy import mass_model
 from .economics import pv_factor
 from .error_budget import clustered_se, combined_se, sources_text
+from .model_decision import evpi_estimate
 from .loss_engine import LossEngine, LossResult, ParameterSpace, fragment_matrix, mass_grid, mass_pmf
 from .measures import SimulationContext, material_value
 from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.risk.mitigation)
@@ -515,7 +516,7 @@ class MitigationStudy(Displayed):
                 "p05": np.percentile(total, 5, axis=0), "p95": np.percentile(total, 95, axis=0),
                 "probability_best": p_best, "expected_regret": regret,
                 "probability_meets_individual_risk": ir_ok.mean(axis=0),
-                "evpi": max(float(total.mean(axis=0).min() - total.min(axis=1).mean()), 0.0),
+                "evpi": evpi_estimate(total).value if total.shape[0] > 1 and total.shape[1] > 1 else 0.0,
                 "samples": total.shape[0]}
 
     def _fn_tolerable(self, r) -> np.ndarray:
