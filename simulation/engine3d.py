@@ -29,10 +29,21 @@ _KERNEL3D_MATERIALS = ("m_en_law", "m_en_mean", "m_en_std", "m_et_law", "m_et_me
                        "m_et_v0")
 
 
+def _kernel3d_materials(scenario: TerrainScenario) -> dict:
+    """The per-material arrays the 3-D kernel takes: the 2-D engine's that it uses, and the lateral deviation's gain
+    ``m_dev`` [-] and speed scale ``m_dev_v`` [m/s] (:func:`simulation.kernel3d.deviation_sd`)."""
+    mats = {k: v for k, v in _material_arrays(scenario).items() if k in _KERNEL3D_MATERIALS}
+    mats["m_dev"] = np.array([m.lateral_deviation for m in scenario.materials], dtype=float)
+    mats["m_dev_v"] = np.array([m.lateral_deviation_speed_ms for m in scenario.materials], dtype=float)
+    return mats
+
+
 def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> dict:
     """Initial state of n blocks: plan position and elevation [m], velocity [m/s] (``speed_ms`` horizontally
     along the local fall line, ``vz_ms`` vertically, or each release point's ``velocity_ms``), spin [rad/s], mass
-    [kg] (or each point's), radius [m] (or each point's ``radius_m``), I / (m r^2).
+    [kg] (or each point's), radius [m] (or each point's ``radius_m``), I / (m r^2), and the block's lateral
+    deviation factor s_b [-] (``sources.deviation_factor``, drawn from a seventh stream of the seed, so the other
+    quantities are those drawn without it).
 
     Parameters
     ----------
@@ -48,12 +59,12 @@ def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> d
     Returns
     -------
     dict of numpy.ndarray
-        Per block: ``x``, ``y``, ``z`` [m], ``vx``, ``vy``, ``vz`` [m/s], spin [rad/s], mass [kg], radius [m] and
-        inertia factor [-].
+        Per block: ``x``, ``y``, ``z`` [m], ``vx``, ``vy``, ``vz`` [m/s], spin [rad/s], mass [kg], radius [m],
+        inertia factor [-] and deviation factor [-].
     """
     sd = scenario.sources
     ss = np.random.SeedSequence(seed)
-    g_xy, g_h, g_m, g_v, g_vz, g_w = (np.random.default_rng(c) for c in ss.spawn(6))
+    g_xy, g_h, g_m, g_v, g_vz, g_w, g_dev = (np.random.default_rng(c) for c in ss.spawn(7))
     per_point = any(v is not None for v in (sd.point_velocity, sd.point_mass, sd.point_radius))
     if per_point:                          # the same draw as sample_sources makes for points
         idx = source_point_index(sd, g_xy, n)
@@ -78,7 +89,8 @@ def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> d
     radius = sd.point_radius[idx] if sd.point_radius is not None and masses_kg is None else sd.radius(mass)
     return {"x": x, "y": y, "z": scenario.terrain.elevation(x, y) + h, "vx": vx, "vy": vy, "vz": vz,
             "w": sd.angular_velocity_rads.sample(g_w, n), "mass": mass, "radius": radius,
-            "inertia_factor": np.full(n, sd.inertia_factor)}
+            "inertia_factor": np.full(n, sd.inertia_factor),
+            "deviation_factor": np.asarray(sd.deviation_factor.sample(g_dev, n), dtype=float)}
 
 
 def _collector_segments(scenario: TerrainScenario):
@@ -140,7 +152,7 @@ def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_
             r_vy=r["vy"], r_vz=r["vz"], r_w=r["w"], r_h=r["h"], r_out=r["out"], r_count=r_count,
             p_block=p["block"], p_cell=p["cell"], p_e=p["e"], p_h=p["h"], p_count=p_count,
             pb=pth["block"], pt=pth["t"], ppx=pth["x"], ppy=pth["y"], ppz=pth["z"], ppv=pth["v"],
-            pmode=pth["mode"], pcount=pcount)
+            pmode=pth["mode"], pcount=pcount, b_dev=sub["deviation_factor"])
         if r_count[1] == 0 and p_count[1] == 0:
             break
         # a buffer was too small: run the chunk again with the exact sizes (same numbers: keyed by block)
@@ -204,7 +216,7 @@ def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, m
     ter = scenario.terrain
     grid = (ter.z, ter.x0, ter.y0, ter.dx, ter.dy, _lipschitz(ter.z, ter.dx, ter.dy), scenario.material_grid.index)
     # only the material arrays the 3-D kernel takes (the 2-D engine may prepare more for its own kernel)
-    mats = {k: v for k, v in _material_arrays(scenario).items() if k in _KERNEL3D_MATERIALS}
+    mats = _kernel3d_materials(scenario)
     cols = _collector_segments(scenario)
     st = scenario.settings
     n_paths = min(int(record_paths), n)
@@ -416,7 +428,7 @@ def run_tile(scenario: TerrainScenario, part: dict, key: int, *, hazard: bool = 
     """
     ter = scenario.terrain
     grid = (ter.z, ter.x0, ter.y0, ter.dx, ter.dy, _lipschitz(ter.z, ter.dx, ter.dy), scenario.material_grid.index)
-    mats = {k: v for k, v in _material_arrays(scenario).items() if k in _KERNEL3D_MATERIALS}
+    mats = _kernel3d_materials(scenario)
     cols = _collector_segments(scenario)
     st = scenario.settings
     ids = np.asarray(part["ids"], dtype=np.int64)

@@ -205,6 +205,60 @@ def _leave_face(vx, vy, vz, x, y, z, nx0, ny0, nz0, v_sep, zg, x0, y0, dx, dy):
             tx, ty, tz)
 
 
+#: Largest sd of the deviation angle at an impact [rad] (22.5 deg), and the largest deviation (90 deg: a block
+#: never turns back at an impact).
+DEVIATION_SD_MAX_RAD = math.pi / 8.0
+DEVIATION_MAX_RAD = math.pi / 2.0
+
+
+@njit(cache=True)
+def deviation_sd(gain, roughness, r, v, v_scale, factor):
+    """Standard deviation [rad] of the random turn of a block's direction of travel at an impact.
+
+    sigma = min(D (roughness / r) s_b / (1 + v / v_D), pi / 8): it grows with the roughness relative to the
+    block (the ratio of the roughness tilt, :func:`simulation.contact.roughness_tilt_max`) and with the block's own
+    deviation factor s_b (its shape; per block, ``sources.deviation_factor``), and falls with the impact speed,
+    as Rockyfor3D's rule has it: after a rebound the fall direction deviates at random, less at high speed
+    and more on rough ground (Dorren 2016, "Rockyfor3D (v5.2) revealed", section 3.5 "Calculation of the fall
+    direction", pp. 21-23) [R: the form of the dependence is chosen here, D, v_D and the cap are this
+    project's defaults, not Rockyfor3D's numbers].  Shape: non-spherical blocks spread laterally more than
+    compact ones (RAMMS::ROCKFALL's shape-dependent contacts, Leine et al. 2014; Caviezel et al. 2021) [R].
+
+    Parameters
+    ----------
+    gain : float
+        D, the material's ``lateral_deviation`` [-] (0: no deviation).
+    roughness : float
+        The material's roughness (asperity height) [m].
+    r : float
+        Block radius [m].
+    v : float
+        Impact speed [m/s].
+    v_scale : float
+        v_D, the material's ``lateral_deviation_speed_ms`` [m/s]: the speed at which the spread halves.
+    factor : float
+        s_b, the block's deviation factor [-].
+
+    Returns
+    -------
+    float
+        The sd of the deviation angle [rad], at most pi / 8.
+    """
+    if gain <= 0.0 or roughness <= 0.0 or r <= 0.0 or factor <= 0.0:
+        return 0.0
+    return min(gain * roughness / r * factor / (1.0 + v / v_scale), DEVIATION_SD_MAX_RAD)
+
+
+@njit(cache=True, inline="always")
+def _turn(vx, vy, vz, nx0, ny0, nz0, delta):
+    """(vx, vy, vz) turned by ``delta`` [rad] about the unit normal (nx0, ny0, nz0) (Rodrigues): the speed and the
+    normal component are kept, so the turn neither creates energy nor changes the contact decision."""
+    c, s = math.cos(delta), math.sin(delta)
+    dn = (vx * nx0 + vy * ny0 + vz * nz0) * (1.0 - c)
+    cx, cy, cz = ny0 * vz - nz0 * vy, nz0 * vx - nx0 * vz, nx0 * vy - ny0 * vx
+    return vx * c + cx * s + nx0 * dn, vy * c + cy * s + ny0 * dn, vz * c + cz * s + nz0 * dn
+
+
 @njit(cache=True)
 def _safe_step(h, vh, vz, g, lip):
     """Longest time [s] a flight at height h [m] above the ground, horizontal speed vh and vertical speed vz
@@ -450,7 +504,7 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                out_x, out_y, out_z, out_reason, out_impacts, out_t, out_excess, out_events,
                r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_out, r_count,
                p_block, p_cell, p_e, p_h, p_count,
-               pb, pt, ppx, ppy, ppz, ppv, pmode, pcount):
+               pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, m_dev, m_dev_v, b_dev):
     """Run every block of a chunk on the DEM surface; fill the output arrays in place.
 
     Grid: ``zg`` (ny, nx) elevations [m] (NaN holes), centre of cell (0, 0) at (x0, y0), cell size dx, dy [m];
@@ -588,6 +642,11 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
         Output per path point: mode code.
     pcount : numpy.ndarray of int
         Output: path points written.
+    m_dev, m_dev_v : numpy.ndarray
+        Per material: gain D [-] (0: none) and speed scale v_D [m/s] of the lateral deviation at impacts
+        (:func:`deviation_sd`).
+    b_dev : numpy.ndarray
+        Per block: deviation factor s_b [-] (its shape).
     """
     ny, nx = zg.shape
     step_len = 0.5 * min(dx, dy)
@@ -701,6 +760,7 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                 nl = math.sqrt(gx * gx + gy * gy + 1.0)
                 nx0, ny0, nz0 = -gx / nl, -gy / nl, 1.0 / nl
                 vn_t = vx * nx0 + vy * ny0 + vz * nz0
+                v_in = math.sqrt(vx * vx + vy * vy + vz * vz)
                 # travel direction in the tangent plane, and the lateral direction n x t1
                 t1x, t1y, t1z = vx - vn_t * nx0, vy - vn_t * ny0, vz - vn_t * nz0
                 tl = math.sqrt(t1x * t1x + t1y * t1y + t1z * t1z)
@@ -747,6 +807,14 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                 vx, vy, vz = vt2 * tx + vn2 * nnx, vt2 * ty + vn2 * nny, vt2 * tz + vn2 * nnz
                 w = w2
                 sx, sy, sz = tx, ty, tz
+                if m_dev[mat] > 0.0:
+                    # lateral deviation: the direction of travel turns about the ground normal by a random angle
+                    # (deviation_sd); the spin axis turns with it, speed and normal share are kept
+                    sig = deviation_sd(m_dev[mat], m_rough[mat], r, v_in, m_dev_v[mat], b_dev[b])
+                    if sig > 0.0:
+                        dlt = min(max(sig * _normal(state), -DEVIATION_MAX_RAD), DEVIATION_MAX_RAD)
+                        vx, vy, vz = _turn(vx, vy, vz, nx0, ny0, nz0, dlt)
+                        sx, sy, sz = _turn(sx, sy, sz, nx0, ny0, nz0, dlt)
                 vn_true = vx * nx0 + vy * ny0 + vz * nz0
                 v_thr = contact_speed(v_contact, g, nz0, m_hop[mat])
                 if vn_true < v_thr and 1.0 - nz0 * nz0 > sin_max_roll * sin_max_roll:

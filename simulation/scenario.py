@@ -176,6 +176,14 @@ class Distribution:
         return p["median"] * np.exp(p["sigma"] * stats.norm.ppf(u)) if p["sigma"] > 0 else np.full(n, p["median"])
 
 
+#: Defaults of the 3-D kernel's lateral deviation at impacts (``Material.lateral_deviation``, D [-], and
+#: ``lateral_deviation_speed_ms``, v_D [m/s]; :func:`simulation.kernel3d.deviation_sd`): chosen [D] so that
+#: the rule's spread spans the range Rockyfor3D describes (Dorren 2016, section 3.5 pp. 21-23) [R] and checked
+#: against the lateral scatter of the Authume stops (docs/validation/authume-3d.md).
+DEFAULT_LATERAL_DEVIATION = 1.0
+DEFAULT_LATERAL_DEVIATION_SPEED_MS = 10.0
+
+
 @dataclass(frozen=True)
 class Material:
     """Impact and ground-contact behaviour of a slope material.
@@ -195,7 +203,10 @@ class Material:
     ``rolling_size_coefficient`` K [-]: the rolling resistance is tan(phi_g) + K roughness / r, so small blocks
     stop sooner (0: tan(phi_g) alone); ``et_normal_scale_ms``: vt0 of the Pfeiffer & Bowen (1989) scaling of the
     tangential energy by 1 / ((v_n / (vt0 e_N))^2 + 1) after a constant or Coulomb law (inf: none;
-    ``tangential.normal_scale_ms`` in a file, 76.2 m/s in CRSP).  In a file, ``preset = NAME`` starts from a
+    ``tangential.normal_scale_ms`` in a file, 76.2 m/s in CRSP); ``lateral_deviation`` D [-] and
+    ``lateral_deviation_speed_ms`` v_D [m/s] (3-D kernel only): after each impact the block's direction of travel
+    turns about the ground normal by a random angle of sd D (roughness / r) s_b / (1 + v / v_D) [rad] (s_b the
+    block's own deviation factor; 0: no deviation; :func:`simulation.kernel3d.deviation_sd`).  In a file, ``preset = NAME`` starts from a
     named material and ``preset_basis = "data"`` beside it from its data-derived table
     (:func:`simulation.materials.preset`).
     See :mod:`simulation.contact`.
@@ -219,6 +230,8 @@ class Material:
     rolling_drag: float = 0.0
     rolling_size_coefficient: float = 0.0
     et_normal_scale_ms: float = math.inf
+    lateral_deviation: float = DEFAULT_LATERAL_DEVIATION
+    lateral_deviation_speed_ms: float = DEFAULT_LATERAL_DEVIATION_SPEED_MS
 
     @classmethod
     def parse(cls, name: str, spec: dict, source: str) -> "Material":
@@ -243,7 +256,8 @@ class Material:
             raise ScenarioError(f"{source}: materials.{name} must be a table of material fields; got {spec!r}")
         _check_keys(spec, {"preset", "preset_basis", "normal_restitution", "tangential", "roughness_m", "ground_motion",
                            "ground_friction_angle_deg", "rolling_resistance", "allow_energy_gain",
-                           "contact_hop_height_m", "rolling_drag", "rolling_size_coefficient"}, where, source)
+                           "contact_hop_height_m", "rolling_drag", "rolling_size_coefficient", "lateral_deviation",
+                           "lateral_deviation_speed_ms"}, where, source)
         if "preset_basis" in spec and "preset" not in spec:
             raise ScenarioError(f"{source}: {where}preset_basis = {spec['preset_basis']!r} needs a preset beside it")
         given = set(spec)
@@ -339,7 +353,13 @@ class Material:
                                         source, lo=0.0, hi=10.0),
                    rolling_drag=_number(spec.get("rolling_drag", 0.0), f"{where}rolling_drag", source, lo=0.0, hi=10.0),
                    rolling_size_coefficient=_number(spec.get("rolling_size_coefficient", 0.0),
-                                                    f"{where}rolling_size_coefficient", source, lo=0.0, hi=10.0))
+                                                    f"{where}rolling_size_coefficient", source, lo=0.0, hi=10.0),
+                   lateral_deviation=_number(spec.get("lateral_deviation", DEFAULT_LATERAL_DEVIATION),
+                                             f"{where}lateral_deviation", source, lo=0.0, hi=20.0),
+                   lateral_deviation_speed_ms=_number(spec.get("lateral_deviation_speed_ms",
+                                                               DEFAULT_LATERAL_DEVIATION_SPEED_MS),
+                                                      f"{where}lateral_deviation_speed_ms", source, lo=0.0, hi=1e4,
+                                                      lo_open=True))
 
 
 #: I / (m r^2) of the block shapes: a solid sphere, and a solid cylinder (disc, wheel) rolling on its rim.

@@ -69,6 +69,12 @@ from .units import DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3, INERTIA_FACTORS, 
 #: Contact steps are events in 3-D (one per half cell rolled), so the default limit is higher than in 2-D.
 DEFAULT_MAX_EVENTS_3D = 200_000
 
+#: Default per-block factor s_b [-] of the lateral deviation at impacts (``sources.deviation_factor``;
+#: :func:`simulation.kernel3d.deviation_sd`): lognormal, median 1, sigma of ln 0.3 [D], the block-to-block
+#: variation of shape: the log-sd of the aspect ratio L1/L3 of the surveyed Authume blocks is 0.25 (P1) and
+#: 0.18 (P2) (tests/data/authume/observed_runout.csv), widened for sites with less uniform blocks.
+DEFAULT_DEVIATION_FACTOR = {"dist": "lognormal", "median": 1.0, "sigma": 0.3, "max": 5.0}
+
 
 @dataclass(frozen=True)
 class Sources:
@@ -95,6 +101,9 @@ class Sources:
     point_velocity: np.ndarray | None = field(repr=False, default=None)
     point_mass: np.ndarray | None = field(repr=False, default=None)
     point_radius: np.ndarray | None = field(repr=False, default=None)
+    #: Per-block factor s_b [-] of the lateral deviation at impacts (:func:`simulation.kernel3d.deviation_sd`).
+    deviation_factor: Distribution = field(
+        default_factory=lambda: Distribution("lognormal", dict(DEFAULT_DEVIATION_FACTOR)))
 
     def radius(self, mass):
         """Radius [m] of spheres (or cylinders of aspect ratio 1) of the given masses [kg].
@@ -443,7 +452,7 @@ def _parse_sources(sd: dict, terrain: Terrain, base: Path, nodata_rule: str, sou
     """
     _check_keys(sd, {"points", "polygon", "line", "file", "layer", "slope_above_deg", "slope_units", "height_m",
                      "mass_kg", "density_kg_m3", "speed_ms", "vz_ms", "angular_velocity_rads", "shape",
-                     "velocity_ms", "radius_m"}, "sources.", source)
+                     "velocity_ms", "radius_m", "deviation_factor"}, "sources.", source)
     geometry = [k for k in ("points", "polygon", "line", "file") if k in sd]
     slope_rule = "slope_above_deg" in sd
     if len(geometry) > 1 or (not geometry and not slope_rule):
@@ -475,6 +484,8 @@ def _parse_sources(sd: dict, terrain: Terrain, base: Path, nodata_rule: str, sou
         vz_ms=Distribution.parse(sd.get("vz_ms", 0.0), "sources.vz_ms", source, lo=-200, hi=200),
         angular_velocity_rads=Distribution.parse(sd.get("angular_velocity_rads", 0.0),
                                                  "sources.angular_velocity_rads", source, lo=-1e3, hi=1e3),
+        deviation_factor=Distribution.parse(sd.get("deviation_factor", DEFAULT_DEVIATION_FACTOR),
+                                            "sources.deviation_factor", source, lo=0.0, hi=100.0),
         shape=shape)
 
 

@@ -314,7 +314,12 @@ def test_crossings_of_an_oblique_barrier_lie_on_its_line():
     line = ((40.0, 100.0), (80.0, 0.0))                 # oblique across the slope, 107.7 m long
     res = run_terrain(_fence_scenario(height=3.0, line=line), 300, seed=8)
     b = res.barrier("fence")
-    assert len(b) == 300
+    # every block crosses the line, except those the lateral deviation at impacts carries off the 100 m wide
+    # plane's side before the line (one of 300 with seed 8; before the deviation all 300 crossed)
+    st = res.stops()
+    side = (st["reason"] == "left terrain (edge)") & ((st["y_m"] <= 0.0) | (st["y_m"] >= 100.0)) & ~st["block"].isin(
+        b["block"])
+    assert len(b) == 300 - side.sum() and side.sum() <= 3
     (xa, ya), (xb, yb) = line
     length = np.hypot(xb - xa, yb - ya)
     # each crossing point is on the segment, and its position is the distance from the first vertex
