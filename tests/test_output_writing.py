@@ -123,6 +123,14 @@ def test_safety_net_still_neutralises_plain_to_csv(tmp_path):
     assert (tmp_path / "out" / "w.csv").read_text() == "a,b\n'=x,1\ny,2\n'=z,3\n"
 
 
+def test_simulate_reads_no_table_back(tmp_path, monkeypatch):
+    checked = []
+    monkeypatch.setattr(outputs, "neutralise_csv", lambda path: checked.append(path))
+    assert main(["simulate", str(BARRIER), "-n", "200", "--out", str(tmp_path / "run.csv"), "--no-progress"]) == 0
+    assert checked == []                # write_csv checked the cells in memory; atomic_outputs trusts it
+    assert (tmp_path / "run-figures" / "runout.csv").is_file()
+
+
 def test_parquet_round_trips_the_table(tmp_path):
     pytest.importorskip("pyarrow", reason="Parquet output needs pyarrow (pip install 'riskrf[parquet]')")
     df = _table()

@@ -195,14 +195,14 @@ def _neutralise_cell(cell: str) -> str:
 
 
 #: Files written by :func:`write_csv`, whose cells are already safe: ``(st_dev, st_ino)`` ->
-#: ``(st_size, st_mtime_ns, st_ctime_ns)`` right after writing (a rename keeps all of them; any later change
-#: to the file changes one, and then :func:`_finish` neutralises it again).
-_NEUTRALISED: dict[tuple[int, int], tuple[int, int, int]] = {}
+#: ``(st_size, st_mtime_ns)`` right after writing (a rename or chmod keeps both; writing to the file changes
+#: its modification time, and then :func:`_finish` neutralises it again).
+_NEUTRALISED: dict[tuple[int, int], tuple[int, int]] = {}
 
 
-def _stat_key(path) -> tuple[tuple[int, int], tuple[int, int, int]]:
+def _stat_key(path) -> tuple[tuple[int, int], tuple[int, int]]:
     st = os.stat(path)
-    return (st.st_dev, st.st_ino), (st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+    return (st.st_dev, st.st_ino), (st.st_size, st.st_mtime_ns)
 
 
 def _already_neutralised(path) -> bool:
@@ -374,16 +374,17 @@ def _arrow_float_text(arr: np.ndarray, pa, pc):
     Arrow's cast to text gives the same shortest round-trip digits as ``repr``; it differs only in layout:
     no ``.0`` after a whole number, and exponent notation at other magnitudes.  Values of magnitude in
     [1e-4, 1e16) that Arrow writes without an exponent are therefore taken from Arrow (``.0`` added to whole
-    numbers); zeros, NaN, infinities and every other value are written by ``repr`` itself.
+    numbers, zeros included); NaN, infinities and every other value are written by ``repr`` itself.
     """
     text = pc.cast(pa.array(arr), pa.string())
     with np.errstate(invalid="ignore"):
         ax = np.abs(arr)
-        plain = (ax >= 1e-4) & (ax < 1e16)
-    plain &= ~pc.match_substring(text, "e").to_numpy(zero_copy_only=False)
-    whole = plain & (arr == np.trunc(arr))          # written without an exponent, so without a fraction
+        plain = ((ax >= 1e-4) & (ax < 1e16)) | (ax == 0)            # Arrow: "0", "-0"
+        plain &= ~pc.match_substring(text, "e").to_numpy(zero_copy_only=False)
+        whole = plain & (arr == np.trunc(arr))      # written without an exponent, so without a fraction
     if whole.any():
-        text = pc.if_else(pa.array(whole), pc.binary_join_element_wise(text, ".0", ""), text)
+        mask = pa.array(whole)
+        text = pc.replace_with_mask(text, mask, pc.binary_join_element_wise(pc.filter(text, mask), ".0", ""))
     rest = np.flatnonzero(~plain)
     if rest.size:
         fixed = ["" if v != v else float.__repr__(v) for v in arr[rest].tolist()]
@@ -554,9 +555,9 @@ def _finish(tmp: Path) -> None:
         if item.is_dir():
             os.chmod(item, mode_dir)
         elif item.is_file():
-            os.chmod(item, mode_file)
             if item.suffix.lower() == ".csv" and not _already_neutralised(item):
                 neutralise_csv(item)
+            os.chmod(item, mode_file)
 
 
 @contextlib.contextmanager

@@ -5,11 +5,11 @@ Run from the repository root::
     python tests/benchmarks/bench_simulate_output.py [-n 1000000] [--cli] [--before DIR]
 
 In one process it times the stages of ``riskrf simulate`` on the shipped barrier scenario: the kernel
-(``simulation.run``), building the crossings table, drawing the figures, then writing the three tables
+(``simulation.run``), building the crossings table, the printed summary, drawing the figures, then writing the three tables
 (crossings, ``runout``, ``envelopes``) three ways: the previous writer (pandas ``to_csv``, then every cell
 read back and checked one by one, timed apart), :func:`riskrf.io.outputs.write_csv`, and Parquet when pyarrow
-is installed.  It prints each stage's seconds and the share of writing in the run (kernel + table + figures +
-writing).  Stage times are wall seconds of one process; the machine's other jobs move them.
+is installed.  It prints each stage's seconds and the share of writing in the run (kernel + table + summary +
+figures + writing, one after the other).  Stage times are wall seconds of one process; the machine's other jobs move them.
 
 With ``--cli`` it also runs the whole command in a child process (``--format csv`` and ``--format parquet``)
 and prints its wall time and peak memory (the child's maximum resident set).  ``--before DIR`` runs the same
@@ -76,6 +76,7 @@ def stages(n: int, seed: int, folder: Path) -> None:
     crossings["outcome"] = crossings["outcome"].astype(str)
     runout, envelopes = result.runout, result.envelopes
     build = time.perf_counter() - t0
+    summary = _timed(result.summary)
     figures = _timed(report_files.write_simulation_figures, result, folder, [c.name for c in sc.collectors])
     tables = {"crossings": crossings, "runout": runout, "envelopes": envelopes}
 
@@ -96,10 +97,11 @@ def stages(n: int, seed: int, folder: Path) -> None:
     prev = sum(r[2] + r[3] for r in rows)
     now = sum(r[4] for r in rows)
     pq = sum(r[5] for r in rows)
-    base = kernel + build + figures
+    base = kernel + build + summary + figures
     print(f"riskrf simulate stages, {n:,} blocks of {SCENARIO.name}, seed {seed} (wall s, one process)")
     print(f"  kernel (simulation.run)      {kernel:8.2f}")
     print(f"  table build (crossings)      {build:8.2f}")
+    print(f"  printed summary              {summary:8.2f}")
     print(f"  figures (4 PNG)              {figures:8.2f}")
     print(f"  {'table':<12}{'rows':>10}{'to_csv':>9}{'neutral.':>10}{'previous':>10}{'write_csv':>11}"
           f"{'parquet':>9}{'CSV MB':>8}{'PQ MB':>7}  identical")
@@ -113,6 +115,7 @@ def stages(n: int, seed: int, folder: Path) -> None:
           f"({'PASS' if now / (base + now) <= 0.20 else 'FAIL'}: target <= 20 %)")
     if pq == pq:
         print(f"  writing, Parquet:  {pq:.2f} s = {pq / (base + pq):.0%} of the run")
+    return now
 
 
 def _child(cmd, cwd, env) -> tuple[float, float, int]:
@@ -126,8 +129,9 @@ def _child(cmd, cwd, env) -> tuple[float, float, int]:
     return wall, usage.ru_maxrss / 1024, proc.returncode          # ru_maxrss is in KiB on Linux
 
 
-def whole_command(n: int, seed: int, folder: Path, trees: dict) -> None:
-    """Run ``riskrf simulate`` in child processes from each source tree; print wall time and peak memory."""
+def whole_command(n: int, seed: int, folder: Path, trees: dict, write_s: float) -> None:
+    """Run ``riskrf simulate`` in child processes from each source tree; print wall time and peak memory, and
+    ``write_s`` (this tree's CSV writing, timed in :func:`stages`) as a share of this tree's CSV run."""
     print(f"\nwhole command: python -m riskrf.cli simulate {SCENARIO.relative_to(ROOT)} -n {n} --seed {seed} "
           "--no-progress --out run.<csv|parquet> (child process)")
     for label, tree in trees.items():
@@ -142,6 +146,9 @@ def whole_command(n: int, seed: int, folder: Path, trees: dict) -> None:
             size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file()) / 1e6
             print(f"  {label:<8} {fmt:<8} {wall:7.2f} s  peak {peak:7.0f} MiB  outputs {size:6.1f} MB")
             shutil.rmtree(out, ignore_errors=True)
+            if label == "now" and fmt == "csv":
+                print(f"           CSV writing ({write_s:.2f} s, timed above) = {write_s / wall:.0%} of this run "
+                      f"(the figures are drawn on the other core meanwhile)")
 
 
 def main(argv=None) -> None:
@@ -154,12 +161,12 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="bench-simulate-output-") as tmp:
         folder = Path(tmp)
-        stages(args.n, args.seed, folder)
+        write_s = stages(args.n, args.seed, folder)
         if args.cli:
             trees = {"now": ROOT}
             if args.before:
                 trees = {"before": Path(args.before).resolve(), **trees}
-            whole_command(args.n, args.seed, folder, trees)
+            whole_command(args.n, args.seed, folder, trees, write_s)
     print(f"\nload average {os.getloadavg()[0]:.1f}")
 
 
