@@ -331,7 +331,12 @@ def main(argv) -> None:
     params.to_csv(DATA / "results_3d_parameters.csv", index=False)
     _figure(stops_for_fig, DOCS / "figures" / "authume-3d.png", "2-D")
     _figure(stops_3d, DOCS / "figures" / "authume-3d-calibrated.png", "3-D")
-    (DOCS / "authume-3d.md").write_text(_document(table, params, n, n_per_release))
+    doc = _document(table, params, n, n_per_release)
+    old = (DOCS / "authume-3d.md").read_text() if (DOCS / "authume-3d.md").exists() else ""
+    mark = "<!-- lateral-dispersion -->"          # the section lateral_dispersion_3d.py writes: kept
+    if old.count(mark) == 2:
+        doc = doc.rstrip("\n") + "\n\n" + mark + old.split(mark)[1] + mark + "\n"
+    (DOCS / "authume-3d.md").write_text(doc)
     print(table.to_string())
     print(params.to_string())
 
