@@ -52,7 +52,9 @@ def test_effect_basis_of_a_combination_follows_its_kinds():
     scale = Option("s", "scaling", 1.0, zone_x_m=(1.0, 2.0))
     away = Option("a", "realignment", 1.0)
     both = Option("b", "combined", options=("s", "d"))
-    assert "draped surface" in options.effect_basis(both, [scale, drape])
+    basis = options.effect_basis(both, [scale, drape])       # both assumed parts named
+    assert "released under the mesh" in basis and "ASSUMED containment 85%" in basis
+    assert "ASSUMED effectiveness" in basis and "others derived" not in basis
     assert options.effect_basis(scale, [scale]).startswith("derived zone and mass range, ASSUMED effectiveness")
     assert options.effect_basis(away, [away]) == "geometry: the road leaves the slope"
     typed = Option("t", "fence", 1.0, capacity_kj=100, height_m=2, retention=0.5, repair_days=30)

@@ -1,4 +1,5 @@
-"""Catch bench, bund and drape options: profiles checked by hand, effects derived by re-simulation."""
+"""Catch bench, bund and drape options: profiles checked by hand; bench and bund effects derived by re-simulation,
+the drape's from the simulated release points and an ASSUMED containment."""
 import numpy as np
 import pytest
 import simulation
@@ -57,12 +58,12 @@ def test_overlapping_slope_measures_and_the_road_line_are_refused():
                          "site.toml")
 
 
-def test_bench_bund_and_drape_effects_are_re_simulated():
+def test_bench_and_bund_are_re_simulated_and_the_drape_contains_what_starts_under_it():
     opts = (Option("nothing", "none"), Option("bench", "bench", 1e5, x_m=15.0, width_m=6.0),
             Option("bund", "bund", 1e5, x_m=40.0, width_m=8.0, height_m=3.0),
-            Option("drape", "drape", 1e5, zone_x_m=(5.5, 29.5)))
+            Option("drape", "drape", 1e5, zone_x_m=(5.5, 29.5), max_mass_kg=1e9))
     # the road 70 m out: on this slope every block rolls past 60 m (to the end of the profile at 80 m) unless a
-    # measure stops it; under the drape they slide to the toe and stop at about 60-64 m
+    # measure stops it
     toe = {**TOE, "collectors": [{"name": "barrier", "x": 31.0}, {"name": "road", "x": 70.0}]}
     s = MitigationStudy(hazard=HAZ, options=opts, consequences=CONSTANT_V, uncertainty=Uncertainty(samples=50),
                         context=SimulationContext(simulation.scenario_from_dict(toe), n_blocks=2000, seed=3))
@@ -71,10 +72,65 @@ def test_bench_bund_and_drape_effects_are_re_simulated():
     for name in ("bench", "bund", "drape"):
         r = s.evaluate(name)
         assert r.road_falls_per_year < base, name                    # each keeps falls off the road
-        assert 0 < r.retention <= 1, name
-    assert "ASSUMED" in t.loc["drape", "effect_basis"]
-    assert t.loc["bund", "effect_basis"] == "derived (simulation and site geometry)"
+        assert 0 < r.retention < 1, name
+    # every block starts under the mesh (seeder x = 6-9 m): the drape keeps the ASSUMED 85 % of them, no more
+    assert s.evaluate("drape").retention == pytest.approx(0.85, abs=1e-9)
+    assert "ASSUMED containment 85% (70%-95%)" in t.loc["drape", "effect_basis"]
+    assert "released under the mesh" in t.loc["drape", "effect_basis"]
+    assert t.loc["bund", "effect_basis"].startswith("derived: the slope re-simulated with the bund")
+    assert t.loc["bench", "effect_basis"].startswith("derived: the slope re-simulated with the bench")
     # the effect is a simulation result: a higher bund stops at least as many falls (common random numbers)
     s2 = _toe_study((Option("nothing", "none"), Option("low", "bund", 1e5, x_m=40.0, width_m=12.0, height_m=1.0),
                      Option("high", "bund", 1e5, x_m=40.0, width_m=12.0, height_m=3.0)))
     assert s2.evaluate("high").retention >= s2.evaluate("low").retention
+
+
+def test_drape_effect_is_the_simulated_share_released_under_it_times_its_containment():
+    """Retained share = containment x share of the road falls released under the mesh (their simulated release
+    points); heavier blocks than the mesh holds are not credited; a stated containment of 1 is labelled."""
+    half = Option("half", "drape", 1e5, zone_x_m=(7.5, 29.5), max_mass_kg=1e9)        # seeder 6-9 m: half
+    full = Option("full", "drape", 1e5, zone_x_m=(5.5, 29.5), max_mass_kg=1e9, containment=1.0)
+    small = Option("small", "drape", 1e5, zone_x_m=(5.5, 29.5), max_mass_kg=400.0)   # every block is 500 kg
+    s = _toe_study((Option("nothing", "none"), half, full, small))
+    t = s.ranking().set_index("option")
+    share = s._slopes.derived["half: share under the mesh"][0]
+    ref = s._slopes.reference_run
+    from riskrf.risk.measures import road_crossings
+    road = road_crossings(ref, "road")
+    x0 = ref.blocks["x"][road]
+    assert share == pytest.approx(np.mean((x0 >= 7.5) & (x0 <= 29.5)), abs=1e-12) and 0.3 < share < 0.7
+    assert s.evaluate("half").retention == pytest.approx(0.85 * share, rel=1e-9)
+    assert s.evaluate("full").retention == pytest.approx(1.0)
+    # no simulated block (500 kg each) is small enough: only the hazard's falls below 400 kg are credited
+    assert s._slopes.derived["small: share under the mesh"][0] == 0.0
+    assert 0 < s.evaluate("small").retention <= 0.85 * HAZ.mass.cdf(400.0) * 1.1
+    assert "stated containment (an ASSUMPTION, not derived) 100%" in t.loc["full", "effect_basis"]
+    assert "blocks above max_mass_kg = 400 kg not contained" in t.loc["small", "effect_basis"]
+    # the ASSUMED containment is an uncertain input of the study (tornado, sampling)
+    assert s.parameter_ranges()["containment:half"][:2] == (0.7, 0.95)
+    assert "containment:full" not in s.parameter_ranges()
+
+
+def test_drape_off_the_face_or_over_no_release_is_refused():
+    sc = simulation.scenario_from_dict(TOE)
+    from riskrf.risk.geometry_measures import check_drape_zone, face_spans
+    assert face_spans(sc.profile) == [(5.0, 30.0)]
+    assert check_drape_zone(sc, (5.0, 30.0)) == pytest.approx(1.0)
+    with pytest.raises(MeasureError, match=r"zone_x_m = \[35, 50\] is not on a rock face.*span x = 5-30 m"):
+        check_drape_zone(sc, (35.0, 50.0))
+    with pytest.raises(MeasureError, match="outside the profile"):
+        check_drape_zone(sc, (5.0, 90.0))
+    with pytest.raises(MeasureError, match="no block is released under the mesh"):
+        check_drape_zone(sc, (20.0, 30.0))
+    flat = simulation.scenario_from_dict({**TOE, "profile": {"x": [0.0, 50.0, 80.0], "z": [20.0, 0.0, 0.0],
+                                                             "materials": ["rock", "soil"]}})
+    with pytest.raises(MeasureError, match="has no rock face to drape"):
+        check_drape_zone(flat, (5.0, 20.0))
+    with pytest.raises(MitigationError, match="containment = 0.5 lies outside containment_range"):
+        parse_mitigation({"options": [{"name": "n", "kind": "none", "capital_cost": 0},
+                                      {"name": "d", "kind": "drape", "capital_cost": 1, "zone_x_m": [5, 20],
+                                       "containment": 0.5, "containment_range": [0.7, 0.9]}]}, "site.toml")
+    with pytest.raises(MitigationError, match="containment and containment_range are only for kind = 'drape'"):
+        parse_mitigation({"options": [{"name": "n", "kind": "none", "capital_cost": 0},
+                                      {"name": "b", "kind": "bund", "capital_cost": 1, "x_m": 40, "width_m": 8,
+                                       "height_m": 2, "containment": 0.9}]}, "site.toml")

@@ -532,5 +532,27 @@ def _check_option_geometry(options, scenario, hz, path, uncertainty=None):
                                     f"line (collector {road.name!r} at x = {road.x:g} m)")
             if o.kind == "scaling" and o.zone_x_m is not None:
                 seeder_share(scenario, o.zone_x_m, where)
+            if o.retention is None and o.kind in ("bench", "bund", "drape"):
+                _check_slope_measure(o, scenario, hz, path)
         except MeasureError as exc:
             raise SiteError(str(exc)) from exc
+
+
+def _check_slope_measure(o, scenario, hz, path):
+    """A bench, bund or drape against the scenario before anything is simulated: inside the profile, fitting the
+    ground, clear of the road line, its material known; a drape on a rock face over part of the release zone.
+    Raises MeasureError naming the site file ``path``, the option and the field."""
+    from ..risk.geometry_measures import SlopeMeasure, check_drape_zone, scenario_with_measures
+    from ..risk.measures import MeasureError
+    where = f"{path}: option {o.name!r}"
+    prof = scenario.profile
+    if o.kind == "drape":
+        check_drape_zone(scenario, o.zone_x_m, where)
+        return
+    end = o.x_m + o.width_m
+    if not prof.x[0] < o.x_m < end < prof.x[-1]:
+        raise MeasureError(f"{where}: x_m = {o.x_m:g} m + width_m = {o.width_m:g} m spans {o.x_m:g}-{end:g} m, "
+                           f"outside the profile ({prof.x[0]:g}, {prof.x[-1]:g}) m")
+    m = SlopeMeasure(o.kind, o.name, o.x_m, o.width_m, o.height_m, None, o.inner_slope_hv, o.outer_slope_hv,
+                     o.material)
+    scenario_with_measures(scenario, [m], where=str(path), road_collector=hz["road_collector"])

@@ -238,7 +238,8 @@ CRITERIA = Table("criteria", (
 OPTIONS = Table("options", (
     _text("name", "the option's name", default=REQUIRED),
     _text("kind", "what the option is", default=REQUIRED,
-          choices=("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "closure", "combined")),
+          choices=("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "closure", "combined",
+                   "bench", "bund", "drape")),
     _nonneg("capital_cost", "currency", "cost to build (required except for combined)"),
     _nonneg("annual_maintenance", "currency/yr", "maintenance per year", default=0.0),
     _pos("life_years", "yr", "service life (renewed at its end)"),
@@ -250,20 +251,21 @@ OPTIONS = Table("options", (
     _share("effectiveness", "scaling: share of the loose blocks actually removed (an ASSUMPTION)"),
     _pos("effectiveness_half_life_years", "yr", "scaling: half-life of its effect"),
     Field("effectiveness_range", "range", "", "[low, high] shares", low=0, high=1),
-    _nonneg("x_m", "m", "position along the profile"),
-    _pos("width_m", "m", "ditch width"),
+    _nonneg("x_m", "m", "position along the profile (a fence's line; the upslope edge of a ditch, bench or bund)"),
+    _pos("width_m", "m", "ditch, bench or bund width along the profile"),
     _pos("depth_m", "m", "ditch depth"),
     _text("kit", "fence or attenuator: a kit of riskrf/data/barrier_kits.csv (its MEL, SEL, nominal height, "
           "maximum elongation and residual category enter the design checks)"),
     _pos("capacity_kj", "kJ", "barrier capacity (MEL)"),
-    _pos("height_m", "m", "barrier height"),
+    _pos("height_m", "m", "barrier height; bund crest height above the ground"),
     _pos("min_mass_kg", "kg", "smallest block scaling removes"),
-    _pos("max_mass_kg", "kg", "largest block scaling removes"),
+    _pos("max_mass_kg", "kg", "largest block scaling removes; drape: largest block the mesh contains (default: a "
+         "1.0 m sphere, ASSUMED)"),
     _pos("covered_length_m", "m", "length of road a shed covers"),
     _nonneg("road_x_m", "m", "position of the road for a realignment"),
-    _pos("inner_slope_hv", "", "ditch inner slope, horizontal to vertical"),
-    _pos("outer_slope_hv", "", "ditch outer slope, horizontal to vertical"),
-    _text("material", "ditch floor material (a material of the scenario)"),
+    _pos("inner_slope_hv", "", "ditch inner slope, bench back wall or bund upslope face, horizontal to vertical"),
+    _pos("outer_slope_hv", "", "ditch outer slope or bund road-side face, horizontal to vertical"),
+    _text("material", "ditch or bench floor, bund fill (a material of the scenario; default: the ground's)"),
     _text("description", "shown in the report"),
     _share("share_while_closed", "typed share of falls while the road is closed (an ASSUMPTION)"),
     _nonneg("closure_hours_per_year", "h/yr", "typed hours closed per year (an ASSUMPTION)"),
@@ -274,7 +276,11 @@ OPTIONS = Table("options", (
     Field("annual_maintenance_range", "range", "currency/yr", "[low, high]", low=0),
     Field("retention_range", "range", "", "[low, high] shares", low=0, high=1),
     Field("rate_reduction_range", "range", "", "[low, high] shares", low=0, high=1),
-    Field("zone_x_m", "range", "m", "scaling zone along the profile", low=0),
+    Field("zone_x_m", "range", "m", "scaling zone, or the draped zone of the rock face, along the profile", low=0),
+    _share("containment", "drape: share of the blocks released under the mesh it keeps on the face (an ASSUMPTION; "
+           "default 0.85, ASSUMED)"),
+    Field("containment_range", "range", "", "drape: [low, high] of the containment (default [0.7, 0.95], ASSUMED)",
+          low=0, high=1),
 ), "Mitigation options (each compared with the others by expected total cost).", array=True)
 
 UNCERTAINTY = Table("uncertainty", (

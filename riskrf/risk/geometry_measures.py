@@ -11,10 +11,21 @@ with common random numbers, exactly as for a ditch (:mod:`riskrf.risk.measures`)
   width_m``, its crest ``height_m`` above the ground, its upslope face ``inner_slope_hv`` (default 0.5H:1V, a
   reinforced face) and its downslope face ``outer_slope_hv`` (default 1.5H:1V); material ``material`` (default:
   the ground's).
-* **drape / secured mesh** (``zone_x_m`` = [x_lo, x_hi]): the slope surface in the zone takes the material
-  :data:`DRAPE_MATERIAL`: low restitution (blocks do not bounce out), no roughness and a high sliding friction
-  (blocks are guided down to the toe under the mesh).  ASSUMPTION: these parameters are engineering judgement,
-  not from a test of a mesh; the option's basis says so.
+* **drape** (``zone_x_m`` = [x_lo, x_hi] on the rock face): the option (:class:`riskrf.risk.options.Drape`) is
+  NOT re-simulated with a changed surface.  What the simulation can tell is which of the falls reaching the road
+  start under the mesh (their release point in the zone, :func:`drape_release_share`); a drape keeps a share of
+  those on the face (its containment efficiency, an ASSUMPTION) and does nothing for falls from above or beside
+  it (Badger & Duffy 2012: unsecured drapery addresses rockfall that originates from the covered slope area;
+  a hybrid drapery or attenuator intercepts falls from upslope).  The zone must lie on the face
+  (:func:`check_drape_zone`: every profile segment under it steeper than :data:`DRAPE_MIN_FACE_DIP_DEG`).
+  :func:`drape_scenario` (the surface under the mesh given the ASSUMED material :data:`DRAPE_MATERIAL`) is kept
+  for what-if runs from Python; its result rests wholly on that assumed material and it is not an option's
+  effect.
+
+References
+----------
+Badger, T. C. & Duffy, J. D. (2012).  Drapery systems.  In Turner, A. K. & Schuster, R. L. (eds), *Rockfall:
+Characterization and Control*, chapter 16.  Transportation Research Board, Washington DC.
 """
 from __future__ import annotations
 
@@ -29,6 +40,9 @@ from .measures import Ditch, MeasureError, ditch_profile, ground_z
 DRAPE_MATERIAL = {"normal_restitution": {"law": "constant", "mean": 0.1, "std": 0.03},
                   "tangential": {"law": "friction", "friction_angle_deg": 40.0}, "roughness_m": 0.0,
                   "ground_motion": "slide", "ground_friction_angle_deg": 45.0}
+#: A drape hangs on a rock face: every profile segment under its zone must dip more steeply than this [deg]
+#: (riskrf's rule; ground flatter than about 40 degrees is talus or an apron, where a mesh does not hang).
+DRAPE_MIN_FACE_DIP_DEG = 40.0
 BENCH_INNER_SLOPE_HV = 0.25
 BUND_INNER_SLOPE_HV = 0.5
 BUND_OUTER_SLOPE_HV = 1.5
@@ -58,6 +72,12 @@ class SlopeMeasure:
 
 def _segment(profile, x) -> int:
     return int(np.clip(np.searchsorted(profile.x, x, side="right") - 1, 0, profile.material_index.size - 1))
+
+
+def _check_inside_closed(profile, x0, x1, where):
+    if not (profile.x[0] <= x0 < x1 <= profile.x[-1]):
+        raise MeasureError(f"{where} spans {x0:g}-{x1:g} m, outside the profile ({profile.x[0]:g}, "
+                           f"{profile.x[-1]:g}) m")
 
 
 def _check_inside(profile, x0, x1, where):
@@ -211,6 +231,117 @@ def drape_scenario(scenario, zone_x_m, where="drape"):
     return replace(scenario, profile=profile, materials=tuple(mats))
 
 
+def face_spans(profile, min_dip_deg: float = DRAPE_MIN_FACE_DIP_DEG) -> list:
+    """The rock faces of ``profile``: runs of consecutive segments dipping more steeply than ``min_dip_deg``.
+
+    Parameters
+    ----------
+    profile : simulation.slope.Profile
+        The slope profile (x, z in m).
+    min_dip_deg : float, optional
+        Smallest dip of a face segment [deg].
+
+    Returns
+    -------
+    list of tuple
+        (x_start, x_end) of each face [m], upslope first; empty when the profile has no face.
+    """
+    x, z = np.asarray(profile.x, dtype=float), np.asarray(profile.z, dtype=float)
+    dip = np.degrees(np.arctan2(np.abs(np.diff(z)), np.diff(x)))
+    spans = []
+    for i, steep in enumerate(dip > min_dip_deg):
+        if not steep:
+            continue
+        if spans and spans[-1][1] == x[i]:
+            spans[-1] = (spans[-1][0], float(x[i + 1]))
+        else:
+            spans.append((float(x[i]), float(x[i + 1])))
+    return spans
+
+
+def check_drape_zone(scenario, zone_x_m, where: str = "drape") -> float:
+    """Check that a drape's zone lies inside the profile, on a rock face, over part of the release zone; the share
+    of the release line under it.
+
+    Parameters
+    ----------
+    scenario : simulation.scenario.Scenario
+        The slope scenario (2-D profile and line seeder).
+    zone_x_m : tuple of float
+        (x_lo, x_hi) of the draped zone [m].
+    where : str, optional
+        What to name in error messages (file, option and field).
+
+    Returns
+    -------
+    float
+        Share of the releases whose release point lies under the mesh [-]
+        (:func:`riskrf.risk.measures.seeder_share`).
+
+    Raises
+    ------
+    MeasureError
+        When the zone is empty or leaves the profile, the scenario has no face (no segment steeper than
+        :data:`DRAPE_MIN_FACE_DIP_DEG`), part of the zone lies on flatter ground, or no block is released under it.
+    """
+    from .measures import seeder_share
+    prof = scenario.profile
+    x0, x1 = float(zone_x_m[0]), float(zone_x_m[1])
+    if not x1 > x0:
+        raise MeasureError(f"{where}: zone_x_m = {list(zone_x_m)} must be [low, high] with low < high")
+    _check_inside_closed(prof, x0, x1, f"{where}: zone_x_m")
+    faces = face_spans(prof)
+    if not faces:
+        raise MeasureError(f"{where}: zone_x_m = [{x0:g}, {x1:g}]: scenario {scenario.name!r} has no rock face to "
+                           f"drape (no profile segment steeper than {DRAPE_MIN_FACE_DIP_DEG:g} deg); a drape "
+                           "hangs on a face")
+    if not any(a <= x0 and x1 <= b for a, b in faces):
+        where_faces = ", ".join(f"{a:g}-{b:g} m" for a, b in faces)
+        raise MeasureError(f"{where}: zone_x_m = [{x0:g}, {x1:g}] is not on a rock face: a drape hangs on a face "
+                           f"(segments steeper than {DRAPE_MIN_FACE_DIP_DEG:g} deg), and the faces of scenario "
+                           f"{scenario.name!r} span x = {where_faces}")
+    sd = scenario.seeder
+    share = 0.0 if (x1 < sd.x_low or x0 > sd.x_high) else seeder_share(scenario, (x0, x1), where)
+    if share <= 0:
+        raise MeasureError(f"{where}: zone_x_m = [{x0:g}, {x1:g}]: no block is released under the mesh (release "
+                           f"zone {sd.x_low:g}-{sd.x_high:g} m); a drape contains the falls that start under it")
+    return share
+
+
+def drape_release_share(result, road_blocks, zone_x_m, max_mass_kg=None) -> tuple:
+    """Of the simulated blocks reaching the road, those released under the mesh and small enough for it.
+
+    Parameters
+    ----------
+    result : simulation.SimulationResult
+        A simulation of the unmitigated slope (release points ``blocks["x"]`` [m], masses ``blocks["mass"]`` [kg]).
+    road_blocks : numpy.ndarray of int
+        Indices of the blocks that cross the road line.
+    zone_x_m : tuple of float
+        (x_lo, x_hi) of the draped zone [m].
+    max_mass_kg : float, optional
+        Largest block the mesh contains [kg]; heavier blocks are not credited.  None: every block.
+
+    Returns
+    -------
+    share : float
+        Share of the road blocks released under the mesh (and not heavier than ``max_mass_kg``) [-].
+    beta : tuple
+        (a, b) of its Monte Carlo Beta law (Jeffreys prior: k + 0.5, n - k + 0.5).
+    under : numpy.ndarray of bool
+        Per road block, released under the mesh and containable.
+    """
+    x0 = np.asarray(result.blocks["x"], dtype=float)[road_blocks]
+    m = np.asarray(result.blocks["mass"], dtype=float)[road_blocks]
+    under = (x0 >= zone_x_m[0]) & (x0 <= zone_x_m[1])
+    if max_mass_kg is not None:
+        under &= m <= max_mass_kg
+    n, k = int(road_blocks.size), int(under.sum())
+    if n == 0:
+        return 0.0, (0.5, 0.5), under
+    return k / n, (k + 0.5, n - k + 0.5), under
+
+
 def scenario_with_measures(scenario, measures, where: str = "measures", road_collector: str | None = "road"):
     """A copy of ``scenario`` carrying every ditch (:class:`~riskrf.risk.measures.Ditch`) and slope measure
     (:class:`SlopeMeasure`) of ``measures``; spans must not overlap and must not cross the road line.
@@ -273,5 +404,5 @@ def scenario_with_measures(scenario, measures, where: str = "measures", road_col
     return replace(sc, name=scenario.name + "+measures")
 
 
-__all__ = ["DRAPE_MATERIAL", "SlopeMeasure", "bench_profile", "bund_profile", "drape_scenario",
-           "scenario_with_measures"]
+__all__ = ["DRAPE_MATERIAL", "DRAPE_MIN_FACE_DIP_DEG", "SlopeMeasure", "bench_profile", "bund_profile",
+           "check_drape_zone", "drape_release_share", "drape_scenario", "face_spans", "scenario_with_measures"]

@@ -428,6 +428,39 @@ class RetentionStage:
 
 
 @dataclass(frozen=True)
+class ContainmentStage:
+    """A drape: keeps on the face the share ``effect[:, containment]`` (its containment efficiency, an ASSUMPTION)
+    of the falls released under the mesh; the share of the falls that start under it, by mass bin and slope
+    model, is ``effect[:, share] + shift[d]`` (derived from the simulation: release points of the blocks that reach
+    the road).  Retained share = containment x share under the mesh."""
+
+    option: str
+    containment: int
+    share: int
+    shift: np.ndarray | None = None
+    after_road = False
+    downstream = True
+    stops_falls = True
+    moves_road = False
+
+    def apply(self, flow: _Flow, P: Parameters, d) -> None:
+        """Apply this stage to the falls in ``flow`` for the parameter samples ``P`` (in place).
+
+        Parameters
+        ----------
+        flow : _Flow
+            Falls per year by mass bin (S, J) [1/yr] and the totals the stages add up; changed in place.
+        P : Parameters
+            The S parameter samples.
+        d : numpy.ndarray of int
+            Slope model of each sample (S,), ``P.material_draw``.
+        """
+        under = P.effect[:, self.share][:, None] + (self.shift[d] if self.shift is not None else 0.0)
+        kept = np.clip(P.effect[:, self.containment], 0.0, 1.0)[:, None] * np.clip(under, 0.0, 1.0)
+        flow.x = flow.x * (1.0 - kept)
+
+
+@dataclass(frozen=True)
 class BarrierStage:
     """A fence, attenuator (at the barrier line or its own line) or shed (over the road, ``after_road``, covering
     ``coverage`` of the exposed length): per slope model and mass bin (models, J) the share of falls passing a

@@ -256,6 +256,8 @@ class Option:
     effectiveness: float | None = None            # scaling: share of the targeted releases removed when new
     effectiveness_range: tuple | None = None      # scaling: (low, high) of that share
     effectiveness_half_life_years: float | None = None   # scaling: years for the effect to halve
+    containment: float | None = None              # drape: share of the falls released under it kept on the face
+    containment_range: tuple | None = None        # drape: (low, high) of that share
 
     def scaling_effect(self) -> tuple:
         """Scaling and bolting by zone and mass: (initial effectiveness, its range, half-life [yr], mean over a
@@ -316,9 +318,9 @@ NUMBER_FIELDS = ("capital_cost", "annual_maintenance", "life_years", "repair_cos
                  "repair_days", "rate_reduction", "retention", "x_m", "width_m", "depth_m", "inner_slope_hv",
                  "outer_slope_hv", "capacity_kj", "height_m", "min_mass_kg", "max_mass_kg", "covered_length_m",
                  "road_x_m", "share_while_closed", "closure_hours_per_year", "cost_per_closure_hour",
-                 "threshold_mm", "window_days", "effectiveness", "effectiveness_half_life_years")
+                 "threshold_mm", "window_days", "effectiveness", "effectiveness_half_life_years", "containment")
 RANGE_FIELDS = ("capital_cost_range", "annual_maintenance_range", "retention_range", "rate_reduction_range",
-                "zone_x_m", "effectiveness_range")
+                "zone_x_m", "effectiveness_range", "containment_range")
 
 
 def _range(v, where: str, *, share: bool = False):
@@ -452,7 +454,8 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
     for key in RANGE_FIELDS:
         if key in spec:
             vals[key] = _range(spec[key], f"{source}: {where}: {key}",
-                               share=key in ("retention_range", "rate_reduction_range", "effectiveness_range"))
+                               share=key in ("retention_range", "rate_reduction_range", "effectiveness_range",
+                                            "containment_range"))
     at = f"{source}: {where}"
     kind_class.read_spec(kind, spec, vals, at)
     for owner in OWN_FIELD_KINDS:       # fields of one kind's own, named by another kind
@@ -462,7 +465,7 @@ def parse_option(spec: dict, i: int, source: str) -> Option:
     if spec.get("effectiveness_half_life_years") is not None and not spec["effectiveness_half_life_years"] > 0:
         raise MitigationError(f"{source}: {where}: effectiveness_half_life_years = "
                               f"{spec['effectiveness_half_life_years']!r} must be > 0 years")
-    for key in ("rate_reduction", "retention", "share_while_closed", "effectiveness"):
+    for key in ("rate_reduction", "retention", "share_while_closed", "effectiveness", "containment"):
         if spec.get(key) is not None and spec[key] > 1:
             raise MitigationError(f"{source}: {where}: {key} = {spec[key]!r} is a share and must lie in [0, 1]")
     for key in kind_class.required_fields:

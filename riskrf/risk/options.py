@@ -40,12 +40,21 @@ import numpy as np
 from ..core.format import money
 from ..core.validation import RiskrfError
 from .geometry_measures import SlopeMeasure
-from .loss_engine import BarrierStage, ClosureStage, ExposureStage, OptionChain, ReleaseStage, RetentionStage
+from .loss_engine import (
+    BarrierStage,
+    ClosureStage,
+    ContainmentStage,
+    ExposureStage,
+    OptionChain,
+    ReleaseStage,
+    RetentionStage,
+)
 from .measures import Ditch, MeasureError, runout_beyond, seeder_share
 
 OPTION_KINDS = ("none", "scaling", "ditch", "fence", "attenuator", "shed", "realignment", "closure", "combined",
                 "bench", "bund", "drape")
-#: Options that change the slope's geometry or surface; their effect is derived by re-simulation (like a ditch).
+#: Options that change the slope or hang on it (bench and bund re-simulated like a ditch; a drape: the falls
+#: released under it, see :class:`Drape`).
 SLOPE_KINDS = ("bench", "bund", "drape")
 BARRIER_KINDS = ("fence", "attenuator", "shed")
 #: Days a destroyed structure stays out of service (ASSUMPTION; override with ``repair_days``).
@@ -57,6 +66,14 @@ DEFAULT_REPAIR_DAYS = {"fence": 30.0, "attenuator": 30.0, "shed": 180.0}
 SCALING_EFFECTIVENESS = 0.8
 SCALING_EFFECTIVENESS_RANGE = (0.6, 0.95)
 SCALING_DEFAULT_CYCLE_YEARS = 10.0
+#: Drape: share of the blocks released under the mesh that it keeps on the face, and its range.  ASSUMPTIONS (no
+#: published containment efficiency was found; blocks bulge or tear the mesh, or leave at its open bottom):
+#: labelled "ASSUMED" in every output; override with containment and containment_range.
+DRAPE_CONTAINMENT = 0.85
+DRAPE_CONTAINMENT_RANGE = (0.7, 0.95)
+#: Drape: the largest block it contains without a stated max_mass_kg, as a sphere diameter [m] (ASSUMED: the upper
+#: end of the 0.6-1.0 m blocks typical of simple drapery, Giacchetti & Grimod, Maccaferri).
+DRAPE_MAX_BLOCK_DIAMETER_M = 1.0
 
 # the order in which the elements of an option act on the falls, in series
 RELEASE, TYPED_RETENTION, GEOMETRY, BARRIER, SHED, CLOSURE, EXPOSURE = range(7)
@@ -504,6 +521,11 @@ class Bench(_SlopeGeometry):
         return f"catch bench {o.width_m:g} m wide cut into the slope from x = {o.x_m:g} m; retention derived by " \
                "simulation"
 
+    @property
+    def sole_basis(self):
+        return ("derived: the slope re-simulated with the bench cut into it (common random numbers, as for a "
+                "ditch)")
+
 
 class Bund(_SlopeGeometry):
     """``bund``: an embankment on the ground."""
@@ -517,21 +539,128 @@ class Bund(_SlopeGeometry):
         return (f"bund {o.height_m:g} m high on the ground from x = {o.x_m:g} m over {o.width_m:g} m; "
                 "retention derived by simulation")
 
+    @property
+    def sole_basis(self):
+        return ("derived: the slope re-simulated with the bund built on it (common random numbers, as for a "
+                "ditch)")
 
-class Drape(_SlopeGeometry):
-    """``drape``: a secured mesh; the surface of its zone takes an ASSUMED material."""
+
+class Drape(OptionEffect):
+    """``drape``: a mesh hung on the rock face over ``zone_x_m``.
+
+    Its effect is derived where the simulation can derive it and assumed where it cannot (Badger & Duffy 2012):
+
+    * derived: the share of the falls reaching the road that are released under the mesh (release point in
+      ``zone_x_m``, by block mass and slope model, :meth:`riskrf.risk.slope_models.SlopeModels.drape_share`), with
+      its Monte Carlo Beta law; falls from above or beside the mesh are not credited (an unsecured or secured
+      drapery addresses the rock fall that originates from the covered area; a hybrid drapery or attenuator, kind
+      ``attenuator``, intercepts falls from upslope);
+    * derived, with an ASSUMED default: blocks heavier than ``max_mass_kg`` are not contained; without it, blocks
+      above a 1.0 m sphere (:data:`DRAPE_MAX_BLOCK_DIAMETER_M`, the upper end of the 0.6-1.0 m typical of simple
+      drapery, Giacchetti & Grimod; at the scenario's rock density) are not credited;
+    * ASSUMED: the containment efficiency ``containment`` (default :data:`DRAPE_CONTAINMENT`, range
+      :data:`DRAPE_CONTAINMENT_RANGE`), the share of the blocks released under the mesh that it keeps on the face
+      and delivers to the toe at low speed; the rest escape (they bulge or tear the mesh, or leave at its open
+      bottom) and are taken as falling as without it.
+
+    Retained share of the falls reaching the road = containment x share released under the mesh; never 100 %
+    without an ASSUMED containment of 1 stated in the option and labelled in every output.  A typed ``retention``
+    replaces all of this (an ASSUMPTION).
+
+    References
+    ----------
+    Badger, T. C. & Duffy, J. D. (2012).  Drapery systems.  In Turner & Schuster (eds), *Rockfall:
+    Characterization and Control*, chapter 16, TRB.
+    Giacchetti, G. & Grimod, A. Rockfall mitigation using simple drapery system: design approach (Maccaferri).
+    """
 
     geometry_fields = ("zone_x_m",)
+    own_fields = ("containment", "containment_range")
+
+    #: A drape acts on the face, before the slope's geometry changes and the structures below it.
+    order = TYPED_RETENTION
+
+    @classmethod
+    def finish_spec(cls, kind, spec, vals, at):
+        """Last check of a drape's table: its containment lies in its range.
+
+        Parameters
+        ----------
+        kind : str
+            The table's ``kind`` (``"drape"``).
+        spec : dict
+            The ``[[options]]`` table as read.
+        vals : dict
+            The values to build the option from.
+        at : str
+            ``"<source>: option '<name>'"``, the start of every error message.
+
+        Returns
+        -------
+        None
+            Raises a MitigationError when ``containment`` lies outside ``containment_range``, or a typed
+            ``retention`` is given with a containment (one replaces the other).
+        """
+        super().finish_spec(kind, spec, vals, at)
+        rng, c = vals.get("containment_range"), spec.get("containment")
+        if rng is not None and c is not None and not rng[0] <= c <= rng[1]:
+            raise MitigationError(f"{at}: containment = {c!r} lies outside containment_range = {list(rng)}")
+        if spec.get("retention") is not None and (c is not None or rng is not None):
+            raise MitigationError(f"{at}: a typed retention replaces the drape's derived effect: give retention "
+                                  "or containment, not both")
+
+    def containment(self) -> tuple:
+        """(containment efficiency [-], its (low, high) range [-], is it riskrf's ASSUMED default?).
+
+        Returns
+        -------
+        tuple
+            ``(c, (low, high), default)``.
+        """
+        o = self.option
+        if o.containment is None:
+            return DRAPE_CONTAINMENT, o.containment_range or DRAPE_CONTAINMENT_RANGE, True
+        return o.containment, o.containment_range or (o.containment, o.containment), False
+
+    def max_mass_kg(self, scenario) -> tuple:
+        """(largest block the mesh contains [kg], how it was set).
+
+        Parameters
+        ----------
+        scenario : simulation.scenario.Scenario or None
+            The slope scenario (its seeder's rock density [kg/m3] sets the default from
+            :data:`DRAPE_MAX_BLOCK_DIAMETER_M`).
+
+        Returns
+        -------
+        tuple
+            ``(mass [kg], text)``.
+        """
+        o = self.option
+        if o.max_mass_kg is not None:
+            return float(o.max_mass_kg), f"blocks above max_mass_kg = {o.max_mass_kg:,.0f} kg not contained"
+        rho = scenario.seeder.density_kg_m3 if scenario is not None else 2650.0
+        m = rho * np.pi * DRAPE_MAX_BLOCK_DIAMETER_M ** 3 / 6.0
+        return m, (f"blocks above {m:,.0f} kg (a {DRAPE_MAX_BLOCK_DIAMETER_M:g} m sphere; ASSUMED: no max_mass_kg "
+                   "given) not contained")
+
+    @property
+    def key(self) -> str:
+        """Name of the derived share under the mesh (its effect parameter is ``retention:<key>``)."""
+        return f"{self.option.name}: share under the mesh"
 
     def describe(self, currency=""):
         o = self.option
         if o.retention is not None:
             return _typed_retention(o, "drape")
-        return (f"drape (secured mesh) over x = {o.zone_x_m[0]:g}-{o.zone_x_m[1]:g} m: the surface takes "
-                "an ASSUMED low-bounce, high-friction material; retention derived by simulation")
+        c, (lo, hi), default = self.containment()
+        return (f"drape over the face at x = {o.zone_x_m[0]:g}-{o.zone_x_m[1]:g} m: keeps on the face "
+                f"{c:.0%} ({'ASSUMED' if default else 'stated, an ASSUMPTION'}, {lo:.0%}-{hi:.0%}) of the blocks "
+                "released under it (which falls start there: derived by simulation); falls from above or beside "
+                "the mesh not credited")
 
     def assumed_basis(self, n_components):
-        """(priority, text): the effect basis of an option with an assumed part of this kind.
+        """(priority, text): the effect basis of an option with a drape.
 
         Parameters
         ----------
@@ -544,8 +673,69 @@ class Drape(_SlopeGeometry):
             ``(priority, text)``: lower priority wins when several components have an assumed part; None when this kind
             assumes nothing.
         """
-        return 0, ("derived by re-simulation of the draped surface, whose material is ASSUMED "
-                   "(riskrf.risk.geometry_measures.DRAPE_MATERIAL)")
+        if self.option.retention is not None:
+            return None
+        c, (lo, hi), default = self.containment()
+        how = "ASSUMED containment" if default else "stated containment (an ASSUMPTION, not derived)"
+        mass = (f"blocks above max_mass_kg = {self.option.max_mass_kg:,.0f} kg not contained"
+                if self.option.max_mass_kg is not None else
+                f"blocks above a {DRAPE_MAX_BLOCK_DIAMETER_M:g} m sphere not contained (ASSUMED)")
+        return 0, (f"derived share of road falls released under the mesh ({self.option.name}: "
+                   f"x = {self.option.zone_x_m[0]:g}-{self.option.zone_x_m[1]:g} m; falls from above not credited; "
+                   f"{mass}) x {how} {c:.0%} ({lo:.0%}-{hi:.0%})"
+                   + ("; others derived (simulation and site geometry)" if n_components > 1 else ""))
+
+    def _own_parameters(self):
+        if self.option.retention is not None:
+            return []
+        return [(f"containment:{self.option.name}", self.containment()[0])]
+
+    def assumed_ranges(self):
+        if self.option.retention is not None:
+            return {}
+        c, (lo, hi), default = self.containment()
+        if not hi > lo:
+            return {}
+        return {f"containment:{self.option.name}": (
+            lo, hi, "uniform, " + ("ASSUMED (riskrf's default containment of a drape: no published efficiency "
+                                   "found)" if default else "stated (containment_range: an assumption)"))}
+
+    def check_zone(self, scenario, where: str) -> float:
+        """Check the draped zone against ``scenario`` (:func:`riskrf.risk.geometry_measures.check_drape_zone`).
+
+        Parameters
+        ----------
+        scenario : simulation.scenario.Scenario
+            The slope scenario.
+        where : str
+            The start of every error message (file and option).
+
+        Returns
+        -------
+        float
+            Share of the release line under the mesh [-].
+
+        Raises
+        ------
+        MitigationError
+            Naming ``where`` and ``zone_x_m`` when the zone leaves the profile, is not on a face or has no release.
+        """
+        from .geometry_measures import check_drape_zone
+        try:
+            return check_drape_zone(scenario, self.option.zone_x_m, where)
+        except MeasureError as exc:
+            raise MitigationError(str(exc)) from exc
+
+    def stages(self, site, space, index):
+        o = self.option
+        if o.retention is not None:
+            return [RetentionStage(o.name, space.column(f"retention:{o.name}"))]
+        ctx = site.need_context(o, "zone_x_m")
+        where = f"{site.source}: option {o.name!r}"
+        cap, _ = self.max_mass_kg(ctx.scenario)
+        s0, _, _, by_mass = site.drape_share(self.key, lambda sc: self.check_zone(sc, where), o.zone_x_m, cap)
+        return [ContainmentStage(o.name, space.column(f"containment:{o.name}"), space.column(f"retention:{self.key}"),
+                                 shift=by_mass - s0)]
 
 
 class _Structure(OptionEffect):
@@ -830,7 +1020,7 @@ class Combined(OptionEffect):
 
 
 #: Kinds with fields no other kind takes (their classes' ``own_fields``), in the order a table is checked for them.
-OWN_FIELD_KINDS = ("closure", "scaling")
+OWN_FIELD_KINDS = ("closure", "scaling", "drape")
 
 #: The class of each option kind.
 KIND_CLASSES = {"none": DoNothing, "scaling": Scaling, "ditch": CatchDitch, "fence": Barrier, "attenuator": Barrier,
@@ -895,8 +1085,12 @@ def effect_basis(option, components) -> str:
     if len(sole) == 1 and None not in sole:
         return sole.pop()
     assumed = [b for b in (e.assumed_basis(len(components)) for e in effects) if b is not None]
-    if assumed:
-        return min(assumed, key=lambda b: b[0])[1]
+    if len(assumed) == 1:
+        return assumed[0][1]
+    if assumed:                 # every assumed part named, lowest priority first; the derived rest once
+        tail = "; others derived (simulation and site geometry)"
+        texts = [t.removesuffix(tail) for _, t in sorted(assumed, key=lambda b: b[0])]
+        return "; ".join(texts) + (tail if len(components) > len(assumed) else "")
     return "derived (simulation and site geometry)"
 
 

@@ -30,7 +30,7 @@ class SensitivityMixin:
         ranges = self.parameter_ranges()
         if name in ranges:
             return ranges[name][0], ranges[name][1], ranges[name][2]
-        if name.startswith(("retention:", "rate_reduction:", "scaling_effectiveness:")):
+        if name.startswith(("retention:", "rate_reduction:", "scaling_effectiveness:", "containment:")):
             return max(value - 0.2, 0.0), min(value + 0.2, 1.0), "+-0.2 (no range stated)"
         if name == "discount_rate":
             return value * 0.5, min(value * 2, 0.2), "x0.5 / x2 (no range stated)"
@@ -85,7 +85,7 @@ class SensitivityMixin:
                               ).reset_index(drop=True)
 
     def _bracket(self, name, value):
-        if name.startswith(("retention:", "rate_reduction:", "scaling_effectiveness:")):
+        if name.startswith(("retention:", "rate_reduction:", "scaling_effectiveness:", "containment:")):
             return 0.0, 1.0, False
         if name == "b":
             return 0.2, 3.0, False

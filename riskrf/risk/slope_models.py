@@ -4,8 +4,9 @@ A :class:`SlopeModels` holds what the option kinds of :mod:`riskrf.risk.options`
 reference model (the hazard's own simulation) and the material-parameter variants (joint draws, and one low and
 one high variant per uncertain material for the tornado), each a :class:`SlopeModel` (speeds and bounce heights at
 the barrier line and the road, reach probability, P(road | barrier line)); for a mass-coupled hazard the arrivals
-by block mass; the fence damage states of every (slope model, mass bin) pair; and the retention of ditches,
-benches, bunds and drapes by re-simulating the changed slope with common random numbers.  Lengths in m, speeds
+by block mass; the fence damage states of every (slope model, mass bin) pair; the retention of ditches,
+benches and bunds by re-simulating the changed slope with common random numbers; and, for a drape, the share of
+the falls reaching the road that start under the mesh (their simulated release points).  Lengths in m, speeds
 in m/s, masses in kg, energies in kJ.
 """
 from __future__ import annotations
@@ -503,6 +504,59 @@ class SlopeModels:
             per_model = self._ditch_retentions(measures)
             self.derived[key] = (per_model[0][0], per_model[0][1], np.array([r for r, _, _ in per_model]),
                                  np.array([b for _, _, b in per_model]))
+        return self.derived[key]
+
+    def drape_share(self, key: str, scenario_check, zone_x_m, max_mass_kg=None) -> tuple:
+        """(share of the road falls released under a drape in the reference model, its Beta law, that share per
+        slope model, by mass bin per slope model) of the draped zone ``zone_x_m``; kept under ``key``.  Derived from
+        the release points of the simulated blocks that reach the road (no re-simulation: a drape does not change
+        where the blocks it does not hold go).
+
+        Parameters
+        ----------
+        key : str
+            Name under which the result is kept (its effect parameter is ``retention:<key>``).
+        scenario_check : callable
+            ``scenario_check(scenario)`` raises a MitigationError when the zone does not fit that slope model's
+            scenario (:func:`riskrf.risk.geometry_measures.check_drape_zone`).
+        zone_x_m : tuple of float
+            (x_lo, x_hi) of the draped zone [m].
+        max_mass_kg : float, optional
+            Largest block the mesh contains [kg]; None: every block.
+
+        Returns
+        -------
+        tuple
+            (share of the reference model [-], its Beta law (a, b), share per slope model [-], share by mass bin per
+            slope model [-]).
+        """
+        from .geometry_measures import drape_release_share
+        if key not in self.derived:
+            ctx = self.context
+            scenario_check(ctx.scenario)
+            mid = self.grid.mid
+            cap = np.ones(mid.size) if max_mass_kg is None else (mid <= max_mass_kg).astype(float)
+            rows = []
+            for i, m in enumerate(self.models):
+                res = self.reference_run if i == 0 else m.result
+                road = self.reference_road_blocks if i == 0 else road_crossings(res, ctx.road_collector)
+                share, beta, under = drape_release_share(res, road, zone_x_m, max_mass_kg)
+                mass = np.asarray(res.blocks["mass"], dtype=float)[road]
+                in_zone = drape_release_share(res, road, zone_x_m)[2]
+                if road.size:
+                    edges = np.quantile(mass, np.linspace(0, 1, 6))
+                    centres, shares = [], []
+                    for lo, hi in zip(edges[:-1], edges[1:]):
+                        sel = (mass >= lo) & (mass <= hi)
+                        if sel.any():
+                            centres.append(float(np.median(mass[sel])))
+                            shares.append(float(in_zone[sel].mean()))
+                    by_mass = np.interp(np.log(mid), np.log(centres), shares) * cap
+                else:
+                    by_mass = np.zeros(mid.size)
+                rows.append((share, beta, by_mass))
+            self.derived[key] = (rows[0][0], rows[0][1], np.array([r[0] for r in rows]),
+                                 np.array([r[2] for r in rows]))
         return self.derived[key]
 
     def _ditch_retentions(self, ditches) -> list:
