@@ -433,6 +433,21 @@ class MitigationStudy(RecommendationMixin, SensitivityMixin, Displayed):
                             float(r.effectiveness[0, k]))
 
     # ---- uncertainty ----------------------------------------------------------------------------
+    def sampled_costs(self) -> dict:
+        """The joint samples' total costs alone, without the tolerability statistics of :attr:`uncertain` (for the
+        repeated ensembles of the error budget, which need the expected costs and P(best) only).
+
+        Returns
+        -------
+        dict
+            ``names`` (options), ``total`` (S, K) [study currency], ``mean`` per option [study currency] and
+            ``probability_best`` per option [-].
+        """
+        r = self._evaluate(self.sample_parameters())
+        best = np.argmin(r.total, axis=1)
+        return {"names": r.names, "total": r.total, "mean": r.total.mean(axis=0),
+                "probability_best": np.bincount(best, minlength=r.total.shape[1]) / r.total.shape[0]}
+
     @cached_property
     def uncertain(self) -> dict:
         """Joint samples: total cost per sample and option (S, K) and the derived statistics per option.
@@ -463,7 +478,9 @@ class MitigationStudy(RecommendationMixin, SensitivityMixin, Displayed):
         regret = (total - total.min(axis=1, keepdims=True)).mean(axis=0)
         ir_ok = r.ir <= self.criteria.individual_risk_per_year
         fn_ok = self._fn_tolerable(r)
-        clusters = P.get("material_draw")
+        # the samples share material re-simulations only when the slope materials are uncertain (else every
+        # sample has the reference model, index 0, and is its own cluster)
+        clusters = P["material_draw"] if np.any(P.get("material_draw", 0) > 0) else None
         ens = self.ensemble
         se = combined_se(clustered_se(total, clusters),
                          None if ens is None else np.array([ens.cost_variance(n) for n in r.names]))
