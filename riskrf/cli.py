@@ -1036,8 +1036,9 @@ def _add_simulate_parser(sub) -> None:
     p = sub.add_parser("simulate", help="Monte Carlo rock fall trajectories on a slope scenario",
                        description="Simulate blocks released by a scenario's seeder (TOML; see the docs: File "
                        "formats, 'Scenario files') and write one row per collector crossing (velocity_ms, "
-                       "angular_velocity_rads, height_m, energy_kj, ...) to a Parquet or CSV file, with figures: "
-                       "the profile and trajectories, distributions at each collector, envelopes.", epilog=EPILOG)
+                       "angular_velocity_rads, height_m, energy_kj, ...) to a CSV or Parquet file (--format), "
+                       "with figures: the profile and trajectories, distributions at each collector, envelopes.",
+                       epilog=EPILOG)
     p.add_argument("scenario", help="scenario TOML file, e.g. simulation/scenarios/road_cut_barrier.toml")
     _add_release_arguments(p, 100_000)
     p.add_argument("--out", default=None, metavar="FILE",
