@@ -5,11 +5,12 @@ Run from the repository root::
     python tests/benchmarks/bench_simulate_output.py [-n 1000000] [--cli] [--before DIR]
 
 In one process it times the stages of ``riskrf simulate`` on the shipped barrier scenario: the kernel
-(``simulation.run``), building the crossings table, the printed summary, drawing the figures, then writing the three tables
-(crossings, ``runout``, ``envelopes``) three ways: the previous writer (pandas ``to_csv``, then every cell
-read back and checked one by one, timed apart), :func:`riskrf.io.outputs.write_csv`, and Parquet when pyarrow
-is installed.  It prints each stage's seconds and the share of writing in the run (kernel + table + summary +
-figures + writing, one after the other).  Stage times are wall seconds of one process; the machine's other jobs move them.
+(``simulation.run``), building the crossings table, the printed summary, drawing the figures, then writing
+the three tables (crossings, ``runout``, ``envelopes``) three ways: the previous writer (pandas ``to_csv``,
+then every cell read back and checked one by one, timed apart), :func:`riskrf.io.outputs.write_csv`, and
+Parquet when pyarrow is installed.  It prints each stage's seconds and the share of writing in the run
+(kernel + table + summary + figures + writing, one after the other).  Stage times are wall seconds of one
+process; the machine's other jobs move them.
 
 With ``--cli`` it also runs the whole command in a child process (``--format csv`` and ``--format parquet``)
 and prints its wall time and peak memory (the child's maximum resident set).  ``--before DIR`` runs the same
