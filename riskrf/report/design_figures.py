@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 OPTION_COLOURS = {"fence": "tab:red", "attenuator": "tab:orange", "ditch": "tab:blue", "shed": "tab:purple",
-                  "scaling": "tab:green", "realignment": "tab:brown", "required": "black"}
+                  "scaling": "tab:green", "realignment": "tab:brown", "required": "black", "bench": "tab:cyan",
+                  "bund": "tab:olive", "drape": "tab:pink"}
 
 
 def _profile_axes(ax, profile, title=None):
@@ -22,8 +23,9 @@ def _profile_axes(ax, profile, title=None):
 
 
 def options_profile_figure(scenario, options, *, barrier_x=None, road_x=None, requirement=None):
-    """The slope profile with each option's geometry: ditches dug into it, fences and attenuators at their height,
-    a shed roof over the road, the scaling zone on the face, a realigned road; and the required barrier (dashed)
+    """The slope profile with each option's geometry: ditches dug into it, benches cut and bunds built, fences and
+    attenuators at their height, a shed roof over the road, the scaling zone and a drape on the face, a realigned
+    road; and the required barrier (dashed)
     at the barrier line.  ``options``: :class:`~riskrf.risk.mitigation_inputs.Option` objects; ``requirement``: a
     :class:`~riskrf.hazard.design_basis.DesignRequirement` or None.
 
@@ -79,6 +81,20 @@ def options_profile_figure(scenario, options, *, barrier_x=None, road_x=None, re
             xs = np.linspace(o.zone_x_m[0], o.zone_x_m[1], 20)
             ax.plot(xs, [ground_z(prof, v) for v in xs], color=c, lw=5, alpha=0.6,
                     label=label("scaling", f"{o.name}: zone x = {o.zone_x_m[0]:g}-{o.zone_x_m[1]:g} m"))
+        elif o.kind in ("bench", "bund") and o.x_m is not None and o.width_m is not None \
+                and (o.kind == "bench" or o.height_m is not None):
+            from ..risk.geometry_measures import bench_profile, bund_profile
+            kw = {k: getattr(o, k) for k in ("inner_slope_hv",) + (("outer_slope_hv",) if o.kind == "bund" else ())
+                  if getattr(o, k) is not None}
+            new = bench_profile(prof, o.x_m, o.width_m, **kw) if o.kind == "bench" else \
+                bund_profile(prof, o.x_m, o.width_m, o.height_m, **kw)
+            sel = (new.x >= o.x_m - 0.5) & (new.x <= o.x_m + o.width_m + 0.5)
+            what = f"{o.width_m:g} m wide" if o.kind == "bench" else f"{o.height_m:g} m high, {o.width_m:g} m base"
+            ax.plot(new.x[sel], new.z[sel], color=c, lw=2.2, label=label(o.kind, f"{o.kind}: {o.name} ({what})"))
+        elif o.kind == "drape" and o.zone_x_m is not None:
+            xs = np.linspace(o.zone_x_m[0], o.zone_x_m[1], 20)
+            ax.plot(xs, [ground_z(prof, v) for v in xs], color=c, lw=3, ls=":",
+                    label=label("drape", f"{o.name}: mesh over x = {o.zone_x_m[0]:g}-{o.zone_x_m[1]:g} m"))
         elif o.kind == "realignment":
             xr = o.road_x_m if o.road_x_m is not None else float(x[-1])
             ax.annotate("", xy=(xr, float(ground_z(prof, min(xr, x[-1] - 1e-6))) + 1.0),

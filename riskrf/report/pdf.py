@@ -836,6 +836,12 @@ def _decision(rep, a, figs, s):
               widths=[1.9, 1.3, 1.3, 1.8, 1.4, 1, 1.1, 1.2, 1.1, 1.3], size=6.8)
     rep.text("Tolerable: meets the tolerability criteria (individual and societal risk); adequate: passes its "
              "design checks (see the table above).  An option that is not adequate is never recommended.", size=8)
+    opts = a.decision.get("options_table")
+    if opts is not None and len(opts):       # every effect's basis, ASSUMED parts labelled (as in report.html)
+        rep.caption("Mitigation options and where their effect comes from")
+        rep.table(["option", "what it is and assumes", "falls kept off the road", "effect from"],
+                  [[r["option"], str(r["what it is and assumes"]), f"{r['effectiveness']:.0%}", str(r["effect_basis"])]
+                   for _, r in opts.iterrows()], widths=[1.9, 5.6, 1.3, 4.6], size=6.5)
     ec = a.study.economics
     rep.text(f"Expected total cost = capital + present value of renewals, maintenance, repairs and replacements + "
              f"present value of expected losses, over {ec.horizon_years:g} years at {ec.discount_rate:.1%}; mean "
