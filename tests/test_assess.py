@@ -202,6 +202,9 @@ def test_options_recommendation_and_fence_heights_in_outputs(assessed):
     ranked = {r["option"]: r for r in s["ranking"]}
     assert ranked[rec["option"]]["design_adequate"] and "NOT ADEQUATE" not in str(rec["design_check"])
     assert set(rec["not_recommended"]) == {n for n, r in ranked.items() if not r["design_adequate"]} != set()
+    # issue 38: the presets are not calibrated on this slope, and every output says so first
+    assert s["trajectory_model"]["status"] == "uncalibrated" and s["warnings"][0].startswith("UNCALIBRATED")
+    assert "UNCALIBRATED trajectory model" in (out / "report.html").read_text()
     rb = s["required_barrier_option"]
     assert rb["placeable"] is False and "above the largest certified class" in rb["reason"]
     assert rb["alternatives"] and "No certified barrier meets" in rec["reason"]

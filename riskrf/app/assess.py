@@ -671,6 +671,9 @@ class Assessment:
     #: the trajectory model's uncertainty carried to the design energies and the ranking
     #: (:class:`~riskrf.app.model_uncertainty.ModelUncertaintyStudy`), None unless the site asks for it
     model_uncertainty: object = None
+    #: whether the trajectory model is calibrated on this slope
+    #: (:class:`~riskrf.hazard.trajectory_status.TrajectoryModelStatus`); its sentence leads the warnings when not
+    trajectory_model: object = None
     #: figures already being drawn beside the computation: {"dir": Path, "pending": [InBackground, ...]} (see
     #: ``run_assessment(figures_dir=...)``); empty when ``write_assessment`` draws them all.
     drawing: dict = field(default_factory=dict, repr=False)
@@ -755,6 +758,7 @@ class Assessment:
             "fn_zone": dict(zip(ranking["option"], ranking["fn_zone"])),
             "defaults_used": list(self.site.defaults_used),
             "warnings": self.warnings,
+            "trajectory_model": self.trajectory_model.to_dict() if self.trajectory_model is not None else None,
             "timings_s": self.timings,
         }
         if self.rates is not None:
@@ -861,11 +865,39 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             site, inventory, hazard, energy, rate_scale, release_factor, rate_note, mitigation, design_masses, log,
             timings)
     notes = _assessment_notes(frequency, [str(c.message) for c in caught], site_rates, inventory)
+    status = site_trajectory_status(site)
+    if status.uncalibrated:
+        notes.insert(0, status.text)
     return Assessment(site=site, inventory=inventory, frequency=frequency, maxima_frequency=maxima_frequency,
                       result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
                       warnings=notes, timings=timings, rates=site_rates, release_factor=release_factor,
-                      design=site_design, model_uncertainty=model_uncertainty,
+                      design=site_design, model_uncertainty=model_uncertainty, trajectory_model=status,
                       drawing={"dir": figures, "pending": pending} if figures is not None else {})
+
+
+def site_trajectory_status(site: Site):
+    """Is the site's trajectory model calibrated on its slope?  (:func:`riskrf.hazard.trajectory_status.
+    trajectory_model_status` of its scenario and calibration files.)
+
+    Parameters
+    ----------
+    site : Site
+        The checked site.
+
+    Returns
+    -------
+    TrajectoryModelStatus
+        The status and the sentence the outputs carry.
+    """
+    from ..hazard.trajectory_status import trajectory_model_status
+    data = None
+    if site.hazard.get("scenario"):
+        from simulation.calibration import scenario_dict
+        data, _ = scenario_dict(site.resolve(site.hazard["scenario"]))
+    unc = site.mitigation.get("uncertainty") if site.mitigation else None
+    mu = site.model_uncertainty or {}
+    return trajectory_model_status(data, calibration_bootstrap=getattr(unc, "calibration_source", "") or None,
+                                   posterior=mu.get("posterior"))
 
 
 def _start_compilation_and_rates(site: Site, log):
@@ -1309,7 +1341,7 @@ def ensemble_replicates(site: Site, result, seed, replicate, mitigation: dict, u
     means, best, names = [], [], None
     for s in seeds:
         _, st, _, _ = replicate(result.scenario, n, option_blocks, s, uncertainty, mitigation=mitigation)
-        u = st.uncertain
+        u = st.sampled_costs()
         names = tuple(u["names"])
         means.append(u["mean"])
         best.append(u["probability_best"])

@@ -211,6 +211,10 @@ def run_terrain_assessment(site: Site, *, seed: int | None = None, n_blocks: int
         log(f"[4/4] no road line named {rname!r} in the scenario: no road outputs")
     timings["road"] = round(time.perf_counter() - t, 2)
     warnings = list(frequency.warnings)
+    from .assess import site_trajectory_status
+    status = site_trajectory_status(site)
+    if status.uncalibrated:
+        warnings.insert(0, status.text)
     if road is None:
         warnings.append(f"hazard.road_collector = {rname!r} is not a line of the terrain scenario: no road outputs")
     return TerrainAssessment(site=site, inventory=inventory, frequency=frequency, hazard=hazard, result=result,
