@@ -277,8 +277,9 @@ def test_off_by_default(tmp_path):
 def carried(tmp_path_factory):
     from riskrf.app.assess import run_assessment
     tmp = tmp_path_factory.mktemp("model_uncertainty")
-    site = load_site(_site(tmp, "[model_uncertainty]\ndraws = 3\nn_blocks = 600\noption_blocks = 300\n"
-                                "bootstrap = 20\nsynthetic_calibrations = 40\ncalibration_releases = 10"))
+    site = load_site(_site(tmp, "[model_uncertainty]\ndraws = 3\nmax_draws = 3\nn_blocks = 600\n"
+                                "option_blocks = 300\nbootstrap = 20\nsynthetic_calibrations = 40\n"
+                                "calibration_releases = 10"))
     return run_assessment(site)
 
 
@@ -436,3 +437,28 @@ def test_an_evpi_of_zero_from_few_draws_is_reported_with_its_upper_bound():
     assert v.evsi == 0.0 and v.to_dict()["evpi_upper_bound_97_5"] > 0
     assert "0 CHF, as is the EVPI of the material parameters (no draw of 8 changes the choice; both at most" \
         in v.verdict()
+
+
+def test_more_draws_until_the_value_of_calibrating_is_resolved():
+    """Issue 40 item 3: the trajectory model's draws are added (doubling, up to max_draws) until the choice between
+    calibrating first and deciding now is resolved; the outputs say which stopped them."""
+    from riskrf.app.model_uncertainty import calibration_resolved, effort_text
+    from riskrf.risk.model_decision import CalibrationValue
+
+    def value(evsi, se, bound, cost=100_000.0):
+        return CalibrationValue(evsi=max(evsi, 0.0), evsi_estimate=evsi, standard_error=se, evpi=evsi, n_releases=20,
+                                n_datasets=200, best_now="a", probability_decision_changes=0.0, after_calibration={},
+                                calibration_cost=cost, evpi_upper_bound=bound)
+    assert calibration_resolved(value(0.0, 0.0, 51_000.0)) == "decide now"            # even the bound is cheaper
+    assert calibration_resolved(value(0.0, 0.0, 150_000.0)) == ""                     # 8 draws cannot tell
+    assert calibration_resolved(value(300_000.0, 50_000.0, 400_000.0)) == "calibrate first"
+    assert calibration_resolved(value(120_000.0, 50_000.0, 400_000.0)) == ""
+    assert calibration_resolved(value(0.0, 0.0, 1e9, cost=None)) == "no cost stated"
+    text = effort_text([(8, ""), (16, ""), (32, "")], 32, value(0.0, 0.0, 150_000.0))
+    assert "8 -> 16 -> 32" in text and "NOT resolved" in text
+    assert "decide now" in effort_text([(8, ""), (16, "decide now")], 32, value(0.0, 0.0, 51_000.0))
+
+
+def test_a_draw_budget_below_the_draws_is_refused(tmp_path):
+    with pytest.raises(SiteError, match="max_draws = 4 is below model_uncertainty.draws = 8"):
+        load_site(_site(tmp_path, "[model_uncertainty]\nmax_draws = 4"))

@@ -91,6 +91,10 @@ def check_model_uncertainty(data, site_path: Path, hazard: dict, *, error=ModelU
                 used.append(f"model_uncertainty.{key} = {default!r}")
     if cfg["seed"] is None:
         cfg["seed"] = hazard["seed"]
+    if "max_draws" in data and isinstance(cfg["max_draws"], int) and isinstance(cfg["draws"], int) \
+            and cfg["max_draws"] < cfg["draws"]:
+        raise error(f"{where}.max_draws = {cfg['max_draws']!r} is below model_uncertainty.draws = {cfg['draws']!r}: "
+                    "the budget must allow at least the draws the study starts with")
     cfg["calibration_cost_is_assumption"] = cfg["calibration_cost"] is None
     if cfg["calibration_cost"] is None:
         cfg["calibration_cost"] = DEFAULT_CALIBRATION_COST
@@ -256,6 +260,65 @@ def _without_material_draws(uncertainty):
     return replace(uncertainty, **kw)
 
 
+def calibration_resolved(calibration) -> str:
+    """Is the choice between calibrating first and deciding now resolved by the draws?  "" when not.
+
+    Resolved as "decide now" when even the EVPI's 97.5 % upper bound (which bounds the EVSI) is below the
+    calibration's cost, as "calibrate first" when the EVSI less two standard errors exceeds it, and as "no cost
+    stated" without a cost (nothing to decide).
+
+    Parameters
+    ----------
+    calibration : riskrf.risk.model_decision.CalibrationValue
+        The value of the field calibration from the draws so far (money in the site currency).
+
+    Returns
+    -------
+    str
+        "decide now", "calibrate first", "no cost stated" or "" (not resolved).
+    """
+    cost = calibration.calibration_cost
+    if cost is None:
+        return "no cost stated"
+    bound = calibration.evpi_upper_bound
+    if np.isfinite(bound) and bound < cost:
+        return "decide now"
+    if calibration.evsi_estimate - 2.0 * calibration.standard_error > cost:
+        return "calibrate first"
+    return ""
+
+
+def effort_text(rounds, budget: int, calibration) -> str:
+    """The draws used and why they stopped, in one sentence.
+
+    Parameters
+    ----------
+    rounds : sequence of (int, str)
+        (draws so far, what resolved, "" when not) after each round.
+    budget : int
+        ``[model_uncertainty] max_draws`` (or ``draws`` when smaller).
+    calibration : riskrf.risk.model_decision.CalibrationValue
+        The final value of the calibration.
+
+    Returns
+    -------
+    str
+        The sentence.
+    """
+    n, reached = rounds[-1]
+    path = " -> ".join(str(k) for k, _ in rounds)
+    if reached:
+        why = {"decide now": "the EVPI's upper bound is below the calibration's cost (decide now, whatever more "
+                             "draws would show)",
+               "calibrate first": "the EVSI exceeds the calibration's cost by more than two standard errors",
+               "no cost stated": "no calibration cost is weighed"}[reached]
+        return f"draws of the trajectory model: {path}; stopped because {why}"
+    return (f"draws of the trajectory model: {path}; the budget (max_draws = {budget}) is used and the choice "
+            f"between calibrating first and deciding now is NOT resolved: EVSI {calibration.evsi_estimate:,.0f} +- "
+            f"{2 * calibration.standard_error:,.0f}, EVPI at most {calibration.evpi_upper_bound:,.0f}, against a "
+            f"cost of {calibration.calibration_cost:,.0f}")
+
+
 def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_T: float = 100.0, T=None,
                           log=None) -> ModelUncertaintyStudy:
     """Re-simulate the site's slope for each draw of the trajectory model and carry it to the design energies,
@@ -297,30 +360,57 @@ def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_
     scenario = cfg["scenario_path"]
     timings = {}
     t0 = time.perf_counter()
-    draws = simulation.material_draws(scenario, int(cfg["draws"]), posterior=cfg["posterior_table"], seed=seed)
+    uncertainty = _without_material_draws(site.mitigation.get("uncertainty"))
+    hazards, costs, samples, stops, rows = [], [], [], [], []
+    names, parts, rounds = None, [], []
+    profile = simulation.load_scenario(scenario).profile
+    T = [design_T] if T is None else sorted(set(float(x) for x in T) | {float(design_T)})
+    budget = max(int(cfg.get("max_draws") or 0), int(cfg["draws"]))
+    k_new, analysis_s = int(cfg["draws"]), 0.0
+    while True:
+        # each round adds draws of its own seed (a Latin hypercube or rows of the posterior), evaluated once
+        new = simulation.material_draws(scenario, k_new, posterior=cfg["posterior_table"],
+                                        seed=seed if not parts else seed + 7919 * len(parts))
+        parts.append(new)
+        for values in new.to_dict(orient="records"):
+            j = len(rows)
+            log(f"      draw {j + 1} of the trajectory model")
+            sc = simulation.scenario_with_values(scenario, values)
+            hz, study, result, share = evaluate_draw(sc, int(cfg["n_blocks"]), int(cfg["option_blocks"]), seed,
+                                                     uncertainty)
+            u = study.uncertain
+            names = tuple(u["names"]) if names is None else names
+            hazards.append(hz)
+            costs.append(np.asarray(u["mean"], dtype=float))
+            samples.append(np.asarray(u["total"], dtype=float))
+            stops.append(np.asarray(result.per_block["x"], dtype=float))
+            rows.append({"draw": j, "reach_probability": hz.reach_probability, "arrivals_per_year": hz.arrival_rate,
+                         "road_share": share, "median_stop_x_m": float(np.median(stops[-1]))})
+            currency = study.currency
+        # (pandas compares the parts' attrs when it concatenates: the ranges table is kept from the first only)
+        draws = pd.concat([pd.DataFrame(p.to_dict(orient="list")) for p in parts], ignore_index=True)
+        draws.attrs = dict(parts[0].attrs)
+        t = time.perf_counter()
+        ranking = ModelUncertainRanking(names, np.vstack(costs), draws=draws, sample_costs=np.stack(samples),
+                                        currency=currency, basis=draws.attrs.get("basis", ""))
+        calibration = ranking.calibration_value(stops, n_releases=int(cfg["calibration_releases"]),
+                                                profile_range_m=(float(profile.x[0]), float(profile.x[-1])),
+                                                obs_error_m=float(cfg["obs_error_m"]),
+                                                n_datasets=int(cfg["synthetic_calibrations"]), seed=seed,
+                                                calibration_cost=float(cfg["calibration_cost"]),
+                                                cost_is_assumption=bool(cfg["calibration_cost_is_assumption"]))
+        analysis_s += time.perf_counter() - t
+        reached = calibration_resolved(calibration)
+        rounds.append((len(draws), reached))
+        if reached or len(draws) >= budget:
+            break
+        k_new = min(len(draws), budget - len(draws))
+        log(f"      the value of calibrating is not resolved with {len(draws)} draws: {k_new} more")
+    timings["draws"] = round(time.perf_counter() - t0 - analysis_s, 2)
     basis = draws.attrs.get("basis", "")
     if cfg["posterior"]:
         basis = f"posterior {Path(cfg['posterior']).name}: " + basis
-    uncertainty = _without_material_draws(site.mitigation.get("uncertainty"))
-    hazards, costs, samples, stops, rows = [], [], [], [], []
-    names = None
-    for j, (_, values) in enumerate(draws.iterrows()):
-        log(f"      draw {j + 1}/{len(draws)} of the trajectory model")
-        sc = simulation.scenario_with_values(scenario, values.to_dict())
-        hz, study, result, share = evaluate_draw(sc, int(cfg["n_blocks"]), int(cfg["option_blocks"]), seed,
-                                                 uncertainty)
-        u = study.uncertain
-        names = tuple(u["names"]) if names is None else names
-        hazards.append(hz)
-        costs.append(np.asarray(u["mean"], dtype=float))
-        samples.append(np.asarray(u["total"], dtype=float))
-        stops.append(np.asarray(result.per_block["x"], dtype=float))
-        rows.append({"draw": j, "reach_probability": hz.reach_probability, "arrivals_per_year": hz.arrival_rate,
-                     "road_share": share, "median_stop_x_m": float(np.median(stops[-1]))})
-        currency = study.currency
-    timings["draws"] = round(time.perf_counter() - t0, 2)
     t = time.perf_counter()
-    T = [design_T] if T is None else sorted(set(float(x) for x in T) | {float(design_T)})
     energy = design_energy_split(hazards, T, n_bootstrap=int(cfg["bootstrap"]), seed=seed,
                                  reference=reference_hazard, basis=basis)
     design_row = energy.per_draw[np.isclose(energy.per_draw["T_years"], design_T)]
@@ -328,15 +418,9 @@ def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_
         columns={"energy_kj": f"energy_{design_T:g}_year_kj"}), on="draw")
     ranking = ModelUncertainRanking(names, np.vstack(costs), draws=draws, sample_costs=np.stack(samples),
                                     currency=currency, basis=basis)
-    profile = simulation.load_scenario(scenario).profile
-    calibration = ranking.calibration_value(stops, n_releases=int(cfg["calibration_releases"]),
-                                            profile_range_m=(float(profile.x[0]), float(profile.x[-1])),
-                                            obs_error_m=float(cfg["obs_error_m"]),
-                                            n_datasets=int(cfg["synthetic_calibrations"]), seed=seed,
-                                            calibration_cost=float(cfg["calibration_cost"]),
-                                            cost_is_assumption=bool(cfg["calibration_cost_is_assumption"]))
-    timings["analysis"] = round(time.perf_counter() - t, 2)
-    notes = [f"{len(draws)} draws of the material parameters ({basis}), each re-simulated with "
+    timings["analysis"] = round(time.perf_counter() - t + analysis_s, 2)
+    notes = [effort_text(rounds, budget, calibration),
+             f"{len(draws)} draws of the material parameters ({basis}), each re-simulated with "
              f"{int(cfg['n_blocks']):,} blocks and seed {seed} (common random numbers; the assessment's own run "
              f"uses {site.hazard['n_blocks']:,}), its options with {int(cfg['option_blocks']):,} blocks",
              "costs per draw: the mitigation study's mean over its joint samples of the other uncertain inputs "

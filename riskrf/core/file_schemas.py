@@ -312,6 +312,8 @@ MODEL_UNCERTAINTY = Table("model_uncertainty", (
     _path("posterior", "posterior sample of the scenario's material parameters (simulation.PooledCalibration.write); "
           "without it, the presets' spread (ASSUMED ranges, simulation.material_uncertainty)"),
     _count("draws", "draws of the material parameters, each re-simulated", default=8, low=2),
+    _count("max_draws", "budget of draws: more are added (doubling) until the choice between calibrating first "
+           "and deciding now is resolved (default 32, at least draws)", default=32, low=2),
     _count("n_blocks", "simulated blocks per draw (energy hazard and the seeder's run)", default=2000, low=100),
     _count("option_blocks", "blocks per re-simulation of an option, per draw", default=1000, low=100),
     _count("bootstrap", "bootstrap replicates of the design energies, per draw", default=100, low=10),
