@@ -62,7 +62,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .materials import ALIASES, PRESETS, resolve_material
+from .materials import ALIASES, PRESETS, PresetError, parameter_sets_any, resolve_material
+from .materials import _unknown as materials_unknown
 from .scenario import Scenario, ScenarioError, scenario_from_dict
 
 #: Half-widths of the ASSUMED ranges of each preset's parameters (see the module docstring): preset -> field ->
@@ -185,7 +186,7 @@ def with_site_spread(sample: pd.DataFrame, bounds: dict, seed=1) -> pd.DataFrame
     Parameters
     ----------
     sample : pandas.DataFrame
-        Posterior draws, one column per dotted field (:func:`simulation.materials.preset_posterior`).
+        Posterior draws, one column per dotted field (:func:`preset_posterior`).
     bounds : dict
         Field -> (low, high) of its prior.
     seed : int, optional
@@ -208,8 +209,43 @@ def with_site_spread(sample: pd.DataFrame, bounds: dict, seed=1) -> pd.DataFrame
     return out
 
 
+def preset_posterior(presets=None, *, new_site: bool = False, seed=1):
+    """The joint posterior sample of the data-derived preset fields (200 draws; rows are joint draws, keep them
+    together).  Columns are dotted scenario paths ``materials.<preset>.<field>``, usable as the parameters of
+    ``[uncertainty.materials]`` draws or of :func:`simulation.pooled.read_posterior`-style propagation.
+
+    Parameters
+    ----------
+    presets : list of str, optional
+        Keep only the columns of these presets (aliases accepted).
+    new_site : bool, optional
+        Add the ASSUMED site-to-site spread (:func:`simulation.material_uncertainty.with_site_spread`): the draws
+        for a site the calibration data did not sample.  The posterior alone is the uncertainty within the data
+        sets; the leave-one-data-set-out check shows a new site differs by more.
+    seed : int, optional
+        Random seed of that spread.
+
+    Returns
+    -------
+    pandas.DataFrame
+    """
+    from . import preset_priors
+    df = pd.DataFrame(preset_priors.SAMPLE)
+    if presets is not None:
+        keys = []
+        for n in presets:
+            k = ALIASES.get(n, n)
+            if k not in PRESETS:
+                raise PresetError(materials_unknown(n, "preset", "<preset_posterior()>"))
+            keys.append(k)
+        df = df[[c for c in df.columns if parameter_sets_any(c, keys)]]
+    if new_site:
+        df = with_site_spread(df, {k: v["bounds"] for k, v in preset_priors.SUMMARY.items()}, seed)
+    return df
+
+
 def _scenario_data(scenario) -> tuple[dict, str, Path | None]:
-    from .calibration import scenario_dict
+    from .parameters import scenario_dict
     data, src = scenario_dict(scenario)
     base = Path(src).parent if Path(src).is_file() else None
     return data, src, base
@@ -319,7 +355,7 @@ def scenario_with_values(scenario, values: dict) -> Scenario:
     Scenario
         The checked scenario with the values set.
     """
-    from .calibration import apply_parameters
+    from .parameters import apply_parameters
     data, src, base = _scenario_data(scenario)
     try:
         return scenario_from_dict(apply_parameters(data, values, source=src), source=src, base_dir=base)
@@ -329,5 +365,6 @@ def scenario_with_values(scenario, values: dict) -> Scenario:
         raise ScenarioError(str(exc)) from None
 
 
-__all__ = ["ASSUMED_HALF_WIDTHS", "PRESET_SPREAD_SOURCES", "assumed_spread", "material_draws", "preset_spread",
+__all__ = ["ASSUMED_HALF_WIDTHS", "PRESET_SPREAD_SOURCES", "assumed_spread", "material_draws", "preset_posterior",
+           "preset_spread",
            "scenario_with_values"]

@@ -360,43 +360,6 @@ def preset_prior(name: str):
     return pd.DataFrame(rows).set_index("field")
 
 
-def preset_posterior(presets=None, *, new_site: bool = False, seed=1):
-    """The joint posterior sample of the data-derived preset fields (200 draws; rows are joint draws, keep them
-    together).  Columns are dotted scenario paths ``materials.<preset>.<field>``, usable as the parameters of
-    ``[uncertainty.materials]`` draws or of :func:`simulation.pooled.read_posterior`-style propagation.
-
-    Parameters
-    ----------
-    presets : list of str, optional
-        Keep only the columns of these presets (aliases accepted).
-    new_site : bool, optional
-        Add the ASSUMED site-to-site spread (:func:`simulation.material_uncertainty.with_site_spread`): the draws
-        for a site the calibration data did not sample.  The posterior alone is the uncertainty within the data
-        sets; the leave-one-data-set-out check shows a new site differs by more.
-    seed : int, optional
-        Random seed of that spread.
-
-    Returns
-    -------
-    pandas.DataFrame
-    """
-    import pandas as pd
-    from . import preset_priors
-    df = pd.DataFrame(preset_priors.SAMPLE)
-    if presets is not None:
-        keys = []
-        for n in presets:
-            k = ALIASES.get(n, n)
-            if k not in PRESETS:
-                raise PresetError(_unknown(n, "preset", "<preset_posterior()>"))
-            keys.append(k)
-        df = df[[c for c in df.columns if parameter_sets_any(c, keys)]]
-    if new_site:
-        from .material_uncertainty import with_site_spread
-        df = with_site_spread(df, {k: v["bounds"] for k, v in preset_priors.SUMMARY.items()}, seed)
-    return df
-
-
 def _unknown(name, where: str, source: str) -> str:
     options = sorted(PRESETS) + sorted(ALIASES)
     close = difflib.get_close_matches(str(name), options, n=1, cutoff=0.5)

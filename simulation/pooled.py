@@ -63,7 +63,7 @@ import pandas as pd
 from scipy import stats
 
 from ._display import Displayed, short_repr
-from .calibration import check_material_names, scenario_dict, set_parameter
+from .parameters import check_material_names, scenario_dict, set_parameter
 from .materials import material_parameter, parameter_materials, parameter_sets_any
 from .scenario import Distribution, Material, Scenario, ScenarioError, scenario_from_dict
 from .surrogate import _in_unit_box, _t_draw, _t_logpdf, gp_posterior_sample, replicate_noise

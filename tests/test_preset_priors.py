@@ -13,7 +13,8 @@ import pytest
 
 import simulation
 from simulation import preset_priors
-from simulation.materials import PRESETS, PresetError, preset, preset_posterior, preset_prior
+from simulation.material_uncertainty import preset_posterior
+from simulation.materials import PRESETS, PresetError, preset, preset_prior
 from simulation.pooled import ReachConstraint, Release, calibrate_pooled
 
 

@@ -892,7 +892,7 @@ def site_trajectory_status(site: Site):
     from ..hazard.trajectory_status import trajectory_model_status
     data = None
     if site.hazard.get("scenario"):
-        from simulation.calibration import scenario_dict
+        from simulation.parameters import scenario_dict
         data, _ = scenario_dict(site.resolve(site.hazard["scenario"]))
     unc = site.mitigation.get("uncertainty") if site.mitigation else None
     mu = site.model_uncertainty or {}

@@ -439,7 +439,7 @@ def vt0_sensitivity(n_draws: int, n_each: int, seed: int) -> pd.DataFrame:
 
     ``n_draws`` joint draws of the shipped posterior (the same for every row), ``n_each`` blocks per Authume
     release and draw; Evans & Hungr one 200-block run per draw; the ODOT cut one 600-block run per draw."""
-    from simulation.materials import preset_posterior
+    from simulation.material_uncertainty import preset_posterior
     draws = preset_posterior().sample(n_draws, random_state=seed).to_dict("records")
     shipped = copy.deepcopy(CONTACT_LAWS)
     rows = []
@@ -615,7 +615,7 @@ def main():
         print(pd.DataFrame(rows).round(3).to_string())
     if args.kernel == "2d" and args.model in ODOT_MODELS and not args.with_ritchie:
         if args.model == "contact":                           # the shipped priors are the contact model's
-            from simulation.materials import preset_posterior
+            from simulation.material_uncertainty import preset_posterior
             label, post = "fitted on all three (the shipped priors)", preset_posterior(list(ODOT_MATERIALS))
         else:
             label, post = "fitted on all three", fit(DATASETS, args.n_per_release, args.seed, n_predictive=0,
