@@ -69,10 +69,10 @@ def test_seed_repeat_z_scores_have_unit_spread():
     re-drawn), the z-scores (value - mean over seeds) / reported SE have an sd between 0.7 and 1.4, for the
     difference of the two cheapest options and for the expected cost of doing nothing.  Each material draw is its
     own ensemble, so the clustered SE carries the trajectory noise (the hazard is fixed here; the app adds the
-    hazard simulation's part by repeated ensembles).  Measured: sd of z 0.93 (difference) and 0.88 (doing
-    nothing); with the SE of before (sd / sqrt(S), the samples taken as independent) 3.05 for the difference, so
-    this test can fail.  On the demo that SE was 10 times too small (8,400 against 74,000 CHF between sampling
-    seeds)."""
+    hazard simulation's part by repeated ensembles).  The draws are a Latin hypercube, whose strata the SE takes
+    into account.  Measured: sd of z 0.81 (difference) and 0.85 (doing nothing); 0.36 with the draws counted as
+    independent (too wide), 3.05 with the samples counted as independent and independent draws (too narrow; on
+    the demo that SE was 10 times too small)."""
     diffs, d_se, naive, nothing, nothing_se = [], [], [], [], []
     for seed in range(24):
         s = _study(seed, 500 + seed)
@@ -80,8 +80,8 @@ def test_seed_repeat_z_scores_have_unit_spread():
         i, j = u["names"].index("nothing"), u["names"].index("fence")
         d = u["total"][:, j] - u["total"][:, i]
         diffs.append(d.mean())
-        d_se.append(float(clustered_se(d, u["clusters"])))
-        naive.append(d.std(ddof=1) / np.sqrt(d.size))
+        d_se.append(float(clustered_se(d, u["clusters"], u["design"])))
+        naive.append(float(clustered_se(d, u["clusters"])))          # the draws taken as independent
         nothing.append(u["mean"][i])
         nothing_se.append(u["se"][i])
     diffs, nothing = np.array(diffs), np.array(nothing)
@@ -89,13 +89,14 @@ def test_seed_repeat_z_scores_have_unit_spread():
     z_n = (nothing - nothing.mean()) / np.array(nothing_se)
     assert 0.7 <= z_d.std(ddof=1) <= 1.4, z_d.std(ddof=1)
     assert 0.7 <= z_n.std(ddof=1) <= 1.4, z_n.std(ddof=1)
-    assert ((diffs - diffs.mean()) / np.array(naive)).std(ddof=1) > 2.0         # the old SE was over-confident
+    # the draws are a Latin hypercube: counted as independent draws, the clustered SE is far too wide
+    assert ((diffs - diffs.mean()) / np.array(naive)).std(ddof=1) < 0.6
 
 
 def test_resolution_reports_the_sources_and_the_clustered_error():
     s = _replicated(3)
     res = s.resolution()
-    assert "400 joint samples in 20 material re-simulations (clustered)" in res["text"]
+    assert "400 joint samples in 20 material re-simulations (clustered, a Latin hypercube)" in res["text"]
     assert "2 repeated trajectory ensembles" in res["text"]
     t = s.ranking()
     assert (t["expected_total_cost_se"] > 0).all()

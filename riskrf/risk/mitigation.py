@@ -481,10 +481,12 @@ class MitigationStudy(RecommendationMixin, SensitivityMixin, Displayed):
         # the samples share material re-simulations only when the slope materials are uncertain (else every
         # sample has the reference model, index 0, and is its own cluster)
         clusters = P["material_draw"] if np.any(P.get("material_draw", 0) > 0) else None
+        design = self._draw_design(clusters)
         ens = self.ensemble
-        se = combined_se(clustered_se(total, clusters),
+        se = combined_se(clustered_se(total, clusters, design),
                          None if ens is None else np.array([ens.cost_variance(n) for n in r.names]))
         return {"names": r.names, "total": total, "mean": total.mean(axis=0), "clusters": clusters, "best": best,
+                "design": design,
                 "se": se, "error_sources": sources_text(total.shape[0], 0 if clusters is None else
                                                         len(np.unique(clusters)), ens),
                 "probability_meets_criteria": (ir_ok & fn_ok).mean(axis=0),
@@ -493,6 +495,17 @@ class MitigationStudy(RecommendationMixin, SensitivityMixin, Displayed):
                 "probability_meets_individual_risk": ir_ok.mean(axis=0),
                 "evpi": evpi_estimate(total).value if total.shape[0] > 1 and total.shape[1] > 1 else 0.0,
                 "samples": total.shape[0]}
+
+    def _draw_design(self, clusters):
+        """The Latin-hypercube coordinates of the material draws the samples use (rows in the order of the draws
+        that occur in ``clusters``), or None (no clusters, or draws from a calibration bootstrap)."""
+        if clusters is None:
+            return None
+        D = self._slopes.draw_design()
+        if D is None:
+            return None
+        used = np.unique(clusters).astype(int)                  # material_draw indices 1 ... G
+        return D[used - 1] if used.max() <= len(D) else None
 
     def _fn_tolerable(self, r) -> np.ndarray:
         """Per sample and option: is the F-N curve outside the selected criteria's unacceptable region (N up to

@@ -51,9 +51,9 @@ class RecommendationMixin:
         d = u["total"][:, names.index(b)] - u["total"][:, names.index(a)]
         ens = self.ensemble
         g = u["clusters"]
-        se = combined_se(clustered_se(d, g), None if ens is None else ens.difference_variance(a, b))
+        se = combined_se(clustered_se(d, g, u["design"]), None if ens is None else ens.difference_variance(a, b))
         p = float(u["probability_best"][names.index(a)])
-        se_p = combined_se(clustered_se((u["best"] == names.index(a)).astype(float), g),
+        se_p = combined_se(clustered_se((u["best"] == names.index(a)).astype(float), g, u["design"]),
                            None if ens is None else ens.probability_variance(a))
         ok = bool(abs(d.mean()) > 2 * se)
         text = (f"{a} and {b} {'are' if ok else 'are NOT'} distinguishable at the stated effort ({u['error_sources']}"

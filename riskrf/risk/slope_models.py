@@ -163,7 +163,14 @@ class SlopeModels:
                 pick = rng.choice(len(rows), size=u.material_draws, replace=len(rows) < u.material_draws)
                 draws = [{n: float(rows.iloc[i][f"materials.{n}"]) for n in names} for i in pick]
             else:
-                draws = [{n: float(rng.uniform(*ranges[n][:2])) for n in names} for _ in range(u.material_draws)]
+                # a Latin hypercube over the stated ranges (each range cut into G strata, one draw in each, the
+                # strata paired at random): the mean over the draws varies less than with independent draws
+                # (demo: the sd of doing nothing's expected cost over sampling seeds 22 % -> 9 %); its standard
+                # error takes the main effects out (riskrf.risk.error_budget.clustered_se with a design)
+                G = u.material_draws
+                cols = {n: ranges[n][0] + (rng.permutation(G) + rng.uniform(size=G)) / G
+                        * (ranges[n][1] - ranges[n][0]) for n in names}
+                draws = [{n: float(cols[n][i]) for n in names} for i in range(G)]
             central = {n: material_value(ctx.scenario, n) for n in names}
             variants = [(vals, "draw") for vals in draws] + \
                 [({**central, n: v}, f"{n} {end}") for n in names for end, v in (("low", ranges[n][0]),
@@ -178,6 +185,27 @@ class SlopeModels:
             for (vals, label), sc, res, seed in zip(variants, scenarios, ctx.run_many(scenarios, seeds), seeds):
                 models.append(self._simulated_model(vals, label, sc, res, seed))
         return models
+
+    def draw_design(self):
+        """The joint material draws' coordinates, one row per draw (models 1 ... G), each parameter scaled to
+        [0, 1] of its range: the design of the Latin hypercube (None for the rows of a calibration bootstrap,
+        which are not stratified, or without material uncertainty).
+
+        Returns
+        -------
+        numpy.ndarray or None
+            Shape (G, p) [-].
+        """
+        u = self.uncertainty
+        ranges = self.material_ranges()
+        if not ranges or u.calibration is not None or self.context is None:
+            return None
+        names = sorted(ranges)
+        draws = [m for m in self.models[1:] if m.label == "draw"]
+        lo = np.array([ranges[n][0] for n in names])
+        span = np.array([ranges[n][1] - ranges[n][0] for n in names])
+        span[span == 0] = 1.0
+        return (np.array([[m.values[n] for n in names] for m in draws]) - lo) / span
 
     def material_ranges(self) -> dict:
         """"material.field" -> (low, high, how) of the uncertain slope material parameters.
