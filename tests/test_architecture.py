@@ -196,7 +196,7 @@ MAX_MODULE_LINES = 900
 #: Modules still longer than that, each to be split where its code has seams; the list only shrinks (a module
 #: that is split or falls below the limit must leave it).  Issue 37 item 4 names cli.py and MitigationStudy.
 STILL_TO_SPLIT = {
-    "riskrf/cli.py", "riskrf/app/assess.py", "riskrf/report/pdf.py",
+    "riskrf/cli/__init__.py", "riskrf/app/assess.py", "riskrf/report/pdf.py",
     "riskrf/hazard/design_basis.py", "riskrf/hazard/energy_study.py", "riskrf/hazard/impact_energy.py",
     "riskrf/frequency/inventory.py", "riskrf/frequency/rates.py", "riskrf/risk/options.py",
 }

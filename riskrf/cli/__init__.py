@@ -14,8 +14,8 @@ import traceback
 import warnings
 from pathlib import Path
 
-from . import __version__
-from .core.units import DEFAULT_DENSITY_KG_M3
+from .. import __version__
+from ..core.units import DEFAULT_DENSITY_KG_M3
 
 EPILOG = "Units: mass kg, volume m3, density kg/m3, energy kJ, velocity m/s, time in years."
 
@@ -86,7 +86,7 @@ def _add_reader_arguments(p, what: str, key: str, *, dates: bool = False, prefix
 
 
 def _read(args, path):
-    from .frequency.inventory import read_inventory
+    from ..frequency.inventory import read_inventory
     if path is None:
         raise ValueError(f"riskrf {args.command} needs --inventory INVENTORY (the rock fall inventory file)")
     reader = {k: getattr(args, k) for k in ("sheet", "header_row", "date_format", "decimal", "encoding",
@@ -109,10 +109,10 @@ def cmd_fit(args) -> int:
     int
         Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
-    from .frequency.study import analyse_inventory
-    from .io.outputs import atomic_output_dir
+    from ..frequency.study import analyse_inventory
+    from ..io.outputs import atomic_output_dir
 
-    from .app.preflight import check_inventory_args, check_out
+    from ..app.preflight import check_inventory_args, check_out
     check_inventory_args(args)
     out = check_out(args, f"{Path(args.inventory).stem}-fit")
     if args.workers is not None and args.workers < 1:
@@ -132,7 +132,7 @@ def cmd_fit(args) -> int:
             sys.stderr.write("\n")          # end the bar's line: the error or "interrupted" gets its own
         raise
     print(analysis.summary_text())
-    from .report.files import write_frequency_study
+    from ..report.files import write_frequency_study
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         write_frequency_study(analysis, tmp)
     print(f"\nWrote summary.json, design_masses.csv, completeness.csv and figures to {out}/")
@@ -179,8 +179,8 @@ def cmd_simulate(args) -> int:
 
     import simulation
 
-    from .io.outputs import atomic_outputs, check_output, check_output_spares_inputs, require_pyarrow, write_table
-    from .app.preflight import command_inputs
+    from ..io.outputs import atomic_outputs, check_output, check_output_spares_inputs, require_pyarrow, write_table
+    from ..app.preflight import command_inputs
     out = Path(f"{Path(args.scenario).stem}-crossings.{'parquet' if args.format == 'parquet' else 'csv'}") \
         if args.out is None else check_output_spares_inputs(args.out, command_inputs(args))
     if out.suffix.lower() not in (".parquet", ".csv"):
@@ -201,7 +201,7 @@ def cmd_simulate(args) -> int:
     check_output_spares_inputs(figures, command_inputs(args), option="--figures")
     check_output(figures, overwrite=args.overwrite, kind="dir", option="--figures")
     scenario = simulation.load_scenario(args.scenario)
-    from .core.file_schemas import check_scenario_file
+    from ..core.file_schemas import check_scenario_file
     check_scenario_file(args.scenario)          # every declared field's type and range
     progress = None if args.progress is None else args.progress
     result = simulation.run(scenario, n=args.n, seed=args.seed, progress=progress)
@@ -213,8 +213,8 @@ def cmd_simulate(args) -> int:
         crossings["outcome"] = crossings["outcome"].astype(str)
     from functools import partial
 
-    from .app.background import InBackground
-    from .report import files as report_files
+    from ..app.background import InBackground
+    from ..report import files as report_files
     report_files.prepare_drawing()
     targets = [(path, "file") for path in outs] + [(figures, "dir")]
     with atomic_outputs(targets, overwrite=args.overwrite) as tmps:    # tables and figures appear together or not
@@ -239,8 +239,8 @@ def _drop_height(args):
     if value is None:
         return None
     if str(value).lower().endswith(".toml"):
-        from .core.units import STANDARD_GRAVITY_MS2
-        from .io.velocities import free_fall_drop_m
+        from ..core.units import STANDARD_GRAVITY_MS2
+        from ..io.velocities import free_fall_drop_m
         h, v0 = free_fall_drop_m(value, args.collector or "barrier")
         return h + v0 ** 2 / (2 * STANDARD_GRAVITY_MS2)        # the release speed as an equivalent extra drop
     try:
@@ -271,7 +271,7 @@ def build_energy_hazard(args, inventory):
     result : SimulationResult or None
         The simulation behind it (None with a velocity file).
     """
-    from .app.assess import energy_hazard_from_inputs
+    from ..app.assess import energy_hazard_from_inputs
     return energy_hazard_from_inputs(
         inventory, m_min=args.m_min, m_max=args.m_max, rate_scale=args.rate_scale, scenario=args.scenario,
         velocities=args.velocities, collector=args.collector, n=args.n, seed=args.seed,
@@ -291,7 +291,7 @@ def _survey_reader(args) -> dict:
 def _energy_design_masses(args, inventory):
     """Masses [kg] the energy command reads design values at: the design-block band, the sensitivity's m_max and
     the fragmentation alternative (a function of the site's law, evaluated once the law is fitted)."""
-    from .hazard.design_block import design_block_candidates_kg, fragment_block_kg, read_block_survey
+    from ..hazard.design_block import design_block_candidates_kg, fragment_block_kg, read_block_survey
     out = [2.0 * args.m_max] if args.m_max else []
     survey_path, pct = getattr(args, "block_survey", None), getattr(args, "design_percentile", None)
     survey = read_block_survey(survey_path, inventory.density_kg_m3, **_survey_reader(args)) if survey_path else None
@@ -323,10 +323,10 @@ def cmd_energy(args) -> int:
     int
         Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
-    from .hazard.energy_study import analyse_energy
-    from .io.outputs import atomic_output_dir
+    from ..hazard.energy_study import analyse_energy
+    from ..io.outputs import atomic_output_dir
 
-    from .app.preflight import check_energy_args, check_out
+    from ..app.preflight import check_energy_args, check_out
     check_energy_args(args)
     out = check_out(args, f"{Path(args.inventory).stem}-energy")
     inv = _read(args, args.inventory)
@@ -336,7 +336,7 @@ def cmd_energy(args) -> int:
     block = sensitivity = None
     fragmenting = args.fractal_dimension is not None or args.fragmentation_iterations is not None
     if args.design_percentile is not None or args.block_survey or fragmenting:
-        from .hazard.design_block import design_block, read_block_survey, resolve_sizes
+        from ..hazard.design_block import design_block, read_block_survey, resolve_sizes
         survey = read_block_survey(args.block_survey, inv.density_kg_m3, **_survey_reader(args)) \
             if args.block_survey else None
         rule = "percentile" if (args.design_percentile is not None or survey is not None) else "fragmentation"
@@ -347,13 +347,13 @@ def cmd_energy(args) -> int:
                              density_kg_m3=inv.density_kg_m3,
                              fractal_dimension=args.fractal_dimension, iterations=args.fragmentation_iterations)
     if args.design_period * hazard.arrival_rate > 1:
-        from .hazard.energy_study import design_energy_sensitivity
+        from ..hazard.energy_study import design_energy_sensitivity
         m_values = [0.5 * gr.m_max, gr.m_max, 2.0 * gr.m_max] if gr.m_max else [None]
         sensitivity = design_energy_sensitivity(hazard, inv.masses, inv.duration_years, m_min=gr.m_min,
                                                 m_max_values=m_values,
                                                 rate_shares=[0.5 * args.rate_scale, args.rate_scale,
                                                              2.0 * args.rate_scale], T=args.design_period)
-    from .hazard.energy_study import design_energy_tornado
+    from ..hazard.energy_study import design_energy_tornado
     tornado = design_energy_tornado(hazard, design_T=args.design_period, block=block, masses_kg=inv.masses,
                                     duration_years=inv.duration_years, rate_share=args.rate_scale,
                                     sensitivity=sensitivity) \
@@ -362,11 +362,11 @@ def cmd_energy(args) -> int:
                               free_board_m=args.free_board, design_T=args.design_period,
                               density_kg_m3=inv.density_kg_m3, n_bootstrap=args.bootstrap, seed=args.seed,
                               design_block=block, sensitivity=sensitivity, tornado=tornado)
-    from .report.format import sig
+    from ..report.format import sig
     print(f"Inventory {inv.source}: power law b = {gr.b:.4f} ± {gr.b_stderr:.4f} above m_min = {sig(gr.m_min, 5)} kg "
           f"({gr.n_tail} falls, {sig(gr.rate_min, 4)} per year)" + (f", m_max = {sig(gr.m_max, 5)} kg" if gr.m_max else ""))
     print(analysis.summary_text())
-    from .report.files import write_energy_study
+    from ..report.files import write_energy_study
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         written = write_energy_study(analysis, tmp)
     tables = [p.name for p in written if p.suffix != ".png"]
@@ -388,17 +388,17 @@ def cmd_decide(args) -> int:
     int
         Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
-    from .risk.decision_tree import DecisionTree
-    from .risk.mitigation import load_mitigation
-    from .io.outputs import atomic_output_dir, write_json
-    from .report.decision_figures import plot_risk_profiles, plot_tornado, plot_tree
-    from .report.files import save_figure
-    from .report.mitigation_text import study_report, write_mitigation_outputs
+    from ..risk.decision_tree import DecisionTree
+    from ..risk.mitigation import load_mitigation
+    from ..io.outputs import atomic_output_dir, write_json
+    from ..report.decision_figures import plot_risk_profiles, plot_tornado, plot_tree
+    from ..report.files import save_figure
+    from ..report.mitigation_text import study_report, write_mitigation_outputs
 
     if (args.tree is None) == (args.options is None):
         raise ValueError("give a decision tree file (riskrf decide TREE.json) or --options OPTIONS.toml with "
                          "--inventory and --scenario, not both")
-    from .app.preflight import check_energy_args, check_number, check_out
+    from ..app.preflight import check_energy_args, check_number, check_out
     check_number(args.risk_tolerance, "--risk-tolerance", low=0, low_open=True,
                  what=" (in money; leave it out for expected values)")
     out = check_out(args, "decision")
@@ -447,11 +447,11 @@ def cmd_decide(args) -> int:
         print(f"\nWrote ranking.csv, decision.json and figures to {out}/")
         return 0
 
-    from .risk.mitigation import check_mitigation_file
+    from ..risk.mitigation import check_mitigation_file
     check_mitigation_file(args.options)          # every option and table checked before the inventory is read
     inv = _read(args, args.inventory)
     gr, hazard, result = build_energy_hazard(args, inv)
-    from .app.assess import road_share, study_context
+    from ..app.assess import road_share, study_context
     road = args.road_collector or "road"
     study = load_mitigation(args.options, hazard, road_share=road_share(result, hazard.collector, road),
                             **study_context(result, hazard.collector, road, args.option_blocks,
@@ -530,11 +530,11 @@ def cmd_assess(args) -> int:
     int
         Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
-    from .app.assess import run_assessment, write_assessment
-    from .io.outputs import atomic_output_dir
-    from .app.site import load_site
+    from ..app.assess import run_assessment, write_assessment
+    from ..io.outputs import atomic_output_dir
+    from ..app.site import load_site
 
-    from .app.preflight import check_number, check_out
+    from ..app.preflight import check_number, check_out
     check_number(args.n, "-n", low=1)
     out = check_out(args, f"{Path(args.site).stem}-assessment")
     site = load_site(args.site)          # every input is checked before anything is computed
@@ -548,7 +548,7 @@ def cmd_assess(args) -> int:
     print(f"\nStage times: {stages}.")
     if assessment.warnings:
         print(f"{len(assessment.warnings)} warning(s), also listed in the report:")
-        from .io.outputs import relative_paths
+        from ..io.outputs import relative_paths
         for w in assessment.warnings:
             print(f"  - {relative_paths(w, site.path.parent)}")        # paths relative to the site file
     print(f"Rate of falls from the {s['hazard']['rate_source']}.")
@@ -564,8 +564,8 @@ def cmd_assess(args) -> int:
 
 def _assess_terrain(site, args, out) -> int:
     """``riskrf assess`` for a site on 3-D terrain (:mod:`riskrf.app.assess3d`)."""
-    from .app.assess3d import run_terrain_assessment
-    from .io.outputs import atomic_output_dir
+    from ..app.assess3d import run_terrain_assessment
+    from ..io.outputs import atomic_output_dir
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         a = run_terrain_assessment(site, seed=args.seed, n_blocks=args.n)
         s = a.write(tmp)
@@ -642,8 +642,8 @@ def cmd_calibrate(args) -> int:
     import simulation
     from simulation.calibration import read_observed
 
-    from .io.outputs import atomic_output_dir, write_json
-    from .report.files import save_figure
+    from ..io.outputs import atomic_output_dir, write_json
+    from ..report.files import save_figure
 
     parameters = _parse_parameters(args.parameter)
     select = {}
@@ -652,13 +652,13 @@ def cmd_calibrate(args) -> int:
         if not sep:
             raise ValueError(f"--select {item!r}: use COLUMN=VALUE, e.g. profile=P1")
         select[key] = value
-    from .app.preflight import check_out
+    from ..app.preflight import check_out
     out = check_out(args, f"{Path(args.scenario).stem}-calibration")
-    from .core.file_schemas import check_scenario_file
+    from ..core.file_schemas import check_scenario_file
     check_scenario_file(args.scenario)
     table = None
     if Path(args.observed).is_file():
-        from .io.tables import read_numeric_table       # separators, decimal commas, encodings, sheets as for inventories
+        from ..io.tables import read_numeric_table       # separators, decimal commas, encodings, sheets as for inventories
         table = read_numeric_table(args.observed, what="observed stops", decimal=args.decimal, sheet=args.sheet,
                                    header_row=args.header_row, encoding=args.encoding, numeric=(args.column,))
     observed = read_observed(args.observed, column=args.column, select=select, table=table)
@@ -742,10 +742,10 @@ def cmd_calibrate_pooled(args) -> int:
     """
     from simulation.pooled import calibrate_pooled, read_releases
 
-    from .app.preflight import check_out
-    from .core.file_schemas import check_scenario_file
-    from .io.outputs import atomic_output_dir, files_named_in_toml, write_json
-    from .report.files import save_figure
+    from ..app.preflight import check_out
+    from ..core.file_schemas import check_scenario_file
+    from ..io.outputs import atomic_output_dir, files_named_in_toml, write_json
+    from ..report.files import save_figure
 
     parameters = _parse_parameters(args.parameter)
     for option, value, least in (("--n-per-release", args.n_per_release, 10), ("--iterations", args.iterations, 0),
@@ -819,8 +819,8 @@ def cmd_corridor(args) -> int:
     int
         Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
-    from .app.corridor import load_corridor, run_corridor, write_corridor
-    from .app.preflight import check_number, check_out
+    from ..app.corridor import load_corridor, run_corridor, write_corridor
+    from ..app.preflight import check_number, check_out
     check_number(args.workers, "--workers", low=1, what=" (whole workers of the local cluster)")
     if args.n is not None and args.n < 100:
         raise ValueError(f"-n = {args.n} (n_blocks = {args.n} blocks per section) must be a whole number >= 100 (the "
@@ -847,7 +847,7 @@ def cmd_corridor(args) -> int:
     print(f"riskrf corridor: {len(corridor.sections)} sections x {n:,} blocks on {where}; "
           f"finished sections go to {parts}")
 
-    from .report.format import probability
+    from ..report.format import probability
 
     def progress(done, total, sid):
         bar = "#" * int(30 * done / total)
@@ -906,8 +906,8 @@ def cmd_hazard_map(args) -> int:
     int
         Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
-    from .app.hazard_map import hazard_map
-    from .io.outputs import check_output
+    from ..app.hazard_map import hazard_map
+    from ..io.outputs import check_output
     out = Path(args.out) if args.out else Path(f"{Path(args.scenario).stem}-hazard-map")
     check_output(out, overwrite=args.overwrite, kind="dir")
     if args.tile_m <= 0:
@@ -938,7 +938,7 @@ def cmd_profile(args) -> int:
     """
     import simulation
 
-    from .io.outputs import atomic_outputs, check_output
+    from ..io.outputs import atomic_outputs, check_output
     out = Path(args.out) if args.out else Path(f"{Path(args.dem).stem}-profile.toml")
     check_output(out, overwrite=args.overwrite, kind="file")
     try:
@@ -1448,8 +1448,8 @@ def cmd_rates(args) -> int:
     int
         Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
-    from .io.outputs import atomic_output_dir
-    from .frequency.rates import rate_model
+    from ..io.outputs import atomic_output_dir
+    from ..frequency.rates import rate_model
 
     try:
         windows = tuple(int(w) for w in args.windows.split(","))
@@ -1460,11 +1460,11 @@ def cmd_rates(args) -> int:
                          "need a daily model (--period day)")
     if (args.heavy_day_change is None) != (args.heavy_day_mm is None):
         raise ValueError("give --heavy-day-mm and --heavy-day-change together")
-    from .app.preflight import check_inventory_args, check_out, check_rates_args
+    from ..app.preflight import check_inventory_args, check_out, check_rates_args
     check_rates_args(args, windows)
     check_inventory_args(args)
     out = check_out(args, f"{Path(args.inventory).stem}-rates")
-    from .io.rainfall import read_rainfall
+    from ..io.rainfall import read_rainfall
     rainfall = read_rainfall(args.rainfall, **{k: getattr(args, f"rainfall_{k}") for k in
                                                ("sheet", "header_row", "decimal", "encoding", "date_format")})
     inv = _read(args, args.inventory)
@@ -1480,7 +1480,7 @@ def cmd_rates(args) -> int:
               f"({changed / base - 1:+.1%})")
     rules = []
     if args.closure_mm or args.warnings:
-        from .risk.closure import closure_rule, warning_closure
+        from ..risk.closure import closure_rule, warning_closure
         rules = [closure_rule(model, mm, window_days=args.closure_window, cost_per_hour=args.cost_per_hour)
                  for mm in (args.closure_mm or [])]
         if args.warnings:
@@ -1490,7 +1490,7 @@ def cmd_rates(args) -> int:
         table = pd.concat([r.summary()["value"].rename(f"rule {i + 1}") for i, r in enumerate(rules)], axis=1)
         print("\nClosure rules (effectiveness = share of falls while closed, from the rate model):")
         print(table.to_string())
-    from .report.rate_figures import write_rate_study
+    from ..report.rate_figures import write_rate_study
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
         write_rate_study(model, tmp)
         if rules:
@@ -1505,7 +1505,7 @@ def _readable_numbers():
     """Printed tables show 4 significant figures with thousands separators, never ``2.308e+04``."""
     import pandas as pd
 
-    from .report.format import sig
+    from ..report.format import sig
 
     def shown(v):          # whole numbers exactly (19,999 stays 19,999), others to 4 significant figures
         return f"{v:,.0f}".replace("-", "−") if float(v).is_integer() and abs(v) < 1e15 else sig(v, 4)
@@ -1541,7 +1541,7 @@ def main(argv=None) -> int:
     try:
         with warnings.catch_warnings(), _readable_numbers(), _terminate_as_interrupt() as signals:
             warnings.simplefilter("ignore")  # every warning is reported in the printed summary instead
-            from .app.preflight import check_common
+            from ..app.preflight import check_common
             check_common(args)               # --seed and -n, before anything is read
             return args.func(args)
     except KeyboardInterrupt:
@@ -1582,7 +1582,7 @@ def _failing_stage(exc) -> str:
 
 
 def _inputs_text(args) -> str:
-    from .app.preflight import command_inputs
+    from ..app.preflight import command_inputs
     try:
         found = command_inputs(args)
     except Exception:                      # noqa: BLE001 (the message must not fail in turn)
