@@ -174,8 +174,8 @@ def test_a_background_child_leaves_the_signal_to_riskrf(tmp_path, how, when):
     started = tmp_path / "started"
     code = textwrap.dedent(f"""
         import multiprocessing.util, pathlib, sys, time
-        from riskrf.app.background import InBackground
         from riskrf.cli import _terminate_as_interrupt
+        from riskrf.cli.runner import InBackground
         STARTED = pathlib.Path({str(started)!r})
 
         def work():

@@ -193,8 +193,8 @@ def test_no_precompile_switch_keeps_the_compilation_in_the_run(monkeypatch):
 
 
 def test_no_fork_switch_keeps_the_work_in_this_process(monkeypatch):
-    """``RISKRF_NO_FORK=1``: :class:`~riskrf.app.background.InBackground` runs its work here, same value."""
-    from riskrf.app.background import InBackground
+    """``RISKRF_NO_FORK=1``: :class:`~riskrf.cli.runner.InBackground` runs its work here, same value."""
+    from riskrf.cli.runner import InBackground
     monkeypatch.setenv("RISKRF_NO_FORK", "1")
     work = InBackground(lambda: 6 * 7)
     assert work.proc is None and work.result() == 42

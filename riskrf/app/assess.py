@@ -22,7 +22,6 @@ import numpy as np
 
 from .. import __version__
 from ..hazard.annual_hazard import EnergyHazard, effective_speeds
-from .background import InBackground
 from ..hazard.design_block import (design_block, design_block_candidates_kg, fragment_block_kg, read_block_survey,
                            resolve_sizes)
 from ..hazard.energy_study import (
@@ -40,6 +39,7 @@ from ..risk.mitigation import MitigationStudy
 from ..io.outputs import relative_paths, relative_paths_in_json_files, write_json
 from ..frequency.power_law import fit_gutenberg_richter
 from .site_design import design_for_site, with_recommended_run
+from .scheduling import InLine
 from .site import Site
 from ..core.validation import RiskrfWarning
 
@@ -674,8 +674,8 @@ class Assessment:
     #: whether the trajectory model is calibrated on this slope
     #: (:class:`~riskrf.hazard.trajectory_status.TrajectoryModelStatus`); its sentence leads the warnings when not
     trajectory_model: object = None
-    #: figures already being drawn beside the computation: {"dir": Path, "pending": [InBackground, ...]} (see
-    #: ``run_assessment(figures_dir=...)``); empty when ``write_assessment`` draws them all.
+    #: figures already being drawn beside the computation: {"dir": Path, "pending": [part with result(), ...]}
+    #: (see ``run_assessment(figures_dir=..., runner=...)``); empty when ``write_assessment`` draws them all.
     drawing: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -777,13 +777,19 @@ class Assessment:
 
 
 def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None = None, log=None,
-                   figures_dir=None) -> Assessment:
+                   figures_dir=None, runner=None) -> Assessment:
     """Run the whole chain for a validated site; each stage is logged (``logging`` logger ``riskrf``, level INFO,
     or the callable ``log``) and timed in :attr:`Assessment.timings`.
 
     ``figures_dir``: a directory (created here, must not exist) that ``write_assessment`` will use as
-    ``OUT/figures``; the figures and tables of each stage are then drawn there beside the later stages (on the
-    second core, where forking is safe) instead of all at the end.  The outputs are the same either way.
+    ``OUT/figures``; the figures and tables of each stage are then handed to the ``runner`` as they are ready
+    (the command line's draws them on the other core beside the later stages) instead of all at the end.  The
+    outputs are the same either way.
+
+    ``runner``: where the work needed only later runs (the site's rate model, each stage's figures); see
+    :mod:`riskrf.app.scheduling`.  The default, :class:`~riskrf.app.scheduling.InLine`, runs it in this process
+    when it is needed; ``riskrf assess`` passes :class:`riskrf.cli.runner.TwoCores` (simulator compiled and
+    figures drawn on the other core).
 
     Parameters
     ----------
@@ -797,6 +803,9 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         ``log(str)`` for stage messages (default the ``riskrf`` logger at INFO).
     figures_dir : str or pathlib.Path, optional
         Directory for figures drawn beside the computation (see above).
+    runner : object, optional
+        The scheduling hook (``start``, ``beside``, ``before_simulation``; default
+        :class:`~riskrf.app.scheduling.InLine`).
 
     Returns
     -------
@@ -805,6 +814,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         decision (costs [site currency]), warnings and timings [s].
     """
     log = log or logger.info
+    runner = InLine() if runner is None else runner
     figures = None if figures_dir is None else Path(figures_dir)
     pending = []
     if figures is not None:
@@ -825,17 +835,17 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RiskrfWarning)
         hz_cfg = site.hazard
-        compiling, beside, rates = _start_compilation_and_rates(site, log)
+        runner.start(bool(hz_cfg["scenario"]), log)
+        rates = _start_rates(site, runner)
         t = stage(1, "reading the inventory and fitting magnitude-frequency models")
         inventory, frequency, maxima_frequency = fit_site_inventory(site, seed)
         timings["fits"] = round(time.perf_counter() - t, 2)
         if figures is not None:
-            pending.append(InBackground(partial(_frequency_outputs, frequency, maxima_frequency, figures),
-                                        fork=beside))
+            pending.append(runner.beside(partial(_frequency_outputs, frequency, maxima_frequency, figures)))
         survey, rate_scale, rate_note, site_rates, m_max_values, shares, extra = _rate_and_design_inputs(
             site, inventory, rates)
         design_masses = partial(_design_masses, site=site, inventory=inventory, extra=extra)
-        _wait_for_compilation(compiling, beside, [rates] + pending, timings)
+        runner.before_simulation(timings)
         t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
         gr, hazard, result, road_hits = _simulate_hazard(site, inventory, rate_scale, rate_note, n_blocks, seed,
                                                          design_masses)
@@ -843,8 +853,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         release_factor, hazard, rate_scale, m_max_values, shares = _release_rate_of_road_record(
             site, inventory, hazard, result, road_hits, rate_scale, seed, m_max_values, shares)
         if figures is not None:
-            pending.append(InBackground(partial(_simulation_figures, result, hz_cfg["collector"], figures,
-                                                fences_to_draw(site))))
+            pending.append(runner.beside(partial(_simulation_figures, result, hz_cfg["collector"], figures,
+                                                 fences_to_draw(site))))
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
         energy, site_design = _energy_stage(site, inventory, gr, hazard, result, survey, m_max_values, shares,
@@ -852,7 +862,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         timings["energy"] = round(time.perf_counter() - t, 2)
         if figures is not None:
             from ..report.files import write_energy_study
-            pending.append(InBackground(partial(write_energy_study, energy, figures)))
+            pending.append(runner.beside(partial(write_energy_study, energy, figures)))
 
         t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
         replicate = partial(draw_evaluator, site, inventory, rate_scale=rate_scale / release_factor,
@@ -900,43 +910,26 @@ def site_trajectory_status(site: Site):
                                    posterior=mu.get("posterior"))
 
 
-def _start_compilation_and_rates(site: Site, log):
-    """Start, beside the fits, the simulator's first compilation and the site's rate model.
-
-    On a fresh installation the simulator is compiled once (numba, cached on disk): that takes the other core
-    while this one fits, fits the rate model and draws the fits' figures; otherwise those two go to forked
-    children on the other core.
+def _start_rates(site: Site, runner):
+    """The site's rate model (hazard rate, closure rules), handed to the runner to evaluate beside the fits.
 
     Parameters
     ----------
     site : Site
         The validated site.
-    log : callable
-        Called with one line of progress text.
+    runner : object
+        The run's scheduling hook (:mod:`riskrf.app.scheduling`).
 
     Returns
     -------
-    compiling : object or None
-        The compilation under way (``simulation.precompile.precompile``), None without a scenario.
-    beside : bool
-        True when work may be forked to the other core (no compilation running there).
-    rates : InBackground or None
-        The site's rate model (hazard rate, closure rules) being evaluated, None when the site has none.
+    object or None
+        The rate model being evaluated (its ``result()`` is the ``SiteRates``), None when the site has none.
     """
+    if site.rates is None:
+        return None
+    from ..risk.site_rates import evaluate_rates
     inv_cfg = site.inventory
-    from simulation.precompile import precompile
-    compiling = precompile() if site.hazard["scenario"] else None
-    beside = compiling is None or not compiling.running
-    if not beside:
-        log("      first run of this installation: the simulator is compiled once on the other core (numba, "
-            "cached on disk for later runs)")
-    # The site's rate model (hazard rate, closure rules).
-    rates = None
-    if site.rates is not None:
-        from ..risk.site_rates import evaluate_rates
-        rates = InBackground(lambda: evaluate_rates(site.rates, site.path.parent, inv_cfg,
-                                                    site.mitigation["options"]), fork=beside)
-    return compiling, beside, rates
+    return runner.beside(lambda: evaluate_rates(site.rates, site.path.parent, inv_cfg, site.mitigation["options"]))
 
 
 def fit_site_inventory(site: Site, seed):
@@ -984,8 +977,9 @@ def _rate_and_design_inputs(site: Site, inventory, rates):
         The validated site.
     inventory : Inventory
         The site's inventory (masses in kg, density in kg/m3).
-    rates : InBackground or None
-        The site's rate model being evaluated; waited for when ``inventory.rate_from = "rate_model"``.
+    rates : object or None
+        The site's rate model being evaluated (``result()``); waited for when ``inventory.rate_from =
+        "rate_model"``.
 
     Returns
     -------
@@ -1055,30 +1049,6 @@ def _design_masses(law, rate, *, site: Site, inventory, extra) -> list:
         finest = [min(float(law.m_min), float(masses[masses > 0].min(initial=np.inf)))
                   / 8.0 ** u.fragmentation_iterations]
     return extra + ([frag] if frag is not None else []) + finest
-
-
-def _wait_for_compilation(compiling, beside: bool, parts: list, timings: dict) -> None:
-    """Wait for the simulator's compilation, if one runs, doing this core's share of work meanwhile.
-
-    Parameters
-    ----------
-    compiling : object or None
-        The compilation under way, None without a scenario.
-    beside : bool
-        False when the compilation took the other core: ``parts`` are then finished here first.
-    parts : list
-        Background work (:class:`InBackground` or None) to finish on this core while compiling.
-    timings : dict
-        Stage timings (s); ``"compilation"`` is added when there was a compilation to wait for.
-    """
-    if compiling is not None and (not beside or compiling.running):
-        t = time.perf_counter()
-        if not beside:          # this core's work while the simulator compiles on the other
-            for part in parts:
-                if part is not None:
-                    part.result()
-        compiling.wait()
-        timings["compilation"] = round(time.perf_counter() - t, 2)
 
 
 def _simulate_hazard(site: Site, inventory, rate_scale: float, rate_note, n_blocks: int, seed, design_masses):
@@ -1244,8 +1214,8 @@ def _decision_stage(site: Site, inventory, hazard, result, road_hits, rate_scale
         Factor on the inventory's rate (dimensionless).
     energy : EnergyAnalysis
         Design energies (kJ) and fence checks.
-    rates : InBackground or None
-        The site's rate model being evaluated; its closure rules resolve the closure options.
+    rates : object or None
+        The site's rate model being evaluated (``result()``); its closure rules resolve the closure options.
     site_rates : object or None
         The evaluated rate model so far.
     site_design : object
@@ -1432,7 +1402,7 @@ def _assessment_notes(frequency, caught: list, site_rates, inventory) -> list:
     return notes
 
 
-def write_assessment(a: Assessment, out: Path, log=None) -> dict:
+def write_assessment(a: Assessment, out: Path, log=None, runner=None) -> dict:
     """Write every output of an assessment into ``out`` (an empty directory); returns the summary.
 
     Parameters
@@ -1443,6 +1413,9 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
         An empty, existing output directory.
     log : callable, optional
         ``log(str)`` for stage messages (default the ``riskrf`` logger at INFO).
+    runner : object, optional
+        Where the figures are drawn (:mod:`riskrf.app.scheduling`; default
+        :class:`~riskrf.app.scheduling.InLine`, this process); pass the one given to :func:`run_assessment`.
 
     Returns
     -------
@@ -1450,6 +1423,7 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
         :meth:`Assessment.summary` with paths relative to the site file's folder.
     """
     log = log or logger.info
+    runner = InLine() if runner is None else runner
     from ..report.html import render_report
     from ..report.mitigation_text import write_mitigation_outputs, write_tree_figure
     from ..report.files import write_energy_study
@@ -1462,10 +1436,11 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
     if not drawn:
         figs.mkdir()
 
-    # The figures are drawn in parts at once on two cores where that is safe (see riskrf.app.background); parts that
-    # run_assessment started beside its later stages are only waited for, while this process draws the decision's.
+    # The figures are drawn in parts handed to the runner (the command line's draws them on the other core, see
+    # riskrf.cli.runner); parts that run_assessment started beside its later stages are only waited for, while
+    # this process draws the decision's.
     if drawn:
-        tree = InBackground(partial(write_tree_figure, a.study, figs))
+        tree = runner.beside(partial(write_tree_figure, a.study, figs))
         write_mitigation_outputs(a.study, a.decision, figs, tree_figure=False)
         for part in a.drawing["pending"] + [tree]:
             part.result()
@@ -1474,7 +1449,7 @@ def write_assessment(a: Assessment, out: Path, log=None) -> dict:
             _simulation_figures(a.result, a.site.hazard["collector"], figs, fences_to_draw(a.site))
             write_mitigation_outputs(a.study, a.decision, figs)
 
-        beside = InBackground(simulation_and_decision_outputs)
+        beside = runner.beside(simulation_and_decision_outputs)
         _frequency_outputs(a.frequency, a.maxima_frequency, figs)
         write_energy_study(a.energy, figs)
         beside.result()
