@@ -184,49 +184,6 @@ DEFAULT_LATERAL_DEVIATION = 1.0
 DEFAULT_LATERAL_DEVIATION_SPEED_MS = 10.0
 
 
-def default_hop_height(roughness_m):
-    """Hop height [m] of a material that does not state one: its roughness (asperity height) ``roughness_m`` [m].
-
-    Whether a rebound is a flight or ground contact is decided by a length of the ground, not by a speed: a
-    block whose rebound would lift it less than the height of the surface's asperities above the mean surface
-    does not clear them -- it meets the next asperity while still among them, which is rolling (or sliding) over
-    a rough surface, the motion whose losses the rolling resistance represents (Kirkby & Statham 1975: the
-    resistance of a stone moving over a bed of stones grows with the bed's asperity size relative to the stone;
-    Dorren 2003 describes rolling as motion in almost continuous contact with the surface [R]).  The
-    asperity height is the length the model already gives the ground: the roughness that tilts the surface at an
-    impact by up to atan(roughness / r) (CRSP, Pfeiffer & Bowen 1989; Rockyfor3D's mean obstacle height, Dorren
-    2016).  So the contact speed is sqrt(2 g cos(beta) roughness) (:func:`simulation.contact.contact_speed`)
-    and ``settings.contact_velocity_ms`` is only the numerical floor under it: on every preset (roughness
-    0.02-0.30 m, hop speeds 0.6-2.4 m/s on flat ground) the floor no longer acts between 0.01 and 0.5 m/s.  Before
-    this default the floor alone decided, and with a constant e_T each micro-bounce it let through cost 45 % of
-    the tangential speed, so the median runout hung on the floor (Authume P1: 3.5 m at 0.01 m/s, 7.3 m at 0.5 m/s;
-    issue 38 item 4).  The choice of the roughness as the height is an **assumption** [D] (the same one the
-    data-derived presets and the cliff-over-talus scenario made, ``simulation.preset_priors``), not a fit.
-
-    Parameters
-    ----------
-    roughness_m : float
-        Asperity height of the material [m] (as given in the file; a bad value is reported by the roughness
-        field's own check).
-
-    Returns
-    -------
-    float
-        The hop height [m] (0 where the roughness is not a number >= 0: the field checks then report it).
-
-    References
-    ----------
-    Kirkby, M.J. & Statham, I. (1975) Surface stone movement and scree formation. J. Geol. 83: 349-362.
-    Dorren, L.K.A. (2003) A review of rockfall mechanics and modelling approaches. Prog. Phys. Geogr. 27: 69-87.
-    Dorren, L.K.A. (2016) Rockyfor3D (v5.2) revealed. ecorisQ paper, 32 p.
-    Pfeiffer, T.J. & Bowen, T.D. (1989) Computer simulation of rockfalls. Bull. Assoc. Eng. Geol. 26: 135-146.
-    """
-    if isinstance(roughness_m, bool) or not isinstance(roughness_m, (int, float)):
-        return 0.0
-    r = float(roughness_m)
-    return r if math.isfinite(r) and 0.0 <= r <= 10.0 else 0.0
-
-
 @dataclass(frozen=True)
 class Material:
     """Impact and ground-contact behaviour of a slope material.
@@ -240,10 +197,8 @@ class Material:
     is the rolling-resistance coefficient mu_r (resisting torque mu_r N r);
     ``en_velocity_scale_ms``: v0 of the Pfeiffer & Bowen (1989) scaling e_N / (1 + (v_n / v0)^2) (inf: none;
     ``normal_restitution.velocity_scale_ms`` in a file); ``hop_height_m``: a rebound that would rise less
-    than this above the surface is ground contact (``contact_hop_height_m``; in a file it defaults to the
-    material's ``roughness_m``, :func:`default_hop_height`: a rebound that does not clear the asperities rolls
-    over them; 0 given explicitly: the numerical ``contact_velocity_ms`` alone decides, the behaviour before
-    issue 38); ``rolling_drag`` kappa [-]: in ground contact the block
+    than this above the surface is ground contact (``contact_hop_height_m``; 0: the numerical
+    ``contact_velocity_ms`` alone decides, as before); ``rolling_drag`` kappa [-]: in ground contact the block
     also decelerates by (kappa / r) v^2 (rolling over asperities, ploughing; 0: none);
     ``rolling_size_coefficient`` K [-]: the rolling resistance is tan(phi_g) + K roughness / r, so small blocks
     stop sooner (0: tan(phi_g) alone); ``et_normal_scale_ms``: vt0 of the Pfeiffer & Bowen (1989) scaling of the
@@ -394,9 +349,8 @@ class Material:
                                                         else 15.0), f"{where}ground_friction_angle_deg", source,
                                                lo=0.0, hi=89.0),
                    allow_energy_gain=gain, en_velocity_scale_ms=en_v0, et_normal_scale_ms=et_v0,
-                   hop_height_m=_number(spec.get("contact_hop_height_m", default_hop_height(spec.get("roughness_m",
-                                                                                                      0.0))),
-                                        f"{where}contact_hop_height_m", source, lo=0.0, hi=10.0),
+                   hop_height_m=_number(spec.get("contact_hop_height_m", 0.0), f"{where}contact_hop_height_m",
+                                        source, lo=0.0, hi=10.0),
                    rolling_drag=_number(spec.get("rolling_drag", 0.0), f"{where}rolling_drag", source, lo=0.0, hi=10.0),
                    rolling_size_coefficient=_number(spec.get("rolling_size_coefficient", 0.0),
                                                     f"{where}rolling_size_coefficient", source, lo=0.0, hi=10.0),
@@ -483,9 +437,9 @@ class Settings:
     holding, the block stops; ``max_events``: per block (reaching it is reported); ``envelope_bins``: bins along
     x for the envelopes (0 = off); ``max_rolling_slope_deg`` [deg]: no rolling or sliding in ground contact on
     segments steeper than this -- a block there leaves the face and meets it in impacts (90, the default: any
-    slope; :func:`simulation.contact.steep_face_launch`).  With a material's ``contact_hop_height_m`` > 0 (by default
-    its roughness, :func:`default_hop_height`) the contact velocity is only a numerical floor under the hop speed
-    sqrt(2 g cos(beta) h) (:func:`simulation.contact.contact_speed`).
+    slope; :func:`simulation.contact.steep_face_launch`).  With a material's ``contact_hop_height_m`` > 0 the
+    contact velocity is only a numerical floor under the hop speed sqrt(2 g cos(beta) h)
+    (:func:`simulation.contact.contact_speed`).
     """
     gravity_ms2: float = STANDARD_GRAVITY_MS2
     contact_velocity_ms: float = 0.5

@@ -292,32 +292,24 @@ def test_energy_never_increases_with_the_new_contact_model(z, law, v0, vt0, hop,
 
 
 # ---- the contact velocity is numerical -------------------------------------------------------------------------------
-def _authume_p1_median(vc, tangential=None, hop=None):
+def _authume_p1_median(vc, tangential=None):
     data, src = scenario_dict(AUTHUME_P1)
     data["settings"]["contact_velocity_ms"] = vc
-    for m in data["materials"].values():
-        if tangential is not None:
+    if tangential is not None:
+        for m in data["materials"].values():
             m["tangential"] = tangential
-        if hop is not None:
-            m["contact_hop_height_m"] = hop
     res = simulation.run(simulation.scenario_from_dict(data, source=src), n=1000, seed=1, record_paths=0)
     return float(np.median(res.per_block["x"]))
 
 
 def test_median_runout_does_not_depend_on_the_contact_velocity():
     """On the Authume P1 terrain section (0.5 m vertices, real micro-topography; the a-priori soil and bedrock
-    presets) the median runout is the same at contact velocities 0.01, 0.1 and 0.5 m/s (n 1,000, seed 1): with
-    the hop height at its default, the roughness (0.1 m, a hop speed of 1.4 m/s on flat ground;
-    ``simulation.scenario.default_hop_height``), 16.2 m with the presets' constant e_T and 25.3 m with the
-    Coulomb-bounded law, at all three.  With the hop height set to 0 (the model before issue 38 item 4) the
-    velocity alone decides and the constant e_T = 0.55 moves the median 3.5 / 5.2 / 7.3 m: every micro-bounce
-    the threshold lets through costs 45 % of the tangential speed.  Measured 2026-12-07; the expected values
-    changed with that default (before it the presets gave 5.2 and 7.3 m at 0.1 and 0.5 m/s)."""
-    presets = [_authume_p1_median(vc) for vc in (0.01, 0.1, 0.5)]
-    assert max(presets) / min(presets) - 1 < 0.05
+    presets) the median runout moves < 5 % between contact velocities 0.1 and 0.5 m/s with the Coulomb-bounded
+    tangential law (measured: 25.3 and 25.4 m, n 1,000, seed 1).  With the constant e_T = 0.55 of the presets it
+    moves 41 % (5.2 -> 7.3 m): every micro-bounce the threshold lets through costs 45 % of the tangential speed."""
     m01, m05 = _authume_p1_median(0.1, COULOMB), _authume_p1_median(0.5, COULOMB)
     assert abs(m05 / m01 - 1) < 0.05
-    legacy01, legacy05 = _authume_p1_median(0.1, hop=0.0), _authume_p1_median(0.5, hop=0.0)
+    legacy01, legacy05 = _authume_p1_median(0.1), _authume_p1_median(0.5)
     assert abs(legacy05 / legacy01 - 1) > 0.2
 
 
