@@ -198,3 +198,60 @@ def test_no_fork_switch_keeps_the_work_in_this_process(monkeypatch):
     monkeypatch.setenv("RISKRF_NO_FORK", "1")
     work = InBackground(lambda: 6 * 7)
     assert work.proc is None and work.result() == 42
+
+
+class _Compiling:
+    """A compilation that runs until waited for."""
+
+    def __init__(self, order):
+        self.running, self.order = True, order
+
+    def wait(self):
+        self.order.append("compiled")
+        self.running = False
+
+
+def test_two_cores_does_this_cores_work_while_the_simulator_compiles(monkeypatch):
+    """:class:`~riskrf.cli.runner.TwoCores` (``riskrf assess``): while the simulator compiles on the other core
+    nothing is forked and the work handed to it is done here before the wait; after it, work is forked again."""
+    from riskrf.cli.runner import TwoCores
+    order, lines, timings = [], [], {}
+    monkeypatch.setattr(pc, "precompile", lambda: _Compiling(order))
+    runner = TwoCores()
+    runner.start(True, lines.append)
+    assert not runner.fork and "compiled once on the other core" in lines[0]
+    part = runner.beside(lambda: order.append("fits' figures") or 1)
+    assert part.proc is None and order == []
+    runner.before_simulation(timings)
+    assert order == ["fits' figures", "compiled"] and "compilation" in timings and part.result() == 1
+    assert runner.fork
+
+
+def test_two_cores_starts_nothing_for_a_run_without_simulation(monkeypatch):
+    """No scenario (velocities read from a file): no compilation, nothing waited for, no timing added."""
+    from riskrf.cli.runner import TwoCores
+    monkeypatch.setattr(pc, "precompile", lambda: pytest.fail("compiled without a scenario"))
+    runner, timings = TwoCores(), {}
+    runner.start(False, lambda line: pytest.fail(line))
+    runner.before_simulation(timings)
+    assert runner.fork and timings == {}
+
+
+def test_in_line_runner_defers_the_work_and_drops_its_warnings():
+    """The app's default runner (:class:`~riskrf.app.scheduling.InLine`) forks nothing: the work runs once, here,
+    at its result, its warnings dropped as a forked child's would be."""
+    import warnings
+
+    from riskrf.app.scheduling import InLine
+    calls = []
+
+    def work():
+        calls.append(1)
+        warnings.warn("not passed on")
+        return 7
+    part = InLine().beside(work)
+    assert calls == []
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert part.result() == 7 and part.result() == 7
+    assert calls == [1]

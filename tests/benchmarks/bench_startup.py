@@ -13,14 +13,14 @@ Pieces switched off, one at a time, by environment variables the code honours:
 * ``no_precompile``  ``RISKRF_NO_PRECOMPILE=1``: no child compiling the simulator on the other core
   (simulation/precompile.py); the kernel compiles on first use in the run's own process.
 * ``no_fork``        ``RISKRF_NO_FORK=1``: figures and the rate model are drawn/fitted in the run's own process,
-  not in forked children (riskrf/app/background.py).
+  not in forked children (riskrf/cli/runner.py).
 * ``no_gc_freeze``   ``RISKRF_NO_GC_FREEZE=1``: no ``gc.freeze()`` at the command's exit or around a fork.
 
 It also times the lazy public names (simulation/_lazy.py): ``import riskrf.cli`` against importing every public
 name at once (what an eager ``__init__`` would cost a light command such as ``riskrf --help``), and, with ``--gc``,
 the two uses of ``gc.freeze()`` on the demo's heap: the CPU seconds of the interpreter's exit after ``riskrf demo``
-with and without it (riskrf/cli.py), and of a full collection in a forked child with and without it
-(riskrf/app/background.py, which freezes before each fork).
+with and without it (riskrf/cli/__init__.py), and of a full collection in a forked child with and without it
+(riskrf/cli/runner.py, which freezes before each fork).
 """
 from __future__ import annotations
 
