@@ -1270,9 +1270,10 @@ def ensemble_replicates(site: Site, result, seed, replicate, mitigation: dict, u
     (:class:`riskrf.risk.error_budget.EnsembleReplicates`).
 
     Each of ``[uncertainty] ensemble_replicates`` replicates re-runs the chain (:func:`draw_evaluator`: the energy
-    hazard's simulation, the road share, every option's re-simulation and the material re-simulations) with its
-    own simulation seed and ``ensemble_effort`` of the blocks, and the same joint samples of the inputs (common
-    random numbers), so that the between-replicate variance is that of the trajectory ensembles alone; it is
+    hazard's simulation, the road share and every option's re-simulation, on the slope's own materials: each
+    material draw of the study is an independent ensemble already counted by its clustered error) with its own
+    simulation seed and ``ensemble_effort`` of the blocks, and the same joint samples of the other inputs (common
+    random numbers), so that the between-replicate variance is that of the common trajectory ensembles; it is
     multiplied by the effort (a variance falling as 1 / blocks).
 
     Parameters
@@ -1308,9 +1309,14 @@ def ensemble_replicates(site: Site, result, seed, replicate, mitigation: dict, u
     n = max(int(round(n_full * effort)), 1)
     option_blocks = max(int(round(site.hazard["option_blocks"] * effort)), 1)
     seeds = tuple(int(x) for x in np.random.SeedSequence([int(seed or 0), 40]).generate_state(R))
+    # the replicates keep the slope's own materials: each material draw of the study is already an ensemble of
+    # its own, whose noise its clustered error counts; what is common to all samples is the hazard's simulation
+    # and the options' re-simulations, and that is what the replicates measure
+    from .model_uncertainty import _without_material_draws
+    reference_only = _without_material_draws(uncertainty)
     means, best, names = [], [], None
     for s in seeds:
-        _, st, _, _ = replicate(result.scenario, n, option_blocks, s, uncertainty, mitigation=mitigation)
+        _, st, _, _ = replicate(result.scenario, n, option_blocks, s, reference_only, mitigation=mitigation)
         u = st.sampled_costs()
         names = tuple(u["names"])
         means.append(u["mean"])
