@@ -29,6 +29,12 @@ def _site_copy(tmp_path, replace=None, drop=None):
     for old, new in (replace or {}).items():
         assert old in text, old
         text = text.replace(old, new)
+    # 3,000 blocks per option re-simulation and 400 joint samples (the demo has 10,000 and 1,000): the tests
+    # check structure and consistency, not the demo's numbers
+    text = text.replace("option_blocks = 10000", "option_blocks = 3000").replace("\nsamples = 1000", "\nsamples = 400")
+    if "ensemble_replicates" not in text:
+        # two repeated ensembles (the least that gives a variance) keep the error budget in every run, cheaply
+        text = text.replace("\nmaterial_draws = 8", "\nensemble_replicates = 2\nmaterial_draws = 8", 1)
     path = tmp_path / "site.toml"
     path.write_text(text)
     return path
