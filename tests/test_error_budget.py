@@ -29,6 +29,20 @@ def test_clustered_se_is_the_usual_one_for_independent_samples_and_counts_cluste
     assert combined_se(3.0, 16.0) == pytest.approx(5.0) and combined_se(3.0) == 3.0
 
 
+def test_a_latin_hypercube_takes_its_main_effects_out_of_the_error():
+    """Additive response over a 3-parameter hypercube of 16 draws: its main effects carry no error of the mean, the
+    interaction does; the plain cluster-robust SE counts both and is far wider."""
+    G, S = 16, 1600
+    D = (np.column_stack([rng.permutation(G) for _ in range(3)]) + rng.uniform(size=(G, 3))) / G
+    c = np.repeat(np.arange(G), S // G)
+    additive = (3 * D[:, 0] + 2 * D[:, 1] - D[:, 2])[c] + rng.normal(0, 0.01, S)
+    assert clustered_se(additive, c, D) < 0.05 * clustered_se(additive, c)
+    with_interaction = additive + (4 * (D[:, 0] - 0.5) * (D[:, 1] - 0.5))[c]
+    assert clustered_se(with_interaction, c, D) > 3 * clustered_se(additive, c, D)
+    few = c % 4                                          # 4 draws of 3 parameters: too few to fit, the plain form
+    assert clustered_se(additive, few, D[:4]) == clustered_se(additive, few)
+
+
 def test_ensemble_replicates_variance_is_scaled_by_the_effort_and_checked():
     names = ("a", "b")
     m = np.array([[1.0, 3.0], [2.0, 5.0], [3.0, 7.0]])

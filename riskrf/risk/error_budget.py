@@ -40,8 +40,8 @@ def clustered_se(x, clusters=None, design=None) -> np.ndarray:
     When the clusters are the draws of a Latin hypercube, ``design`` gives each draw's coordinates: the cluster
     means are then regressed (weighted by n_g) on them and ``m_g - m`` is replaced by the residual, with the
     factor G / (G - p - 1) for p coordinates.  A Latin hypercube removes the main effects from the mean's error
-    (Stein 1987; Owen 1992): counting them, as the plain cluster-robust error does, would overstate it (four
-    times on the demo).  Main effects that are not linear stay in the residual, so the error stays on the safe
+    (Stein 1987; Owen 1992): counting them, as the plain cluster-robust error does, would overstate it
+    (several times on the demo).  Main effects that are not linear stay in the residual, so the error stays on the safe
     side.  With one coordinate the within-stratum variances come from the differences of neighbouring strata
     instead (Cochran 1977, sec. 5A.12).  With G <= p + 2 draws the plain form is used.
 
