@@ -16,7 +16,7 @@ from riskrf.risk.required_barrier import (DEFAULT_COST_PER_M, BarrierCostModel, 
 from .test_design_basis import RHO, _block, _hazard
 from .test_mitigation import OPTIONS, study
 
-BAD = "NOT ADEQUATE under UNI 11211-4: energy: E_d x gamma_E (1.2) <= MEL (demand 3.4e+04 > capacity 2e+03 kJ)"
+BAD = "NOT ADEQUATE under UNI 11211-4: energy: E_d x gamma_E (1.2) <= MEL (demand 34,000 > capacity 2,000 kJ)"
 
 
 def _cheap_fence_study(**kw):

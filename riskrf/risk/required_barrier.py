@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ..core.format import money
+from ..core.format import money, sig
 from ..hazard.design_basis import MEL_PRODUCT_CLASSES_KJ
 from .options import MitigationError
 
@@ -223,7 +223,7 @@ def cost_model_from_site(table: dict | None, *, site_fences=(), source: str = ""
                   if cost and cap and h and length and model.capital(cap, h, length) > 0]
         if ratios:
             k = float(np.median(ratios))
-            model = BarrierCostModel(**kw, scale=k, scale_note=f"scaled by {k:.3g} to the site's own "
+            model = BarrierCostModel(**kw, scale=k, scale_note=f"scaled by {sig(k, 3)} to the site's own "
                                      f"{len(ratios)} priced fence option(s)")
     return model, include
 
@@ -463,7 +463,7 @@ def basis_design_checks(requirement) -> dict:
         unchecked = rows[~known]
         if len(failed):
             out[name] = f"NOT ADEQUATE under {basis}: " + "; ".join(
-                f"{r['check']} (demand {r['demand']:,.3g} > capacity {r['capacity']:,.3g} {r['unit']})"
+                f"{r['check']} (demand {sig(r['demand'], 3)} > capacity {sig(r['capacity'], 3)} {r['unit']})"
                 for _, r in failed.iterrows())
         else:
             out[name] = f"adequate under {basis}" + ("" if unchecked.empty else "; not checked: " + "; ".join(
