@@ -91,7 +91,7 @@ def simulation_graph():
 
 @pytest.mark.parametrize("which", ["riskrf", "simulation"])
 def test_no_import_cycle(which, graph, simulation_graph):
-    """No circle of imports, counting the imports inside functions too (issue 37: simulation/ had an 8-module
+    """No circle of imports, counting the imports inside functions too (simulation/ once had an 8-module
     circle through calibration, pooled, materials and material_uncertainty)."""
     graph = graph if which == "riskrf" else simulation_graph
     order, state = [], {}
@@ -193,11 +193,10 @@ def test_no_backend_choice_outside_the_command_line():
     assert bad == [], f"backend chosen outside riskrf.cli: {bad}"
 
 
-#: Longest a module of ``riskrf/`` may be [lines]: a newcomer reads one in a sitting (issue 37, build item 4).
+#: Longest a module of ``riskrf/`` may be [lines]: a newcomer reads one in a sitting.
 MAX_MODULE_LINES = 900
 #: Modules still longer than that, each to be split where its code has seams; the list only shrinks (a module
-#: that is split or falls below the limit must leave it).  Issue 37 item 4 names MitigationStudy (cli.py is
-#: the package riskrf/cli/ now).
+#: that is split or falls below the limit must leave it).
 STILL_TO_SPLIT = {
     "riskrf/app/assess.py", "riskrf/report/pdf.py",
     "riskrf/hazard/design_basis.py", "riskrf/hazard/energy_study.py", "riskrf/hazard/impact_energy.py",

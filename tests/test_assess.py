@@ -203,12 +203,12 @@ def test_options_recommendation_and_fence_heights_in_outputs(assessed):
             assert o.get("retention") is not None and 0.0 <= o["retention"] <= 1.0, o["name"]
     rec = s["recommendation"]
     assert rec["option"] in {o["name"] for o in s["options"]} and rec["reason"].strip()
-    # issue 39 item 1: the recommendation passes its design checks; the rejected fences are named; the required
+    # the recommendation passes its design checks; the rejected fences are named; the required
     # barrier is reported (on the demo the required MEL is above every certified class: none can be placed)
     ranked = {r["option"]: r for r in s["ranking"]}
     assert ranked[rec["option"]]["design_adequate"] and "NOT ADEQUATE" not in str(rec["design_check"])
     assert set(rec["not_recommended"]) == {n for n, r in ranked.items() if not r["design_adequate"]} != set()
-    # issue 38: the presets are not calibrated on this slope, and every output says so first
+    # the presets are not calibrated on this slope, and every output says so first
     assert s["trajectory_model"]["status"] == "uncalibrated" and s["warnings"][0].startswith("UNCALIBRATED")
     assert "UNCALIBRATED trajectory model" in (out / "report.html").read_text()
     rb = s["required_barrier_option"]
@@ -407,7 +407,7 @@ def _pdf_sections(path) -> dict:
 
 
 def test_html_and_pdf_carry_the_same_sections_and_tables(assessed):
-    """Issue 39 item 5: report.html and report.pdf have the same sections in the same order (the HTML headings are
+    """report.html and report.pdf have the same sections in the same order (the HTML headings are
     the PDF's outline), and the same tables in the same section: road-user risk, Bunce per lane, the F-N chart, the
     design checks of every option, the catchment widths beside the Modified Ritchie Criterion, and the
     recommendation with the options not recommended because they fail their design checks and the required

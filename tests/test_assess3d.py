@@ -156,7 +156,7 @@ def test_the_mass_coupled_hazard_on_a_plane_matches_the_2d_section():
 
 
 def test_the_3d_chain_fits_the_inventory_with_the_2d_fits_stage(site3d, monkeypatch):
-    """One chain (issue 37): the 3-D assessment differs from the 2-D one only in the hazard stage; its fits are
+    """One chain: the 3-D assessment differs from the 2-D one only in the hazard stage; its fits are
     riskrf.app.assess.fit_site_inventory (the same m_min and bootstrap sizes), not a copy of its own."""
     import riskrf.app.assess as assess
     from riskrf.app.assess3d import run_terrain_assessment

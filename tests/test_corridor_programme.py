@@ -183,7 +183,7 @@ def test_cli_refuses_a_bad_budget_before_any_work(tmp_path, capsys):
     assert "--budget = -5 must be a finite amount >= 0" in capsys.readouterr().err and not out.exists()
 
 
-# ---- the default objective: tolerability first, then net benefit at the VSL with the GDF (issue 40 item 4) -----
+# ---- the default objective: tolerability first, then net benefit at the VSL with the GDF -----
 def _fake(result, rows):
     """The small corridor's result with a made-up table: ``rows`` of (id, individual risk of doing nothing,
     [(option, capital, deaths per year, individual risk, expected total cost)]); doing nothing costs 1e6 of

@@ -265,7 +265,7 @@ def test_return_period_basis_without_a_T_year_event_says_why():
         design_requirement(hz, DesignBasis("return period", design_T=100.0), block=_block())
 
 
-# ---- issue 39 items 2 and 3: ONR 24810 event-frequency fractiles and consequence classes, elongation, kits ----
+# ---- ONR 24810 event-frequency fractiles and consequence classes, elongation, kits ----
 def test_onr24810_event_frequency_class_sets_the_design_block_fractile():
     # Trumer Schutzbauten's summary of ONR 24810, "Design Block" table: EF4 n >= 10/yr V98, EF3 1 <= n < 10 V97,
     # EF2 0.03 <= n < 1 V96, EF1 n < 0.03 V95 (a design-block SIZE fractile)

@@ -1,4 +1,4 @@
-"""One error budget (issue 40): reported standard errors cover the joint samples, the material re-simulations
+"""One error budget: reported standard errors cover the joint samples, the material re-simulations
 they share (clustered) and the trajectory ensembles (repeated), and the effort adapts until the ranking is
 resolved or the budget is used (riskrf.risk.error_budget)."""
 import numpy as np
@@ -79,7 +79,7 @@ def _replicated(seed, R=2):
 
 
 def test_seed_repeat_z_scores_have_unit_spread():
-    """Issue 40 must-show: over 24 seeds (joint samples, material draws and their trajectory ensembles all
+    """Over 24 seeds (joint samples, material draws and their trajectory ensembles all
     re-drawn), the z-scores (value - mean over seeds) / reported SE have an sd between 0.7 and 1.4, for the
     difference of the two cheapest options and for the expected cost of doing nothing.  Each material draw is its
     own ensemble, so the clustered SE carries the trajectory noise (the hazard is fixed here; the app adds the

@@ -1,4 +1,4 @@
-"""Hazard maps aggregated chunk by chunk (issue 37 item 5) and rasters a GIS user can trust (issue 39 item 6):
+"""Hazard maps aggregated chunk by chunk and rasters a GIS user can trust:
 streamed rasters equal the unchunked ones, nodata on DEM holes, quantity and unit in each band, and the
 intensity-frequency layers on cases with a known answer."""
 import numpy as np

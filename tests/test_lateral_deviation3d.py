@@ -1,4 +1,4 @@
-"""Lateral deviation at impacts in the 3-D kernel (issue 38 item 5): the rule, its switch, its seed, its energy,
+"""Lateral deviation at impacts in the 3-D kernel: the rule, its switch, its seed, its energy,
 and the lateral scatter of the real Authume stops.
 
 Authume data: Garcia et al. (2022), Engineering Geology 310:106855; richefeu/AuthumeQuarryRockfalls_Data-in-Brief

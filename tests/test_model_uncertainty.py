@@ -440,7 +440,7 @@ def test_an_evpi_of_zero_from_few_draws_is_reported_with_its_upper_bound():
 
 
 def test_more_draws_until_the_value_of_calibrating_is_resolved():
-    """Issue 40 item 3: the trajectory model's draws are added (doubling, up to max_draws) until the choice between
+    """The trajectory model's draws are added (doubling, up to max_draws) until the choice between
     calibrating first and deciding now is resolved; the outputs say which stopped them."""
     from riskrf.app.model_uncertainty import calibration_resolved, effort_text
     from riskrf.risk.model_decision import CalibrationValue

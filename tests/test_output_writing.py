@@ -17,7 +17,7 @@ from .test_simulation_run import BARRIER
 
 
 def previous_writer(df, path, index=False):
-    """The writer before issue 37 item 5: pandas' to_csv, then every cell read back and checked one by one."""
+    """The previous writer: pandas' to_csv, then every cell read back and checked one by one."""
     df.to_csv(path, index=index)
     with open(path, newline="", encoding="utf-8", errors="surrogateescape") as fh:
         rows = list(csv.reader(fh))

@@ -1,4 +1,4 @@
-"""Drape, bench and bund from a site file (issue 39 item 4): accepted by the schema, run through ``riskrf assess``,
+"""Drape, bench and bund from a site file: accepted by the schema, run through ``riskrf assess``,
 each effect derived and labelled; bad geometry refused naming the file, the option and the field."""
 import json
 

@@ -1,5 +1,5 @@
 """Every output says whether the trajectory model is calibrated, and how wrong the presets were on held-out real
-releases (issue 38 item 1, riskrf.hazard.trajectory_status)."""
+releases (riskrf.hazard.trajectory_status)."""
 import pandas as pd
 import pytest
 

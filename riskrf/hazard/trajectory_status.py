@@ -1,4 +1,4 @@
-"""Is the trajectory model calibrated on this slope?  The status every output of an assessment states (issue 38).
+"""Is the trajectory model calibrated on this slope?  The status every output of an assessment states.
 
 A run whose slope materials are riskrf's presets (``preset = NAME`` in the scenario) is **uncalibrated**: the
 presets' values were not fitted to this slope, and on real releases held out of their derivation they were both

@@ -1,4 +1,4 @@
-"""One error budget for the Monte Carlo outputs of a mitigation study (issue 40).
+"""One error budget for the Monte Carlo outputs of a mitigation study.
 
 A study's expected costs, their differences and P(best) are means over ``S`` joint samples of the uncertain
 inputs.  Three sources of Monte Carlo randomness sit behind them:

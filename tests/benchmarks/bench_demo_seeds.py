@@ -1,4 +1,4 @@
-"""Does the demo's stated uncertainty match its real Monte Carlo spread?  (Issue 40: one error budget.)
+"""Does the demo's stated uncertainty match its real Monte Carlo spread?
 
 Runs the demo site's assessment (``riskrf.app.assess.run_assessment``, the demo's default effort) for several
 simulation seeds, and its mitigation study for several seeds of the joint sampling (which also re-draws the

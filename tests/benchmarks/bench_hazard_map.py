@@ -1,4 +1,4 @@
-"""Benchmark: peak memory of a 3-D hazard map against the number of blocks (issue 37 item 5).
+"""Benchmark: peak memory of a 3-D hazard map against the number of blocks.
 
 Run: python tests/benchmarks/bench_hazard_map.py [--blocks 10000 100000] [--legacy] [--workers 2] [--write]
 

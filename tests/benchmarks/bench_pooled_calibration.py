@@ -1,4 +1,4 @@
-"""Benchmark: a pooled calibration of 3 parameters on 80 releases (issue 23 target: under 5 minutes on 2 cores).
+"""Benchmark: a pooled calibration of 3 parameters on 80 releases (target: under 5 minutes on 2 cores).
 
 Run: python tests/benchmarks/bench_pooled_calibration.py [--n-per-release 200]
 

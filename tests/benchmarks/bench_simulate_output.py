@@ -1,4 +1,4 @@
-"""Where the time of ``riskrf simulate`` goes, and what writing its tables costs (issue 37, build item 5).
+"""Where the time of ``riskrf simulate`` goes, and what writing its tables costs.
 
 Run from the repository root::
 
@@ -34,7 +34,7 @@ SCENARIO = ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml"
 
 
 def previous_neutralise(path) -> None:
-    """The cell-by-cell check of every CSV before issue 37 item 5 (read whole, rewrite when a cell changed)."""
+    """The cell-by-cell check of every CSV in the previous writer (read whole, rewrite when a cell changed)."""
     from riskrf.io.outputs import _neutralise_cell
     with open(path, newline="", encoding="utf-8", errors="surrogateescape") as fh:
         rows = list(csv.reader(fh))

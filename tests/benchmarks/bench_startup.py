@@ -6,7 +6,7 @@ Each configuration runs ``riskrf demo`` twice in a row: a *first* run with an em
 ``NUMBA_CACHE_DIR``: every kernel compiles, as on a fresh installation) and a *later* run on the cache the first
 one wrote.  The configurations are interleaved (A/B/A/B ...) over ``--rounds`` rounds so that a busy machine's
 load falls on all of them alike; the wall-clock seconds of every run, the median per configuration and the
-load average before and after are printed.  Targets (issue 22): first run < 30 s, later < 10 s on 2 quiet cores.
+load average before and after are printed.  Targets: first run < 30 s, later < 10 s on 2 quiet cores.
 
 Pieces switched off, one at a time, by environment variables the code honours:
 
