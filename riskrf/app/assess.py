@@ -35,7 +35,7 @@ from ..frequency.study import FrequencyAnalysis, analyse_inventory
 from ..frequency.inventory import Inventory, read_inventory
 from ..hazard.simulated import simulate_energy_hazard
 from ..risk.measures import road_crossings
-from ..risk.mitigation import MitigationStudy
+from ..risk.mitigation import Exposure, MitigationStudy
 from ..io.outputs import relative_paths, relative_paths_in_json_files, write_json
 from ..frequency.power_law import fit_gutenberg_richter
 from .site_design import design_for_site, with_recommended_run
@@ -585,7 +585,7 @@ def required_barrier_for_site(site, mitigation: dict, energy, site_design) -> tu
     if requirement is None:
         return mitigation, checks, None
     checks.update(basis_design_checks(requirement))
-    exposed = mitigation["exposure"].exposed_length_m if "exposure" in mitigation else 100.0
+    exposed = mitigation.get("exposure", Exposure()).exposed_length_m
     fences = [(o.capacity_kj, o.height_m, o.capital_cost, exposed) for o in options
               if o.kind in ("fence", "attenuator") and o.x_m is None]
     model, include = cost_model_from_site(site.required_barrier, site_fences=fences, source=str(site.path))

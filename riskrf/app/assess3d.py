@@ -63,6 +63,8 @@ class TerrainAssessment:
     n_blocks: int = 0
     warnings: tuple = ()
     timings: dict = field(default_factory=dict)
+    #: the fits of the dated annual maxima (FrequencyAnalysis), None when the site gives none
+    maxima_frequency: object = field(default=None, repr=False)
 
     def barrier_crossings(self) -> pd.DataFrame:
         """First crossing of the barrier line by each simulated block (see :meth:`TerrainResult.collector`).
@@ -166,7 +168,7 @@ def run_terrain_assessment(site: Site, *, seed: int | None = None, n_blocks: int
     t = time.perf_counter()
     log("[1/4] reading the inventory and fitting the power law")
     from .assess import fit_site_inventory
-    inventory, frequency, _maxima = fit_site_inventory(site, seed)     # the 2-D chain's fits stage
+    inventory, frequency, maxima = fit_site_inventory(site, seed)     # the 2-D chain's fits stage
     from ..frequency.power_law import fit_gutenberg_richter
     gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=inv_cfg["m_min_kg"],
                                m_max=inv_cfg["m_max_kg"])
@@ -219,7 +221,7 @@ def run_terrain_assessment(site: Site, *, seed: int | None = None, n_blocks: int
         warnings.append(f"hazard.road_collector = {rname!r} is not a line of the terrain scenario: no road outputs")
     return TerrainAssessment(site=site, inventory=inventory, frequency=frequency, hazard=hazard, result=result,
                              energy=energy, road=road, seed=int(seed), n_blocks=int(n_blocks),
-                             warnings=tuple(warnings), timings=timings)
+                             warnings=tuple(warnings), timings=timings, maxima_frequency=maxima)
 
 
 __all__ = ["TerrainAssessment", "run_terrain_assessment"]

@@ -371,6 +371,9 @@ def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_
         # each round adds draws of its own seed (a Latin hypercube or rows of the posterior), evaluated once
         new = simulation.material_draws(scenario, k_new, posterior=cfg["posterior_table"],
                                         seed=seed if not parts else seed + 7919 * len(parts))
+        if not parts:                          # where the draws come from: said once, by every output
+            basis = (f"posterior {Path(cfg['posterior']).name}: " if cfg["posterior"] else "") \
+                + new.attrs.get("basis", "")
         parts.append(new)
         for values in new.to_dict(orient="records"):
             j = len(rows)
@@ -392,7 +395,7 @@ def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_
         draws.attrs = dict(parts[0].attrs)
         t = time.perf_counter()
         ranking = ModelUncertainRanking(names, np.vstack(costs), draws=draws, sample_costs=np.stack(samples),
-                                        currency=currency, basis=draws.attrs.get("basis", ""))
+                                        currency=currency, basis=basis)
         calibration = ranking.calibration_value(stops, n_releases=int(cfg["calibration_releases"]),
                                                 profile_range_m=(float(profile.x[0]), float(profile.x[-1])),
                                                 obs_error_m=float(cfg["obs_error_m"]),
@@ -407,17 +410,12 @@ def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_
         k_new = min(len(draws), budget - len(draws))
         log(f"      the value of calibrating is not resolved with {len(draws)} draws: {k_new} more")
     timings["draws"] = round(time.perf_counter() - t0 - analysis_s, 2)
-    basis = draws.attrs.get("basis", "")
-    if cfg["posterior"]:
-        basis = f"posterior {Path(cfg['posterior']).name}: " + basis
     t = time.perf_counter()
     energy = design_energy_split(hazards, T, n_bootstrap=int(cfg["bootstrap"]), seed=seed,
                                  reference=reference_hazard, basis=basis)
     design_row = energy.per_draw[np.isclose(energy.per_draw["T_years"], design_T)]
     per_draw = pd.DataFrame(rows).merge(design_row[["draw", "energy_kj"]].rename(
         columns={"energy_kj": f"energy_{design_T:g}_year_kj"}), on="draw")
-    ranking = ModelUncertainRanking(names, np.vstack(costs), draws=draws, sample_costs=np.stack(samples),
-                                    currency=currency, basis=basis)
     timings["analysis"] = round(time.perf_counter() - t + analysis_s, 2)
     notes = [effort_text(rounds, budget, calibration),
              f"{len(draws)} draws of the material parameters ({basis}), each re-simulated with "

@@ -122,7 +122,7 @@ def load_site(path) -> Site:
     used += mu_used
     required = data.get("required_barrier", {})
     if not isinstance(required, dict):
-        raise SiteError(f"{path}: [required_barrier] must be a table")
+        raise SiteError(f"{path}: [required_barrier] = {required!r} must be a table (required_barrier.FIELD = value)")
     from ..risk.required_barrier import cost_model_from_site
     try:
         cost_model_from_site(required, source=str(path))

@@ -101,8 +101,8 @@ class RecommendationMixin:
         t_all = self.ranking() if ranking is None else ranking
         cur = self.currency
         lim = self.criteria.individual_risk_per_year
-        bad = t_all["design_check"].astype(str).str.contains("NOT ADEQUATE", regex=False) \
-            if "design_check" in t_all else pd.Series(False, index=t_all.index)
+        bad = ~t_all["design_adequate"].astype(bool) if "design_adequate" in t_all \
+            else pd.Series(False, index=t_all.index)
         rejected = t_all[bad]
         t = t_all[~bad]
         rb = self.required_barrier
