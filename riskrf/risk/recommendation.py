@@ -130,7 +130,8 @@ class RecommendationMixin:
         if len(ok):
             rec = ok.iloc[0]
             why = (f"{rec['option']} is the cheapest option that meets the tolerability criteria (individual risk "
-                   f"{probability(rec['individual_risk'])}/yr against {probability(lim)}/yr; societal risk {rec['fn_zone']} on the "
+                   f"{probability(rec['individual_risk'])}/yr against {probability(lim)}/yr; societal risk "
+                   f"{rec['fn_zone']} on the "
                    f"{self.criteria.fn_diagram} F-N diagram). Its expected total cost is "
                    f"{money(rec['expected_total_cost'], cur, sig=3)} (5-95 %: {money(rec['cost_p05'], sig=3)} to "
                    f"{money(rec['cost_p95'], cur, sig=3)}); it meets them in "
