@@ -211,6 +211,13 @@ def test_options_recommendation_and_fence_heights_in_outputs(assessed):
     # the presets are not calibrated on this slope, and every output says so first
     assert s["trajectory_model"]["status"] == "uncalibrated" and s["warnings"][0].startswith("UNCALIBRATED")
     assert "UNCALIBRATED trajectory model" in (out / "report.html").read_text()
+    # ... and what a release campaign is worth is priced beside the ranking, from the study's material draws
+    campaign = s["release_campaign"]
+    assert campaign["draws"] == s["effort"]["rounds"][-1]["material_draws"] >= 8
+    assert campaign["calibration_releases"] == 20 and campaign["calibration_cost_is_assumption"]
+    assert 0.0 <= campaign["evsi"] <= campaign["evpi_upper_bound_97_5"]
+    assert "EVSI of a field calibration with 20 released blocks" in campaign["verdict"]
+    assert "Value of a release campaign" in (out / "report.html").read_text()
     rb = s["required_barrier_option"]
     assert rb["placeable"] is False and "above the largest certified class" in rb["reason"]
     assert rb["alternatives"] and "No certified barrier meets" in rec["reason"]

@@ -52,3 +52,14 @@ def test_evsi_is_zero_without_releases_grows_with_them_and_reaches_the_evpi(stud
 def test_no_material_draws_no_campaign_value():
     s = MitigationStudy(hazard=HAZ, options=_study(1, 2).options, consequences=CONSTANT_V)
     assert material_draw_ranking(s) is None and release_campaign_value(s) is None
+
+
+def test_a_large_re_simulation_is_thinned_to_its_quantiles(study, monkeypatch):
+    import riskrf.risk.campaign as campaign
+    from riskrf.risk.campaign import draw_stops
+    full = draw_stops(study)
+    monkeypatch.setattr(campaign, "MAX_STOPS_PER_DRAW", 50)
+    thin = draw_stops(study)
+    assert all(t.size == 50 for t in thin)
+    for f, t in zip(full, thin):
+        np.testing.assert_allclose(np.median(t), np.median(f), atol=0.05 * (f.max() - f.min()) + 1e-9)

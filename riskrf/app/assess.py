@@ -754,6 +754,7 @@ class Assessment:
             "second_option": ranking["option"].iloc[1],
             "break_even": self.decision["break_even"].to_dict(orient="records"),
             "value_of_information": self.decision["value_of_information"],
+            "release_campaign": self.decision.get("release_campaign"),
             "individual_risk_do_nothing": float(nothing["individual_risk"].iloc[0]) if len(nothing) else None,
             "fn_zone": dict(zip(ranking["option"], ranking["fn_zone"])),
             "defaults_used": list(self.site.defaults_used),

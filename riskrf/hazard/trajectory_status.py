@@ -113,8 +113,9 @@ def trajectory_model_status(scenario_data: dict | None, *, calibration_bootstrap
             f"UNCALIBRATED trajectory model: the slope materials are riskrf's presets ({named}), not fitted to this "
             f"slope.  On real releases held out of their derivation the presets gave {held_out_range()} "
             "(docs/validation/trajectories.md): read run-out, speeds, bounce heights and energies as a screening "
-            "estimate.  Calibrate on test releases (riskrf calibrate-pooled), or price a release campaign first "
-            "with a [model_uncertainty] table."))
+            "estimate.  Calibrate on test releases (riskrf calibrate-pooled).  What a release campaign is worth to the "
+            "decision is stated beside the ranking when the slope materials are sampled ([uncertainty.materials]), "
+            "and with draws of its own by a [model_uncertainty] table."))
 
 
 __all__ = ["TrajectoryModelStatus", "UNCALIBRATED_HELD_OUT", "held_out_range", "trajectory_model_status"]

@@ -706,6 +706,10 @@ def _decision_body(doc, a, figs: Path, s) -> None:
             f"<b>{money_est(voi['evpi'])}</b>; about all "
             f"sampled inputs at once: <b>{money_est(voi['evpi_all_sampled_inputs'])}</b> &mdash; the most that "
             "investigations settling them are worth.</p>")
+    campaign = a.decision.get("release_campaign")
+    if campaign is not None and a.model_uncertainty is None:
+        doc.add(f"<p>Value of a release campaign, priced from the {campaign['draws']} material draws of the "
+                f"ranking (stated ranges, uniform): <b>{_e(campaign['verdict'])}</b>.</p>")
 
 
 def _assumptions_body(doc, a, figs: Path, s) -> None:

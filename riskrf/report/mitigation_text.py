@@ -60,13 +60,17 @@ def study_report(study) -> dict:
     -------
     dict
         ``ranking``, ``tornado``, ``break_even``, ``options_table`` (DataFrames), ``value_of_information``,
+        ``release_campaign`` (the value of a release campaign priced from the study's material draws,
+        :func:`riskrf.risk.campaign.release_campaign_value`: a JSON-ready dict, or None without material draws),
         ``recommendation``, ``options``, ``uncertainty`` and ``text``.
     """
+    from ..risk.campaign import release_campaign_value
     ranking = study.ranking()
     tornado = study.tornado()
     be = study.break_even_table()
     rec = study.recommendation(ranking)
     voi = study.value_of_information()
+    campaign = release_campaign_value(study)
     cur = study.currency
     u = study.uncertainty
     ranges = study.parameter_ranges()
@@ -107,6 +111,9 @@ def study_report(study) -> dict:
     lines += ["", f"Value of perfect information: about the fall rate (x0.5 / x1 / x2 with probabilities 1/4, 1/2, "
                   f"1/4) {money(voi['evpi'], cur, sig=3)}; about all sampled inputs "
                   f"{money(voi['evpi_all_sampled_inputs'], cur, sig=3)}."]
+    if campaign is not None:
+        lines.append(f"Value of a release campaign (from the {campaign.n_draws} material draws): "
+                     + campaign.verdict() + ".")
     lines += ["", "Tornado (lowest expected total cost at central values as each input moves over its range; "
                   "inputs that change the best option first):"]
     for r in tornado.itertuples():
@@ -128,7 +135,7 @@ def study_report(study) -> dict:
                    "inputs": {k: {"low": lo, "high": hi, "law": how} for k, (lo, hi, how) in ranges.items()},
                    "not_sampled": not_sampled}
     return {"ranking": ranking, "tornado": tornado, "break_even": be, "value_of_information": voi,
-            "recommendation": rec, "options": option_entries(study, ranking), "uncertainty": uncertainty,
+            "release_campaign": None if campaign is None else campaign.to_dict(), "recommendation": rec, "options": option_entries(study, ranking), "uncertainty": uncertainty,
             "options_table": study.options_table(), "text": "\n".join(lines)}
 
 
@@ -173,7 +180,8 @@ def write_mitigation_outputs(study, report, tmp, *, tree_figure: bool = True) ->
     write_json({"currency": study.currency, "recommendation": report["recommendation"],
                 "options": report["options"], "ranking": report["ranking"], "break_even": report["break_even"],
                 "tornado": report["tornado"], "tree_value": tree.rollback().value,
-                "value_of_information": report["value_of_information"], "uncertainty": report["uncertainty"],
+                "value_of_information": report["value_of_information"],
+                "release_campaign": report["release_campaign"], "uncertainty": report["uncertainty"],
                 "defaults_used": list(study.defaults_used)}, tmp / "decision.json")
     if tree_figure:
         write_tree_figure(study, tmp)

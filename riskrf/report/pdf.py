@@ -858,6 +858,10 @@ def _decision(rep, a, figs, s):
     rep.text(f"Value of perfect information about the rate of falls: {fmt(voi['evpi'])} {cur}; about all sampled "
              f"inputs at once: {fmt(voi['evpi_all_sampled_inputs'])} {cur} (the most that investigations settling "
              "them are worth).", size=8.5)
+    campaign = a.decision.get("release_campaign")
+    if campaign is not None and a.model_uncertainty is None:
+        rep.text(f"Value of a release campaign, priced from the {campaign['draws']} material draws of the ranking "
+                 f"(stated ranges, uniform): {campaign['verdict']}.", size=8.5)
 
 
 def _model_uncertainty(rep, a, figs, s):
