@@ -16,9 +16,9 @@ from .conftest import ROOT
 EXAMPLES = sorted((ROOT / "docs" / "examples").glob("*.py"))
 
 
-def test_there_are_five_examples():
+def test_there_are_six_examples():
     assert {p.stem for p in EXAMPLES} >= {"fit_inventory", "energy_at_fence", "calibrate_authume",
-                                          "mitigation_ranking", "corridor"}
+                                          "mitigation_ranking", "corridor", "calibrate_then_assess"}
 
 
 @pytest.mark.slow
