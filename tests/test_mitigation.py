@@ -482,6 +482,10 @@ def test_material_draws_from_a_calibration_bootstrap(tmp_path):
     assert len(draws) == 4 and all(tuple(r) in rows for r in draws.to_numpy())   # joint rows, correlation kept
     ranges = s.parameter_ranges()
     assert ranges["material:gravel.roughness_m"][0] == pytest.approx(np.quantile(boot.iloc[:, 1], 0.05))
+    # the posterior of a pooled calibration (its first line a comment with the prior's bounds) is read the same
+    (tmp_path / "bootstrap.csv").write_text('# simulation pooled posterior; bounds = {"x": [0, 1]}\n'
+                                            + boot.to_csv(index=False))
+    assert parse_mitigation(data, str(site))[5].calibration.equals(boot)
     bad = boot.rename(columns={"materials.gravel.roughness_m": "seeder.height_m"})
     (tmp_path / "bootstrap.csv").write_text(bad.to_csv(index=False))
     with pytest.raises(MitigationError, match="column 'seeder.height_m' is not a material parameter"):

@@ -582,8 +582,8 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
             path = base / str(v)
             if not path.is_file():
                 raise MitigationError(f"{w} = {v!r}: file not found ({path.resolve()}); give the bootstrap.csv "
-                                      "written by riskrf calibrate")
-            df = pd.read_csv(path)
+                                      "written by riskrf calibrate or the posterior.csv of riskrf calibrate-pooled")
+            df = pd.read_csv(path, comment="#")       # a pooled posterior's first line is a comment
             from .measures import MATERIAL_FIELDS
             if len(df) < 2:
                 raise MitigationError(f"{w} = {v!r}: needs at least 2 bootstrap rows; got {len(df)}")
