@@ -6,11 +6,34 @@ selects a non-interactive one once, at start-up).
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 
 import numpy as np
 
 FIGURE_DPI = 200
+
+#: A line printed at the foot of every figure :func:`save_figure` writes while it is set (:func:`figure_note`):
+#: an assessment whose trajectory model is uncalibrated stamps it on each figure drawn from the trajectories.
+_FIGURE_NOTE: ContextVar[str | None] = ContextVar("riskrf_figure_note", default=None)
+
+
+@contextmanager
+def figure_note(text: str | None):
+    """Stamp ``text`` at the foot of every figure :func:`save_figure` writes inside the ``with`` block (in this
+    process and in processes forked inside it); None stamps nothing.
+
+    Parameters
+    ----------
+    text : str or None
+        One short line (it is wrapped to the figure's width).
+    """
+    token = _FIGURE_NOTE.set(text)
+    try:
+        yield
+    finally:
+        _FIGURE_NOTE.reset(token)
 
 
 _SUPERSCRIPT = str.maketrans("-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079")
@@ -67,7 +90,8 @@ def _sparse_minor_log_ticks(fig) -> None:
 
 
 def save_figure(fig, path, *, tight_layout: bool = False) -> Path:
-    """Write ``fig`` to ``path`` (PNG, :data:`FIGURE_DPI`) and close it; returns the path.
+    """Write ``fig`` to ``path`` (PNG, :data:`FIGURE_DPI`) and close it; returns the path.  Inside
+    :func:`figure_note`, the note is printed at the figure's foot.
 
     Parameters
     ----------
@@ -83,6 +107,9 @@ def save_figure(fig, path, *, tight_layout: bool = False) -> Path:
     pathlib.Path
     """
     import matplotlib.pyplot as plt
+    note = _FIGURE_NOTE.get()
+    if note:
+        fig.text(0.0, -0.01, note, ha="left", va="top", fontsize=6.5, color="#9b1c1c", wrap=True)
     _plain_log_labels(fig)
     _sparse_minor_log_ticks(fig)
     if tight_layout:
@@ -106,8 +133,13 @@ def write_frequency_figures(analysis, out: Path) -> list[Path]:
     Returns
     -------
     list of pathlib.Path
-        The files written.
+        The files written (without a :func:`figure_note`: the fits use no trajectory).
     """
+    with figure_note(None):
+        return _frequency_figures(analysis, out)
+
+
+def _frequency_figures(analysis, out: Path) -> list[Path]:
     from .fit_figures import plot_gumbel, plot_magnitude_frequency, plot_return_levels
     ax = plot_magnitude_frequency(analysis.power_law)
     ax.set_title("Magnitude - cumulative frequency")
