@@ -85,6 +85,10 @@ def test_hazard_map_writes_geotiffs_on_the_dem_grid_and_crs(tmp_path, south_up):
     assert pyogrio.read_info(out / "hazard_map.gpkg", layer="trajectories")["features"] > 0
     assert (out / "hillshade.png").stat().st_size > 10_000
     assert np.all(np.isfinite(dem_z))
+    # the talus preset is not fitted to this slope: the map says so beside the rasters and in their tags
+    assert (out / "trajectory_model.txt").read_text().startswith("UNCALIBRATED trajectory model")
+    with rasterio.open(out / "reach_probability.tif") as ds:
+        assert ds.tags()["riskrf_trajectory_model"] == "uncalibrated"
 
 
 def test_a_dem_without_crs_needs_crs(tmp_path, capsys):

@@ -115,22 +115,19 @@ class TerrainAssessment:
         dict
             The summary, with paths relative to the site file's folder.
         """
-        import matplotlib.pyplot as plt
-
-        from ..report.files import write_energy_study
+        from ..report.files import figure_note, save_figure, write_energy_study
+        from .assess import site_trajectory_status
         out = Path(out)
-        write_energy_study(self.energy, out)
-        self.barrier_crossings().to_csv(out / "barrier_crossings.csv", index=False)
-        self.result.stops().to_csv(out / "stops.csv", index=False)
-        if self.road is not None:
-            self.road.summary().to_csv(out / "road_per_metre.csv", index=False)
-            ax = self.road.plot()
-            ax.figure.savefig(out / "road_per_metre.png", dpi=120, bbox_inches="tight")
-            plt.close(ax.figure)
-        ax = self.result.plot()
-        ax.set_title(f"{self.site.name}: {self.result.n:,} blocks (masses over the law's range)")
-        ax.figure.savefig(out / "plan.png", dpi=120, bbox_inches="tight")
-        plt.close(ax.figure)
+        with figure_note(site_trajectory_status(self.site).figure_note):
+            write_energy_study(self.energy, out)
+            self.barrier_crossings().to_csv(out / "barrier_crossings.csv", index=False)
+            self.result.stops().to_csv(out / "stops.csv", index=False)
+            if self.road is not None:
+                self.road.summary().to_csv(out / "road_per_metre.csv", index=False)
+                save_figure(self.road.plot().figure, out / "road_per_metre.png", dpi=120)
+            ax = self.result.plot()
+            ax.set_title(f"{self.site.name}: {self.result.n:,} blocks (masses over the law's range)")
+            save_figure(ax.figure, out / "plan.png", dpi=120)
         s = self.summary()
         write_json(s, out / "summary.json")
         return relative_paths(s, self.site.path.parent)

@@ -19,6 +19,8 @@ crosses and returns a :class:`HazardMap`; :meth:`HazardMap.write` writes, all or
 * ``hazard_map.gpkg`` (GeoPackage, written with pyogrio) with layers ``stop_points`` (every block's final
   point, reason, mass, runout) and ``trajectories`` (the recorded sample of paths as 3-D lines);
 * ``hillshade.png``: the reach probability over a hillshade of the DEM with the stop points and paths;
+* ``trajectory_model.txt``: whether the trajectory model is calibrated, in the sentence every output carries (the
+  rasters' tag ``riskrf_trajectory_model`` holds its status; an uncalibrated model is stamped on the figure);
 * ``summary.csv`` and ``crossings.csv`` (one row per crossing of each plan collector, with its outcome at a
   barrier); ``barriers.csv`` (per barrier: blocks caught, through and over, shares, largest energy and height).
 
@@ -82,6 +84,17 @@ class HazardMap:
     def scenario(self):
         """The :class:`simulation.TerrainScenario` that was run."""
         return self.result.scenario
+
+    @property
+    def trajectory_model(self):
+        """Is the scenario's trajectory model calibrated?  (:class:`~riskrf.hazard.trajectory_status.
+        TrajectoryModelStatus` of the scenario's materials: "uncalibrated" when they are presets.)"""
+        from ..hazard.trajectory_status import trajectory_model_status
+        sc = self.scenario
+        if sc.source == "<dict>" or not Path(sc.source).is_file():
+            return trajectory_model_status(None)
+        from simulation.parameters import scenario_dict
+        return trajectory_model_status(scenario_dict(sc.source)[0])
 
     def summary(self) -> pd.DataFrame:
         """One row per raster: unit, pixels reached, largest value, and the run's runout quantiles.
@@ -151,8 +164,9 @@ class HazardMap:
         ter = self.scenario.terrain
         with atomic_output_dir(out, overwrite=overwrite) as tmp:
             units = {**RASTERS, **dict.fromkeys(FREQUENCY_RASTERS, "kJ")}
+            status = self.trajectory_model
             tags = {"riskrf_scenario": self.scenario.name, "riskrf_blocks": self.result.n,
-                    "riskrf_seed": self.result.seed,
+                    "riskrf_seed": self.result.seed, "riskrf_trajectory_model": status.status,
                     "riskrf_rate_per_year": "none" if self.rate_per_year is None else repr(self.rate_per_year)}
             for name, unit in units.items():
                 if name in self.grids:
@@ -160,6 +174,7 @@ class HazardMap:
                                       unit=unit, tags=tags)
             write_geopackage(self.result, tmp / "hazard_map.gpkg")
             self.summary().to_csv(tmp / "summary.csv", index=False)
+            (tmp / "trajectory_model.txt").write_text(status.text + "\n", encoding="utf-8")
             self.result.summary().to_csv(tmp / "run_summary.csv", index=False)
             tables = [self.result.collector(c.name).assign(collector=c.name) for c in self.scenario.collectors]
             if tables:
@@ -168,10 +183,9 @@ class HazardMap:
                         for c in self.scenario.collectors if c.is_barrier]
             if barriers:
                 pd.concat(barriers).reset_index().to_csv(tmp / "barriers.csv", index=False)
-            import matplotlib.pyplot as plt
-            ax = self.plot()
-            ax.figure.savefig(tmp / "hillshade.png", dpi=130, bbox_inches="tight")
-            plt.close(ax.figure)
+            from ..report.files import figure_note, save_figure
+            with figure_note(status.figure_note):
+                save_figure(self.plot().figure, tmp / "hillshade.png", dpi=130)
         return out
 
 

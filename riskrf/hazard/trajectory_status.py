@@ -41,6 +41,14 @@ class TrajectoryModelStatus:
         """True when the run's own materials come from presets and no calibration of the site is used."""
         return self.status == "uncalibrated"
 
+    @property
+    def figure_note(self) -> str | None:
+        """The line stamped on the figures drawn from the trajectories (None unless uncalibrated)."""
+        if not self.uncalibrated:
+            return None
+        return (f"UNCALIBRATED trajectory model (presets, not fitted to this slope): a screening estimate; on "
+                f"held-out real releases the presets gave {held_out_range()}.")
+
     def to_dict(self) -> dict:
         """JSON-ready: status, presets, calibrations, the held-out errors of the presets and the text.
 
