@@ -48,3 +48,12 @@ def test_the_frequency_figures_carry_no_trajectory_note(tmp_path, saved):
     with files.figure_note(NOTE):
         files.write_frequency_figures(fits, tmp_path)
     assert saved and all(NOTE not in t for t in saved)
+
+
+def test_riskrf_simulate_says_when_its_trajectory_model_is_uncalibrated(tmp_path, capsys):
+    from riskrf.cli import main
+
+    from .conftest import ROOT
+    assert main(["simulate", str(ROOT / "simulation" / "scenarios" / "road_cut_barrier.toml"), "-n", "20",
+                 "--out", str(tmp_path / "c.csv")]) == 0
+    assert "UNCALIBRATED trajectory model" in capsys.readouterr().out

@@ -138,7 +138,11 @@ def cmd_assess(args) -> int:
         return _assess_terrain(site, args, out)
     from .runner import TwoCores
     runner = TwoCores()                  # the simulator compiled and the figures drawn on the other core
-    with atomic_output_dir(out, overwrite=args.overwrite) as tmp:
+    from ..app.assess import site_trajectory_status
+    from ..report.files import figure_note
+    # an uncalibrated trajectory model is stamped on every figure drawn from the trajectories
+    with atomic_output_dir(out, overwrite=args.overwrite) as tmp, \
+            figure_note(site_trajectory_status(site).figure_note):
         # figures of each stage are drawn into the temporary output beside the later stages
         assessment = run_assessment(site, seed=args.seed, n_blocks=args.n, figures_dir=tmp / "figures",
                                     runner=runner)

@@ -129,6 +129,12 @@ def cmd_simulate(args) -> int:
     result = simulation.run(scenario, n=args.n, seed=args.seed, progress=progress)
     print(f"Scenario {scenario.name} ({scenario.source}): {args.n:,} blocks, seed {args.seed}")
     print(result.summary().to_string(header=False))
+    from simulation.parameters import scenario_dict
+
+    from ..hazard.trajectory_status import trajectory_model_status
+    status = trajectory_model_status(scenario_dict(args.scenario)[0])
+    if status.uncalibrated:
+        print(status.text)
     tables = [result.collector(c.name).assign(collector=c.name) for c in scenario.collectors]
     crossings = pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
     if "outcome" in crossings:
@@ -139,7 +145,8 @@ def cmd_simulate(args) -> int:
     from ..report import files as report_files
     report_files.prepare_drawing()
     targets = [(path, "file") for path in outs] + [(figures, "dir")]
-    with atomic_outputs(targets, overwrite=args.overwrite) as tmps:    # tables and figures appear together or not
+    # tables and figures appear together or not; an uncalibrated trajectory model is stamped on the figures
+    with atomic_outputs(targets, overwrite=args.overwrite) as tmps, report_files.figure_note(status.figure_note):
         *tmp_outs, tmp = tmps
         drawn = InBackground(partial(report_files.write_simulation_figures, result, tmp,   # on the other core
                                      [c.name for c in scenario.collectors]))                 # while tables are written
