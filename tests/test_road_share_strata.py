@@ -112,3 +112,46 @@ def test_without_a_reference_run_the_classes_of_the_coupled_run_alone():
     light = sl.grid.mid < EDGES[0]
     # below the simulated masses there are no blocks: the lightest class's share (the stated extrapolation)
     np.testing.assert_allclose(share[light], road_c[c0].sum() / c0.sum(), rtol=1e-12)
+
+
+# ---- the joint material draws: their design and their blocks -------------------------------------------------
+def test_material_design_is_a_latin_hypercube_and_a_net_for_powers_of_two():
+    from riskrf.risk.slope_models import material_design
+    for p, G in ((3, 32), (3, 8), (2, 16), (3, 12), (1, 20)):
+        D = material_design(p, G, np.random.default_rng(7))
+        assert D.shape == (G, p) and np.all((D >= 0) & (D < 1))
+        for j in range(p):       # every coordinate: one draw in each of its G strata
+            assert sorted(np.floor(D[:, j] * G).astype(int)) == list(range(G))
+    # a (0, m, 2)-net in base 2 (Sobol's first two coordinates): every box of 1/2^a x 1/2^(m-a) holds one draw,
+    # which a random pairing of strata misses; the random hypercube keeps its former stream for G = 20
+    D = material_design(3, 32, np.random.default_rng(7))
+    for a in range(6):
+        boxes = np.floor(D[:, 0] * 2 ** a).astype(int) * 2 ** (5 - a) + np.floor(D[:, 1] * 2 ** (5 - a)).astype(int)
+        assert sorted(boxes) == list(range(32)), a
+    rng = np.random.default_rng(3)
+    old = (rng.permutation(20) + rng.uniform(size=20)) / 20
+    np.testing.assert_array_equal(material_design(1, 20, np.random.default_rng(3))[:, 0], old)
+
+
+def test_draw_blocks_sets_the_blocks_of_the_joint_draws_only():
+    import simulation
+    from riskrf.risk.measures import SimulationContext
+    from riskrf.risk.mitigation import MitigationStudy, Option, Uncertainty, parse_mitigation
+    from riskrf.risk.mitigation_inputs import MitigationError
+
+    from .test_mitigation import CONSTANT_V, HAZ, TOE
+    sc = simulation.scenario_from_dict(TOE)
+    opts = (Option("nothing", "none"), Option("ditch", "ditch", 1.5e6, x_m=31.0, width_m=8.0, depth_m=1.0,
+                                               material="gravel"))
+    s = MitigationStudy(hazard=HAZ, options=opts, consequences=CONSTANT_V,
+                        uncertainty=Uncertainty(samples=50, material_draws=4, draw_blocks=150,
+                                                materials={"gravel.ground_friction_angle_deg": (20.0, 45.0)}),
+                        context=SimulationContext(sc, n_blocks=400, seed=3))
+    ms = s._models
+    assert [m.result.n for m in ms[1:5]] == [150] * 4 and [m.result.n for m in ms[5:]] == [400, 400]
+    s.central_parameters()                    # the ditch re-simulated on every model with that model's blocks
+    assert s._derived["ditch"][2].shape == (7,)
+    u = parse_mitigation({"uncertainty": {"draw_blocks": 2500}}, "site.toml", require_options=False)[5]
+    assert u.draw_blocks == 2500 and Uncertainty().draw_blocks is None
+    with pytest.raises(MitigationError, match="site.toml: uncertainty.draw_blocks = 0 must be a whole number >= 1"):
+        parse_mitigation({"uncertainty": {"draw_blocks": 0}}, "site.toml", require_options=False)

@@ -293,6 +293,7 @@ UNCERTAINTY = Table("uncertainty", (
     Field("vehicles_per_day", "range", "vehicles/day", "[low, high]", low=0, low_open=True),
     Field("discount_rate", "range", "1/yr", "[low, high]", low=0, high=1, high_open=True),
     _count("material_draws", "re-simulations with drawn material parameters", default=8),
+    _count("draw_blocks", "blocks of each of those re-simulations (default: [hazard] option_blocks)"),
     Field("sample_power_law", "bool", "", "sample b and the rate from their posteriors", True),
     Field("sample_retention", "bool", "", "sample derived retentions", True),
     _count("ensemble_replicates", "repeated trajectory ensembles of the error budget (0: off; else >= 2)",

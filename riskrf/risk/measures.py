@@ -260,7 +260,7 @@ class SimulationContext:
 
     threads: int = 0              # simulations run at once by run_many (0: one per core); corridor workers use 1
 
-    def run(self, scenario, seed: int | None = None):
+    def run(self, scenario, seed: int | None = None, n_blocks: int | None = None):
         """Simulate ``scenario`` with this context's number of blocks and seed (no recorded paths); a
         :class:`simulation.SimulationResult`.
 
@@ -270,6 +270,8 @@ class SimulationContext:
             The slope scenario.
         seed : int, optional
             Seed of this run (default the context's ``seed``: common random numbers).
+        n_blocks : int, optional
+            Blocks of this run (default the context's ``n_blocks``).
 
         Returns
         -------
@@ -277,10 +279,10 @@ class SimulationContext:
             The simulated run of ``n_blocks`` blocks with ``seed``.
         """
         import simulation
-        return simulation.run(scenario, n=self.n_blocks, seed=self.seed if seed is None else seed,
-                              record_paths=0)
+        return simulation.run(scenario, n=self.n_blocks if n_blocks is None else int(n_blocks),
+                              seed=self.seed if seed is None else seed, record_paths=0)
 
-    def run_many(self, scenarios, seeds=None) -> list:
+    def run_many(self, scenarios, seeds=None, n_blocks=None) -> list:
         """:meth:`run` for each scenario, several at once on threads (the kernel releases the GIL); the results
         are those of one-by-one runs, in order.
 
@@ -290,6 +292,8 @@ class SimulationContext:
             The scenarios to simulate.
         seeds : sequence of int or None, optional
             One seed per scenario (None entries, or no sequence: the context's seed).
+        n_blocks : sequence of int or None, optional
+            Blocks per scenario (None entries, or no sequence: the context's ``n_blocks``).
 
         Returns
         -------
@@ -298,11 +302,12 @@ class SimulationContext:
         """
         scenarios = list(scenarios)
         seeds = [None] * len(scenarios) if seeds is None else list(seeds)
+        blocks = [None] * len(scenarios) if n_blocks is None else list(n_blocks)
         threads = min(self.threads or os.cpu_count() or 1, len(scenarios))
         if threads <= 1:
-            return [self.run(sc, s) for sc, s in zip(scenarios, seeds)]
+            return [self.run(sc, s, n) for sc, s, n in zip(scenarios, seeds, blocks)]
         with ThreadPoolExecutor(threads) as pool:
-            return list(pool.map(self.run, scenarios, seeds))
+            return list(pool.map(self.run, scenarios, seeds, blocks))
 
 
 def road_crossings(result, road: str) -> np.ndarray:

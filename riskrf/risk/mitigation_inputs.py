@@ -167,7 +167,9 @@ class Uncertainty:
     ("talus.ground_friction_angle_deg" = [20, 30]); the scenario is re-simulated for ``material_draws``
     joint draws (and once at each end of each range, for the tornado) and every sample uses one of the
     draws: reach probability, velocities and heights at the barrier, the road share and every derived
-    retention change with it.  ``calibration`` (the ``bootstrap.csv`` of ``riskrf calibrate``: one row
+    retention change with it.  The draws are a Latin hypercube over the ranges (a scrambled Sobol' net when
+    ``material_draws`` is a power of 2 and there are several parameters); each simulates ``draw_blocks`` blocks
+    (default: the option re-simulations' blocks).  ``calibration`` (the ``bootstrap.csv`` of ``riskrf calibrate``: one row
     of re-fitted parameters per replicate) gives the material draws instead: rows drawn jointly, so the
     correlation the calibration found is kept; the tornado uses its 5 % and 95 % quantiles.
     ``fractal_dimension`` (low, high): each event volume breaks up into the expected fragments of fractal
@@ -189,6 +191,8 @@ class Uncertainty:
     sample_retention: bool = True
     materials: dict = field(default_factory=dict)    # {"material.field": (low, high)} of the slope scenario
     material_draws: int = 8
+    #: blocks per joint material re-simulation (None: the option re-simulations' blocks, ``[hazard] option_blocks``)
+    draw_blocks: int | None = None
     calibration: object = field(default=None, repr=False)   # DataFrame: joint draws of a calibration's bootstrap
     calibration_source: str = ""
     fractal_dimension: tuple | None = None   # (low, high): event volumes break up by fractal fragmentation
@@ -559,7 +563,7 @@ def _uncertainty(data: dict, source: str, used: list) -> Uncertainty:
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v <= 1:
                 raise MitigationError(f"{w} = {v!r} must be a share of the blocks > 0 and <= 1")
             vals[key] = float(v)
-        elif key in ("samples", "seed", "material_draws", "fragmentation_iterations"):
+        elif key in ("samples", "seed", "material_draws", "fragmentation_iterations", "draw_blocks"):
             if isinstance(v, bool) or not isinstance(v, int) or v < (0 if key == "seed" else 1):
                 raise MitigationError(f"{w} = {v!r} must be a whole number {'>= 0' if key == 'seed' else '>= 1'}")
             if key == "fragmentation_iterations" and v > 12:

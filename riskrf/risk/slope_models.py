@@ -92,6 +92,37 @@ def quantile_map(x, ref, var):
     return out
 
 
+def material_design(p: int, G: int, rng) -> np.ndarray:
+    """G points in [0, 1)^p for the joint material draws, one in each of G equal strata of every coordinate (a Latin
+    hypercube): with G a power of 2 and p >= 2, a scrambled Sobol' net (Owen 1997; ``scipy.stats.qmc.Sobol``), whose
+    pairs of coordinates are stratified too; otherwise strata paired at random (McKay et al. 1979).
+
+    Parameters
+    ----------
+    p : int
+        Number of parameters.
+    G : int
+        Number of draws.
+    rng : numpy.random.Generator
+        The stream (consumed differently by the two designs).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (G, p) [-].
+
+    References
+    ----------
+    McKay, M.D., Beckman, R.J. & Conover, W.J. (1979) A comparison of three methods for selecting values of input
+    variables in the analysis of output from a computer code. Technometrics 21:239-245.  Owen, A.B. (1997)
+    Scrambled net variance for integrals of smooth functions. Annals of Statistics 25:1541-1562.
+    """
+    if p >= 2 and G >= 2 and G & (G - 1) == 0:
+        from scipy.stats import qmc
+        return qmc.Sobol(p, scramble=True, rng=rng).random(G)
+    return np.column_stack([(rng.permutation(G) + rng.uniform(size=G)) / G for _ in range(p)]).reshape(G, p)
+
+
 @dataclass(frozen=True, eq=False)
 class SlopeModels:
     """The slope models of a study and the effects derived from them (computed on first use and kept).
@@ -163,14 +194,17 @@ class SlopeModels:
                 pick = rng.choice(len(rows), size=u.material_draws, replace=len(rows) < u.material_draws)
                 draws = [{n: float(rows.iloc[i][f"materials.{n}"]) for n in names} for i in pick]
             else:
-                # a Latin hypercube over the stated ranges (each range cut into G strata, one draw in each, the
-                # strata paired at random): the mean over the draws varies less than with independent draws
-                # (demo: the sd of doing nothing's expected cost over sampling seeds 22 % -> 9 %); its standard
-                # error takes the main effects out (riskrf.risk.error_budget.clustered_se with a design)
-                G = u.material_draws
-                cols = {n: ranges[n][0] + (rng.permutation(G) + rng.uniform(size=G)) / G
-                        * (ranges[n][1] - ranges[n][0]) for n in names}
-                draws = [{n: float(cols[n][i]) for n in names} for i in range(G)]
+                # a Latin hypercube over the stated ranges (each range cut into G strata, one draw in each): the
+                # mean over the draws varies less than with independent draws (demo: the sd of doing nothing's
+                # expected cost over sampling seeds 22 % -> 9 %); its standard error takes the main effects out
+                # (riskrf.risk.error_budget.clustered_se with a design).  With G a power of 2 and several
+                # parameters, the hypercube is a scrambled Sobol' net (Owen 1997), whose pairs of parameters are
+                # stratified too: the demo's expected cost of doing nothing grows some hundredfold towards high
+                # talus restitution AND low friction together, a corner a random pairing of strata samples
+                # unevenly (16 draws: sd over sampling seeds 8.7 % as a random hypercube, 5.4 % as a net)
+                cols = {n: ranges[n][0] + u01 * (ranges[n][1] - ranges[n][0])
+                        for n, u01 in zip(names, material_design(len(names), u.material_draws, rng).T)}
+                draws = [{n: float(cols[n][i]) for n in names} for i in range(u.material_draws)]
             central = {n: material_value(ctx.scenario, n) for n in names}
             variants = [(vals, "draw") for vals in draws] + \
                 [({**central, n: v}, f"{n} {end}") for n in names for end, v in (("low", ranges[n][0]),
@@ -182,7 +216,12 @@ class SlopeModels:
             draw_seeds = [int(x) for x in np.random.SeedSequence([int(ctx.seed), int(u.seed), 17]).generate_state(
                 len(draws))]
             seeds = draw_seeds + [None] * (len(variants) - len(draws))
-            for (vals, label), sc, res, seed in zip(variants, scenarios, ctx.run_many(scenarios, seeds), seeds):
+            # the joint draws with [uncertainty] draw_blocks each (their spread is mostly between draws, so more
+            # draws of fewer blocks buy more precision for the same blocks); the tornado's variants keep the
+            # context's blocks and seed (common random numbers with the reference)
+            blocks = [u.draw_blocks] * len(draws) + [None] * (len(variants) - len(draws))
+            runs = ctx.run_many(scenarios, seeds, blocks)
+            for (vals, label), sc, res, seed in zip(variants, scenarios, runs, seeds):
                 models.append(self._simulated_model(vals, label, sc, res, seed))
         return models
 
@@ -553,7 +592,7 @@ class SlopeModels:
                                   f"({prof.x[0]:g}, {prof.x[-1]:g}) m")
         col = sc_mod.Collector(f"{opt.name} line", float(opt.x_m))
         runs = ctx.run_many((replace(m.scenario, collectors=m.scenario.collectors + (col,)) for m in self.models),
-                            [m.seed for m in self.models])
+                            [m.seed for m in self.models], self._model_blocks())
         return [effective_samples(res, col.name) for res in runs]
 
     # ---- the reference run (common random numbers) ---------------------------------------------------------
@@ -686,7 +725,13 @@ class SlopeModels:
         except (MeasureError, ValueError) as exc:
             raise MitigationError(str(exc)) from exc
         return [self._ditch_retention(m, i, res) for i, (m, res) in
-                enumerate(zip(self.models, ctx.run_many(scenarios, [m.seed for m in self.models])))]
+                enumerate(zip(self.models, ctx.run_many(scenarios, [m.seed for m in self.models],
+                                                        self._model_blocks())))]
+
+    def _model_blocks(self) -> list:
+        """Blocks of each slope model's own run (None: the context's), for re-simulating its changed slopes with
+        the same blocks and seed (common random numbers); the reference's base is :attr:`reference_run`."""
+        return [None] + [None if m.result is None else int(m.result.n) for m in self.models[1:]]
 
     def _ditch_retention(self, model: SlopeModel, index: int, ditched):
         """Share of the falls that would reach the road that the ditches stop (common random numbers): overall,
