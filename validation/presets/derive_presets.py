@@ -301,6 +301,11 @@ def _drawn(draws) -> dict:
     return {k: b for k, b in _parameters().items() if any(k in d for d in draws)}
 
 
+#: Blocks per release and posterior draw in the LOO predictions (40 draws: 400 per release), blocks per release
+#: for the published presets (one parameter set, the same 400), and the first seed of those predictions.
+N_EACH_FITTED, N_EACH_PUBLISHED, PREDICT_SEED = 10, 400, 50_000
+
+
 def predict_release_stops(rels, draws, n_each, seed0):
     P = _drawn(draws)
     pool = _Pool(rels, {k: P[k] for k in P if parameter_sets_any(k, rels[0].scenario["materials"])})
@@ -312,17 +317,34 @@ def predict_release_stops(rels, draws, n_each, seed0):
     return [np.concatenate(p) for p in per]
 
 
+def release_quantiles(per_release, q: float) -> np.ndarray:
+    """Each release's predictive ``q`` quantile: one value per release of ``per_release`` (its simulated stops
+    over every posterior draw, :func:`predict_release_stops`) [m]."""
+    return np.array([np.quantile(s, q) for s in per_release])
+
+
+def beyond_share(observed, bound) -> float:
+    """Share of the observed stops beyond their own release's predictive bound (``observed > bound``, element by
+    element; the ``beyond_p95`` / ``beyond_p99`` columns of the LOO tables)."""
+    return float(np.mean(np.asarray(observed) > np.asarray(bound)))
+
+
+def median_error_pct(predicted_median, observed_median) -> float:
+    """Relative error of the predicted median against the observed one [%] (the ``median_error_pct`` column)."""
+    return 100.0 * (predicted_median / observed_median - 1.0)
+
+
 def release_row(dataset, model, per_release, rels):
     obs = np.array([r.x_stop_m[0] for r in rels])
     pred = np.concatenate(per_release)
-    p95 = np.array([np.quantile(s, 0.95) for s in per_release])
-    p99 = np.array([np.quantile(s, 0.99) for s in per_release])
+    p95 = release_quantiles(per_release, 0.95)
+    p99 = release_quantiles(per_release, 0.99)
     qo, qp = np.quantile(obs, [0.1, 0.5, 0.9]), np.quantile(pred, [0.1, 0.5, 0.9])
     return {"held_out": dataset, "model": model, "observations": obs.size,
             "obs_p10": qo[0], "obs_p50": qo[1], "obs_p90": qo[2], "pred_p10": qp[0], "pred_p50": qp[1],
-            "pred_p90": qp[2], "median_error_pct": 100.0 * (qp[1] / qo[1] - 1.0),
+            "pred_p90": qp[2], "median_error_pct": median_error_pct(qp[1], qo[1]),
             "ks_d": stats.ks_2samp(pred, obs).statistic, "w1": stats.wasserstein_distance(pred, obs),
-            "beyond_p95": float(np.mean(obs > p95)), "beyond_p99": float(np.mean(obs > p99)),
+            "beyond_p95": beyond_share(obs, p95), "beyond_p99": beyond_share(obs, p99),
             "unit": "m (plan runout, 3-D)" if KERNEL["name"] == "3d" else "m (stop x)"}, (obs, pred)
 
 
@@ -340,15 +362,22 @@ ODOT_MODELS = ("contact", "contact-measured", "contact-vscale", "contact-vscale-
 def ritchie_row(posterior, model, n_draws, seed):
     """A data set none of the fits saw: the Modified Ritchie width of the ODOT 60 ft cut (W = 0.2 H + 4.5 m = 8.16 m,
     Ryan & Pryor 2000), against the 90 % retention width predicted from ``posterior`` (a fit on all three data
-    sets), one re-simulation of 600 blocks per posterior draw (``n_draws``)."""
+    sets), one re-simulation of 600 blocks per posterior draw (``n_draws``).  ``posterior=None``: the cut's
+    presets as published (``preset_basis`` dropped, nothing fitted), ``n_draws`` runs of 600 blocks."""
     import simulation
     from riskrf.hazard.catchment import catchment_retention, modified_ritchie_width_m
     from simulation.calibration import apply_parameters
     data, _ = scenario_dict(ODOT_CUT)
-    cols = [k for k in posterior.columns if parameter_sets_any(k, ODOT_MATERIALS)]
-    draws = posterior[cols].sample(n_draws, random_state=seed)
+    if posterior is None:
+        data = copy.deepcopy(data)
+        for m in ODOT_MATERIALS.values():
+            data["materials"][m].pop("preset_basis", None)
+        records = [{}] * n_draws
+    else:
+        cols = [k for k in posterior.columns if parameter_sets_any(k, ODOT_MATERIALS)]
+        records = posterior[cols].sample(n_draws, random_state=seed).to_dict("records")
     widths = []
-    for t, d in enumerate(draws.to_dict("records")):
+    for t, d in enumerate(records):
         vals = {material_parameter(k, ODOT_MATERIALS[m]): v for k, v in d.items() for m in parameter_materials(k)
                 if m in ODOT_MATERIALS}
         sc = simulation.scenario_from_dict(apply_parameters(data, vals), str(ODOT_CUT))
@@ -358,7 +387,7 @@ def ritchie_row(posterior, model, n_draws, seed):
     q = np.quantile(w, [0.1, 0.5, 0.9])
     return {"held_out": "odot_ritchie_rule", "model": model, "observations": 1,
             "obs_p10": np.nan, "obs_p50": obs, "obs_p90": np.nan, "pred_p10": q[0], "pred_p50": q[1],
-            "pred_p90": q[2], "median_error_pct": 100.0 * (q[1] / obs - 1.0), "ks_d": np.nan,
+            "pred_p90": q[2], "median_error_pct": median_error_pct(q[1], obs), "ks_d": np.nan,
             "w1": float(np.mean(np.abs(w - obs))), "beyond_p95": float(obs > np.quantile(w, 0.95)),
             "beyond_p99": float(obs > np.quantile(w, 0.99)),
             "unit": "m (90 % retention width, 60 ft ODOT cut)"}, w
@@ -398,12 +427,22 @@ def ritchie_constraint() -> ReachConstraint:
                            source="riskrf.hazard.catchment.modified_ritchie_width_m (Ryan & Pryor 2000)")
 
 
+def evans_hungr_angles(draws, repeats=1):
+    """The Evans & Hungr reach constraint and the shadow angle [deg] of the simulated p99 stop on its section, one
+    per posterior draw and repeat (200 blocks each, seeds 30,000 + 100 t + repeat), with the laws of ``MODEL``."""
+    c = evans_hungr()
+    cp = _ConstraintPool([c], _drawn(draws))
+    angles = [cp.far_angles(cp.simulate(v, 30_000 + 100 * t + rep))[0]
+              for t, v in enumerate(draws) for rep in range(repeats)]
+    return c, angles
+
+
 def constraint_row(model, cons, angles):
     a = np.asarray(angles)
     q = np.quantile(a, [0.1, 0.5, 0.9])
     return {"held_out": "evans_hungr_1993", "model": model, "observations": 1, "obs_p10": np.nan,
             "obs_p50": cons.shadow_angle_deg, "obs_p90": np.nan, "pred_p10": q[0], "pred_p50": q[1],
-            "pred_p90": q[2], "median_error_pct": 100.0 * (q[1] / cons.shadow_angle_deg - 1.0),
+            "pred_p90": q[2], "median_error_pct": median_error_pct(q[1], cons.shadow_angle_deg),
             "ks_d": np.nan, "w1": float(np.mean(np.abs(a - cons.shadow_angle_deg))),
             "beyond_p95": float(cons.shadow_angle_deg < np.quantile(a, 0.05)),
             "beyond_p99": float(cons.shadow_angle_deg < np.quantile(a, 0.01)),
@@ -456,15 +495,13 @@ def vt0_sensitivity(n_draws: int, n_each: int, seed: int) -> pd.DataFrame:
                 row = {"vt0_ms": vt0, "on": "every material (shipped)" if vt0 == CRSP_TANGENTIAL_SCALE_MS else where}
                 for prof in ("P1", "P2"):
                     rels = releases(prof)
-                    r, (_, pred) = release_row(prof, "", predict_release_stops(rels, draws, n_each, 50_000), rels)
+                    r, (_, pred) = release_row(prof, "", predict_release_stops(rels, draws, n_each, PREDICT_SEED), rels)
                     row[f"{prof}_median_error_pct"] = r["median_error_pct"]
                     row[f"{prof}_beyond_p99_pct"] = 100.0 * r["beyond_p99"]
                     row[f"{prof}_w1_m"] = r["w1"]
                     if prof == "P1":
                         row["P1_before_bench_end_pct"] = 100.0 * float(np.mean(pred < AUTHUME_P1_BENCH_END_M))
-                c = evans_hungr()
-                cp = _ConstraintPool([c], _drawn(draws))
-                angles = [cp.far_angles(cp.simulate(v, 30_000 + 100 * t))[0] for t, v in enumerate(draws)]
+                _, angles = evans_hungr_angles(draws)
                 row["eh_p99_shadow_angle_deg"] = float(np.median(angles))
                 post = pd.DataFrame(draws)
                 for m in [m for m in ODOT_MATERIALS if m in mats]:    # the ODOT cut's face and floor take it too
@@ -597,19 +634,14 @@ def main():
             if held == "odot_ritchie_rule":
                 r, cv = ritchie_row(pd.DataFrame(ds), model, len(ds), args.seed)
             elif held == "evans_hungr_1993":
-                c = evans_hungr()
-                cp = _ConstraintPool([c], _drawn(ds))
+                c, angs = evans_hungr_angles(ds, 1 if fitted else args.draws)
                 MODEL["laws"] = laws
-                angs = []
-                for t, v in enumerate(ds):
-                    for rep in range(1 if fitted else args.draws):
-                        angs.append(cp.far_angles(cp.simulate(v, 30_000 + 100 * t + rep))[0])
                 r, cv = constraint_row(model, c, angs)
             else:
                 rels = releases(held.split("_")[1].upper())
                 MODEL["laws"] = laws
-                r, cv = release_row(held, model, predict_release_stops(rels, ds, 10 if fitted else 400, 50_000),
-                                    rels)
+                n_each = N_EACH_FITTED if fitted else N_EACH_PUBLISHED
+                r, cv = release_row(held, model, predict_release_stops(rels, ds, n_each, PREDICT_SEED), rels)
             rows.append(r)
             curves[(held, model)] = cv
         print(pd.DataFrame(rows).round(3).to_string())
