@@ -1,6 +1,6 @@
 """Coverage by block size: the leave-one-dataset-out check of the presets, uncalibrated beside calibrated.
 
-    python validation/presets/coverage_by_size.py                  # the whole table and figure (about 8 min, 2 cores)
+    python validation/presets/coverage_by_size.py                  # the whole table and figure (about 4 min, 2 cores)
     python validation/presets/coverage_by_size.py --figure-only    # the figure again from coverage_by_size.csv
 
 For every data set the presets can be checked against (those of derive_presets.py: the Authume quarry releases of
