@@ -1476,11 +1476,13 @@ def write_assessment(a: Assessment, out: Path, log=None, runner=None) -> dict:
     write_json(summary, out / "summary.json")
     if a.design is not None:
         _design_outputs(a, out, figs)
-    (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
     from ..report.pdf import write_pdf_report
-    write_pdf_report(a, out / "report.pdf", figs)
+    # the PDF (from the assessment and the finished figures) on the other core while this one writes the rest
+    pdf = runner.beside(partial(write_pdf_report, a, out / "report.pdf", figs))
+    (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
     _copy_inputs(a, out / "inputs")
     relative_paths_in_json_files(out, a.site.path.parent)          # paths relative to the site file
+    pdf.result()
     return relative_paths(summary, a.site.path.parent)
 
 

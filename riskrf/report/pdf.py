@@ -102,6 +102,41 @@ def pct(v, digits: int = 1) -> str:
     return "n/a" if v is None or not np.isfinite(float(v)) else f"{100 * float(v):.{digits}f} %"
 
 
+def _remember_text_widths(pdf) -> None:
+    """Make the document's fonts measure a text from the width of the same text one character shorter.
+
+    fpdf2's line breaking measures each line again as every character is added (the text so far, summed glyph by
+    glyph), so a paragraph or table cell of n characters costs about n^2 / 2 glyph look-ups: most of the time of
+    the report's PDF.  The widths are kept per font and text for this document, so each measurement adds one
+    glyph to the one before.  The glyph widths are whole numbers of font units, so the sums, and the PDF, are
+    the same as fpdf2's own.
+    """
+    from fpdf.fonts import TTFFont
+
+    widths: dict = {}
+
+    class _Widths(TTFFont):
+        __slots__ = ()        # the layout of TTFFont, so that the document's font objects can take this class
+
+        def get_text_width(self, text, font_size_pt, text_shaping_params):
+            if text_shaping_params or self.is_symbol or not text:
+                return super().get_text_width(text, font_size_pt, text_shaping_params)
+            if font_size_pt > self.biggest_size_pt:
+                self.biggest_size_pt = font_size_pt
+            key = (self.fontkey, text)
+            units = widths.get(key)
+            if units is None:
+                shorter = widths.get((self.fontkey, text[:-1]))
+                units = shorter + self.cw[ord(text[-1])] if shorter is not None else \
+                    sum(self.cw[ord(c)] for c in text)
+                widths[key] = units
+            return len(text), units * font_size_pt * 0.001
+
+    for font in pdf.fonts.values():
+        if type(font) is TTFFont:
+            font.__class__ = _Widths
+
+
 class _Report:
     """fpdf2 document with the title block in the footer and header, sections registered for the contents."""
 
@@ -138,6 +173,7 @@ class _Report:
         pdf.add_font("DejaVu", "", str(regular))
         pdf.add_font("DejaVu", "B", str(bold))
         pdf.add_font("DejaVu", "I", str(italic))
+        _remember_text_widths(pdf)
         pdf.set_margins(15, 15, 15)
         pdf.set_auto_page_break(True, margin=16)
         pdf.alias_nb_pages()

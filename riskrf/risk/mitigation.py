@@ -517,10 +517,13 @@ class MitigationStudy(RecommendationMixin, SensitivityMixin, Displayed):
             return np.ones(r.total.shape, dtype=bool)
         kk, pk = occupancy_distribution(self.exposure.occupants_per_vehicle, self.exposure.occupants_distribution)
         Ns = np.arange(1, int(kk.max()) + 1)
-        a_d, a_s = share_with_at_least(r.v_d, kk, pk), share_with_at_least(r.v_s, kk, pk)   # (S, K, J, N)
         x = r.road_bins * r.user_share[:, :, None]               # (S, K, J) falls meeting open road
-        F = np.einsum("skj,skjn->skn", x * r.p_st[:, None, None], a_d) \
-            + np.einsum("skj,skjn->skn", x * r.p_strike[:, None, None], a_s)
+        F = 0.0
+        for v, p in ((r.v_d, r.p_st), (r.v_s, r.p_strike)):
+            if np.array_equal(v, np.broadcast_to(v[:, :1], v.shape)):    # every option the same vulnerabilities
+                F = F + np.einsum("skj,sjn->skn", x * p[:, None, None], share_with_at_least(v[:, 0], kk, pk))
+            else:                                                          # e.g. fragments: each option its own
+                F = F + np.einsum("skj,skjn->skn", x * p[:, None, None], share_with_at_least(v, kk, pk))
         return cs.fn_exceedance(F, Ns) <= 1.0
 
     # ---- societal risk -------------------------------------------------------------------------
