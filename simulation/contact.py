@@ -17,7 +17,8 @@ What the module holds
 * the roughness tilt amplitude relative to the block radius (:func:`roughness_tilt_max`);
 * the switch between flight and ground contact (:func:`contact_speed`): a physical hop height, with the
   scenario's ``contact_velocity_ms`` only a numerical floor under it;
-* rolling and sliding in contact (:func:`contact_acceleration`, :func:`roll_on_speed`);
+* rolling and sliding in contact (:func:`contact_acceleration`, :func:`roll_on_speed`), with the bounded
+  size law of the rolling resistance (:func:`rolling_resistance`, :data:`ROLLING_RESISTANCE_CAP_DEG`);
 * the steep-face rule (:func:`steep_face_launch`): on faces steeper than a stated angle a block does not
   roll in contact; it leaves the face and meets it again in impacts.
 
@@ -572,16 +573,45 @@ def contact_speed(v_floor, g, cos_beta, hop_height_m):
     return max(v_floor, hop)
 
 
-@njit(cache=True)
-def rolling_resistance(mu_0, size_k, roughness_m, r):
-    """Rolling-resistance coefficient [-] of a block of radius r [m]: mu_0 + size_k * roughness_m / r.
+#: The default largest rolling-resistance angle [deg] the size term can raise a material's resistance to
+#: (:func:`rolling_resistance`; a material's ``rolling_resistance_cap_deg``): 38 deg, the steepest angle at which
+#: loose rock debris stands.  Basis: talus slopes stand at 30-38 deg, the dynamic angle of repose of their debris
+#: (Evans & Hungr 1993, Can. Geotech. J. 30:620; Kirkby & Statham 1975, J. Geol. 83:349; Statham 1976, Earth Surf.
+#: Process. 1:43: screes stand below the angle of repose of their debris and are sorted, the small stones stopping
+#: high) [R].  A stone that sinks between asperities of its own size sits in the hollows as a grain of loose debris
+#: does, so the steepest slope on which it is held is the debris' angle of repose; a resistance above it would hold
+#: small blocks on slopes steeper than any loose debris stands at.  It equals the talus preset's phi_g
+#: (simulation.materials: chosen above the steepest usual talus so that blocks can stop on it) and lies within the
+#: rolling friction of soil and vegetated ground, 0.5-0.8 or 27-39 deg (Dorren 2003, Progr. Phys. Geogr. 27:69)
+#: [R].  The value is ASSUMED: no published maximum rolling-friction angle of small blocks was found.  A terrain
+#: whose asperities are boulders larger than the blocks (coarse talus) traps them in its hollows, and the lumped
+#: resistance then stands for impacts as well: such a material may state its own, higher cap.
+ROLLING_RESISTANCE_CAP_DEG = 38.0
 
-    ``mu_0`` = tan(phi_g) is the resistance of a block much larger than the asperities; the second term
-    makes smaller blocks, which sink between asperities of height ``roughness_m`` [m], stop sooner: the
-    friction of a stone moving over scree falls as its size grows relative to the surface stones
-    (Kirkby & Statham 1975, J. Geol. 83:349, mu = tan(phi) + K d/D, d and D the sizes of surface and moving
-    stones [R]; Statham 1976, Earth Surf. Process. 1:43, the resulting downslope size sorting of screes).
-    With ``size_k`` = 0 it is mu_0 (the former behaviour).
+
+@njit(cache=True)
+def rolling_resistance(mu_0, size_k, roughness_m, r, mu_cap, size_exp):
+    """Rolling-resistance coefficient [-] of a block of radius r [m]: a bounded size law.
+
+    mu = mu_0 + s c / sqrt(s^2 + c^2), with s = size_k * (roughness_m / r)^size_exp the size term of Kirkby &
+    Statham (1975; their form has size_exp = 1) and c = max(mu_cap - mu_0, 0) the room left below the material's
+    cap ``mu_cap`` (tan of its
+    ``rolling_resistance_cap_deg``, by default :data:`ROLLING_RESISTANCE_CAP_DEG`).  ``mu_0`` = tan(phi_g) is the
+    resistance of a block much larger than the asperities; the size term makes smaller blocks, which sink between
+    asperities of height ``roughness_m`` [m], stop sooner: the friction of a stone moving over scree falls as its
+    size grows relative to the surface stones (Kirkby & Statham 1975, J. Geol. 83:349, mu = tan(phi) + K d/D, d and
+    D the sizes of surface and moving stones [R]; Statham 1976, Earth Surf. Process. 1:43, the resulting downslope
+    size sorting of screes).
+
+    The exponent ``size_exp`` lets the data set how fast the resistance rises as blocks get smaller (1: Kirkby &
+    Statham's d/D; below 1 more slowly, above 1 faster): fitted with K, it carries the uncertainty of the size
+    dependence beyond the block sizes a calibration saw.
+
+    The size term saturates smoothly (the root-sum-square of s and c, S = s / sqrt(1 + (s / c)^2)): for blocks
+    large against the asperities (s << c) it is Kirkby & Statham's mu_0 + s (at s = c / 2 it is 89 % of s), and as
+    r -> 0 it tends to the cap, never above it, so a small block cannot meet more resistance than the terrain's
+    cap.  It is continuous and non-increasing in r and continuous in every argument.  With ``size_k`` = 0, no
+    roughness, or ``mu_0`` >= ``mu_cap``, it is mu_0 (a typed or fitted phi_g above the cap is kept).
 
     Parameters
     ----------
@@ -590,22 +620,33 @@ def rolling_resistance(mu_0, size_k, roughness_m, r):
     size_k : float
         Size coefficient K [-].
     roughness_m : float
-        Asperity height of the surface [m].
+        Asperity height of the surface [m] (a property of the terrain: the material's ``roughness_m``).
     r : float
         Block radius [m].
+    mu_cap : float
+        Largest coefficient the size term can raise the resistance to [-] (tan of the cap angle).
+    size_exp : float
+        Exponent of the size ratio roughness / r [-] (1: Kirkby & Statham's form).
 
     Returns
     -------
     float
-        Rolling-resistance coefficient [-].
+        Rolling-resistance coefficient [-], between mu_0 and max(mu_0, mu_cap).
 
     References
     ----------
     Kirkby, M.J. & Statham, I. (1975), J. Geol. 83: 349 (mu = tan(phi) + K d/D).
+    Evans, S.G. & Hungr, O. (1993), Can. Geotech. J. 30: 620 (talus slopes of 30-38 deg).
+    Dorren, L.K.A. (2003), Progr. Phys. Geogr. 27: 69 (rolling friction of soft ground 0.5-0.8).
     """
-    if size_k <= 0.0 or r <= 0.0:
+    if size_k <= 0.0 or r <= 0.0 or roughness_m <= 0.0:
         return mu_0
-    return mu_0 + size_k * roughness_m / r
+    room = mu_cap - mu_0
+    if room <= 0.0:
+        return mu_0
+    ratio = roughness_m / r
+    s = size_k * (ratio if size_exp == 1.0 else ratio ** size_exp)
+    return mu_0 + s * room / math.hypot(s, room)        # hypot: no underflow of s^2 + c^2 to 0
 
 
 @njit(cache=True)

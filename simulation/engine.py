@@ -33,7 +33,9 @@ def _material_arrays(scenario: Scenario):
         m_mu_ground=np.tan(np.radians(f("ground_friction_deg"))),
         m_gain=np.array([m.allow_energy_gain for m in mats]),
         m_en_v0=f("en_velocity_scale_ms"), m_hop=f("hop_height_m"),
-        m_drag=f("rolling_drag"), m_size_k=f("rolling_size_coefficient"), m_et_v0=f("et_normal_scale_ms"))
+        m_drag=f("rolling_drag"), m_size_k=f("rolling_size_coefficient"),
+        m_mu_cap=np.tan(np.radians(f("rolling_resistance_cap_deg"))), m_size_exp=f("rolling_size_exponent"),
+        m_et_v0=f("et_normal_scale_ms"))
 
 
 def kernel_features(scenario: Scenario) -> tuple[bool, bool]:

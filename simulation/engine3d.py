@@ -26,7 +26,7 @@ from .units import J_PER_KJ, kinetic_energy_kj
 DEFAULT_CHUNK_3D = 20_000
 _KERNEL3D_MATERIALS = ("m_en_law", "m_en_mean", "m_en_std", "m_et_law", "m_et_mean", "m_et_std", "m_phi", "m_phi_std",
                        "m_rough", "m_roll", "m_mu_ground", "m_gain", "m_en_v0", "m_hop", "m_drag", "m_size_k",
-                       "m_et_v0")
+                       "m_mu_cap", "m_size_exp", "m_et_v0")
 
 
 def _kernel3d_materials(scenario: TerrainScenario) -> dict:

@@ -413,7 +413,7 @@ def _envelope_contact(env_x, env_acc, xa, xb, x0, mass, inertia, r, contact_spee
 def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
              px, pz, tree, n_leaves, seg_mat, run_first, run_last,
              m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
-             m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k, m_et_v0,
+             m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k, m_mu_cap, m_size_exp, m_et_v0,
              c_x, c_cap, c_h, c_order, env_x, env_acc,
              g, v_contact, v_stop, sin_max_roll, max_events, key, n_path_blocks,
              out_x, out_z, out_reason, out_impacts, out_t,
@@ -429,7 +429,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
     (sorted by the caller: a sort compiled here would add about 2 s to the first compilation).
     The contact laws are those of :mod:`simulation.contact`: ``m_en_v0`` the velocity scale of e_N [m/s] (inf:
     none), ``m_hop`` the hop height [m] below which a rebound is ground contact (:func:`contact_speed`), and
-    ``m_size_k`` the size term of the rolling resistance (:func:`rolling_resistance`), ``m_drag`` the rolling drag (the contact's v^2 resistance c = m_drag / r [1/m], :func:`contact_speed_at`),
+    ``m_size_k`` the size coefficient of the rolling resistance (:func:`rolling_resistance`, the bounded size law:
+    never above tan(:data:`simulation.contact.ROLLING_RESISTANCE_CAP_DEG`) from the size term), ``m_drag`` the rolling drag (the contact's v^2 resistance c = m_drag / r [1/m], :func:`contact_speed_at`),
     ``sin_max_roll`` the sine of the steepest slope a block may roll or slide on in contact (1: any slope);
     on steeper segments it leaves the face (:func:`steep_face_launch`) and meets it in impacts.
 
@@ -483,6 +484,10 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
         array of zeros; :func:`simulation.engine.kernel_features`).
     m_size_k : numpy.ndarray
         Per material: size coefficient of the rolling resistance [-].
+    m_mu_cap : numpy.ndarray
+        Per material: the cap of the rolling resistance's size term, tan(``rolling_resistance_cap_deg``) [-].
+    m_size_exp : numpy.ndarray
+        Per material: exponent of the size ratio roughness / r in the size term [-] (``rolling_size_exponent``).
     m_et_v0 : numpy.ndarray
         Per material: velocity scale of the tangential scaling [m/s] (inf: none; :func:`tangential_scaling`).
     c_x : numpy.ndarray
@@ -737,7 +742,8 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
             k = seg
             mat = seg_mat[k]
             cosb, sinb = seg_cos[k], seg_sin[k]
-            mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r)
+            mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r, m_mu_cap[mat],
+                                    m_size_exp[mat])
             roll = m_roll[mat]
             trapped = False
             if sin_max_roll is not None and abs(sinb) > sin_max_roll:

@@ -35,7 +35,8 @@ Physics (shared with the 2-D kernel :mod:`simulation.kernel`)
   :func:`simulation.kernel.roll_on_speed` for the transition to rolling; the block then moves along the surface in steps of at most half a cell with the
   gravity component in the tangent plane and the rolling-resistance (or sliding) friction of the 2-D
   contact law, a = f (g_t - mu_r g cos(theta) v/|v|) - c |v| v, f = 1 / (1 + k) rolling (5/7 for a sphere), 1
-  sliding, mu_r = tan(phi_g) + K roughness / r (:func:`simulation.contact.rolling_resistance`) and the
+  sliding, mu_r = tan(phi_g) + s c / sqrt(s^2 + c^2), s = K (roughness / r)^a, c the room below the material's cap
+  (38 deg by default; the bounded size law of :func:`simulation.contact.rolling_resistance`, the 2-D kernel's) and the
   velocity-squared drag c = rolling_drag / r [1/m].  The speed after each step comes from the work-energy
   balance over the step's 3-D path (drop minus friction work; with drag, the closed form of
   :func:`simulation.contact.contact_speed_at` along the step), so no step can gain energy; the velocity is
@@ -498,7 +499,7 @@ def _find_impact(zg, x0, y0, dx, dy, lip, x, y, z, vx, vy, vz, g):
 def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                zg, x0, y0, dx, dy, lip, mat_grid,
                m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
-               m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k, m_et_v0,
+               m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k, m_mu_cap, m_size_exp, m_et_v0,
                c_ax, c_ay, c_bx, c_by, c_id, c_s0, c_cap, c_net,
                g, v_contact, v_stop, sin_max_roll, max_events, key, n_path_blocks, rec_pass,
                out_x, out_y, out_z, out_reason, out_impacts, out_t, out_excess, out_events,
@@ -565,6 +566,10 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
         Per material: rolling drag coefficient [-] (c = m_drag / r [1/m]).
     m_size_k : numpy.ndarray
         Per material: size term K of the rolling resistance [-] (:func:`simulation.contact.rolling_resistance`).
+    m_mu_cap : numpy.ndarray
+        Per material: the cap of the size term, tan(``rolling_resistance_cap_deg``) [-].
+    m_size_exp : numpy.ndarray
+        Per material: exponent of the size ratio roughness / r in the size term [-] (``rolling_size_exponent``).
     m_et_v0 : numpy.ndarray
         Per material: velocity scale of the tangential scaling [m/s] (inf: none;
         :func:`simulation.contact.tangential_scaling`).
@@ -881,7 +886,8 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
                     _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, t_abs, x, y, z,
                                  math.sqrt(vx * vx + vy * vy + vz * vz), MODE_FLIGHT)
                 continue
-            mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r)
+            mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r, m_mu_cap[mat],
+                                    m_size_exp[mat])
             roll = m_roll[mat]
             factor = 1.0 / (1.0 + k_in) if roll else 1.0
             c_drag = m_drag[mat] / r if r > 0.0 else 0.0

@@ -357,7 +357,17 @@ def preset_prior(name: str):
                 sd = float(p[tab]["std_deg"])
             rows.append({"field": field, "basis": "published", "published": value, "mean": value, "sd": sd,
                          "median": value, "q05": float("nan"), "q95": float("nan"), "datasets": ""})
+    for field, st in data.items():            # fitted fields the published table leaves at the scenario default
+        if field not in flat:
+            rows.append({"field": field, "basis": "data", "published": p.get(field, FIELD_DEFAULTS.get(field)),
+                         "mean": st["mean"], "sd": st["sd"], "median": st["median"], "q05": st["q05"],
+                         "q95": st["q95"], "datasets": ", ".join(preset_priors.DATASETS)})
     return pd.DataFrame(rows).set_index("field")
+
+
+#: The default of a material field no preset sets (simulation.scenario.Material reads it from here): what the
+#: published basis uses for a field the data-derived presets fit (the size law of the rolling resistance).
+FIELD_DEFAULTS = {"rolling_size_coefficient": 0.0, "rolling_size_exponent": 1.0}
 
 
 def _unknown(name, where: str, source: str) -> str:

@@ -15,8 +15,9 @@ import numpy as np
 from scipy import stats
 
 from .errors import RiskrfError
-from .materials import PresetError, resolve_material
-from .contact import CRSP_VELOCITY_SCALE_MS, EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_COULOMB, ET_FRICTION
+from .materials import FIELD_DEFAULTS, PresetError, resolve_material
+from .contact import (CRSP_VELOCITY_SCALE_MS, EN_CONSTANT, EN_VELOCITY, EN_WYLLIE, ET_CONSTANT, ET_COULOMB, ET_FRICTION,
+                      ROLLING_RESISTANCE_CAP_DEG)
 from .slope import Profile
 from ._display import Displayed, short_repr
 from .units import DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3, INERTIA_FACTORS, STANDARD_GRAVITY_MS2, block_radius
@@ -200,8 +201,12 @@ class Material:
     than this above the surface is ground contact (``contact_hop_height_m``; 0: the numerical
     ``contact_velocity_ms`` alone decides, as before); ``rolling_drag`` kappa [-]: in ground contact the block
     also decelerates by (kappa / r) v^2 (rolling over asperities, ploughing; 0: none);
-    ``rolling_size_coefficient`` K [-]: the rolling resistance is tan(phi_g) + K roughness / r, so small blocks
-    stop sooner (0: tan(phi_g) alone); ``et_normal_scale_ms``: vt0 of the Pfeiffer & Bowen (1989) scaling of the
+    ``rolling_size_coefficient`` K [-]: the rolling resistance is tan(phi_g) + s c / sqrt(s^2 + c^2), s = K (roughness / r)^a
+    and c = tan(cap) - tan(phi_g) (:func:`simulation.contact.rolling_resistance`: Kirkby & Statham's tan(phi_g) + s
+    for large blocks, never above the cap from the size term), so small blocks stop sooner (0: tan(phi_g) alone);
+    ``rolling_resistance_cap_deg`` [deg]: that cap (default 38, :data:`simulation.contact.ROLLING_RESISTANCE_CAP_DEG`,
+    the steepest angle of repose of loose debris; a terrain of boulders larger than the blocks may state more);
+    ``rolling_size_exponent`` a [-]: the exponent of the size ratio (default 1, Kirkby & Statham's form); ``et_normal_scale_ms``: vt0 of the Pfeiffer & Bowen (1989) scaling of the
     tangential energy by 1 / ((v_n / (vt0 e_N))^2 + 1) after a constant or Coulomb law (inf: none;
     ``tangential.normal_scale_ms`` in a file, 76.2 m/s in CRSP); ``lateral_deviation`` D [-] and
     ``lateral_deviation_speed_ms`` v_D [m/s] (3-D kernel only): after each impact the block's direction of travel
@@ -228,7 +233,9 @@ class Material:
     en_velocity_scale_ms: float = math.inf
     hop_height_m: float = 0.0
     rolling_drag: float = 0.0
-    rolling_size_coefficient: float = 0.0
+    rolling_size_coefficient: float = FIELD_DEFAULTS["rolling_size_coefficient"]
+    rolling_resistance_cap_deg: float = ROLLING_RESISTANCE_CAP_DEG
+    rolling_size_exponent: float = FIELD_DEFAULTS["rolling_size_exponent"]
     et_normal_scale_ms: float = math.inf
     lateral_deviation: float = DEFAULT_LATERAL_DEVIATION
     lateral_deviation_speed_ms: float = DEFAULT_LATERAL_DEVIATION_SPEED_MS
@@ -256,8 +263,8 @@ class Material:
             raise ScenarioError(f"{source}: materials.{name} must be a table of material fields; got {spec!r}")
         _check_keys(spec, {"preset", "preset_basis", "normal_restitution", "tangential", "roughness_m", "ground_motion",
                            "ground_friction_angle_deg", "rolling_resistance", "allow_energy_gain",
-                           "contact_hop_height_m", "rolling_drag", "rolling_size_coefficient", "lateral_deviation",
-                           "lateral_deviation_speed_ms"}, where, source)
+                           "contact_hop_height_m", "rolling_drag", "rolling_size_coefficient", "rolling_resistance_cap_deg",
+                           "rolling_size_exponent", "lateral_deviation", "lateral_deviation_speed_ms"}, where, source)
         if "preset_basis" in spec and "preset" not in spec:
             raise ScenarioError(f"{source}: {where}preset_basis = {spec['preset_basis']!r} needs a preset beside it")
         given = set(spec)
@@ -352,8 +359,15 @@ class Material:
                    hop_height_m=_number(spec.get("contact_hop_height_m", 0.0), f"{where}contact_hop_height_m",
                                         source, lo=0.0, hi=10.0),
                    rolling_drag=_number(spec.get("rolling_drag", 0.0), f"{where}rolling_drag", source, lo=0.0, hi=10.0),
-                   rolling_size_coefficient=_number(spec.get("rolling_size_coefficient", 0.0),
-                                                    f"{where}rolling_size_coefficient", source, lo=0.0, hi=10.0),
+                   rolling_size_coefficient=_number(
+                       spec.get("rolling_size_coefficient", FIELD_DEFAULTS["rolling_size_coefficient"]),
+                       f"{where}rolling_size_coefficient", source, lo=0.0, hi=10.0),
+                   rolling_resistance_cap_deg=_number(
+                       spec.get("rolling_resistance_cap_deg", ROLLING_RESISTANCE_CAP_DEG),
+                       f"{where}rolling_resistance_cap_deg", source, lo=0.0, hi=89.0),
+                   rolling_size_exponent=_number(
+                       spec.get("rolling_size_exponent", FIELD_DEFAULTS["rolling_size_exponent"]),
+                       f"{where}rolling_size_exponent", source, lo=0.0, hi=3.0),
                    lateral_deviation=_number(spec.get("lateral_deviation", DEFAULT_LATERAL_DEVIATION),
                                              f"{where}lateral_deviation", source, lo=0.0, hi=20.0),
                    lateral_deviation_speed_ms=_number(spec.get("lateral_deviation_speed_ms",

@@ -155,9 +155,11 @@ def test_contact_speed_is_the_hop_speed_above_the_numerical_floor():
 
 
 def test_rolling_resistance_and_acceleration():
-    assert rolling_resistance(0.5, 0.0, 0.3, 0.5) == 0.5
-    assert rolling_resistance(0.5, 1.0, 0.3, 0.5) == pytest.approx(1.1)
-    assert rolling_resistance(0.5, 1.0, 0.3, 3.0) == pytest.approx(0.6)
+    cap = math.tan(math.radians(38.0))
+    assert rolling_resistance(0.5, 0.0, 0.3, 0.5, cap, 1.0) == 0.5
+    c = cap - 0.5                           # the bounded law: mu_0 + s c / sqrt(s^2 + c^2), s = K h / r
+    assert rolling_resistance(0.5, 1.0, 0.3, 0.5, cap, 1.0) == pytest.approx(0.5 + 0.6 * c / math.hypot(0.6, c))
+    assert rolling_resistance(0.5, 1.0, 0.3, 3.0, cap, 1.0) == pytest.approx(0.5 + 0.1 * c / math.hypot(0.1, c))
     b = math.radians(-30.0)   # down in +x
     assert contact_acceleration(G, math.sin(b), math.cos(b), 1.0, 0.2, 0.4, True) == pytest.approx(
         5 / 7 * G * (0.5 - 0.2 * math.cos(b)))

@@ -14,21 +14,22 @@ import pytest
 import simulation
 from simulation import preset_priors
 from simulation.material_uncertainty import preset_posterior
-from simulation.materials import PRESETS, PresetError, preset, preset_prior
+from simulation.materials import PRESETS, PresetError, parameter_materials, preset, preset_prior
 from simulation.pooled import ReachConstraint, Release, calibrate_pooled
 
 
 def test_default_presets_are_the_published_values_and_data_basis_swaps_in_posterior_medians():
     for name in PRESETS:
         assert preset(name) == PRESETS[name]                         # nothing changed for existing scenarios
-    fitted = {p.split(".")[1] for p in preset_priors.SUMMARY}
+    fitted = {m for p in preset_priors.SUMMARY for m in parameter_materials(p)}
     assert fitted == {"soil", "bedrock", "talus"}
     for path, st in preset_priors.SUMMARY.items():
-        _, mat, *field = path.split(".")
-        table = preset(mat, basis="data")
-        for f in field[:-1]:
-            table = table[f]
-        assert table[field[-1]] == pytest.approx(st["median"])
+        field = path.split(".")[2:]
+        for mat in parameter_materials(path):             # a shared field (materials.A+B.FIELD) is each one's
+            table = preset(mat, basis="data")
+            for f in field[:-1]:
+                table = table[f]
+            assert table[field[-1]] == pytest.approx(st["median"])
     # fields no data set constrains keep their published values
     assert preset("soil", basis="data")["normal_restitution"] == PRESETS["soil"]["normal_restitution"]
     # a data-based table is a valid material
@@ -46,7 +47,9 @@ def test_prior_tables_give_a_spread_for_every_fitted_field():
         assert len(data) >= 1
         assert (data["sd"] > 0).all() and (data["q05"] <= data["median"]).all() and (data["median"] <= data["q95"]).all()
         for field, row in data.iterrows():
-            lo, hi = preset_priors.SUMMARY[f"materials.{name}.{field}"]["bounds"]
+            key = next(k for k in preset_priors.SUMMARY                # a shared field: materials.A+B.FIELD
+                       if name in parameter_materials(k) and k.split(".", 2)[2] == field)
+            lo, hi = preset_priors.SUMMARY[key]["bounds"]
             assert lo <= row["q05"] and row["q95"] <= hi
     t = preset_prior("meadow")
     assert (t["basis"] == "published").all()
@@ -61,7 +64,9 @@ def test_posterior_sample_matches_its_summary():
         assert abs(df[k].median() - st["median"]) < 0.5 * st["sd"] + 1e-9   # a 200-draw subsample of the posterior
         lo, hi = st["bounds"]
         assert df[k].between(lo, hi).all()
-    assert list(preset_posterior(["talus"]).columns) == ["materials.talus.ground_friction_angle_deg"]
+    assert list(preset_posterior(["talus"]).columns) == [
+        "materials.talus.ground_friction_angle_deg", "materials.soil+bedrock+talus.rolling_size_coefficient",
+        "materials.soil+bedrock+talus.rolling_size_exponent"]
 
 
 def test_new_site_draws_add_the_assumed_site_to_site_spread():
@@ -149,9 +154,12 @@ def test_the_shipped_priors_were_made_with_the_generator_s_laws_and_data_sets():
     spec.loader.exec_module(mod)
     assert preset_priors.LAWS == mod.CONTACT_LAWS
     assert preset_priors.DATASETS == mod.DATASETS
-    assert set(preset_priors.SUMMARY) == set(mod.CONTACT_PARAMETERS)
+    assert set(preset_priors.SUMMARY) == set(mod.SHIPPED_PARAMETERS)
     for path, st in preset_priors.SUMMARY.items():
-        assert tuple(st["bounds"]) == tuple(mod.CONTACT_PARAMETERS[path])
+        assert tuple(st["bounds"]) == tuple(mod.SHIPPED_PARAMETERS[path])
+    # the size dependence of the rolling resistance is fitted, not fixed: its coefficient and exponent
+    assert {"materials.soil+bedrock+talus.rolling_size_coefficient",
+            "materials.soil+bedrock+talus.rolling_size_exponent"} <= set(preset_priors.SUMMARY)
     p2 = mod.authume_scenario("P2")
     assert set(p2["profile"]["materials"]) == {"soil", "bedrock", "talus"}
     sc = simulation.scenario_from_dict(p2)
