@@ -198,7 +198,7 @@ MAX_MODULE_LINES = 900
 #: Modules still longer than that, each to be split where its code has seams; the list only shrinks (a module
 #: that is split or falls below the limit must leave it).
 STILL_TO_SPLIT = {
-    "riskrf/app/assess.py", "riskrf/report/pdf.py",
+    "riskrf/app/assess.py",
     "riskrf/hazard/design_basis.py", "riskrf/hazard/energy_study.py", "riskrf/hazard/impact_energy.py",
     "riskrf/frequency/inventory.py", "riskrf/frequency/rates.py", "riskrf/risk/options.py",
 }

@@ -547,7 +547,7 @@ def _kv_table(doc, rows, caption: str) -> str:
 
 def _design_values_body(doc, a, figs: Path, s) -> None:
     """The design values sheet: design block, speeds, energies, bounce heights and the required barrier."""
-    from .pdf import design_values_rows
+    from .report_rows import design_values_rows
     doc.add(_kv_table(doc, design_values_rows(a), "Design values at the barrier line"),
             "<p>Energies in kJ, lengths in m.  The shares stopped / over / through take bounce height and energy "
             "of the arriving falls (under the site's mass law) as independent.</p>")
@@ -574,7 +574,7 @@ def _positions_body(doc, a, figs: Path, s) -> None:
 
 def _slope_model_body(doc, a, figs: Path, s) -> None:
     """The slope model: profile vertices with segment dips, materials with the source of their values."""
-    from .pdf import slope_tables
+    from .report_rows import slope_tables
     sc, vert, mats = slope_tables(a.site)
     doc.add(f"<p>Scenario {_e(_name(a.site.hazard['scenario']))}: {_e(sc.description.strip())}</p>",
             "<h3>Profile vertices and segment angles</h3>",
@@ -591,7 +591,7 @@ def _figures_body(doc, a, figs: Path, s) -> None:
 
 def _runout_body(doc, a, figs: Path, s) -> None:
     """The stop points with their run-out statistics."""
-    from .pdf import runout_rows
+    from .report_rows import runout_rows
     doc.add(*(doc.figure(figs / name, cap) for name, cap in s.figures),
             doc.figure(figs / "recommended_trajectories.png", "Trajectories on the slope with the recommended option"))
     rows = runout_rows(getattr(a, "design", None))
