@@ -21,7 +21,7 @@ import pandas as pd
 import pytest
 
 from riskrf.cli import main
-from riskrf.frequency.inventory import read_inventory
+from riskrf.frequency.inventory.reader import read_inventory
 from riskrf.core.validation import RiskrfWarning
 from riskrf.io.velocities import read_velocities
 

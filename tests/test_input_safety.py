@@ -234,7 +234,7 @@ def _inventory(tmp_path, column, values, *, name="inv.csv", dates=None, sidecar=
 @pytest.mark.parametrize("column", ["mass_kg", "volume_m3"])
 def test_us_thousands_with_exactly_three_digits_refused_naming_the_column(tmp_path, column):
     """'146,402' from an en-US export is 146,402, not 146.402: ambiguous alone, so refused with the remedy."""
-    from riskrf.frequency.inventory import read_inventory
+    from riskrf.frequency.inventory.reader import read_inventory
     path = _inventory(tmp_path, column, ["146,402", "2,500", "1,250", "3,000"])
     with pytest.raises(ValueError, match=rf"column '{column}': every number with a comma has exactly three "
                                          r"digits after it \(such as '146,402', row 2\).*--decimal"):
@@ -247,34 +247,34 @@ def test_us_thousands_with_exactly_three_digits_refused_naming_the_column(tmp_pa
 
 
 def test_a_column_holding_1_234_567_reads_every_three_digit_comma_as_thousands(tmp_path):
-    from riskrf.frequency.inventory import read_inventory
+    from riskrf.frequency.inventory.reader import read_inventory
     path = _inventory(tmp_path, "mass_kg", ["1,234,567", "146,402", "12", "2,500"])
     inv = read_inventory(path)
     assert sorted(inv.masses) == [12.0, 2500.0, 146402.0, 1234567.0]
 
 
 def test_decimal_commas_with_other_digit_counts_still_read_as_decimals(tmp_path):
-    from riskrf.frequency.inventory import read_inventory
+    from riskrf.frequency.inventory.reader import read_inventory
     inv = read_inventory(_inventory(tmp_path, "volume_m3", ["1,5", "0,125", "2,25", "12,5"]))
     assert sorted(inv.volumes) == [0.125, 1.5, 2.25, 12.5]
 
 
 def test_grouped_and_decimal_commas_mixed_refused(tmp_path):
-    from riskrf.frequency.inventory import read_inventory
+    from riskrf.frequency.inventory.reader import read_inventory
     with pytest.raises(ValueError, match=r"row 3, column 'mass_kg': '1,234,567' separates thousands.*row 2 "
                                          r"\('1,5'\) has a decimal comma"):
         read_inventory(_inventory(tmp_path, "mass_kg", ["1,5", "1,234,567"]))
 
 
 def test_the_decimal_choice_from_the_sidecar_is_used(tmp_path):
-    from riskrf.frequency.inventory import read_inventory
+    from riskrf.frequency.inventory.reader import read_inventory
     path = _inventory(tmp_path, "mass_kg", ["146,402", "2,500"], sidecar='duration_years = 10\ndecimal = "."\n')
     assert sorted(read_inventory(path).masses) == [2500.0, 146402.0]
 
 
 @pytest.mark.parametrize("density", [2.65, 0.0027, 100.0, 7000.0, 2.65e6])
 def test_density_outside_500_6000_refused_everywhere(tmp_path, capsys, density, no_work):
-    from riskrf.frequency.inventory import read_inventory
+    from riskrf.frequency.inventory.reader import read_inventory
     path = _inventory(tmp_path, "volume_m3", [1.0, 2.0, 3.0])
     with pytest.raises(ValueError, match=rf"density_kg_m3 = {density!r}: a rock density must lie between 500 and "
                                          r"6,000 kg/m3"):
@@ -299,7 +299,7 @@ def test_g_per_cm3_density_message_says_so():
 
 def test_a_fall_beyond_any_recorded_rock_avalanche_is_refused_even_with_the_unit_declared(tmp_path):
     """Seymareh (about 4.4e10 m3, Roberts & Evans 2013) is the largest known; 1e30 m3 is a typing mistake."""
-    from riskrf.frequency.inventory import read_inventory
+    from riskrf.frequency.inventory.reader import read_inventory
     path = _inventory(tmp_path, "volume_m3", ["2.5", "1e30", "3"])
     with pytest.raises(ValueError, match=r"row 3, column 'volume_m3': a fall of 1e\+30 m3, larger than any rock "
                                          r"fall"):
@@ -309,7 +309,7 @@ def test_a_fall_beyond_any_recorded_rock_avalanche_is_refused_even_with_the_unit
 
 
 def test_tonnes_typed_into_mass_kg_are_warned(tmp_path):
-    from riskrf.frequency.inventory import read_inventory
+    from riskrf.frequency.inventory.reader import read_inventory
     from riskrf.core.validation import RiskrfWarning
     path = _inventory(tmp_path, "mass_kg", ["0.2", "0.5", "1.5", "0.05"])
     with pytest.warns(RiskrfWarning, match=r"median mass 0.35 kg is below 1 kg, implausibly small.*mass_unit='t'"):
@@ -317,7 +317,7 @@ def test_tonnes_typed_into_mass_kg_are_warned(tmp_path):
 
 
 def test_volumes_below_a_litre_are_warned(tmp_path):
-    from riskrf.frequency.inventory import read_inventory
+    from riskrf.frequency.inventory.reader import read_inventory
     from riskrf.core.validation import RiskrfWarning
     path = _inventory(tmp_path, "volume_l", ["0.2", "0.5", "0.3"])
     with pytest.warns(RiskrfWarning, match=r"median volume 0.0003 m3 is below one litre"):
@@ -335,7 +335,7 @@ def test_partly_undated_inventory_uses_its_dated_rows_and_says_how_many_were_lef
     path = _inventory(tmp_path, "volume_m3", volumes, dates=dates,
                       sidecar='start = "1990-01-01"\nend = "2019-12-31"\n')
     from riskrf.frequency.study import analyse_inventory
-    from riskrf.frequency.inventory import read_inventory
+    from riskrf.frequency.inventory.reader import read_inventory
     inv = read_inventory(path)
     assert inv.n_undated == 18 and inv.undated_rows == [i + 2 for i in undated]
     maxima = inv.annual_maxima()

@@ -325,7 +325,7 @@ def test_a_road_record_is_reproduced_in_every_draw(tmp_path):
 
     from riskrf.app.assess import draw_evaluator
     from riskrf.app.model_uncertainty import _without_material_draws
-    from riskrf.frequency.inventory import read_inventory
+    from riskrf.frequency.inventory.reader import read_inventory
     path = _site(tmp_path, "[model_uncertainty]\ndraws = 2")
     path.write_text(path.read_text().replace("rate_scale = 0.05", 'rate_scale = 0.05\nrate_basis = "road"'))
     site = load_site(path)

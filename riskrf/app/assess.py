@@ -32,7 +32,8 @@ from ..hazard.energy_study import (
     design_energy_tornado,
 )
 from ..frequency.study import FrequencyAnalysis, analyse_inventory
-from ..frequency.inventory import Inventory, read_inventory
+from ..frequency.inventory.reader import read_inventory
+from ..frequency.inventory.record import Inventory
 from ..hazard.simulated import simulate_energy_hazard
 from ..risk.measures import road_crossings
 from ..risk.mitigation import Exposure, MitigationStudy
@@ -956,7 +957,7 @@ def fit_site_inventory(site: Site, seed):
         The analysis of the dated annual maxima (200 replicates), None when the site gives none.
     """
     inv_cfg = site.inventory
-    from ..frequency.inventory import READER_OPTIONS
+    from ..frequency.inventory.reader import READER_OPTIONS
     reader = {k: inv_cfg[k] for k in READER_OPTIONS if inv_cfg.get(k) is not None}
     inventory = read_inventory(site.resolve(inv_cfg["path"]), start=inv_cfg["start"], end=inv_cfg["end"],
                                duration_years=inv_cfg["duration_years"], density_kg_m3=inv_cfg["density_kg_m3"],

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..frequency.inventory import Inventory
+from ..frequency.inventory.record import Inventory
 from ..hazard.energy_study import analyse_energy
 from ..hazard.simulated import simulate_energy_hazard
 from ..io.outputs import relative_paths, write_json

@@ -8,7 +8,7 @@ from pathlib import Path
 
 
 def _read(args, path):
-    from ..frequency.inventory import read_inventory
+    from ..frequency.inventory.reader import read_inventory
     if path is None:
         raise ValueError(f"riskrf {args.command} needs --inventory INVENTORY (the rock fall inventory file)")
     reader = {k: getattr(args, k) for k in ("sheet", "header_row", "date_format", "decimal", "encoding",

@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from .inventory import Inventory
+from .inventory.record import Inventory
 from ..io.rainfall import Rainfall, read_rainfall
 from ..core.validation import RiskrfWarning, warn
 from simulation._display import Displayed, short_repr

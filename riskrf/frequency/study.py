@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from .extremes import MIN_MAXIMA, GEVFit, GumbelFit, fit_gev, fit_gumbel
-from .inventory import Inventory
+from .inventory.record import Inventory
 from ..io.outputs import write_json
 from .power_law import (
     LARGE_SAMPLE,

@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..frequency.inventory import SIZES  # one home: what an inventory's sizes can be
+from ..frequency.inventory.reader import SIZES  # one home: what an inventory's sizes can be
 from ..core.format import sig
 from ..core.units import DEFAULT_DENSITY_KG_M3, DESIGN_RETURN_PERIODS, kinetic_energy_kj
 
@@ -171,7 +171,7 @@ def read_block_survey(path, density_kg_m3: float, *, sheet=None, header_row: int
     numpy.ndarray
         Block volumes [m³].
     """
-    from ..frequency.inventory import _MASS_NAMES, _MASS_UNITS, _VOLUME_NAMES, _VOLUME_UNITS, _find_column
+    from ..frequency.inventory.reader import _MASS_NAMES, _MASS_UNITS, _VOLUME_NAMES, _VOLUME_UNITS, _find_column
     from ..io.tables import is_blank, parse_numbers, read_table
     path = Path(path)
     if not path.exists():

@@ -289,7 +289,7 @@ def _read_rates_inputs(r: dict, inventory: dict, path: Path, error) -> None:
     """
     from .closure import read_rainstorm_warnings
     from ..io.rainfall import read_rainfall
-    from ..frequency.inventory import READER_OPTIONS, read_inventory
+    from ..frequency.inventory.reader import READER_OPTIONS, read_inventory
 
     base = path.parent
     w = r["windows_days"]
@@ -497,7 +497,7 @@ def evaluate_rates(rates: dict, base, inventory: dict, options=()) -> SiteRates:
         Rates [1/yr] and closure rules of the fitted model.
     """
     from .closure import closure_rule, warning_closure
-    from ..frequency.inventory import READER_OPTIONS, read_inventory
+    from ..frequency.inventory.reader import READER_OPTIONS, read_inventory
     from ..frequency.rates import rate_model
 
     base = Path(base)

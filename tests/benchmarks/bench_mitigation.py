@@ -17,7 +17,7 @@ import warnings
 from dataclasses import replace
 
 from riskrf.app.assess import energy_hazard_from_inputs, road_share, study_context
-from riskrf.frequency.inventory import read_inventory
+from riskrf.frequency.inventory.reader import read_inventory
 from riskrf.risk.mitigation import MitigationStudy
 from riskrf.app.site import load_site
 

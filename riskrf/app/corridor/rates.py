@@ -60,7 +60,7 @@ def _mass_law(table: dict, base: Path, source: str):
     if "inventory" in table:
         if "b" in table:
             raise CorridorError(f"{source}: give mass.inventory (fitted) or mass.b (typed), not both")
-        from ...frequency.inventory import read_inventory
+        from ...frequency.inventory.reader import read_inventory
         inv_path = (base / table["inventory"]).resolve()
         if not inv_path.exists():
             raise CorridorError(f"{source}: mass.inventory = {table['inventory']!r}: file not found ({inv_path})")
@@ -108,7 +108,7 @@ def inventory_rate(path: Path, m_min_kg: float, where: str) -> tuple[float, str]
     """
     import warnings
 
-    from ...frequency.inventory import read_inventory
+    from ...frequency.inventory.reader import read_inventory
     from ...frequency.power_law import fit_gutenberg_richter
     if not path.exists():
         raise CorridorError(f"{where}: file not found ({path})")

@@ -135,7 +135,7 @@ def _check_fit_arguments(masses, duration_years, method, level, m_max, ks_statis
     ValueError
         Naming the first bad argument and its value.
     """
-    from ..inventory import Inventory
+    from ..inventory.record import Inventory
 
     if isinstance(masses, Inventory):
         if duration_years is None:
