@@ -29,7 +29,7 @@ _EXPORTS = {
     "energy_hazard_ensemble": "hazard.model_uncertainty", "ModelUncertainRanking": "risk.model_decision",
     "GutenbergRichterFit": "frequency.power_law", "find_m_min": "frequency.power_law", "fit_gutenberg_richter": "frequency.power_law",
     "Rainfall": "io.rainfall", "read_rainfall": "io.rainfall",
-    "RateModel": "frequency.rates", "rate_model": "frequency.rates",
+    "RateModel": "frequency.rates.result", "rate_model": "frequency.rates.fit",
     # mitigation and the whole chain for one site (the user guide's names)
     "MitigationStudy": "risk.mitigation", "load_mitigation": "risk.mitigation",
     "load_site": "app.site", "run_assessment": "app.assess",

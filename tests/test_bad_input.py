@@ -412,12 +412,12 @@ def test_rates_refuses_impossible_options_before_reading_files(inputs, tmp_path,
     """`riskrf rates` checks its numbers first, naming the option (not the Python argument) and the value."""
     import riskrf.cli.steps
     import riskrf.io.rainfall
-    import riskrf.frequency.rates  # noqa: F401  (the module; the package attribute of that name is the function)
+    import riskrf.frequency.rates.fit  # noqa: F401  (the module ``riskrf rates`` takes rate_model from)
 
     def boom(*a, **k):
         raise AssertionError("a file was read or a model fitted before the option was refused")
     monkeypatch.setattr(riskrf.io.rainfall, "read_rainfall", boom)
-    monkeypatch.setattr(sys.modules["riskrf.frequency.rates"], "rate_model", boom)
+    monkeypatch.setattr(sys.modules["riskrf.frequency.rates.fit"], "rate_model", boom)
     monkeypatch.setattr(riskrf.cli.steps, "_read", boom)      # the inventory reader of ``riskrf rates``
     inv = write(inputs / "falls.csv", "date,volume_m3\n2001-02-03,1.0\n")
     rain = write(inputs / "rain.csv", "date,rainfall_mm\n2001-02-03,1.0\n")

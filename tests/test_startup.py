@@ -157,7 +157,7 @@ def test_the_flat_module_paths_of_before_the_stage_layout_are_gone():
             "try:\n    import riskrf.assess\nexcept ModuleNotFoundError as e:\n    print(e.name)\n"
             "print(callable(riskrf.rate_model), riskrf.rate_model.__module__)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
-    assert out == ["riskrf.assess", "True", "riskrf.frequency.rates"]
+    assert out == ["riskrf.assess", "True", "riskrf.frequency.rates.fit"]
 
 
 def test_every_input_error_is_a_riskrf_error():

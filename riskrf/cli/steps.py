@@ -319,7 +319,7 @@ def cmd_rates(args) -> int:
         Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
     from ..io.outputs import atomic_output_dir
-    from ..frequency.rates import rate_model
+    from ..frequency.rates.fit import rate_model
 
     try:
         windows = tuple(int(w) for w in args.windows.split(","))

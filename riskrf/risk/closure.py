@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..frequency.rates import RateModel
+from ..frequency.rates.result import RateModel
 
 
 @dataclass(frozen=True)

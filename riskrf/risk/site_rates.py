@@ -241,7 +241,8 @@ def _check_rates_model_fields(r: dict, heavy_day_mm, path: Path, error) -> None:
     Exception
         ``error``, naming the file, field and value.
     """
-    from ..frequency.rates import _PERIODS, _SEASONS, _TRANSFORMS
+    from ..frequency.rates.design import _PERIODS, _SEASONS
+    from ..frequency.rates.result import _TRANSFORMS
 
     if r["period"] not in _PERIODS:
         raise error(f"{path}: rates.period = {r['period']!r} must be one of {list(_PERIODS)}")
@@ -498,7 +499,7 @@ def evaluate_rates(rates: dict, base, inventory: dict, options=()) -> SiteRates:
     """
     from .closure import closure_rule, warning_closure
     from ..frequency.inventory.reader import READER_OPTIONS, read_inventory
-    from ..frequency.rates import rate_model
+    from ..frequency.rates.fit import rate_model
 
     base = Path(base)
     with warnings.catch_warnings(record=True) as caught:
