@@ -16,26 +16,63 @@ import time
 import numpy as np
 
 from . import kernel
+from .kernel_args import (Blocks2D, Collectors2D, Crossings2D, Envelope2D, KernelSettings, MaterialTable, Paths2D,
+                          Profile2D, Stops2D)
 from .result import SimulationResult
 from .scenario import Scenario
 
 DEFAULT_CHUNK = 100_000
 
 
-def _material_arrays(scenario: Scenario):
+def material_table(scenario: Scenario) -> tuple[MaterialTable, np.ndarray]:
+    """The scenario's materials as the kernels take them: the :class:`~simulation.kernel_args.MaterialTable` (one
+    entry per material index) and the per-material rolling drag [-].
+
+    Parameters
+    ----------
+    scenario : Scenario or TerrainScenario
+        The scenario about to be simulated.
+
+    Returns
+    -------
+    tuple
+        (MaterialTable, rolling drag per material).
+    """
     mats = scenario.materials
     f = lambda attr: np.array([getattr(m, attr) for m in mats], dtype=float)  # noqa: E731
-    return dict(
-        m_en_law=np.array([m.en_law for m in mats], dtype=np.int64), m_en_mean=f("en_mean"), m_en_std=f("en_std"),
-        m_et_law=np.array([m.et_law for m in mats], dtype=np.int64), m_et_mean=f("et_mean"), m_et_std=f("et_std"),
-        m_phi=f("friction_deg"), m_phi_std=f("friction_std_deg"), m_rough=f("roughness_m"),
-        m_roll=np.array([m.ground_motion == "roll" for m in mats]),
-        m_mu_ground=np.tan(np.radians(f("ground_friction_deg"))),
-        m_gain=np.array([m.allow_energy_gain for m in mats]),
-        m_en_v0=f("en_velocity_scale_ms"), m_hop=f("hop_height_m"),
-        m_drag=f("rolling_drag"), m_size_k=f("rolling_size_coefficient"),
-        m_mu_cap=np.tan(np.radians(f("rolling_resistance_cap_deg"))), m_size_exp=f("rolling_size_exponent"),
-        m_et_v0=f("et_normal_scale_ms"))
+    table = MaterialTable(
+        en_law=np.array([m.en_law for m in mats], dtype=np.int64), en_mean=f("en_mean"), en_std=f("en_std"),
+        et_law=np.array([m.et_law for m in mats], dtype=np.int64), et_mean=f("et_mean"), et_std=f("et_std"),
+        phi=f("friction_deg"), phi_std=f("friction_std_deg"), rough=f("roughness_m"),
+        roll=np.array([m.ground_motion == "roll" for m in mats], dtype=np.bool_),
+        mu_ground=np.tan(np.radians(f("ground_friction_deg"))),
+        gain=np.array([m.allow_energy_gain for m in mats], dtype=np.bool_),
+        en_v0=f("en_velocity_scale_ms"), hop=f("hop_height_m"), size_k=f("rolling_size_coefficient"),
+        mu_cap=np.tan(np.radians(f("rolling_resistance_cap_deg"))), size_exp=f("rolling_size_exponent"),
+        et_v0=f("et_normal_scale_ms"), dev=f("lateral_deviation"), dev_v=f("lateral_deviation_speed_ms"))
+    return table, f("rolling_drag")
+
+
+def kernel_settings(settings, key, n_path_blocks: int) -> KernelSettings:
+    """The run's scalars as the kernels take them, each of the type the compiled kernel was built for (a float
+    gravity typed as an integer would otherwise compile a second version).
+
+    Parameters
+    ----------
+    settings : simulation.scenario.Settings
+        The scenario's settings.
+    key : numpy.uint64
+        The run's random key.
+    n_path_blocks : int
+        The paths of the blocks with index below this are recorded.
+
+    Returns
+    -------
+    KernelSettings
+    """
+    return KernelSettings(g=float(settings.gravity_ms2), v_contact=float(settings.contact_velocity_ms),
+                          v_stop=float(settings.stop_velocity_ms), max_events=int(settings.max_events),
+                          key=np.uint64(key), n_path_blocks=int(n_path_blocks))
 
 
 def kernel_features(scenario: Scenario) -> tuple[bool, bool]:
@@ -202,22 +239,24 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
     blocks = seed_blocks(scenario, n, seed, masses_kg)
     prof = scenario.profile
     st = scenario.settings
-    mats = _material_arrays(scenario)
+    mats, m_drag = material_table(scenario)
     uses_drag, uses_steep = kernel_features(scenario)
     if not uses_drag:
-        mats["m_drag"] = None            # the kernel's specialisation without rolling drag (kernel_features)
+        m_drag = None                    # the kernel's specialisation without rolling drag (kernel_features)
     sin_max_roll = st.sin_max_roll if uses_steep else None
     cols = scenario.collectors
     c_x = np.array([c.x for c in cols], dtype=float)
     c_cap = np.array([np.nan if c.capacity_kj is None else c.capacity_kj for c in cols], dtype=float)
     c_h = np.array([np.nan if c.height_m is None else c.height_m for c in cols], dtype=float)
     c_order = np.argsort(c_x, kind="stable")     # collectors in x order: the order of crossing along the motion
+    collectors = Collectors2D(c_x, c_cap, c_h, c_order)
     nb = st.envelope_bins
     edges = np.linspace(prof.x[0], prof.x[-1], nb + 1)
     env_x = 0.5 * (edges[:-1] + edges[1:]) if nb else np.empty(0)
     env_acc = np.zeros((env_x.size, 7))
     n_paths = min(int(record_paths), n)
     path_cap = max(n_paths * (st.max_events * 3 + 8), 1)
+    settings = kernel_settings(st, key, n_paths)
     paths = {k: np.empty(path_cap, dtype=dt) for k, dt in
              (("block", np.int64), ("t", float), ("x", float), ("z", float), ("vx", float), ("vz", float),
               ("w", float), ("mode", np.int64), ("event", np.int64))}
@@ -244,20 +283,14 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
             env_chunk = np.zeros_like(env_acc)
             pcount[0] = p_start
             kernel.simulate(
-                np.arange(lo, hi, dtype=np.int64), blocks["x"][lo:hi], blocks["z"][lo:hi], blocks["vx"][lo:hi],
-                blocks["vz"][lo:hi], blocks["w"][lo:hi], blocks["mass"][lo:hi], blocks["radius"][lo:hi],
-                blocks["inertia_factor"][lo:hi],
-                prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.material_index, prof.run_first, prof.run_last,
-                **mats, c_x=c_x, c_cap=c_cap, c_h=c_h, c_order=c_order, env_x=env_x, env_acc=env_chunk,
-                g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
-                sin_max_roll=sin_max_roll,
-                max_events=st.max_events, key=key, n_path_blocks=n_paths,
-                out_x=per_block["x"][lo:hi], out_z=per_block["z"][lo:hi], out_reason=per_block["reason"][lo:hi],
-                out_impacts=per_block["impacts"][lo:hi], out_t=per_block["t"][lo:hi],
-                r_block=r["block"], r_coll=r["coll"], r_t=r["t"], r_vx=r["vx"], r_vz=r["vz"], r_w=r["w"],
-                r_h=r["h"], r_outcome=r["outcome"], r_count=r_count,
-                pb=paths["block"], pt=paths["t"], pxs=paths["x"], pzs=paths["z"], pvx=paths["vx"], pvz=paths["vz"],
-                pw=paths["w"], pmode=paths["mode"], pev=paths["event"], pcount=pcount)
+                Blocks2D(np.arange(lo, hi, dtype=np.int64), *(blocks[k][lo:hi] for k in
+                                                             ("x", "z", "vx", "vz", "w", "mass", "radius",
+                                                              "inertia_factor"))),
+                Profile2D(prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.material_index, prof.run_first,
+                          prof.run_last),
+                mats, m_drag, collectors, Envelope2D(env_x, env_chunk), settings, sin_max_roll,
+                Stops2D(*(per_block[k][lo:hi] for k in ("x", "z", "reason", "impacts", "t"))),
+                Crossings2D(**r, count=r_count), Paths2D(**paths, count=pcount))
             if r_count[1] == 0:
                 break
             cap = int(r_count[0] + r_count[1])

@@ -18,24 +18,22 @@ from numba import njit
 
 from . import kernel3d
 from .hazard_grids import deposition_density, mask_holes
-from .engine import _material_arrays, check_masses
+from .engine import check_masses, kernel_settings, material_table
+from .kernel_args import Blocks3D, Collectors3D, Crossings3D, Grid3D, Passages3D, Paths3D, Stops3D
 from .scenario3d import TerrainScenario, _lipschitz, fall_line, sample_sources, source_point_index
 from ._display import Displayed
 from .units import J_PER_KJ, kinetic_energy_kj
 
 DEFAULT_CHUNK_3D = 20_000
-_KERNEL3D_MATERIALS = ("m_en_law", "m_en_mean", "m_en_std", "m_et_law", "m_et_mean", "m_et_std", "m_phi", "m_phi_std",
-                       "m_rough", "m_roll", "m_mu_ground", "m_gain", "m_en_v0", "m_hop", "m_drag", "m_size_k",
-                       "m_mu_cap", "m_size_exp", "m_et_v0")
 
 
-def _kernel3d_materials(scenario: TerrainScenario) -> dict:
-    """The per-material arrays the 3-D kernel takes: the 2-D engine's that it uses, and the lateral deviation's gain
-    ``m_dev`` [-] and speed scale ``m_dev_v`` [m/s] (:func:`simulation.kernel3d.deviation_sd`)."""
-    mats = {k: v for k, v in _material_arrays(scenario).items() if k in _KERNEL3D_MATERIALS}
-    mats["m_dev"] = np.array([m.lateral_deviation for m in scenario.materials], dtype=float)
-    mats["m_dev_v"] = np.array([m.lateral_deviation_speed_ms for m in scenario.materials], dtype=float)
-    return mats
+def _kernel_inputs(scenario: TerrainScenario):
+    """The terrain, material table, rolling drag and collectors of ``scenario`` as the 3-D kernel takes them."""
+    ter = scenario.terrain
+    grid = Grid3D(ter.z, float(ter.x0), float(ter.y0), float(ter.dx), float(ter.dy),
+                  float(_lipschitz(ter.z, ter.dx, ter.dy)), scenario.material_grid.index)
+    mats, m_drag = material_table(scenario)
+    return grid, mats, m_drag, _collector_segments(scenario)
 
 
 def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> dict:
@@ -105,8 +103,8 @@ def _collector_segments(scenario: TerrainScenario):
             net.append(np.nan if c.height_m is None else c.height_m)
             cap.append(np.inf if c.capacity_kj is None else c.capacity_kj)
     f = lambda v: np.asarray(v, dtype=float)  # noqa: E731
-    return dict(c_ax=f(ax), c_ay=f(ay), c_bx=f(bx), c_by=f(by), c_id=np.asarray(cid, dtype=np.int64), c_s0=f(s0),
-                c_cap=f(cap), c_net=f(net))
+    return Collectors3D(ax=f(ax), ay=f(ay), bx=f(bx), by=f(by), id=np.asarray(cid, dtype=np.int64), s0=f(s0),
+                        cap=f(cap), net=f(net))
 
 
 _CROSS = (("block", np.int64), ("coll", np.int64), ("s", float), ("t", float), ("x", float), ("y", float),
@@ -116,8 +114,10 @@ _PATH = (("block", np.int64), ("t", float), ("x", float), ("y", float), ("z", fl
          ("mode", np.int64))
 
 
-def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap, hint=None, ids=None):
-    """Run blocks lo..hi-1 (or, with ``ids``, the blocks of those indices: ``blocks`` then holds only theirs)."""
+def _run_chunk(lo, hi, blocks, inputs, st, key, n_paths, hazard, path_cap, hint=None, ids=None):
+    """Run blocks lo..hi-1 (or, with ``ids``, the blocks of those indices: ``blocks`` then holds only theirs) on the
+    kernel ``inputs`` of :func:`_kernel_inputs`."""
+    grid, mats, m_drag, cols = inputs
     if ids is None:
         ids = np.arange(lo, hi, dtype=np.int64)
         sub = {k: v[lo:hi] for k, v in blocks.items()}
@@ -128,7 +128,7 @@ def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_
     out = {k: np.empty(m, dtype=dt) for k, dt in (("x", float), ("y", float), ("z", float), ("reason", np.int64),
                                                    ("impacts", np.int64), ("t", float), ("excess", float),
                                                    ("events", np.int64))}
-    cap_r = max(4 * m * max(len(cols["c_id"]), 1), 16)
+    cap_r = max(4 * m * max(len(cols.id), 1), 16)
     # pixel passages per block: a guess, then what the chunks run so far needed (a rerun when short)
     per_block = hint.get("passages", 300.0) if hint is not None else 300.0
     cap_p = max(int(per_block * m), 16) if hazard else 1
@@ -140,19 +140,12 @@ def _run_chunk(lo, hi, blocks, grid, mats, cols, st, key, n_paths, hazard, path_
         pth = {k: np.empty(pth_cap, dtype=dt) for k, dt in _PATH}
         r_count, p_count, pcount = np.zeros(2, np.int64), np.zeros(2, np.int64), np.zeros(1, np.int64)
         kernel3d.simulate3d(
-            ids, *(sub[k] for k in
-                                                  ("x", "y", "z", "vx", "vy", "vz", "w", "mass", "radius",
-                                                   "inertia_factor")),
-            *grid, **mats, **cols, g=st.gravity_ms2, v_contact=st.contact_velocity_ms, v_stop=st.stop_velocity_ms,
-            sin_max_roll=st.sin_max_roll,
-            max_events=st.max_events, key=key, n_path_blocks=n_paths, rec_pass=hazard,
-            out_x=out["x"], out_y=out["y"], out_z=out["z"], out_reason=out["reason"], out_impacts=out["impacts"],
-            out_t=out["t"], out_excess=out["excess"], out_events=out["events"],
-            r_block=r["block"], r_coll=r["coll"], r_s=r["s"], r_t=r["t"], r_x=r["x"], r_y=r["y"], r_vx=r["vx"],
-            r_vy=r["vy"], r_vz=r["vz"], r_w=r["w"], r_h=r["h"], r_out=r["out"], r_count=r_count,
-            p_block=p["block"], p_cell=p["cell"], p_e=p["e"], p_h=p["h"], p_count=p_count,
-            pb=pth["block"], pt=pth["t"], ppx=pth["x"], ppy=pth["y"], ppz=pth["z"], ppv=pth["v"],
-            pmode=pth["mode"], pcount=pcount, b_dev=sub["deviation_factor"])
+            Blocks3D(ids, *(sub[k] for k in ("x", "y", "z", "vx", "vy", "vz", "w", "mass", "radius", "inertia_factor",
+                                             "deviation_factor"))),
+            grid, mats, m_drag, cols, kernel_settings(st, key, n_paths), st.sin_max_roll, hazard,
+            Stops3D(*(out[k] for k in Stops3D._fields)),
+            Crossings3D(*(r[k] for k, _ in _CROSS), r_count), Passages3D(*(p[k] for k, _ in _PASS), p_count),
+            Paths3D(*(pth[k] for k, _ in _PATH), pcount))
         if r_count[1] == 0 and p_count[1] == 0:
             break
         # a buffer was too small: run the chunk again with the exact sizes (same numbers: keyed by block)
@@ -213,24 +206,19 @@ def run_terrain(scenario: TerrainScenario, n: int | None = None, seed=None, *, m
     n = int(n)
     key = np.random.SeedSequence(seed).generate_state(1, dtype=np.uint64)[0]
     blocks = seed_blocks_3d(scenario, n, seed, masses_kg)
-    ter = scenario.terrain
-    grid = (ter.z, ter.x0, ter.y0, ter.dx, ter.dy, _lipschitz(ter.z, ter.dx, ter.dy), scenario.material_grid.index)
-    # only the material arrays the 3-D kernel takes (the 2-D engine may prepare more for its own kernel)
-    mats = _kernel3d_materials(scenario)
-    cols = _collector_segments(scenario)
+    inputs = _kernel_inputs(scenario)
     st = scenario.settings
     n_paths = min(int(record_paths), n)
     path_cap = max(n_paths * 4000, 16)
     # compile (or load from cache) untimed
-    _run_chunk(0, 0, blocks, grid, mats, cols, st, key, 0, hazard, 1)
+    _run_chunk(0, 0, blocks, inputs, st, key, 0, hazard, 1)
     # with hazard pixels, a small first chunk measures how many pixels a block crosses (the buffer size of
     # the others); chunk boundaries do not change any result
     first = min(500, chunk_size, n) if hazard else min(chunk_size, n)
     chunks = [(0, first)] + [(lo, min(lo + chunk_size, n)) for lo in range(first, n, chunk_size)]
     started = time.perf_counter()
     hint = {}
-    job = lambda c: _run_chunk(c[0], c[1], blocks, grid, mats, cols, st, key, n_paths, hazard, path_cap,  # noqa: E731
-                               hint)
+    job = lambda c: _run_chunk(c[0], c[1], blocks, inputs, st, key, n_paths, hazard, path_cap, hint)  # noqa: E731
     sink = passage_sink if hazard else None
 
     def keep(part):
@@ -426,10 +414,7 @@ def run_tile(scenario: TerrainScenario, part: dict, key: int, *, hazard: bool = 
     dict of numpy.ndarray
         ``ids``, ``per_block``, ``crossings``, ``passages`` and ``paths`` of the tile.
     """
-    ter = scenario.terrain
-    grid = (ter.z, ter.x0, ter.y0, ter.dx, ter.dy, _lipschitz(ter.z, ter.dx, ter.dy), scenario.material_grid.index)
-    mats = _kernel3d_materials(scenario)
-    cols = _collector_segments(scenario)
+    inputs = _kernel_inputs(scenario)
     st = scenario.settings
     ids = np.asarray(part["ids"], dtype=np.int64)
     hint = {}
@@ -437,7 +422,7 @@ def run_tile(scenario: TerrainScenario, part: dict, key: int, *, hazard: bool = 
     for lo in range(0, ids.size, int(chunk_size)):
         sel = slice(lo, lo + int(chunk_size))
         sub = {k: np.ascontiguousarray(part[k][sel]) for k in part if k != "ids"}
-        outs.append(_run_chunk(0, 0, sub, grid, mats, cols, st, np.uint64(key), n_paths, hazard,
+        outs.append(_run_chunk(0, 0, sub, inputs, st, np.uint64(key), n_paths, hazard,
                                max(n_paths * 4000, 16), hint, ids=ids[sel]))
     cat = lambda i: {k: np.concatenate([o[i][k] for o in outs]) for k in outs[0][i]}  # noqa: E731
     return {"ids": ids, "per_block": cat(0), "crossings": cat(1), "passages": cat(2), "paths": cat(3)}

@@ -410,15 +410,7 @@ def _envelope_contact(env_x, env_acc, xa, xb, x0, mass, inertia, r, contact_spee
 
 
 @njit(cache=True, nogil=True)
-def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
-             px, pz, tree, n_leaves, seg_mat, run_first, run_last,
-             m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
-             m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k, m_mu_cap, m_size_exp, m_et_v0,
-             c_x, c_cap, c_h, c_order, env_x, env_acc,
-             g, v_contact, v_stop, sin_max_roll, max_events, key, n_path_blocks,
-             out_x, out_z, out_reason, out_impacts, out_t,
-             r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count,
-             pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount):
+def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_max_roll, stops, crossings, paths):
     """Run every block of a chunk; fill the per-block and per-crossing output arrays in place.
 
     Energy: between events motion is exact (flight conserves kinetic + potential energy; rolling
@@ -436,114 +428,43 @@ def simulate(block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk,
 
     Parameters
     ----------
-    block_ids : numpy.ndarray of int64
-        Global index of each block of the chunk (seeds its random stream).
-    bx, bz : numpy.ndarray
-        Release position [m].
-    bvx, bvz : numpy.ndarray
-        Release velocity [m/s].
-    bw : numpy.ndarray
-        Release spin [rad/s].
-    bmass : numpy.ndarray
-        Block mass [kg].
-    bradius : numpy.ndarray
-        Block radius [m].
-    bk : numpy.ndarray
-        Inertia factor I / (m r^2) [-].
-    px, pz : numpy.ndarray
-        Profile vertices [m].
-    tree : numpy.ndarray
-        Chord-offset tree of the profile [m].
-    n_leaves : int
-        Number of leaves of the tree.
-    seg_mat : numpy.ndarray of int
-        Material index of each segment.
-    run_first, run_last : numpy.ndarray of int
-        First and last segment of each segment's straight run.
-    m_en_law, m_en_mean, m_en_std : numpy.ndarray
-        Per material: normal restitution law code, mean and standard deviation of e_N [-].
-    m_et_law, m_et_mean, m_et_std : numpy.ndarray
-        Per material: tangential law code, mean and standard deviation of e_T [-].
-    m_phi, m_phi_std : numpy.ndarray
-        Per material: impact friction angle and its standard deviation [deg].
-    m_rough : numpy.ndarray
-        Per material: roughness (asperity height) [m].
-    m_roll : numpy.ndarray of bool
-        Per material: the block rolls (True) or slides in contact.
-    m_mu_ground : numpy.ndarray
-        Per material: rolling-resistance or sliding coefficient tan(phi_g) [-].
-    m_gain : numpy.ndarray of bool
-        Per material: energy gain allowed at impacts.
-    m_en_v0 : numpy.ndarray
-        Per material: velocity scale of e_N [m/s] (inf: none).
-    m_hop : numpy.ndarray
-        Per material: hop height [m].
+    blocks : simulation.kernel_args.Blocks2D
+        The chunk's blocks: global index, release position [m], velocity [m/s], spin [rad/s], mass [kg], radius
+        [m] and inertia factor [-].
+    profile : simulation.kernel_args.Profile2D
+        The slope section: vertices [m], chord-offset tree, material and straight run of each segment.
+    mats : simulation.kernel_args.MaterialTable
+        The material table (its lateral-deviation fields are the 3-D kernel's).
     m_drag : numpy.ndarray or None
         Per material: rolling drag coefficient [-] (c = m_drag / r [1/m]).  None where no material has one: numba
         then compiles a version without the drag terms (c = 0 in every contact step, the same numbers as an
         array of zeros; :func:`simulation.engine.kernel_features`).
-    m_size_k : numpy.ndarray
-        Per material: size coefficient of the rolling resistance [-].
-    m_mu_cap : numpy.ndarray
-        Per material: the cap of the rolling resistance's size term, tan(``rolling_resistance_cap_deg``) [-].
-    m_size_exp : numpy.ndarray
-        Per material: exponent of the size ratio roughness / r in the size term [-] (``rolling_size_exponent``).
-    m_et_v0 : numpy.ndarray
-        Per material: velocity scale of the tangential scaling [m/s] (inf: none; :func:`tangential_scaling`).
-    c_x : numpy.ndarray
-        Collector positions [m].
-    c_cap : numpy.ndarray
-        Barrier capacity [kJ] (NaN: plain collector).
-    c_h : numpy.ndarray
-        Barrier height [m] (NaN: plain collector).
-    c_order : numpy.ndarray of int
-        Collectors in increasing x.
-    env_x : numpy.ndarray
-        Centres of the envelope bins [m].
-    env_acc : numpy.ndarray
-        Envelope accumulator (bins, 7): count, max and sum of speed [m/s], height [m] and energy [kJ].
-    g : float
-        Gravitational acceleration [m/s^2].
-    v_contact : float
-        Numerical floor of the contact speed [m/s].
-    v_stop : float
-        Stop speed [m/s].
+    collectors : simulation.kernel_args.Collectors2D
+        Collector positions [m], barrier capacities [kJ] and heights [m], and the collectors in increasing x.
+    envelope : simulation.kernel_args.Envelope2D
+        Envelope bin centres [m] and accumulator, added to in place.
+    settings : simulation.kernel_args.KernelSettings
+        Gravity, contact and stop speeds, event limit, random key, blocks whose paths are recorded.
     sin_max_roll : float or None
         Sine of the steepest slope a block may roll or slide on [-].  None where no segment is steeper: the
         version compiled for it has no steep-face tests (they would all be false).
-    max_events : int
-        Largest number of events per block.
-    key : numpy.uint64
-        Random key of the run.
-    n_path_blocks : int
-        Record the paths of the blocks with index below this.
-    out_x, out_z : numpy.ndarray
-        Output: stop position [m].
-    out_reason : numpy.ndarray of int
-        Output: stop reason code (``STOP_REASONS``).
-    out_impacts : numpy.ndarray of int
-        Output: number of impacts.
-    out_t : numpy.ndarray
-        Output: travel time [s].
-    r_block, r_coll : numpy.ndarray of int
-        Output per crossing: block and collector index.
-    r_t : numpy.ndarray
-        Output per crossing: time [s].
-    r_vx, r_vz : numpy.ndarray
-        Output per crossing: velocity [m/s].
-    r_w : numpy.ndarray
-        Output per crossing: spin [rad/s].
-    r_h : numpy.ndarray
-        Output per crossing: height of the centre above the ground [m].
-    r_outcome : numpy.ndarray of int
-        Output per crossing: outcome code (``OUTCOMES``).
-    r_count : numpy.ndarray of int
-        Output: crossings written and crossings that did not fit.
-    pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev : numpy.ndarray
-        Output per path point: block, time [s], position [m], velocity [m/s], spin [rad/s], mode and event code.
-    pcount : numpy.ndarray of int
-        Output: path points written.
+    stops : simulation.kernel_args.Stops2D
+        Output per block: stop position [m], stop reason code (``STOP_REASONS``), impacts, travel time [s].
+    crossings : simulation.kernel_args.Crossings2D
+        Output per crossing, and the counts written and not fitted.
+    paths : simulation.kernel_args.Paths2D
+        Output per path point, and the count written.
     """
+    block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk = blocks
+    px, pz, tree, n_leaves, seg_mat, run_first, run_last = profile
+    (m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough, m_roll, m_mu_ground,
+     m_gain, m_en_v0, m_hop, m_size_k, m_mu_cap, m_size_exp, m_et_v0, _m_dev, _m_dev_v) = mats
+    c_x, c_cap, c_h, c_order = collectors
+    env_x, env_acc = envelope
+    g, v_contact, v_stop, max_events, key, n_path_blocks = settings
+    out_x, out_z, out_reason, out_impacts, out_t = stops
+    r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_count = crossings
+    pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount = paths
     n_coll = c_x.shape[0]
     n_seg = px.shape[0] - 1
     state = np.empty(1, np.uint64)

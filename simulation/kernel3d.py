@@ -496,16 +496,8 @@ def _find_impact(zg, x0, y0, dx, dy, lip, x, y, z, vx, vy, vz, g):
 
 
 @njit(cache=True, nogil=True)
-def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
-               zg, x0, y0, dx, dy, lip, mat_grid,
-               m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough,
-               m_roll, m_mu_ground, m_gain, m_en_v0, m_hop, m_drag, m_size_k, m_mu_cap, m_size_exp, m_et_v0,
-               c_ax, c_ay, c_bx, c_by, c_id, c_s0, c_cap, c_net,
-               g, v_contact, v_stop, sin_max_roll, max_events, key, n_path_blocks, rec_pass,
-               out_x, out_y, out_z, out_reason, out_impacts, out_t, out_excess, out_events,
-               r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_out, r_count,
-               p_block, p_cell, p_e, p_h, p_count,
-               pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, m_dev, m_dev_v, b_dev):
+def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, rec_pass, stops, crossings, passages,
+               paths):
     """Run every block of a chunk on the DEM surface; fill the output arrays in place.
 
     Grid: ``zg`` (ny, nx) elevations [m] (NaN holes), centre of cell (0, 0) at (x0, y0), cell size dx, dy [m];
@@ -520,139 +512,47 @@ def simulate3d(block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk,
 
     Parameters
     ----------
-    block_ids : numpy.ndarray of int64
-        Global index of each block of the chunk (seeds its random stream).
-    bx, by, bz : numpy.ndarray
-        Release position [m].
-    bvx, bvy, bvz : numpy.ndarray
-        Release velocity [m/s].
-    bw : numpy.ndarray
-        Release spin [rad/s].
-    bmass : numpy.ndarray
-        Block mass [kg].
-    bradius : numpy.ndarray
-        Block radius [m].
-    bk : numpy.ndarray
-        Inertia factor I / (m r^2) [-].
-    zg : numpy.ndarray
-        Elevations (ny, nx) [m], NaN holes.
-    x0, y0 : float
-        Centre of cell (0, 0) [m].
-    dx, dy : float
-        Cell size [m].
-    lip : float
-        Upper bound of the surface slope |grad z| [-].
-    mat_grid : numpy.ndarray of int
-        Material index per cell.
-    m_en_law, m_en_mean, m_en_std : numpy.ndarray
-        Per material: normal restitution law code, mean and standard deviation of e_N [-].
-    m_et_law, m_et_mean, m_et_std : numpy.ndarray
-        Per material: tangential law code, mean and standard deviation of e_T [-].
-    m_phi, m_phi_std : numpy.ndarray
-        Per material: impact friction angle and its standard deviation [deg].
-    m_rough : numpy.ndarray
-        Per material: roughness (asperity height) [m].
-    m_roll : numpy.ndarray of bool
-        Per material: the block rolls (True) or slides in contact.
-    m_mu_ground : numpy.ndarray
-        Per material: rolling-resistance or sliding coefficient tan(phi_g) [-].
-    m_gain : numpy.ndarray of bool
-        Per material: energy gain allowed at impacts.
-    m_en_v0 : numpy.ndarray
-        Per material: velocity scale of e_N [m/s] (inf: none; :func:`simulation.contact.velocity_scaled`).
-    m_hop : numpy.ndarray
-        Per material: hop height [m] below which a rebound is ground contact (:func:`simulation.contact.contact_speed`).
+    blocks : simulation.kernel_args.Blocks3D
+        The chunk's blocks: global index, release position [m], velocity [m/s], spin [rad/s], mass [kg], radius
+        [m], inertia factor [-] and deviation factor s_b [-] (its shape).
+    grid : simulation.kernel_args.Grid3D
+        Elevations (ny, nx) [m] with NaN holes, centre of cell (0, 0) [m], cell size [m], Lipschitz bound [-],
+        material index per cell.
+    mats : simulation.kernel_args.MaterialTable
+        The material table, with the lateral deviation's gain D [-] (0: none) and speed scale v_D [m/s]
+        (:func:`deviation_sd`).
     m_drag : numpy.ndarray
         Per material: rolling drag coefficient [-] (c = m_drag / r [1/m]).
-    m_size_k : numpy.ndarray
-        Per material: size term K of the rolling resistance [-] (:func:`simulation.contact.rolling_resistance`).
-    m_mu_cap : numpy.ndarray
-        Per material: the cap of the size term, tan(``rolling_resistance_cap_deg``) [-].
-    m_size_exp : numpy.ndarray
-        Per material: exponent of the size ratio roughness / r in the size term [-] (``rolling_size_exponent``).
-    m_et_v0 : numpy.ndarray
-        Per material: velocity scale of the tangential scaling [m/s] (inf: none;
-        :func:`simulation.contact.tangential_scaling`).
-    c_ax, c_ay, c_bx, c_by : numpy.ndarray
-        Ends of the collector segments in plan [m].
-    c_id : numpy.ndarray of int
-        Collector of each segment.
-    c_s0 : numpy.ndarray
-        Distance of each segment's start along its polyline [m].
-    c_cap : numpy.ndarray
-        Barrier capacity [kJ] (NaN: plain collector).
-    c_net : numpy.ndarray
-        Barrier net height above the ground [m] (NaN: plain collector).
-    g : float
-        Gravitational acceleration [m/s^2].
-    v_contact : float
-        Numerical floor of the contact speed [m/s].
-    v_stop : float
-        Stop speed [m/s].
+    collectors : simulation.kernel_args.Collectors3D
+        The collectors' plan segments, their collector, start along its polyline [m], capacity [kJ] and net
+        height [m].
+    settings : simulation.kernel_args.KernelSettings
+        Gravity, contact and stop speeds, event limit, random key, blocks whose paths are recorded.
     sin_max_roll : float
         Sine of the steepest slope a block may roll or slide on in contact (1: any slope).
-    max_events : int
-        Largest number of events per block.
-    key : numpy.uint64
-        Random key of the run.
-    n_path_blocks : int
-        Record the paths of the blocks with index below this.
     rec_pass : bool
         Record the pixels each block crosses.
-    out_x, out_y, out_z : numpy.ndarray
-        Output: stop position [m].
-    out_reason : numpy.ndarray of int
-        Output: stop reason code.
-    out_impacts : numpy.ndarray of int
-        Output: number of impacts.
-    out_t : numpy.ndarray
-        Output: travel time [s].
-    out_excess : numpy.ndarray
-        Output: largest rise of the total energy between events [J].
-    out_events : numpy.ndarray of int
-        Output: number of events.
-    r_block, r_coll : numpy.ndarray of int
-        Output per crossing: block and collector index.
-    r_s : numpy.ndarray
-        Output per crossing: distance along the collector [m].
-    r_t : numpy.ndarray
-        Output per crossing: time [s].
-    r_x, r_y : numpy.ndarray
-        Output per crossing: plan position [m].
-    r_vx, r_vy, r_vz : numpy.ndarray
-        Output per crossing: velocity [m/s].
-    r_w : numpy.ndarray
-        Output per crossing: spin [rad/s].
-    r_h : numpy.ndarray
-        Output per crossing: height of the centre above the ground [m].
-    r_out : numpy.ndarray of int
-        Output per crossing: outcome code.
-    r_count : numpy.ndarray of int
-        Output: crossings written and crossings that did not fit.
-    p_block, p_cell : numpy.ndarray of int
-        Output per pixel passage: block and cell index.
-    p_e : numpy.ndarray
-        Output per pixel passage: largest kinetic energy [kJ].
-    p_h : numpy.ndarray
-        Output per pixel passage: largest height above the ground [m].
-    p_count : numpy.ndarray of int
-        Output: passages written and passages that did not fit.
-    pb, pt : numpy.ndarray
-        Output per path point: block and time [s].
-    ppx, ppy, ppz : numpy.ndarray
-        Output per path point: position [m].
-    ppv : numpy.ndarray
-        Output per path point: speed [m/s].
-    pmode : numpy.ndarray of int
-        Output per path point: mode code.
-    pcount : numpy.ndarray of int
-        Output: path points written.
-    m_dev, m_dev_v : numpy.ndarray
-        Per material: gain D [-] (0: none) and speed scale v_D [m/s] of the lateral deviation at impacts
-        (:func:`deviation_sd`).
-    b_dev : numpy.ndarray
-        Per block: deviation factor s_b [-] (its shape).
+    stops : simulation.kernel_args.Stops3D
+        Output per block: stop position [m], stop reason code, impacts, travel time [s], largest rise of the
+        total energy between events [J], events.
+    crossings : simulation.kernel_args.Crossings3D
+        Output per crossing, and the counts written and not fitted.
+    passages : simulation.kernel_args.Passages3D
+        Output per pixel passage: block, cell, largest kinetic energy [kJ] and height above the ground [m], and
+        the counts written and not fitted.
+    paths : simulation.kernel_args.Paths3D
+        Output per path point, and the count written.
     """
+    block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk, b_dev = blocks
+    zg, x0, y0, dx, dy, lip, mat_grid = grid
+    (m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough, m_roll, m_mu_ground,
+     m_gain, m_en_v0, m_hop, m_size_k, m_mu_cap, m_size_exp, m_et_v0, m_dev, m_dev_v) = mats
+    c_ax, c_ay, c_bx, c_by, c_id, c_s0, c_cap, c_net = collectors
+    g, v_contact, v_stop, max_events, key, n_path_blocks = settings
+    out_x, out_y, out_z, out_reason, out_impacts, out_t, out_excess, out_events = stops
+    r_block, r_coll, r_s, r_t, r_x, r_y, r_vx, r_vy, r_vz, r_w, r_h, r_out, r_count = crossings
+    p_block, p_cell, p_e, p_h, p_count = passages
+    pb, pt, ppx, ppy, ppz, ppv, pmode, pcount = paths
     ny, nx = zg.shape
     step_len = 0.5 * min(dx, dy)
     n_cseg = c_ax.shape[0]

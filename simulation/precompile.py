@@ -150,33 +150,40 @@ def compile_kernel() -> None:
 
 
 def empty_kernel_arguments() -> dict:
-    """Arguments of :func:`simulation.kernel.simulate` for no blocks, by name: empty arrays of each argument's
-    dtype, the envelope accumulator 2-d, scalars of the run's types.
+    """Arguments of :func:`simulation.kernel.simulate` for no blocks, by name: its records
+    (:mod:`simulation.kernel_args`) of empty arrays of each field's dtype, the envelope accumulator 2-d, scalars of
+    the run's types.
 
     Returns
     -------
     dict
-        Argument name -> empty array or scalar.
+        Argument name -> record, empty array or scalar.
     """
-    import inspect
-
     import numpy as np
 
-    from . import kernel
-    ints = {"block_ids", "seg_mat", "run_first", "run_last", "m_en_law", "m_et_law", "c_order",
-            "out_reason", "out_impacts", "r_block", "r_coll", "r_outcome", "r_count", "pb", "pmode", "pev",
-            "pcount"}
-    bools = {"m_roll", "m_gain"}
+    from . import kernel_args as ka
+
+    def f(*_):
+        return np.zeros(0)
+
+    def i(*_):
+        return np.zeros(0, dtype=np.int64)
+
+    def b(*_):
+        return np.zeros(0, dtype=np.bool_)
+
     # m_drag and sin_max_roll None: the specialisation of scenarios without rolling drag or steep faces
     # (simulation.engine.kernel_features), the one the demo and most sites run
-    scalars = {"g": 9.81, "v_contact": 0.5, "v_stop": 0.1, "sin_max_roll": None, "max_events": 1, "n_leaves": 1,
-               "n_path_blocks": 0, "key": np.uint64(1), "m_drag": None}
-    out = {}
-    for name in inspect.signature(getattr(kernel.simulate, "py_func", kernel.simulate)).parameters:
-        if name in scalars:
-            out[name] = scalars[name]
-        elif name == "env_acc":
-            out[name] = np.zeros((0, 7))
-        else:
-            out[name] = np.zeros(0, dtype=np.int64 if name in ints else bool if name in bools else float)
-    return out
+    return {
+        "blocks": ka.Blocks2D(i(), *(f() for _ in range(8))),
+        "profile": ka.Profile2D(f(), f(), f(), 1, i(), i(), i()),
+        "mats": ka.MaterialTable(i(), f(), f(), i(), f(), f(), f(), f(), f(), b(), f(), b(), *(f() for _ in range(8))),
+        "m_drag": None,
+        "collectors": ka.Collectors2D(f(), f(), f(), i()),
+        "envelope": ka.Envelope2D(f(), np.zeros((0, 7))),
+        "settings": ka.KernelSettings(9.81, 0.5, 0.1, 1, np.uint64(1), 0),
+        "sin_max_roll": None,
+        "stops": ka.Stops2D(f(), f(), i(), i(), f()),
+        "crossings": ka.Crossings2D(i(), i(), f(), f(), f(), f(), f(), i(), i()),
+        "paths": ka.Paths2D(i(), f(), f(), f(), f(), f(), f(), i(), i(), i()),
+    }
