@@ -22,7 +22,7 @@ _EXPORTS = {
     **dict.fromkeys(["GEVFit", "GumbelFit", "encounter_probability", "fit_gev", "fit_gumbel",
                      "gumbel_frequency_factor", "gumbel_reduced_variate", "plotting_positions"], "frequency.extremes"),
     "FrequencyAnalysis": "frequency.study", "analyse_inventory": "frequency.study",
-    "exceedance_probability": "hazard.impact_energy", "fit_velocity": "hazard.impact_energy",
+    "exceedance_probability": "hazard.impact_energy", "fit_velocity": "hazard.velocity_models",
     "DEFAULT_DENSITY_KG_M3": "frequency.inventory", "Inventory": "frequency.inventory.record", "read_inventory": "frequency.inventory.reader",
     "MassCoupledSamples": "hazard.mass_coupling", "energy_hazard": "hazard.simulated",
     # the trajectory model's uncertainty: hazards over material draws, ranking and value of calibrating first

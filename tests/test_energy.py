@@ -7,8 +7,8 @@ from hypothesis import strategies as st
 from scipy import integrate, stats
 
 import riskrf
-from riskrf.hazard.impact_energy import (PairedSamples, energy_quantile, exceedance_probability, exceedance_probability_mc,
-                           fit_velocity)
+from riskrf.hazard.impact_energy import energy_quantile, exceedance_probability, exceedance_probability_mc
+from riskrf.hazard.velocity_models import PairedSamples, fit_velocity
 from riskrf.hazard.annual_hazard import EnergyHazard
 from riskrf.hazard.barriers import check_fence, service_energy_level, uni11211_design_energy
 

@@ -15,7 +15,7 @@ from riskrf.hazard.design_block import (
     sphere_diameter_m,
 )
 from riskrf.hazard.energy_study import design_energy_sensitivity
-from riskrf.hazard.impact_energy import mass_model
+from riskrf.hazard.mass_models import mass_model
 from riskrf.hazard.mass_coupling import MassCoupledSamples
 
 from .conftest import ROOT
@@ -225,7 +225,7 @@ def test_site_design_masses_follow_the_hazard_law_and_stay_below_m_max(demo_haza
     # The T-year fall reaching the line: rate x P(M > m, reaches) = 1/T.  On the shipped slope (material presets)
     # 29-47 % of the blocks reach the barrier, by mass class, so the line's T-year mass lies below the source's and
     # P(M > m_line) is bracketed by the smallest and largest reach probability of the classes.
-    from riskrf.hazard.impact_energy import mass_model
+    from riskrf.hazard.mass_models import mass_model
     mm = mass_model(demo_hazard.mass)
     line, src = t["line_mass_kg"].to_numpy(), t["source_mass_kg"].to_numpy()
     assert np.all(line <= src * (1 + 1e-9))

@@ -9,7 +9,8 @@ from scipy import stats
 import riskrf
 from riskrf.hazard.annual_hazard import EnergyHazard
 from riskrf.hazard.energy_study import analyse_energy
-from riskrf.hazard.impact_energy import MassModel, exceedance_probability, mass_model
+from riskrf.hazard.impact_energy import exceedance_probability
+from riskrf.hazard.mass_models import MassModel, mass_model
 from riskrf.risk.loss_engine import mass_pmf
 
 ROOT = Path(__file__).resolve().parents[1]

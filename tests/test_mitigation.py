@@ -546,7 +546,7 @@ def test_mass_coupled_hazard_gives_each_mass_its_own_reach_and_speed_at_the_fenc
     (E >= 4,500 kJ): the barrier is destroyed by exactly the heavy arrivals, rate x P(heavy) x 1.  Pooled
     speeds (one law for all masses) would let light blocks break it and heavy ones be held."""
     from riskrf.hazard.mass_coupling import MassCoupledSamples
-    from riskrf.hazard.impact_energy import mass_model
+    from riskrf.hazard.mass_models import mass_model
     n = 2000
     m = np.geomspace(1e3, 1e5, n + 2)[1:-1]
     heavy = m > 1e4

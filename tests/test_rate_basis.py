@@ -42,7 +42,7 @@ def test_road_share_by_block_size_matches_the_mass_law_reach(road_basis):
     mass-coupled run and the seeder's reference run, pooled by mass class; one road share for all sizes does not."""
     from dataclasses import replace
 
-    from riskrf.hazard.impact_energy import mass_model
+    from riskrf.hazard.mass_models import mass_model
     from riskrf.risk.measures import road_crossings
     from riskrf.risk.mitigation import MitigationStudy, Option
     a = road_basis

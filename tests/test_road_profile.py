@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from riskrf.hazard.impact_energy import mass_model
+from riskrf.hazard.mass_models import mass_model
 from riskrf.hazard.mass_coupling import MassCoupledSamples, stratified_log_uniform
 from riskrf.risk.road_profile import RoadProfileError, block_weights_per_year, road_risk_along_line
 from riskrf.risk.road_users import (Vulnerability, lane_hit_probability, lane_strike_probability,

@@ -8,8 +8,9 @@ from scipy import stats
 
 import riskrf
 from riskrf.hazard.annual_hazard import EnergyHazard
-from riskrf.hazard.impact_energy import (PairedSamples, VelocityModel, exceedance_probability,
-                                         exceedance_probability_mc, fit_velocity, mass_model, velocity_model)
+from riskrf.hazard.impact_energy import exceedance_probability, exceedance_probability_mc
+from riskrf.hazard.mass_models import mass_model
+from riskrf.hazard.velocity_models import PairedSamples, VelocityModel, fit_velocity, velocity_model
 from riskrf.hazard.mass_coupling import MassCoupledSamples
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -16,13 +16,9 @@ import numpy as np
 import pandas as pd
 from scipy import optimize
 
-from .impact_energy import (
-    PairedSamples,
-    exceedance_function,
-    exceedance_probability,
-    mass_model,
-    velocity_model,
-)
+from .impact_energy import exceedance_function, exceedance_probability
+from .mass_models import mass_model
+from .velocity_models import PairedSamples, velocity_model
 from ..core.format import sig
 from ..core.units import DESIGN_RETURN_PERIODS, SPHERE_INERTIA
 from ..core.validation import check_positive, check_probability_level, check_return_periods
@@ -130,7 +126,7 @@ class EnergyHazard(Displayed):
         rotational : bool
             Include the rotational energy: v_eff² = v² + k (ω r)².
         condition_on_mass : bool
-            Class the velocities by the seeder's masses (:class:`~riskrf.hazard.impact_energy.PairedSamples`).
+            Class the velocities by the seeder's masses (:class:`~riskrf.hazard.velocity_models.PairedSamples`).
 
         Returns
         -------

@@ -1007,7 +1007,7 @@ def _onr_design_block(hazard, block, notes: list):
 
 
 def _mass_model(hazard):
-    from .impact_energy import mass_model
+    from .mass_models import mass_model
     return mass_model(hazard.mass)
 
 

@@ -344,7 +344,7 @@ def line_return_period_mass(hazard, T) -> np.ndarray:
     numpy.ndarray
         Mass [kg].
     """
-    from .impact_energy import mass_model
+    from .mass_models import mass_model
     T = np.atleast_1d(np.asarray(T, dtype=float))
     mm = mass_model(hazard.mass)
     if not hazard.mass_coupled:
@@ -374,7 +374,7 @@ def _law_text(hazard) -> str:
         return (f"power law b = {sig(m.b)} above {sig(m.m_min)} kg"
                 + (f", truncated at m_max = {sig(m.m_max)} kg" if getattr(m, "m_max", None) else ", not truncated")
                 + f", {sig(hazard.rate_per_year)} falls/yr")
-    from .impact_energy import mass_model
+    from .mass_models import mass_model
     return f"{mass_model(m).description}, {sig(hazard.rate_per_year)} falls/yr"
 
 
@@ -398,7 +398,7 @@ def site_design_masses(hazard, T=DESIGN_RETURN_PERIODS,
     pandas.DataFrame
         ``T_years``, the source and line masses [kg] and volumes [m³].
     """
-    from .impact_energy import mass_model
+    from .mass_models import mass_model
     T = np.atleast_1d(np.asarray(T, dtype=float))
     mm = mass_model(hazard.mass)
     p = 1.0 / (T * hazard.rate_per_year)
@@ -734,7 +734,7 @@ def fragment_block_kg(law, rate_per_year: float, *, design_T: float, fractal_dim
     """
     if fractal_dimension is None or iterations is None:
         return None
-    from .impact_energy import mass_model
+    from .mass_models import mass_model
     p = 1.0 / (float(design_T) * float(rate_per_year))
     if not p < 1:
         return None

@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 
 from .annual_hazard import EnergyHazard
-from .impact_energy import mass_model
+from .mass_models import mass_model
 from .barriers import UNI11211_FACTORS, check_fence, uni11211_design_energy
 from ..io.outputs import write_json
 from ..frequency.power_law import fit_gutenberg_richter

@@ -65,7 +65,7 @@ class MassCoupledSamples(Displayed):
     The per-class tables are computed on first use and cached (the fields are never changed).
     """
 
-    #: Declares the mass-coupled velocity model (:func:`riskrf.hazard.impact_energy.is_mass_coupled`).
+    #: Declares the mass-coupled velocity model (:func:`riskrf.hazard.velocity_models.is_mass_coupled`).
     mass_coupled_velocity = True
 
     mass_kg: np.ndarray = field(repr=False)
@@ -224,7 +224,7 @@ class MassCoupledSamples(Displayed):
         energy_kj : float or array_like
             Energies [kJ].
         mm : _MassModel
-            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+            Mass model of the falls (:func:`riskrf.hazard.mass_models.mass_model`) [kg].
 
         Returns
         -------
@@ -241,7 +241,7 @@ class MassCoupledSamples(Displayed):
         Parameters
         ----------
         mm : _MassModel
-            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+            Mass model of the falls (:func:`riskrf.hazard.mass_models.mass_model`) [kg].
 
         Returns
         -------
@@ -263,7 +263,7 @@ class MassCoupledSamples(Displayed):
         Parameters
         ----------
         mm : _MassModel
-            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+            Mass model of the falls (:func:`riskrf.hazard.mass_models.mass_model`) [kg].
 
         Returns
         -------
@@ -280,7 +280,7 @@ class MassCoupledSamples(Displayed):
         mass_kg : float
             Mass m [kg].
         mm : _MassModel
-            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+            Mass model of the falls (:func:`riskrf.hazard.mass_models.mass_model`) [kg].
 
         Returns
         -------
@@ -302,7 +302,7 @@ class MassCoupledSamples(Displayed):
         Parameters
         ----------
         mm : _MassModel
-            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+            Mass model of the falls (:func:`riskrf.hazard.mass_models.mass_model`) [kg].
 
         Returns
         -------
@@ -318,7 +318,7 @@ class MassCoupledSamples(Displayed):
         Parameters
         ----------
         mm : _MassModel
-            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+            Mass model of the falls (:func:`riskrf.hazard.mass_models.mass_model`) [kg].
 
         Returns
         -------
@@ -333,7 +333,7 @@ class MassCoupledSamples(Displayed):
         Parameters
         ----------
         mm : _MassModel
-            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+            Mass model of the falls (:func:`riskrf.hazard.mass_models.mass_model`) [kg].
 
         Returns
         -------
@@ -375,7 +375,7 @@ class MassCoupledSamples(Displayed):
         energy_kj : array_like
             Energies [kJ].
         mm : _MassModel
-            Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+            Mass model of the falls (:func:`riskrf.hazard.mass_models.mass_model`) [kg].
 
         Returns
         -------
@@ -537,7 +537,7 @@ def default_mass_range(mm, rate_per_year: float) -> tuple:
     Parameters
     ----------
     mm : _MassModel
-        Mass model of the falls (:func:`riskrf.hazard.impact_energy.mass_model`) [kg].
+        Mass model of the falls (:func:`riskrf.hazard.mass_models.mass_model`) [kg].
     rate_per_year : float
         Falls per year described by the mass model [1/yr].
 

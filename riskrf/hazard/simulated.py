@@ -16,7 +16,7 @@ from ..core.format import sig
 from ..core.units import DESIGN_RETURN_PERIODS
 from ..core.validation import check_positive
 from .annual_hazard import EnergyHazard, effective_speeds
-from .impact_energy import mass_model
+from .mass_models import mass_model
 from .mass_coupling import MassCoupledSamples, NoArrivalsError, default_mass_range, stratified_log_uniform
 
 

@@ -267,7 +267,7 @@ def plot_mass_velocity(hazard, ax=None, *, energies=(100, 500, 1000, 2000, 5000,
     ----------
     Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, eq. 3.1.
     """
-    from ..hazard.impact_energy import mass_model
+    from ..hazard.mass_models import mass_model
     ax = _axes(ax)
     rng = np.random.default_rng(seed)
     m = mass_model(hazard.mass).rvs(n_points, rng)

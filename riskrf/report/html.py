@@ -18,7 +18,7 @@ import pandas as pd
 
 from .. import __version__
 from ..hazard.energy_study import INTERVAL_COVERS, sensitivity_grid
-from ..hazard.impact_energy import PairedSamples
+from ..hazard.velocity_models import PairedSamples
 from ..risk.road_risk import fn_zone
 from .format import Document, cell, human_header, money, probability, sig
 from .format import escape as _e

@@ -23,7 +23,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..hazard.barriers import out_of_service_share
-from ..hazard.impact_energy import mass_model
+from ..hazard.mass_models import mass_model
 from .economics import pv_factor, renewal_factor
 from .road_risk import commuter_passage_probability, commuter_strike_probability, occupancy_distribution, \
     vulnerability_by_mass
@@ -74,7 +74,7 @@ def mass_grid(mass, small_fall_masses_kg, small_falls_per_year: float, uncertain
     Parameters
     ----------
     mass : object
-        The study's mass distribution, as accepted by :func:`riskrf.hazard.impact_energy.mass_model`.
+        The study's mass distribution, as accepted by :func:`riskrf.hazard.mass_models.mass_model`.
     small_fall_masses_kg : array_like or None
         Masses of the inventory's falls below the power law's m_min [kg].
     small_falls_per_year : float
@@ -115,7 +115,7 @@ def mass_pmf(edges: np.ndarray, mass, b=None, m_max=None) -> np.ndarray:
     edges : numpy.ndarray
         Mass bin edges (J + 1) [kg].
     mass : object
-        The study's mass distribution, as accepted by :func:`riskrf.hazard.impact_energy.mass_model`.
+        The study's mass distribution, as accepted by :func:`riskrf.hazard.mass_models.mass_model`.
     b : numpy.ndarray, optional
         Sampled power-law exponents (S,) [-].
     m_max : numpy.ndarray, optional

@@ -41,7 +41,7 @@ from simulation._display import Displayed, short_repr
 from ..core.figures import draw
 from ..core.format import money
 from ..hazard.annual_hazard import EnergyHazard
-from ..hazard.impact_energy import mass_model
+from ..hazard.mass_models import mass_model
 from .economics import pv_factor
 from .error_budget import clustered_se, combined_se, sources_text
 from .recommendation import RecommendationMixin

@@ -142,7 +142,7 @@ def block_weights_per_year(samples, mass_model, rate_per_year: float) -> np.ndar
     numpy.ndarray
         Weight of each block [1/yr].
     """
-    from ..hazard.impact_energy import mass_model as _wrap
+    from ..hazard.mass_models import mass_model as _wrap
     cls = samples.class_of(samples.mass_kg)
     counts = np.bincount(cls, minlength=samples.n_bins).astype(float)
     return float(rate_per_year) * samples.class_weights(_wrap(mass_model))[cls] / counts[cls]

@@ -19,7 +19,7 @@ import pandas as pd
 
 from ..core.units import kinetic_energy_kj
 from ..hazard.barriers import damage_state_shares
-from ..hazard.impact_energy import velocity_model
+from ..hazard.velocity_models import velocity_model
 from .loss_engine import MassGrid
 from .measures import (
     Ditch,

@@ -311,7 +311,7 @@ def assess_section(section: Section, corridor: Corridor, n_blocks: int | None = 
         One row of the corridor table: rates [1/yr], risks [deaths/yr], costs in the corridor currency, the best
         option and the RHRS columns.
     """
-    from ...hazard.impact_energy import mass_model
+    from ...hazard.mass_models import mass_model
 
     n = int(n_blocks or corridor.n_blocks)
     s_seed = _section_seed(corridor.seed if seed is None else seed, section.id)
