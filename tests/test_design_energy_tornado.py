@@ -14,7 +14,8 @@ from scipy import stats
 import riskrf
 from riskrf.hazard.annual_hazard import EnergyHazard
 from riskrf.hazard.design_block import design_block
-from riskrf.hazard.energy_study import DesignEnergyTornado, design_energy_sensitivity, design_energy_tornado
+from riskrf.hazard.energy_study import design_energy_sensitivity
+from riskrf.hazard.energy_tornado import DesignEnergyTornado, design_energy_tornado
 
 LO, HI, B = 1.0e3, 1.0e6, 0.7
 V0 = 20.0                      # m/s, every arriving block (the exact case)

@@ -29,8 +29,8 @@ from ..hazard.energy_study import (
     EnergyAnalysis,
     analyse_energy,
     design_energy_sensitivity,
-    design_energy_tornado,
 )
+from ..hazard.energy_tornado import design_energy_tornado
 from ..frequency.study import FrequencyAnalysis, analyse_inventory
 from ..frequency.inventory.reader import read_inventory
 from ..frequency.inventory.record import Inventory

@@ -282,7 +282,7 @@ def cmd_energy(args) -> int:
                                                 m_max_values=m_values,
                                                 rate_shares=[0.5 * args.rate_scale, args.rate_scale,
                                                              2.0 * args.rate_scale], T=args.design_period)
-    from ..hazard.energy_study import design_energy_tornado
+    from ..hazard.energy_tornado import design_energy_tornado
     tornado = design_energy_tornado(hazard, design_T=args.design_period, block=block, masses_kg=inv.masses,
                                     duration_years=inv.duration_years, rate_share=args.rate_scale,
                                     sensitivity=sensitivity) \

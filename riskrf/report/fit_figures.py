@@ -330,7 +330,7 @@ def plot_design_energy_sensitivity(table, ax=None):
 
 
 def plot_design_energy_tornado(tornado, axes=None):
-    """One tornado per design energy of a :class:`~riskrf.hazard.energy_study.DesignEnergyTornado` (stacked panels,
+    """One tornado per design energy of a :class:`~riskrf.hazard.energy_tornado.DesignEnergyTornado` (stacked panels,
     each with its own base line and x axis in kJ), drawn by :func:`riskrf.report.decision_figures.plot_tornado`.
 
     Parameters
