@@ -10,8 +10,9 @@ import simulation
 from riskrf.hazard.annual_hazard import EnergyHazard
 from riskrf.hazard.design_block import DesignBlock
 from riskrf.hazard.catchment import catchment_retention, cut_geometry, odot_chart_applies, with_chart
-from riskrf.hazard.design_basis import (DesignBasis, design_basis_from_site, design_requirement, position_search,
-                                        required_product_class, residual_height_category, round_up)
+from riskrf.hazard.design_basis import (DesignBasis, design_basis_from_site, required_product_class,
+                                        residual_height_category, round_up)
+from riskrf.hazard.design_requirement import design_requirement, position_search
 from riskrf.app.site import SiteError, load_site
 
 from .conftest import ROOT

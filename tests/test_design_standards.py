@@ -8,8 +8,8 @@ import pytest
 import simulation
 from riskrf.core.figures import FIGURES, draw
 from riskrf.hazard.catchment import catchment_retention, modified_ritchie_width_m
-from riskrf.hazard.design_basis import (DEFAULT_FACTORS, DesignBasis, PositionSearch, design_requirement,
-                                        onr24810_min_distance_m, permitted_elongation_m)
+from riskrf.hazard.design_basis import DEFAULT_FACTORS, DesignBasis, onr24810_min_distance_m, permitted_elongation_m
+from riskrf.hazard.design_requirement import PositionSearch, design_requirement
 
 from .conftest import ROOT
 from .test_design_basis import RHO, _block, _hazard

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from riskrf.app.site import SiteError, load_site
-from riskrf.hazard.design_basis import DesignBasis, design_requirement
+from riskrf.hazard.design_basis import DesignBasis
+from riskrf.hazard.design_requirement import design_requirement
 from riskrf.risk.mitigation import MitigationError, Option
 from riskrf.risk.required_barrier import (DEFAULT_COST_PER_M, BarrierCostModel, basis_design_checks,
                                           cost_model_from_site, required_barrier)

@@ -1,7 +1,7 @@
 """The barrier and ditch design of one site, from its ``[design]`` table: the governing basis's requirement at
 the barrier line, the position search along the profile, the run-out to the road and the catchment retention
-of the site's cut.  Orchestration only: the computations are :mod:`riskrf.hazard.design_basis` and
-:mod:`riskrf.hazard.catchment`."""
+of the site's cut.  Orchestration only: the computations are :mod:`riskrf.hazard.design_basis`,
+:mod:`riskrf.hazard.design_requirement` and :mod:`riskrf.hazard.catchment`."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -9,14 +9,15 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..hazard.design_basis import DesignBasis, design_basis_from_site, design_requirement, position_search
+from ..hazard.design_basis import DesignBasis, design_basis_from_site
+from ..hazard.design_requirement import design_requirement, position_search
 
 
 @dataclass(frozen=True)
 class SiteDesign:
     """Design outputs of a site: ``basis`` (:class:`~riskrf.hazard.design_basis.DesignBasis`), ``requirement``
-    at the barrier line (:class:`~riskrf.hazard.design_basis.DesignRequirement`), ``positions``
-    (:class:`~riskrf.hazard.design_basis.PositionSearch` or None, with the reason in ``notes``), ``runout`` (dict:
+    at the barrier line (:class:`~riskrf.hazard.design_requirement.DesignRequirement`), ``positions``
+    (:class:`~riskrf.hazard.design_requirement.PositionSearch` or None, with the reason in ``notes``), ``runout`` (dict:
     shares of released blocks reaching the barrier line and the road, stop-point percentiles [m]), ``catchment``
     (:class:`~riskrf.hazard.catchment.CatchmentStudy` of the site's cut, or None) and ``notes``."""
 

@@ -5,7 +5,7 @@ The table shipped (``riskrf/data/barrier_kits.csv``, provenance in ``riskrf/data
 GENERIC kits only: their MEL levels are the EAD 340059 energy levels [published, secondary], SEL = MEL/3
 [published], and their heights, elongations and residual categories are ASSUMED typical magnitudes, not a
 product's values.  A site option names a kit with ``kit = "..."`` (:func:`riskrf.risk.mitigation_inputs.parse_option`);
-the design checks (:func:`riskrf.hazard.design_basis.design_requirement`) then use the kit's SEL, elongation and
+the design checks (:func:`riskrf.hazard.design_requirement.design_requirement`) then use the kit's SEL, elongation and
 residual category instead of generic rules.
 """
 from __future__ import annotations

@@ -27,7 +27,7 @@ def options_profile_figure(scenario, options, *, barrier_x=None, road_x=None, re
     attenuators at their height, a shed roof over the road, the scaling zone and a drape on the face, a realigned
     road; and the required barrier (dashed)
     at the barrier line.  ``options``: :class:`~riskrf.risk.mitigation_inputs.Option` objects; ``requirement``: a
-    :class:`~riskrf.hazard.design_basis.DesignRequirement` or None.
+    :class:`~riskrf.hazard.design_requirement.DesignRequirement` or None.
 
     Parameters
     ----------
@@ -170,7 +170,7 @@ def plot_position_search(search, ax=None):
     Parameters
     ----------
     search : PositionSearch
-        A :class:`~riskrf.hazard.design_basis.PositionSearch` (its ``table``: position [m], required MEL [kJ],
+        A :class:`~riskrf.hazard.design_requirement.PositionSearch` (its ``table``: position [m], required MEL [kJ],
         height [m]).
     ax : matplotlib.axes.Axes, optional
         Axes of the requirement panel (a new two-panel figure when None).
@@ -221,7 +221,7 @@ def position_search_figure(search):
     Parameters
     ----------
     search : PositionSearch
-        A :class:`~riskrf.hazard.design_basis.PositionSearch`.
+        A :class:`~riskrf.hazard.design_requirement.PositionSearch`.
 
     Returns
     -------

@@ -1,8 +1,9 @@
 """The barrier the governing design basis requires, as a costed option of the ranking, and the governing basis's
 checks of the site's own fences.
 
-The design basis (:mod:`riskrf.hazard.design_basis`) gives, at the barrier line and at every position of its
-position search, the required MEL, the smallest certified product class meeting it and the required net height.
+The design basis (:mod:`riskrf.hazard.design_basis`, applied by :mod:`riskrf.hazard.design_requirement`) gives,
+at the barrier line and at every position of its position search, the required MEL, the smallest certified product
+class meeting it and the required net height.
 :func:`required_barrier` turns that into one option of the mitigation study: the smallest certified class that
 meets the required MEL and height, at the position of the search where it costs least, with a cost from a
 :class:`BarrierCostModel` (the site file's ``[required_barrier]`` table, or riskrf's default price table, labelled
@@ -12,7 +13,7 @@ first flight above the tallest catalogue net at every position), it says so, pos
 work instead.
 
 :func:`basis_design_checks` gives each site fence the verdict of the governing basis's checks
-(:attr:`riskrf.hazard.design_basis.DesignRequirement.candidates`): these, not the legacy "100-year energy vs MEL"
+(:attr:`riskrf.hazard.design_requirement.DesignRequirement.candidates`): these, not the legacy "100-year energy vs MEL"
 comparison of :mod:`riskrf.hazard.energy_study`, decide whether an option may be recommended.
 """
 from __future__ import annotations
@@ -354,9 +355,9 @@ def required_barrier(requirement, positions, cost_model: BarrierCostModel, *, ex
 
     Parameters
     ----------
-    requirement : riskrf.hazard.design_basis.DesignRequirement
+    requirement : riskrf.hazard.design_requirement.DesignRequirement
         The governing basis's requirement at the barrier line (energies kJ, heights m).
-    positions : riskrf.hazard.design_basis.PositionSearch or None
+    positions : riskrf.hazard.design_requirement.PositionSearch or None
         The position search (None: the barrier line only).
     cost_model : BarrierCostModel
         Unit prices and running-cost shares.
@@ -444,7 +445,7 @@ def basis_design_checks(requirement) -> dict:
 
     Parameters
     ----------
-    requirement : riskrf.hazard.design_basis.DesignRequirement
+    requirement : riskrf.hazard.design_requirement.DesignRequirement
         The requirement at the barrier line with its candidate checks (demand and capacity in kJ or m).
 
     Returns
