@@ -3,8 +3,9 @@
 Public: module-level functions and classes, and methods of public classes, whose names do not start
 with an underscore, in modules whose path has no part starting with an underscore (``__init__``
 aside).  Dunder methods, properties' setters and test/script files under ``scenarios`` are exempt.  A method
-that overrides a documented method of a base class defined in the same module inherits its docstring (as
-``inspect.getdoc`` and the API reference do).
+that overrides a documented method of a base class inherits its docstring (as ``inspect.getdoc`` and the API
+reference do), when the base is defined in the same module or imported into it from a module of the same package
+(``from .base import OptionEffect``).
 """
 import ast
 from pathlib import Path
@@ -28,6 +29,35 @@ def _inherits_doc(cls, name, classes, seen=()):
     return False
 
 
+_CLASS_TABLES: dict = {}
+
+
+def _class_table(path: Path, _open=()) -> dict:
+    """Name -> ``ast.ClassDef`` of the classes a module defines, and of those it imports with a relative
+    ``from .module import Name`` (followed into that module, so a base's own bases resolve too)."""
+    if path in _CLASS_TABLES:
+        return _CLASS_TABLES[path]
+    if path in _open or not path.exists():
+        return {}
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    table = {}
+    for node in tree.body:
+        if isinstance(node, ast.ImportFrom) and node.level:
+            folder = path.parent
+            for _ in range(node.level - 1):
+                folder = folder.parent
+            target = folder.joinpath(*(node.module or "").split("."))
+            source = target / "__init__.py" if target.is_dir() else target.with_suffix(".py")
+            imported = _class_table(source, _open + (path,))
+            for alias in node.names:
+                if alias.name in imported:
+                    table.update(imported)
+                    table[alias.asname or alias.name] = imported[alias.name]
+    table.update({n.name: n for n in tree.body if isinstance(n, ast.ClassDef)})
+    _CLASS_TABLES[path] = table
+    return table
+
+
 def _public_definitions_without_docstring():
     missing = []
     for pkg in PACKAGES:
@@ -36,7 +66,7 @@ def _public_definitions_without_docstring():
             if any(p.startswith("_") and p != "__init__.py" for p in rel.parts) or "scenarios" in rel.parts:
                 continue
             tree = ast.parse(path.read_text(encoding="utf-8"))
-            classes = {n.name: n for n in tree.body if isinstance(n, ast.ClassDef)}
+            classes = _class_table(path)
             for node in tree.body:
                 if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
                     continue
@@ -115,7 +145,7 @@ def _numpydoc_gaps(rel: str, root: Path = ROOT) -> list[str]:
         if _returns_value(fn) and not (_section(doc, "Returns") or _section(doc, "Yields")):
             gaps.append(f"{rel}:{fn.lineno} {owner}{fn.name}: no Returns section")
 
-    classes = {n.name: n for n in tree.body if isinstance(n, ast.ClassDef)}
+    classes = _class_table(root / rel)
     for node in tree.body:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             check(node)
@@ -139,3 +169,19 @@ def test_numpydoc_check_finds_a_missing_section(tmp_path):
                                    'def g(x):\n    """Twice x.\n\n    Parameters\n    ----------\n    x : float\n'
                                    '        A number.\n\n    Returns\n    -------\n    float\n    """\n    return 2 * x\n')
     assert _numpydoc_gaps("m.py", tmp_path) == ["m.py:1 f: no Parameters section", "m.py:1 f: no Returns section"]
+
+
+def test_an_override_inherits_the_docstring_of_a_base_imported_from_another_module(tmp_path):
+    """A kind's override without a docstring is documented by its base's in another module of the package; an
+    override whose base documents nothing is still a gap."""
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / "__init__.py").write_text("")
+    (tmp_path / "pkg" / "base.py").write_text(
+        'class Base:\n    """A base."""\n\n    def describe(self, x):\n        """What it is.\n\n'
+        '        Parameters\n        ----------\n        x : float\n\n        Returns\n        -------\n'
+        '        str\n        """\n        return ""\n\n    def stages(self, x):\n        return []\n')
+    (tmp_path / "pkg" / "kind.py").write_text(
+        'from .base import Base\n\n\nclass Kind(Base):\n    """A kind."""\n\n    def describe(self, x):\n'
+        '        return "kind"\n\n    def stages(self, x):\n        return [x]\n')
+    assert _numpydoc_gaps("pkg/kind.py", tmp_path) == ["pkg/kind.py:10 Kind.stages: no Parameters section",
+                                                       "pkg/kind.py:10 Kind.stages: no Returns section"]

@@ -3,20 +3,21 @@
 import numpy as np
 import pytest
 
-from riskrf.risk import loss_engine, options
+from riskrf.risk import loss_engine
+from riskrf.risk.options import base, chain
 from riskrf.risk.mitigation import Option
 
 from .test_mitigation import OPTIONS, study
 
 
 def test_every_option_kind_has_its_class_and_the_old_names_still_import():
-    assert tuple(options.KIND_CLASSES) == options.OPTION_KINDS
-    for kind, cls in options.KIND_CLASSES.items():
-        assert issubclass(cls, options.OptionEffect) and isinstance(options.effect_of(Option("x", kind)), cls)
+    assert tuple(chain.KIND_CLASSES) == base.OPTION_KINDS
+    for kind, cls in chain.KIND_CLASSES.items():
+        assert issubclass(cls, base.OptionEffect) and isinstance(chain.effect_of(Option("x", kind)), cls)
     from riskrf.risk.mitigation import (MASS_BINS, OPTION_KINDS, MitigationError, _quantile_map,  # noqa: F401
                                         closure_cost_per_fall)
     from riskrf.risk.mitigation_inputs import SCALING_EFFECTIVENESS, MitigationError as E2
-    assert MitigationError is E2 is options.MitigationError and MASS_BINS == loss_engine.MASS_BINS
+    assert MitigationError is E2 is base.MitigationError and MASS_BINS == loss_engine.MASS_BINS
     assert SCALING_EFFECTIVENESS == 0.8 and _quantile_map is not None
 
 
@@ -52,10 +53,10 @@ def test_effect_basis_of_a_combination_follows_its_kinds():
     scale = Option("s", "scaling", 1.0, zone_x_m=(1.0, 2.0))
     away = Option("a", "realignment", 1.0)
     both = Option("b", "combined", options=("s", "d"))
-    basis = options.effect_basis(both, [scale, drape])       # both assumed parts named
+    basis = chain.effect_basis(both, [scale, drape])       # both assumed parts named
     assert "released under the mesh" in basis and "ASSUMED containment 85%" in basis
     assert "ASSUMED effectiveness" in basis and "others derived" not in basis
-    assert options.effect_basis(scale, [scale]).startswith("derived zone and mass range, ASSUMED effectiveness")
-    assert options.effect_basis(away, [away]) == "geometry: the road leaves the slope"
+    assert chain.effect_basis(scale, [scale]).startswith("derived zone and mass range, ASSUMED effectiveness")
+    assert chain.effect_basis(away, [away]) == "geometry: the road leaves the slope"
     typed = Option("t", "fence", 1.0, capacity_kj=100, height_m=2, retention=0.5, repair_days=30)
-    assert options.effect_basis(typed, [typed]) == "ASSUMPTION: typed effectiveness (t)"
+    assert chain.effect_basis(typed, [typed]) == "ASSUMPTION: typed effectiveness (t)"

@@ -11,7 +11,7 @@ with common random numbers, exactly as for a ditch (:mod:`riskrf.risk.measures`)
   width_m``, its crest ``height_m`` above the ground, its upslope face ``inner_slope_hv`` (default 0.5H:1V, a
   reinforced face) and its downslope face ``outer_slope_hv`` (default 1.5H:1V); material ``material`` (default:
   the ground's).
-* **drape** (``zone_x_m`` = [x_lo, x_hi] on the rock face): the option (:class:`riskrf.risk.options.Drape`) is
+* **drape** (``zone_x_m`` = [x_lo, x_hi] on the rock face): the option (:class:`riskrf.risk.options.slope.Drape`) is
   NOT re-simulated with a changed surface.  What the simulation can tell is which of the falls reaching the road
   start under the mesh (their release point in the zone, :func:`drape_release_share`); a drape keeps a share of
   those on the face (its containment efficiency, an ASSUMPTION) and does nothing for falls from above or beside

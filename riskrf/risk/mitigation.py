@@ -67,7 +67,7 @@ from .mitigation_inputs import (  # noqa: F401  (public names of riskrf.risk.mit
     parse_option,
 )
 from .option_result import OptionResult  # noqa: F401  (a public name of riskrf.risk.mitigation)
-from .options import effect_basis, effect_of, option_chain
+from .options.chain import effect_basis, effect_of, option_chain
 from .road_risk import occupancy_distribution, occupant_fn
 from .sensitivity import SensitivityMixin
 from .slope_models import SlopeModels, quantile_map

@@ -17,19 +17,23 @@ from .road_users import DEFAULT_VULNERABILITY
 from .tolerability import CRITERIA_SETS, CriteriaSet, user_criteria
 from .road_risk import occupancy_distribution
 from .loss_engine import MASS_BINS, closure_cost_per_fall  # noqa: F401  (public names of this module)
-from .options import (  # noqa: F401  (public names of this module)
+from .options.base import (  # noqa: F401  (public names of this module)
     BARRIER_KINDS,
     DEFAULT_REPAIR_DAYS,
-    KIND_CLASSES,
     OPTION_KINDS,
+    SLOPE_KINDS,
+    MitigationError,
+)
+from .options.chain import (  # noqa: F401  (public names of this module)
+    KIND_CLASSES,
     OWN_FIELD_KINDS,
+    effect_of,
+    scaling_effect,
+)
+from .options.slope import (  # noqa: F401  (public names of this module)
     SCALING_DEFAULT_CYCLE_YEARS,
     SCALING_EFFECTIVENESS,
     SCALING_EFFECTIVENESS_RANGE,
-    SLOPE_KINDS,
-    MitigationError,
-    effect_of,
-    scaling_effect,
 )
 
 
@@ -265,7 +269,7 @@ class Option:
 
     def scaling_effect(self) -> tuple:
         """Scaling and bolting by zone and mass: (initial effectiveness, its range, half-life [yr], mean over a
-        renewal cycle, mean at the range's ends); see :meth:`riskrf.risk.options.Scaling.effect`.
+        renewal cycle, mean at the range's ends); see :meth:`riskrf.risk.options.slope.Scaling.effect`.
 
         Returns
         -------

@@ -25,7 +25,7 @@ import pandas as pd
 
 from ..core.format import money, sig
 from ..hazard.design_basis import MEL_PRODUCT_CLASSES_KJ
-from .options import MitigationError
+from .options.base import MitigationError
 
 #: riskrf's default unit price of a certified flexible barrier [study currency per metre of barrier] at
 #: :data:`DEFAULT_REFERENCE_HEIGHT_M` net height, by MEL class [kJ] (the classes of

@@ -30,7 +30,7 @@ from .measures import (
     scenario_with_ditches,
     scenario_with_materials,
 )
-from .options import MitigationError
+from .options.base import MitigationError
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ for f in ["mitigation", "options", "slope_models", "loss_engine", "mitigation_in
         print(f"lines riskrf/risk/{f}.py: {len(q.read_text().splitlines())}")
 print("longest functions:", sorted(funcs)[-3:][::-1])
 print("longest classes:", sorted(classes)[-3:][::-1])
-mit = [c for c in classes if "risk/mitigation.py" in c[1] or "risk/options.py" in c[1] or "risk/loss_engine.py" in c[1] or "risk/slope_models.py" in c[1]]
+mit = [c for c in classes if "risk/mitigation.py" in c[1] or "risk/options/" in c[1] or "risk/loss_engine.py" in c[1] or "risk/slope_models.py" in c[1]]
 print("classes in the mitigation modules:", sorted(mit)[::-1][:6])
-fm = [f for f in funcs if any(s in f[1] for s in ("risk/mitigation.py", "risk/options.py", "risk/loss_engine.py", "risk/slope_models.py"))]
+fm = [f for f in funcs if any(s in f[1] for s in ("risk/mitigation.py", "risk/options/", "risk/loss_engine.py", "risk/slope_models.py"))]
 print("longest functions in the mitigation modules:", sorted(fm)[-3:][::-1])

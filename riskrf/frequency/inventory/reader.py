@@ -1,4 +1,5 @@
-""":func:`read_inventory`: an inventory file and its sidecar read into an :class:`~riskrf.frequency.inventory.record.Inventory`.
+""":func:`read_inventory`: an inventory file and its sidecar read into an
+:class:`~riskrf.frequency.inventory.record.Inventory`.
 
 The file (CSV, Excel, Parquet; :mod:`riskrf.io.tables`) and the sidecar's ``[record]`` table (:func:`_sidecar`,
 the reader options :data:`READER_OPTIONS`); the size, date, location and notes columns recognised by name and unit
