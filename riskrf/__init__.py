@@ -32,7 +32,7 @@ _EXPORTS = {
     "RateModel": "frequency.rates.result", "rate_model": "frequency.rates.fit",
     # mitigation and the whole chain for one site (the user guide's names)
     "MitigationStudy": "risk.mitigation", "load_mitigation": "risk.mitigation",
-    "load_site": "app.site", "run_assessment": "app.assess",
+    "load_site": "app.site", "run_assessment": "app.assess.run",
     "RiskrfError": "core.validation", "RiskrfWarning": "core.validation",
 }
 

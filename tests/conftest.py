@@ -36,15 +36,18 @@ def data_dir():
 @pytest.fixture
 def no_work(monkeypatch):
     """Every expensive stage fails loudly: a refusal must come before any of them runs (the bad-input tests)."""
-    import riskrf.app.assess
+    import riskrf.app.assess.decision
+    import riskrf.app.assess.hazard
+    import riskrf.app.assess.run
     import riskrf.frequency.study
     import simulation
 
     def boom(*a, **k):
         raise AssertionError("work started before the input was refused")
     monkeypatch.setattr(riskrf.frequency.study, "analyse_inventory", boom)
-    monkeypatch.setattr(riskrf.app.assess, "energy_hazard_from_inputs", boom)
-    monkeypatch.setattr(riskrf.app.assess, "run_assessment", boom)
+    monkeypatch.setattr(riskrf.app.assess.hazard, "energy_hazard_from_inputs", boom)
+    monkeypatch.setattr(riskrf.app.assess.decision, "energy_hazard_from_inputs", boom)
+    monkeypatch.setattr(riskrf.app.assess.run, "run_assessment", boom)
     monkeypatch.setattr(simulation, "run", boom)
     monkeypatch.setattr(simulation, "calibrate", boom)
 

@@ -118,7 +118,7 @@ def test_the_checker_sees_imports():
     modules = _modules()
     known = set(modules)
     cli = _imports("riskrf.cli.decisions", modules["riskrf.cli.decisions"], known)
-    assert {"riskrf.app.assess", "riskrf.io.outputs", "riskrf.cli.steps"} <= cli   # ``from ..app.assess import``
+    assert {"riskrf.app.assess.run", "riskrf.io.outputs", "riskrf.cli.steps"} <= cli   # ``from ..app.assess.run import``
     parser = _imports("riskrf.cli.parser", modules["riskrf.cli.parser"], known)
     assert "riskrf.core.units" in parser
     model = _imports("riskrf.app.corridor.model", modules["riskrf.app.corridor.model"], known)
@@ -197,9 +197,7 @@ def test_no_backend_choice_outside_the_command_line():
 MAX_MODULE_LINES = 900
 #: Modules still longer than that, each to be split where its code has seams; the list only shrinks (a module
 #: that is split or falls below the limit must leave it).
-STILL_TO_SPLIT = {
-    "riskrf/app/assess.py",
-}
+STILL_TO_SPLIT: set = set()
 
 
 def _module_lengths() -> dict[str, int]:

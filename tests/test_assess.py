@@ -293,7 +293,8 @@ def test_copied_inputs_rerun_to_the_same_numbers(assessed, tmp_path):
     rerun.mkdir()
     # From Python this time: the figures are all drawn by write_assessment (the command line draws them beside
     # the computation); the same files and numbers either way.
-    from riskrf.app.assess import run_assessment, write_assessment
+    from riskrf.app.assess.outputs import write_assessment
+    from riskrf.app.assess.run import run_assessment
     write_assessment(run_assessment(load_site(inputs / "site.toml")), rerun)
     a = json.loads((out / "summary.json").read_text())
     b = json.loads((rerun / "summary.json").read_text())

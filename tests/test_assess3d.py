@@ -157,8 +157,8 @@ def test_the_mass_coupled_hazard_on_a_plane_matches_the_2d_section():
 
 def test_the_3d_chain_fits_the_inventory_with_the_2d_fits_stage(site3d, monkeypatch):
     """One chain: the 3-D assessment differs from the 2-D one only in the hazard stage; its fits are
-    riskrf.app.assess.fit_site_inventory (the same m_min and bootstrap sizes), not a copy of its own."""
-    import riskrf.app.assess as assess
+    riskrf.app.assess.site_inputs.fit_site_inventory (the same m_min and bootstrap sizes), not a copy of its own."""
+    import riskrf.app.assess.site_inputs as site_inputs
     from riskrf.app.assess3d import run_terrain_assessment
 
     seen = []
@@ -167,7 +167,7 @@ def test_the_3d_chain_fits_the_inventory_with_the_2d_fits_stage(site3d, monkeypa
         seen.append(seed)
         raise RuntimeError("the shared fits stage was called")
 
-    monkeypatch.setattr(assess, "fit_site_inventory", fits)
+    monkeypatch.setattr(site_inputs, "fit_site_inventory", fits)
     with pytest.raises(RuntimeError, match="shared fits stage"):
         run_terrain_assessment(load_site(site3d / "site.toml"), seed=7, log=lambda *_: None)
     assert seen == [7]

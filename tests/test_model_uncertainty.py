@@ -275,7 +275,7 @@ def test_off_by_default(tmp_path):
 
 @pytest.fixture(scope="module")
 def carried(tmp_path_factory):
-    from riskrf.app.assess import run_assessment
+    from riskrf.app.assess.run import run_assessment
     tmp = tmp_path_factory.mktemp("model_uncertainty")
     site = load_site(_site(tmp, "[model_uncertainty]\ndraws = 3\nmax_draws = 3\nn_blocks = 600\n"
                                 "option_blocks = 300\nbootstrap = 20\nsynthetic_calibrations = 40\n"
@@ -323,7 +323,7 @@ def test_a_road_record_is_reproduced_in_every_draw(tmp_path):
     recorded on the road (the draws move the reach, not the record)."""
     from functools import partial
 
-    from riskrf.app.assess import draw_evaluator
+    from riskrf.app.assess.decision import draw_evaluator
     from riskrf.app.model_uncertainty import _without_material_draws
     from riskrf.frequency.inventory.reader import read_inventory
     path = _site(tmp_path, "[model_uncertainty]\ndraws = 2")

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from riskrf.app.assess import run_assessment
+from riskrf.app.assess.run import run_assessment
 from riskrf.app.site import SiteError, load_site
 
 from .test_assess import _site_copy

@@ -1,7 +1,7 @@
 """A recommendation a checking engineer can sign: options that fail their design checks are
 never recommended, the barrier the design basis requires is costed and ranked, and where no certified barrier can
 be placed the report says so and what would work instead (riskrf.risk.required_barrier, MitigationStudy.
-recommendation, riskrf.app.assess.required_barrier_for_site)."""
+recommendation, riskrf.app.assess.decision.required_barrier_for_site)."""
 from dataclasses import replace
 
 import numpy as np

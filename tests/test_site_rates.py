@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from riskrf import read_inventory, rate_model
-from riskrf.app.assess import run_assessment
+from riskrf.app.assess.run import run_assessment
 from riskrf.risk.closure import closure_rule, warning_closure
 from riskrf.risk.mitigation import MitigationError, MitigationStudy
 from riskrf.io.rainfall import read_rainfall

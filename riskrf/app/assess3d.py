@@ -2,7 +2,7 @@
 
 The chain, from one site file (the same fields as a 2-D site; see docs/user-guide/terrain-3d.md):
 
-1. the inventory and its fits, by the 2-D chain's own fits stage (:func:`riskrf.app.assess.fit_site_inventory`:
+1. the inventory and its fits, by the 2-D chain's own fits stage (:func:`riskrf.app.assess.site_inputs.fit_site_inventory`:
    the site's m_min, the same bootstrap sizes, the annual maxima when given); the hazard's power law takes the
    site's m_min and m_max, and the rate at the source is its rate above m_min times ``inventory.rate_scale``;
 2. the mass-coupled energy hazard at the barrier line ``hazard.collector`` (a plan polyline of the terrain
@@ -116,7 +116,7 @@ class TerrainAssessment:
             The summary, with paths relative to the site file's folder.
         """
         from ..report.files import figure_note, save_figure, write_energy_study
-        from .assess import site_trajectory_status
+        from .assess.site_inputs import site_trajectory_status
         out = Path(out)
         with figure_note(site_trajectory_status(self.site).figure_note):
             write_energy_study(self.energy, out)
@@ -164,7 +164,7 @@ def run_terrain_assessment(site: Site, *, seed: int | None = None, n_blocks: int
     timings = {}
     t = time.perf_counter()
     log("[1/4] reading the inventory and fitting the power law")
-    from .assess import fit_site_inventory
+    from .assess.site_inputs import fit_site_inventory
     inventory, frequency, maxima = fit_site_inventory(site, seed)     # the 2-D chain's fits stage
     from ..frequency.power_law import fit_gutenberg_richter
     gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=inv_cfg["m_min_kg"],
@@ -178,13 +178,13 @@ def run_terrain_assessment(site: Site, *, seed: int | None = None, n_blocks: int
     scenario = simulation.load_terrain_scenario(site.resolve(hz_cfg["scenario"]))
     hazard, result = simulate_energy_hazard(gr, scenario, hz_cfg["collector"], rate_per_year=rate, n=n_blocks,
                                             seed=seed, workers=workers)
-    from .assess import with_rate_note
+    from .assess.hazard import with_rate_note
     hazard = with_rate_note(hazard, inv_cfg["rate_scale"])
     timings["simulation"] = round(time.perf_counter() - t, 2)
 
     t = time.perf_counter()
     log("[3/4] design energies and fence checks at the barrier line")
-    from .assess import fence_checks_from_site
+    from .assess.site_inputs import fence_checks_from_site
     fences, heights = fence_checks_from_site(site)
     energy = analyse_energy(hazard, fences=fences, fence_height_m=heights, free_board_m=hz_cfg["free_board_m"],
                             design_T=hz_cfg["design_period_years"], density_kg_m3=inventory.density_kg_m3,
@@ -210,7 +210,7 @@ def run_terrain_assessment(site: Site, *, seed: int | None = None, n_blocks: int
         log(f"[4/4] no road line named {rname!r} in the scenario: no road outputs")
     timings["road"] = round(time.perf_counter() - t, 2)
     warnings = list(frequency.warnings)
-    from .assess import site_trajectory_status
+    from .assess.site_inputs import site_trajectory_status
     status = site_trajectory_status(site)
     if status.uncalibrated:
         warnings.insert(0, status.text)

@@ -4,7 +4,7 @@ When the table is present, after the assessment's own chain the slope is re-simu
 parameters -- rows of a posterior sample (``posterior = "file.csv"``, written by
 :meth:`simulation.PooledCalibration.write`) or the presets' spread (:mod:`simulation.material_uncertainty`, ASSUMED
 ranges) -- and for each draw the energy hazard, the design energies and the mitigation study are computed again
-(:func:`riskrf.app.assess.energy_hazard_from_inputs` and :class:`~riskrf.risk.mitigation.MitigationStudy`, used
+(:func:`riskrf.app.assess.hazard.energy_hazard_from_inputs` and :class:`~riskrf.risk.mitigation.MitigationStudy`, used
 as they are).  From the draws:
 
 * the design energies' intervals split into the trajectory model's part and the statistical part
@@ -326,7 +326,7 @@ def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_
 
     ``evaluate_draw(scenario, n_blocks, option_blocks, seed, uncertainty)`` runs the assessment's own chain for
     one scenario and returns (EnergyHazard, MitigationStudy, SimulationResult of the scenario's seeder, road
-    share) (:func:`riskrf.app.assess.draw_evaluator`); ``uncertainty`` is the study's uncertainty to use (its
+    share) (:func:`riskrf.app.assess.decision.draw_evaluator`); ``uncertainty`` is the study's uncertainty to use (its
     material draws switched off).  ``reference_hazard``: the assessment's own hazard (reported beside the
     draws); ``T``: return periods [yr] of the design energies (default the design period).
 

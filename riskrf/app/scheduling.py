@@ -1,5 +1,5 @@
 """How an assessment schedules the work it needs only later: the ``runner=`` hook of
-:func:`~riskrf.app.assess.run_assessment` and :func:`~riskrf.app.assess.write_assessment`, and its default,
+:func:`~riskrf.app.assess.run.run_assessment` and :func:`~riskrf.app.assess.outputs.write_assessment`, and its default,
 :class:`InLine` (everything in this process, in order).
 
 The chain says *what* can run beside it (the site's rate model, each stage's figures) and *when* it is about to

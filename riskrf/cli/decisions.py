@@ -83,7 +83,7 @@ def cmd_decide(args) -> int:
     check_mitigation_file(args.options)          # every option and table checked before the inventory is read
     inv = _read(args, args.inventory)
     gr, hazard, result = build_energy_hazard(args, inv)
-    from ..app.assess import road_share, study_context
+    from ..app.assess.decision import road_share, study_context
     road = args.road_collector or "road"
     study = load_mitigation(args.options, hazard, road_share=road_share(result, hazard.collector, road),
                             **study_context(result, hazard.collector, road, args.option_blocks,
@@ -126,7 +126,8 @@ def cmd_assess(args) -> int:
     int
         Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
-    from ..app.assess import run_assessment, write_assessment
+    from ..app.assess.outputs import write_assessment
+    from ..app.assess.run import run_assessment
     from ..io.outputs import atomic_output_dir
     from ..app.site import load_site
 
@@ -138,7 +139,7 @@ def cmd_assess(args) -> int:
         return _assess_terrain(site, args, out)
     from .runner import TwoCores
     runner = TwoCores()                  # the simulator compiled and the figures drawn on the other core
-    from ..app.assess import site_trajectory_status
+    from ..app.assess.site_inputs import site_trajectory_status
     from ..report.files import figure_note
     # an uncalibrated trajectory model is stamped on every figure drawn from the trajectories
     with atomic_output_dir(out, overwrite=args.overwrite) as tmp, \

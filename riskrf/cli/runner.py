@@ -4,7 +4,7 @@ Nothing outside ``riskrf.cli`` starts a process or asks how many cores there are
 
 - :func:`_compile_early`: ``riskrf demo`` / ``riskrf assess`` start compiling the simulator in a child before the
   command imports pandas, scipy and numba (``simulation.precompile.start_early``);
-- :class:`TwoCores`: the runner ``riskrf assess`` hands to :func:`riskrf.app.assess.run_assessment` and
+- :class:`TwoCores`: the runner ``riskrf assess`` hands to :func:`riskrf.app.assess.run.run_assessment` and
   ``write_assessment`` (the ``runner=`` hook of :mod:`riskrf.app.scheduling`): it takes over that compilation
   (``simulation.precompile.precompile``), does this core's share of the work while it runs, and forks the rate
   model and each stage's figure writers to the other core;

@@ -200,7 +200,7 @@ def build_energy_hazard(args, inventory):
     result : SimulationResult or None
         The simulation behind it (None with a velocity file).
     """
-    from ..app.assess import energy_hazard_from_inputs
+    from ..app.assess.hazard import energy_hazard_from_inputs
     return energy_hazard_from_inputs(
         inventory, m_min=args.m_min, m_max=args.m_max, rate_scale=args.rate_scale, scenario=args.scenario,
         velocities=args.velocities, collector=args.collector, n=args.n, seed=args.seed,

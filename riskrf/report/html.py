@@ -236,7 +236,7 @@ def render_report(a, figs: Path) -> str:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
     figs : pathlib.Path
         Folder of its figures (PNG), embedded as data URIs.

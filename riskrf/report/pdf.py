@@ -34,7 +34,7 @@ def write_pdf_report(a, path, figs) -> Path:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
     path : str or path
         The PDF written.

@@ -92,7 +92,7 @@ def other_site_data(a) -> bool:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
 
     Returns
@@ -108,7 +108,7 @@ def rates_transferred(a) -> bool:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
 
     Returns
@@ -169,7 +169,7 @@ def report_sections(a) -> list:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
 
     Returns
@@ -195,7 +195,7 @@ def section_number(a, key: str) -> str:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
     key : str
         A :attr:`Section.key`.
@@ -218,7 +218,7 @@ def render(a, bodies: dict, open_section: Callable) -> None:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
     bodies : dict
         :attr:`Section.key` -> callable(section) writing the section's content.
@@ -241,7 +241,7 @@ def run_record(a) -> list:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
 
     Returns
@@ -260,7 +260,7 @@ def bunce_table(a) -> pd.DataFrame:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment (its study's exposure).
 
     Returns
@@ -297,7 +297,7 @@ def road_risk_table(a) -> pd.DataFrame:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
 
     Returns
@@ -321,7 +321,7 @@ def design_checks_table(a) -> pd.DataFrame:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
 
     Returns
@@ -347,7 +347,7 @@ def recommendation_lines(a) -> list:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
 
     Returns
@@ -395,7 +395,7 @@ def road_risk_text(a) -> str:
 
     Parameters
     ----------
-    a : riskrf.app.assess.Assessment
+    a : riskrf.app.assess.result.Assessment
         The assessment.
 
     Returns

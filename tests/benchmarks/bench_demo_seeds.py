@@ -1,6 +1,6 @@
 """Does the demo's stated uncertainty match its real Monte Carlo spread?
 
-Runs the demo site's assessment (``riskrf.app.assess.run_assessment``, the demo's default effort) for several
+Runs the demo site's assessment (``riskrf.app.assess.run.run_assessment``, the demo's default effort) for several
 simulation seeds, and its mitigation study for several seeds of the joint sampling (which also re-draws the
 material re-simulations), and prints per option the spread between seeds (sd and sd/mean) beside the reported
 standard error, and the same for the difference of the two cheapest options and P(best).  The issue's targets:
@@ -27,7 +27,7 @@ def main(argv=None) -> int:
     ap.add_argument("--sim-seeds", type=int, default=4, help="simulation seeds (hazard.seed)")
     ap.add_argument("--sampling-seeds", type=int, default=6, help="seeds of the joint sampling ([uncertainty] seed)")
     args = ap.parse_args(argv)
-    from riskrf.app.assess import run_assessment
+    from riskrf.app.assess.run import run_assessment
     from riskrf.app.site import load_site
     with resources.as_file(resources.files("riskrf") / "data" / "demo_site.toml") as path:
         site = load_site(path)

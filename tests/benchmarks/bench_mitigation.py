@@ -16,7 +16,8 @@ import time
 import warnings
 from dataclasses import replace
 
-from riskrf.app.assess import energy_hazard_from_inputs, road_share, study_context
+from riskrf.app.assess.decision import road_share, study_context
+from riskrf.app.assess.hazard import energy_hazard_from_inputs
 from riskrf.frequency.inventory.reader import read_inventory
 from riskrf.risk.mitigation import MitigationStudy
 from riskrf.app.site import load_site
