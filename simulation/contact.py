@@ -18,7 +18,8 @@ What the module holds
 * the switch between flight and ground contact (:func:`contact_speed`): a physical hop height, with the
   scenario's ``contact_velocity_ms`` only a numerical floor under it;
 * rolling and sliding in contact (:func:`contact_acceleration`, :func:`roll_on_speed`), with the bounded
-  size law of the rolling resistance (:func:`rolling_resistance`, :data:`ROLLING_RESISTANCE_CAP_DEG`);
+  size law of the rolling resistance (:func:`rolling_resistance`, :data:`ROLLING_RESISTANCE_CAP_DEG`) and each
+  block's own phi_g (:func:`block_ground_resistance`);
 * the steep-face rule (:func:`steep_face_launch`): on faces steeper than a stated angle a block does not
   roll in contact; it leaves the face and meets it again in impacts.
 
@@ -587,6 +588,36 @@ def contact_speed(v_floor, g, cos_beta, hop_height_m):
 #: whose asperities are boulders larger than the blocks (coarse talus) traps them in its hollows, and the lumped
 #: resistance then stands for impacts as well: such a material may state its own, higher cap.
 ROLLING_RESISTANCE_CAP_DEG = 38.0
+
+
+@njit(cache=True)
+def block_ground_resistance(mu_0, phi_g_deg, phi_g_std_deg, z_b):
+    """The rolling-resistance coefficient tan(phi_g) [-] of one block: phi_g + z_b sd, clipped to 0-89 deg.
+
+    A block's own shape and angularity make it roll farther or less far than the mean block on every ground (a
+    rounder block farther): ``z_b`` is the block's standard normal deviate, the same on every material, and
+    ``phi_g_std_deg`` the material's spread of phi_g between blocks (``ground_friction_std_deg``).  With no spread it
+    is ``mu_0`` itself, so runs without one give the same numbers as before.
+
+    Parameters
+    ----------
+    mu_0 : float
+        tan(phi_g) of the material [-].
+    phi_g_deg : float
+        phi_g of the material [deg].
+    phi_g_std_deg : float
+        Its spread between blocks [deg] (0: none).
+    z_b : float
+        The block's standard normal deviate [-].
+
+    Returns
+    -------
+    float
+        The block's tan(phi_g) [-], before the size term of :func:`rolling_resistance`.
+    """
+    if phi_g_std_deg <= 0.0 or z_b == 0.0:
+        return mu_0
+    return math.tan(math.radians(min(max(phi_g_deg + z_b * phi_g_std_deg, 0.0), 89.0)))
 
 
 @njit(cache=True)

@@ -49,7 +49,8 @@ def material_table(scenario: Scenario) -> tuple[MaterialTable, np.ndarray]:
         gain=np.array([m.allow_energy_gain for m in mats], dtype=np.bool_),
         en_v0=f("en_velocity_scale_ms"), hop=f("hop_height_m"), size_k=f("rolling_size_coefficient"),
         mu_cap=np.tan(np.radians(f("rolling_resistance_cap_deg"))), size_exp=f("rolling_size_exponent"),
-        et_v0=f("et_normal_scale_ms"), dev=f("lateral_deviation"), dev_v=f("lateral_deviation_speed_ms"))
+        et_v0=f("et_normal_scale_ms"), phig=f("ground_friction_deg"), phig_std=f("ground_friction_std_deg"),
+        dev=f("lateral_deviation"), dev_v=f("lateral_deviation_speed_ms"))
     return table, f("rolling_drag")
 
 
@@ -173,7 +174,33 @@ def seed_blocks(scenario: Scenario, n: int, seed, masses_kg=None) -> dict:
         vx, vz = vx + u * cos_b, vz + u * sin_b
     return {"x": x, "z": scenario.profile.ground(x) + h, "vx": vx,
             "vz": vz, "w": sd.angular_velocity_rads.sample(g_w, n),
-            "mass": mass, "radius": sd.radius(mass), "inertia_factor": np.full(n, sd.inertia_factor)}
+            "mass": mass, "radius": sd.radius(mass), "inertia_factor": np.full(n, sd.inertia_factor),
+            "resistance_deviate": resistance_deviates(scenario, ss, n)}
+
+
+def resistance_deviates(scenario, ss: np.random.SeedSequence, n: int) -> np.ndarray:
+    """Each block's standard normal deviate z_b of its rolling resistance: it rolls with phi_g + z_b
+    ``ground_friction_std_deg`` on every material (:class:`simulation.scenario.Material`).  Drawn from the next
+    child stream of ``ss`` (after those of the other quantities, which are the same with and without it), and only
+    where a material has a spread: zeros otherwise, so such runs draw nothing more.
+
+    Parameters
+    ----------
+    scenario : Scenario or TerrainScenario
+        The scenario (its materials).
+    ss : numpy.random.SeedSequence
+        The run's seed sequence, its other streams spawned.
+    n : int
+        Number of blocks.
+
+    Returns
+    -------
+    numpy.ndarray
+        z_b per block [-].
+    """
+    if not any(m.ground_friction_std_deg > 0.0 for m in scenario.materials):
+        return np.zeros(n)
+    return np.random.default_rng(ss.spawn(1)[0]).standard_normal(n)
 
 
 def _merge_envelopes(total, chunk) -> None:
@@ -285,7 +312,7 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
             kernel.simulate(
                 Blocks2D(np.arange(lo, hi, dtype=np.int64), *(blocks[k][lo:hi] for k in
                                                              ("x", "z", "vx", "vz", "w", "mass", "radius",
-                                                              "inertia_factor"))),
+                                                              "inertia_factor", "resistance_deviate"))),
                 Profile2D(prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.material_index, prof.run_first,
                           prof.run_last),
                 mats, m_drag, collectors, Envelope2D(env_x, env_chunk), settings, sin_max_roll,

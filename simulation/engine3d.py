@@ -18,7 +18,7 @@ from numba import njit
 
 from . import kernel3d
 from .hazard_grids import deposition_density, mask_holes
-from .engine import check_masses, kernel_settings, material_table
+from .engine import check_masses, kernel_settings, material_table, resistance_deviates
 from .kernel_args import Blocks3D, Collectors3D, Crossings3D, Grid3D, Passages3D, Paths3D, Stops3D
 from .scenario3d import TerrainScenario, _lipschitz, fall_line, sample_sources, source_point_index
 from ._display import Displayed
@@ -88,7 +88,8 @@ def seed_blocks_3d(scenario: TerrainScenario, n: int, seed, masses_kg=None) -> d
     return {"x": x, "y": y, "z": scenario.terrain.elevation(x, y) + h, "vx": vx, "vy": vy, "vz": vz,
             "w": sd.angular_velocity_rads.sample(g_w, n), "mass": mass, "radius": radius,
             "inertia_factor": np.full(n, sd.inertia_factor),
-            "deviation_factor": np.asarray(sd.deviation_factor.sample(g_dev, n), dtype=float)}
+            "deviation_factor": np.asarray(sd.deviation_factor.sample(g_dev, n), dtype=float),
+            "resistance_deviate": resistance_deviates(scenario, ss, n)}
 
 
 def _collector_segments(scenario: TerrainScenario):
@@ -141,7 +142,7 @@ def _run_chunk(lo, hi, blocks, inputs, st, key, n_paths, hazard, path_cap, hint=
         r_count, p_count, pcount = np.zeros(2, np.int64), np.zeros(2, np.int64), np.zeros(1, np.int64)
         kernel3d.simulate3d(
             Blocks3D(ids, *(sub[k] for k in ("x", "y", "z", "vx", "vy", "vz", "w", "mass", "radius", "inertia_factor",
-                                             "deviation_factor"))),
+                                             "resistance_deviate", "deviation_factor"))),
             grid, mats, m_drag, cols, kernel_settings(st, key, n_paths), st.sin_max_roll, hazard,
             Stops3D(*(out[k] for k in Stops3D._fields)),
             Crossings3D(*(r[k] for k, _ in _CROSS), r_count), Passages3D(*(p[k] for k, _ in _PASS), p_count),

@@ -21,8 +21,8 @@ import numpy as np
 from numba import njit
 
 from .contact import (EN_WYLLIE, contact_acceleration, contact_speed, contact_speed_at,  # noqa: F401
-                      contact_stop_distance, contact_time, rebound, roll_on_speed, rolling_resistance,
-                      roughness_tilt_max,
+                      block_ground_resistance, contact_stop_distance, contact_time, rebound, roll_on_speed,
+                      rolling_resistance, roughness_tilt_max,
                       steep_face_launch, steep_trap)
 from .units import J_PER_KJ
 
@@ -455,10 +455,10 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
     paths : simulation.kernel_args.Paths2D
         Output per path point, and the count written.
     """
-    block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk = blocks
+    block_ids, bx, bz, bvx, bvz, bw, bmass, bradius, bk, bres = blocks
     px, pz, tree, n_leaves, seg_mat, run_first, run_last = profile
     (m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough, m_roll, m_mu_ground,
-     m_gain, m_en_v0, m_hop, m_size_k, m_mu_cap, m_size_exp, m_et_v0, _m_dev, _m_dev_v) = mats
+     m_gain, m_en_v0, m_hop, m_size_k, m_mu_cap, m_size_exp, m_et_v0, m_phig, m_phig_std, _m_dev, _m_dev_v) = mats
     c_x, c_cap, c_h, c_order = collectors
     env_x, env_acc = envelope
     g, v_contact, v_stop, max_events, key, n_path_blocks = settings
@@ -663,8 +663,8 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
             k = seg
             mat = seg_mat[k]
             cosb, sinb = seg_cos[k], seg_sin[k]
-            mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r, m_mu_cap[mat],
-                                    m_size_exp[mat])
+            mu = rolling_resistance(block_ground_resistance(m_mu_ground[mat], m_phig[mat], m_phig_std[mat], bres[b]),
+                                    m_size_k[mat], m_rough[mat], r, m_mu_cap[mat], m_size_exp[mat])
             roll = m_roll[mat]
             trapped = False
             if sin_max_roll is not None and abs(sinb) > sin_max_roll:

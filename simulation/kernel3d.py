@@ -75,8 +75,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .contact import (EN_WYLLIE, contact_speed, contact_speed_at, contact_stop_distance, contact_time, rebound,
-                      roll_on_speed, rolling_resistance, steep_face_launch, steep_trap)
+from .contact import (EN_WYLLIE, block_ground_resistance, contact_speed, contact_speed_at, contact_stop_distance,
+                      contact_time, rebound, roll_on_speed, rolling_resistance, steep_face_launch, steep_trap)
 from .kernel import (BARRIER_CAUGHT, BARRIER_THROUGH, CROSSED, OUTCOMES, _GOLDEN, _normal, _uniform,  # noqa: F401
                      barrier_outcome)
 
@@ -543,10 +543,10 @@ def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, r
     paths : simulation.kernel_args.Paths3D
         Output per path point, and the count written.
     """
-    block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk, b_dev = blocks
+    block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk, bres, b_dev = blocks
     zg, x0, y0, dx, dy, lip, mat_grid = grid
     (m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough, m_roll, m_mu_ground,
-     m_gain, m_en_v0, m_hop, m_size_k, m_mu_cap, m_size_exp, m_et_v0, m_dev, m_dev_v) = mats
+     m_gain, m_en_v0, m_hop, m_size_k, m_mu_cap, m_size_exp, m_et_v0, m_phig, m_phig_std, m_dev, m_dev_v) = mats
     c_ax, c_ay, c_bx, c_by, c_id, c_s0, c_cap, c_net = collectors
     g, v_contact, v_stop, max_events, key, n_path_blocks = settings
     out_x, out_y, out_z, out_reason, out_impacts, out_t, out_excess, out_events = stops
@@ -786,8 +786,8 @@ def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, r
                     _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, t_abs, x, y, z,
                                  math.sqrt(vx * vx + vy * vy + vz * vz), MODE_FLIGHT)
                 continue
-            mu = rolling_resistance(m_mu_ground[mat], m_size_k[mat], m_rough[mat], r, m_mu_cap[mat],
-                                    m_size_exp[mat])
+            mu = rolling_resistance(block_ground_resistance(m_mu_ground[mat], m_phig[mat], m_phig_std[mat], bres[b]),
+                                    m_size_k[mat], m_rough[mat], r, m_mu_cap[mat], m_size_exp[mat])
             roll = m_roll[mat]
             factor = 1.0 / (1.0 + k_in) if roll else 1.0
             c_drag = m_drag[mat] / r if r > 0.0 else 0.0

@@ -16,12 +16,14 @@ from collections import namedtuple
 
 #: The blocks of a 2-D chunk, one entry per block: global index ``ids`` (int64, seeds the block's random stream),
 #: release position ``x``, ``z``, velocity ``vx``, ``vz``, spin ``w``, ``mass``, ``radius`` and inertia factor
-#: ``k`` = I / (m r^2) [-].
-Blocks2D = namedtuple("Blocks2D", ["ids", "x", "z", "vx", "vz", "w", "mass", "radius", "k"])
+#: ``k`` = I / (m r^2) [-], and ``resist`` the block's standard normal deviate of its rolling resistance angle (phi_g
+#: + resist * ``phig_std`` on every material, :data:`MaterialTable`).
+Blocks2D = namedtuple("Blocks2D", ["ids", "x", "z", "vx", "vz", "w", "mass", "radius", "k", "resist"])
 
 #: The blocks of a 3-D chunk: as :data:`Blocks2D` with ``y`` and ``vy``, and ``dev`` the block's own factor of the
 #: lateral deviation [-] (:func:`simulation.kernel3d.deviation_sd`).
-Blocks3D = namedtuple("Blocks3D", ["ids", "x", "y", "z", "vx", "vy", "vz", "w", "mass", "radius", "k", "dev"])
+Blocks3D = namedtuple("Blocks3D", ["ids", "x", "y", "z", "vx", "vy", "vz", "w", "mass", "radius", "k", "resist",
+                                   "dev"])
 
 #: The 2-D slope section: vertices ``x``, ``z``, the chord-offset tree ``tree`` of the profile and its number of
 #: leaves ``n_leaves``, the material index of each segment ``seg_mat`` and the first and last segment of each
@@ -38,11 +40,13 @@ Grid3D = namedtuple("Grid3D", ["z", "x0", "y0", "dx", "dy", "lip", "mat"])
 #: ``roll``, rolling or sliding resistance tan(phi_g) ``mu_ground`` [-], energy gain allowed ``gain``, velocity
 #: scale of e_N ``en_v0`` [m/s] (inf: none), hop height ``hop`` [m], the rolling resistance's size coefficient
 #: ``size_k`` [-], cap ``mu_cap`` [-] and exponent ``size_exp`` [-], the tangential scaling's velocity scale
-#: ``et_v0`` [m/s] (inf: none), and the lateral deviation's gain ``dev`` [-] and speed scale ``dev_v`` [m/s]
-#: (3-D kernel only).  The laws are those of :mod:`simulation.contact`.
+#: ``et_v0`` [m/s] (inf: none), phi_g itself ``phig`` [deg] and its spread between blocks ``phig_std`` [deg] (0:
+#: none), and the lateral deviation's gain ``dev`` [-] and speed scale ``dev_v`` [m/s] (3-D kernel only).  The laws
+#: are those of :mod:`simulation.contact`.
 MaterialTable = namedtuple("MaterialTable", ["en_law", "en_mean", "en_std", "et_law", "et_mean", "et_std", "phi",
                                              "phi_std", "rough", "roll", "mu_ground", "gain", "en_v0", "hop", "size_k",
-                                             "mu_cap", "size_exp", "et_v0", "dev", "dev_v"])
+                                             "mu_cap", "size_exp", "et_v0", "phig", "phig_std", "dev",
+                                             "dev_v"])
 
 #: The 2-D collectors: position ``x``, barrier capacity ``cap`` [kJ] and height ``h`` (NaN: a plain collector), and
 #: ``order`` (int64) the collectors by increasing x, the order a block moving downslope crosses them.

@@ -366,8 +366,9 @@ def preset_prior(name: str):
 
 
 #: The default of a material field no preset sets (simulation.scenario.Material reads it from here): what the
-#: published basis uses for a field the data-derived presets fit (the size law of the rolling resistance).
-FIELD_DEFAULTS = {"rolling_size_coefficient": 0.0, "rolling_size_exponent": 1.0}
+#: published basis uses for a field the data-derived presets fit (the size law of the rolling resistance, the
+#: spread of phi_g between blocks).
+FIELD_DEFAULTS = {"rolling_size_coefficient": 0.0, "rolling_size_exponent": 1.0, "ground_friction_std_deg": 0.0}
 
 
 def _unknown(name, where: str, source: str) -> str:

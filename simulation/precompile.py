@@ -175,9 +175,9 @@ def empty_kernel_arguments() -> dict:
     # m_drag and sin_max_roll None: the specialisation of scenarios without rolling drag or steep faces
     # (simulation.engine.kernel_features), the one the demo and most sites run
     return {
-        "blocks": ka.Blocks2D(i(), *(f() for _ in range(8))),
+        "blocks": ka.Blocks2D(i(), *(f() for _ in range(9))),
         "profile": ka.Profile2D(f(), f(), f(), 1, i(), i(), i()),
-        "mats": ka.MaterialTable(i(), f(), f(), i(), f(), f(), f(), f(), f(), b(), f(), b(), *(f() for _ in range(8))),
+        "mats": ka.MaterialTable(i(), f(), f(), i(), f(), f(), f(), f(), f(), b(), f(), b(), *(f() for _ in range(10))),
         "m_drag": None,
         "collectors": ka.Collectors2D(f(), f(), f(), i()),
         "envelope": ka.Envelope2D(f(), np.zeros((0, 7))),

@@ -206,7 +206,10 @@ class Material:
     for large blocks, never above the cap from the size term), so small blocks stop sooner (0: tan(phi_g) alone);
     ``rolling_resistance_cap_deg`` [deg]: that cap (default 38, :data:`simulation.contact.ROLLING_RESISTANCE_CAP_DEG`,
     the steepest angle of repose of loose debris; a terrain of boulders larger than the blocks may state more);
-    ``rolling_size_exponent`` a [-]: the exponent of the size ratio (default 1, Kirkby & Statham's form); ``et_normal_scale_ms``: vt0 of the Pfeiffer & Bowen (1989) scaling of the
+    ``rolling_size_exponent`` a [-]: the exponent of the size ratio (default 1, Kirkby & Statham's form);
+    ``ground_friction_std_deg`` [deg]: the spread of phi_g between blocks: each block rolls with phi_g + z_b sd,
+    z_b one standard normal deviate per block, the same on every material (its own shape and angularity: a rounder
+    block rolls farther everywhere; 0: every block the same, the default; the kernels' per-block draw); ``et_normal_scale_ms``: vt0 of the Pfeiffer & Bowen (1989) scaling of the
     tangential energy by 1 / ((v_n / (vt0 e_N))^2 + 1) after a constant or Coulomb law (inf: none;
     ``tangential.normal_scale_ms`` in a file, 76.2 m/s in CRSP); ``lateral_deviation`` D [-] and
     ``lateral_deviation_speed_ms`` v_D [m/s] (3-D kernel only): after each impact the block's direction of travel
@@ -236,6 +239,7 @@ class Material:
     rolling_size_coefficient: float = FIELD_DEFAULTS["rolling_size_coefficient"]
     rolling_resistance_cap_deg: float = ROLLING_RESISTANCE_CAP_DEG
     rolling_size_exponent: float = FIELD_DEFAULTS["rolling_size_exponent"]
+    ground_friction_std_deg: float = FIELD_DEFAULTS["ground_friction_std_deg"]
     et_normal_scale_ms: float = math.inf
     lateral_deviation: float = DEFAULT_LATERAL_DEVIATION
     lateral_deviation_speed_ms: float = DEFAULT_LATERAL_DEVIATION_SPEED_MS
@@ -264,7 +268,8 @@ class Material:
         _check_keys(spec, {"preset", "preset_basis", "normal_restitution", "tangential", "roughness_m", "ground_motion",
                            "ground_friction_angle_deg", "rolling_resistance", "allow_energy_gain",
                            "contact_hop_height_m", "rolling_drag", "rolling_size_coefficient", "rolling_resistance_cap_deg",
-                           "rolling_size_exponent", "lateral_deviation", "lateral_deviation_speed_ms"}, where, source)
+                           "rolling_size_exponent", "ground_friction_std_deg", "lateral_deviation",
+                           "lateral_deviation_speed_ms"}, where, source)
         if "preset_basis" in spec and "preset" not in spec:
             raise ScenarioError(f"{source}: {where}preset_basis = {spec['preset_basis']!r} needs a preset beside it")
         given = set(spec)
@@ -368,6 +373,9 @@ class Material:
                    rolling_size_exponent=_number(
                        spec.get("rolling_size_exponent", FIELD_DEFAULTS["rolling_size_exponent"]),
                        f"{where}rolling_size_exponent", source, lo=0.0, hi=3.0),
+                   ground_friction_std_deg=_number(
+                       spec.get("ground_friction_std_deg", FIELD_DEFAULTS["ground_friction_std_deg"]),
+                       f"{where}ground_friction_std_deg", source, lo=0.0, hi=20.0),
                    lateral_deviation=_number(spec.get("lateral_deviation", DEFAULT_LATERAL_DEVIATION),
                                              f"{where}lateral_deviation", source, lo=0.0, hi=20.0),
                    lateral_deviation_speed_ms=_number(spec.get("lateral_deviation_speed_ms",
