@@ -30,8 +30,9 @@ DEFAULT_CHUNK_3D = 20_000
 def _kernel_inputs(scenario: TerrainScenario):
     """The terrain, material table, rolling drag and collectors of ``scenario`` as the 3-D kernel takes them."""
     ter = scenario.terrain
+    rough = np.zeros((0, 0)) if scenario.roughness_grid is None else scenario.roughness_grid
     grid = Grid3D(ter.z, float(ter.x0), float(ter.y0), float(ter.dx), float(ter.dy),
-                  float(_lipschitz(ter.z, ter.dx, ter.dy)), scenario.material_grid.index)
+                  float(_lipschitz(ter.z, ter.dx, ter.dy)), scenario.material_grid.index, rough)
     mats, m_drag = material_table(scenario)
     return grid, mats, m_drag, _collector_segments(scenario)
 

@@ -496,6 +496,17 @@ def _find_impact(zg, x0, y0, dx, dy, lip, x, y, z, vx, vy, vz, g):
 
 
 @njit(cache=True, nogil=True)
+def cell_roughness(rough_grid, m_rough, mat, i, j):
+    """Roughness height [m] of cell (i, j): the roughness raster's value there, or the cell material's
+    ``roughness_m`` where the raster has none (NaN) or no raster was given (``rough_grid`` of shape (0, 0))."""
+    if rough_grid.shape[0] > 0:
+        v = rough_grid[i, j]
+        if v == v:
+            return v
+    return m_rough[mat]
+
+
+@njit(cache=True, nogil=True)
 def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, rec_pass, stops, crossings, passages,
                paths):
     """Run every block of a chunk on the DEM surface; fill the output arrays in place.
@@ -544,7 +555,7 @@ def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, r
         Output per path point, and the count written.
     """
     block_ids, bx, by, bz, bvx, bvy, bvz, bw, bmass, bradius, bk, bres, b_dev = blocks
-    zg, x0, y0, dx, dy, lip, mat_grid = grid
+    zg, x0, y0, dx, dy, lip, mat_grid, rough_grid = grid
     (m_en_law, m_en_mean, m_en_std, m_et_law, m_et_mean, m_et_std, m_phi, m_phi_std, m_rough, m_roll, m_mu_ground,
      m_gain, m_en_v0, m_hop, m_size_k, m_mu_cap, m_size_exp, m_et_v0, m_phig, m_phig_std, m_dev, m_dev_v) = mats
     c_ax, c_ay, c_bx, c_by, c_id, c_s0, c_cap, c_net = collectors
@@ -660,8 +671,9 @@ def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, r
                 impacts += 1
                 zs, gx, gy = _surface(zg, x0, y0, dx, dy, x, y)
                 z = zs
-                mat = mat_grid[min(max(int(round((y - y0) / dy)), 0), ny - 1),
-                               min(max(int(round((x - x0) / dx)), 0), nx - 1)]
+                ci, cj = min(max(int(round((y - y0) / dy)), 0), ny - 1), min(max(int(round((x - x0) / dx)), 0), nx - 1)
+                mat = mat_grid[ci, cj]
+                rough = cell_roughness(rough_grid, m_rough, mat, ci, cj)
                 nl = math.sqrt(gx * gx + gy * gy + 1.0)
                 nx0, ny0, nz0 = -gx / nl, -gy / nl, 1.0 / nl
                 vn_t = vx * nx0 + vy * ny0 + vz * nz0
@@ -674,7 +686,7 @@ def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, r
                 else:
                     t1x, t1y, t1z = t1x / tl, t1y / tl, t1z / tl
                 t2x, t2y, t2z = ny0 * t1z - nz0 * t1y, nz0 * t1x - nx0 * t1z, nx0 * t1y - ny0 * t1x
-                theta_max = math.atan(m_rough[mat] / r) if r > 0 else 0.0
+                theta_max = math.atan(rough / r) if r > 0 else 0.0
                 d1 = (2.0 * _uniform(state) - 1.0) * theta_max
                 d2 = (2.0 * _uniform(state) - 1.0) * theta_max
                 a1, a2 = math.tan(d1), math.tan(d2)
@@ -715,7 +727,7 @@ def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, r
                 if m_dev[mat] > 0.0:
                     # lateral deviation: the direction of travel turns about the ground normal by a random angle
                     # (deviation_sd); the spin axis turns with it, speed and normal share are kept
-                    sig = deviation_sd(m_dev[mat], m_rough[mat], r, v_in, m_dev_v[mat], b_dev[b])
+                    sig = deviation_sd(m_dev[mat], rough, r, v_in, m_dev_v[mat], b_dev[b])
                     if sig > 0.0:
                         dlt = min(max(sig * _normal(state), -DEVIATION_MAX_RAD), DEVIATION_MAX_RAD)
                         vx, vy, vz = _turn(vx, vy, vz, nx0, ny0, nz0, dlt)
@@ -764,8 +776,8 @@ def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, r
             else:
                 zs, gx, gy = _surface(zg, x0, y0, dx, dy, x, y)
             have_s = False
-            mat = mat_grid[min(max(int(round((y - y0) / dy)), 0), ny - 1),
-                           min(max(int(round((x - x0) / dx)), 0), nx - 1)]
+            ci, cj = min(max(int(round((y - y0) / dy)), 0), ny - 1), min(max(int(round((x - x0) / dx)), 0), nx - 1)
+            mat = mat_grid[ci, cj]
             nl = math.sqrt(gx * gx + gy * gy + 1.0)
             nx0, ny0, nz0 = -gx / nl, -gy / nl, 1.0 / nl
             if 1.0 - nz0 * nz0 > sin_max_roll * sin_max_roll:
@@ -787,7 +799,8 @@ def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, r
                                  math.sqrt(vx * vx + vy * vy + vz * vz), MODE_FLIGHT)
                 continue
             mu = rolling_resistance(block_ground_resistance(m_mu_ground[mat], m_phig[mat], m_phig_std[mat], bres[b]),
-                                    m_size_k[mat], m_rough[mat], r, m_mu_cap[mat], m_size_exp[mat])
+                                    m_size_k[mat], cell_roughness(rough_grid, m_rough, mat, ci, cj), r,
+                                    m_mu_cap[mat], m_size_exp[mat])
             roll = m_roll[mat]
             factor = 1.0 / (1.0 + k_in) if roll else 1.0
             c_drag = m_drag[mat] / r if r > 0.0 else 0.0

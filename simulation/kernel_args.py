@@ -31,8 +31,9 @@ Blocks3D = namedtuple("Blocks3D", ["ids", "x", "y", "z", "vx", "vy", "vz", "w", 
 Profile2D = namedtuple("Profile2D", ["x", "z", "tree", "n_leaves", "seg_mat", "run_first", "run_last"])
 
 #: The 3-D terrain: elevations ``z`` (ny, nx; NaN holes), the centre of cell (0, 0) at (``x0``, ``y0``), the cell
-#: sizes ``dx``, ``dy``, the grid's Lipschitz bound ``lip`` [-] and the material index of each cell ``mat``.
-Grid3D = namedtuple("Grid3D", ["z", "x0", "y0", "dx", "dy", "lip", "mat"])
+#: sizes ``dx``, ``dy``, the grid's Lipschitz bound ``lip`` [-], the material index of each cell ``mat`` and the
+#: roughness of each cell ``rough`` [m] (NaN: the material's; an array of shape (0, 0): the materials' everywhere).
+Grid3D = namedtuple("Grid3D", ["z", "x0", "y0", "dx", "dy", "lip", "mat", "rough"])
 
 #: One entry per material (:func:`simulation.engine.material_table`): normal restitution law code, mean and sd
 #: (``en_law``, ``en_mean``, ``en_std``), tangential law code, mean and sd (``et_law``, ``et_mean``, ``et_std``),

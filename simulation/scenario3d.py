@@ -11,6 +11,7 @@ collectors, read from TOML.
                                      # a DEM whose fall lines from the sources meet a hole, before any work
     material = "soil"                # one material everywhere (or the default where no polygon lies), or:
     # material_raster = "materials.tif"        # integer codes on the DEM's grid
+    # roughness_raster = "roughness.tif"      # roughness height per cell [m] on the DEM's grid (nodata: the material's)
     # material_codes = { 1 = "soil", 2 = "bedrock" }
     # material_polygons = "zones.gpkg"         # or polygons (GeoPackage, shapefile), rasterised on the grid
     # material_field = "zone"                  # the attribute naming each polygon's class
@@ -63,7 +64,7 @@ import numpy as np
 from ._display import Displayed, short_repr
 from .scenario import (Distribution, ScenarioError, Settings, _check_keys, _number, parse_settings,
                        parse_tables_and_materials)
-from .terrain import MaterialGrid, Terrain, TerrainError, read_dem, read_material_raster
+from .terrain import MaterialGrid, Terrain, TerrainError, read_dem, read_material_raster, read_roughness_raster
 from .units import DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3, INERTIA_FACTORS, block_radius
 
 #: Contact steps are events in 3-D (one per half cell rolled), so the default limit is higher than in 2-D.
@@ -167,7 +168,9 @@ class PlanCollector:
 @dataclass(frozen=True, repr=False)
 class TerrainScenario(Displayed):
     """A checked 3-D scenario: ``terrain`` (DEM), ``materials``, ``material_grid`` (material per cell),
-    ``sources``, plan ``collectors`` and ``settings``; run it with :func:`simulation.run_terrain`."""
+    ``sources``, plan ``collectors`` and ``settings``, and ``roughness_grid``, the roughness per cell [m] of a
+    ``terrain.roughness_raster`` (NaN where the material's applies; None: the materials' everywhere); run it with
+    :func:`simulation.run_terrain`."""
 
     name: str
     description: str
@@ -178,6 +181,7 @@ class TerrainScenario(Displayed):
     collectors: tuple
     settings: Settings
     source: str = "<dict>"
+    roughness_grid: np.ndarray | None = None
 
     def __repr__(self) -> str:
         ny, nx = self.terrain.z.shape
@@ -269,6 +273,7 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
         if terrain is None:
             terrain = _read_terrain_dem(tt, base, crs, source)
         grid = _material_grid(tt, terrain, base, names, source)
+        rough = read_roughness_raster(base / str(tt["roughness_raster"]), terrain) if "roughness_raster" in tt else None
     except TerrainError as exc:
         raise ScenarioError(f"{source}: [terrain]: {exc}") from None
     sources = _parse_sources(data["sources"], terrain, base, nodata_rule, source)
@@ -276,7 +281,7 @@ def terrain_scenario_from_dict(data: dict, source: str = "<dict>", base_dir: Pat
     settings = parse_settings(data.get("settings", {}), source, max_events=DEFAULT_MAX_EVENTS_3D, envelopes=False)
     return TerrainScenario(name=str(data.get("name", Path(source).stem)), description=str(data.get("description", "")),
                            terrain=terrain, materials=materials, material_grid=grid, sources=sources,
-                           collectors=collectors, settings=settings, source=source)
+                           collectors=collectors, settings=settings, source=source, roughness_grid=rough)
 
 
 def _check_terrain_table(tt: dict, source: str) -> str:
@@ -295,7 +300,8 @@ def _check_terrain_table(tt: dict, source: str) -> str:
         The nodata rule, "leave" or "error".
     """
     _check_keys(tt, {"dem", "crs", "material", "material_raster", "material_codes", "material_polygons",
-                     "material_field", "material_layer", "material_values", "nodata"}, "terrain.", source)
+                     "material_field", "material_layer", "material_values", "nodata", "roughness_raster"},
+                "terrain.", source)
     nodata_rule = tt.get("nodata", "leave")
     if nodata_rule not in ("leave", "error"):
         raise ScenarioError(f"{source}: terrain.nodata = {nodata_rule!r} must be \"leave\" (a block reaching a hole "

@@ -553,6 +553,87 @@ class MaterialGrid:
         return self.index[i, j]
 
 
+def _read_on_dem_grid(path, terrain: Terrain, what: str, resampling: str):
+    """Band 1 of a raster that must lie on the DEM's grid: the same shape, transform (to 1e-6 of a cell) and CRS
+    (a raster without CRS is taken to share the DEM's); a clear error otherwise, naming both grids.
+
+    Parameters
+    ----------
+    path : str or path
+        The raster file.
+    terrain : Terrain
+        The DEM.
+    what : str
+        What the raster is, for messages (``"material raster"``).
+    resampling : str
+        The resampling to advise when it is on another grid.
+
+    Returns
+    -------
+    tuple
+        (values in the DEM's internal orientation, the raster's nodata value or None).
+    """
+    import rasterio
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"{what} not found: {path}")
+    with rasterio.open(path) as ds:
+        t, tt = ds.transform, terrain.transform
+        same = (ds.height, ds.width) == terrain.shape and all(
+            abs(a - b) <= 1e-6 * max(terrain.dx, terrain.dy) for a, b in zip(tuple(t)[:6], tuple(tt)[:6]))
+        if not same:
+            raise TerrainError(f"{path}: the {what} is on another grid than the DEM {terrain.source} "
+                               f"(its {ds.height} x {ds.width} cells, transform {tuple(t)[:6]}; the DEM's "
+                               f"{terrain.shape[0]} x {terrain.shape[1]}, {tuple(tt)[:6]}); resample it onto the "
+                               f"DEM's grid (e.g. gdalwarp -te/-tr with {resampling})")
+        if ds.crs is not None and terrain.crs is not None and ds.crs != terrain.crs:
+            raise TerrainError(f"{path}: the {what}'s CRS {ds.crs.to_string()} is not the DEM's "
+                               f"{terrain.crs.to_string()}")
+        raw = ds.read(1)
+        nodata = ds.nodata
+    return (raw if terrain.south_up else raw[::-1]), nodata
+
+
+#: Largest roughness height a roughness raster may give [m] (the material field's limit).
+MAX_ROUGHNESS_M = 10.0
+
+
+def read_roughness_raster(path, terrain: Terrain) -> np.ndarray:
+    """A roughness raster on the DEM's grid: the asperity height of each cell [m], as Rockyfor3D's mean obstacle
+    height (Dorren 2016, Rockyfor3D (v5.2) revealed, ecorisQ).  Where it has a value it replaces the material's
+    ``roughness_m`` in the 3-D kernel (the impact tilt, the lateral deviation and the rolling resistance's size
+    term); its nodata cells (and NaN) keep the material's.  It must lie on the DEM's grid (as a material raster).
+
+    Parameters
+    ----------
+    path : str or path
+        The raster file.
+    terrain : Terrain
+        The DEM.
+
+    Returns
+    -------
+    numpy.ndarray
+        Roughness per cell [m] (ny, nx) in the DEM's internal orientation, NaN where the material's applies.
+
+    Raises
+    ------
+    TerrainError
+        On another grid or CRS than the DEM, or a value below 0 or above :data:`MAX_ROUGHNESS_M` (naming a cell).
+    """
+    raw, nodata = _read_on_dem_grid(path, terrain, "roughness raster", "bilinear or average resampling")
+    rough = raw.astype(float)
+    if nodata is not None:
+        rough[raw == nodata] = np.nan
+    bad = np.isfinite(rough) & ((rough < 0.0) | (rough > MAX_ROUGHNESS_M))
+    if bad.any():
+        i, j = np.argwhere(bad)[0]
+        raise TerrainError(f"{path}: roughness {rough[i, j]:g} m (cell row "
+                           f"{i if terrain.south_up else rough.shape[0] - 1 - i}, column {j}) is outside 0-"
+                           f"{MAX_ROUGHNESS_M:g} m")
+    return np.ascontiguousarray(rough)
+
+
 def read_material_raster(path, terrain: Terrain, codes: dict, material_names) -> MaterialGrid:
     """A material raster on the DEM's grid: integer codes per cell, mapped to material names by ``codes``
     (``{code: name}``).  The raster must have the DEM's shape, transform (to 1e-6 of a cell) and CRS (a
@@ -574,26 +655,8 @@ def read_material_raster(path, terrain: Terrain, codes: dict, material_names) ->
     -------
     MaterialGrid
     """
-    import rasterio
-    path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"material raster not found: {path}")
     names = list(material_names)
-    with rasterio.open(path) as ds:
-        t, tt = ds.transform, terrain.transform
-        same = (ds.height, ds.width) == terrain.shape and all(
-            abs(a - b) <= 1e-6 * max(terrain.dx, terrain.dy) for a, b in zip(tuple(t)[:6], tuple(tt)[:6]))
-        if not same:
-            raise TerrainError(f"{path}: the material raster is on another grid than the DEM {terrain.source} "
-                               f"(its {ds.height} x {ds.width} cells, transform {tuple(t)[:6]}; the DEM's "
-                               f"{terrain.shape[0]} x {terrain.shape[1]}, {tuple(tt)[:6]}); resample it onto the "
-                               "DEM's grid (e.g. gdalwarp -te/-tr with nearest neighbour)")
-        if ds.crs is not None and terrain.crs is not None and ds.crs != terrain.crs:
-            raise TerrainError(f"{path}: the material raster's CRS {ds.crs.to_string()} is not the DEM's "
-                               f"{terrain.crs.to_string()}")
-        raw = ds.read(1)
-        nodata = ds.nodata
-    raw = raw if terrain.south_up else raw[::-1]
+    raw, nodata = _read_on_dem_grid(path, terrain, "material raster", "nearest neighbour")
     index = np.zeros(raw.shape, dtype=np.int64)
     known = np.zeros(raw.shape, dtype=bool)
     for code, name in codes.items():

@@ -53,14 +53,16 @@ def test_each_block_slides_as_far_as_its_own_friction_says_3d():
 
 def _spread_run(**material):
     sc = scenario([0, 200], [0, 0], material={"ground_friction_angle_deg": PHI, **material},
-                  seeder={"type": "line", "x": [1.0, 5.0], "height_m": 0.0, "vx_ms": {"dist": "uniform", "low": 2.0, "high": 8.0}})
+                  seeder={"type": "line", "x": [1.0, 5.0], "height_m": 0.0,
+                          "vx_ms": {"dist": "uniform", "low": 2.0, "high": 8.0}})
     return simulation.run(sc, n=100, seed=7, record_paths=0)
 
 
 def test_no_spread_is_the_former_model_and_the_other_draws_do_not_move():
     """With sd 0 no deviate is drawn and the run is the one without the field; with a spread, every other
     quantity of the blocks is drawn as without it (its own stream)."""
-    base, zero, spread = _spread_run(), _spread_run(ground_friction_std_deg=0.0), _spread_run(ground_friction_std_deg=SD)
+    base, zero = _spread_run(), _spread_run(ground_friction_std_deg=0.0)
+    spread = _spread_run(ground_friction_std_deg=SD)
     assert np.array_equal(base.per_block["x"], zero.per_block["x"])
     assert not zero.blocks["resistance_deviate"].any()
     for k in ("x", "vx", "mass", "radius"):

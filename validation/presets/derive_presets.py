@@ -320,7 +320,11 @@ N_EACH_FITTED, N_EACH_PUBLISHED, PREDICT_SEED = 10, 400, 50_000
 
 def predict_release_stops(rels, draws, n_each, seed0):
     P = _drawn(draws)
-    pool = _Pool(rels, {k: P[k] for k in P if parameter_sets_any(k, rels[0].scenario["materials"])})
+    # a field shared by several materials (``materials.A+B.FIELD``) is set on those of them the releases' scenario
+    # has: a profile without talus still takes the shared value of its soil and rock
+    fitted = {m for k in P for m in parameter_materials(k)}
+    pool = _Pool(rels, {k: P[k] for k in P if parameter_sets_any(k, rels[0].scenario["materials"])},
+                 extra_materials=fitted)
     per = [[] for _ in rels]
     for t, values in enumerate(draws):
         vals = {k: v for k, v in values.items() if k in pool.bounds}
