@@ -498,7 +498,24 @@ def _find_impact(zg, x0, y0, dx, dy, lip, x, y, z, vx, vy, vz, g):
 @njit(cache=True, nogil=True)
 def cell_roughness(rough_grid, m_rough, mat, i, j):
     """Roughness height [m] of cell (i, j): the roughness raster's value there, or the cell material's
-    ``roughness_m`` where the raster has none (NaN) or no raster was given (``rough_grid`` of shape (0, 0))."""
+    ``roughness_m`` where the raster has none (NaN) or no raster was given (``rough_grid`` of shape (0, 0)).
+
+    Parameters
+    ----------
+    rough_grid : numpy.ndarray
+        Roughness per cell [m] (ny, nx), NaN where the material's applies, or of shape (0, 0).
+    m_rough : numpy.ndarray
+        Per material: roughness [m].
+    mat : int
+        Material index of the cell.
+    i, j : int
+        Row and column of the cell.
+
+    Returns
+    -------
+    float
+        Roughness height [m].
+    """
     if rough_grid.shape[0] > 0:
         v = rough_grid[i, j]
         if v == v:
