@@ -18,8 +18,10 @@ _EXPORTS = {
     # Calibration to observed stop points and profiles extracted from 3-D terrain.
     **dict.fromkeys(["Calibration", "CalibrationWarning", "calibrate", "read_observed"], "calibration"),
     # Calibration pooled over many releases, with a posterior sample.
-    **dict.fromkeys(["Release", "PooledCalibration", "PooledCalibrationWarning", "calibrate_pooled",
-                     "read_releases", "read_posterior", "ReachConstraint", "stop_density"], "pooled"),
+    **dict.fromkeys(["Release", "read_releases", "ReachConstraint"], "pooled.releases"),
+    **dict.fromkeys(["PooledCalibration", "read_posterior"], "pooled.result"),
+    "PooledCalibrationWarning": "pooled.posterior", "calibrate_pooled": "pooled.fit",
+    "stop_density": "pooled.likelihood",
     # The trajectory model's uncertainty as material draws: a posterior's rows or the presets' spread.
     **dict.fromkeys(["material_draws", "preset_spread", "scenario_with_values"], "material_uncertainty"),
     **dict.fromkeys(["TerrainProfile", "profile_from_points", "read_stl"], "profile_extraction"),

@@ -532,7 +532,8 @@ def calibrate(scenario, observed=None, parameters: dict | None = None, *, n: int
     -------
     Calibration (one scenario) or PooledCalibration (releases)
     """
-    from .pooled import Release, calibrate_pooled
+    from .pooled.fit import calibrate_pooled
+    from .pooled.releases import Release
     if isinstance(scenario, (list, tuple)) and scenario and all(isinstance(r, Release) for r in scenario):
         if parameters is None and isinstance(observed, dict):
             observed, parameters = None, observed

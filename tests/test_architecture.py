@@ -4,8 +4,8 @@ Every ``import`` and ``from ... import`` of every module under ``riskrf/`` is re
 inside functions included), resolved to the riskrf module it names, and checked against the stage order
 ``core < io < frequency < hazard < risk < report < app < cli``: a module imports only its own stage and the
 stages before it, the science (core .. risk) never imports ``riskrf.report`` or ``riskrf.app``, and the
-module graph has no cycle.  No module is longer than :data:`MAX_MODULE_LINES` but the few listed in
-:data:`STILL_TO_SPLIT`.
+module graph has no cycle.  No module of ``riskrf/`` or ``simulation/`` is longer than :data:`MAX_MODULE_LINES`
+but the few listed in :data:`STILL_TO_SPLIT`.
 """
 from __future__ import annotations
 
@@ -193,16 +193,18 @@ def test_no_backend_choice_outside_the_command_line():
     assert bad == [], f"backend chosen outside riskrf.cli: {bad}"
 
 
-#: Longest a module of ``riskrf/`` may be [lines]: a newcomer reads one in a sitting.
+#: Longest a module of ``riskrf/`` or ``simulation/`` may be [lines]: a newcomer reads one in a sitting.
 MAX_MODULE_LINES = 900
 #: Modules still longer than that, each to be split where its code has seams; the list only shrinks (a module
 #: that is split or falls below the limit must leave it).
-STILL_TO_SPLIT: set = set()
+STILL_TO_SPLIT = {
+    "simulation/kernel3d.py",       # the 3-D kernel (numba), kept whole for now
+}
 
 
 def _module_lengths() -> dict[str, int]:
     return {str(p.relative_to(ROOT.parent)): len(p.read_text(encoding="utf-8").splitlines())
-            for p in sorted(ROOT.rglob("*.py"))}
+            for package in ("riskrf", "simulation") for p in sorted((ROOT.parent / package).rglob("*.py"))}
 
 
 def test_no_module_is_a_big_room():

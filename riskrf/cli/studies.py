@@ -143,7 +143,8 @@ def cmd_calibrate_pooled(args) -> int:
     int
         Exit status: 0 on success, 2 for bad input (errors raised here are reported by :func:`main`).
     """
-    from simulation.pooled import calibrate_pooled, read_releases
+    from simulation.pooled.fit import calibrate_pooled
+    from simulation.pooled.releases import read_releases
 
     from ..app.preflight import check_out
     from ..core.file_schemas import check_scenario_file

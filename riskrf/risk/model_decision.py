@@ -503,7 +503,7 @@ class ModelUncertainRanking(Displayed):
         -------
         CalibrationValue
         """
-        from simulation.pooled import DEFENSIVE_SHARE, stop_bandwidth, stop_density
+        from simulation.pooled.likelihood import DEFENSIVE_SHARE, stop_bandwidth, stop_density
 
         J, K = self.costs.shape
         stops = [np.asarray(s, dtype=float).ravel() for s in stops]
