@@ -155,9 +155,10 @@ def write_tree_figure(study, tmp) -> None:
     save_figure(ax.figure, tmp / "tree.png")
 
 
-def write_mitigation_outputs(study, report, tmp, *, tree_figure: bool = True) -> None:
+def write_mitigation_outputs(study, report, tmp, *, tree_figure: bool = True, figures: bool = True) -> None:
     """Ranking, tornado, break-even and decision tables, and the tree (unless ``tree_figure`` is False: drawn
-    apart by :func:`write_tree_figure`), tornado and F-N figures.
+    apart by :func:`write_tree_figure`), tornado and F-N figures (unless ``figures`` is False: drawn apart by
+    :func:`write_mitigation_figures`).
 
     Parameters
     ----------
@@ -169,10 +170,10 @@ def write_mitigation_outputs(study, report, tmp, *, tree_figure: bool = True) ->
         Folder written into.
     tree_figure : bool
         Draw the tree here.
+    figures : bool
+        Draw the tornado and F-N figures here.
     """
     from ..io.outputs import write_json
-    from .decision_figures import plot_fn, plot_tornado
-    from .files import save_figure
     report["ranking"].to_csv(tmp / "ranking.csv", index=False)
     report["tornado"].to_csv(tmp / "tornado.csv", index=False)
     report["break_even"].to_csv(tmp / "break_even.csv", index=False)
@@ -185,6 +186,24 @@ def write_mitigation_outputs(study, report, tmp, *, tree_figure: bool = True) ->
                 "defaults_used": list(study.defaults_used)}, tmp / "decision.json")
     if tree_figure:
         write_tree_figure(study, tmp)
+    if figures:
+        write_mitigation_figures(study, report, tmp)
+
+
+def write_mitigation_figures(study, report, tmp) -> None:
+    """The tornado (tornado.png) and F-N (fn_curve.png) figures of a mitigation study.
+
+    Parameters
+    ----------
+    study : MitigationStudy
+        The study.
+    report : dict
+        Its :func:`study_report`.
+    tmp : pathlib.Path
+        Folder written into.
+    """
+    from .decision_figures import plot_fn, plot_tornado
+    from .files import save_figure
     ax = plot_tornado(report["tornado"].head(15), currency=study.currency,   # the 15 inputs that matter most
                       xlabel=f"lowest cost of the options at central values [{study.currency}]")
     ax.xaxis.set_major_formatter(lambda v, _pos: f"{v:,.0f}")

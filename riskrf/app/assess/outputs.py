@@ -48,7 +48,7 @@ def write_assessment(a: Assessment, out: Path, log=None, runner=None) -> dict:
     log = log or logger.info
     runner = InLine() if runner is None else runner
     from ...report.html import render_report
-    from ...report.mitigation_text import write_mitigation_outputs, write_tree_figure
+    from ...report.mitigation_text import write_mitigation_figures, write_mitigation_outputs, write_tree_figure
     from ...report.files import write_energy_study
 
     log("[5/5] writing the report, tables and figures")
@@ -63,9 +63,13 @@ def write_assessment(a: Assessment, out: Path, log=None, runner=None) -> dict:
     # riskrf.cli.runner); parts that run_assessment started beside its later stages are only waited for, while
     # this process draws the decision's.
     if drawn:
-        tree = runner.beside(partial(write_tree_figure, a.study, figs))
-        write_mitigation_outputs(a.study, a.decision, figs, tree_figure=False)
-        for part in a.drawing["pending"] + [tree]:
+        # the decision's and the design's figures beside this process's tables, with the earlier stages' parts
+        parts = [runner.beside(partial(write_tree_figure, a.study, figs)),
+                 runner.beside(partial(write_mitigation_figures, a.study, a.decision, figs))]
+        if a.design is not None:
+            parts += [runner.beside(partial(_design_figures, a, figs, part)) for part in (0, 1)]
+        write_mitigation_outputs(a.study, a.decision, figs, tree_figure=False, figures=False)
+        for part in a.drawing["pending"] + parts:
             part.result()
     else:
         def simulation_and_decision_outputs():
@@ -91,7 +95,7 @@ def write_assessment(a: Assessment, out: Path, log=None, runner=None) -> dict:
     summary = a.summary()
     write_json(summary, out / "summary.json")
     if a.design is not None:
-        _design_outputs(a, out, figs)
+        _design_outputs(a, out, figs, figures=not drawn)
     from ...report.pdf import write_pdf_report
     # the PDF (from the assessment and the finished figures) on the other core while this one writes the rest
     pdf = runner.beside(partial(write_pdf_report, a, out / "report.pdf", figs))
@@ -150,36 +154,50 @@ def _simulation_figures(result, collector: str, figs: Path, fences=()) -> None:
                              fences=fences)
 
 
-def _design_outputs(a: Assessment, out: Path, figs: Path) -> None:
-    """The design basis's tables (design_requirement.csv, design_checks.csv, barrier_positions.csv) and figures
-    (options on the profile, stop points, barrier positions, catchment retention)."""
-    from ...report.design_figures import (catchment_figure, options_profile_figure, position_search_figure,
-                                        stop_points_figure)
-    from ...report.files import save_figure
+def _design_outputs(a: Assessment, out: Path, figs: Path, figures: bool = True) -> None:
+    """The design basis's tables (design_requirement.csv, design_checks.csv, barrier_positions.csv,
+    catchment_retention.csv) and, unless ``figures`` is False (drawn apart by :func:`_design_figures`), figures."""
     d = a.design
     d.summary().to_csv(out / "design_requirement.csv")
     if d.requirement is not None:
         d.requirement.candidates.to_csv(out / "design_checks.csv", index=False)
     if d.positions is not None:
         d.positions.table.to_csv(out / "barrier_positions.csv", index=False)
-        save_figure(position_search_figure(d.positions), figs / "barrier_positions.png")
-    if a.result is not None:
-        sc = a.result.scenario
-        save_figure(options_profile_figure(sc, a.site.mitigation["options"], barrier_x=d.barrier_x_m,
-                                           road_x=d.road_x_m, requirement=d.requirement),
-                    figs / "options_profile.png")
-        ditches = [(o.x_m, o.x_m + o.width_m, o.name) for o in a.site.mitigation["options"]
-                   if o.kind == "ditch" and o.x_m is not None and o.width_m is not None]
-        save_figure(stop_points_figure(a.result, road_x=d.road_x_m, ditches=ditches,
-                                       option=d.recommended), figs / "stop_points.png")
-        if d.recommended is not None:
-            from simulation.plotting import plot_profile
-            ax = plot_profile(d.recommended[1])
-            ax.set_title(f"Trajectories with the recommended option: {d.recommended[0]}", fontsize=10)
-            save_figure(ax.figure, figs / "recommended_trajectories.png")
     if d.catchment is not None:
         d.catchment.curve.to_csv(out / "catchment_retention.csv", index=False)
-        save_figure(catchment_figure(d.catchment), figs / "catchment_retention.png")
+    if figures:
+        _design_figures(a, figs)
+
+
+def _design_figures(a: Assessment, figs: Path, part: int | None = None) -> None:
+    """The design basis's figures: barrier positions and options on the profile (``part`` 0), stop points,
+    trajectories with the recommended option and catchment retention (``part`` 1); both parts when ``part`` is
+    None."""
+    from ...report.design_figures import (catchment_figure, options_profile_figure, position_search_figure,
+                                        stop_points_figure)
+    from ...report.files import save_figure
+    d = a.design
+    if part in (None, 0):
+        if d.positions is not None:
+            save_figure(position_search_figure(d.positions), figs / "barrier_positions.png")
+        if a.result is not None:
+            save_figure(options_profile_figure(a.result.scenario, a.site.mitigation["options"],
+                                               barrier_x=d.barrier_x_m, road_x=d.road_x_m,
+                                               requirement=d.requirement),
+                        figs / "options_profile.png")
+    if part in (None, 1):
+        if a.result is not None:
+            ditches = [(o.x_m, o.x_m + o.width_m, o.name) for o in a.site.mitigation["options"]
+                       if o.kind == "ditch" and o.x_m is not None and o.width_m is not None]
+            save_figure(stop_points_figure(a.result, road_x=d.road_x_m, ditches=ditches,
+                                           option=d.recommended), figs / "stop_points.png")
+            if d.recommended is not None:
+                from simulation.plotting import plot_profile
+                ax = plot_profile(d.recommended[1])
+                ax.set_title(f"Trajectories with the recommended option: {d.recommended[0]}", fontsize=10)
+                save_figure(ax.figure, figs / "recommended_trajectories.png")
+        if d.catchment is not None:
+            save_figure(catchment_figure(d.catchment), figs / "catchment_retention.png")
 
 
 def _copy_inputs(a: Assessment, dest: Path) -> None:
