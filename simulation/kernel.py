@@ -487,9 +487,18 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
     mat_mu = np.empty(m_phi.shape[0])
     for m in range(m_phi.shape[0]):
         mat_mu[m] = math.tan(math.radians(min(max(m_phi[m] + 0.0, 0.0), 89.0)))
+    # Per material and block: tan(phi_g) of this block (block_ground_resistance), set once per block where a material
+    # has a spread of phi_g between blocks (otherwise the materials' own, for every block).
+    mu_blk = m_mu_ground.copy()
+    spread = False
+    for m in range(m_phig_std.shape[0]):
+        spread = spread or m_phig_std[m] > 0.0
     for b in range(block_ids.shape[0]):
         bid = block_ids[b]
         state[0] = key ^ (np.uint64(bid + 1) * _GOLDEN)
+        if spread:
+            for m in range(mu_blk.shape[0]):
+                mu_blk[m] = block_ground_resistance(m_mu_ground[m], m_phig[m], m_phig_std[m], bres[b])
         mass, r, k_in = bmass[b], bradius[b], bk[b]
         inertia = k_in * mass * r * r
         x, z, vx, vz, w = bx[b], bz[b], bvx[b], bvz[b], bw[b]
@@ -663,8 +672,7 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
             k = seg
             mat = seg_mat[k]
             cosb, sinb = seg_cos[k], seg_sin[k]
-            mu = rolling_resistance(block_ground_resistance(m_mu_ground[mat], m_phig[mat], m_phig_std[mat], bres[b]),
-                                    m_size_k[mat], m_rough[mat], r, m_mu_cap[mat], m_size_exp[mat])
+            mu = rolling_resistance(mu_blk[mat], m_size_k[mat], m_rough[mat], r, m_mu_cap[mat], m_size_exp[mat])
             roll = m_roll[mat]
             trapped = False
             if sin_max_roll is not None and abs(sinb) > sin_max_roll:

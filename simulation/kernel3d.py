@@ -589,9 +589,18 @@ def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, r
     j_hit = np.empty(max(n_cseg, 1), np.int64)
     state = np.empty(1, np.uint64)
     acc = np.empty(3)
+    # Per material and block: tan(phi_g) of this block (block_ground_resistance), set once per block where a material
+    # has a spread of phi_g between blocks (otherwise the materials' own, for every block).
+    mu_blk = m_mu_ground.copy()
+    spread = False
+    for m in range(m_phig_std.shape[0]):
+        spread = spread or m_phig_std[m] > 0.0
     for b in range(block_ids.shape[0]):
         bid = block_ids[b]
         state[0] = key ^ (np.uint64(bid + 1) * _GOLDEN)
+        if spread:
+            for m in range(mu_blk.shape[0]):
+                mu_blk[m] = block_ground_resistance(m_mu_ground[m], m_phig[m], m_phig_std[m], bres[b])
         mass, r, k_in = bmass[b], bradius[b], bk[b]
         inertia = k_in * mass * r * r
         x, y, z = bx[b], by[b], bz[b]
@@ -815,8 +824,7 @@ def simulate3d(blocks, grid, mats, m_drag, collectors, settings, sin_max_roll, r
                     _record_path(pb, pt, ppx, ppy, ppz, ppv, pmode, pcount, bid, t_abs, x, y, z,
                                  math.sqrt(vx * vx + vy * vy + vz * vz), MODE_FLIGHT)
                 continue
-            mu = rolling_resistance(block_ground_resistance(m_mu_ground[mat], m_phig[mat], m_phig_std[mat], bres[b]),
-                                    m_size_k[mat], cell_roughness(rough_grid, m_rough, mat, ci, cj), r,
+            mu = rolling_resistance(mu_blk[mat], m_size_k[mat], cell_roughness(rough_grid, m_rough, mat, ci, cj), r,
                                     m_mu_cap[mat], m_size_exp[mat])
             roll = m_roll[mat]
             factor = 1.0 / (1.0 + k_in) if roll else 1.0

@@ -163,13 +163,13 @@ def empty_kernel_arguments() -> dict:
 
     from . import kernel_args as ka
 
-    def f(*_):
+    def f():
         return np.zeros(0)
 
-    def i(*_):
+    def i():
         return np.zeros(0, dtype=np.int64)
 
-    def b(*_):
+    def b():
         return np.zeros(0, dtype=np.bool_)
 
     # m_drag and sin_max_roll None: the specialisation of scenarios without rolling drag or steep faces
