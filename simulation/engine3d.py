@@ -19,6 +19,7 @@ from numba import njit
 from . import kernel3d
 from .hazard_grids import deposition_density, mask_holes
 from .engine import check_masses, kernel_settings, material_table, resistance_deviates
+from .kernel import OUTCOMES
 from .kernel_args import Blocks3D, Collectors3D, Crossings3D, Grid3D, Passages3D, Paths3D, Stops3D
 from .scenario3d import TerrainScenario, _lipschitz, fall_line, sample_sources, source_point_index
 from ._display import Displayed
@@ -647,7 +648,7 @@ class TerrainResult(Displayed):
                            "vz_ms": c["vz"][sel], "angular_velocity_rads": c["w"][sel], "height_m": c["h"][sel],
                            "mass_kg": mass, "radius_m": radius, "inertia_factor": k,
                            "energy_kj": kinetic_energy_kj(mass, v, c["w"][sel], radius, k),
-                           "outcome": pd.Categorical.from_codes(c["out"][sel], list(kernel3d.OUTCOMES.values()))})
+                           "outcome": pd.Categorical.from_codes(c["out"][sel], list(OUTCOMES.values()))})
         df = df.sort_values(["block", "time_s"])
         if first_only:
             df = df.drop_duplicates("block", keep="first")

@@ -21,7 +21,7 @@ from collections import namedtuple
 Blocks2D = namedtuple("Blocks2D", ["ids", "x", "z", "vx", "vz", "w", "mass", "radius", "k", "resist"])
 
 #: The blocks of a 3-D chunk: as :data:`Blocks2D` with ``y`` and ``vy``, and ``dev`` the block's own factor of the
-#: lateral deviation [-] (:func:`simulation.kernel3d.deviation_sd`).
+#: lateral deviation [-] (:func:`simulation.kernel3d_contact.deviation_sd`).
 Blocks3D = namedtuple("Blocks3D", ["ids", "x", "y", "z", "vx", "vy", "vz", "w", "mass", "radius", "k", "resist",
                                    "dev"])
 

@@ -178,7 +178,7 @@ class Distribution:
 
 
 #: Defaults of the 3-D kernel's lateral deviation at impacts (``Material.lateral_deviation``, D [-], and
-#: ``lateral_deviation_speed_ms``, v_D [m/s]; :func:`simulation.kernel3d.deviation_sd`): chosen [D] so that
+#: ``lateral_deviation_speed_ms``, v_D [m/s]; :func:`simulation.kernel3d_contact.deviation_sd`): chosen [D] so that
 #: the rule's spread spans the range Rockyfor3D describes (Dorren 2016, section 3.5 pp. 21-23) [R] and checked
 #: against the lateral scatter of the Authume stops (docs/validation/authume-3d.md).
 DEFAULT_LATERAL_DEVIATION = 1.0
@@ -214,7 +214,7 @@ class Material:
     ``tangential.normal_scale_ms`` in a file, 76.2 m/s in CRSP); ``lateral_deviation`` D [-] and
     ``lateral_deviation_speed_ms`` v_D [m/s] (3-D kernel only): after each impact the block's direction of travel
     turns about the ground normal by a random angle of sd D (roughness / r) s_b / (1 + v / v_D) [rad] (s_b the
-    block's own deviation factor; 0: no deviation; :func:`simulation.kernel3d.deviation_sd`).  In a file, ``preset = NAME`` starts from a
+    block's own deviation factor; 0: no deviation; :func:`simulation.kernel3d_contact.deviation_sd`).  In a file, ``preset = NAME`` starts from a
     named material and ``preset_basis = "data"`` beside it from its data-derived table
     (:func:`simulation.materials.preset`).
     See :mod:`simulation.contact`.

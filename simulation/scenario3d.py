@@ -71,7 +71,7 @@ from .units import DEFAULT_DENSITY_KG_M3, DENSITY_RANGE_KG_M3, INERTIA_FACTORS, 
 DEFAULT_MAX_EVENTS_3D = 200_000
 
 #: Default per-block factor s_b [-] of the lateral deviation at impacts (``sources.deviation_factor``;
-#: :func:`simulation.kernel3d.deviation_sd`): lognormal, median 1, sigma of ln 0.3 [D], the block-to-block
+#: :func:`simulation.kernel3d_contact.deviation_sd`): lognormal, median 1, sigma of ln 0.3 [D], the block-to-block
 #: variation of shape: the log-sd of the aspect ratio L1/L3 of the surveyed Authume blocks is 0.25 (P1) and
 #: 0.18 (P2) (tests/data/authume/observed_runout.csv), widened for sites with less uniform blocks.
 DEFAULT_DEVIATION_FACTOR = {"dist": "lognormal", "median": 1.0, "sigma": 0.3, "max": 5.0}
@@ -102,7 +102,7 @@ class Sources:
     point_velocity: np.ndarray | None = field(repr=False, default=None)
     point_mass: np.ndarray | None = field(repr=False, default=None)
     point_radius: np.ndarray | None = field(repr=False, default=None)
-    #: Per-block factor s_b [-] of the lateral deviation at impacts (:func:`simulation.kernel3d.deviation_sd`).
+    #: Per-block factor s_b [-] of the lateral deviation at impacts (:func:`simulation.kernel3d_contact.deviation_sd`).
     deviation_factor: Distribution = field(
         default_factory=lambda: Distribution("lognormal", dict(DEFAULT_DEVIATION_FACTOR)))
 

@@ -4,7 +4,7 @@ A DEM is read with rasterio (GDAL) and kept as a :class:`Terrain`: elevations on
 file's CRS, affine transform and nodata value.  Internally the grid is held in one orientation whatever
 the file's (north-up rasters store the northernmost row first, south-up ones the southernmost): row index
 increasing with the plan coordinate y, column index with x, elevations at cell centres.  The surface
-between cell centres is bilinear (see :mod:`simulation.kernel3d` for why), so the simulated domain is the
+between cell centres is bilinear (see :mod:`simulation.kernel3d_surface` for why), so the simulated domain is the
 rectangle spanned by the cell centres, half a cell inside the raster's outer edge.
 
 Nodata handling (stated, not silent): a nodata (or NaN) cell is a hole.  A bilinear cell that touches a

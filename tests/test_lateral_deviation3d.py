@@ -19,7 +19,7 @@ import pandas as pd
 import pytest
 
 import simulation
-from simulation.kernel3d import DEVIATION_SD_MAX_RAD, deviation_sd
+from simulation.kernel3d_contact import DEVIATION_SD_MAX_RAD, deviation_sd
 from simulation.engine3d import run_terrain
 from simulation.profile_extraction import TerrainProfile
 from simulation.scenario import DEFAULT_LATERAL_DEVIATION, ScenarioError

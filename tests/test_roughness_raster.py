@@ -1,6 +1,6 @@
 """Roughness as a property of the terrain: ``terrain.roughness_raster``, the roughness height of each DEM cell [m]
 (as Rockyfor3D's mean obstacle height), replaces the material's ``roughness_m`` in the 3-D kernel where it has a
-value (:func:`simulation.terrain.read_roughness_raster`, :func:`simulation.kernel3d.cell_roughness`).
+value (:func:`simulation.terrain.read_roughness_raster`, :func:`simulation.kernel3d_surface.cell_roughness`).
 
 Exact checks: a raster equal to the material's roughness everywhere, or of nodata everywhere, gives the run without
 it bit for bit; a rougher raster scatters the blocks more.  Bad rasters (another grid, another CRS, a negative
