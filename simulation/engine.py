@@ -3,8 +3,8 @@
 ``run(scenario, n, seed)`` draws every block's initial state with NumPy
 generators spawned from ``SeedSequence(seed)`` (one per quantity, so the draws
 do not depend on chunking), runs the compiled kernel chunk by chunk (default
-100,000 blocks per chunk, so a million blocks never hold more than one chunk
-of per-crossing rows in flight), and merges the results.  Per-impact random
+100,000 blocks per chunk), each chunk appending its collector crossings to one
+set of buffers that the result keeps, and merges the envelopes.  Per-impact random
 numbers come from a stream keyed by (seed, block index): the same seed gives
 the same numbers whatever the chunk size.
 """
@@ -22,6 +22,7 @@ from .result import SimulationResult
 from .scenario import Scenario
 
 DEFAULT_CHUNK = 100_000
+CROSSING_BLOCKS = 1_000_000    # crossing rows are allotted for this many blocks at a time (crossing_capacity)
 
 
 def material_table(scenario: Scenario) -> tuple[MaterialTable, np.ndarray]:
@@ -203,6 +204,42 @@ def resistance_deviates(scenario, ss: np.random.SeedSequence, n: int) -> np.ndar
     return np.random.default_rng(ss.spawn(1)[0]).standard_normal(n)
 
 
+_CROSSING_FIELDS = (("block", np.int64), ("coll", np.int64), ("t", float), ("vx", float), ("vz", float),
+                    ("w", float), ("h", float), ("outcome", np.int64))
+
+
+def crossing_capacity(n: int, n_collectors: int) -> int:
+    """Rows first allotted to the collector crossings of ``n`` blocks: four per block and collector (a block crosses
+    a collector once unless it rolls back over it), at least 16.  More rows are made when they are needed.
+
+    Parameters
+    ----------
+    n : int
+        Number of blocks.
+    n_collectors : int
+        Number of collectors.
+
+    Returns
+    -------
+    int
+        Number of rows.
+    """
+    return max(4 * n * max(n_collectors, 1), 16)
+
+
+def _crossing_buffers(cap: int) -> dict:
+    """Empty per-crossing arrays of ``cap`` rows (the kernel's ``Crossings2D`` fields)."""
+    return {k: np.empty(cap, dtype=dt) for k, dt in _CROSSING_FIELDS}
+
+
+def _grown(r: dict, keep: int, cap: int) -> dict:
+    """New per-crossing arrays of ``cap`` rows holding the first ``keep`` rows of ``r``."""
+    out = _crossing_buffers(cap)
+    for k in out:
+        out[k][:keep] = r[k][:keep]
+    return out
+
+
 def _merge_envelopes(total, chunk) -> None:
     """Add one chunk's envelope accumulators: counts and sums add, maxima take the larger."""
     for col in (0, 4, 5, 6):
@@ -290,23 +327,26 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
     pcount = np.zeros(1, np.int64)
     per_block = {k: np.empty(n, dtype=dt) for k, dt in
                  (("x", float), ("z", float), ("reason", np.int64), ("impacts", np.int64), ("t", float))}
-    rows = []
+    # One set of crossing buffers for the whole run: each chunk's kernel call appends at the count the previous
+    # chunks left (as the paths do), so the rows are written once, where the result keeps them (no copy per chunk
+    # and no concatenation at the end).  Only the rows written are ever touched, so the generous capacity costs
+    # address space, not memory; it is allotted for up to CROSSING_BLOCKS blocks at a time.
+    r = _crossing_buffers(crossing_capacity(min(n, CROSSING_BLOCKS), len(cols)))
+    r_count = np.zeros(2, np.int64)
     chunks = [(lo, min(lo + chunk_size, n)) for lo in range(0, n, chunk_size)]
     started = None
     for lo, hi in [(0, 0)] + chunks:     # an empty first call compiles (or loads) the kernel, untimed
         if started is None and hi > 0:
             started = time.perf_counter()
-        m = hi - lo
-        cap = max(4 * m * max(len(cols), 1), 16)
-        p_start = int(pcount[0])
+        p_start, r_start = int(pcount[0]), int(r_count[0])
+        room = r["block"].shape[0] - r_start
+        if room < crossing_capacity(hi - lo, len(cols)):
+            r = _grown(r, r_start, max(2 * r["block"].shape[0],
+                                       r_start + crossing_capacity(min(n - lo, CROSSING_BLOCKS), len(cols))))
         while True:
-            # Every crossing is kept: when a chunk's buffer is too small the chunk is run again with the
-            # exact size needed (trajectories depend only on the seed and the block index, so the rerun
-            # gives the same numbers).
-            r = {k: np.empty(cap, dtype=dt) for k, dt in
-                 (("block", np.int64), ("coll", np.int64), ("t", float), ("vx", float), ("vz", float),
-                  ("w", float), ("h", float), ("outcome", np.int64))}
-            r_count = np.zeros(2, np.int64)
+            # Every crossing is kept: when the buffers are too small for a chunk, they grow to hold the rows the
+            # chunk needs (the earlier chunks' rows copied over) and the chunk is run again (trajectories depend
+            # only on the seed and the block index, so the rerun gives the same numbers).
             env_chunk = np.zeros_like(env_acc)
             pcount[0] = p_start
             kernel.simulate(
@@ -320,14 +360,15 @@ def run(scenario: Scenario, n: int | None = None, seed=None, *, masses_kg=None, 
                 Crossings2D(**r, count=r_count), Paths2D(**paths, count=pcount))
             if r_count[1] == 0:
                 break
-            cap = int(r_count[0] + r_count[1])
+            need = int(r_count[0] + r_count[1])
+            r = _grown(r, r_start, need + crossing_capacity(min(n - hi, CROSSING_BLOCKS), len(cols)))
+            r_count[:] = (r_start, 0)
         _merge_envelopes(env_acc, env_chunk)
-        k = int(r_count[0])
-        rows.append({name: arr[:k].copy() for name, arr in r.items()})
         if progress and hi > 0:
             _progress_bar(hi, n, started, sys.stderr)
     elapsed = time.perf_counter() - started
-    merged = {name: np.concatenate([c[name] for c in rows]) for name in rows[0]}
+    k = int(r_count[0])
+    merged = {name: arr[:k] for name, arr in r.items()}
     k = int(pcount[0])
     return SimulationResult(scenario=scenario, n=n, seed=seed, blocks=blocks, per_block=per_block,
                             crossings=merged, envelope_x=env_x, envelope_acc=env_acc,

@@ -56,6 +56,28 @@ def test_same_seed_same_numbers_whatever_the_chunking():
     assert not np.array_equal(a["velocity_ms"].to_numpy()[:50], c["velocity_ms"].to_numpy()[:50])
 
 
+def test_crossings_kept_when_their_buffers_must_grow(monkeypatch):
+    """Every crossing is kept, in the same order, when the crossing buffers are too small: grown before a chunk
+    and, when a chunk overflows them, grown and the chunk run again (a capacity of one row per ten blocks)."""
+    from simulation import engine
+    sc = load_scenario(BARRIER)
+    ref = simulation.run(sc, n=600, seed=8, chunk_size=250)
+    assert ref.crossings["block"].size > 250 // 10 * 3          # more crossings than a chunk's rows, per chunk
+    monkeypatch.setattr(engine, "crossing_capacity", lambda n, n_collectors: max(n // 10, 1))
+    calls = []
+    simulate = engine.kernel.simulate
+    monkeypatch.setattr(engine.kernel, "simulate", lambda *a: calls.append(1) or simulate(*a))
+    small = simulation.run(sc, n=600, seed=8, chunk_size=250)
+    assert len(calls) > 4                                       # the empty call, 3 chunks and at least one rerun
+    for k in ref.crossings:
+        np.testing.assert_array_equal(small.crossings[k], ref.crossings[k])
+    for k in ref.per_block:
+        np.testing.assert_array_equal(small.per_block[k], ref.per_block[k])
+    np.testing.assert_array_equal(small.envelope_acc, ref.envelope_acc)
+    for k in ref.paths:
+        np.testing.assert_array_equal(small.paths[k], ref.paths[k])
+
+
 def test_collector_statistics_converge_as_one_over_root_n():
     sc = load_scenario(BARRIER)
     spread = {}
