@@ -112,17 +112,52 @@ def _ground(px, pz, x):
     return pz[k] + (pz[k + 1] - pz[k]) * (x - px[k]) / (px[k + 1] - px[k])
 
 
+@njit(cache=True)
+def chord_slopes(px, pz, n_leaves):
+    """Slope dz / dx [-] of the chord of each node of the profile's search tree (:mod:`simulation.slope`; node
+    ``n_leaves + k`` is segment k), by the expressions the impact search used to evaluate at every flight (the chord
+    from the node's first vertex to its last, or the profile's last): worked out once per kernel call instead.
+    Nodes past the profile's end keep NaN (the search never reads them).
+
+    Parameters
+    ----------
+    px, pz : numpy.ndarray
+        Profile vertices [m].
+    n_leaves : int
+        Leaves of the search tree (a power of two, at least the number of segments).
+
+    Returns
+    -------
+    numpy.ndarray
+        2 ``n_leaves`` slopes [-], index 0 unused.
+    """
+    n_seg = px.shape[0] - 1
+    out = np.full(2 * n_leaves, np.nan)
+    for node in range(1, 2 * n_leaves):
+        depth = 0
+        while (node >> (depth + 1)) > 0:
+            depth += 1
+        size = n_leaves >> depth
+        lo = (node - (1 << depth)) * size
+        if lo >= n_seg:
+            continue
+        k1 = min(lo + size, n_seg)
+        out[node] = (pz[k1] - pz[lo]) / (px[k1] - px[lo])
+    return out
+
+
 @njit(cache=True, _nrt=False)
-def _leaf_hit(px, pz, k, x0, z0, vx, vz, g):
+def _leaf_hit(px, pz, slopes, k, x0, z0, vx, vz, g):
     """Time > 0 at which the parabola comes down through segment k within its x-range, or inf."""
-    return _span_hit(px, pz, k, k, x0, z0, vx, vz, g)
+    return _span_hit(px, pz, slopes, k, k, x0, z0, vx, vz, g)
 
 
 @njit(cache=True, _nrt=False)
-def _span_hit(px, pz, k0, k1, x0, z0, vx, vz, g):
+def _span_hit(px, pz, slopes, k0, k1, x0, z0, vx, vz, g):
     """Time > 0 at which the parabola comes down through the line of segment k0 within the x-range of
-    segments k0..k1 (a straight run), or inf: the larger root of z(t) = line(x(t))."""
-    slope = (pz[k0 + 1] - pz[k0]) / (px[k0 + 1] - px[k0])
+    segments k0..k1 (a straight run), or inf: the larger root of z(t) = line(x(t)); ``slopes`` from
+    :func:`chord_slopes` (segment k0's at node n_leaves + k0)."""
+    slope = slopes[(slopes.shape[0] >> 1) + k0]
     c0 = z0 - (pz[k0] + slope * (x0 - px[k0]))
     c1 = vz - slope * vx
     disc = c1 * c1 + 2.0 * g * c0
@@ -143,16 +178,17 @@ def _span_hit(px, pz, k0, k1, x0, z0, vx, vz, g):
 
 
 @njit(cache=True, _nrt=False)
-def _may_hit(px, pz, tree, node, lo, hi, n_seg, x0, z0, vx, vz, g, xa_travel, xb_travel):
-    """False when the parabola stays above the ground of ``node`` over the travelled x-range."""
+def _may_hit(px, pz, slopes, tree, node, lo, hi, n_seg, x0, z0, vx, vz, g, xa_travel, xb_travel):
+    """False when the parabola stays above the ground of ``node`` (segments lo..hi, its natural range in the tree)
+    over the travelled x-range."""
     if lo >= n_seg:
         return False
     xa = max(px[lo], xa_travel)
     xb = min(px[min(hi + 1, n_seg)], xb_travel)
     if xa > xb:
         return False
-    k0, k1 = lo, min(hi + 1, n_seg)
-    slope = (pz[k1] - pz[k0]) / (px[k1] - px[k0])
+    k0 = lo
+    slope = slopes[node]              # the chord from vertex lo to vertex min(hi + 1, n_seg): chord_slopes
     ta = (xa - x0) / vx
     tb = (xb - x0) / vx
     ha = z0 + vz * ta - 0.5 * g * ta * ta - (pz[k0] + slope * (xa - px[k0]))
@@ -162,7 +198,7 @@ def _may_hit(px, pz, tree, node, lo, hi, n_seg, x0, z0, vx, vz, g, xa_travel, xb
 
 
 @njit(cache=True, _nrt=False)
-def _descend(px, pz, tree, root, root_lo, root_hi, x0, z0, vx, vz, g, xa_travel, xb_travel, stack):
+def _descend(px, pz, slopes, tree, root, root_lo, root_hi, x0, z0, vx, vz, g, xa_travel, xb_travel, stack):
     """Earliest hit inside the subtree ``root`` covering segments root_lo..root_hi (near child first)."""
     n_seg = px.shape[0] - 1
     stack[0, 0], stack[1, 0], stack[2, 0] = root, root_lo, root_hi
@@ -170,10 +206,10 @@ def _descend(px, pz, tree, root, root_lo, root_hi, x0, z0, vx, vz, g, xa_travel,
     while top > 0:
         top -= 1
         node, lo, hi = stack[0, top], stack[1, top], stack[2, top]
-        if not _may_hit(px, pz, tree, node, lo, hi, n_seg, x0, z0, vx, vz, g, xa_travel, xb_travel):
+        if not _may_hit(px, pz, slopes, tree, node, lo, hi, n_seg, x0, z0, vx, vz, g, xa_travel, xb_travel):
             continue
         if lo == hi:
-            t = _leaf_hit(px, pz, lo, x0, z0, vx, vz, g)
+            t = _leaf_hit(px, pz, slopes, lo, x0, z0, vx, vz, g)
             if t < math.inf:
                 return t, lo
             continue
@@ -189,16 +225,16 @@ def _descend(px, pz, tree, root, root_lo, root_hi, x0, z0, vx, vz, g, xa_travel,
 
 
 @njit(cache=True, _nrt=False)
-def _run_hit(px, pz, k0, k1, x0, z0, vx, vz, g):
+def _run_hit(px, pz, slopes, k0, k1, x0, z0, vx, vz, g):
     """_span_hit for a straight run k0..k1, with the segment hit: (t, segment) or (inf, -1)."""
-    t = _span_hit(px, pz, k0, k1, x0, z0, vx, vz, g)
+    t = _span_hit(px, pz, slopes, k0, k1, x0, z0, vx, vz, g)
     if t == math.inf:
         return math.inf, -1
     return t, _seg_in(px, x0 + vx * t, k0, k1)
 
 
 @njit(cache=True, _nrt=False)
-def find_impact(px, pz, tree, n_leaves, run_first, run_last, x0, z0, vx, vz, g, seg_now, stack):
+def find_impact(px, pz, slopes, tree, n_leaves, run_first, run_last, x0, z0, vx, vz, g, seg_now, stack):
     """First (time, segment) where the flight from (x0, z0) meets the ground; segment -1 if it leaves.
 
     The straight run the block leaves from is tested first (one line, O(1)); then a
@@ -211,6 +247,8 @@ def find_impact(px, pz, tree, n_leaves, run_first, run_last, x0, z0, vx, vz, g, 
     ----------
     px, pz : numpy.ndarray
         Profile vertices [m].
+    slopes : numpy.ndarray
+        Slope dz / dx [-] of each tree node's chord (:func:`chord_slopes`).
     tree : numpy.ndarray
         Chord-offset tree of the profile (``TerrainProfile.tree_offset``) [m].
     n_leaves : int
@@ -237,9 +275,9 @@ def find_impact(px, pz, tree, n_leaves, run_first, run_last, x0, z0, vx, vz, g, 
     """
     n_seg = px.shape[0] - 1
     if abs(vx) < 1e-12:
-        return _leaf_hit(px, pz, seg_now, x0, z0, vx, vz, g), seg_now
+        return _leaf_hit(px, pz, slopes, seg_now, x0, z0, vx, vz, g), seg_now
     # The straight run (collinear segments of one material) the block leaves from acts as one segment.
-    t, k = _run_hit(px, pz, run_first[seg_now], run_last[seg_now], x0, z0, vx, vz, g)
+    t, k = _run_hit(px, pz, slopes, run_first[seg_now], run_last[seg_now], x0, z0, vx, vz, g)
     if k >= 0:
         return t, k
     if vx > 0:
@@ -250,17 +288,17 @@ def find_impact(px, pz, tree, n_leaves, run_first, run_last, x0, z0, vx, vz, g, 
     while node > 1:
         size = hi - lo + 1
         if node % 2 == 0:      # left child: the sibling lies ahead when moving right
-            if vx > 0 and _may_hit(px, pz, tree, node + 1, hi + 1, hi + size, n_seg, x0, z0, vx, vz, g,
+            if vx > 0 and _may_hit(px, pz, slopes, tree, node + 1, hi + 1, hi + size, n_seg, x0, z0, vx, vz, g,
                                    xa_travel, xb_travel):
-                t, k = _descend(px, pz, tree, node + 1, hi + 1, hi + size, x0, z0, vx, vz, g,
+                t, k = _descend(px, pz, slopes, tree, node + 1, hi + 1, hi + size, x0, z0, vx, vz, g,
                                 xa_travel, xb_travel, stack)
                 if k >= 0:
                     return t, k
             hi += size
         else:                  # right child: the sibling lies ahead when moving left
-            if vx < 0 and _may_hit(px, pz, tree, node - 1, lo - size, lo - 1, n_seg, x0, z0, vx, vz, g,
+            if vx < 0 and _may_hit(px, pz, slopes, tree, node - 1, lo - size, lo - 1, n_seg, x0, z0, vx, vz, g,
                                    xa_travel, xb_travel):
-                t, k = _descend(px, pz, tree, node - 1, lo - size, lo - 1, x0, z0, vx, vz, g,
+                t, k = _descend(px, pz, slopes, tree, node - 1, lo - size, lo - 1, x0, z0, vx, vz, g,
                                 xa_travel, xb_travel, stack)
                 if k >= 0:
                     return t, k
@@ -476,6 +514,7 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
     n_arr = max(n_seg, 0)                          # a call on no profile (the precompile's) has none
     seg_beta, seg_sin_beta, seg_cos_beta = np.empty(n_arr), np.empty(n_arr), np.empty(n_arr)
     seg_cos, seg_sin = np.empty(n_arr), np.empty(n_arr)
+    seg_slope = chord_slopes(px, pz, n_leaves)
     for k in range(n_seg):
         beta = math.atan2(pz[k + 1] - pz[k], px[k + 1] - px[k])
         seg_beta[k], seg_sin_beta[k], seg_cos_beta[k] = beta, math.sin(beta), math.cos(beta)
@@ -536,7 +575,8 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
                                  MODE_STOP, EV_LIMIT)
                 break
             if not contact:
-                t_hit, k = find_impact(px, pz, tree, n_leaves, run_first, run_last, x, z, vx, vz, g, seg, stack)
+                t_hit, k = find_impact(px, pz, seg_slope, tree, n_leaves, run_first, run_last, x, z, vx, vz, g, seg,
+                                       stack)
                 if t_hit == math.inf:          # vertical motion already at the ground: settle into contact
                     contact = True
                     z = _ground(px, pz, x)

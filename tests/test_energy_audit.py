@@ -118,11 +118,11 @@ def test_wyllie_spread_is_applied():
 
 
 def test_flight_from_a_concave_vertex_meets_the_next_segment():
-    from simulation.kernel import find_impact
+    from simulation.kernel import chord_slopes, find_impact
     sc = scenario([0, 10, 20], [10, 0, 10])
     p = sc.profile
     stack = np.empty((3, 128), np.int64)
-    t, k = find_impact(p.x, p.z, p.tree_offset, p.n_leaves, p.run_first, p.run_last, 10.0, 0.0, 1.0, -1.0, G, 0,
+    t, k = find_impact(p.x, p.z, chord_slopes(p.x, p.z, p.n_leaves), p.tree_offset, p.n_leaves, p.run_first, p.run_last, 10.0, 0.0, 1.0, -1.0, G, 0,
                        stack)
     assert k == 1 and t < 1e-9
 

@@ -158,7 +158,7 @@ def test_barrier_catches_passes_through_or_is_overtopped():
 @given(seed=st.integers(0, 10_000), n_seg=st.integers(1, 300))
 def test_impact_search_matches_brute_force(seed, n_seg):
     """The tree search finds the same first impact as scanning the parabola against every segment."""
-    from simulation.kernel import find_impact
+    from simulation.kernel import chord_slopes, find_impact
     from simulation.slope import Profile
     rng = np.random.default_rng(seed)
     x = np.cumsum(rng.uniform(0.1, 3.0, n_seg + 1))
@@ -170,7 +170,7 @@ def test_impact_search_matches_brute_force(seed, n_seg):
     z0 = prof.ground(x0) + rng.uniform(0.01, 20.0)
     vx, vz = rng.normal(0, 10), rng.normal(0, 5)
     seg = int(prof.segment_at(x0))
-    t, k = find_impact(prof.x, prof.z, prof.tree_offset, prof.n_leaves, prof.run_first, prof.run_last,
+    t, k = find_impact(prof.x, prof.z, chord_slopes(prof.x, prof.z, prof.n_leaves), prof.tree_offset, prof.n_leaves, prof.run_first, prof.run_last,
                        x0, z0, vx, vz, G, seg, np.empty((3, 128), np.int64))
     ts = np.linspace(0, 60, 600_001)[1:]
     xs = x0 + vx * ts
