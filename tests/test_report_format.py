@@ -61,3 +61,25 @@ def test_assumption_values_read_as_text():
     assert [_plain_text(t) for t in ("True", "False", "None", "'inventory'", "[2000.0, 5000.0]")] == \
         ["yes", "no", "not given", "inventory", "2,000; 5,000"]
     assert _field_label("hazard.free_board_m").endswith("[m]") and "." not in _field_label("rates.trend")
+
+
+def test_pdf_waits_once_before_the_first_figure_not_yet_written(tmp_path):
+    """report.pdf laid out beside the figures still being drawn (``riskrf assess``): the figures known to be
+    written go in at once; the first other one waits (once) for the rest to be written; an absent figure is left
+    out as before."""
+    from PIL import Image
+
+    from riskrf.report.pdf_layout import _Report
+    for name in ("early.png", "late.png", "later.png"):
+        Image.new("RGB", (40, 20), "white").save(tmp_path / name)
+    calls = []
+    tb = {k: "x" for k in ("project", "site", "location", "revision", "date", "author", "checker", "client")}
+    rep = _Report(tb, wait=lambda: calls.append(len(rep.pdf.pages)), finished=[tmp_path / "early.png"])
+    rep.pdf.add_page()
+    rep.figure(tmp_path / "early.png", "written before")
+    assert calls == []
+    rep.figure(tmp_path / "absent.png", "never drawn")          # not finished: waits, then leaves it out
+    assert calls == [1]
+    rep.figure(tmp_path / "late.png", "drawn beside")
+    rep.figure(tmp_path / "later.png", "drawn beside")
+    assert calls == [1] and len(rep.pdf.image_cache.images) == 3

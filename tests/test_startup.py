@@ -255,3 +255,57 @@ def test_in_line_runner_defers_the_work_and_drops_its_warnings():
         warnings.simplefilter("error")
         assert part.result() == 7 and part.result() == 7
     assert calls == [1]
+
+
+def test_gate_holds_forked_work_until_this_process_opens_it(tmp_path, monkeypatch):
+    """:class:`~riskrf.cli.runner.Gate`: work forked beside this process that calls ``wait()`` goes on only after
+    ``open()`` (here: it reads a file written just before); in this process ``wait()`` never blocks."""
+    from riskrf.cli.runner import Gate, InBackground
+    monkeypatch.delenv("RISKRF_NO_FORK", raising=False)
+    gate, ready = Gate(), tmp_path / "ready.txt"
+
+    def work():
+        gate.wait()
+        return ready.read_text()
+    part = InBackground(work)
+    if part.proc is None:
+        pytest.skip("no fork here")
+    ready.write_text("written before the gate opened")
+    gate.open()
+    assert part.result() == "written before the gate opened"
+    gate.wait()                                    # here: returns at once
+    gate.close()
+
+
+_ORPHANED_GATE = """
+import os, select, sys
+from riskrf.cli.runner import Gate
+r, w = os.pipe()
+if os.fork() == 0:                      # the parent of the gate, which ends without opening it
+    os.close(r)
+    gate = Gate()
+    if os.fork() == 0:                  # its child, waiting on the gate
+        gate.wait()
+        os.write(w, b"1")
+        os._exit(0)
+    os._exit(0)
+os.close(w)
+ready, _, _ = select.select([r], [], [], 30.0)
+print(os.read(r, 1).decode() if ready else "still waiting")
+"""
+
+
+def test_gate_of_a_child_ends_with_its_parent():
+    """A child waiting on a gate its parent never opens is not left waiting for ever: the read returns when the
+    parent ends (the child's own copy of the write end was closed by ``wait()``)."""
+    done = subprocess.run([sys.executable, "-c", _ORPHANED_GATE], capture_output=True, text=True, timeout=60)
+    assert done.stdout.strip() == "1", done.stderr
+
+
+def test_in_line_gate_never_waits():
+    """The default runner's gate (:class:`~riskrf.app.scheduling.OpenGate`) neither waits nor signals."""
+    from riskrf.app.scheduling import InLine
+    gate = InLine().gate()
+    gate.wait()
+    gate.open()
+    gate.wait()

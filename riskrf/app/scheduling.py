@@ -13,7 +13,10 @@ A runner has three methods:
 - ``beside(work)``: ``work()`` (no arguments, returning a picklable value) is needed later; returns an object
   whose ``result()`` returns its value (computed once, then kept; an exception ``work`` raised is raised again);
 - ``before_simulation(timings)``: the simulation is next; a runner that waited for something records the wait
-  in the stage timings ``timings`` [s].
+  in the stage timings ``timings`` [s];
+- ``gate()`` (optional): an object with ``open()`` and ``wait()``: work handed to ``beside`` may call ``wait()``
+  where it needs what this process finishes later (the report's PDF, before the figures drawn beside it); the
+  chain calls ``open()`` once they are finished.  A runner without it runs such work after ``open()`` anyway.
 """
 from __future__ import annotations
 
@@ -58,9 +61,29 @@ class Deferred:
         return self._done[0]
 
 
+class OpenGate:
+    """The gate of a runner that runs work handed to ``beside`` in this process, when its result is asked for (so
+    after :meth:`open`): :meth:`wait` never waits."""
+
+    def open(self) -> None:
+        """Nothing to signal."""
+
+    def wait(self) -> None:
+        """Return at once."""
+
+
 class InLine:
     """The default runner: no compilation started ahead, no process forked; work handed to :meth:`beside` runs
     in this process when its result is asked for."""
+
+    def gate(self) -> OpenGate:
+        """A gate that never waits (work handed to :meth:`beside` runs at its result, after the gate opened).
+
+        Returns
+        -------
+        OpenGate
+        """
+        return OpenGate()
 
     def start(self, simulates: bool, log) -> None:
         """Nothing to start (the simulator compiles on its first use, in this process).

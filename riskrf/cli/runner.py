@@ -112,6 +112,48 @@ class InBackground:
         return value
 
 
+class Gate:
+    """A signal from this process to the work it forked beside it: :meth:`open` (here, once), :meth:`wait` (in
+    the child: returns once this process opened the gate, or ended).
+
+    The report's PDF is forked before the decision's figures are finished, so that it lays out the pages before
+    them (fonts, title page, tables) on the other core; it waits at the first figure not finished at the fork.  A
+    pipe: the child's :meth:`wait` closes its copy of the write end first, so that the read ends (EOF) if this
+    process ends without opening the gate.  Work that runs in this process (no fork, or the fork failed) runs
+    at its ``result()``, after :meth:`open`, and never waits.
+    """
+
+    def __init__(self):
+        self._pid = os.getpid()
+        self._read, self._write = os.pipe()
+        self._opened = False           # this process: open() was called; a child: wait() returned
+
+    def open(self) -> None:
+        """Let the work waiting in children go on (once; later calls do nothing)."""
+        if os.getpid() == self._pid and not self._opened:
+            self._opened = True
+            try:
+                os.write(self._write, b"1")
+            finally:
+                os.close(self._write)
+
+    def wait(self) -> None:
+        """In a forked child: wait until the gate is open (or the process that made it ended); here: return."""
+        if os.getpid() == self._pid or self._opened:
+            return
+        self._opened = True
+        os.close(self._write)          # this child's copy: EOF when the parent's is closed
+        os.read(self._read, 1)
+
+    def close(self) -> None:
+        """Open the gate if it is not yet, and close this process's read end (after the work's result)."""
+        if os.getpid() == self._pid:
+            self.open()
+            if self._read is not None:
+                os.close(self._read)
+                self._read = None
+
+
 def _send_result(work, conn):
     """The child's body.  The signals are the parent's to answer: the child was forked with riskrf's SIGTERM
     handler (which raises KeyboardInterrupt), and Ctrl-C at a terminal reaches the whole process group.  Here
@@ -182,6 +224,15 @@ class TwoCores:
         if not self.fork:
             self._here.append(part)
         return part
+
+    def gate(self) -> Gate:
+        """A :class:`Gate` for work forked beside this process that must wait for something it finishes later.
+
+        Returns
+        -------
+        Gate
+        """
+        return Gate()
 
     def before_simulation(self, timings: dict) -> None:
         """Wait for the simulator's compilation, if one runs, doing this core's share of the work meanwhile.

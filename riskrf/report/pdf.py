@@ -29,7 +29,7 @@ from .report_rows import design_values_rows, runout_rows, slope_tables
 from .sections import render as render_sections
 
 
-def write_pdf_report(a, path, figs) -> Path:
+def write_pdf_report(a, path, figs, *, wait=None, finished=None) -> Path:
     """Write report.pdf for the assessment ``a`` (figures read from ``figs``); returns the path.
 
     Parameters
@@ -40,6 +40,11 @@ def write_pdf_report(a, path, figs) -> Path:
         The PDF written.
     figs : str or path
         Folder of its figures (PNG).
+    wait : callable, optional
+        Called (once, with no arguments) before the first figure that is not in ``finished``: it returns when
+        every figure is written (the figures may still be drawn beside this work when it starts).
+    finished : collection of str or path, optional
+        Figures known to be written already (``wait`` is not called for them); default none.
 
     Returns
     -------
@@ -47,7 +52,7 @@ def write_pdf_report(a, path, figs) -> Path:
     """
     figs = Path(figs)
     tb = title_block(a.site)
-    rep = _Report(tb)
+    rep = _Report(tb, wait=wait, finished=finished)
     pdf = rep.pdf
     _title_page(rep, a, tb)
 

@@ -136,8 +136,12 @@ def _remember_text_widths(pdf) -> None:
 class _Report:
     """fpdf2 document with the title block in the footer and header, sections registered for the contents."""
 
-    def __init__(self, title_block: dict):
+    def __init__(self, title_block: dict, *, wait=None, finished=None):
         from fpdf import FPDF
+
+        # figures drawn beside this work: wait() once, before the first figure not known to be finished
+        self._wait = wait
+        self._finished = {str(Path(f).resolve()) for f in (finished or ())}
 
         tb = title_block
 
@@ -267,6 +271,9 @@ class _Report:
 
     def figure(self, path, caption: str, width: float = A4_TEXT_WIDTH_MM, max_height: float = 200.0):
         path = Path(path)
+        if self._wait is not None and str(path.resolve()) not in self._finished:
+            wait, self._wait = self._wait, None
+            wait()
         if not path.exists():
             return
         pdf = self.pdf

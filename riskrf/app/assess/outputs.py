@@ -62,47 +62,69 @@ def write_assessment(a: Assessment, out: Path, log=None, runner=None) -> dict:
     # The figures are drawn in parts handed to the runner (the command line's draws them on the other core, see
     # riskrf.cli.runner); parts that run_assessment started beside its later stages are only waited for, while
     # this process draws the decision's.
-    if drawn:
-        # the decision's and the design's figures beside this process's tables, with the earlier stages' parts
-        parts = [runner.beside(partial(write_tree_figure, a.study, figs)),
-                 runner.beside(partial(write_mitigation_figures, a.study, a.decision, figs))]
-        if a.design is not None:
-            parts += [runner.beside(partial(_design_figures, a, figs, part)) for part in (0, 1)]
-        write_mitigation_outputs(a.study, a.decision, figs, tree_figure=False, figures=False)
-        for part in a.drawing["pending"] + parts:
-            part.result()
-    else:
-        def simulation_and_decision_outputs():
-            _simulation_figures(a.result, a.site.hazard["collector"], figs, fences_to_draw(a.site))
-            write_mitigation_outputs(a.study, a.decision, figs)
-
-        beside = runner.beside(simulation_and_decision_outputs)
-        _frequency_outputs(a.frequency, a.maxima_frequency, figs)
-        write_energy_study(a.energy, figs)
-        beside.result()
-    for name in ("summary.json", "completeness.csv", "whole_wall_design_masses.csv"):
-        shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
-    for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv", "design_energy_sensitivity.csv",
-                 "design_energy_tornado.csv", "design_block.csv", "site_design_masses.csv"):
-        if (figs / name).exists():
-            shutil.move(str(figs / name), str(out / name))
-    for name in ("ranking.csv", "tornado.csv", "break_even.csv", "decision.json"):
-        shutil.move(str(figs / name), str(out / name))
-    if a.model_uncertainty is not None:
-        a.model_uncertainty.write(out)
-        a.model_uncertainty.figures(figs)
-    a.timings["report"] = round(time.perf_counter() - t, 2)
-    summary = a.summary()
-    write_json(summary, out / "summary.json")
-    if a.design is not None:
-        _design_outputs(a, out, figs, figures=not drawn)
     from ...report.pdf import write_pdf_report
-    # the PDF (from the assessment and the finished figures) on the other core while this one writes the rest
-    pdf = runner.beside(partial(write_pdf_report, a, out / "report.pdf", figs))
-    (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
-    _copy_inputs(a, out / "inputs")
-    relative_paths_in_json_files(out, a.site.path.parent)          # paths relative to the site file
-    pdf.result()
+    summary = pdf = gate = None
+    try:
+        if drawn:
+            for part in a.drawing["pending"]:          # the earlier stages' figures (finished by now, as a rule)
+                part.result()
+            # The PDF first, beside the decision's figures: it lays out its pages up to the first figure not
+            # written yet (fonts, title page, tables), then waits until the gate opens (every figure written).
+            gate = runner.gate() if hasattr(runner, "gate") else None
+            if gate is not None:
+                pdf = runner.beside(partial(write_pdf_report, a, out / "report.pdf", figs, wait=gate.wait,
+                                            finished=sorted(figs.rglob("*.png"))))
+            # the decision's and the design's figures beside this process's tables and summary
+            parts = [runner.beside(partial(write_tree_figure, a.study, figs)),
+                     runner.beside(partial(write_mitigation_figures, a.study, a.decision, figs))]
+            if a.design is not None:
+                parts += [runner.beside(partial(_design_figures, a, figs, part)) for part in (0, 1)]
+            write_mitigation_outputs(a.study, a.decision, figs, tree_figure=False, figures=False)
+            # the summary (about a second: the percentiles of the hazard, every table as records) while the
+            # figures are drawn; its stage timings are completed below
+            summary = a.summary()
+            for part in parts:
+                part.result()
+        else:
+            def simulation_and_decision_outputs():
+                _simulation_figures(a.result, a.site.hazard["collector"], figs, fences_to_draw(a.site))
+                write_mitigation_outputs(a.study, a.decision, figs)
+
+            beside = runner.beside(simulation_and_decision_outputs)
+            _frequency_outputs(a.frequency, a.maxima_frequency, figs)
+            write_energy_study(a.energy, figs)
+            beside.result()
+        for name in ("summary.json", "completeness.csv", "whole_wall_design_masses.csv"):
+            shutil.move(str(figs / name), str(out / ("frequency_" + name if name == "summary.json" else name)))
+        for name in ("energy_summary.json", "design_energies.csv", "fence_checks.csv",
+                     "design_energy_sensitivity.csv", "design_energy_tornado.csv", "design_block.csv",
+                     "site_design_masses.csv"):
+            if (figs / name).exists():
+                shutil.move(str(figs / name), str(out / name))
+        for name in ("ranking.csv", "tornado.csv", "break_even.csv", "decision.json"):
+            shutil.move(str(figs / name), str(out / name))
+        if a.model_uncertainty is not None:
+            a.model_uncertainty.write(out)
+            a.model_uncertainty.figures(figs)
+        if gate is not None:
+            gate.open()                                 # every figure is written: the PDF goes on
+        a.timings["report"] = round(time.perf_counter() - t, 2)
+        if summary is None:
+            summary = a.summary()
+        summary["timings_s"] = a.timings
+        write_json(summary, out / "summary.json")
+        if a.design is not None:
+            _design_outputs(a, out, figs, figures=not drawn)
+        if pdf is None:
+            # the PDF (from the assessment and the finished figures) on the other core while this one writes
+            pdf = runner.beside(partial(write_pdf_report, a, out / "report.pdf", figs))
+        (out / "report.html").write_text(render_report(a, figs), encoding="utf-8")
+        _copy_inputs(a, out / "inputs")
+        relative_paths_in_json_files(out, a.site.path.parent)          # paths relative to the site file
+        pdf.result()
+    finally:
+        if gate is not None:          # opened (a PDF waiting in a child goes on), its read end closed here
+            getattr(gate, "close", gate.open)()
     return relative_paths(summary, a.site.path.parent)
 
 
