@@ -273,13 +273,20 @@ def find_impact(px, pz, slopes, tree, n_leaves, run_first, run_last, x0, z0, vx,
     k : int
         Segment hit, -1 when the block leaves the profile.
     """
-    n_seg = px.shape[0] - 1
     if abs(vx) < 1e-12:
         return _leaf_hit(px, pz, slopes, seg_now, x0, z0, vx, vz, g), seg_now
     # The straight run (collinear segments of one material) the block leaves from acts as one segment.
     t, k = _run_hit(px, pz, slopes, run_first[seg_now], run_last[seg_now], x0, z0, vx, vz, g)
     if k >= 0:
         return t, k
+    return _tree_impact(px, pz, slopes, tree, n_leaves, x0, z0, vx, vz, g, seg_now, stack)
+
+
+@njit(cache=True, _nrt=False)
+def _tree_impact(px, pz, slopes, tree, n_leaves, x0, z0, vx, vz, g, seg_now, stack):
+    """:func:`find_impact` after its test of the run the block leaves from (vx not 0): the finger search in the
+    chord-offset tree, or the time to leave the profile (segment -1)."""
+    n_seg = px.shape[0] - 1
     if vx > 0:
         xa_travel, xb_travel = x0, px[n_seg]
     else:
@@ -575,8 +582,15 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
                                  MODE_STOP, EV_LIMIT)
                 break
             if not contact:
-                t_hit, k = find_impact(px, pz, seg_slope, tree, n_leaves, run_first, run_last, x, z, vx, vz, g, seg,
-                                       stack)
+                # find_impact, its first test (the run the block leaves from) written out here: the flights that
+                # land on that run then cost no call with the whole profile as arguments
+                if abs(vx) < 1e-12:
+                    t_hit, k = find_impact(px, pz, seg_slope, tree, n_leaves, run_first, run_last, x, z, vx, vz, g,
+                                           seg, stack)
+                else:
+                    t_hit, k = _run_hit(px, pz, seg_slope, run_first[seg], run_last[seg], x, z, vx, vz, g)
+                    if k < 0:
+                        t_hit, k = _tree_impact(px, pz, seg_slope, tree, n_leaves, x, z, vx, vz, g, seg, stack)
                 if t_hit == math.inf:          # vertical motion already at the ground: settle into contact
                     contact = True
                     z = _ground(px, pz, x)
