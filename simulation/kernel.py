@@ -199,14 +199,18 @@ def _may_hit(px, pz, slopes, tree, node, lo, hi, n_seg, x0, z0, vx, vz, g, xa_tr
 
 @njit(cache=True, _nrt=False)
 def _descend(px, pz, slopes, tree, root, root_lo, root_hi, x0, z0, vx, vz, g, xa_travel, xb_travel, stack):
-    """Earliest hit inside the subtree ``root`` covering segments root_lo..root_hi (near child first)."""
+    """Earliest hit inside the subtree ``root`` covering segments root_lo..root_hi (near child first).  The caller
+    has found that the parabola may reach the root's ground (:func:`_may_hit` true), so the root is not tested again."""
     n_seg = px.shape[0] - 1
     stack[0, 0], stack[1, 0], stack[2, 0] = root, root_lo, root_hi
     top = 1
+    at_root = True
     while top > 0:
         top -= 1
         node, lo, hi = stack[0, top], stack[1, top], stack[2, top]
-        if not _may_hit(px, pz, slopes, tree, node, lo, hi, n_seg, x0, z0, vx, vz, g, xa_travel, xb_travel):
+        if at_root:
+            at_root = False
+        elif not _may_hit(px, pz, slopes, tree, node, lo, hi, n_seg, x0, z0, vx, vz, g, xa_travel, xb_travel):
             continue
         if lo == hi:
             t = _leaf_hit(px, pz, slopes, lo, x0, z0, vx, vz, g)
