@@ -517,7 +517,6 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
     n_coll = c_x.shape[0]
     n_seg = px.shape[0] - 1
     state = np.empty(1, np.uint64)
-    cross_t = np.empty(n_coll)
     stack = np.empty((3, 128), np.int64)
     # Per segment, once per chunk, by the very expressions the event loop used to evaluate at every event (so
     # the numbers are the same): sine and cosine of the slope angle atan2(dz, dx) (impacts) and the direction
@@ -533,6 +532,12 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
         sinb_raw = pz[k + 1] - pz[k]
         ls = math.sqrt(cosb_raw * cosb_raw + sinb_raw * sinb_raw)
         seg_cos[k], seg_sin[k] = cosb_raw / ls, sinb_raw / ls
+    # Per segment: the normal speed below which a rebound (with the impact's cosine) or a take-off (with the contact's)
+    # is ground contact, contact_speed of the segment's material.
+    seg_v_impact, seg_v_contact = np.empty(n_arr), np.empty(n_arr)
+    for k in range(n_seg):
+        seg_v_impact[k] = contact_speed(v_contact, g, seg_cos_beta[k], m_hop[seg_mat[k]])
+        seg_v_contact[k] = contact_speed(v_contact, g, seg_cos[k], m_hop[seg_mat[k]])
     # Per material: the impact friction coefficient where it has no spread (the loop's expression with phi + 0.0).
     mat_mu = np.empty(m_phi.shape[0])
     for m in range(m_phi.shape[0]):
@@ -577,6 +582,7 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
         events = 0
         trap_n, trap_x, trap_y = 0, 0.0, 0.0          # the run of launches from steep faces (steep_trap)
         theta_mat, theta_max = -1, 0.0                 # roughness tilt of this block on material theta_mat
+        mu_mat, mu_roll = -1, 0.0                      # rolling resistance of this block on material mu_mat
         while reason == RUNNING:
             events += 1
             if events > max_events:
@@ -604,11 +610,16 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
                 x_end = x + vx * t_hit
                 # Collector crossings on this flight, in time order; a barrier may cut the flight.
                 cut = False
-                for j in range(n_coll):
-                    cross_t[j] = (c_x[j] - x) / vx if abs(vx) > 1e-12 else -1.0
+                # The crossing time (c_x - x) / vx is divided out only for a collector within the flight's x-range:
+                # it is <= 0 when c_x - x and vx differ in sign, and > t_hit when |c_x - x| exceeds |vx| t_hit by
+                # more than rounding (the 1e-12 margin), so the test below would reject those anyway.
+                reach = abs(vx) * t_hit * (1.0 + 1e-12)
                 for jj in range(n_coll):
                     j = c_order[jj] if vx > 0 else c_order[n_coll - 1 - jj]
-                    tc = cross_t[j]
+                    dxc = c_x[j] - x
+                    if abs(vx) <= 1e-12 or (dxc <= 0.0 if vx > 0 else dxc >= 0.0) or abs(dxc) > reach:
+                        continue
+                    tc = dxc / vx
                     if not (1e-12 < tc <= t_hit):
                         continue
                     zc = z + vz * tc - 0.5 * g * tc * tc
@@ -688,7 +699,7 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
                 vx = vt2 * cos_bp - vn2 * sin_bp
                 vz = vt2 * sin_bp + vn2 * cos_bp
                 vn_true = -vx * sin_beta + vz * cos_beta
-                v_thr = contact_speed(v_contact, g, cos_beta, m_hop[mat])
+                v_thr = seg_v_impact[k]
                 if sin_max_roll is not None and vn_true < v_thr and abs(sin_beta) > sin_max_roll:
                     # A face too steep to roll on: the block leaves it again (speed kept), no ground contact --
                     # unless it has kept doing so in one place (a notch with flanks too steep to roll on).
@@ -730,7 +741,10 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
             k = seg
             mat = seg_mat[k]
             cosb, sinb = seg_cos[k], seg_sin[k]
-            mu = rolling_resistance(mu_blk[mat], m_size_k[mat], m_rough[mat], r, m_mu_cap[mat], m_size_exp[mat])
+            if mat != mu_mat:
+                mu_mat = mat
+                mu_roll = rolling_resistance(mu_blk[mat], m_size_k[mat], m_rough[mat], r, m_mu_cap[mat], m_size_exp[mat])
+            mu = mu_roll
             roll = m_roll[mat]
             trapped = False
             if sin_max_roll is not None and abs(sinb) > sin_max_roll:
@@ -738,7 +752,7 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
                 # it has kept doing so in one place (steep_trap: then it is held, below).
                 trap_n, trap_x, trap_y, trapped = steep_trap(trap_n, trap_x, trap_y, x, 0.0)
             if sin_max_roll is not None and abs(sinb) > sin_max_roll and not trapped:
-                vt_new, vn_new = steep_face_launch(v_along, contact_speed(v_contact, g, cosb, m_hop[mat]))
+                vt_new, vn_new = steep_face_launch(v_along, seg_v_contact[k])
                 vx = vt_new * cosb - vn_new * sinb
                 vz = vt_new * sinb + vn_new * cosb
                 if vn_new <= 0.0:
@@ -789,11 +803,15 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
             x_new = x + direction * d_step * cosb
             # Collector crossings during this contact step.
             cut = False
-            for j in range(n_coll):
-                cross_t[j] = direction * (c_x[j] - x) / cosb   # distance along the slope to the collector
+            # The distance along the slope to a collector, direction (c_x - x) / cosb (cosb > 0), is divided out only
+            # where it can lie within the step (as in the flight above).
+            reach = d_step * cosb * (1.0 + 1e-12)
             for jj in range(n_coll):
                 j = c_order[jj] if direction > 0 else c_order[n_coll - 1 - jj]
-                s_c = cross_t[j]
+                ahead = direction * (c_x[j] - x)
+                if ahead <= 0.0 or ahead > reach:
+                    continue
+                s_c = ahead / cosb
                 if not (1e-12 < s_c <= d_step):
                     continue
                 uc = contact_speed_at(u, a_dir, drag, s_c)
@@ -852,7 +870,7 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
             # A convex edge launches the block when its speed away from the next segment reaches the
             # contact velocity; below it the block stays in contact (as a landing below it would), so a
             # finely kinked terrain profile is not turned into thousands of micro-flights and impacts.
-            if -vxe * sin2 + vze * cos2 >= contact_speed(v_contact, g, cos2, m_hop[seg_mat[k2]]):
+            if -vxe * sin2 + vze * cos2 >= seg_v_contact[k2]:
                 contact = False            # convex edge: the block takes off
                 vx, vz = vxe, vze
                 seg = k2
