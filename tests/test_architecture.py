@@ -212,3 +212,29 @@ def test_no_module_is_a_big_room():
                        "riskrf/app/corridor/ and riskrf/frequency/power_law/):\n" + "\n".join(big))
     done = sorted(m for m in STILL_TO_SPLIT if lengths.get(m, 0) <= MAX_MODULE_LINES)
     assert done == [], f"split or below {MAX_MODULE_LINES} lines now: remove from STILL_TO_SPLIT: {done}"
+
+
+def test_every_plot_method_draws_with_its_own_stage_figures():
+    """A science result's ``plot()`` calls a drawing function of its own stage's ``figures`` module (imported inside
+    the method, so the stage loads without matplotlib) or another result's ``plot()``; never a string registry,
+    riskrf.report or matplotlib itself."""
+    found = 0
+    for name, path in _modules().items():
+        stage = _stage(name)
+        if stage not in SCIENCE or name.endswith(".figures"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+            if not (isinstance(node, ast.FunctionDef) and node.name == "plot"):
+                continue
+            found += 1
+            package = name.rpartition(".")[0]
+            sources = []
+            for sub in ast.walk(node):
+                if isinstance(sub, ast.ImportFrom):
+                    base = package.split(".")[: len(package.split(".")) - (sub.level - 1)] if sub.level else []
+                    sources.append(".".join(base + [sub.module or ""]) if sub.level else sub.module)
+            delegates = not sources and not any(isinstance(sub, ast.Import) for sub in ast.walk(node))
+            assert f"riskrf.{stage}.figures" in sources or delegates, f"{name}.plot imports from {sources}"
+    assert found >= 10
+    import riskrf.core.figures as core_figures
+    assert not hasattr(core_figures, "FIGURES") and not hasattr(core_figures, "draw")

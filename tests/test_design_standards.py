@@ -6,7 +6,6 @@ import pandas as pd
 import pytest
 
 import simulation
-from riskrf.core.figures import FIGURES, draw
 from riskrf.hazard.catchment import catchment_retention, modified_ritchie_width_m
 from riskrf.hazard.design_basis import DEFAULT_FACTORS, DesignBasis, onr24810_min_distance_m, permitted_elongation_m
 from riskrf.hazard.design_requirement import PositionSearch, design_requirement
@@ -155,13 +154,3 @@ def test_catchment_plot_and_summary(odot_study):
     assert isinstance(ax, matplotlib.axes.Axes)
     assert any("Ritchie" in t.get_text() for t in ax.get_legend().get_texts())
     plt.close("all")
-
-
-def test_every_registered_figure_is_a_report_function():
-    import importlib
-    for key, target in FIGURES.items():
-        module, _, name = target.partition(":")
-        assert module.startswith("riskrf.report."), (key, target)
-        assert callable(getattr(importlib.import_module(module), name)), (key, target)
-    with pytest.raises(KeyError, match="registered figures"):
-        draw("no such figure", None)

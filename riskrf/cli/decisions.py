@@ -23,7 +23,8 @@ def cmd_decide(args) -> int:
     from ..risk.decision_tree import DecisionTree
     from ..risk.mitigation import load_mitigation
     from ..io.outputs import atomic_output_dir, write_json
-    from ..report.decision_figures import plot_risk_profiles, plot_tornado, plot_tree
+    from ..report.decision_figures import plot_risk_profiles
+    from ..risk.figures import plot_tornado, plot_tree
     from ..report.files import save_figure
     from ..report.mitigation_text import study_report, write_mitigation_outputs
 

@@ -41,65 +41,11 @@ from ..core.validation import (
     check_return_periods,
     warn,
 )
+from .empirical import _n_unknown_years, gumbel_reduced_variate
 
 EULER_GAMMA = 0.5772156649015329
 
-#: Plotting-position constants ``a`` of ``(i - a) / (n + 1 - 2a)`` for ascending rank i.
-PLOTTING_POSITIONS = {"weibull": 0.0, "gringorten": 0.44, "cunnane": 0.4, "hazen": 0.5, "blom": 0.375}
-
 MIN_MAXIMA = {"gumbel": 5, "gev": 10}
-
-
-def plotting_positions(n: int, formula: str = "gringorten") -> np.ndarray:
-    """Non-exceedance probabilities of the ascending order statistics 1..n.
-
-    ``(i - a) / (n + 1 - 2a)`` with a = 0 (Weibull, i/(n+1)), 0.44 (Gringorten,
-    recommended for Gumbel), 0.4 (Cunnane), 0.5 (Hazen, (i-0.5)/n) or 0.375 (Blom).
-
-    Parameters
-    ----------
-    n : int
-        Number of ordered values (years), >= 1.
-    formula : str
-        ``"gringorten"`` (default), ``"weibull"``, ``"cunnane"``, ``"hazen"`` or ``"blom"``.
-
-    Returns
-    -------
-    numpy.ndarray
-        n non-exceedance probabilities [-], increasing.
-
-    References
-    ----------
-    Gringorten, I. I. (1963). A plotting rule for extreme probability paper. Journal of Geophysical Research
-    68(3), 813-814.
-    """
-    check_choice(formula, "formula", tuple(PLOTTING_POSITIONS))
-    if int(n) < 1:
-        raise ValueError(f"n must be >= 1; got {n}")
-    a = PLOTTING_POSITIONS[formula]
-    i = np.arange(1, int(n) + 1)
-    return (i - a) / (n + 1 - 2 * a)
-
-
-def gumbel_reduced_variate(T):
-    """y_T = -ln(-ln(1 - 1/T)): the Gumbel reduced variate of return period T [yr].
-
-    Parameters
-    ----------
-    T : float or array_like
-        Return period [yr], > 1.
-
-    Returns
-    -------
-    numpy.ndarray
-        Reduced variate y_T [-].
-
-    References
-    ----------
-    Wyllie, D. C. (2014). Rock Fall Engineering. CRC Press, section 8.4.2.
-    """
-    T = check_return_periods(T)
-    return -np.log(-np.log1p(-1.0 / T))
 
 
 def gumbel_frequency_factor(T):
@@ -187,11 +133,6 @@ def _split_maxima(maxima, zero_years: str, model: str):
     return values, n_empty / n_years, n_years
 
 
-def _n_unknown_years(maxima) -> int:
-    """Years left out of an annual-maxima series because their falls have no exact size (see Inventory.annual_maxima)."""
-    return len(getattr(maxima, "attrs", {}).get("years_without_exact_size", ()))
-
-
 @dataclass(frozen=True, repr=False)
 class _AnnualMaximumFit(Displayed):
     """Shared behaviour of the Gumbel and GEV fits (mixed model with empty years)."""
@@ -257,7 +198,7 @@ class _AnnualMaximumFit(Displayed):
                           n_years=self.n_years, p_zero=self.p_zero, method=self.method)
 
     def plot(self, ax=None, **kwargs):
-        """Return-level plot: the fitted annual maximum against the return period [yr], with its interval band (drawn by :func:`riskrf.report.fit_figures.plot_return_levels`).
+        """Return-level plot: the fitted annual maximum against the return period [yr], with its interval band (drawn by :func:`riskrf.frequency.figures.plot_return_levels`).
 
         Parameters
         ----------
@@ -270,8 +211,8 @@ class _AnnualMaximumFit(Displayed):
         -------
         matplotlib.axes.Axes
         """
-        from ..core.figures import draw
-        return draw("return_levels", self, ax=ax, **kwargs)
+        from .figures import plot_return_levels
+        return plot_return_levels(self, ax=ax, **kwargs)
 
     def return_period(self, x):
         """Return period [yr] of an annual maximum x, 1 / P(annual max > x)."""

@@ -555,7 +555,7 @@ class EnergyHazard(Displayed):
                           mass_coupled=self.mass_coupled)
 
     def plot(self, ax=None, **kwargs):
-        """Annual frequency of impacts above an energy at the line [1/yr] against the energy [kJ], log-log, with the bootstrap band (drawn by :func:`riskrf.report.fit_figures.plot_energy_exceedance`).
+        """Annual frequency of impacts above an energy at the line [1/yr] against the energy [kJ], log-log, with the bootstrap band (drawn by :func:`riskrf.hazard.figures.plot_energy_exceedance`).
 
         Parameters
         ----------
@@ -568,8 +568,8 @@ class EnergyHazard(Displayed):
         -------
         matplotlib.axes.Axes
         """
-        from ..core.figures import draw
-        return draw("energy_exceedance", self, ax=ax, **kwargs)
+        from .figures import plot_energy_exceedance
+        return plot_energy_exceedance(self, ax=ax, **kwargs)
 
 def _interp_log_inverse(curve, p):
     """Energy on _E_GRID where the non-increasing curve P(E > e) crosses p (log-log interpolation)."""

@@ -50,7 +50,7 @@ class CatchmentStudy:
     retains that share, e.g. blocks leave the profile); ``chart`` (width_m, retained_percent, simulated_percent,
     difference_points) or None; ``chart_source``; ``n_over_face``: blocks that went over the cut face (the shares
     are of these; the others stopped on the crest).  Its figure: :meth:`plot`
-    (:func:`riskrf.report.design_figures.plot_catchment`).
+    (:func:`riskrf.hazard.figures.plot_catchment`).
     """
 
     title: str
@@ -78,6 +78,11 @@ class CatchmentStudy:
             Share of the released blocks retained within the width [-].
         """
         return np.interp(np.asarray(width_m, dtype=float), self.curve["width_m"], self.curve["retained"])
+
+    @property
+    def ritchie_width_m(self) -> float:
+        """The Modified Ritchie Criterion's ditch width for this cut [m] (:func:`modified_ritchie_width_m`)."""
+        return modified_ritchie_width_m(self.cut_height_m)
 
     def summary(self) -> pd.DataFrame:
         """One row per compared width: the re-simulated widths for 90/95/99 % retention, the Modified Ritchie
@@ -111,7 +116,7 @@ class CatchmentStudy:
 
     def plot(self, ax=None):
         """Retention against catchment width with the Ritchie width and chart values; returns the matplotlib axes
-        (drawn by :func:`riskrf.report.design_figures.plot_catchment`).
+        (drawn by :func:`riskrf.hazard.figures.plot_catchment`).
 
         Parameters
         ----------
@@ -123,8 +128,8 @@ class CatchmentStudy:
         matplotlib.axes.Axes
             The axes drawn on.
         """
-        from ..core.figures import draw
-        return draw("catchment", self, ax=ax)
+        from .figures import plot_catchment
+        return plot_catchment(self, ax=ax)
 
     def to_dict(self) -> dict:
         """JSON-ready summary: geometry, widths for 90/95/99 %, chart comparison (or why there is none).

@@ -433,7 +433,7 @@ class PositionSearch:
     ``table``: one row per position: x [m], ground z [m], share of released blocks reaching it, arrivals per year,
     E_d [kJ], required MEL [kJ] and product class [kJ], required net height [m], clearance [m]; ``profile``:
     (x, z) of the slope; ``basis``: the :class:`DesignBasis`; ``n``: blocks simulated.  Its figure: :meth:`plot`
-    (drawn by :func:`riskrf.report.design_figures.plot_position_search`; the science draws nothing).
+    (drawn by :func:`riskrf.hazard.figures.plot_position_search`; the science draws nothing).
     """
 
     table: pd.DataFrame
@@ -464,7 +464,7 @@ class PositionSearch:
 
     def plot(self, ax=None):
         """Required MEL, product class and net height per position; returns the matplotlib axes (drawn by
-        :func:`riskrf.report.design_figures.plot_position_search`).
+        :func:`riskrf.hazard.figures.plot_position_search`).
 
         Parameters
         ----------
@@ -476,8 +476,8 @@ class PositionSearch:
         matplotlib.axes.Axes
             The axes drawn on.
         """
-        from ..core.figures import draw
-        return draw("position_search", self, ax=ax)
+        from .figures import plot_position_search
+        return plot_position_search(self, ax=ax)
 
     def cheapest(self) -> pd.Series | None:
         """The position with the smallest required class, then the lowest net height (None when no position has a

@@ -479,7 +479,7 @@ class MassCoupledSamples(Displayed):
                           f"{sig(self.edges_kg[0])}-{sig(self.edges_kg[-1])} kg in {self.n_bins} classes")
 
     def plot(self, ax=None, **kwargs):
-        """Reach probability and median speed [m/s] at the line by mass class [kg] (drawn by :func:`riskrf.report.fit_figures.plot_mass_classes`).
+        """Reach probability and median speed [m/s] at the line by mass class [kg] (drawn by :func:`riskrf.hazard.figures.plot_mass_classes`).
 
         Parameters
         ----------
@@ -492,8 +492,8 @@ class MassCoupledSamples(Displayed):
         -------
         matplotlib.axes.Axes
         """
-        from ..core.figures import draw
-        return draw("mass_classes", self, ax=ax, **kwargs)
+        from .figures import plot_mass_classes
+        return plot_mass_classes(self, ax=ax, **kwargs)
 
     @property
     def description(self) -> str:

@@ -170,26 +170,8 @@ class DesignEnergySplit(Displayed):
         -------
         matplotlib.axes.Axes
         """
-        import matplotlib.pyplot as plt
-        ok = self.table[self.table["variance_total_kj2"] > 0]
-        T = float(ok["T_years"].max() if T is None else T)
-        r = self.row(T)
-        d = self.per_draw[np.isclose(self.per_draw["T_years"], T)]
-        if ax is None:
-            _, ax = plt.subplots(figsize=(6.5, 3.6))
-        x = np.arange(len(d))
-        ax.axhspan(r["combined_low_kj"], r["combined_high_kj"], color="0.85",
-                   label=f"combined {self.level:.0%} interval ({r['share_from_trajectory_model']:.0%} of its "
-                         "variance: trajectory model)")
-        ax.errorbar(x, d["energy_kj"], yerr=[d["energy_kj"] - d["ci_low_kj"], d["ci_high_kj"] - d["energy_kj"]],
-                    fmt="o", color="C0", capsize=3, label="draw: point estimate and bootstrap interval")
-        if np.isfinite(r["energy_kj_reference"]):
-            ax.axhline(r["energy_kj_reference"], color="C3", lw=1, label="scenario's own values")
-        ax.set_xticks(x)
-        ax.set_xlabel("draw of the material parameters")
-        ax.set_ylabel(f"{T:g}-year energy [kJ]")
-        ax.legend(fontsize="small", loc="best")
-        return ax
+        from .figures import plot_design_energy_split
+        return plot_design_energy_split(self, T=T, ax=ax)
 
 
 def _check_hazards(hazards) -> list:

@@ -106,7 +106,7 @@ class Rainfall(Displayed):
                           f"{int(self.daily.isna().sum())} missing")
 
     def plot(self, ax=None, **kwargs):
-        """Daily rainfall [mm] against date (drawn by :func:`riskrf.report.rate_figures.plot_rainfall`).
+        """Daily rainfall [mm] against date (drawn by :func:`riskrf.io.figures.plot_rainfall`).
 
         Parameters
         ----------
@@ -119,8 +119,8 @@ class Rainfall(Displayed):
         -------
         matplotlib.axes.Axes
         """
-        from ..core.figures import draw
-        return draw("rainfall", self, ax=ax, **kwargs)
+        from .figures import plot_rainfall
+        return plot_rainfall(self, ax=ax, **kwargs)
 
     def _row_label(self, day) -> str:
         r = int(self.rows.get(day, 0))

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..hazard.figures import plot_catchment, plot_position_search
+
 OPTION_COLOURS = {"fence": "tab:red", "attenuator": "tab:orange", "ditch": "tab:blue", "shed": "tab:purple",
                   "scaling": "tab:green", "realignment": "tab:brown", "required": "black", "bench": "tab:cyan",
                   "bund": "tab:olive", "drape": "tab:pink"}
@@ -163,58 +165,6 @@ def stop_points_figure(result, *, road_x=None, ditches=(), option=None):
     return fig
 
 
-def plot_position_search(search, ax=None):
-    """Required MEL [kJ] and product class at each searched barrier position, with the required net height [m] on
-    a second y axis; with ``ax=None`` a new two-panel figure also shows the slope profile and the positions above.
-
-    Parameters
-    ----------
-    search : PositionSearch
-        A :class:`~riskrf.hazard.design_requirement.PositionSearch` (its ``table``: position [m], required MEL [kJ],
-        height [m]).
-    ax : matplotlib.axes.Axes, optional
-        Axes of the requirement panel (a new two-panel figure when None).
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        The requirement panel (its figure: ``ax.figure``).
-    """
-    import matplotlib.pyplot as plt
-    t = search.table
-    if ax is None:
-        _, (a0, a1) = plt.subplots(2, 1, figsize=(9, 7), sharex=True, gridspec_kw={"height_ratios": [1, 1.2]})
-        px, pz = search.profile
-        a0.fill_between(px, pz, np.min(pz) - 5.0, color="0.88")
-        a0.plot(px, pz, color="0.2")
-        a0.plot(t["x_m"], t["ground_z_m"], "v", color="tab:red", label="searched positions")
-        if search.road_x_m is not None:
-            a0.axvline(search.road_x_m, color="k", ls=":", label="road line")
-        a0.set_ylabel("elevation z [m]")
-        a0.legend(fontsize=8)
-        a0.set_title(f"Barrier position search ({search.basis.basis} governs; {search.n:,} blocks simulated)",
-                     fontsize=10)
-    else:
-        a1 = ax
-        a1.set_title(f"Barrier position search ({search.basis.basis} governs)", fontsize=10)
-    mel = t["required_mel_kj"].to_numpy(dtype=float)
-    cls = t["required_class_kj"].to_numpy(dtype=float)
-    a1.semilogy(t["x_m"], mel, "o-", color="tab:red", label="required MEL [kJ]")
-    ok = np.isfinite(cls)
-    a1.semilogy(t["x_m"][ok], cls[ok], "s", color="tab:red", mfc="none", ms=10, label="product class [kJ]")
-    top = max(search.basis.mel_classes_kj)
-    a1.axhline(top, color="tab:red", ls=":", lw=1, label=f"largest product class {top:,.0f} kJ")
-    a1.set_ylabel("energy [kJ]")
-    a1.set_xlabel("barrier position x [m]")
-    b = a1.twinx()
-    b.plot(t["x_m"], t["required_net_height_m"], "^--", color="tab:blue", label="required net height [m]")
-    b.set_ylabel("required net height [m]", color="tab:blue")
-    h1, l1 = a1.get_legend_handles_labels()
-    h2, l2 = b.get_legend_handles_labels()
-    a1.legend(h1 + h2, l1 + l2, fontsize=8, loc="upper right")
-    return a1
-
-
 def position_search_figure(search):
     """The two-panel position-search figure (slope with positions; requirement per position).
 
@@ -228,47 +178,6 @@ def position_search_figure(search):
     matplotlib.figure.Figure
     """
     return plot_position_search(search).figure
-
-
-def plot_catchment(study, ax=None):
-    """Retention against catchment width from the re-simulation, with the widths for 90/95/99 %, the Modified
-    Ritchie Criterion width and the chart values beside it (when given).
-
-    Parameters
-    ----------
-    study : CatchmentStudy
-        A :class:`~riskrf.hazard.catchment.CatchmentStudy` (its ``curve``: ``width_m`` [m], ``retained`` [-]).
-    ax : matplotlib.axes.Axes, optional
-        Axes to draw on (a new figure when None).
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-    """
-    import matplotlib.pyplot as plt
-
-    from ..hazard.catchment import modified_ritchie_width_m
-    if ax is None:
-        _, ax = plt.subplots(figsize=(7, 4.5))
-    ax.plot(study.curve["width_m"], 100 * study.curve["retained"], color="k",
-            label=f"re-simulated ({study.blocks_counted:,} blocks over the face)")
-    for q, w in study.widths.items():
-        ax.axhline(q, color="0.7", lw=0.8)
-        if np.isfinite(w):
-            ax.plot([w], [q], "o", color="tab:blue")
-            ax.annotate(f"{w:.1f} m", (w, q), textcoords="offset points", xytext=(4, -12), fontsize=8)
-    w_mrc = modified_ritchie_width_m(study.cut_height_m)
-    ax.axvline(w_mrc, color="tab:green", ls="--",
-               label=f"Modified Ritchie Criterion 0.2 H + 4.5 m = {w_mrc:.1f} m")
-    if study.chart is not None and len(study.chart):
-        ax.plot(study.chart["width_m"], study.chart["retained_percent"], "s", color="tab:red",
-                label=f"chart: {study.chart_source}")
-    ax.set_xlabel("catchment width from the toe [m]")
-    ax.set_ylabel("blocks retained [%]")
-    ax.set_ylim(0, 101)
-    ax.set_title(study.title, fontsize=10)
-    ax.legend(fontsize=8)
-    return ax
 
 
 def catchment_figure(study):

@@ -200,7 +200,7 @@ def write_frequency_figures(analysis, out: Path) -> list[Path]:
 
 
 def _frequency_figures(analysis, out: Path) -> list[Path]:
-    from .fit_figures import plot_gumbel, plot_magnitude_frequency, plot_return_levels
+    from ..frequency.figures import plot_gumbel, plot_magnitude_frequency, plot_return_levels
     ax = plot_magnitude_frequency(analysis.power_law)
     ax.set_title("Magnitude - cumulative frequency")
     written = [save_figure(ax.figure, out / "magnitude_frequency.png")]
@@ -234,7 +234,8 @@ def write_energy_figures(analysis, out: Path, fence_capacities_kj) -> list[Path]
     list of pathlib.Path
         The files written.
     """
-    from .fit_figures import plot_energy_exceedance, plot_mass_velocity
+    from ..hazard.figures import plot_energy_exceedance
+    from .fit_figures import plot_mass_velocity
     ax = plot_energy_exceedance(analysis.hazard, fences=list(fence_capacities_kj),
                                 n_bootstrap=min(analysis.n_bootstrap, 200), seed=analysis.seed)
     ax.set_title("Impact energy at the barrier line")

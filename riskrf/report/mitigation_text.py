@@ -149,7 +149,7 @@ def write_tree_figure(study, tmp) -> None:
     tmp : pathlib.Path
         Folder the figure is written into.
     """
-    from .decision_figures import plot_tree
+    from ..risk.figures import plot_tree
     from .files import save_figure
     ax = plot_tree(study.to_tree())
     save_figure(ax.figure, tmp / "tree.png")
@@ -202,7 +202,8 @@ def write_mitigation_figures(study, report, tmp) -> None:
     tmp : pathlib.Path
         Folder written into.
     """
-    from .decision_figures import plot_fn, plot_tornado
+    from ..risk.figures import plot_tornado
+    from .decision_figures import plot_fn
     from .files import save_figure
     ax = plot_tornado(report["tornado"].head(15), currency=study.currency,   # the 15 inputs that matter most
                       xlabel=f"lowest cost of the options at central values [{study.currency}]")

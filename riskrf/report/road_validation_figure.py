@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .axes import _axes
+from ..core.figures import _axes
 
 
 def plot_road_validation(validation, ax=None):

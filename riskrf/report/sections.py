@@ -376,7 +376,7 @@ def catchment_text(c) -> str:
 
     Parameters
     ----------
-    c : riskrf.hazard.design_basis.CatchmentStudy
+    c : riskrf.hazard.catchment.CatchmentStudy
         The design's catchment study.
 
     Returns
@@ -420,7 +420,7 @@ def catchment_tables(c) -> tuple:
 
     Parameters
     ----------
-    c : riskrf.hazard.design_basis.CatchmentStudy
+    c : riskrf.hazard.catchment.CatchmentStudy
         The design's catchment study.
 
     Returns

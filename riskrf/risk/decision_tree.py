@@ -266,6 +266,10 @@ class DecisionTree(Displayed):
         """The one course of a tree whose root is not a decision (its name, else "the tree")."""
         return self.root.name or "the tree"
 
+    def _probability(self, branch) -> float:
+        """The probability of a chance branch, its expression evaluated with the tree's parameters [-]."""
+        return _evaluate(branch.probability, self.parameters, branch.name)
+
     def _net(self, branch) -> float:
         cost = _evaluate(branch.cost, self.parameters, branch.name)
         payoff = _evaluate(branch.payoff, self.parameters, branch.name)
@@ -386,7 +390,7 @@ class DecisionTree(Displayed):
                           source=self.source if self.source != "<dict>" else None)
 
     def plot(self, ax=None, **kwargs):
-        """The tree: squares decide, circles are chance, triangles end; the optimal path in red (drawn by :func:`riskrf.report.decision_figures.plot_tree`).
+        """The tree: squares decide, circles are chance, triangles end; the optimal path in red (drawn by :func:`riskrf.risk.figures.plot_tree`).
 
         Parameters
         ----------
@@ -399,8 +403,8 @@ class DecisionTree(Displayed):
         -------
         matplotlib.axes.Axes
         """
-        from ..core.figures import draw
-        return draw("decision_tree", self, ax=ax, **kwargs)
+        from .figures import plot_tree
+        return plot_tree(self, ax=ax, **kwargs)
 
     # ---- risk profiles ------------------------------------------------------------------
     def risk_profile(self, option: str | None = None) -> pd.DataFrame:

@@ -38,7 +38,6 @@ import pandas as pd
 
 from simulation._display import Displayed, short_repr
 
-from ..core.figures import draw
 from ..core.format import money
 from ..hazard.annual_hazard import EnergyHazard
 from ..hazard.mass_models import mass_model
@@ -771,7 +770,7 @@ class MitigationStudy(RecommendationMixin, SensitivityMixin, Displayed):
         return self.ranking()
 
     def plot(self, kind: str = "tornado", ax=None):
-        """The study's figure, drawn by :mod:`riskrf.report.decision_figures` (through :mod:`riskrf.core.figures`).
+        """The study's figure, drawn by :mod:`riskrf.risk.figures`.
 
         Parameters
         ----------
@@ -792,7 +791,8 @@ class MitigationStudy(RecommendationMixin, SensitivityMixin, Displayed):
         """
         if kind not in ("tornado", "ranking"):
             raise MitigationError(f"plot: kind must be 'tornado' or 'ranking', not {kind!r}")
-        return draw(f"mitigation_{kind}", self, ax=ax)
+        from .figures import plot_study_ranking, plot_study_tornado
+        return (plot_study_tornado if kind == "tornado" else plot_study_ranking)(self, ax=ax)
 
 
 def study_inputs(data: dict, source: str, *, require_options: bool = True) -> dict:

@@ -608,22 +608,8 @@ class ModelUncertainRanking(Displayed):
         matplotlib.axes.Axes
             The axes drawn on (expected total cost [currency] on x, log scale when all costs are positive).
         """
-        import matplotlib.pyplot as plt
-        if ax is None:
-            _, ax = plt.subplots(figsize=(7, 0.45 * len(self.options) + 1.5))
-        order = np.argsort(self.expected_costs())[::-1]
-        y = np.arange(len(order))
-        ax.barh(y, self.expected_costs()[order], color="0.8", label="expected over the draws")
-        for i, k in enumerate(order):
-            ax.plot(self.costs[:, k], np.full(self.n_draws, y[i]), "o", color="C0", ms=3,
-                    label="one draw of the trajectory model" if i == 0 else None)
-        ax.set_yticks(y)
-        ax.set_yticklabels([self.options[k] for k in order])
-        if np.all(self.costs > 0):
-            ax.set_xscale("log")
-        ax.set_xlabel(f"expected total cost [{self.currency}]" if self.currency else "expected total cost")
-        ax.legend(fontsize="small", loc="lower right")
-        return ax
+        from .figures import plot_model_ranking
+        return plot_model_ranking(self, ax=ax)
 
 
 __all__ = ["CalibrationValue", "DecisionValueError", "EVPIEstimate", "ModelUncertainRanking", "evpi_estimate",

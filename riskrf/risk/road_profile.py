@@ -104,19 +104,8 @@ class RoadRiskProfile:
         matplotlib.axes.Axes
             The axes of the falls (deaths on a twin axis).
         """
-        import matplotlib.pyplot as plt
-        if ax is None:
-            _, ax = plt.subplots(figsize=(8, 3.5))
-        t = self.table
-        mid = 0.5 * (t["start_m"] + t["end_m"])
-        ax.step(mid, t["falls_per_year_per_m"], where="mid", color="tab:blue", label="falls reaching the road")
-        ax.set_xlabel(f"position along {self.road} [m]")
-        ax.set_ylabel("falls per year per metre")
-        ax2 = ax.twinx()
-        ax2.step(mid, t["deaths_per_year_per_m"], where="mid", color="tab:red", label="road-user deaths")
-        ax2.set_ylabel("deaths per year per metre", color="tab:red")
-        ax.set_title(f"{self.road}: {self.totals()['falls_per_year']:.3g} falls/yr reach the road")
-        return ax
+        from .figures import plot_road_profile
+        return plot_road_profile(self, ax=ax)
 
     def __repr__(self) -> str:
         t = self.totals()

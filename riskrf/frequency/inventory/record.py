@@ -321,7 +321,7 @@ class Inventory(Displayed):
                           f"{self.duration_years:.4g} yr", f"mass {sig(m.min())}-{sig(m.max())} kg" if m.size else "")
 
     def plot(self, ax=None, **kwargs):
-        """Empirical magnitude-frequency curve: falls of at least m per year [1/yr] against m [kg], log-log (drawn by :func:`riskrf.report.fit_figures.plot_inventory`).
+        """Empirical magnitude-frequency curve: falls of at least m per year [1/yr] against m [kg], log-log (drawn by :func:`riskrf.frequency.figures.plot_inventory`).
 
         Parameters
         ----------
@@ -334,8 +334,8 @@ class Inventory(Displayed):
         -------
         matplotlib.axes.Axes
         """
-        from ...core.figures import draw
-        return draw("inventory", self, ax=ax, **kwargs)
+        from ..figures import plot_inventory
+        return plot_inventory(self, ax=ax, **kwargs)
 
 
 def _undated_note(source: str, events: pd.DataFrame) -> str:

@@ -542,7 +542,7 @@ class GutenbergRichterFit(Displayed):
                           units=self.units)
 
     def plot(self, ax=None, **kwargs):
-        """Magnitude-frequency plot: the recorded falls and the fitted N(>=m) [1/yr] with the band of b, log-log (drawn by :func:`riskrf.report.fit_figures.plot_magnitude_frequency`).
+        """Magnitude-frequency plot: the recorded falls and the fitted N(>=m) [1/yr] with the band of b, log-log (drawn by :func:`riskrf.frequency.figures.plot_magnitude_frequency`).
 
         Parameters
         ----------
@@ -555,6 +555,6 @@ class GutenbergRichterFit(Displayed):
         -------
         matplotlib.axes.Axes
         """
-        from ...core.figures import draw
-        return draw("magnitude_frequency", self, ax=ax, **kwargs)
+        from ..figures import plot_magnitude_frequency
+        return plot_magnitude_frequency(self, ax=ax, **kwargs)
 

@@ -293,7 +293,7 @@ class RateModel(Displayed):
                           preferred=self.preferred)
 
     def plot(self, ax=None, **kwargs):
-        """Events per year: recorded, and expected by the preferred model (drawn by :func:`riskrf.report.rate_figures.plot_rate_counts`).
+        """Events per year: recorded, and expected by the preferred model (drawn by :func:`riskrf.frequency.figures.plot_rate_counts`).
 
         Parameters
         ----------
@@ -306,8 +306,8 @@ class RateModel(Displayed):
         -------
         matplotlib.axes.Axes
         """
-        from ...core.figures import draw
-        return draw("rate_counts", self, ax=ax, **kwargs)
+        from ..figures import plot_rate_counts
+        return plot_rate_counts(self, ax=ax, **kwargs)
 
     def summary_text(self) -> str:
         """A readable report (what ``riskrf rates`` prints).
