@@ -410,3 +410,20 @@ def test_joint_exceedance_equals_direct_count_including_class_energy_bounds():
         vstar = np.sqrt(2000.0 * e[:, None] / mq[None, :])
         direct += (np.sum(speeds[None, None, :] > vstar[:, :, None], axis=2) / n_c) @ w
     np.testing.assert_allclose(samples.joint_exceedance(e, mm), np.clip(direct, 0, 1), rtol=1e-12, atol=1e-15)
+
+
+def test_joint_exceedance_at_one_energy_is_the_same_float_as_the_general_path():
+    """Root finding evaluates the joint exceedance one energy at a time (MassCoupledSamples._joint_one, without the
+    general path's masks and index arrays); it must give the very float the general path (_joint_many) gives for
+    that one energy, at every energy including a class's energy bounds, below and above every class, and NaN (which no class counts)."""
+    _, m, s, edges = _random_blocks(11, 600, 4, shape=4.0, lost=0.4)
+    samples = MassCoupledSamples(m, s, np.where(np.isfinite(s), 1.0, np.nan), edges)
+    mm = mass_model(stats.lognorm(1.2, scale=500.0))
+    groups = samples._groups(mm)[0]
+    bounds = [0.5 * f(mq) * sp[i] ** 2 / 1000.0 for mq, _, _, sp, *_ in groups for f, i in ((np.min, 0), (np.max, -1))]
+    e = np.concatenate([np.geomspace(1e-6, 1e9, 300), bounds, np.nextafter(bounds, 0), [np.nan, 0.0]])
+    one = np.array([MassCoupledSamples._joint_one(e[i:i + 1], groups)[0] for i in range(e.size)])
+    many = np.array([MassCoupledSamples._joint_many(e[i:i + 1], groups)[0] for i in range(e.size)])
+    assert np.array_equal(one, many, equal_nan=True)
+    assert 0.0 < one[0] and one[299] == 0.0 == one[-2]            # NaN energy: no class counts it
+    assert np.array_equal(samples.joint_exceedance(e[:5].reshape(5, 1)[2], mm), one[2:3])

@@ -206,6 +206,13 @@ class MassCoupledSamples(Displayed):
     @staticmethod
     def _joint(e, groups) -> np.ndarray:
         flat = e.ravel()
+        if flat.size == 1:
+            return MassCoupledSamples._joint_one(flat, groups).reshape(e.shape)
+        return MassCoupledSamples._joint_many(flat, groups).reshape(e.shape)
+
+    @staticmethod
+    def _joint_many(flat, groups) -> np.ndarray:
+        """:meth:`_joint` at the energies ``flat`` (1-d [kJ]), all classes' speed searches at once."""
         out = np.zeros(flat.size)
         for m, w, n_c, speeds, cum, e_low, e_high, all_above in groups:
             out[flat < e_low] += all_above
@@ -214,7 +221,22 @@ class MassCoupledSamples(Displayed):
                 vstar = np.sqrt(2.0 * J_PER_KJ * flat[mid, None] / m[None, :])
                 above = cum[-1] - cum[np.searchsorted(speeds, vstar.ravel(), side="right")].reshape(vstar.shape)
                 out[mid] += (above / n_c) @ w
-        return np.clip(out, 0.0, 1.0).reshape(e.shape)
+        return np.clip(out, 0.0, 1.0)
+
+    @staticmethod
+    def _joint_one(flat, groups) -> np.ndarray:
+        """:meth:`_joint` at one energy (``flat``, one element [kJ]; what root finding asks): the same operations
+        in the same order, so the same float, without the masks and index arrays of many energies."""
+        x = flat[0]
+        total = 0.0
+        for m, w, n_c, speeds, cum, e_low, e_high, all_above in groups:
+            if x < e_low:
+                total += all_above
+            elif x <= e_high:
+                vstar = np.sqrt(2.0 * J_PER_KJ * flat[:, None] / m[None, :])
+                above = cum[-1] - cum[speeds.searchsorted(vstar.ravel(), side="right")].reshape(vstar.shape)
+                total += ((above / n_c) @ w)[0]
+        return np.clip(np.array([total]), 0.0, 1.0)
 
     def joint_exceedance(self, energy_kj, mm) -> np.ndarray:
         """P(a fall reaches the line with energy above e) [-] under mass model ``mm`` (a ``mass_model``).

@@ -18,7 +18,8 @@ import numpy as np
 import pandas as pd
 
 from ..core.units import kinetic_energy_kj
-from ..hazard.barriers import damage_state_shares
+from ..core.validation import check_positive
+from ..hazard.barriers import damage_state_shares, service_energy_level
 from ..hazard.velocity_models import velocity_model
 from .loss_engine import MassGrid
 from .measures import (
@@ -145,6 +146,7 @@ class SlopeModels:
     source: str
     derived: dict = field(default_factory=dict)      # geometry key -> (ret0, Beta law, per model, by mass)
     _variant_classes: dict = field(default_factory=dict)
+    _variant_pairs: dict = field(default_factory=dict)
 
     def need_context(self, opt, fld):
         """The simulation context, or a MitigationError naming the option and the field that needs it.
@@ -554,17 +556,52 @@ class SlopeModels:
         return samples
 
     def _damage_by_mass(self, model: SlopeModel, v, h, height_m: float, cap: float):
-        """damage_state_shares per mass bin with the speeds and heights of the bin's own mass class (see by_mass)."""
+        """damage_state_shares per mass bin with the speeds and heights of the bin's own mass class (see by_mass).
+
+        Every class at once: each (block of the class, bin of the class) pair is one element, with the same
+        energy E = 1/2 m v^2 [kJ] and the same comparisons as damage_state_shares makes per class; the states
+        are counted per bin and divided by the class's number of blocks, which is the mean of the 0/1 flags
+        that function takes (sums of ones are exact), so the shares are the same floats."""
+        bins, n_bin, e, clearance = self._class_pairs(model, v, h)
+        mel = check_positive(cap, "mel_kj")
+        sel = service_energy_level(mel)
+        over = clearance > height_m
+        working = ~over
+        through = working & (e > mel)
+        held_repair = working & (e > sel) & (e <= mel)
+        size, has = self.grid.mid.size, n_bin > 0
+        out = []
+        for flag in (over | through, held_repair, through):
+            count = np.bincount(bins, weights=flag, minlength=size)
+            out.append(np.divide(count, n_bin, out=np.zeros(size), where=has))
+        return tuple(out)
+
+    def _class_pairs(self, model: SlopeModel, v, h) -> tuple:
+        """The (block, bin) pairs of :meth:`_damage_by_mass` for ``model``: per pair its mass bin; per bin the
+        number of blocks of its class (0: none, or a bin of a class without samples); per pair the energy
+        E = 1/2 m v^2 [kJ] of the bin's mass at the block's speed and the height [m] of the block's underside
+        (centre height less the bin's radius).  Once per model (every barrier option shares them)."""
+        cached = self._variant_pairs.get(id(model))
+        if cached is not None:
+            return cached
         cls = self.by_mass[0]
-        mid = self.grid.mid
-        shares = [np.zeros(mid.size) for _ in range(3)]
+        n_bin = np.zeros(self.grid.mid.size)
+        rows, bins, speeds, heights, start = [], [], [], [], 0
         for c, (vc, hc) in self._class_samples(model, v, h).items():
-            j = cls == c
-            over = np.asarray(hc)[:, None] - self.radius_m[j][None, :] > height_m
-            got = damage_state_shares(kinetic_energy_kj(mid[j][None, :], vc[:, None]), over, cap)
-            for out, part in zip(shares, got):
-                out[j] = part
-        return tuple(shares)
+            j = np.flatnonzero(cls == c)
+            vc, hc = np.asarray(vc, dtype=float), np.asarray(hc, dtype=float)
+            n = vc.size
+            rows.append(np.repeat(np.arange(start, start + n), j.size))
+            bins.append(np.tile(j, n))
+            n_bin[j] = n
+            speeds.append(vc)
+            heights.append(hc)
+            start += n
+        cat = (lambda parts, dtype: np.concatenate(parts) if parts else np.zeros(0, dtype=dtype))
+        rows, bins, vc, hc = cat(rows, np.intp), cat(bins, np.intp), cat(speeds, float), cat(heights, float)
+        pairs = (bins, n_bin, kinetic_energy_kj(self.grid.mid[bins], vc[rows]), hc[rows] - self.radius_m[bins])
+        self._variant_pairs[id(model)] = pairs
+        return pairs
 
     def fence_samples_at(self, opt) -> list:
         """Per slope model: (effective speeds [m/s], bounce heights [m]) at the option's own line x_m.
