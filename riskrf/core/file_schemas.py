@@ -2,7 +2,8 @@
 
 One :class:`~riskrf.core.schema.Field` per field: type, unit, range, default, meaning.  The defaults here are
 the ones the readers apply (:data:`riskrf.app.site.SITE_FIELDS` is built from :data:`SITE_SCHEMA`; a test holds
-the mitigation dataclasses' defaults to :data:`TRAFFIC` and the others).  Shares and probabilities lie in
+the mitigation dataclasses' defaults to :data:`TRAFFIC` and the others), and the typed records a site's checked tables
+are read into are generated from them (:data:`SITE_RECORDS`, :meth:`riskrf.core.schema.Table.record`).  Shares and probabilities lie in
 [0, 1]; rates, speeds, lengths and traffic are > 0.
 """
 from __future__ import annotations
@@ -467,5 +468,22 @@ def write_reference(path=None) -> str:
     return text
 
 
-__all__ = ["ALL_SCHEMAS", "CORRIDOR_SCHEMA", "OPTIONS_SCHEMA", "SCENARIO_SCHEMA", "SITE_SCHEMA",
+
+def _export_records(tables) -> dict:
+    """The typed record of each table (:meth:`riskrf.core.schema.Table.record`), made a name of this module so that
+    records pickle (a site goes to the forked and spawned writers of ``riskrf assess``)."""
+    out = {}
+    for t in tables:
+        cls = t.record_type
+        cls.__module__ = __name__
+        globals()[cls.__name__] = cls
+        out[t.name] = cls
+    return out
+
+
+#: Table name -> the record class of that [table] of a site file (``riskrf.app.site.Site`` holds them).
+SITE_RECORDS = _export_records(SITE_SCHEMA.tables)
+
+
+__all__ = ["ALL_SCHEMAS", "CORRIDOR_SCHEMA", "OPTIONS_SCHEMA", "SCENARIO_SCHEMA", "SITE_RECORDS", "SITE_SCHEMA",
            "check_scenario_file", "write_reference"]

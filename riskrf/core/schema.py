@@ -4,7 +4,10 @@ Each table of a file is a :class:`Table` of :class:`Field` declarations: type, u
 and meaning.  :func:`check` holds a parsed TOML document against a :class:`FileSchema` before any work and
 raises one message naming the file, the table, the field and the value (``site.toml: traffic.vehicles_per_day
 = 0 must be a number > 0 vehicles/day``); :func:`render_markdown` writes the same declarations as the
-file-format reference (``docs/reference/file-formats-generated.md``).
+file-format reference (``docs/reference/file-formats-generated.md``); :func:`record_class` makes of the same
+declarations the typed record a checked table is read into (:meth:`Table.record`: a frozen dataclass, one attribute
+per declared field in declaration order, with the declared default), so that a field's name, type, unit and default
+have one home and the code reads ``site.hazard.n_blocks``, never ``site.hazard["n_blocks"]``.
 
 The hand-written readers (:func:`riskrf.app.site.load_site`, :func:`riskrf.risk.mitigation_inputs.parse_mitigation`,
 :func:`riskrf.app.corridor.load_corridor`, :func:`simulation.load_scenario`) keep what a flat declaration cannot
@@ -17,8 +20,13 @@ error format would have to be rewritten field by field), and the package gains n
 """
 from __future__ import annotations
 
+import copy
+import dataclasses
 import datetime as _dt
+import functools
+import keyword
 import math
+import re
 from dataclasses import dataclass
 
 #: A field without a default must be given.
@@ -159,6 +167,38 @@ class Table:
         """
         return {f.name: (None if f.default is REQUIRED else f.default) for f in self.fields}
 
+    @functools.cached_property
+    def record_type(self) -> type:
+        """The typed record of this table (:func:`record_class`), built once per table.
+
+        Returns
+        -------
+        type
+            A frozen, slotted dataclass with one attribute per declared field, in declaration order.
+        """
+        return record_class(self)
+
+    def record(self, values: dict):
+        """A checked table (``{field: value}``, e.g. the merged table of a reader) as its typed record.
+
+        Parameters
+        ----------
+        values : dict
+            Field name -> value (in the field's unit); fields left out take the declared default (None for
+            required or optional fields without one).
+
+        Returns
+        -------
+        object
+            An instance of :attr:`record_type`.
+
+        Raises
+        ------
+        TypeError
+            For a key the table does not declare (the readers refuse unknown fields with a did-you-mean first).
+        """
+        return self.record_type(**values)
+
 
 @dataclass(frozen=True)
 class FileSchema:
@@ -271,6 +311,68 @@ def check(data: dict, schema: FileSchema, source, *, error=ValueError) -> None:
         raise error(found[0])
 
 
+#: Python type of each field kind, the annotation of the record's attribute (not enforced: :func:`check` is).
+KIND_TYPES = {"number": float, "integer": int, "text": str, "path": str, "bool": bool, "date": object,
+              "numbers": list, "range": list, "number|numbers": object, "any": object}
+
+
+def _record_as_dict(self) -> dict:
+    """``{field: value}`` of every attribute, in declaration order (shallow: lists are not copied); for the
+    readers that take a table as a dict (e.g. :func:`riskrf.hazard.design_basis.design_basis_from_site`).
+
+    Returns
+    -------
+    dict
+        Field name -> value.
+    """
+    return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+
+
+def record_class(table: Table, *, name: str | None = None, extra=()) -> type:
+    """A frozen, slotted dataclass generated from ``table``'s declarations: one attribute per :class:`Field`, in
+    declaration order, annotated with the field kind's Python type (:data:`KIND_TYPES`) and defaulting to the
+    declared default (None for required fields and optional fields without one; a list default is copied for
+    each record).  An attribute the table does not declare raises :class:`AttributeError`; the record cannot be
+    changed (:func:`dataclasses.replace` makes a changed copy).  ``as_dict()`` gives the fields as a dict.
+
+    Parameters
+    ----------
+    table : Table
+        The declarations.
+    name : str, optional
+        Class name (default: the table's name in CamelCase + ``"Table"``, e.g. ``DesignBlockTable``).
+    extra : sequence of (name, type, default), optional
+        Attributes a reader adds after its checks that are not fields of the file (e.g. a file it read), after the
+        declared ones.
+
+    Returns
+    -------
+    type
+        The record class.
+    """
+    if name is None:
+        name = "".join(p.capitalize() for p in re.split(r"[^0-9A-Za-z]+", table.name) if p) + "Table"
+    spec = []
+    for f in table.fields:
+        if not f.name.isidentifier() or keyword.iskeyword(f.name):
+            raise ValueError(f"table {table.name!r}: field {f.name!r} is not a Python name; it cannot be a record "
+                             "attribute")
+        default = None if f.default is REQUIRED else f.default
+        if isinstance(default, (list, dict, set)):
+            value = dataclasses.field(default_factory=functools.partial(copy.deepcopy, default))
+        else:
+            value = dataclasses.field(default=default)
+        spec.append((f.name, KIND_TYPES.get(f.kind, object), value))
+    for attr, kind, default in extra:
+        spec.append((attr, kind, dataclasses.field(default=default)))
+    doc = (f"The checked [{table.name}] table as a typed record, generated from its declaration "
+           f"(:func:`riskrf.core.schema.record_class`). {table.doc}").strip()
+    cls = dataclasses.make_dataclass(name, spec, frozen=True, slots=True, namespace={"as_dict": _record_as_dict,
+                                                                                   "__doc__": doc})
+    cls.__module__ = __name__
+    return cls
+
+
 def _cell(text) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
@@ -308,4 +410,5 @@ def render_markdown(schemas) -> str:
     return "\n".join(lines).rstrip() + "\n"
 
 
-__all__ = ["REQUIRED", "Field", "FileSchema", "Table", "check", "problems", "render_markdown"]
+__all__ = ["KIND_TYPES", "REQUIRED", "Field", "FileSchema", "Table", "check", "problems", "record_class",
+           "render_markdown"]

@@ -1,0 +1,43 @@
+"""The typed records of the site file's tables are generated from the one declaration of the file
+(riskrf.core.file_schemas.SITE_SCHEMA): every declared field is an attribute with its declared default, in
+declaration order, and nothing else is."""
+import dataclasses
+import pickle
+
+import pytest
+
+from riskrf.core import file_schemas as fs
+from riskrf.core.schema import REQUIRED, Field, Table, record_class
+
+
+@pytest.mark.parametrize("table", fs.SITE_SCHEMA.tables, ids=lambda t: t.name)
+def test_record_has_every_declared_field_with_its_default(table):
+    rec = table.record({})
+    assert [f.name for f in dataclasses.fields(rec)] == [f.name for f in table.fields]
+    for f in table.fields:
+        want = None if f.default is REQUIRED else f.default
+        assert getattr(rec, f.name) == want, (table.name, f.name)
+    assert rec.as_dict() == table.defaults()
+    with pytest.raises(AttributeError):
+        rec.not_a_declared_field
+    with pytest.raises(AttributeError):           # frozen (dataclasses.FrozenInstanceError is an AttributeError)
+        setattr(rec, table.fields[0].name, 1)
+    with pytest.raises(TypeError):                # a key the table does not declare
+        table.record({"not_a_declared_field": 1})
+    assert pickle.loads(pickle.dumps(rec)) == rec
+    assert table.record_type is fs.SITE_RECORDS[table.name]     # built once per table
+
+
+def test_given_values_and_copied_list_defaults():
+    a, b = fs.HAZARD.record({"n_blocks": 7}), fs.HAZARD.record({})
+    assert (a.n_blocks, b.n_blocks) == (7, 50_000)
+    assert a.fences_kj == [2000.0, 5000.0] and a.fences_kj is not b.fences_kj
+    assert a.fences_kj is not fs.HAZARD.field("fences_kj").default
+
+
+def test_record_class_extra_attributes_and_bad_names():
+    t = Table("demo_table", (Field("x_m", "number", "m", default=1.5),))
+    cls = record_class(t, extra=(("read_file", object, None),))
+    assert cls.__name__ == "DemoTableTable" and cls(read_file=3).read_file == 3 and cls().x_m == 1.5
+    with pytest.raises(ValueError, match="'class'"):
+        record_class(Table("t", (Field("class", "text"),)))
