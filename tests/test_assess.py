@@ -222,7 +222,7 @@ def test_options_recommendation_and_fence_heights_in_outputs(assessed):
     rb = s["required_barrier_option"]
     assert rb["placeable"] is False and "above the largest certified class" in rb["reason"]
     assert rb["alternatives"] and "No certified barrier meets" in rec["reason"]
-    fences = [o for o in load_site(site).mitigation["options"] if o.kind == "fence" and o.x_m is None]
+    fences = [o for o in load_site(site).mitigation.options if o.kind == "fence" and o.x_m is None]
     assert len({o.height_m for o in fences}) > 1                  # the demo's fences differ in height
     checks = pd.read_csv(out / "fence_checks.csv")
     for o in fences:

@@ -535,7 +535,7 @@ def test_site_file_and_inventory_with_the_same_stem(inputs):
     inv.write_bytes(LAUTER.read_bytes())
     site = site_file(inputs, name="lauter.toml", inventory={"path": "lauter.csv", "duration_years": 5.2})
     s = load_site(site)
-    assert s.inventory["duration_years"] == 5.2
+    assert s.inventory.duration_years == 5.2
     with pytest.warns(RiskrfWarning, match=r"lauter.toml is a site file, not a \[record\] sidecar"):
         got = read_inventory(inv, duration_years=5.2)
     assert got.n_events == 317 and got.period_source == "argument"

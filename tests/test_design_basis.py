@@ -165,7 +165,7 @@ def test_site_file_design_errors_name_the_field(tmp_path):
     path = _site_copy(tmp_path, replace={'basis = "UNI 11211-4"': 'basis = "ONR 24810"\ngamma_m = 1.1',
                                          'revision = "A"': 'revision = "B"'})
     site = load_site(path)
-    assert site.design["basis"] == "ONR 24810" and site.report["revision"] == "B"
+    assert site.design.basis == "ONR 24810" and site.report.revision == "B"
 
 
 def test_position_search_reach_never_grows_downslope():
@@ -247,7 +247,7 @@ def test_assess_writes_the_pdf_and_the_design_entries(tmp_path):
 def test_option_scenario_builds_the_recommended_option_into_the_slope():
     from riskrf.app.site_design import option_scenario
     site = load_site(ROOT / "riskrf" / "data" / "demo_site.toml")
-    sc = simulation.load_scenario(site.resolve(site.hazard["scenario"]))
+    sc = simulation.load_scenario(site.resolve(site.hazard.scenario))
     dug = option_scenario(site, sc, "catch ditch")          # 8 m x 2 m at x = 85 m
     from riskrf.risk.measures import ground_z
     assert float(ground_z(dug.profile, 89.0)) == pytest.approx(float(ground_z(sc.profile, 93.0)) - 2.0)
@@ -352,14 +352,14 @@ def test_site_file_elongation_forms_and_kit_errors_name_file_and_field(tmp_path)
     for form, want in (("elongation_m = 5.0", 5.0), ('elongation_m = { "fence 2000 kJ" = 5.0, "fence 3000 kJ" = 7.0 }',
                                                        {"fence 2000 kJ": 5.0, "fence 3000 kJ": 7.0})):
         site = load_site(_site_copy(tmp_path, replace={anchor: f"{anchor}\n{form}"}))
-        assert design_basis_from_site(site.design).elongation_m == want
+        assert design_basis_from_site(site.design.as_dict()).elongation_m == want
     path = _site_copy(tmp_path, replace={anchor: f'{anchor}\nelongation_m = "five"'})
     with pytest.raises(SiteError, match=r"site.toml: design.elongation_m = 'five' must be one number"):
         load_site(path)
     # a fence naming a kit takes its MEL and height; a kit not in the table is refused with the known kits
     fence = 'capacity_kj = 2000\nheight_m = 5.0'
     site = load_site(_site_copy(tmp_path, replace={fence: 'kit = "generic 2000 kJ"'}))
-    f = next(o for o in site.mitigation["options"] if o.name == "fence 2000 kJ")
+    f = next(o for o in site.mitigation.options if o.name == "fence 2000 kJ")
     assert (f.kit, f.capacity_kj, f.height_m) == ("generic 2000 kJ", 2000.0, 5.0)
     path = _site_copy(tmp_path, replace={fence: 'kit = "RXI-200"'})
     with pytest.raises((SiteError, MitigationError)) as err:

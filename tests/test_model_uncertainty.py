@@ -329,7 +329,7 @@ def test_a_road_record_is_reproduced_in_every_draw(tmp_path):
     path = _site(tmp_path, "[model_uncertainty]\ndraws = 2")
     path.write_text(path.read_text().replace("rate_scale = 0.05", 'rate_scale = 0.05\nrate_basis = "road"'))
     site = load_site(path)
-    inv = read_inventory(site.resolve(site.inventory["path"]))
+    inv = read_inventory(site.resolve(site.inventory.path))
     evaluate = partial(draw_evaluator, site, inv, rate_scale=0.05, rate_note=None, mitigation=site.mitigation,
                        design_masses=())
     draws = simulation.material_draws(SCENARIO, 2, seed=5)
@@ -337,7 +337,7 @@ def test_a_road_record_is_reproduced_in_every_draw(tmp_path):
     gr = None
     for _, row in draws.iterrows():
         hz, study, result, share = evaluate(simulation.scenario_with_values(SCENARIO, row.to_dict()), 600, 300, 1,
-                                            _without_material_draws(site.mitigation["uncertainty"]))
+                                            _without_material_draws(site.mitigation.uncertainty))
         gr = hz.mass
         recorded.append(study.evaluate("do nothing").road_falls_per_year)
     small = np.sum(inv.masses < gr.m_min)

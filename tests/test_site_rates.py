@@ -96,12 +96,12 @@ def test_closure_rule_option_share_and_hours_equal_closure_rule_on_the_same_mode
     # test_closure checks that closure_rule's effectiveness is the share of simulated falls in the closure windows;
     # here the site's option must carry exactly closure_rule's numbers on the same model.
     site = load_site(write_site(tmp_path / "s"))
-    opt = site.mitigation["options"][1]
+    opt = site.mitigation.options[1]
     assert opt.has_closure_rule and opt.share_while_closed is None and not opt.typed
     with pytest.raises(MitigationError, match="closure rule .* has not been evaluated"):
-        MitigationStudy(hazard=None, options=site.mitigation["options"], source="x")
-    sr = evaluate_rates(site.rates, site.path.parent, site.inventory, site.mitigation["options"])
-    resolved = resolve_closures(site.mitigation["options"], sr)[1]
+        MitigationStudy(hazard=None, options=site.mitigation.options, source="x")
+    sr = evaluate_rates(site.rates.reader_table, site.path.parent, site.inventory.as_dict(), site.mitigation.options)
+    resolved = resolve_closures(site.mitigation.options, sr)[1]
     _, model = direct_model(tmp_path / "s")
     rule = closure_rule(model, 60.0, window_days=1, cost_per_hour=500.0)
     assert resolved.share_while_closed == pytest.approx(rule.effectiveness, rel=1e-12)
@@ -113,8 +113,8 @@ def test_closure_rule_option_share_and_hours_equal_closure_rule_on_the_same_mode
     assert "ASSUMED" not in text
     # a warning rule on the same model
     site = load_site(write_site(tmp_path / "s", closure='warning_levels = ["Red", "black"]\ncost_per_closure_hour = 50'))
-    sr = evaluate_rates(site.rates, site.path.parent, site.inventory, site.mitigation["options"])
-    resolved = resolve_closures(site.mitigation["options"], sr)[1]
+    sr = evaluate_rates(site.rates.reader_table, site.path.parent, site.inventory.as_dict(), site.mitigation.options)
+    resolved = resolve_closures(site.mitigation.options, sr)[1]
     rule = warning_closure(model, tmp_path / "s" / "warnings.csv", levels=("Red", "Black"), cost_per_hour=50.0)
     assert resolved.share_while_closed == pytest.approx(rule.effectiveness, rel=1e-12)
     assert resolved.closure_hours_per_year == pytest.approx(rule.closure_hours_per_year, rel=1e-12)
@@ -123,9 +123,9 @@ def test_closure_rule_option_share_and_hours_equal_closure_rule_on_the_same_mode
 def test_typed_closure_shares_are_labelled_assumptions(tmp_path):
     site = load_site(write_site(tmp_path / "s", rates="", closure="share_while_closed = 0.2\n"
                                                                    "closure_hours_per_year = 30"))
-    opt = site.mitigation["options"][1]
+    opt = site.mitigation.options[1]
     assert opt.typed and "ASSUMED (typed)" in opt.describe()
-    study = MitigationStudy(hazard=None, options=site.mitigation["options"], source="x")
+    study = MitigationStudy(hazard=None, options=site.mitigation.options, source="x")
     assert study._basis(opt).startswith("ASSUMPTION: typed effectiveness")
 
 

@@ -41,3 +41,23 @@ def test_record_class_extra_attributes_and_bad_names():
     assert cls.__name__ == "DemoTableTable" and cls(read_file=3).read_file == 3 and cls().x_m == 1.5
     with pytest.raises(ValueError, match="'class'"):
         record_class(Table("t", (Field("class", "text"),)))
+
+
+def test_site_holds_the_records():
+    from pathlib import Path
+
+    import riskrf
+    from riskrf.app.site import SiteMitigation, load_site
+    site = load_site(Path(riskrf.__file__).parent / "data" / "demo_site.toml")
+    for name in ("inventory", "hazard", "design_block", "design", "report", "required_barrier"):
+        assert type(getattr(site, name)) is fs.SITE_RECORDS[name]
+    assert isinstance(site.mitigation, SiteMitigation) and site.mitigation.options
+    assert site.hazard.collector == "barrier"            # filled in by the reader when left out
+    # a default the reader applied is both in the record and reported
+    for entry in site.defaults_used:
+        table, _, rest = entry.partition(".")
+        key = rest.split(" = ")[0]
+        if table in ("inventory", "hazard", "design_block", "design", "report"):
+            assert repr(getattr(getattr(site, table), key)) == rest.split(" = ", 1)[1], entry
+    with pytest.raises(AttributeError):
+        site.hazard.n_block                              # a misspelt field fails loudly, not a silent None

@@ -151,7 +151,7 @@ def test_a_drape_on_a_site_without_a_face_is_refused(tmp_path):
 
 def test_the_site_file_drape_with_a_typed_retention_is_an_assumption(tmp_path):
     site = _with(tmp_path, '[[options]]\nname = "drape"\nkind = "drape"\ncapital_cost = 1\nretention = 0.9\n')
-    opts = load_site(site).mitigation["options"]
+    opts = load_site(site).mitigation.options
     from riskrf.risk.options.chain import effect_basis
     drape = [o for o in opts if o.name == "drape"][0]
     assert effect_basis(drape, [drape]) == "ASSUMPTION: typed effectiveness (drape)"

@@ -74,7 +74,7 @@ class TerrainAssessment:
         pandas.DataFrame
             One row per block crossing the barrier line.
         """
-        return self.result.collector(self.site.hazard["collector"], first_only=True)
+        return self.result.collector(self.site.hazard.collector, first_only=True)
 
     def summary(self) -> dict:
         """Machine-readable summary: rate, reach, design energies, fence verdicts, road totals, assumptions.
@@ -86,9 +86,9 @@ class TerrainAssessment:
         """
         hz = self.hazard
         design = self.energy.design
-        line = self.result.scenario.collectors[self.result.scenario.collector_index(self.site.hazard["collector"])]
+        line = self.result.scenario.collectors[self.result.scenario.collector_index(self.site.hazard.collector)]
         out = {"site": self.site.name, "source": str(self.site.path), "terrain": True,
-               "scenario": self.site.hazard["scenario"], "seed": self.seed, "n_blocks": self.n_blocks,
+               "scenario": self.site.hazard.scenario, "seed": self.seed, "n_blocks": self.n_blocks,
                "hazard": {"collector": hz.collector, "line": line.description(),
                           "rate_per_year_at_source": hz.rate_per_year,
                           "reach_probability": hz.reach_probability, "arrival_rate_per_year": hz.arrival_rate,
@@ -158,8 +158,8 @@ def run_terrain_assessment(site: Site, *, seed: int | None = None, n_blocks: int
     log = log or logger.info
     if not site.three_d:
         raise ValueError(f"{site.path}: hazard.scenario is not a 3-D terrain scenario; use run_assessment")
-    seed = site.hazard["seed"] if seed is None else seed
-    n_blocks = site.hazard["n_blocks"] if n_blocks is None else n_blocks
+    seed = site.hazard.seed if seed is None else seed
+    n_blocks = site.hazard.n_blocks if n_blocks is None else n_blocks
     inv_cfg, hz_cfg = site.inventory, site.hazard
     timings = {}
     t = time.perf_counter()
@@ -167,40 +167,40 @@ def run_terrain_assessment(site: Site, *, seed: int | None = None, n_blocks: int
     from .assess.site_inputs import fit_site_inventory
     inventory, frequency, maxima = fit_site_inventory(site, seed)     # the 2-D chain's fits stage
     from ..frequency.power_law import fit_gutenberg_richter
-    gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=inv_cfg["m_min_kg"],
-                               m_max=inv_cfg["m_max_kg"])
-    rate = gr.rate_min * inv_cfg["rate_scale"]
+    gr = fit_gutenberg_richter(inventory.masses, inventory.duration_years, m_min=inv_cfg.m_min_kg,
+                               m_max=inv_cfg.m_max_kg)
+    rate = gr.rate_min * inv_cfg.rate_scale
     timings["fits"] = round(time.perf_counter() - t, 2)
 
     t = time.perf_counter()
     log(f"[2/4] simulating {n_blocks:,} trajectories on the 3-D terrain across the mass range")
     import simulation
-    scenario = simulation.load_terrain_scenario(site.resolve(hz_cfg["scenario"]))
-    hazard, result = simulate_energy_hazard(gr, scenario, hz_cfg["collector"], rate_per_year=rate, n=n_blocks,
+    scenario = simulation.load_terrain_scenario(site.resolve(hz_cfg.scenario))
+    hazard, result = simulate_energy_hazard(gr, scenario, hz_cfg.collector, rate_per_year=rate, n=n_blocks,
                                             seed=seed, workers=workers)
     from .assess.hazard import with_rate_note
-    hazard = with_rate_note(hazard, inv_cfg["rate_scale"])
+    hazard = with_rate_note(hazard, inv_cfg.rate_scale)
     timings["simulation"] = round(time.perf_counter() - t, 2)
 
     t = time.perf_counter()
     log("[3/4] design energies and fence checks at the barrier line")
     from .assess.site_inputs import fence_checks_from_site
     fences, heights = fence_checks_from_site(site)
-    energy = analyse_energy(hazard, fences=fences, fence_height_m=heights, free_board_m=hz_cfg["free_board_m"],
-                            design_T=hz_cfg["design_period_years"], density_kg_m3=inventory.density_kg_m3,
-                            n_bootstrap=hz_cfg["bootstrap"], seed=seed)
+    energy = analyse_energy(hazard, fences=fences, fence_height_m=heights, free_board_m=hz_cfg.free_board_m,
+                            design_T=hz_cfg.design_period_years, density_kg_m3=inventory.density_kg_m3,
+                            n_bootstrap=hz_cfg.bootstrap, seed=seed)
     timings["energy"] = round(time.perf_counter() - t, 2)
 
     t = time.perf_counter()
     road = None
-    rname = hz_cfg["road_collector"]
+    rname = hz_cfg.road_collector
     if rname in [c.name for c in scenario.collectors]:
         log(f"[4/4] falls and road-user risk per metre of {rname!r}")
         line = scenario.collectors[scenario.collector_index(rname)]
         pos = np.full(result.n, np.nan)
         df = result.collector(rname, first_only=True)
         pos[df["block"].to_numpy()] = df["position_m"].to_numpy()
-        ex, co = site.mitigation["exposure"], site.mitigation["consequences"]
+        ex, co = site.mitigation.exposure, site.mitigation.consequences
         road = road_risk_along_line(hazard.velocity, gr, rate, pos, line.length_m, road=rname, bin_m=ROAD_BIN_M,
                                     lanes=ex.lane_list(), vehicle_length_m=ex.vehicle_length_m,
                                     occupants=ex.occupants_per_vehicle, hours_on_road=ex.hours_rock_on_road,

@@ -30,6 +30,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.file_schemas import MODEL_UNCERTAINTY
+from ..core.schema import record_class
 from ..core.format import money, sig
 from ..hazard.model_uncertainty import DesignEnergySplit, ModelUncertaintyError, design_energy_split, \
     read_model_posterior
@@ -41,6 +42,15 @@ DEFAULT_CALIBRATION_COST = 100_000.0
 
 #: The table's fields and defaults (from the one declaration, riskrf.core.file_schemas.MODEL_UNCERTAINTY).
 FIELDS = MODEL_UNCERTAINTY.defaults()
+
+#: The checked table (:func:`check_model_uncertainty`): its declared fields (generated from the declaration,
+#: defaults filled in) plus what the check derives: ``scenario_path`` (the resolved hazard.scenario),
+#: ``posterior_table`` (the read posterior sample, None for the presets' spread), ``posterior_path`` and
+#: ``calibration_cost_is_assumption`` (True when calibration_cost is the ASSUMED default).
+ModelUncertaintySettings = record_class(MODEL_UNCERTAINTY, name="ModelUncertaintySettings", extra=(
+    ("scenario_path", Path, None), ("posterior_table", object, None), ("posterior_path", Path, None),
+    ("calibration_cost_is_assumption", bool, False)))
+ModelUncertaintySettings.__module__ = __name__
 
 
 def check_model_uncertainty(data, site_path: Path, hazard: dict, *, error=ModelUncertaintyError):
@@ -62,7 +72,7 @@ def check_model_uncertainty(data, site_path: Path, hazard: dict, *, error=ModelU
 
     Returns
     -------
-    cfg : dict or None
+    cfg : ModelUncertaintySettings or None
         The table with defaults filled in, plus ``scenario_path``, ``posterior_table`` (the read posterior or None),
         ``calibration_cost`` [site currency] and ``calibration_cost_is_assumption``; None when the table is absent.
     used : list of str
@@ -118,7 +128,7 @@ def check_model_uncertainty(data, site_path: Path, hazard: dict, *, error=ModelU
             raise error(f"{where}: no posterior given and no material of {hazard['scenario']} names a preset, so "
                         "there is no spread to draw from; give model_uncertainty.posterior")
         cfg["posterior_table"] = None
-    return cfg, used
+    return ModelUncertaintySettings(**cfg), used
 
 
 @dataclass
@@ -137,7 +147,7 @@ class ModelUncertaintyStudy:
     energy: DesignEnergySplit
     ranking: ModelUncertainRanking
     calibration: CalibrationValue
-    config: dict
+    config: ModelUncertaintySettings
     per_draw: pd.DataFrame
     design_T: float
     ranges: pd.DataFrame | None = None
@@ -183,9 +193,9 @@ class ModelUncertaintyStudy:
         row = self.energy.row(self.design_T) if np.isclose(self.energy.table["T_years"], self.design_T).any() \
             else None
         rank = self.ranking.summary()
-        out = {"basis": self.basis, "posterior": str(cfg["posterior"]) if cfg["posterior"] else None,
-               "draws": int(self.ranking.n_draws), "blocks_per_draw": int(cfg["n_blocks"]),
-               "option_blocks_per_draw": int(cfg["option_blocks"]), "seed": int(cfg["seed"]),
+        out = {"basis": self.basis, "posterior": str(cfg.posterior) if cfg.posterior else None,
+               "draws": int(self.ranking.n_draws), "blocks_per_draw": int(cfg.n_blocks),
+               "option_blocks_per_draw": int(cfg.option_blocks), "seed": int(cfg.seed),
                "parameters": list(self.draws.columns),
                "assumed_ranges": None if self.ranges is None else {
                    k: {"low": r["low"], "high": r["high"], "basis": r["basis"]} for k, r in self.ranges.iterrows()},
@@ -356,30 +366,30 @@ def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_
 
     cfg = site.model_uncertainty
     log = log or (lambda s: None)
-    seed = int(cfg["seed"])
-    scenario = cfg["scenario_path"]
+    seed = int(cfg.seed)
+    scenario = cfg.scenario_path
     timings = {}
     t0 = time.perf_counter()
-    uncertainty = _without_material_draws(site.mitigation.get("uncertainty"))
+    uncertainty = _without_material_draws(site.mitigation.uncertainty)
     hazards, costs, samples, stops, rows = [], [], [], [], []
     names, parts, rounds = None, [], []
     profile = simulation.load_scenario(scenario).profile
     T = [design_T] if T is None else sorted(set(float(x) for x in T) | {float(design_T)})
-    budget = max(int(cfg.get("max_draws") or 0), int(cfg["draws"]))
-    k_new, analysis_s = int(cfg["draws"]), 0.0
+    budget = max(int(cfg.max_draws or 0), int(cfg.draws))
+    k_new, analysis_s = int(cfg.draws), 0.0
     while True:
         # each round adds draws of its own seed (a Latin hypercube or rows of the posterior), evaluated once
-        new = simulation.material_draws(scenario, k_new, posterior=cfg["posterior_table"],
+        new = simulation.material_draws(scenario, k_new, posterior=cfg.posterior_table,
                                         seed=seed if not parts else seed + 7919 * len(parts))
         if not parts:                          # where the draws come from: said once, by every output
-            basis = (f"posterior {Path(cfg['posterior']).name}: " if cfg["posterior"] else "") \
+            basis = (f"posterior {Path(cfg.posterior).name}: " if cfg.posterior else "") \
                 + new.attrs.get("basis", "")
         parts.append(new)
         for values in new.to_dict(orient="records"):
             j = len(rows)
             log(f"      draw {j + 1} of the trajectory model")
             sc = simulation.scenario_with_values(scenario, values)
-            hz, study, result, share = evaluate_draw(sc, int(cfg["n_blocks"]), int(cfg["option_blocks"]), seed,
+            hz, study, result, share = evaluate_draw(sc, int(cfg.n_blocks), int(cfg.option_blocks), seed,
                                                      uncertainty)
             u = study.uncertain
             names = tuple(u["names"]) if names is None else names
@@ -396,12 +406,12 @@ def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_
         t = time.perf_counter()
         ranking = ModelUncertainRanking(names, np.vstack(costs), draws=draws, sample_costs=np.stack(samples),
                                         currency=currency, basis=basis)
-        calibration = ranking.calibration_value(stops, n_releases=int(cfg["calibration_releases"]),
+        calibration = ranking.calibration_value(stops, n_releases=int(cfg.calibration_releases),
                                                 profile_range_m=(float(profile.x[0]), float(profile.x[-1])),
-                                                obs_error_m=float(cfg["obs_error_m"]),
-                                                n_datasets=int(cfg["synthetic_calibrations"]), seed=seed,
-                                                calibration_cost=float(cfg["calibration_cost"]),
-                                                cost_is_assumption=bool(cfg["calibration_cost_is_assumption"]))
+                                                obs_error_m=float(cfg.obs_error_m),
+                                                n_datasets=int(cfg.synthetic_calibrations), seed=seed,
+                                                calibration_cost=float(cfg.calibration_cost),
+                                                cost_is_assumption=bool(cfg.calibration_cost_is_assumption))
         analysis_s += time.perf_counter() - t
         reached = calibration_resolved(calibration)
         rounds.append((len(draws), reached))
@@ -411,7 +421,7 @@ def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_
         log(f"      the value of calibrating is not resolved with {len(draws)} draws: {k_new} more")
     timings["draws"] = round(time.perf_counter() - t0 - analysis_s, 2)
     t = time.perf_counter()
-    energy = design_energy_split(hazards, T, n_bootstrap=int(cfg["bootstrap"]), seed=seed,
+    energy = design_energy_split(hazards, T, n_bootstrap=int(cfg.bootstrap), seed=seed,
                                  reference=reference_hazard, basis=basis)
     design_row = energy.per_draw[np.isclose(energy.per_draw["T_years"], design_T)]
     per_draw = pd.DataFrame(rows).merge(design_row[["draw", "energy_kj"]].rename(
@@ -419,16 +429,16 @@ def run_model_uncertainty(site, evaluate_draw, *, reference_hazard=None, design_
     timings["analysis"] = round(time.perf_counter() - t + analysis_s, 2)
     notes = [effort_text(rounds, budget, calibration),
              f"{len(draws)} draws of the material parameters ({basis}), each re-simulated with "
-             f"{int(cfg['n_blocks']):,} blocks and seed {seed} (common random numbers; the assessment's own run "
-             f"uses {site.hazard['n_blocks']:,}), its options with {int(cfg['option_blocks']):,} blocks",
+             f"{int(cfg.n_blocks):,} blocks and seed {seed} (common random numbers; the assessment's own run "
+             f"uses {site.hazard.n_blocks:,}), its options with {int(cfg.option_blocks):,} blocks",
              "costs per draw: the mitigation study's mean over its joint samples of the other uncertain inputs "
              "(the same samples for every draw); the study's own material draws are switched off inside the draws"]
     if draws.attrs.get("ranges") is not None and draws.attrs["ranges"]["assumption"].any():
         notes.append("the presets' ranges are ASSUMPTIONS (simulation.material_uncertainty): "
                      + "; ".join(f"{k} {sig(r['low'], 3)}-{sig(r['high'], 3)}"
                                  for k, r in draws.attrs["ranges"].iterrows()))
-    if cfg["calibration_cost_is_assumption"]:
-        notes.append(f"calibration cost {money(cfg['calibration_cost'])} {currency}: ASSUMED default "
+    if cfg.calibration_cost_is_assumption:
+        notes.append(f"calibration cost {money(cfg.calibration_cost)} {currency}: ASSUMED default "
                      "(model_uncertainty.calibration_cost)")
     notes += list(energy.notes) + list(calibration.notes)
     return ModelUncertaintyStudy(draws=draws, basis=basis, energy=energy, ranking=ranking, calibration=calibration,

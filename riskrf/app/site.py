@@ -4,17 +4,22 @@ Every field is described in the documentation (File formats, "Site files").  Pat
 the site file.  Unknown fields are errors with a did-you-mean; optional fields
 left out take documented defaults, and :attr:`Site.defaults_used` lists them so
 the report can state them.  Everything is checked before any computing starts.
+
+The checked tables are typed records generated from the file's one declaration
+(:data:`riskrf.core.file_schemas.SITE_SCHEMA`, :meth:`riskrf.core.schema.Table.record`): the code reads
+``site.hazard.n_blocks``, and a field's name, type, unit and default have one home.
 """
 from __future__ import annotations
 
 import datetime
 import difflib
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from ..core import file_schemas as _fs
 from ..core.schema import check as _check_schema
+from ..core.schema import record_class
 from ..core.validation import RiskrfError, is_finite_number
 from ..risk.mitigation import MitigationError, study_inputs
 from ..risk.site_rates import check_closure_options, check_rates
@@ -33,34 +38,68 @@ MITIGATION_TABLES = ("traffic", "consequences", "economics", "options", "uncerta
 #: (riskrf.app.model_uncertainty), [required_barrier] (riskrf.risk.required_barrier).
 OTHER_TABLES = ("rates", "model_uncertainty", "required_barrier")
 
+#: The checked [rates] table (:func:`riskrf.risk.site_rates.check_rates`): its declared fields, whether the record is
+#: the site inventory, and ``reader_table``, the checked table as :func:`riskrf.risk.site_rates.evaluate_rates` reads
+#: it (with the rainfall, record and warning list already read).
+SiteRatesTable = record_class(_fs.RATES, name="SiteRatesTable",
+                              extra=(("record_is_inventory", bool, False), ("reader_table", dict, None)))
+SiteRatesTable.__module__ = __name__
+
+
+@dataclass(frozen=True)
+class SiteMitigation:
+    """The checked mitigation tables of a site (:func:`riskrf.risk.mitigation.study_inputs`): ``options`` (list of
+    :class:`~riskrf.risk.mitigation_inputs.Option`), ``exposure`` ([traffic]), ``consequences``, ``economics``,
+    ``uncertainty`` (None when there is no [uncertainty] table) and ``criteria``, each the typed object its parser
+    gives; :meth:`study_kwargs` passes them to :class:`~riskrf.risk.mitigation.MitigationStudy`."""
+    options: list
+    exposure: object
+    consequences: object
+    economics: object
+    uncertainty: object = None
+    criteria: object = None
+
+    def study_kwargs(self) -> dict:
+        """The tables as keyword arguments of :class:`~riskrf.risk.mitigation.MitigationStudy`.
+
+        Returns
+        -------
+        dict
+            ``options``, ``exposure``, ``consequences``, ``economics``, ``uncertainty``, ``criteria``.
+        """
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
 
 @dataclass(frozen=True)
 class Site:
     """A checked site file (``riskrf assess SITE.toml``, documentation: File formats, "Site files").
 
-    ``path`` of the file (relative paths inside it resolve against its folder), ``name`` and ``description``,
-    the ``inventory``, ``hazard``, ``mitigation``, ``design_block`` and optional ``rates`` sections as
-    checked dicts with defaults filled in, and ``defaults_used``: the names of the defaults applied, reported
-    as such in every output.
+    ``path`` of the file (relative paths inside it resolve against its folder), ``name`` and ``description``;
+    ``inventory``, ``hazard``, ``design_block``, ``design``, ``report`` and ``required_barrier``: the checked tables
+    as typed records with every default filled in (:data:`riskrf.core.file_schemas.SITE_RECORDS`, generated from the
+    file's declaration: ``site.hazard.n_blocks``); ``mitigation``: the checked mitigation tables
+    (:class:`SiteMitigation`); ``rates`` (:data:`SiteRatesTable`) and ``model_uncertainty``
+    (:data:`riskrf.app.model_uncertainty.ModelUncertaintySettings`): None when the table is absent; and
+    ``defaults_used``: the names of the defaults applied, reported as such in every output.
     """
     path: Path
     name: str
     description: str
-    inventory: dict
-    hazard: dict
-    mitigation: dict
+    inventory: _fs.SITE_RECORDS["inventory"]
+    hazard: _fs.SITE_RECORDS["hazard"]
+    mitigation: SiteMitigation
     defaults_used: tuple = field(default_factory=tuple)
-    design_block: dict = field(default_factory=lambda: dict(SITE_FIELDS["design_block"]))
-    rates: dict | None = None
-    design: dict = field(default_factory=lambda: dict(SITE_FIELDS["design"]))
-    report: dict = field(default_factory=lambda: dict(SITE_FIELDS["report"]))
+    design_block: _fs.SITE_RECORDS["design_block"] = field(default_factory=_fs.SITE_RECORDS["design_block"])
+    rates: SiteRatesTable | None = None
+    design: _fs.SITE_RECORDS["design"] = field(default_factory=_fs.SITE_RECORDS["design"])
+    report: _fs.SITE_RECORDS["report"] = field(default_factory=_fs.SITE_RECORDS["report"])
     #: True when hazard.scenario is a 3-D terrain scenario (a ``[terrain]`` table): ``riskrf assess`` then runs
     #: :func:`riskrf.app.assess3d.run_terrain_assessment` (hazard, energy and road outputs; no option ranking).
     three_d: bool = False
     #: the checked [model_uncertainty] table (riskrf.app.model_uncertainty), None when absent (off)
-    model_uncertainty: dict | None = None
-    #: the [required_barrier] table as given (its cost model, riskrf.risk.required_barrier), {} when absent
-    required_barrier: dict = field(default_factory=dict)
+    model_uncertainty: object = None
+    #: the [required_barrier] table (its cost model, riskrf.risk.required_barrier), its defaults when absent
+    required_barrier: _fs.SITE_RECORDS["required_barrier"] = field(default_factory=_fs.SITE_RECORDS["required_barrier"])
 
     def resolve(self, relative) -> Path:
         """A path given in the site file, resolved against the site file's folder.
@@ -128,11 +167,18 @@ def load_site(path) -> Site:
         cost_model_from_site(required, source=str(path))
     except ValueError as exc:
         raise SiteError(str(exc)) from exc
+    if rates is not None:
+        rates_record = SiteRatesTable(**{f.name: rates[f.name] for f in _fs.RATES.fields},
+                                      record_is_inventory=rates["record_is_inventory"], reader_table=rates)
+    else:
+        rates_record = None
     return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
-                description=str(tables["site"]["description"]), inventory=inv, hazard=hz,
-                mitigation=mitigation, defaults_used=tuple(used), design_block=tables["design_block"], rates=rates,
-                design=tables["design"], report=tables["report"], three_d=three_d,
-                model_uncertainty=model_uncertainty, required_barrier=dict(required))
+                description=str(tables["site"]["description"]), inventory=_fs.INVENTORY.record(inv),
+                hazard=_fs.HAZARD.record(hz), mitigation=SiteMitigation(**mitigation), defaults_used=tuple(used),
+                design_block=_fs.DESIGN_BLOCK.record(tables["design_block"]), rates=rates_record,
+                design=_fs.DESIGN.record(tables["design"]), report=_fs.REPORT.record(tables["report"]),
+                three_d=three_d, model_uncertainty=model_uncertainty,
+                required_barrier=_fs.REQUIRED_BARRIER.record(required))
 
 
 def _read_site_toml(path: Path) -> dict:

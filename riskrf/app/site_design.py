@@ -130,7 +130,7 @@ def option_scenario(site, scenario, option_name: str, options=None):
     from dataclasses import replace
 
     from ..risk.measures import Ditch, scenario_with_ditches
-    opts = {o.name: o for o in (site.mitigation["options"] if options is None else options)}
+    opts = {o.name: o for o in (site.mitigation.options if options is None else options)}
     o = opts[option_name]
     parts = [opts[n] for n in o.options] if o.kind == "combined" else [o]
     ditches = [Ditch(p.x_m, p.width_m, p.depth_m, **{k: getattr(p, k) for k in ("inner_slope_hv", "outer_slope_hv")
@@ -142,10 +142,10 @@ def option_scenario(site, scenario, option_name: str, options=None):
         return None
     sc = scenario
     if ditches:
-        sc = scenario_with_ditches(sc, ditches, where=str(site.path), road_collector=site.hazard["road_collector"])
+        sc = scenario_with_ditches(sc, ditches, where=str(site.path), road_collector=site.hazard.road_collector)
     for f in fences:
         if f.x_m is None:
-            sc = sc.with_barrier(site.hazard["collector"], f.capacity_kj, f.height_m)
+            sc = sc.with_barrier(site.hazard.collector, f.capacity_kj, f.height_m)
         else:
             from simulation.scenario import Collector
             sc = replace(sc, collectors=sc.collectors + (Collector(name=f"{f.name} line", x=float(f.x_m),
@@ -187,7 +187,7 @@ def with_recommended_run(design: SiteDesign, site, result, option_name: str | No
     sc = option_scenario(site, result.scenario, option_name, options)
     if sc is None:
         return design
-    res = simulation.run(sc, n=int(site.hazard["option_blocks"]), seed=seed)
+    res = simulation.run(sc, n=int(site.hazard.option_blocks), seed=seed)
     return replace(design, recommended=(option_name, res))
 
 
@@ -214,20 +214,20 @@ def design_for_site(site, hazard, block, result, density_kg_m3: float, seed) -> 
     SiteDesign
         Design basis, requirement, position search, run-out and catchment outputs.
     """
-    cfg = dict(site.design)
+    cfg = site.design.as_dict()
     positions_x = cfg.pop("positions_x_m", None)
-    n_pos = cfg.pop("position_blocks", None) or site.hazard["option_blocks"]
-    basis = design_basis_from_site(cfg, design_T=site.hazard["design_period_years"],
-                                   free_board_m=site.hazard["free_board_m"])
+    n_pos = cfg.pop("position_blocks", None) or site.hazard.option_blocks
+    basis = design_basis_from_site(cfg, design_T=site.hazard.design_period_years,
+                                   free_board_m=site.hazard.free_board_m)
     notes = []
     barrier_x = road_x = None
     if result is not None:
         names = [c.name for c in result.scenario.collectors]
-        barrier_x = result.scenario.collectors[names.index(site.hazard["collector"])].x
-        road = site.hazard["road_collector"]
+        barrier_x = result.scenario.collectors[names.index(site.hazard.collector)].x
+        road = site.hazard.road_collector
         road_x = result.scenario.collectors[names.index(road)].x if road in names else None
     clearance = (road_x - barrier_x) if road_x is not None and barrier_x is not None else None
-    fences = [o for o in site.mitigation["options"] if o.kind in ("fence", "attenuator") and o.x_m is None]
+    fences = [o for o in site.mitigation.options if o.kind in ("fence", "attenuator") and o.x_m is None]
     candidates = [(o.name, o.capacity_kj, o.height_m, getattr(o, "kit", None)) for o in fences] or [
         (f"candidate fence {c:g} kJ", c, h) for c, h in zip(*_fence_list(site))]
     try:
@@ -242,7 +242,7 @@ def design_for_site(site, hazard, block, result, density_kg_m3: float, seed) -> 
         pass
     elif result is not None and hazard.mass_coupled:
         positions = position_search(hazard, result.scenario, basis, block=block, density_kg_m3=density_kg_m3,
-                                    positions_m=positions_x, road_collector=site.hazard["road_collector"],
+                                    positions_m=positions_x, road_collector=site.hazard.road_collector,
                                     barrier_x=barrier_x, n=int(n_pos), seed=seed)
     else:
         notes.append("no position search: it needs a simulated, mass-coupled hazard (a scenario, "
@@ -256,17 +256,17 @@ def design_for_site(site, hazard, block, result, density_kg_m3: float, seed) -> 
                   "stop_x_p50_m": float(np.nanpercentile(xs, 50)), "stop_x_p95_m": float(np.nanpercentile(xs, 95)),
                   "stop_x_p99_m": float(np.nanpercentile(xs, 99))}
         if barrier_x is not None:
-            runout["share_reaching_barrier_line"] = float(result.reach_probability(site.hazard["collector"])[0])
+            runout["share_reaching_barrier_line"] = float(result.reach_probability(site.hazard.collector)[0])
         if road_x is not None:
-            runout["share_reaching_road"] = float(result.reach_probability(site.hazard["road_collector"])[0])
+            runout["share_reaching_road"] = float(result.reach_probability(site.hazard.road_collector)[0])
         catchment = retention_from_result(result)
     return SiteDesign(basis=basis, requirement=req, positions=positions, runout=runout, catchment=catchment,
                       barrier_x_m=barrier_x, road_x_m=road_x, notes=tuple(notes))
 
 
 def _fence_list(site):
-    caps = list(site.hazard["fences_kj"])
-    fh = site.hazard["fence_height_m"]
+    caps = list(site.hazard.fences_kj)
+    fh = site.hazard.fence_height_m
     return caps, (list(fh) if isinstance(fh, list) else [fh] * len(caps))
 
 

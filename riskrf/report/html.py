@@ -159,7 +159,7 @@ def _assumptions(a, hz, rate_scale) -> pd.DataFrame:
         add("inventory.m_max_kg", "maximum credible block m_max [kg]", sig(hz.mass.m_max), "judgement (site file)")
     add("inventory.rate_scale", _field_label("inventory.rate_scale"), sig(rate_scale),
         "judgement (site file)" if rate_scale != 1 else "whole inventory (no scaling)")
-    from_model = a.site.inventory.get("rate_from") == "rate_model"
+    from_model = a.site.inventory.rate_from == "rate_model"
     add("inventory.rate_from", "hazard rate source", a.rate_source, "computed: rate model ([rates])" if from_model
         else "computed: the inventory's record")
     if a.rates is not None and a.rates.climate and from_model:
@@ -279,7 +279,7 @@ def _summary_box(a) -> str:
     ranking, cur = a.decision["ranking"], a.study.currency
     best, second = ranking["option"].iloc[0], ranking["option"].iloc[1]
     design = en.design.set_index("T_years")
-    rate_scale = a.site.inventory["rate_scale"]
+    rate_scale = a.site.inventory.rate_scale
     money_est = _money_formatters(cur)[1]
     verdicts = en.fence_verdicts()
     summary = ["<div class='box'><b>Summary.</b><ul>",
@@ -576,7 +576,7 @@ def _slope_model_body(doc, a, figs: Path, s) -> None:
     """The slope model: profile vertices with segment dips, materials with the source of their values."""
     from .report_rows import slope_tables
     sc, vert, mats = slope_tables(a.site)
-    doc.add(f"<p>Scenario {_e(_name(a.site.hazard['scenario']))}: {_e(sc.description.strip())}</p>",
+    doc.add(f"<p>Scenario {_e(_name(a.site.hazard.scenario))}: {_e(sc.description.strip())}</p>",
             "<h3>Profile vertices and segment angles</h3>",
             doc.table(pd.DataFrame(vert, columns=list(S.SLOPE_VERTEX_COLUMNS)), "Profile vertices and segment angles"),
             "<h3>Materials and the source of their values</h3>",
@@ -715,7 +715,7 @@ def _decision_body(doc, a, figs: Path, s) -> None:
 def _assumptions_body(doc, a, figs: Path, s) -> None:
     """Assumptions, defaults and judgement inputs, and warnings."""
     en, hz = a.energy, a.energy.hazard
-    rate_scale = a.site.inventory["rate_scale"]
+    rate_scale = a.site.inventory.rate_scale
     classed = isinstance(hz.velocity, PairedSamples)
     items = [("Lumped-mass trajectories of round blocks; restitution and friction parameters are starting values "
               "to be calibrated on site (Wyllie 2014, ch. 7)."),

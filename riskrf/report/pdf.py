@@ -220,7 +220,7 @@ def _slope_model(rep, a, figs, s):
     """
     site = a.site
     sc, vert, mats = slope_tables(site)
-    rep.text(f"Scenario {Path(str(site.hazard['scenario'])).name}: {sc.description.strip()}", size=8.5)
+    rep.text(f"Scenario {Path(str(site.hazard.scenario)).name}: {sc.description.strip()}", size=8.5)
     rep.sub("Profile vertices and segment angles")
     rep.table(list(S.SLOPE_VERTEX_COLUMNS), vert, widths=[0.8, 1, 1, 2, 2])
     rep.sub("Materials and the source of their values")

@@ -313,7 +313,7 @@ def title_block(site, now: datetime.date | None = None) -> dict:
     Parameters
     ----------
     site : Site
-        The site (its ``report`` table and name).
+        The site (its ``report`` record, :data:`riskrf.core.file_schemas.SITE_RECORDS`, and its name).
     now : datetime.date, optional
         Date used when the table gives none (default: today).
 
@@ -322,13 +322,13 @@ def title_block(site, now: datetime.date | None = None) -> dict:
     dict
         ``project``, ``site``, ``location``, ``revision``, ``date``, ``author``, ``checker``, ``client``.
     """
-    r = dict(getattr(site, "report", {}) or {})
-    d = r.get("date")
-    return {"project": str(r.get("project") or site.name), "site": site.name,
-            "location": str(r.get("location") or "not stated"), "revision": str(r.get("revision") or "A"),
+    r = site.report
+    d = r.date
+    return {"project": str(r.project or site.name), "site": site.name,
+            "location": str(r.location or "not stated"), "revision": str(r.revision or "A"),
             "date": str(d) if d is not None else (now or datetime.date.today()).isoformat(),
-            "author": str(r.get("author") or "not stated"), "checker": str(r.get("checker") or "not stated"),
-            "client": str(r.get("client") or "not stated")}
+            "author": str(r.author or "not stated"), "checker": str(r.checker or "not stated"),
+            "client": str(r.client or "not stated")}
 
 
 __all__ = ["A4_TEXT_WIDTH_MM", "fmt", "pct", "title_block", "year"]

@@ -32,7 +32,7 @@ def slope_tables(site):
     """
     import simulation
     from simulation.materials import ALIASES, SOURCES
-    path = site.resolve(site.hazard["scenario"])
+    path = site.resolve(site.hazard.scenario)
     sc = simulation.load_scenario(path)
     raw = tomllib.loads(Path(path).read_text(encoding="utf-8"))
     prof = sc.profile

@@ -128,7 +128,7 @@ _SECTIONS: tuple = (
     ("positions", "Barrier position along the profile",
      lambda a: _design(a) is not None and a.design.positions is not None, (T_POSITIONS,),
      (("barrier_positions.png", "Required MEL and net height by barrier position"),)),
-    ("slope_model", "Slope model", lambda a: bool(a.site.hazard.get("scenario")),
+    ("slope_model", "Slope model", lambda a: bool(a.site.hazard.scenario),
      ("Profile vertices and segment angles", "Materials and the source of their values"), ()),
     ("options_profile", "Mitigation options on the profile", lambda a: True, (),
      (("options_profile.png", F_OPTIONS),)),

@@ -212,7 +212,7 @@ def cost_model_from_site(table: dict | None, *, site_fences=(), source: str = ""
             kw[name] = _number(t[name], f"{at}.{name}")
     if t.get("cost_range") is not None:
         r = t["cost_range"]
-        if not (isinstance(r, list) and len(r) == 2):
+        if not (isinstance(r, (list, tuple)) and len(r) == 2):      # a tuple: the declared default
             raise MitigationError(f"{at}.cost_range = {r!r} must be [low, high] factors of the central cost")
         lo, hi = (_number(x, f"{at}.cost_range", open_low=True) for x in r)
         if not lo <= 1.0 <= hi:

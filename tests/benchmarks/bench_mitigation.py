@@ -30,19 +30,19 @@ def main(samples: int = 1000):
     inv_cfg, hz_cfg = site.inventory, site.hazard
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        inv = read_inventory(site.resolve(inv_cfg["path"]))
+        inv = read_inventory(site.resolve(inv_cfg.path))
     gr, hazard, result = energy_hazard_from_inputs(
-        inv, m_max=inv_cfg["m_max_kg"], rate_scale=inv_cfg["rate_scale"], scenario=site.resolve(hz_cfg["scenario"]),
-        n=hz_cfg["n_blocks"], seed=hz_cfg["seed"])
-    mit = dict(site.mitigation)
+        inv, m_max=inv_cfg.m_max_kg, rate_scale=inv_cfg.rate_scale, scenario=site.resolve(hz_cfg.scenario),
+        n=hz_cfg.n_blocks, seed=hz_cfg.seed)
+    mit = site.mitigation.study_kwargs()
     if site.rates is not None:          # closure rules: share and hours from the site's daily rate model
         from riskrf.risk.site_rates import evaluate_rates, resolve_closures
-        rates = evaluate_rates(site.rates, site.path.parent, inv_cfg, mit["options"])
+        rates = evaluate_rates(site.rates.reader_table, site.path.parent, inv_cfg.as_dict(), mit["options"])
         mit["options"] = resolve_closures(mit["options"], rates)
     mit["uncertainty"] = replace(mit["uncertainty"], samples=samples)
     study = MitigationStudy(hazard=hazard, road_share=road_share(result, "barrier", "road"),
-                            **study_context(result, "barrier", "road", hz_cfg["option_blocks"], hz_cfg["seed"], inv,
-                                            hazard, inv_cfg["rate_scale"]), **mit)
+                            **study_context(result, "barrier", "road", hz_cfg.option_blocks, hz_cfg.seed, inv,
+                                            hazard, inv_cfg.rate_scale), **mit)
     n_opt = len(study.options)
     t0 = time.perf_counter()
     study.central_parameters()          # derives every option's effect (re-simulations included)
@@ -53,7 +53,7 @@ def main(samples: int = 1000):
     study.break_even_table()
     t3 = time.perf_counter()
     print(f"options: {n_opt} ({', '.join(study.options[i].name for i in range(n_opt))})")
-    print(f"deriving effects (ditch re-simulations with {hz_cfg['option_blocks']:,} blocks, damage tables): "
+    print(f"deriving effects (ditch re-simulations with {hz_cfg.option_blocks:,} blocks, damage tables): "
           f"{t1 - t0:.2f} s")
     print(f"uncertainty ranking, {samples:,} joint samples x {n_opt} options: {t2 - t1:.2f} s")
     print(f"tornado and break-even over {len(study.central_parameters())} inputs: {t3 - t2:.2f} s")

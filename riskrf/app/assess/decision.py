@@ -20,8 +20,8 @@ from functools import partial
 
 import numpy as np
 
-from ...risk.mitigation import Exposure, MitigationStudy
-from ..site import Site
+from ...risk.mitigation import MitigationStudy
+from ..site import Site, SiteMitigation
 from ..site_design import with_recommended_run
 from .hazard import energy_hazard_from_inputs
 from .site_inputs import sensitivity_inputs
@@ -151,7 +151,7 @@ def release_factor_for_road_record(hazard, share: float, context: dict, source: 
 
 
 def draw_evaluator(site, inventory, scenario, n_blocks: int, option_blocks: int, seed, uncertainty, *,
-                   rate_scale: float, rate_note, mitigation: dict, design_masses) -> tuple:
+                   rate_scale: float, rate_note, mitigation: SiteMitigation, design_masses) -> tuple:
     """The assessment's chain for one draw of the trajectory model (``[model_uncertainty]``): the energy hazard
     simulated on ``scenario`` with ``n_blocks`` blocks, the road-basis release factor recomputed when the record
     counts road falls, and the mitigation study with ``option_blocks`` per option re-simulation and the study's
@@ -178,8 +178,8 @@ def draw_evaluator(site, inventory, scenario, n_blocks: int, option_blocks: int,
         Factor [-] on the fitted rate, as the assessment used it.
     rate_note : str or None
         Note on the rate, as the assessment used it.
-    mitigation : dict
-        The site's mitigation keyword arguments of :class:`MitigationStudy`.
+    mitigation : SiteMitigation
+        The site's mitigation tables (:meth:`SiteMitigation.study_kwargs` are passed to :class:`MitigationStudy`).
     design_masses : sequence of float or callable
         Design masses [kg] (or a function of the fit and rate [1/yr]), as the assessment used them.
 
@@ -195,13 +195,13 @@ def draw_evaluator(site, inventory, scenario, n_blocks: int, option_blocks: int,
         P(road | barrier line) [-].
     """
     hz_cfg, inv_cfg = site.hazard, site.inventory
-    collector, road = hz_cfg["collector"], hz_cfg["road_collector"]
+    collector, road = hz_cfg.collector, hz_cfg.road_collector
     _, hz, result, hits = energy_hazard_from_inputs(
-        inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=rate_scale, scenario=scenario,
-        collector=collector, n=n_blocks, seed=seed, mass_coupling=hz_cfg["mass_coupling"],
+        inventory, m_min=inv_cfg.m_min_kg, m_max=inv_cfg.m_max_kg, rate_scale=rate_scale, scenario=scenario,
+        collector=collector, n=n_blocks, seed=seed, mass_coupling=hz_cfg.mass_coupling,
         design_masses_kg=design_masses, rate_note=rate_note, road_collector=road)
     share = road_share(result, collector, road)
-    if inv_cfg.get("rate_basis", "release") == "road":
+    if inv_cfg.rate_basis == "road":
         factor = release_factor_for_road_record(
             hz, share, study_context(result, collector, road, option_blocks, seed, inventory, hz, rate_scale, hits),
             str(site.path), uncertainty=uncertainty)
@@ -210,7 +210,8 @@ def draw_evaluator(site, inventory, scenario, n_blocks: int, option_blocks: int,
     study = MitigationStudy(hazard=hz, road_share=share, source=str(site.path), defaults_used=site.defaults_used,
                             **study_context(result, collector, road, option_blocks, seed, inventory, hz, rate_scale,
                                             hits),
-                            **(dict(mitigation, uncertainty=uncertainty) if uncertainty is not None else mitigation))
+                            **(replace(mitigation, uncertainty=uncertainty) if uncertainty is not None
+                               else mitigation).study_kwargs())
     return hz, study, result, share
 
 
@@ -242,7 +243,7 @@ def fence_design_checks(options, energy) -> dict:
     return out
 
 
-def required_barrier_for_site(site, mitigation: dict, energy, site_design) -> tuple:
+def required_barrier_for_site(site, mitigation: SiteMitigation, energy, site_design) -> tuple:
     """The options to rank with the required barrier among them, every fence's design verdict, and the required
     barrier itself.
 
@@ -257,7 +258,7 @@ def required_barrier_for_site(site, mitigation: dict, energy, site_design) -> tu
     ----------
     site : Site
         The checked site.
-    mitigation : dict
+    mitigation : SiteMitigation
         Its mitigation tables (options, traffic, consequences, ...).
     energy : EnergyAnalysis
         Design energies [kJ] and fence checks.
@@ -272,24 +273,24 @@ def required_barrier_for_site(site, mitigation: dict, energy, site_design) -> tu
         requirement or when ``include`` is false).
     """
     from ...risk.required_barrier import basis_design_checks, cost_model_from_site, required_barrier
-    options = list(mitigation["options"])
+    options = list(mitigation.options)
     checks = fence_design_checks(options, energy)
     requirement = getattr(site_design, "requirement", None)
     if requirement is None:
         return mitigation, checks, None
     checks.update(basis_design_checks(requirement))
-    exposed = mitigation.get("exposure", Exposure()).exposed_length_m
+    exposed = mitigation.exposure.exposed_length_m
     fences = [(o.capacity_kj, o.height_m, o.capital_cost, exposed) for o in options
               if o.kind in ("fence", "attenuator") and o.x_m is None]
-    model, include = cost_model_from_site(site.required_barrier, site_fences=fences, source=str(site.path))
+    model, include = cost_model_from_site(site.required_barrier.as_dict(), site_fences=fences, source=str(site.path))
     if not include:
         return mitigation, checks, None
-    currency = mitigation["consequences"].currency if "consequences" in mitigation else ""
+    currency = mitigation.consequences.currency
     required = required_barrier(requirement, getattr(site_design, "positions", None), model,
                                 exposed_length_m=model.length_m or exposed, currency=currency,
                                 source=str(site.path))
     if required.placeable and required.option.name not in {o.name for o in options}:
-        mitigation = dict(mitigation, options=options + [required.option])
+        mitigation = replace(mitigation, options=options + [required.option])
         checks[required.option.name] = required.verdict
     return mitigation, checks, required
 
@@ -328,13 +329,13 @@ def _release_rate_of_road_record(site: Site, inventory, hazard, result, road_hit
     """
     inv_cfg, hz_cfg = site.inventory, site.hazard
     release_factor = 1.0
-    if inv_cfg.get("rate_basis", "release") == "road":
+    if inv_cfg.rate_basis == "road":
         # the record counts falls that reached the road: release rate = recorded / P(road | release)
         release_factor = release_factor_for_road_record(
-            hazard, road_share(result, hz_cfg["collector"], hz_cfg["road_collector"]),
-            study_context(result, hz_cfg["collector"], hz_cfg["road_collector"], hz_cfg["option_blocks"], seed,
+            hazard, road_share(result, hz_cfg.collector, hz_cfg.road_collector),
+            study_context(result, hz_cfg.collector, hz_cfg.road_collector, hz_cfg.option_blocks, seed,
                           inventory, hazard, rate_scale, road_hits), str(site.path),
-            uncertainty=site.mitigation.get("uncertainty"))
+            uncertainty=site.mitigation.uncertainty)
         hazard = replace(hazard, rate_per_year=hazard.rate_per_year * release_factor)
         rate_scale = rate_scale * release_factor
         m_max_values, shares = sensitivity_inputs(site, rate_scale)
@@ -385,19 +386,19 @@ def _decision_stage(site: Site, inventory, hazard, result, road_hits, rate_scale
         with the recommended option's run.
     """
     hz_cfg = site.hazard
-    share = road_share(result, hz_cfg["collector"], hz_cfg["road_collector"])
+    share = road_share(result, hz_cfg.collector, hz_cfg.road_collector)
     mitigation = site.mitigation
     if rates is not None:
         from ...risk.site_rates import resolve_closures
         site_rates = rates.result()
-        mitigation = dict(mitigation, options=resolve_closures(mitigation["options"], site_rates))
+        mitigation = replace(mitigation, options=resolve_closures(mitigation.options, site_rates))
     mitigation, checks, required = required_barrier_for_site(site, mitigation, energy, site_design)
     study = MitigationStudy(hazard=hazard, road_share=share, source=str(site.path),
                             defaults_used=site.defaults_used,
-                            **study_context(result, hz_cfg["collector"], hz_cfg["road_collector"],
-                                            hz_cfg["option_blocks"], seed, inventory, hazard,
+                            **study_context(result, hz_cfg.collector, hz_cfg.road_collector,
+                                            hz_cfg.option_blocks, seed, inventory, hazard,
                                             rate_scale, road_hits),
-                            **mitigation)
+                            **mitigation.study_kwargs())
     ensemble = ensemble_replicates(site, result, seed, replicate, mitigation, study.uncertainty,
                                    n_blocks=n_blocks) if replicate is not None else None
     study = replace(study, design_checks=checks, required_barrier=required, ensemble=ensemble)
@@ -407,11 +408,11 @@ def _decision_stage(site: Site, inventory, hazard, result, road_hits, rate_scale
     decision["effort"] = effort.to_dict()
     decision["recommendation"]["reason"] += " " + effort.text()
     site_design = with_recommended_run(site_design, site, result, decision["recommendation"]["option"], seed,
-                                       options=mitigation["options"])
+                                       options=mitigation.options)
     return mitigation, site_rates, study, decision, site_design
 
 
-def ensemble_replicates(site: Site, result, seed, replicate, mitigation: dict, uncertainty, *,
+def ensemble_replicates(site: Site, result, seed, replicate, mitigation: SiteMitigation, uncertainty, *,
                         n_blocks: int | None = None):
     """The mitigation study repeated with independent trajectory ensembles, for the error budget
     (:class:`riskrf.risk.error_budget.EnsembleReplicates`).
@@ -434,7 +435,7 @@ def ensemble_replicates(site: Site, result, seed, replicate, mitigation: dict, u
     replicate : callable
         ``replicate(scenario, n_blocks, option_blocks, seed, uncertainty, mitigation=...)`` ->
         (hazard, study, result, share), :func:`draw_evaluator` with the assessment's rate bound.
-    mitigation : dict
+    mitigation : SiteMitigation
         The mitigation tables the study ranks (with the required barrier).
     uncertainty : riskrf.risk.mitigation_inputs.Uncertainty
         The study's uncertain inputs (``ensemble_replicates``, ``ensemble_effort``).
@@ -451,10 +452,10 @@ def ensemble_replicates(site: Site, result, seed, replicate, mitigation: dict, u
     R = int(uncertainty.ensemble_replicates)
     if R < 2 or result is None:
         return None
-    n_full = int(site.hazard["n_blocks"] if n_blocks is None else n_blocks)
+    n_full = int(site.hazard.n_blocks if n_blocks is None else n_blocks)
     effort = float(uncertainty.ensemble_effort)
     n = max(int(round(n_full * effort)), 1)
-    option_blocks = max(int(round(site.hazard["option_blocks"] * effort)), 1)
+    option_blocks = max(int(round(site.hazard.option_blocks * effort)), 1)
     seeds = tuple(int(x) for x in np.random.SeedSequence([int(seed or 0), 40]).generate_state(R))
     # the replicates keep the slope's own materials: each material draw of the study is already an ensemble of
     # its own, whose noise its clustered error counts; what is common to all samples is the hazard's simulation
@@ -492,7 +493,7 @@ def _model_uncertainty_stage(site: Site, inventory, hazard, energy, rate_scale: 
         Factor turning a road record into a release rate (dimensionless); each draw recomputes its own.
     rate_note : str or None
         How the rate was obtained.
-    mitigation : dict
+    mitigation : SiteMitigation
         The mitigation table used by the study.
     design_masses : callable
         ``design_masses(law, rate)``: masses (kg) to simulate.
@@ -510,12 +511,12 @@ def _model_uncertainty_stage(site: Site, inventory, hazard, energy, rate_scale: 
         return None
     from ..model_uncertainty import run_model_uncertainty
     t = time.perf_counter()
-    log(f"      the trajectory model's uncertainty: {site.model_uncertainty['draws']} draws of the material "
+    log(f"      the trajectory model's uncertainty: {site.model_uncertainty.draws} draws of the material "
         "parameters re-simulated (design energies, ranking, value of a field calibration)")
     evaluate = partial(draw_evaluator, site, inventory, rate_scale=rate_scale / release_factor,
                        rate_note=rate_note, mitigation=mitigation, design_masses=design_masses)
     model_uncertainty = run_model_uncertainty(
-        site, evaluate, reference_hazard=hazard, design_T=site.hazard["design_period_years"],
+        site, evaluate, reference_hazard=hazard, design_T=site.hazard.design_period_years,
         T=energy.design["T_years"].tolist(), log=log)
     timings["model_uncertainty"] = round(time.perf_counter() - t, 2)
     return model_uncertainty

@@ -327,13 +327,13 @@ def _simulate_hazard(site: Site, inventory, rate_scale: float, rate_note, n_bloc
     """
     inv_cfg, hz_cfg = site.inventory, site.hazard
     return energy_hazard_from_inputs(
-        inventory, m_min=inv_cfg["m_min_kg"], m_max=inv_cfg["m_max_kg"], rate_scale=rate_scale,
-        scenario=site.resolve(hz_cfg["scenario"]) if hz_cfg["scenario"] else None,
-        velocities=site.resolve(hz_cfg["velocities"]) if hz_cfg["velocities"] else None,
-        collector=hz_cfg["collector"], n=n_blocks, seed=seed, reach_probability=hz_cfg["reach_probability"],
-        mass_coupling=hz_cfg["mass_coupling"], design_masses_kg=design_masses,
-        velocity_unit=hz_cfg["velocity_unit"], drop_height_m=hz_cfg.get("drop_height_m"), rate_note=rate_note,
-        road_collector=hz_cfg["road_collector"])
+        inventory, m_min=inv_cfg.m_min_kg, m_max=inv_cfg.m_max_kg, rate_scale=rate_scale,
+        scenario=site.resolve(hz_cfg.scenario) if hz_cfg.scenario else None,
+        velocities=site.resolve(hz_cfg.velocities) if hz_cfg.velocities else None,
+        collector=hz_cfg.collector, n=n_blocks, seed=seed, reach_probability=hz_cfg.reach_probability,
+        mass_coupling=hz_cfg.mass_coupling, design_masses_kg=design_masses,
+        velocity_unit=hz_cfg.velocity_unit, drop_height_m=hz_cfg.drop_height_m, rate_note=rate_note,
+        road_collector=hz_cfg.road_collector)
 
 
 def _energy_stage(site: Site, inventory, gr, hazard, result, survey, m_max_values, shares, rate_scale: float,
@@ -371,17 +371,17 @@ def _energy_stage(site: Site, inventory, gr, hazard, result, survey, m_max_value
         The site's design masses (:func:`design_for_site`).
     """
     db_cfg, hz_cfg, inv_cfg = site.design_block, site.hazard, site.inventory
-    block = design_block(hazard, rule=db_cfg["rule"], percentile=db_cfg["percentile"], survey_volumes_m3=survey,
-                         survey_source=db_cfg["survey"], inventory=inventory,
-                         sizes=resolve_sizes(inv_cfg["sizes"], inventory),
-                         design_T=hz_cfg["design_period_years"], density_kg_m3=inventory.density_kg_m3,
-                         fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"])
+    block = design_block(hazard, rule=db_cfg.rule, percentile=db_cfg.percentile, survey_volumes_m3=survey,
+                         survey_source=db_cfg.survey, inventory=inventory,
+                         sizes=resolve_sizes(inv_cfg.sizes, inventory),
+                         design_T=hz_cfg.design_period_years, density_kg_m3=inventory.density_kg_m3,
+                         fractal_dimension=db_cfg.fractal_dimension, iterations=db_cfg.iterations)
     sensitivity = design_energy_sensitivity(
         hazard, inventory.masses, inventory.duration_years, m_min=gr.m_min, m_max_values=m_max_values,
-        rate_shares=shares, T=hz_cfg["design_period_years"]) \
-        if hz_cfg["design_period_years"] * hazard.arrival_rate > 1 else None
+        rate_shares=shares, T=hz_cfg.design_period_years) \
+        if hz_cfg.design_period_years * hazard.arrival_rate > 1 else None
     tornado = design_energy_tornado(
-        hazard, design_T=hz_cfg["design_period_years"], block=block, masses_kg=inventory.masses,
+        hazard, design_T=hz_cfg.design_period_years, block=block, masses_kg=inventory.masses,
         duration_years=inventory.duration_years, m_max_range=_ends(m_max_values),
         rate_share=rate_scale, rate_share_range=_ends(shares), sensitivity=sensitivity,
         **({"rate_label": "rate factor on the inventory's rate (rate model x rate_scale)"}
@@ -389,8 +389,8 @@ def _energy_stage(site: Site, inventory, gr, hazard, result, survey, m_max_value
         if sensitivity is not None else None
     fences, heights = fence_checks_from_site(site)
     energy = analyse_energy(hazard, fences=fences, fence_height_m=heights,
-                            free_board_m=hz_cfg["free_board_m"], design_T=hz_cfg["design_period_years"],
-                            density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg["bootstrap"], seed=seed,
+                            free_board_m=hz_cfg.free_board_m, design_T=hz_cfg.design_period_years,
+                            density_kg_m3=inventory.density_kg_m3, n_bootstrap=hz_cfg.bootstrap, seed=seed,
                             design_block=block, sensitivity=sensitivity, tornado=tornado)
     site_design = design_for_site(site, hazard, block, result, inventory.density_kg_m3, seed)
     return energy, site_design

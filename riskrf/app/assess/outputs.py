@@ -87,7 +87,7 @@ def write_assessment(a: Assessment, out: Path, log=None, runner=None) -> dict:
                 part.result()
         else:
             def simulation_and_decision_outputs():
-                _simulation_figures(a.result, a.site.hazard["collector"], figs, fences_to_draw(a.site))
+                _simulation_figures(a.result, a.site.hazard.collector, figs, fences_to_draw(a.site))
                 write_mitigation_outputs(a.study, a.decision, figs)
 
             beside = runner.beside(simulation_and_decision_outputs)
@@ -156,7 +156,7 @@ def fences_to_draw(site) -> list:
     list of tuple
         ``(x [m] or None, height [m], label)`` per fence.
     """
-    opts = [o for o in site.mitigation["options"] if o.kind in ("fence", "attenuator")]
+    opts = [o for o in site.mitigation.options if o.kind in ("fence", "attenuator")]
     if opts:
         return [(o.x_m, o.height_m, f"{o.name} ({o.height_m:g} m high)" if f"{o.capacity_kj:g}" in o.name
                  else f"{o.name}: {o.capacity_kj:,.0f} kJ, {o.height_m:g} m high") for o in opts]
@@ -203,13 +203,13 @@ def _design_figures(a: Assessment, figs: Path, part: int | None = None) -> None:
         if d.positions is not None:
             save_figure(position_search_figure(d.positions), figs / "barrier_positions.png")
         if a.result is not None:
-            save_figure(options_profile_figure(a.result.scenario, a.site.mitigation["options"],
+            save_figure(options_profile_figure(a.result.scenario, a.site.mitigation.options,
                                                barrier_x=d.barrier_x_m, road_x=d.road_x_m,
                                                requirement=d.requirement),
                         figs / "options_profile.png")
     if part in (None, 1):
         if a.result is not None:
-            ditches = [(o.x_m, o.x_m + o.width_m, o.name) for o in a.site.mitigation["options"]
+            ditches = [(o.x_m, o.x_m + o.width_m, o.name) for o in a.site.mitigation.options
                        if o.kind == "ditch" and o.x_m is not None and o.width_m is not None]
             save_figure(stop_points_figure(a.result, road_x=d.road_x_m, ditches=ditches,
                                            option=d.recommended), figs / "stop_points.png")
@@ -230,8 +230,8 @@ def _copy_inputs(a: Assessment, dest: Path) -> None:
     for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
                        ("hazard", "velocities"), ("design_block", "survey"), ("rates", "record"),
                        ("rates", "rainfall"), ("rates", "warnings"), ("model_uncertainty", "posterior")):
-        rel = {"inventory": site.inventory, "hazard": site.hazard, "design_block": site.design_block,
-               "rates": site.rates or {}, "model_uncertainty": site.model_uncertainty or {}}[table].get(key)
+        section = getattr(site, table)              # rates and model_uncertainty are None when absent
+        rel = getattr(section, key) if section is not None else None
         if rel:
             src = site.resolve(rel)
             shutil.copy2(src, dest / src.name)

@@ -55,15 +55,15 @@ class Assessment:
     def rate_source(self) -> str:
         """Where the hazard's annual rate comes from, in words."""
         inv = self.inventory
-        if self.site.inventory.get("rate_from") == "rate_model" and self.rates is not None:
+        if self.site.inventory.rate_from == "rate_model" and self.rates is not None:
             text = "rate model: " + self.rates.rate_text()
         else:
             text = (f"inventory: {inv.n_events:,} recorded falls in {inv.duration_years:.3g} years "
                     f"({self.frequency.power_law.rate_min:.4g} per year at or above m_min)")
-        scale = self.site.inventory["rate_scale"]
+        scale = self.site.inventory.rate_scale
         text += (f"; times rate_scale {scale:g} (typed: share of the recorded source above this road)"
                  if scale != 1 else "")
-        if self.site.inventory.get("rate_basis", "release") == "road":
+        if self.site.inventory.rate_basis == "road":
             return text + (f"; rate_basis = 'road': the record counts falls that reached the road, so the release "
                            f"rate is {self.release_factor:.4g} times it (1 / P(road | release), simulated; doing "
                            "nothing reproduces the recorded road falls)")
@@ -106,7 +106,7 @@ class Assessment:
                                                 "m_min_kg": float(hz.mass.m_min)},
                        "mass_coupled": hz.mass_coupled,
                        "falls_per_year": hz.rate_per_year, "rate_source": self.rate_source,
-                       "rate_basis": self.site.inventory.get("rate_basis", "release"),
+                       "rate_basis": self.site.inventory.rate_basis,
                        "release_factor": self.release_factor,
                        "reach_probability": hz.reach_probability,
                        "arrivals_per_year": hz.arrival_rate,

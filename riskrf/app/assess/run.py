@@ -73,8 +73,8 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         prepare_drawing()           # pyplot imported once here, not in each process drawing beside
     from ...report.mitigation_text import study_report
 
-    seed = site.hazard["seed"] if seed is None else seed
-    n_blocks = site.hazard["n_blocks"] if n_blocks is None else n_blocks
+    seed = site.hazard.seed if seed is None else seed
+    n_blocks = site.hazard.n_blocks if n_blocks is None else n_blocks
     timings = {}
     stages = 5
 
@@ -85,7 +85,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RiskrfWarning)
         hz_cfg = site.hazard
-        runner.start(bool(hz_cfg["scenario"]), log)
+        runner.start(bool(hz_cfg.scenario), log)
         rates = _start_rates(site, runner)
         t = stage(1, "reading the inventory and fitting magnitude-frequency models")
         inventory, frequency, maxima_frequency = fit_site_inventory(site, seed)
@@ -96,14 +96,14 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             site, inventory, rates)
         design_masses = partial(_design_masses, site=site, inventory=inventory, extra=extra)
         runner.before_simulation(timings)
-        t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg["scenario"] else "reading velocities")
+        t = stage(2, f"simulating {n_blocks:,} trajectories" if hz_cfg.scenario else "reading velocities")
         gr, hazard, result, road_hits = _simulate_hazard(site, inventory, rate_scale, rate_note, n_blocks, seed,
                                                          design_masses)
         timings["simulation"] = round(time.perf_counter() - t, 2)
         release_factor, hazard, rate_scale, m_max_values, shares = _release_rate_of_road_record(
             site, inventory, hazard, result, road_hits, rate_scale, seed, m_max_values, shares)
         if figures is not None:
-            pending.append(runner.beside(partial(_simulation_figures, result, hz_cfg["collector"], figures,
+            pending.append(runner.beside(partial(_simulation_figures, result, hz_cfg.collector, figures,
                                                  fences_to_draw(site))))
 
         t = stage(3, "computing the impact-energy hazard, design block, design energies and fence checks")
@@ -119,7 +119,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                             rate_note=rate_note, design_masses=design_masses)
         mitigation, site_rates, study, decision, site_design = _decision_stage(
             site, inventory, hazard, result, road_hits, rate_scale, energy, rates, site_rates, site_design, seed,
-            study_report, replicate=replicate if hz_cfg["scenario"] else None, n_blocks=n_blocks)
+            study_report, replicate=replicate if hz_cfg.scenario else None, n_blocks=n_blocks)
         timings["decision"] = round(time.perf_counter() - t, 2)
         model_uncertainty = _model_uncertainty_stage(
             site, inventory, hazard, energy, rate_scale, release_factor, rate_note, mitigation, design_masses, log,

@@ -37,11 +37,11 @@ def fence_checks_from_site(site) -> tuple:
     heights : tuple of float
         Their heights [m].
     """
-    opts = [o for o in site.mitigation["options"] if o.kind in ("fence", "attenuator") and o.x_m is None]
+    opts = [o for o in site.mitigation.options if o.kind in ("fence", "attenuator") and o.x_m is None]
     if opts:
         return tuple(o.capacity_kj for o in opts), tuple(o.height_m for o in opts)
-    fh = site.hazard["fence_height_m"]
-    caps = tuple(site.hazard["fences_kj"])
+    fh = site.hazard.fence_height_m
+    caps = tuple(site.hazard.fences_kj)
     return caps, tuple(fh) if isinstance(fh, list) else tuple([fh] * len(caps))
 
 
@@ -55,7 +55,7 @@ def sensitivity_inputs(site, rate_scale: float | None = None) -> tuple:
     Parameters
     ----------
     site : Site
-        The checked site (``inventory`` and ``mitigation["uncertainty"]`` are read).
+        The checked site (``inventory`` and ``mitigation.uncertainty`` are read).
     rate_scale : float, optional
         Replaces inventory.rate_scale [-].
 
@@ -66,15 +66,15 @@ def sensitivity_inputs(site, rate_scale: float | None = None) -> tuple:
     shares : list of float
         Rate shares [-], sorted.
     """
-    m_max = site.inventory["m_max_kg"]
-    unc = site.mitigation.get("uncertainty")
+    m_max = site.inventory.m_max_kg
+    unc = site.mitigation.uncertainty
     if m_max is None:
         m_values = [None]
     elif unc is not None and unc.m_max_kg is not None:
         m_values = sorted({float(unc.m_max_kg[0]), float(m_max), float(unc.m_max_kg[1])})
     else:
         m_values = [0.5 * m_max, float(m_max), 2.0 * m_max]
-    share = float(site.inventory["rate_scale"] if rate_scale is None else rate_scale)
+    share = float(site.inventory.rate_scale if rate_scale is None else rate_scale)
     lo, hi = (unc.rate_factor if unc is not None and unc.rate_factor[0] != unc.rate_factor[1] else (0.5, 2.0))
     return m_values, sorted({share * lo, share, share * hi})
 
@@ -95,13 +95,13 @@ def site_trajectory_status(site: Site):
     """
     from ...hazard.trajectory_status import trajectory_model_status
     data = None
-    if site.hazard.get("scenario"):
+    if site.hazard.scenario:
         from simulation.parameters import scenario_dict
-        data, _ = scenario_dict(site.resolve(site.hazard["scenario"]))
-    unc = site.mitigation.get("uncertainty") if site.mitigation else None
-    mu = site.model_uncertainty or {}
+        data, _ = scenario_dict(site.resolve(site.hazard.scenario))
+    unc = site.mitigation.uncertainty
+    mu = site.model_uncertainty
     return trajectory_model_status(data, calibration_bootstrap=getattr(unc, "calibration_source", "") or None,
-                                   posterior=mu.get("posterior"))
+                                   posterior=mu.posterior if mu is not None else None)
 
 
 def _start_rates(site: Site, runner):
@@ -122,8 +122,9 @@ def _start_rates(site: Site, runner):
     if site.rates is None:
         return None
     from ...risk.site_rates import evaluate_rates
-    inv_cfg = site.inventory
-    return runner.beside(lambda: evaluate_rates(site.rates, site.path.parent, inv_cfg, site.mitigation["options"]))
+    inv_cfg = site.inventory.as_dict()
+    return runner.beside(lambda: evaluate_rates(site.rates.reader_table, site.path.parent, inv_cfg,
+                                                site.mitigation.options))
 
 
 def fit_site_inventory(site: Site, seed):
@@ -150,12 +151,12 @@ def fit_site_inventory(site: Site, seed):
     """
     inv_cfg = site.inventory
     from ...frequency.inventory.reader import READER_OPTIONS
-    reader = {k: inv_cfg[k] for k in READER_OPTIONS if inv_cfg.get(k) is not None}
-    inventory = read_inventory(site.resolve(inv_cfg["path"]), start=inv_cfg["start"], end=inv_cfg["end"],
-                               duration_years=inv_cfg["duration_years"], density_kg_m3=inv_cfg["density_kg_m3"],
+    reader = {k: getattr(inv_cfg, k) for k in READER_OPTIONS if getattr(inv_cfg, k) is not None}
+    inventory = read_inventory(site.resolve(inv_cfg.path), start=inv_cfg.start, end=inv_cfg.end,
+                               duration_years=inv_cfg.duration_years, density_kg_m3=inv_cfg.density_kg_m3,
                                **reader)
-    dated = read_inventory(site.resolve(inv_cfg["annual_maxima"])) if inv_cfg["annual_maxima"] else None
-    frequency = analyse_inventory(inventory, m_min=inv_cfg["m_min_kg"], n_bootstrap=500, seed=seed)
+    dated = read_inventory(site.resolve(inv_cfg.annual_maxima)) if inv_cfg.annual_maxima else None
+    frequency = analyse_inventory(inventory, m_min=inv_cfg.m_min_kg, n_bootstrap=500, seed=seed)
     maxima_frequency = None
     if dated is not None:
         maxima_frequency = analyse_inventory(dated, n_bootstrap=200, seed=seed)
@@ -193,17 +194,17 @@ def _rate_and_design_inputs(site: Site, inventory, rates):
     """
     inv_cfg = site.inventory
     db_cfg = site.design_block
-    survey = read_block_survey(site.resolve(db_cfg["survey"]), inventory.density_kg_m3) \
-        if db_cfg["survey"] else None
-    rate_scale, rate_note, site_rates = inv_cfg["rate_scale"], None, None
-    if inv_cfg.get("rate_from") == "rate_model":
+    survey = read_block_survey(site.resolve(db_cfg.survey), inventory.density_kg_m3) \
+        if db_cfg.survey else None
+    rate_scale, rate_note, site_rates = inv_cfg.rate_scale, None, None
+    if inv_cfg.rate_from == "rate_model":
         site_rates = rates.result()
-        rate_scale = inv_cfg["rate_scale"] * site_rates.hazard_factor(inventory)
+        rate_scale = inv_cfg.rate_scale * site_rates.hazard_factor(inventory)
         rate_note = "rate from the " + site_rates.rate_text() + (
-            f"; times rate_scale {inv_cfg['rate_scale']:g}" if inv_cfg["rate_scale"] != 1 else "")
+            f"; times rate_scale {inv_cfg.rate_scale:g}" if inv_cfg.rate_scale != 1 else "")
     m_max_values, shares = sensitivity_inputs(site, rate_scale)
     # masses design values are read at: the percentile band of the design block, the largest m_max studied
-    extra = design_block_candidates_kg(rule=db_cfg["rule"], percentile=db_cfg["percentile"],
+    extra = design_block_candidates_kg(rule=db_cfg.rule, percentile=db_cfg.percentile,
                                        survey_volumes_m3=survey, inventory=inventory,
                                        density_kg_m3=inventory.density_kg_m3)
     extra += [m for m in m_max_values if m is not None]
@@ -233,11 +234,11 @@ def _design_masses(law, rate, *, site: Site, inventory, extra) -> list:
         the uncertainty table fragments the blocks.
     """
     db_cfg = site.design_block
-    frag = fragment_block_kg(law, rate, design_T=site.hazard["design_period_years"],
-                             fractal_dimension=db_cfg["fractal_dimension"], iterations=db_cfg["iterations"],
-                             percentile=db_cfg["percentile"], density_kg_m3=inventory.density_kg_m3)
+    frag = fragment_block_kg(law, rate, design_T=site.hazard.design_period_years,
+                             fractal_dimension=db_cfg.fractal_dimension, iterations=db_cfg.iterations,
+                             percentile=db_cfg.percentile, density_kg_m3=inventory.density_kg_m3)
     finest = []
-    u = site.mitigation["uncertainty"]
+    u = site.mitigation.uncertainty
     if u is not None and u.fractal_dimension:     # fragments travel: simulate down to the finest one
         masses = np.asarray(inventory.masses, dtype=float)
         finest = [min(float(law.m_min), float(masses[masses > 0].min(initial=np.inf)))
