@@ -64,8 +64,8 @@ def check_model_uncertainty(data, site_path: Path, hazard: dict, *, error=ModelU
         The site file's ``[model_uncertainty]`` table as parsed from TOML (None when absent).
     site_path : pathlib.Path
         The site file; relative paths (``posterior``, ``hazard.scenario``) are resolved against its folder.
-    hazard : dict
-        The site's checked ``[hazard]`` table (its ``scenario`` [path] and ``seed`` are used).
+    hazard : HazardTable
+        The site's checked ``[hazard]`` record (its ``scenario`` [path] and ``seed`` are used).
     error : type, optional
         Exception class raised on bad input (a subclass of :class:`riskrf.RiskrfError`; default
         :class:`~riskrf.hazard.model_uncertainty.ModelUncertaintyError`).
@@ -88,7 +88,7 @@ def check_model_uncertainty(data, site_path: Path, hazard: dict, *, error=ModelU
             close = difflib.get_close_matches(key, list(FIELDS), n=1)
             raise error(f"{site_path}: unknown field model_uncertainty.{key!r}"
                         + (f"; did you mean {close[0]!r}?" if close else f"; allowed: {', '.join(FIELDS)}"))
-    if hazard.get("scenario") is None:
+    if hazard.scenario is None:
         raise error(f"{where}: needs hazard.scenario (the slope to re-simulate); hazard.velocities gives no "
                     "material parameters to vary")
     cfg, used = {}, []
@@ -100,7 +100,7 @@ def check_model_uncertainty(data, site_path: Path, hazard: dict, *, error=ModelU
             if default is not None:
                 used.append(f"model_uncertainty.{key} = {default!r}")
     if cfg["seed"] is None:
-        cfg["seed"] = hazard["seed"]
+        cfg["seed"] = hazard.seed
     if "max_draws" in data and isinstance(cfg["max_draws"], int) and isinstance(cfg["draws"], int) \
             and cfg["max_draws"] < cfg["draws"]:
         raise error(f"{where}.max_draws = {cfg['max_draws']!r} is below model_uncertainty.draws = {cfg['draws']!r}: "
@@ -110,7 +110,7 @@ def check_model_uncertainty(data, site_path: Path, hazard: dict, *, error=ModelU
         cfg["calibration_cost"] = DEFAULT_CALIBRATION_COST
         used.append(f"model_uncertainty.calibration_cost = {DEFAULT_CALIBRATION_COST:g} (ASSUMED: a campaign of test "
                     "releases with a survey of the stops)")
-    scenario = (site_path.parent / hazard["scenario"]).resolve()
+    scenario = (site_path.parent / hazard.scenario).resolve()
     cfg["scenario_path"] = scenario
     if cfg["posterior"] is not None:
         path = (site_path.parent / cfg["posterior"]).resolve()
@@ -125,7 +125,7 @@ def check_model_uncertainty(data, site_path: Path, hazard: dict, *, error=ModelU
         import simulation
         spread = simulation.preset_spread(scenario)
         if spread.empty:
-            raise error(f"{where}: no posterior given and no material of {hazard['scenario']} names a preset, so "
+            raise error(f"{where}: no posterior given and no material of {hazard.scenario} names a preset, so "
                         "there is no spread to draw from; give model_uncertainty.posterior")
         cfg["posterior_table"] = None
     return ModelUncertaintySettings(**cfg), used

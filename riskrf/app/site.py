@@ -14,7 +14,7 @@ from __future__ import annotations
 import datetime
 import difflib
 import tomllib
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 from ..core import file_schemas as _fs
@@ -139,18 +139,18 @@ def load_site(path) -> Site:
     path = Path(path)
     data = _read_site_toml(path)
     tables, used = _merge_site_tables(data, path)
-    if tables["inventory"]["path"] is None:
+    if tables["inventory"].path is None:
         raise SiteError(f"{path}: inventory.path is required (the rock fall inventory file)")
     hz, inv = tables["hazard"], tables["inventory"]
     _check_hazard(hz, path)
     _check_inventory(inv, path)
-    _check_design_block(tables, path)
+    tables["design_block"] = _check_design_block(tables, path)
     _check_design(tables, path)
     _check_site_files(tables, path)
-    rates = check_rates(data.get("rates"), inv, path, error=SiteError)
+    rates = check_rates(data.get("rates"), inv.as_dict(), path, error=SiteError)
     if rates is not None:
         used += rates.pop("defaults_used")
-    three_d, scenario = _check_scenario(data, hz, path, used)
+    three_d, scenario, hz = _check_scenario(data, hz, path, used)
     _check_velocity_file(hz, path)
     mitigation = _check_mitigation(data, path, rates, hz, scenario, three_d, used)
     # every declared field against its type and range (shares and probabilities in [0, 1], rates, speeds,
@@ -172,13 +172,11 @@ def load_site(path) -> Site:
                                       record_is_inventory=rates["record_is_inventory"], reader_table=rates)
     else:
         rates_record = None
-    return Site(path=path.resolve(), name=str(tables["site"]["name"] or path.stem),
-                description=str(tables["site"]["description"]), inventory=_fs.INVENTORY.record(inv),
-                hazard=_fs.HAZARD.record(hz), mitigation=SiteMitigation(**mitigation), defaults_used=tuple(used),
-                design_block=_fs.DESIGN_BLOCK.record(tables["design_block"]), rates=rates_record,
-                design=_fs.DESIGN.record(tables["design"]), report=_fs.REPORT.record(tables["report"]),
-                three_d=three_d, model_uncertainty=model_uncertainty,
-                required_barrier=_fs.REQUIRED_BARRIER.record(required))
+    return Site(path=path.resolve(), name=str(tables["site"].name or path.stem),
+                description=str(tables["site"].description), inventory=inv, hazard=hz, mitigation=mitigation,
+                defaults_used=tuple(used), design_block=tables["design_block"], rates=rates_record,
+                design=tables["design"], report=tables["report"], three_d=three_d,
+                model_uncertainty=model_uncertainty, required_barrier=_fs.REQUIRED_BARRIER.record(required))
 
 
 def _read_site_toml(path: Path) -> dict:
@@ -225,7 +223,8 @@ def _merge_site_tables(data: dict, path: Path) -> tuple[dict, list]:
     Returns
     -------
     tables : dict
-        Table name -> {field: value}, every field of :data:`SITE_FIELDS` present.
+        Table name -> its typed record (:data:`riskrf.core.file_schemas.SITE_RECORDS`), every field of
+        :data:`SITE_FIELDS` present.
     used : list of str
         The defaults applied, as ``"table.field = value"``.
 
@@ -255,7 +254,7 @@ def _merge_site_tables(data: dict, path: Path) -> tuple[dict, list]:
                 merged[key] = default
                 if default is not None:
                     used.append(f"{table}.{key} = {default!r}")
-        tables[table] = merged
+        tables[table] = _fs.SITE_RECORDS[table](**merged)
     return tables, used
 
 
@@ -264,7 +263,7 @@ def _check_hazard(hz: dict, path: Path) -> None:
 
     Parameters
     ----------
-    hz : dict
+    hz : HazardTable
         The merged [hazard] table (``fences_kj`` [kJ], ``fence_height_m``, ``free_board_m``, ``drop_height_m`` [m],
         ``design_period_years`` [yr], ``reach_probability`` [-]).
     path : pathlib.Path
@@ -275,35 +274,36 @@ def _check_hazard(hz: dict, path: Path) -> None:
     SiteError
         Naming the file, the hazard field and its value.
     """
-    if (hz["scenario"] is None) == (hz["velocities"] is None):
+    if (hz.scenario is None) == (hz.velocities is None):
         raise SiteError(f"{path}: give exactly one of hazard.scenario (a slope scenario to simulate) or "
                         "hazard.velocities (a velocity file)")
     for key in ("n_blocks", "bootstrap", "option_blocks"):
-        if not isinstance(hz[key], int) or hz[key] < 1:
-            raise SiteError(f"{path}: hazard.{key} = {hz[key]!r} must be a whole number >= 1")
-    if not isinstance(hz["fences_kj"], list) or not all(isinstance(v, (int, float)) and v > 0
-                                                        for v in hz["fences_kj"]):
-        raise SiteError(f"{path}: hazard.fences_kj = {hz['fences_kj']!r} must be a list of capacities > 0")
-    fh = hz["fence_height_m"]
+        value = getattr(hz, key)
+        if not isinstance(value, int) or value < 1:
+            raise SiteError(f"{path}: hazard.{key} = {value!r} must be a whole number >= 1")
+    if not isinstance(hz.fences_kj, list) or not all(isinstance(v, (int, float)) and v > 0
+                                                        for v in hz.fences_kj):
+        raise SiteError(f"{path}: hazard.fences_kj = {hz.fences_kj!r} must be a list of capacities > 0")
+    fh = hz.fence_height_m
     if isinstance(fh, list):
-        if len(fh) != len(hz["fences_kj"]) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+        if len(fh) != len(hz.fences_kj) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
                                                       and v > 0 for v in fh):
             raise SiteError(f"{path}: hazard.fence_height_m = {fh!r} must be one height > 0 or one per fence in "
-                            f"hazard.fences_kj ({len(hz['fences_kj'])})")
+                            f"hazard.fences_kj ({len(hz.fences_kj)})")
     elif isinstance(fh, bool) or not isinstance(fh, (int, float)) or fh <= 0:
         raise SiteError(f"{path}: hazard.fence_height_m = {fh!r} must be a number > 0 (or a list, one per fence)")
-    if not is_finite_number(hz["free_board_m"]) or hz["free_board_m"] < 0:
-        raise SiteError(f"{path}: hazard.free_board_m = {hz['free_board_m']!r} must be a number >= 0 m")
-    if not is_finite_number(hz["design_period_years"]) or hz["design_period_years"] <= 1:
-        raise SiteError(f"{path}: hazard.design_period_years = {hz['design_period_years']!r} must be a number > 1 "
+    if not is_finite_number(hz.free_board_m) or hz.free_board_m < 0:
+        raise SiteError(f"{path}: hazard.free_board_m = {hz.free_board_m!r} must be a number >= 0 m")
+    if not is_finite_number(hz.design_period_years) or hz.design_period_years <= 1:
+        raise SiteError(f"{path}: hazard.design_period_years = {hz.design_period_years!r} must be a number > 1 "
                         "year (a T-year event has annual probability 1/T)")
-    if not is_finite_number(hz["reach_probability"]) or not 0 < hz["reach_probability"] <= 1:
-        raise SiteError(f"{path}: hazard.reach_probability = {hz['reach_probability']!r} must be a probability in "
+    if not is_finite_number(hz.reach_probability) or not 0 < hz.reach_probability <= 1:
+        raise SiteError(f"{path}: hazard.reach_probability = {hz.reach_probability!r} must be a probability in "
                         "(0, 1]")
-    if hz["velocity_unit"] not in (None, "m/s", "km/h"):
-        raise SiteError(f"{path}: hazard.velocity_unit = {hz['velocity_unit']!r} is not 'm/s' or 'km/h'")
-    if hz["drop_height_m"] is not None and (not is_finite_number(hz["drop_height_m"]) or hz["drop_height_m"] <= 0):
-        raise SiteError(f"{path}: hazard.drop_height_m = {hz['drop_height_m']!r} must be a height > 0 m (release "
+    if hz.velocity_unit not in (None, "m/s", "km/h"):
+        raise SiteError(f"{path}: hazard.velocity_unit = {hz.velocity_unit!r} is not 'm/s' or 'km/h'")
+    if hz.drop_height_m is not None and (not is_finite_number(hz.drop_height_m) or hz.drop_height_m <= 0):
+        raise SiteError(f"{path}: hazard.drop_height_m = {hz.drop_height_m!r} must be a height > 0 m (release "
                         "to the barrier line, for the velocity plausibility check)")
 
 
@@ -312,7 +312,7 @@ def _check_inventory(inv: dict, path: Path) -> None:
 
     Parameters
     ----------
-    inv : dict
+    inv : InventoryTable
         The merged [inventory] table (``m_min_kg``, ``m_max_kg`` [kg], ``density_kg_m3`` [kg/m3],
         ``duration_years`` [yr], ``rate_scale`` [-], ``rate_basis``).
     path : pathlib.Path
@@ -324,15 +324,16 @@ def _check_inventory(inv: dict, path: Path) -> None:
         Naming the file, field and value.
     """
     for key in ("m_min_kg", "m_max_kg", "density_kg_m3", "duration_years"):
-        if inv[key] is not None and (not is_finite_number(inv[key]) or inv[key] <= 0):
-            raise SiteError(f"{path}: inventory.{key} = {inv[key]!r} must be a number > 0")
-    if inv["m_min_kg"] is not None and inv["m_max_kg"] is not None and inv["m_min_kg"] >= inv["m_max_kg"]:
-        raise SiteError(f"{path}: inventory.m_min_kg = {inv['m_min_kg']!r} must be below inventory.m_max_kg = "
-                        f"{inv['m_max_kg']!r}")
-    if not isinstance(inv["rate_scale"], (int, float)) or not 0 < inv["rate_scale"] <= 1e6:
-        raise SiteError(f"{path}: inventory.rate_scale = {inv['rate_scale']!r} must be a number > 0")
-    if inv["rate_basis"] not in ("release", "road"):
-        raise SiteError(f"{path}: inventory.rate_basis = {inv['rate_basis']!r} must be 'release' (the inventory "
+        value = getattr(inv, key)
+        if value is not None and (not is_finite_number(value) or value <= 0):
+            raise SiteError(f"{path}: inventory.{key} = {value!r} must be a number > 0")
+    if inv.m_min_kg is not None and inv.m_max_kg is not None and inv.m_min_kg >= inv.m_max_kg:
+        raise SiteError(f"{path}: inventory.m_min_kg = {inv.m_min_kg!r} must be below inventory.m_max_kg = "
+                        f"{inv.m_max_kg!r}")
+    if not isinstance(inv.rate_scale, (int, float)) or not 0 < inv.rate_scale <= 1e6:
+        raise SiteError(f"{path}: inventory.rate_scale = {inv.rate_scale!r} must be a number > 0")
+    if inv.rate_basis not in ("release", "road"):
+        raise SiteError(f"{path}: inventory.rate_basis = {inv.rate_basis!r} must be 'release' (the inventory "
                         "counts falls released from the slope) or 'road' (it counts falls that reached the road, "
                         "e.g. a patrol record)")
 
@@ -343,7 +344,7 @@ def _check_site_files(tables: dict, path: Path) -> None:
     Parameters
     ----------
     tables : dict
-        The merged site tables.
+        Table name -> the merged site table's record.
     path : pathlib.Path
         The site file; paths in it are relative to its folder.
 
@@ -354,7 +355,7 @@ def _check_site_files(tables: dict, path: Path) -> None:
     """
     for table, key in (("inventory", "path"), ("inventory", "annual_maxima"), ("hazard", "scenario"),
                        ("hazard", "velocities"), ("design_block", "survey")):
-        rel = tables[table][key]
+        rel = getattr(tables[table], key)
         if rel is not None and not (path.parent / rel).exists():
             raise SiteError(f"{path}: {table}.{key} = {rel!r}: file not found ({(path.parent / rel).resolve()})")
 
@@ -362,13 +363,13 @@ def _check_site_files(tables: dict, path: Path) -> None:
 def _check_scenario(data: dict, hz: dict, path: Path, used: list) -> tuple:
     """Load hazard.scenario (2-D profile or 3-D terrain) and check the collectors the site names in it.
 
-    A missing ``hazard.collector`` defaults to ``"barrier"`` (set in ``hz`` and recorded in ``used``).
+    A missing ``hazard.collector`` defaults to ``"barrier"`` (set in the returned ``hz`` and recorded in ``used``).
 
     Parameters
     ----------
     data : dict
         The parsed site file (a 3-D terrain site refuses the tables it does not use yet).
-    hz : dict
+    hz : HazardTable
         The checked [hazard] table.
     path : pathlib.Path
         The site file; the scenario is relative to its folder.
@@ -381,33 +382,35 @@ def _check_scenario(data: dict, hz: dict, path: Path, used: list) -> tuple:
         True for a 3-D terrain scenario (False also when there is no scenario).
     scenario : object or None
         The loaded scenario, None when the hazard comes from a velocity file.
+    hz : HazardTable
+        ``hz`` with its collector default filled in.
 
     Raises
     ------
     SiteError
         For a collector the scenario does not have, a bad scenario file, or a table a 3-D site cannot use.
     """
-    if hz["scenario"] is None:
-        return False, None
+    if hz.scenario is None:
+        return False, None, hz
     import simulation
-    if hz["collector"] is None:
-        hz["collector"] = "barrier"
+    if hz.collector is None:
+        hz = replace(hz, collector="barrier")
         used.append("hazard.collector = 'barrier'")
-    three_d = simulation.is_terrain_scenario_file(path.parent / hz["scenario"])
+    three_d = simulation.is_terrain_scenario_file(path.parent / hz.scenario)
     if three_d:
-        scenario = simulation.load_terrain_scenario(path.parent / hz["scenario"])
+        scenario = simulation.load_terrain_scenario(path.parent / hz.scenario)
         _check_terrain_site(data, hz, path)
     else:
-        scenario = simulation.load_scenario(path.parent / hz["scenario"])
-        _fs.check_scenario_file(path.parent / hz["scenario"], error=SiteError)
+        scenario = simulation.load_scenario(path.parent / hz.scenario)
+        _fs.check_scenario_file(path.parent / hz.scenario, error=SiteError)
     names = [c.name for c in scenario.collectors]
-    if hz["collector"] not in names:
-        raise SiteError(f"{path}: hazard.collector = {hz['collector']!r}: scenario {hz['scenario']!r} has no "
-                        f"collector named {hz['collector']!r}; its collectors are {names}")
-    if hz["road_collector"] not in names and "road_collector" in data.get("hazard", {}):
-        raise SiteError(f"{path}: hazard.road_collector = {hz['road_collector']!r}: scenario {hz['scenario']!r} "
+    if hz.collector not in names:
+        raise SiteError(f"{path}: hazard.collector = {hz.collector!r}: scenario {hz.scenario!r} has no "
+                        f"collector named {hz.collector!r}; its collectors are {names}")
+    if hz.road_collector not in names and "road_collector" in data.get("hazard", {}):
+        raise SiteError(f"{path}: hazard.road_collector = {hz.road_collector!r}: scenario {hz.scenario!r} "
                         f"has no such collector; its collectors are {names}")
-    return three_d, scenario
+    return three_d, scenario, hz
 
 
 def _check_velocity_file(hz: dict, path: Path) -> None:
@@ -415,7 +418,7 @@ def _check_velocity_file(hz: dict, path: Path) -> None:
 
     Parameters
     ----------
-    hz : dict
+    hz : HazardTable
         The checked [hazard] table (``velocities``, ``collector``, ``velocity_unit``).
     path : pathlib.Path
         The site file; the velocity file is relative to its folder.
@@ -425,17 +428,17 @@ def _check_velocity_file(hz: dict, path: Path) -> None:
     SiteError
         Naming the field, the value and the reader's message.
     """
-    if hz["velocities"] is None:
+    if hz.velocities is None:
         return
     from ..io.velocities import read_velocities
     try:
-        read_velocities(path.parent / hz["velocities"], collector=hz["collector"],
-                        velocity_unit=hz["velocity_unit"])
+        read_velocities(path.parent / hz.velocities, collector=hz.collector,
+                        velocity_unit=hz.velocity_unit)
     except ValueError as exc:
-        raise SiteError(f"{path}: hazard.velocities = {hz['velocities']!r}: {exc}") from exc
+        raise SiteError(f"{path}: hazard.velocities = {hz.velocities!r}: {exc}") from exc
 
 
-def _check_mitigation(data: dict, path: Path, rates, hz: dict, scenario, three_d: bool, used: list) -> dict:
+def _check_mitigation(data: dict, path: Path, rates, hz, scenario, three_d: bool, used: list) -> SiteMitigation:
     """The mitigation tables (:data:`MITIGATION_TABLES`), their closure rules and option geometry.
 
     Parameters
@@ -446,7 +449,7 @@ def _check_mitigation(data: dict, path: Path, rates, hz: dict, scenario, three_d
         The site file, named in errors.
     rates : dict or None
         The checked [rates] table (closure rules need it).
-    hz : dict
+    hz : HazardTable
         The checked [hazard] table.
     scenario : object or None
         The loaded scenario (:func:`_check_scenario`).
@@ -457,7 +460,7 @@ def _check_mitigation(data: dict, path: Path, rates, hz: dict, scenario, three_d
 
     Returns
     -------
-    dict
+    SiteMitigation
         The checked study inputs (:func:`riskrf.risk.mitigation.study_inputs`), without ``defaults_used``.
 
     Raises
@@ -471,10 +474,11 @@ def _check_mitigation(data: dict, path: Path, rates, hz: dict, scenario, three_d
     except MitigationError as exc:
         raise SiteError(str(exc)) from exc
     used += list(mitigation.pop("defaults_used"))
+    mitigation = SiteMitigation(**mitigation)
     if not three_d:
-        check_closure_options(mitigation["options"], rates, path, error=SiteError)
-    if hz["scenario"] is not None and not three_d:
-        _check_option_geometry(mitigation["options"], scenario, hz, path, mitigation["uncertainty"])
+        check_closure_options(mitigation.options, rates, path, error=SiteError)
+    if hz.scenario is not None and not three_d:
+        _check_option_geometry(mitigation.options, scenario, hz, path, mitigation.uncertainty)
     return mitigation
 
 
@@ -483,11 +487,11 @@ def _check_terrain_site(data, hz, path):
     metre) and what it does not do yet, refused before any work rather than ignored."""
     for table in ("options", "rates", "uncertainty", "model_uncertainty"):
         if data.get(table) or (table == "model_uncertainty" and table in data):     # an empty one switches it on
-            raise SiteError(f"{path}: [{table}] is given, but hazard.scenario {hz['scenario']!r} is a 3-D terrain "
+            raise SiteError(f"{path}: [{table}] is given, but hazard.scenario {hz.scenario!r} is a 3-D terrain "
                             "scenario: on 3-D terrain riskrf assess writes the hazard, energy and road outputs and "
                             f"does not rank mitigation options yet; remove [{table}] or give a 2-D profile scenario")
-    if hz["mass_coupling"] != "simulated":
-        raise SiteError(f"{path}: hazard.mass_coupling = {hz['mass_coupling']!r}: a 3-D terrain site is assessed "
+    if hz.mass_coupling != "simulated":
+        raise SiteError(f"{path}: hazard.mass_coupling = {hz.mass_coupling!r}: a 3-D terrain site is assessed "
                         "with the mass-coupled hazard only ('simulated')")
     if data.get("inventory", {}).get("rate_basis", "release") != "release":
         raise SiteError(f"{path}: inventory.rate_basis = 'road' is not supported on 3-D terrain yet (the inventory "
@@ -499,51 +503,53 @@ def _check_design(tables, path):
     from ..hazard.design_basis import design_basis_from_site
     d = tables["design"]
     for key in ("positions_x_m", "mel_classes_kj"):
-        v = d[key]
+        v = getattr(d, key)
         if v is not None and (not isinstance(v, list) or not v or not all(is_finite_number(x) for x in v)):
             raise SiteError(f"{path}: design.{key} = {v!r} must be a list of numbers")
-    pb = d["position_blocks"]
+    pb = d.position_blocks
     if pb is not None and (isinstance(pb, bool) or not isinstance(pb, int) or pb < 100):
         raise SiteError(f"{path}: design.position_blocks = {pb!r} must be a whole number >= 100")
-    cfg = {k: v for k, v in d.items() if k not in ("positions_x_m", "position_blocks")}
+    cfg = {k: v for k, v in d.as_dict().items() if k not in ("positions_x_m", "position_blocks")}
     try:
-        design_basis_from_site(cfg, design_T=tables["hazard"]["design_period_years"],
-                               free_board_m=tables["hazard"]["free_board_m"])
+        design_basis_from_site(cfg, design_T=tables["hazard"].design_period_years,
+                               free_board_m=tables["hazard"].free_board_m)
     except (TypeError, ValueError) as exc:
         raise SiteError(f"{path}: {exc}") from exc
-    for key, v in tables["report"].items():
+    for key, v in tables["report"].as_dict().items():
         if v is not None and (isinstance(v, bool) or not isinstance(v, (str, int, datetime.date))):
             raise SiteError(f"{path}: report.{key} = {v!r} must be text")
 
 
 def _check_design_block(tables, path):
-    """inventory.sizes, hazard.mass_coupling and the [design_block] table (rule, percentile, survey)."""
+    """inventory.sizes, hazard.mass_coupling and the [design_block] table (rule, percentile, survey); returns the
+    [design_block] record with its percentile as checked."""
     from ..hazard.design_block import RULES, SIZES, check_percentile
     inv, hz, db = tables["inventory"], tables["hazard"], tables["design_block"]
-    if inv["sizes"] is not None and inv["sizes"] not in SIZES:
-        raise SiteError(f"{path}: inventory.sizes = {inv['sizes']!r} must be one of {list(SIZES)} (what the "
+    if inv.sizes is not None and inv.sizes not in SIZES:
+        raise SiteError(f"{path}: inventory.sizes = {inv.sizes!r} must be one of {list(SIZES)} (what the "
                         "inventory's volumes are: detached event volumes, or individual block sizes)")
-    if hz["mass_coupling"] not in ("simulated", "independent"):
-        raise SiteError(f"{path}: hazard.mass_coupling = {hz['mass_coupling']!r} must be 'simulated' (reach and "
+    if hz.mass_coupling not in ("simulated", "independent"):
+        raise SiteError(f"{path}: hazard.mass_coupling = {hz.mass_coupling!r} must be 'simulated' (reach and "
                         "speed by block mass, the default) or 'independent'")
-    if db["rule"] not in RULES:
-        raise SiteError(f"{path}: design_block.rule = {db['rule']!r} must be one of {list(RULES)}")
+    if db.rule not in RULES:
+        raise SiteError(f"{path}: design_block.rule = {db.rule!r} must be one of {list(RULES)}")
     try:
-        db["percentile"] = check_percentile(db["percentile"], "design_block.percentile")
+        db = replace(db, percentile=check_percentile(db.percentile, "design_block.percentile"))
     except (TypeError, ValueError) as exc:
         raise SiteError(f"{path}: {exc}") from exc
-    fragmenting = db["fractal_dimension"] is not None or db["iterations"] is not None
-    if db["rule"] == "fragmentation" and not fragmenting:
+    fragmenting = db.fractal_dimension is not None or db.iterations is not None
+    if db.rule == "fragmentation" and not fragmenting:
         raise SiteError(f"{path}: design_block.rule = 'fragmentation' needs design_block.fractal_dimension and "
                         "design_block.iterations (the fragmentation parameters you assume)")
     if fragmenting:
         from ..hazard.design_block import fractal_fragments
         try:
-            fractal_fragments(1.0, db["fractal_dimension"], db["iterations"])
+            fractal_fragments(1.0, db.fractal_dimension, db.iterations)
         except (TypeError, ValueError) as exc:
             raise SiteError(f"{path}: {exc}") from exc
-    if db["survey"] is not None and not isinstance(db["survey"], str):
-        raise SiteError(f"{path}: design_block.survey = {db['survey']!r} must be a file name")
+    if db.survey is not None and not isinstance(db.survey, str):
+        raise SiteError(f"{path}: design_block.survey = {db.survey!r} must be a file name")
+    return db
 
 
 def _check_option_geometry(options, scenario, hz, path, uncertainty=None):
@@ -572,7 +578,7 @@ def _check_option_geometry(options, scenario, hz, path, uncertainty=None):
                 if o.material is not None and o.material not in prof.material_names:
                     raise SiteError(f"{where}: material = {o.material!r} is not a material of the scenario "
                                     f"({', '.join(prof.material_names)})")
-                road = next((c for c in scenario.collectors if c.name == hz["road_collector"]), None)
+                road = next((c for c in scenario.collectors if c.name == hz.road_collector), None)
                 if road is not None and d.span[0] <= road.x <= d.span[1]:
                     raise SiteError(f"{where}: the ditch ({d.span[0]:g}-{d.span[1]:g} m) would cut through the road "
                                     f"line (collector {road.name!r} at x = {road.x:g} m)")
@@ -601,4 +607,4 @@ def _check_slope_measure(o, scenario, hz, path):
                            f"outside the profile ({prof.x[0]:g}, {prof.x[-1]:g}) m")
     m = SlopeMeasure(o.kind, o.name, o.x_m, o.width_m, o.height_m, None, o.inner_slope_hv, o.outer_slope_hv,
                      o.material)
-    scenario_with_measures(scenario, [m], where=str(path), road_collector=hz["road_collector"])
+    scenario_with_measures(scenario, [m], where=str(path), road_collector=hz.road_collector)
