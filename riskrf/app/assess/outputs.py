@@ -74,11 +74,15 @@ def write_assessment(a: Assessment, out: Path, log=None, runner=None) -> dict:
             if gate is not None:
                 pdf = runner.beside(partial(write_pdf_report, a, out / "report.pdf", figs, wait=gate.wait,
                                             finished=sorted(figs.rglob("*.png"))))
-            # the decision's and the design's figures beside this process's tables and summary
-            parts = [runner.beside(partial(write_tree_figure, a.study, figs)),
-                     runner.beside(partial(write_mitigation_figures, a.study, a.decision, figs))]
+            # the decision's and the design's figures beside this process's tables and summary (but those
+            # run_assessment handed to the runner as soon as their inputs were known)
+            early = a.drawing.get("early", ())
+            parts = [runner.beside(partial(write_mitigation_figures, a.study, a.decision, figs))]
+            if "tree" not in early:
+                parts.append(runner.beside(partial(write_tree_figure, a.study, figs)))
             if a.design is not None:
-                parts += [runner.beside(partial(_design_figures, a, figs, part)) for part in (0, 1)]
+                parts += [runner.beside(partial(_design_figures, a, figs, part)) for part in (0, 1)
+                          if f"design_{part}" not in early]
             write_mitigation_outputs(a.study, a.decision, figs, tree_figure=False, figures=False)
             # the summary (about a second: the percentiles of the hazard, every table as records) while the
             # figures are drawn; its stage timings are completed below
@@ -195,23 +199,44 @@ def _design_figures(a: Assessment, figs: Path, part: int | None = None) -> None:
     """The design basis's figures: barrier positions and options on the profile (``part`` 0), stop points,
     trajectories with the recommended option and catchment retention (``part`` 1); both parts when ``part`` is
     None."""
+    draw_design_figures(a.design, a.result, a.site, figs, part)
+
+
+def draw_design_figures(d, result, site, figs: Path, part: int | None = None) -> None:
+    """The figures of :func:`_design_figures` from the site's design ``d`` (``SiteDesign``), the site's
+    simulation ``result`` (or None) and the ``site``.  Part 0 needs only what the energy stage found (barrier
+    positions, requirement), so :func:`~riskrf.app.assess.run.run_assessment` hands it to the runner then; part 1
+    needs the recommended option's run.
+
+    Parameters
+    ----------
+    d : riskrf.app.site_design.SiteDesign
+        The site's design (barrier positions, requirement, recommended option's run).
+    result : simulation.SimulationResult or None
+        The site's simulation.
+    site : Site
+        The checked site (its mitigation options).
+    figs : pathlib.Path
+        Folder the PNG figures are written into.
+    part : int, optional
+        0 or 1 (see above); both when None.
+    """
     from ...report.design_figures import (catchment_figure, options_profile_figure, position_search_figure,
                                         stop_points_figure)
     from ...report.files import save_figure
-    d = a.design
     if part in (None, 0):
         if d.positions is not None:
             save_figure(position_search_figure(d.positions), figs / "barrier_positions.png")
-        if a.result is not None:
-            save_figure(options_profile_figure(a.result.scenario, a.site.mitigation.options,
+        if result is not None:
+            save_figure(options_profile_figure(result.scenario, site.mitigation.options,
                                                barrier_x=d.barrier_x_m, road_x=d.road_x_m,
                                                requirement=d.requirement),
                         figs / "options_profile.png")
     if part in (None, 1):
-        if a.result is not None:
-            ditches = [(o.x_m, o.x_m + o.width_m, o.name) for o in a.site.mitigation.options
+        if result is not None:
+            ditches = [(o.x_m, o.x_m + o.width_m, o.name) for o in site.mitigation.options
                        if o.kind == "ditch" and o.x_m is not None and o.width_m is not None]
-            save_figure(stop_points_figure(a.result, road_x=d.road_x_m, ditches=ditches,
+            save_figure(stop_points_figure(result, road_x=d.road_x_m, ditches=ditches,
                                            option=d.recommended), figs / "stop_points.png")
             if d.recommended is not None:
                 from simulation.plotting import plot_profile

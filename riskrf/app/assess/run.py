@@ -18,7 +18,7 @@ from ..scheduling import InLine
 from ..site import Site
 from .decision import _decision_stage, _model_uncertainty_stage, _release_rate_of_road_record, draw_evaluator
 from .hazard import _energy_stage, _simulate_hazard
-from .outputs import _frequency_outputs, _simulation_figures, fences_to_draw
+from .outputs import _frequency_outputs, _simulation_figures, draw_design_figures, fences_to_draw
 from .result import Assessment
 from .site_inputs import (_design_masses, _rate_and_design_inputs, _start_rates, fit_site_inventory,
                           site_trajectory_status)
@@ -66,7 +66,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
     log = log or logger.info
     runner = InLine() if runner is None else runner
     figures = None if figures_dir is None else Path(figures_dir)
-    pending = []
+    pending, early = [], set()        # work handed to the runner; which of the report's figures it draws early
     if figures is not None:
         figures.mkdir()
         from ...report.files import prepare_drawing
@@ -113,13 +113,23 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         if figures is not None:
             from ...report.files import write_energy_study
             pending.append(runner.beside(partial(write_energy_study, energy, figures)))
+            if site_design is not None:         # barrier positions and options on the profile: known now
+                pending.append(runner.beside(partial(draw_design_figures, site_design, result, site, figures, 0)))
+                early.add("design_0")
 
         t = stage(4, "ranking mitigation options (expected total cost, break-even, tornado)")
+        decision_report = study_report
+        if figures is not None:
+            def decision_report(study):         # the study is final: its tree drawn beside the ranking's report
+                from ...report.mitigation_text import write_tree_figure
+                pending.append(runner.beside(partial(write_tree_figure, study, figures)))
+                early.add("tree")
+                return study_report(study)
         replicate = partial(draw_evaluator, site, inventory, rate_scale=rate_scale / release_factor,
                             rate_note=rate_note, design_masses=design_masses)
         mitigation, site_rates, study, decision, site_design = _decision_stage(
             site, inventory, hazard, result, road_hits, rate_scale, energy, rates, site_rates, site_design, seed,
-            study_report, replicate=replicate if hz_cfg.scenario else None, n_blocks=n_blocks)
+            decision_report, replicate=replicate if hz_cfg.scenario else None, n_blocks=n_blocks)
         timings["decision"] = round(time.perf_counter() - t, 2)
         model_uncertainty = _model_uncertainty_stage(
             site, inventory, hazard, energy, rate_scale, release_factor, rate_note, mitigation, design_masses, log,
@@ -132,7 +142,7 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                       result=result, energy=energy, study=study, decision=decision, seed=seed, n_blocks=n_blocks,
                       warnings=notes, timings=timings, rates=site_rates, release_factor=release_factor,
                       design=site_design, model_uncertainty=model_uncertainty, trajectory_model=status,
-                      drawing={"dir": figures, "pending": pending} if figures is not None else {})
+                      drawing={"dir": figures, "pending": pending, "early": early} if figures is not None else {})
 
 
 def _assessment_notes(frequency, caught: list, site_rates, inventory) -> list:
