@@ -44,8 +44,14 @@ def _site_copy(tmp_path, replace=None, drop=None):
 @pytest.fixture(scope="module")
 def assessed(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("assess")
-    # One shared assessment for the whole module; its site name is hostile HTML, checked for escaping below.
-    site = _site_copy(tmp, replace={f'name = "{DEMO_NAME}"': f'name = "{HOSTILE_NAME}"'})
+    # One shared assessment for the whole module; its site name is hostile HTML, checked for escaping below.  The
+    # report's signature block is edited (author, checker, revision: checked in the PDF below) and the barrier
+    # position search re-simulates 600 blocks per candidate position (its default is option_blocks, 3,000 here).
+    site = _site_copy(tmp, replace={f'name = "{DEMO_NAME}"': f'name = "{HOSTILE_NAME}"',
+                                    'basis = "UNI 11211-4"': 'basis = "UNI 11211-4"\nposition_blocks = 600',
+                                    'author = "riskrf demo"': 'author = "A. Engineer"',
+                                    'checker = "not checked"': 'checker = "B. Checker"',
+                                    'revision = "A"': 'revision = "C"'})
     out = tmp / "out"
     assert main(["assess", str(site), "--out", str(out)]) == 0
     return site, out
@@ -63,6 +69,35 @@ def test_assess_writes_everything(assessed):
     html = (out / "report.html").read_text()
     assert "http://" not in html.replace("http://www.w3.org", "") and "https://" not in html   # no network needed
     assert html.count("data:image/png;base64,") >= 10
+
+
+def test_assess_writes_the_pdf_and_the_design_entries(assessed):
+    """report.pdf beside report.html (title block, page numbers, >= 10 pages), its text naming the design basis and
+    the required barrier; summary.json with the basis, required MEL and height, deflection check and chart
+    comparison."""
+    from pypdf import PdfReader
+
+    site, out = assessed                  # the shared assessment: UNI 11211-4, 600 blocks per position
+    s = json.loads((out / "summary.json").read_text())
+    assert s["design_basis"]["basis"] == "UNI 11211-4"
+    rb = s["required_barrier"]
+    assert rb["required_mel_kj"] == pytest.approx(1.2 * rb["E_d_kj"]) or "SEL" in rb["governs"]
+    assert rb["required_net_height_m"] >= rb["required_height_m"]
+    assert s["deflection_check"]["permitted_max_elongation_m"] == pytest.approx(20.0 / 1.3)   # road 120, line 100
+    assert "width_for_retention_m" in s["ditch_chart_comparison"]
+    ditch = s["ditch_chart_comparison"]          # the Modified Ritchie width W = 0.2 H + 4.5 m beside the retention
+    assert ditch["modified_ritchie_criterion"]["width_m"] == pytest.approx(0.2 * ditch["cut_height_m"] + 4.5)
+    assert len(s["position_search"]) >= 5
+    reader = PdfReader(out / "report.pdf")
+    assert len(reader.pages) >= 10
+    text = "\n".join(p.extract_text() for p in reader.pages)
+    flat = " ".join(text.split())
+    assert "UNI 11211-4 governs" in flat and "required MEL" in flat and "REQUIRED net height" in flat
+    assert f"page 3 of {len(reader.pages)}" in flat and "revision C" in flat and "checker B. Checker" in flat
+    assert "Contents" in flat and "Appendix A" in flat
+    assert "impacts per second" not in flat and "2,020" not in flat
+    for name in ("options_profile.png", "stop_points.png", "barrier_positions.png", "catchment_retention.png"):
+        assert (out / "figures" / name).exists(), name
 
 
 def test_outputs_name_no_directory_of_the_machine(assessed):

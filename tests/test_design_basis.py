@@ -204,46 +204,6 @@ def test_catchment_geometry_widths_and_chart_comparison():
         with_chart(study, [(3.0, 80.0)], "")
 
 
-def test_assess_writes_the_pdf_and_the_design_entries(tmp_path):
-    """report.pdf beside report.html (title block, page numbers, >= 10 pages), its text naming the design basis and
-    the required barrier; summary.json with the basis, required MEL and height, deflection check and chart
-    comparison."""
-    import json
-
-    from pypdf import PdfReader
-
-    from riskrf.cli import main
-
-    from .test_assess import _site_copy
-    site = _site_copy(tmp_path, replace={'basis = "UNI 11211-4"': 'basis = "UNI 11211-4"\nposition_blocks = 600',
-                                         'author = "riskrf demo"': 'author = "A. Engineer"',
-                                         'checker = "not checked"': 'checker = "B. Checker"',
-                                         'revision = "A"': 'revision = "C"',
-                                         "option_blocks = 10000": "option_blocks = 1500"})
-    out = tmp_path / "out"
-    assert main(["assess", str(site), "--out", str(out)]) == 0
-    s = json.loads((out / "summary.json").read_text())
-    assert s["design_basis"]["basis"] == "UNI 11211-4"
-    rb = s["required_barrier"]
-    assert rb["required_mel_kj"] == pytest.approx(1.2 * rb["E_d_kj"]) or "SEL" in rb["governs"]
-    assert rb["required_net_height_m"] >= rb["required_height_m"]
-    assert s["deflection_check"]["permitted_max_elongation_m"] == pytest.approx(20.0 / 1.3)   # road 120, line 100
-    assert "width_for_retention_m" in s["ditch_chart_comparison"]
-    ditch = s["ditch_chart_comparison"]          # the Modified Ritchie width W = 0.2 H + 4.5 m beside the retention
-    assert ditch["modified_ritchie_criterion"]["width_m"] == pytest.approx(0.2 * ditch["cut_height_m"] + 4.5)
-    assert len(s["position_search"]) >= 5
-    reader = PdfReader(out / "report.pdf")
-    assert len(reader.pages) >= 10
-    text = "\n".join(p.extract_text() for p in reader.pages)
-    flat = " ".join(text.split())
-    assert "UNI 11211-4 governs" in flat and "required MEL" in flat and "REQUIRED net height" in flat
-    assert f"page 3 of {len(reader.pages)}" in flat and "revision C" in flat and "checker B. Checker" in flat
-    assert "Contents" in flat and "Appendix A" in flat
-    assert "impacts per second" not in flat and "2,020" not in flat
-    for name in ("options_profile.png", "stop_points.png", "barrier_positions.png", "catchment_retention.png"):
-        assert (out / "figures" / name).exists(), name
-
-
 def test_option_scenario_builds_the_recommended_option_into_the_slope():
     from riskrf.app.site_design import option_scenario
     site = load_site(ROOT / "riskrf" / "data" / "demo_site.toml")
