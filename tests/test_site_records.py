@@ -61,3 +61,20 @@ def test_site_holds_the_records():
             assert repr(getattr(getattr(site, table), key)) == rest.split(" = ", 1)[1], entry
     with pytest.raises(AttributeError):
         site.hazard.n_block                              # a misspelt field fails loudly, not a silent None
+
+
+def test_no_string_key_reads_of_the_site():
+    """The site's sections are read by attribute everywhere (a misspelt key would give None or a KeyError at run
+    time; a misspelt attribute fails the same way for every site, and this scan keeps the dict reads out)."""
+    import re
+    from pathlib import Path
+
+    import riskrf
+    sections = "inventory|hazard|mitigation|design_block|rates|design|report|model_uncertainty|required_barrier"
+    read = re.compile(rf"\bsite\.({sections})(\[|\.get\()")
+    root = Path(riskrf.__file__).parent
+    found = [f"{p.relative_to(root)}:{i}: {line.strip()}"
+             for sub in ("app", "report", "cli") for p in sorted((root / sub).rglob("*.py"))
+             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) if read.search(line)]
+    assert found == []
+    assert read.search('x = a.site.hazard["n_blocks"]') and read.search("site.inventory.get('path')")
