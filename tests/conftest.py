@@ -28,6 +28,59 @@ def pytest_configure(config):
     config.addinivalue_line("filterwarnings", "ignore::riskrf.core.validation.RiskrfWarning")
 
 
+# ---- the kernels compiled once for both test processes (tests/kernel_warmup.py) ---------------------------------------
+WARMUP_ENV = "RISKRF_TEST_KERNEL_WARMUP"
+_warmup = []
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_sessionstart(session):
+    """In the pytest-xdist controller, before it starts the test processes: two children compile the two halves of
+    the kernels into numba's cache (each specialisation once, not once per test process); the folder where they
+    mark themselves done is passed to the test processes in the environment."""
+    import subprocess
+    import sys
+    import tempfile
+    config = session.config
+    if (hasattr(config, "workerinput") or not getattr(config.option, "numprocesses", None)
+            or getattr(config.option, "dist", "no") == "no"
+            or os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0") or WARMUP_ENV in os.environ):
+        return
+    done = Path(tempfile.mkdtemp(prefix="riskrf-kernel-warmup-"))
+    os.environ[WARMUP_ENV] = str(done)
+    for half in (0, 1):
+        try:
+            _warmup.append(subprocess.Popen([sys.executable, "-m", "tests.kernel_warmup", str(half),
+                                             str(done / f"half{half}.done")], cwd=ROOT,
+                                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                            stderr=subprocess.DEVNULL))
+        except OSError:
+            (done / f"half{half}.done").touch()      # no child: the kernels compile on first use
+
+
+def pytest_collection_finish(session):
+    """In a test process, after collecting (which overlaps the compilation): wait until both halves are compiled
+    (at most 10 minutes; a child that failed has marked itself done too)."""
+    import time
+    folder = os.environ.get(WARMUP_ENV)
+    if not folder or not hasattr(session.config, "workerinput"):
+        return
+    deadline = time.monotonic() + 600.0
+    while time.monotonic() < deadline and not all((Path(folder) / f"half{h}.done").exists() for h in (0, 1)):
+        time.sleep(0.1)
+
+
+def pytest_unconfigure(config):
+    import shutil
+    for child in _warmup:
+        if child.poll() is None:
+            child.kill()
+        child.wait()
+    if _warmup and os.environ.get(WARMUP_ENV):
+        shutil.rmtree(os.environ.pop(WARMUP_ENV), ignore_errors=True)
+    _warmup.clear()
+
+
 @pytest.fixture
 def data_dir():
     return DATA
