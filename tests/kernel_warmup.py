@@ -4,8 +4,9 @@ On a machine whose cache is cold (CI's fresh clone), each of the two pytest-xdis
 specialisation it met first (the 2-D kernel ``simulation.kernel.simulate`` in its four specialisations, with and
 without rolling drag and steep faces, and the 3-D kernel), mostly the same ones at the same time: the same machine
 code compiled twice.  ``tests/conftest.py`` starts two children of this module from the pytest-xdist controller,
-each compiling a different half (``python -m tests.kernel_warmup 0`` and ``... 1``), while the test processes start
-and collect; each test process waits for both children before its first test, then loads the kernels from the cache.
+each compiling a different half (``python -m tests.kernel_warmup HALF DONE_FILE``, HALF 0 or 1), while the test
+processes start and collect; each test process waits for both children before its first test, then loads the
+kernels from the cache.
 Nothing is checked here: a child that fails only means the kernel is compiled on first use, as without it.
 """
 from __future__ import annotations
