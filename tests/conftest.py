@@ -28,7 +28,7 @@ def pytest_configure(config):
     config.addinivalue_line("filterwarnings", "ignore::riskrf.core.validation.RiskrfWarning")
 
 
-# ---- the kernels compiled once for both test processes (tests/kernel_warmup.py) ---------------------------------------
+# ---- the kernels compiled once for both test processes (tests/kernel_warmup.py) ----------------------------------
 WARMUP_ENV = "RISKRF_TEST_KERNEL_WARMUP"
 _warmup = []
 
