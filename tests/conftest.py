@@ -54,19 +54,35 @@ def pytest_sessionstart(session):
                                              str(done / f"half{half}.done")], cwd=ROOT,
                                             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                             stderr=subprocess.DEVNULL))
+            (done / f"half{half}.pid").write_text(str(_warmup[-1].pid))
         except OSError:
             (done / f"half{half}.done").touch()      # no child: the kernels compile on first use
 
 
+def _warmup_finished(folder: Path, half: int) -> bool:
+    """True when the child compiling ``half`` marked itself done or is no longer running (killed before it could)."""
+    if (folder / f"half{half}.done").exists():
+        return True
+    try:
+        pid = int((folder / f"half{half}.pid").read_text())
+        os.kill(pid, 0)
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        return state in ("Z", "X")                   # ended, not yet reaped by the controller
+    except ProcessLookupError:
+        return True
+    except (OSError, ValueError, IndexError):
+        return False                                 # pid file not written yet, or no /proc: the time limit holds
+
+
 def pytest_collection_finish(session):
     """In a test process, after collecting (which overlaps the compilation): wait until both halves are compiled
-    (at most 10 minutes; a child that failed has marked itself done too)."""
+    (at most 10 minutes; a child that failed has marked itself done too, and one killed counts as finished)."""
     import time
     folder = os.environ.get(WARMUP_ENV)
     if not folder or not hasattr(session.config, "workerinput"):
         return
     deadline = time.monotonic() + 600.0
-    while time.monotonic() < deadline and not all((Path(folder) / f"half{h}.done").exists() for h in (0, 1)):
+    while time.monotonic() < deadline and not all(_warmup_finished(Path(folder), h) for h in (0, 1)):
         time.sleep(0.1)
 
 
