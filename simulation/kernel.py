@@ -47,6 +47,11 @@ EVENTS = {EV_RELEASE: "release", EV_IMPACT: "impact", EV_TAKEOFF: "take-off", EV
 # without the runtime's reference counting): numba otherwise increments and decrements the count of every array
 # argument at each call, atomic operations that took about a quarter of the kernel's time (6-12 per impact
 # search; measured with perf, 2026-12-07).  The numbers are unchanged; under NUMBA_DISABLE_JIT the option is moot.
+# contact.rebound compiled into the event loop itself (numba's inlining of its code; it takes and returns scalars only,
+# so no reference counts are involved): a call per impact otherwise, its four results returned through memory.  The
+# same function, so the same numbers.
+_rebound = njit(cache=True, inline="always")(rebound.py_func)
+
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
 _M2 = np.uint64(0x94D049BB133111EB)
@@ -472,7 +477,7 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
                 else:
                     mu = mat_mu[mat]
                 if vn < 0.0:
-                    vn2, vt2, w, _ = rebound(vn, vt, w, r, k_in, m_en_law[mat], en, m_en_v0[mat], m_et_law[mat], et,
+                    vn2, vt2, w, _ = _rebound(vn, vt, w, r, k_in, m_en_law[mat], en, m_en_v0[mat], m_et_law[mat], et,
                                              mu, gain, m_et_v0[mat])
                 else:
                     vn2, vt2 = 0.0, vt
