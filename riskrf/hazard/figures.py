@@ -150,10 +150,7 @@ def plot_catchment(study, ax=None):
     -------
     matplotlib.axes.Axes
     """
-    import matplotlib.pyplot as plt
-
-    if ax is None:
-        _, ax = plt.subplots(figsize=(7, 4.5))
+    ax = _axes(ax, figsize=(7, 4.5))
     ax.plot(study.curve["width_m"], 100 * study.curve["retained"], color="k",
             label=f"re-simulated ({study.blocks_counted:,} blocks over the face)")
     for q, w in study.widths.items():
@@ -192,13 +189,11 @@ def plot_design_energy_split(split, T=None, ax=None):
     -------
     matplotlib.axes.Axes
     """
-    import matplotlib.pyplot as plt
     ok = split.table[split.table["variance_total_kj2"] > 0]
     T = float(ok["T_years"].max() if T is None else T)
     r = split.row(T)
     d = split.per_draw[np.isclose(split.per_draw["T_years"], T)]
-    if ax is None:
-        _, ax = plt.subplots(figsize=(6.5, 3.6))
+    ax = _axes(ax, figsize=(6.5, 3.6))
     x = np.arange(len(d))
     ax.axhspan(r["combined_low_kj"], r["combined_high_kj"], color="0.85",
                label=f"combined {split.level:.0%} interval ({r['share_from_trajectory_model']:.0%} of its "

@@ -213,9 +213,7 @@ def plot_model_ranking(ranking, ax=None):
     matplotlib.axes.Axes
         The axes drawn on (expected total cost [currency] on x, log scale when all costs are positive).
     """
-    import matplotlib.pyplot as plt
-    if ax is None:
-        _, ax = plt.subplots(figsize=(7, 0.45 * len(ranking.options) + 1.5))
+    ax = _axes(ax, figsize=(7, 0.45 * len(ranking.options) + 1.5))
     order = np.argsort(ranking.expected_costs())[::-1]
     y = np.arange(len(order))
     ax.barh(y, ranking.expected_costs()[order], color="0.8", label="expected over the draws")
@@ -246,9 +244,7 @@ def plot_road_profile(profile, ax=None):
     matplotlib.axes.Axes
         The axes of the falls (deaths on a twin axis).
     """
-    import matplotlib.pyplot as plt
-    if ax is None:
-        _, ax = plt.subplots(figsize=(8, 3.5))
+    ax = _axes(ax, figsize=(8, 3.5))
     t = profile.table
     mid = 0.5 * (t["start_m"] + t["end_m"])
     ax.step(mid, t["falls_per_year_per_m"], where="mid", color="tab:blue", label="falls reaching the road")
