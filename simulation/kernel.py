@@ -50,7 +50,7 @@ EVENTS = {EV_RELEASE: "release", EV_IMPACT: "impact", EV_TAKEOFF: "take-off", EV
 # contact.rebound compiled into the event loop itself (numba's inlining of its code; it takes and returns scalars only,
 # so no reference counts are involved): a call per impact otherwise, its four results returned through memory.  The
 # same function, so the same numbers.
-_rebound = njit(cache=True, inline="always")(rebound.py_func)
+_rebound = njit(cache=True, inline="always")(getattr(rebound, "py_func", rebound))  # a plain function without JIT
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _M1 = np.uint64(0xBF58476D1CE4E5B9)

@@ -1,5 +1,6 @@
 """Start-up of the command and the packages: public names exported lazily, the simulator's compilation started
 before the heavy imports (README "Speed of the demo")."""
+import os
 import subprocess
 import sys
 
@@ -309,3 +310,11 @@ def test_in_line_gate_never_waits():
     gate.wait()
     gate.open()
     gate.wait()
+
+
+def test_every_kernel_module_imports_with_the_jit_disabled():
+    """Coverage runs the kernels as plain Python; a module that needs a compiled object at import fails there."""
+    code = "import simulation.kernel, simulation.kernel3d, simulation.engine, simulation.engine3d"
+    env = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
