@@ -29,7 +29,7 @@ vehicle damage, closure and clean-up.  All inputs come from a TOML file (README,
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
 
@@ -249,6 +249,29 @@ class MitigationStudy(RecommendationMixin, SensitivityMixin, Displayed):
                           reach, share, slopes.road_profile, None if slopes.by_mass is None else slopes.by_mass[2],
                           self.exposure, self.consequences, self.economics,
                           self.uncertainty.fragmentation_iterations, chains)
+
+    #: What this study computes on first use that the repeated trajectory ensembles (``ensemble``) do not change:
+    #: :meth:`with_ensemble` keeps it.
+    _KEPT_WITH_ENSEMBLE = ("_grid", "_slopes", "_space", "_effects", "_engine")
+
+    def with_ensemble(self, ensemble) -> "MitigationStudy":
+        """This study with the repeated trajectory ensembles of the error budget (the ``ensemble`` field); the slope
+        models, option chains and loss engine already computed are kept, not computed again.
+
+        Parameters
+        ----------
+        ensemble : riskrf.risk.error_budget.EnsembleReplicates or None
+            Expected costs [study currency] and P(best) [-] per replicate and option.
+
+        Returns
+        -------
+        MitigationStudy
+        """
+        new = replace(self, ensemble=ensemble)
+        for name in self._KEPT_WITH_ENSEMBLE:
+            if name in self.__dict__:
+                new.__dict__[name] = self.__dict__[name]
+        return new
 
     # ---- parameters -------------------------------------------------------------------------------
     def central_parameters(self) -> dict:

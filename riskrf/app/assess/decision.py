@@ -21,6 +21,7 @@ from functools import partial
 import numpy as np
 
 from ...risk.mitigation import MitigationStudy
+from ..scheduling import Deferred
 from ..site import Site, SiteMitigation
 from ..site_design import with_recommended_run
 from .hazard import energy_hazard_from_inputs
@@ -343,7 +344,7 @@ def _release_rate_of_road_record(site: Site, inventory, hazard, result, road_hit
 
 
 def _decision_stage(site: Site, inventory, hazard, result, road_hits, rate_scale: float, energy, rates, site_rates,
-                    site_design, seed, study_report, replicate=None, n_blocks: int | None = None):
+                    site_design, seed, study_report, replicate=None, n_blocks: int | None = None, beside=None):
     """Rank the mitigation options and re-run the recommended one on the site.
 
     Parameters
@@ -377,6 +378,9 @@ def _decision_stage(site: Site, inventory, hazard, result, road_hits, rate_scale
         independent trajectory ensembles for the error budget (:func:`ensemble_replicates`); None: not repeated.
     n_blocks : int, optional
         Blocks of the site's simulation (default ``hazard.n_blocks``).
+    beside : callable, optional
+        The runner's ``beside`` (:mod:`riskrf.app.scheduling`): where the repeated ensembles run (default: in
+        this process, when they are needed).
 
     Returns
     -------
@@ -394,14 +398,18 @@ def _decision_stage(site: Site, inventory, hazard, result, road_hits, rate_scale
         mitigation = replace(mitigation, options=resolve_closures(mitigation.options, site_rates))
     mitigation, checks, required = required_barrier_for_site(site, mitigation, energy, site_design)
     study = MitigationStudy(hazard=hazard, road_share=share, source=str(site.path),
-                            defaults_used=site.defaults_used,
+                            defaults_used=site.defaults_used, design_checks=checks, required_barrier=required,
                             **study_context(result, hz_cfg.collector, hz_cfg.road_collector,
                                             hz_cfg.option_blocks, seed, inventory, hazard,
                                             rate_scale, road_hits),
                             **mitigation.study_kwargs())
-    ensemble = ensemble_replicates(site, result, seed, replicate, mitigation, study.uncertainty,
-                                   n_blocks=n_blocks) if replicate is not None else None
-    study = replace(study, design_checks=checks, required_barrier=required, ensemble=ensemble)
+    if replicate is not None:
+        # the repeated ensembles beside (the command line's runner: on the other core) while this process
+        # computes the study's slope models and option chains, which they do not change
+        ensemble = (beside or Deferred)(partial(ensemble_replicates, site, result, seed, replicate, mitigation,
+                                                study.uncertainty, n_blocks=n_blocks))
+        study.parameter_ranges()
+        study = study.with_ensemble(ensemble.result())
     from ...risk.error_budget import adapt_effort
     study, effort = adapt_effort(study, log=logger.info)
     decision = study_report(study)

@@ -66,18 +66,20 @@ def write_assessment(a: Assessment, out: Path, log=None, runner=None) -> dict:
     summary = pdf = gate = None
     try:
         if drawn:
-            for part in a.drawing["pending"]:          # the earlier stages' figures (finished by now, as a rule)
-                part.result()
             # The PDF first, beside the decision's figures: it lays out its pages up to the first figure not
             # written yet (fonts, title page, tables), then waits until the gate opens (every figure written).
+            # A *.png present is whole (save_figure renames it into place), so the earlier stages' figures still
+            # being drawn are simply not finished yet.
             gate = runner.gate() if hasattr(runner, "gate") else None
             if gate is not None:
                 pdf = runner.beside(partial(write_pdf_report, a, out / "report.pdf", figs, wait=gate.wait,
                                             finished=sorted(figs.rglob("*.png"))))
             # the decision's and the design's figures beside this process's tables and summary (but those
-            # run_assessment handed to the runner as soon as their inputs were known)
+            # run_assessment handed to the runner as soon as their inputs were known, waited for with them)
             early = a.drawing.get("early", ())
-            parts = [runner.beside(partial(write_mitigation_figures, a.study, a.decision, figs))]
+            parts = list(a.drawing["pending"])
+            if "mitigation" not in early:
+                parts.append(runner.beside(partial(write_mitigation_figures, a.study, a.decision, figs)))
             if "tree" not in early:
                 parts.append(runner.beside(partial(write_tree_figure, a.study, figs)))
             if a.design is not None:

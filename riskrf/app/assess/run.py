@@ -121,15 +121,21 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         decision_report = study_report
         if figures is not None:
             def decision_report(study):         # the study is final: its tree drawn beside the ranking's report
-                from ...report.mitigation_text import write_tree_figure
+                from ...report.mitigation_text import write_mitigation_figures, write_tree_figure
                 pending.append(runner.beside(partial(write_tree_figure, study, figures)))
                 early.add("tree")
-                return study_report(study)
+                report = study_report(study)
+                # its tornado and F-N figures beside the rest of the decision stage (they read the study and the
+                # report's tornado, which nothing after this changes)
+                pending.append(runner.beside(partial(write_mitigation_figures, study, report, figures)))
+                early.add("mitigation")
+                return report
         replicate = partial(draw_evaluator, site, inventory, rate_scale=rate_scale / release_factor,
                             rate_note=rate_note, design_masses=design_masses)
         mitigation, site_rates, study, decision, site_design = _decision_stage(
             site, inventory, hazard, result, road_hits, rate_scale, energy, rates, site_rates, site_design, seed,
-            decision_report, replicate=replicate if hz_cfg.scenario else None, n_blocks=n_blocks)
+            decision_report, replicate=replicate if hz_cfg.scenario else None, n_blocks=n_blocks,
+            beside=runner.beside)
         timings["decision"] = round(time.perf_counter() - t, 2)
         model_uncertainty = _model_uncertainty_stage(
             site, inventory, hazard, energy, rate_scale, release_factor, rate_note, mitigation, design_masses, log,
