@@ -48,13 +48,15 @@ def option_entries(study, ranking: pd.DataFrame) -> list:
     return out
 
 
-def study_report(study) -> dict:
+def study_report(study, *, tornado=None) -> dict:
     """Ranking, recommendation, tornado, break-even, value of information and a printable text.
 
     Parameters
     ----------
     study : MitigationStudy
         The study.
+    tornado : pandas.DataFrame, optional
+        ``study.tornado()`` when it was computed already (it is then not computed again).
 
     Returns
     -------
@@ -66,7 +68,7 @@ def study_report(study) -> dict:
     """
     from ..risk.campaign import release_campaign_value
     ranking = study.ranking()
-    tornado = study.tornado()
+    tornado = study.tornado() if tornado is None else tornado
     be = study.break_even_table()
     rec = study.recommendation(ranking)
     voi = study.value_of_information()
@@ -198,7 +200,7 @@ def write_mitigation_figures(study, report, tmp) -> None:
     study : MitigationStudy
         The study.
     report : dict
-        Its :func:`study_report`.
+        Its :func:`study_report` (only its ``tornado`` is read).
     tmp : pathlib.Path
         Folder written into.
     """

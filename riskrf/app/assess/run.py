@@ -124,12 +124,13 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
                 from ...report.mitigation_text import write_mitigation_figures, write_tree_figure
                 pending.append(runner.beside(partial(write_tree_figure, study, figures)))
                 early.add("tree")
-                report = study_report(study)
-                # its tornado and F-N figures beside the rest of the decision stage (they read the study and the
-                # report's tornado, which nothing after this changes)
-                pending.append(runner.beside(partial(write_mitigation_figures, study, report, figures)))
+                # its tornado and F-N figures too, beside the rest of the report (the value of a release campaign
+                # is the longest part of it)
+                tornado = study.tornado()
+                pending.append(runner.beside(partial(write_mitigation_figures, study, {"tornado": tornado},
+                                                     figures)))
                 early.add("mitigation")
-                return report
+                return study_report(study, tornado=tornado)
         replicate = partial(draw_evaluator, site, inventory, rate_scale=rate_scale / release_factor,
                             rate_note=rate_note, design_masses=design_masses)
         mitigation, site_rates, study, decision, site_design = _decision_stage(
@@ -137,6 +138,9 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
             decision_report, replicate=replicate if hz_cfg.scenario else None, n_blocks=n_blocks,
             beside=runner.beside)
         timings["decision"] = round(time.perf_counter() - t, 2)
+        if figures is not None and site_design is not None:     # the recommended option's run is known now
+            pending.append(runner.beside(partial(draw_design_figures, site_design, result, site, figures, 1)))
+            early.add("design_1")
         model_uncertainty = _model_uncertainty_stage(
             site, inventory, hazard, energy, rate_scale, release_factor, rate_note, mitigation, design_masses, log,
             timings)
