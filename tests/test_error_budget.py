@@ -107,6 +107,21 @@ def test_seed_repeat_z_scores_have_unit_spread():
     assert ((diffs - diffs.mean()) / np.array(naive)).std(ddof=1) < 0.6
 
 
+def test_with_ensemble_keeps_the_slope_models_and_gives_the_same_numbers():
+    """The ensembles added to a study whose slope models are computed (the assessment computes them while the
+    ensembles run beside): the models are kept, not re-simulated, and every sampled cost and error is the one of
+    a study built with the ensembles from the start."""
+    ens = _replicated(3).ensemble
+    first = _study(3, 503)
+    first.parameter_ranges()
+    added = first.with_ensemble(ens)
+    assert added._slopes is first._slopes and added.ensemble is ens and first.ensemble is None
+    built = _study(3, 503, ensemble=ens)
+    for key in ("mean", "se", "probability_best"):
+        np.testing.assert_array_equal(added.uncertain[key], built.uncertain[key])
+    assert added.resolution()["text"] == built.resolution()["text"]
+
+
 def test_resolution_reports_the_sources_and_the_clustered_error():
     s = _replicated(3)
     res = s.resolution()
