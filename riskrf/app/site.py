@@ -18,6 +18,7 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 from ..core import file_schemas as _fs
+from ..core.schema import as_record as _as_record
 from ..core.schema import check as _check_schema
 from ..core.schema import record_class
 from ..core.validation import RiskrfError, is_finite_number
@@ -159,9 +160,7 @@ def load_site(path) -> Site:
     from .model_uncertainty import check_model_uncertainty
     model_uncertainty, mu_used = check_model_uncertainty(data.get("model_uncertainty"), path, hz, error=SiteError)
     used += mu_used
-    required = data.get("required_barrier", {})
-    if not isinstance(required, dict):
-        raise SiteError(f"{path}: [required_barrier] = {required!r} must be a table (required_barrier.FIELD = value)")
+    required = _as_record(_fs.REQUIRED_BARRIER, data.get("required_barrier", {}), source=path, error=SiteError)
     from ..risk.required_barrier import cost_model_from_site
     try:
         cost_model_from_site(required, source=str(path))
@@ -176,7 +175,7 @@ def load_site(path) -> Site:
                 description=str(tables["site"].description), inventory=inv, hazard=hz, mitigation=mitigation,
                 defaults_used=tuple(used), design_block=tables["design_block"], rates=rates_record,
                 design=tables["design"], report=tables["report"], three_d=three_d,
-                model_uncertainty=model_uncertainty, required_barrier=_fs.REQUIRED_BARRIER.record(required))
+                model_uncertainty=model_uncertainty, required_barrier=required)
 
 
 def _read_site_toml(path: Path) -> dict:
@@ -509,9 +508,8 @@ def _check_design(tables, path):
     pb = d.position_blocks
     if pb is not None and (isinstance(pb, bool) or not isinstance(pb, int) or pb < 100):
         raise SiteError(f"{path}: design.position_blocks = {pb!r} must be a whole number >= 100")
-    cfg = {k: v for k, v in d.as_dict().items() if k not in ("positions_x_m", "position_blocks")}
     try:
-        design_basis_from_site(cfg, design_T=tables["hazard"].design_period_years,
+        design_basis_from_site(d, design_T=tables["hazard"].design_period_years,
                                free_board_m=tables["hazard"].free_board_m)
     except (TypeError, ValueError) as exc:
         raise SiteError(f"{path}: {exc}") from exc

@@ -214,10 +214,9 @@ def design_for_site(site, hazard, block, result, density_kg_m3: float, seed) -> 
     SiteDesign
         Design basis, requirement, position search, run-out and catchment outputs.
     """
-    cfg = site.design.as_dict()
-    positions_x = cfg.pop("positions_x_m", None)
-    n_pos = cfg.pop("position_blocks", None) or site.hazard.option_blocks
-    basis = design_basis_from_site(cfg, design_T=site.hazard.design_period_years,
+    positions_x = site.design.positions_x_m
+    n_pos = site.design.position_blocks or site.hazard.option_blocks
+    basis = design_basis_from_site(site.design, design_T=site.hazard.design_period_years,
                                    free_board_m=site.hazard.free_board_m)
     notes = []
     barrier_x = road_x = None

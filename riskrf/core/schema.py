@@ -373,6 +373,47 @@ def record_class(table: Table, *, name: str | None = None, extra=()) -> type:
     return cls
 
 
+def as_record(table: Table, value, *, source="", error=ValueError):
+    """``value`` as the typed record of ``table`` (:attr:`Table.record_type`): the boundary of a reader that takes
+    the record a site gives it and also accepts the table as a user writes it (a dict of its fields, or None).
+
+    Parameters
+    ----------
+    table : Table
+        The declarations of the table.
+    value : record, dict or None
+        A record of ``table`` (returned as it is), a dict of some of its fields (the others take their declared
+        defaults) or None (every default).
+    source : str or path, optional
+        The file the table comes from, named in errors.
+    error : type
+        Exception class raised (default :class:`ValueError`).
+
+    Returns
+    -------
+    object
+        An instance of :attr:`Table.record_type`.
+
+    Raises
+    ------
+    error
+        For a dict key the table does not declare (``"source: unknown field table.key; allowed: ..."``), or a value
+        that is neither a record, a dict nor None.
+    """
+    where = f"{source}: " if source else ""
+    if value is None:
+        return table.record({})
+    if isinstance(value, table.record_type):
+        return value
+    if not isinstance(value, dict):
+        raise error(f"{where}[{table.name}] = {value!r} must be a table ({table.name}.FIELD = value)")
+    names = [f.name for f in table.fields]
+    unknown = sorted(set(value) - set(names))
+    if unknown:
+        raise error(f"{where}unknown field {table.name}.{unknown[0]}; allowed: {', '.join(sorted(names))}")
+    return table.record(value)
+
+
 def _cell(text) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
@@ -410,5 +451,5 @@ def render_markdown(schemas) -> str:
     return "\n".join(lines).rstrip() + "\n"
 
 
-__all__ = ["KIND_TYPES", "REQUIRED", "Field", "FileSchema", "Table", "check", "problems", "record_class",
-           "render_markdown"]
+__all__ = ["KIND_TYPES", "REQUIRED", "Field", "FileSchema", "Table", "as_record", "check", "problems",
+           "record_class", "render_markdown"]

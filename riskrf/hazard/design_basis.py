@@ -66,6 +66,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from ..core.file_schemas import DESIGN
+from ..core.schema import as_record
 from ..core.units import kinetic_energy_kj
 
 BASES = ("ONR 24810", "UNI 11211-4", "return period")
@@ -580,13 +582,23 @@ class DesignBasis:
         return s
 
 
-def design_basis_from_site(cfg: dict | None, *, design_T: float = 100.0, free_board_m: float = 0.5) -> DesignBasis:
-    """A :class:`DesignBasis` from a site file's ``[design]`` table (already checked for unknown keys).
+#: Fields of the ``[design]`` table that a :class:`DesignBasis` takes as they are (when given); the basis and its
+#: factors are read apart, and ``positions_x_m`` and ``position_blocks`` belong to the position search
+#: (:mod:`riskrf.app.site_design`).
+_BASIS_FIELDS = ("frequent_T_years", "frequent_events_sel", "residual_category", "consequence_class", "clearance_m",
+                "mel_classes_kj", "elongation_m")
+
+
+def design_basis_from_site(design=None, *, design_T: float = 100.0, free_board_m: float = 0.5) -> DesignBasis:
+    """A :class:`DesignBasis` from a site file's ``[design]`` table.
 
     Parameters
     ----------
-    cfg : dict or None
-        The site file's ``[design]`` table (None: all defaults).
+    design : DesignTable, dict or None
+        The checked ``[design]`` table (``site.design``, a :data:`riskrf.core.file_schemas.SITE_RECORDS` record),
+        or the table as written (a dict of its fields, read into that record: fields left out take their
+        defaults), or None (all defaults).  ``positions_x_m`` and ``position_blocks`` are not the basis's and
+        are left to the position search.
     design_T : float, optional
         Design return period [years] (from ``hazard.design_period_years``).
     free_board_m : float, optional
@@ -596,29 +608,35 @@ def design_basis_from_site(cfg: dict | None, *, design_T: float = 100.0, free_bo
     -------
     DesignBasis
         The stated basis with its partial factors.
+
+    Raises
+    ------
+    TypeError
+        For a dict key the ``[design]`` table does not declare.
+    ValueError
+        For an unknown basis, a factor that is not one of the basis, or a value out of range.
     """
-    cfg = dict(cfg or {})
-    basis = cfg.pop("basis", DEFAULT_BASIS)
+    d = as_record(DESIGN, design, error=TypeError)
+    basis = d.basis
     check_basis(basis)
     factor_names = set(DEFAULT_FACTORS[basis])
     all_factors = set().union(*DEFAULT_FACTORS.values())
     factors = {}
-    for k in list(cfg):
-        if k in all_factors:
-            v = cfg.pop(k)
-            if v is None:
-                continue
-            if k not in factor_names:
-                raise ValueError(f"design.{k} is not a factor of the basis {basis!r} (its factors: "
-                                 f"{', '.join(sorted(factor_names))})")
-            factors[k] = v
-    keep = {k: v for k, v in cfg.items() if v is not None}
+    for k in [f.name for f in DESIGN.fields if f.name in all_factors]:       # declaration order
+        v = getattr(d, k)
+        if v is None:
+            continue
+        if k not in factor_names:
+            raise ValueError(f"design.{k} is not a factor of the basis {basis!r} (its factors: "
+                             f"{', '.join(sorted(factor_names))})")
+        factors[k] = v
+    keep = {k: getattr(d, k) for k in _BASIS_FIELDS if getattr(d, k) is not None}
     if "mel_classes_kj" in keep:
         keep["mel_classes_kj"] = tuple(keep["mel_classes_kj"])
     if "elongation_m" in keep:
         keep["elongation_m"] = check_elongation(keep["elongation_m"])
-    keep.setdefault("free_board_m", free_board_m)
-    return DesignBasis(basis=basis, factors=factors, stated=tuple(factors), design_T=float(design_T), **keep)
+    return DesignBasis(basis=basis, factors=factors, stated=tuple(factors), design_T=float(design_T),
+                       free_board_m=free_board_m, **keep)
 
 
 __all__ = ["BASES", "CONFIRM", "DEFAULT_BASIS", "DEFAULT_FACTORS", "DesignBasis", "OWNER_OPTIONS",

@@ -23,7 +23,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from ..core.file_schemas import REQUIRED_BARRIER
 from ..core.format import money, sig
+from ..core.schema import as_record
 from ..hazard.design_basis import MEL_PRODUCT_CLASSES_KJ
 from .options.base import MitigationError
 
@@ -149,7 +151,7 @@ def _number(v, where: str, *, low: float = 0.0, open_low: bool = False) -> float
     return float(v)
 
 
-def cost_model_from_site(table: dict | None, *, site_fences=(), source: str = "") -> tuple:
+def cost_model_from_site(table=None, *, site_fences=(), source: str = "") -> tuple:
     """The :class:`BarrierCostModel` of a site's ``[required_barrier]`` table (None or absent: the defaults), and
     whether the required barrier enters the ranking.
 
@@ -159,8 +161,10 @@ def cost_model_from_site(table: dict | None, *, site_fences=(), source: str = ""
 
     Parameters
     ----------
-    table : dict or None
-        The ``[required_barrier]`` table as read (fields :data:`COST_FIELDS`).
+    table : RequiredBarrierTable, dict or None
+        The checked ``[required_barrier]`` table (``site.required_barrier``, a
+        :data:`riskrf.core.file_schemas.SITE_RECORDS` record), or the table as written (a dict of the fields of
+        :data:`COST_FIELDS`, read into that record: fields left out take their defaults), or None (all defaults).
     site_fences : sequence of (capacity [kJ], height [m], capital cost [currency], length [m]), optional
         The site's priced fences.
     source : str, optional
@@ -178,17 +182,13 @@ def cost_model_from_site(table: dict | None, *, site_fences=(), source: str = ""
     MitigationError
         An unknown field, or a value out of range (naming file, field and value).
     """
-    t = dict(table or {})
-    unknown = sorted(set(t) - set(COST_FIELDS))
-    if unknown:
-        raise MitigationError(f"{source}: unknown field required_barrier.{unknown[0]}; allowed: "
-                              f"{', '.join(sorted(COST_FIELDS))}")
+    t = as_record(REQUIRED_BARRIER, table, source=source, error=MitigationError)
     at = f"{source}: required_barrier"
-    include = t.get("include", True)
+    include = t.include
     if not isinstance(include, bool):
         raise MitigationError(f"{at}.include = {include!r} must be true or false")
     kw = {}
-    classes, prices = t.get("cost_classes_kj"), t.get("cost_per_m")
+    classes, prices = t.cost_classes_kj, t.cost_per_m
     if (classes is None) != (prices is None):
         raise MitigationError(f"{at}: cost_classes_kj = {classes!r} and cost_per_m = {prices!r} go together "
                               "(unit prices per metre, one per MEL class)")
@@ -204,14 +204,17 @@ def cost_model_from_site(table: dict | None, *, site_fences=(), source: str = ""
         if np.any(np.diff(np.asarray(classes, dtype=float)) <= 0):
             raise MitigationError(f"{at}.cost_classes_kj = {classes!r} must increase")
         kw.update(classes_kj=tuple(map(float, classes)), cost_per_m=tuple(map(float, prices)), from_site=True)
-    for name in ("reference_height_m", "life_years", "max_net_height_m", "length_m"):
-        if t.get(name) is not None:
-            kw[name] = _number(t[name], f"{at}.{name}", open_low=True)
-    for name in ("height_exponent", "fixed_cost", "annual_maintenance_share", "repair_share", "replacement_share"):
-        if t.get(name) is not None:
-            kw[name] = _number(t[name], f"{at}.{name}")
-    if t.get("cost_range") is not None:
-        r = t["cost_range"]
+    for name, value in (("reference_height_m", t.reference_height_m), ("life_years", t.life_years),
+                        ("max_net_height_m", t.max_net_height_m), ("length_m", t.length_m)):
+        if value is not None:
+            kw[name] = _number(value, f"{at}.{name}", open_low=True)
+    for name, value in (("height_exponent", t.height_exponent), ("fixed_cost", t.fixed_cost),
+                        ("annual_maintenance_share", t.annual_maintenance_share), ("repair_share", t.repair_share),
+                        ("replacement_share", t.replacement_share)):
+        if value is not None:
+            kw[name] = _number(value, f"{at}.{name}")
+    if t.cost_range is not None:
+        r = t.cost_range
         if not (isinstance(r, (list, tuple)) and len(r) == 2):      # a tuple: the declared default
             raise MitigationError(f"{at}.cost_range = {r!r} must be [low, high] factors of the central cost")
         lo, hi = (_number(x, f"{at}.cost_range", open_low=True) for x in r)

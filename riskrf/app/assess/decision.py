@@ -283,7 +283,7 @@ def required_barrier_for_site(site, mitigation: SiteMitigation, energy, site_des
     exposed = mitigation.exposure.exposed_length_m
     fences = [(o.capacity_kj, o.height_m, o.capital_cost, exposed) for o in options
               if o.kind in ("fence", "attenuator") and o.x_m is None]
-    model, include = cost_model_from_site(site.required_barrier.as_dict(), site_fences=fences, source=str(site.path))
+    model, include = cost_model_from_site(site.required_barrier, site_fences=fences, source=str(site.path))
     if not include:
         return mitigation, checks, None
     currency = mitigation.consequences.currency
