@@ -100,7 +100,7 @@ def test_closure_rule_option_share_and_hours_equal_closure_rule_on_the_same_mode
     assert opt.has_closure_rule and opt.share_while_closed is None and not opt.typed
     with pytest.raises(MitigationError, match="closure rule .* has not been evaluated"):
         MitigationStudy(hazard=None, options=site.mitigation.options, source="x")
-    sr = evaluate_rates(site.rates.reader_table, site.path.parent, site.inventory.as_dict(), site.mitigation.options)
+    sr = evaluate_rates(site.rates, site.path.parent, site.inventory, site.mitigation.options)
     resolved = resolve_closures(site.mitigation.options, sr)[1]
     _, model = direct_model(tmp_path / "s")
     rule = closure_rule(model, 60.0, window_days=1, cost_per_hour=500.0)
@@ -113,7 +113,7 @@ def test_closure_rule_option_share_and_hours_equal_closure_rule_on_the_same_mode
     assert "ASSUMED" not in text
     # a warning rule on the same model
     site = load_site(write_site(tmp_path / "s", closure='warning_levels = ["Red", "black"]\ncost_per_closure_hour = 50'))
-    sr = evaluate_rates(site.rates.reader_table, site.path.parent, site.inventory.as_dict(), site.mitigation.options)
+    sr = evaluate_rates(site.rates, site.path.parent, site.inventory, site.mitigation.options)
     resolved = resolve_closures(site.mitigation.options, sr)[1]
     rule = warning_closure(model, tmp_path / "s" / "warnings.csv", levels=("Red", "Black"), cost_per_hour=50.0)
     assert resolved.share_while_closed == pytest.approx(rule.effectiveness, rel=1e-12)

@@ -20,10 +20,9 @@ from pathlib import Path
 from ..core import file_schemas as _fs
 from ..core.schema import as_record as _as_record
 from ..core.schema import check as _check_schema
-from ..core.schema import record_class
 from ..core.validation import RiskrfError, is_finite_number
 from ..risk.mitigation import MitigationError, study_inputs
-from ..risk.site_rates import check_closure_options, check_rates
+from ..risk.site_rates import SiteRatesTable, check_closure_options, check_rates
 
 
 class SiteError(RiskrfError, ValueError):
@@ -38,14 +37,6 @@ MITIGATION_TABLES = ("traffic", "consequences", "economics", "options", "uncerta
 #: Optional tables checked by their own modules: [rates] (riskrf.risk.site_rates), [model_uncertainty]
 #: (riskrf.app.model_uncertainty), [required_barrier] (riskrf.risk.required_barrier).
 OTHER_TABLES = ("rates", "model_uncertainty", "required_barrier")
-
-#: The checked [rates] table (:func:`riskrf.risk.site_rates.check_rates`): its declared fields, whether the record is
-#: the site inventory, and ``reader_table``, the checked table as :func:`riskrf.risk.site_rates.evaluate_rates` reads
-#: it (with the rainfall, record and warning list already read).
-SiteRatesTable = record_class(_fs.RATES, name="SiteRatesTable",
-                              extra=(("record_is_inventory", bool, False), ("reader_table", dict, None)))
-SiteRatesTable.__module__ = __name__
-
 
 @dataclass(frozen=True)
 class SiteMitigation:
@@ -148,9 +139,8 @@ def load_site(path) -> Site:
     tables["design_block"] = _check_design_block(tables, path)
     _check_design(tables, path)
     _check_site_files(tables, path)
-    rates = check_rates(data.get("rates"), inv.as_dict(), path, error=SiteError)
-    if rates is not None:
-        used += rates.pop("defaults_used")
+    rates, rates_used = check_rates(data.get("rates"), inv, path, error=SiteError)
+    used += rates_used
     three_d, scenario, hz = _check_scenario(data, hz, path, used)
     _check_velocity_file(hz, path)
     mitigation = _check_mitigation(data, path, rates, hz, scenario, three_d, used)
@@ -166,14 +156,9 @@ def load_site(path) -> Site:
         cost_model_from_site(required, source=str(path))
     except ValueError as exc:
         raise SiteError(str(exc)) from exc
-    if rates is not None:
-        rates_record = SiteRatesTable(**{f.name: rates[f.name] for f in _fs.RATES.fields},
-                                      record_is_inventory=rates["record_is_inventory"], reader_table=rates)
-    else:
-        rates_record = None
     return Site(path=path.resolve(), name=str(tables["site"].name or path.stem),
                 description=str(tables["site"].description), inventory=inv, hazard=hz, mitigation=mitigation,
-                defaults_used=tuple(used), design_block=tables["design_block"], rates=rates_record,
+                defaults_used=tuple(used), design_block=tables["design_block"], rates=rates,
                 design=tables["design"], report=tables["report"], three_d=three_d,
                 model_uncertainty=model_uncertainty, required_barrier=required)
 
@@ -446,7 +431,7 @@ def _check_mitigation(data: dict, path: Path, rates, hz, scenario, three_d: bool
         The parsed site file (its mitigation tables are taken from it).
     path : pathlib.Path
         The site file, named in errors.
-    rates : dict or None
+    rates : SiteRatesTable or None
         The checked [rates] table (closure rules need it).
     hz : HazardTable
         The checked [hazard] table.

@@ -859,8 +859,8 @@ def check_mitigation_file(path):
         Keyword arguments of :class:`MitigationStudy` (:func:`study_inputs`).
     raw : dict
         The parsed TOML.
-    rates : dict or None
-        The checked ``[rates]`` table, or None.
+    rates : SiteRatesTable or None
+        The checked ``[rates]`` table (:func:`riskrf.risk.site_rates.check_rates`), or None.
 
     Raises
     ------
@@ -883,9 +883,9 @@ def check_mitigation_file(path):
     rates = None
     if any(o.kind == "closure" and o.has_closure_rule for o in inputs["options"]):
         # closure rules: share and hours from the file's [rates] model (riskrf.risk.site_rates)
-        from .site_rates import check_closure_options, check_rates
-        inv = dict(raw.get("inventory", {})) if isinstance(raw.get("inventory"), dict) else {}
-        rates = check_rates(raw.get("rates"), inv, path, error=MitigationError)
+        from .site_rates import check_closure_options, check_rates, inventory_record
+        rates, _ = check_rates(raw.get("rates"), inventory_record(raw.get("inventory")), path,
+                               error=MitigationError)
         check_closure_options(inputs["options"], rates, path, error=MitigationError)
     return inputs, raw, rates
 
@@ -915,8 +915,8 @@ def load_mitigation(path, hazard: EnergyHazard, *, road_share: float = 1.0, **kw
     path = Path(path)
     inputs, raw, rates = check_mitigation_file(path)
     if rates is not None:
-        from .site_rates import evaluate_rates, resolve_closures
-        inv = dict(raw.get("inventory", {})) if isinstance(raw.get("inventory"), dict) else {}
+        from .site_rates import evaluate_rates, inventory_record, resolve_closures
+        inv = inventory_record(raw.get("inventory"))
         inputs["options"] = resolve_closures(inputs["options"], evaluate_rates(rates, path.parent, inv,
                                                                                inputs["options"]))
     return MitigationStudy(hazard=hazard, road_share=road_share, source=str(path), **inputs, **kw)

@@ -37,7 +37,7 @@ def main(samples: int = 1000):
     mit = site.mitigation.study_kwargs()
     if site.rates is not None:          # closure rules: share and hours from the site's daily rate model
         from riskrf.risk.site_rates import evaluate_rates, resolve_closures
-        rates = evaluate_rates(site.rates.reader_table, site.path.parent, inv_cfg.as_dict(), mit["options"])
+        rates = evaluate_rates(site.rates, site.path.parent, inv_cfg, mit["options"])
         mit["options"] = resolve_closures(mit["options"], rates)
     mit["uncertainty"] = replace(mit["uncertainty"], samples=samples)
     study = MitigationStudy(hazard=hazard, road_share=road_share(result, "barrier", "road"),

@@ -122,8 +122,7 @@ def _start_rates(site: Site, runner):
     if site.rates is None:
         return None
     from ...risk.site_rates import evaluate_rates
-    inv_cfg = site.inventory.as_dict()
-    return runner.beside(lambda: evaluate_rates(site.rates.reader_table, site.path.parent, inv_cfg,
+    return runner.beside(lambda: evaluate_rates(site.rates, site.path.parent, site.inventory,
                                                 site.mitigation.options))
 
 
