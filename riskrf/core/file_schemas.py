@@ -339,7 +339,7 @@ OPTIONS_SCHEMA = FileSchema("Mitigation options file (riskrf decide --options OP
                             "The mitigation tables of a site file on their own.")
 
 CORRIDOR_SCHEMA = FileSchema("Corridor file (riskrf corridor CORRIDOR.toml)", (
-    Table("corridor", (
+    CORRIDOR := Table("corridor", (
         _text("name", "shown in the report"),
         _text("description", "shown in the report"),
         _path("sections", "the sections table (CSV, Excel or Parquet)", default=REQUIRED),
@@ -364,7 +364,7 @@ CORRIDOR_SCHEMA = FileSchema("Corridor file (riskrf corridor CORRIDOR.toml)", (
         _num("centreline_chainage_start_m", "m", "chainage of the line's first vertex (without calibration points)",
              default=0.0),
     ), "The corridor and its sections table."),
-    Table("defaults", (
+    CORRIDOR_DEFAULTS := Table("defaults", (
         _pos("cut_height_m", "m", "height of a generated cut"),
         _num("face_angle_deg", "deg", "face angle of a generated cut", low=0, high=90, low_open=True),
         _nonneg("ditch_width_m", "m", "ditch width at the toe"),
@@ -378,14 +378,24 @@ CORRIDOR_SCHEMA = FileSchema("Corridor file (riskrf corridor CORRIDOR.toml)", (
         _pos("speed_kmh", "km/h", "posted speed"),
         _share("release_zone_share", "share of the face releasing blocks"),
     ), "Values of the sections table's columns used where a row leaves them empty."),
-    Table("mass", (
+    CORRIDOR_MASS := Table("mass", (
         _pos("b", "", "power-law exponent of the typed mass law (an ASSUMPTION)"),
         _pos("m_min_kg", "kg", "smallest mass of the law"),
         _pos("m_max_kg", "kg", "largest mass of the law"),
         _path("inventory", "an inventory to fit the law to instead"),
     ), "The mass law shared by the sections."),
-    Table("materials", (_path("scenario", "scenario whose materials the generated cuts use"),),
-          "Materials of the generated cuts."),
+    CORRIDOR_MATERIALS := Table("materials", (_path("scenario", "scenario whose materials the generated cuts use"),),
+                                "Materials of the generated cuts."),
+    # kinds "any": riskrf.app.corridor.rates checks these fields with its own messages
+    CORRIDOR_RATES := Table("rates", (
+        Field("inventory", "any", "", "the corridor-wide inventory (a file), shared among the sections that give no "
+              "rate of their own"),
+        Field("share", "any", "", "how it is shared: 'km' (by section length) or 'm2' (by rock-face area)"),
+        Field("covered_length_km", "any", "km", "with share = 'km': road length the inventory covers (default: the "
+              "sharing sections together), a number > 0"),
+        Field("covered_face_area_m2", "any", "m2", "with share = 'm2': rock-face area the inventory covers (default: "
+              "the sharing sections together), a number > 0"),
+    ), "A corridor-wide rate of falls (riskrf.app.corridor.rates).", record_name="CorridorRatesTable"),
 ) + MITIGATION_TABLES, "Many sections along a road, each assessed like a site.")
 
 SCENARIO_SCHEMA = FileSchema("Slope scenario (simulation TOML)", (
@@ -483,7 +493,10 @@ def _export_records(tables) -> dict:
 
 #: Table name -> the record class of that [table] of a site file (``riskrf.app.site.Site`` holds them).
 SITE_RECORDS = _export_records(SITE_SCHEMA.tables)
+#: Table name -> the record class of that [table] of a corridor file (:func:`riskrf.app.corridor.load_corridor`
+#: reads its tables into them; the mitigation tables' are the site file's).
+CORRIDOR_RECORDS = _export_records(CORRIDOR_SCHEMA.tables)
 
 
-__all__ = ["ALL_SCHEMAS", "CORRIDOR_SCHEMA", "OPTIONS_SCHEMA", "SCENARIO_SCHEMA", "SITE_RECORDS", "SITE_SCHEMA",
-           "check_scenario_file", "write_reference"]
+__all__ = ["ALL_SCHEMAS", "CORRIDOR_RECORDS", "CORRIDOR_SCHEMA", "OPTIONS_SCHEMA", "SCENARIO_SCHEMA", "SITE_RECORDS",
+           "SITE_SCHEMA", "check_scenario_file", "write_reference"]

@@ -137,11 +137,13 @@ class Field:
 @dataclass(frozen=True)
 class Table:
     """One TOML table (``[name]``), or an array of tables (``[[name]]``, ``array=True``) whose entries are
-    named by their ``name`` field in messages."""
+    named by their ``name`` field in messages; ``record_name`` names its record class when the default
+    (:func:`record_class`) would be the name of another file's table of the same name."""
     name: str
     fields: tuple
     doc: str = ""
     array: bool = False
+    record_name: str | None = None
 
     def field(self, name: str) -> Field | None:
         """The declaration of ``name`` (None when the table has no such field).
@@ -176,7 +178,7 @@ class Table:
         type
             A frozen, slotted dataclass with one attribute per declared field, in declaration order.
         """
-        return record_class(self)
+        return record_class(self, name=self.record_name)
 
     def record(self, values: dict):
         """A checked table (``{field: value}``, e.g. the merged table of a reader) as its typed record.

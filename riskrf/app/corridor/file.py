@@ -10,11 +10,14 @@ from __future__ import annotations
 
 import difflib
 import tomllib
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from ...core.file_schemas import CORRIDOR_MATERIALS, CORRIDOR_SCHEMA
+from ...core.schema import check as check_schema
 from ...core.units import M_PER_KM
 from ...risk import rhrs
 from ...risk.mitigation_inputs import MitigationError, parse_mitigation
@@ -101,13 +104,29 @@ def _read_corridor_toml(path: Path) -> tuple[dict, str]:
     return data, src
 
 
-def _corridor_settings(cor: dict, path: Path, src: str, sheet, header_row, decimal, encoding) -> dict:
+@dataclass(frozen=True)
+class _CorridorSettings:
+    """The checked ``[corridor]`` table (:func:`_corridor_settings`): ``table``, its typed record
+    (:data:`riskrf.core.file_schemas.CORRIDOR_RECORDS`), and what is read or decided from it: ``variant`` (RHRS
+    variant), ``centreline`` (:mod:`riskrf.io.gis` centreline or None), ``reader`` (options of :func:`_read_table`),
+    ``rhrs_cap`` (points or None), ``unit`` (chainage unit, 'm' or 'km') and ``basis`` (rate basis, 'road' or
+    'release')."""
+    table: object
+    variant: str
+    centreline: object
+    reader: dict
+    rhrs_cap: float | None
+    unit: str
+    basis: str
+
+
+def _corridor_settings(cor: dict, path: Path, src: str, sheet, header_row, decimal, encoding) -> _CorridorSettings:
     """Check the ``[corridor]`` table and read its centreline, in the order the errors are raised.
 
     Parameters
     ----------
     cor : dict
-        The ``[corridor]`` table.
+        The ``[corridor]`` table as written (read into its typed record once its field names are checked).
     path : pathlib.Path
         The corridor file (paths in it are relative to its folder).
     src : str
@@ -117,66 +136,64 @@ def _corridor_settings(cor: dict, path: Path, src: str, sheet, header_row, decim
 
     Returns
     -------
-    dict
-        ``variant`` (RHRS variant), ``centreline`` (:class:`riskrf.io.gis` centreline or None), ``reader``
-        (options of :func:`_read_table`), ``rhrs_cap`` (points or None), ``unit`` (chainage unit, 'm' or 'km')
-        and ``basis`` (rate basis, 'road' or 'release').
+    _CorridorSettings
+        The record and the settings read from it.
 
     Raises
     ------
     CorridorError
         An unknown or invalid field, or a centreline that cannot be read.
     """
-    from ...core.file_schemas import CORRIDOR_SCHEMA
     cor_table = CORRIDOR_SCHEMA.table("corridor")          # one declaration of the [corridor] fields
     _unknown(cor, {f.name for f in cor_table.fields}, "corridor.", src)
-    variant = cor.get("rhrs_variant", "fhwa")
+    given = list(cor)                                      # the fields the file states, in its order
+    c = cor_table.record(cor)
+    variant = c.rhrs_variant
     why = rhrs.variant_problem(variant)
     if why:
         raise CorridorError(f"{src}: corridor.rhrs_variant = {variant!r} {why}")
-    for k in [k for k in cor if k.startswith("centreline")]:     # checked before the line is read
-        why = cor_table.field(k).problem(cor[k])
+    for k in [k for k in given if k.startswith("centreline")]:     # checked before the line is read
+        why = cor_table.field(k).problem(getattr(c, k))
         if why:
-            raise CorridorError(f"{src}: corridor.{k} = {cor[k]!r} {why}")
+            raise CorridorError(f"{src}: corridor.{k} = {getattr(c, k)!r} {why}")
     centreline = None
-    if "centreline" in cor:
+    if c.centreline is not None:
         from ...io.gis import GISError, read_centreline
         try:
             centreline = read_centreline(
-                (path.parent / str(cor["centreline"])).resolve(), layer=cor.get("centreline_layer"),
-                calibration_layer=cor.get("centreline_calibration_layer"),
-                calibration_field=cor.get("centreline_calibration_field", "chainage_m"),
-                chainage_start_m=float(cor.get("centreline_chainage_start_m", 0.0)))
+                (path.parent / str(c.centreline)).resolve(), layer=c.centreline_layer,
+                calibration_layer=c.centreline_calibration_layer,
+                calibration_field=c.centreline_calibration_field,
+                chainage_start_m=float(c.centreline_chainage_start_m))
         except GISError as exc:
-            raise CorridorError(f"{src}: corridor.centreline = {cor['centreline']!r}: {exc}") from None
-    elif any(k.startswith("centreline_") for k in cor):
+            raise CorridorError(f"{src}: corridor.centreline = {c.centreline!r}: {exc}") from None
+    elif any(k.startswith("centreline_") for k in given):
         raise CorridorError(f"{src}: centreline_* fields need corridor.centreline = \"road.gpkg\" (the road's line)")
-    reader = {"sheet": sheet if sheet is not None else cor.get("sections_sheet"),
-              "header_row": header_row if header_row is not None else cor.get("sections_header_row"),
-              "decimal": decimal if decimal is not None else cor.get("sections_decimal"),
-              "encoding": encoding if encoding is not None else cor.get("sections_encoding")}
+    reader = {"sheet": sheet if sheet is not None else c.sections_sheet,
+              "header_row": header_row if header_row is not None else c.sections_header_row,
+              "decimal": decimal if decimal is not None else c.sections_decimal,
+              "encoding": encoding if encoding is not None else c.sections_encoding}
     if reader["decimal"] not in (None, ".", ","):
         raise CorridorError(f"{src}: corridor.sections_decimal = {reader['decimal']!r} must be '.' or ','")
-    rhrs_cap = cor.get("rhrs_cap_points")
+    rhrs_cap = c.rhrs_cap_points
     if rhrs_cap is not None and (isinstance(rhrs_cap, bool) or not isinstance(rhrs_cap, (int, float))
                                  or rhrs_cap < 81):
         raise CorridorError(f"{src}: corridor.rhrs_cap_points = {rhrs_cap!r} must be a number >= 81")
-    if "sections" not in cor:
+    if c.sections is None:
         raise CorridorError(f"{src}: [corridor] needs sections = \"table.csv\" (CSV, Excel or Parquet)")
-    for k in ("seed", "n_blocks", "option_blocks"):
-        v = cor.get(k)
+    for k, v in (("seed", c.seed), ("n_blocks", c.n_blocks), ("option_blocks", c.option_blocks)):
         if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v < (0 if k == "seed" else 100)):
             raise CorridorError(f"{src}: corridor.{k} = {v!r} must be a whole number"
                                 + (" >= 0" if k == "seed" else " >= 100"))
-    unit = cor.get("chainage_unit", "m")
+    unit = c.chainage_unit
     if unit not in ("m", "km"):
         raise CorridorError(f"{src}: corridor.chainage_unit = {unit!r} must be 'm' or 'km'")
-    basis = cor.get("rate_basis", "road")
+    basis = c.rate_basis
     if basis not in ("road", "release"):
         raise CorridorError(f"{src}: corridor.rate_basis = {basis!r} must be 'road' (rates count falls reaching "
                             "the road, as a road maintenance record does) or 'release' (falls >= m_min released)")
-    return {"variant": variant, "centreline": centreline, "reader": reader, "rhrs_cap": rhrs_cap, "unit": unit,
-            "basis": basis}
+    return _CorridorSettings(table=c, variant=variant, centreline=centreline, reader=reader, rhrs_cap=rhrs_cap,
+                             unit=unit, basis=basis)
 
 
 def _materials_template(mat: dict, path: Path, src: str) -> tuple[dict, dict, Path]:
@@ -185,7 +202,7 @@ def _materials_template(mat: dict, path: Path, src: str) -> tuple[dict, dict, Pa
     Parameters
     ----------
     mat : dict
-        The ``[materials]`` table (``scenario``: a scenario TOML relative to the corridor file).
+        The ``[materials]`` table as written (``scenario``: a scenario TOML relative to the corridor file).
     path : pathlib.Path
         The corridor file.
     src : str
@@ -200,10 +217,11 @@ def _materials_template(mat: dict, path: Path, src: str) -> tuple[dict, dict, Pa
     template_path : pathlib.Path
         The template file read.
     """
-    _unknown(mat, {"scenario"}, "materials.", src)
-    template_path = (path.parent / mat["scenario"]).resolve() if "scenario" in mat else BUNDLED_MATERIALS
+    _unknown(mat, {f.name for f in CORRIDOR_MATERIALS.fields}, "materials.", src)
+    m = CORRIDOR_MATERIALS.record(mat)
+    template_path = (path.parent / m.scenario).resolve() if m.scenario is not None else BUNDLED_MATERIALS
     if not template_path.exists():
-        raise CorridorError(f"{src}: materials.scenario = {mat.get('scenario')!r}: file not found ({template_path})")
+        raise CorridorError(f"{src}: materials.scenario = {m.scenario!r}: file not found ({template_path})")
     template = tomllib.loads(template_path.read_text(encoding="utf-8"))
     return template["materials"], template.get("settings", {}), template_path
 
@@ -338,11 +356,8 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     """
     path = Path(path)
     data, src = _read_corridor_toml(path)
-    from ...core.file_schemas import CORRIDOR_SCHEMA
-    from ...core.schema import check as check_schema
-    cor = data.get("corridor", {})
-    cs = _corridor_settings(cor, path, src, sheet, header_row, decimal, encoding)
-    centreline, variant = cs["centreline"], cs["variant"]
+    cs = _corridor_settings(data.get("corridor", {}), path, src, sheet, header_row, decimal, encoding)
+    cor, centreline, variant = cs.table, cs.centreline, cs.variant
     defaults = data.get("defaults", {})
     _unknown(defaults, [c for c in ALL_COLUMNS if c not in ("id", "chainage_from", "chainage_to", "inventory")]
              + ["seeder_mass_kg"],
@@ -355,14 +370,14 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
     options, study, used = _corridor_options(data, src)
     _check_corridor_gdf(study["criteria"].disproportion_factor, f"{src}: criteria.disproportion_factor")
 
-    df, file_rows, tsrc = _read_sections_table((path.parent / cor["sections"]).resolve(), cs["reader"])
+    df, file_rows, tsrc = _read_sections_table((path.parent / cor.sections).resolve(), cs.reader)
     default_seeder = {"dist": "lognormal", "median": float(gr.m_min) * 2, "sigma": 1.0,
                       "max": float(gr.m_max or gr.m_min * 1e4)}
     ctx = _RowContext(path=path, columns=df.columns, defaults=defaults,
-                      scale=M_PER_KM if cs["unit"] == "km" else 1.0, unit=cs["unit"], shared=shared,
+                      scale=M_PER_KM if cs.unit == "km" else 1.0, unit=cs.unit, shared=shared,
                       m_min_kg=float(gr.m_min), materials=materials, settings=settings, template_path=template_path,
                       default_seeder=default_seeder, option_names=[o.name for o, _ in options],
-                      exposure=study["exposure"], variant=variant, rhrs_cap=cs["rhrs_cap"], centreline=centreline)
+                      exposure=study["exposure"], variant=variant, rhrs_cap=cs.rhrs_cap, centreline=centreline)
     errors, sections, bad_rows = [], [], set()
     weights, seen = {}, {}
     for i, raw in df.iterrows():
@@ -400,9 +415,10 @@ def load_corridor(path, *, keep_going: bool = False, sheet=None, header_row: int
         used.append(f"defaults.seeder_mass_kg = {default_seeder!r} (default; ASSUMPTION: masses [kg] of the "
                     "generated cuts' own seeder, used only for the option effects (the reference run of the "
                     "mitigation study); the hazard is mass-coupled over the mass law)")
-    return Corridor(name=str(cor.get("name", path.stem)), path=path, sections=tuple(ordered), mass=gr,
-                    mass_note=mass_note, rate_basis=cs["basis"], study=study, options=options,
-                    n_blocks=int(cor.get("n_blocks", 2000)), option_blocks=int(cor.get("option_blocks", 1000)),
-                    seed=int(cor.get("seed", 1)), currency=study["consequences"].currency, errors=tuple(errors),
+    return Corridor(name=str(cor.name if cor.name is not None else path.stem), path=path, sections=tuple(ordered),
+                    mass=gr, mass_note=mass_note, rate_basis=cs.basis, study=study, options=options,
+                    n_blocks=int(cor.n_blocks if cor.n_blocks is not None else 2000),
+                    option_blocks=int(cor.option_blocks if cor.option_blocks is not None else 1000),
+                    seed=int(cor.seed if cor.seed is not None else 1), currency=study["consequences"].currency, errors=tuple(errors),
                     defaults_used=tuple(used), crs=None if centreline is None else centreline.crs,
                     centreline=centreline, rhrs_variant=variant)

@@ -7,11 +7,14 @@ its own column or inventory, or from its share (by km of road or m2 of rock face
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ...core.file_schemas import CORRIDOR_MASS, CORRIDOR_RATES
 from .model import CorridorError, _unknown
+
 
 def _face_area(num: dict, length_m: float, where: str, what: str) -> float:
     """Rock-face area [m2] of a section: length x the face's slope length (height / sin angle)."""
@@ -21,58 +24,73 @@ def _face_area(num: dict, length_m: float, where: str, what: str) -> float:
     return length_m * num["cut_height_m"] / math.sin(math.radians(num["face_angle_deg"]))
 
 
-def _shared_rate(table, base: Path, m_min_kg: float, source: str):
+@dataclass(frozen=True)
+class SharedRate:
+    """A corridor-wide rate of falls (:func:`_shared_rate`): ``rate`` of the ``[rates]`` inventory [1/yr] (falls >=
+    the corridor's m_min), ``share`` ('km': by section length, 'm2': by rock-face area), ``covered`` (km of road or
+    m2 of face the inventory covers; None: the sharing sections together) and ``note`` (how the rate was
+    obtained)."""
+    rate: float
+    share: str
+    covered: float | None
+    note: str
+
+
+def _shared_rate(table, base: Path, m_min_kg: float, source: str) -> SharedRate | None:
     """``[rates]``: a corridor-wide inventory shared among the sections that give no rate of their own, in
     proportion to their length (``share = "km"``) or rock-face area (``share = "m2"``).  ``covered_length_km`` /
     ``covered_face_area_m2``: what the inventory covers (default: the sharing sections together).
-    Returns None or dict(rate, share, covered, note)."""
+    Returns None (no ``[rates]`` table) or the :class:`SharedRate`."""
     if table is None:
         return None
     if not isinstance(table, dict):
         raise CorridorError(f"{source}: rates = {table!r} must be a table ([rates] with inventory = ...)")
-    _unknown(table, {"inventory", "share", "covered_length_km", "covered_face_area_m2"}, "rates.", source)
-    if "inventory" not in table:
+    _unknown(table, {f.name for f in CORRIDOR_RATES.fields}, "rates.", source)
+    r = CORRIDOR_RATES.record(table)
+    if r.inventory is None:
         raise CorridorError(f"{source}: [rates] needs inventory = \"file\" (the corridor-wide inventory)")
-    share = table.get("share")
+    share = r.share
     if share not in ("km", "m2"):
         raise CorridorError(f"{source}: rates.share = {share!r} must be 'km' (by section length) or 'm2' (by "
                             "rock-face area)")
-    key = "covered_length_km" if share == "km" else "covered_face_area_m2"
-    other = "covered_face_area_m2" if share == "km" else "covered_length_km"
-    if other in table:
+    key, cov, other, other_value = (("covered_length_km", r.covered_length_km, "covered_face_area_m2",
+                                     r.covered_face_area_m2) if share == "km" else
+                                    ("covered_face_area_m2", r.covered_face_area_m2, "covered_length_km",
+                                     r.covered_length_km))
+    if other_value is not None:
         raise CorridorError(f"{source}: rates.{other} does not apply with share = {share!r} (give {key})")
-    cov = table.get(key)
     if cov is not None and (isinstance(cov, bool) or not isinstance(cov, (int, float)) or not cov > 0):
         raise CorridorError(f"{source}: rates.{key} = {cov!r} must be a number > 0")
-    inv_path = (base / str(table["inventory"])).resolve()
-    rate, note = inventory_rate(inv_path, m_min_kg, f"{source}: rates.inventory = {table['inventory']!r}")
-    return {"rate": rate, "share": share, "covered": None if cov is None else float(cov), "note": note}
+    inv_path = (base / str(r.inventory)).resolve()
+    rate, note = inventory_rate(inv_path, m_min_kg, f"{source}: rates.inventory = {r.inventory!r}")
+    return SharedRate(rate=rate, share=share, covered=None if cov is None else float(cov), note=note)
 
 
 def _mass_law(table: dict, base: Path, source: str):
-    """The corridor's mass law: fitted to an inventory file, or typed (b, m_min_kg, m_max_kg; an ASSUMPTION)."""
+    """The corridor's mass law: fitted to an inventory file, or typed (b, m_min_kg, m_max_kg; an ASSUMPTION).
+
+    ``table`` is the ``[mass]`` table as written, read into its typed record once its field names are checked."""
     from ...frequency.power_law import GutenbergRichterFit, fit_gutenberg_richter
-    _unknown(table, {"inventory", "m_min_kg", "m_max_kg", "b"}, "mass.", source)
-    for k in ("m_min_kg", "m_max_kg", "b"):
-        v = table.get(k)
+    _unknown(table, {f.name for f in CORRIDOR_MASS.fields}, "mass.", source)
+    m = CORRIDOR_MASS.record(table)
+    for k, v in (("m_min_kg", m.m_min_kg), ("m_max_kg", m.m_max_kg), ("b", m.b)):
         if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not v > 0):
             raise CorridorError(f"{source}: mass.{k} = {v!r} must be a number > 0")
-    if "inventory" in table:
-        if "b" in table:
+    if m.inventory is not None:
+        if m.b is not None:
             raise CorridorError(f"{source}: give mass.inventory (fitted) or mass.b (typed), not both")
         from ...frequency.inventory.reader import read_inventory
-        inv_path = (base / table["inventory"]).resolve()
+        inv_path = (base / m.inventory).resolve()
         if not inv_path.exists():
-            raise CorridorError(f"{source}: mass.inventory = {table['inventory']!r}: file not found ({inv_path})")
+            raise CorridorError(f"{source}: mass.inventory = {m.inventory!r}: file not found ({inv_path})")
         inv = read_inventory(inv_path)
-        gr = fit_gutenberg_richter(inv.masses, inv.duration_years, m_min=table.get("m_min_kg"),
-                                   m_max=table.get("m_max_kg"))
+        gr = fit_gutenberg_richter(inv.masses, inv.duration_years, m_min=m.m_min_kg, m_max=m.m_max_kg)
         note = (f"mass law fitted to {inv_path.name}: b = {gr.b:.3g} +- {gr.b_stderr:.2g}, m_min = {gr.m_min:.4g} kg "
                 f"({gr.n_tail} falls)")
         return gr, note
-    if "b" not in table or "m_min_kg" not in table:
+    if m.b is None or m.m_min_kg is None:
         raise CorridorError(f"{source}: [mass] needs inventory = \"file\" (fitted) or b and m_min_kg (typed)")
-    b, m_min, m_max = float(table["b"]), float(table["m_min_kg"]), table.get("m_max_kg")
+    b, m_min, m_max = float(m.b), float(m.m_min_kg), m.m_max_kg
     if m_max is not None and m_max <= m_min:
         raise CorridorError(f"{source}: mass.m_max_kg = {m_max!r} must exceed mass.m_min_kg = {m_min!r}")
     gr = GutenbergRichterFit(a=0.0, b=b, b_stderr=0.0, b_ci=(b, b), level=0.95, b_ci_method="typed", m_min=m_min,

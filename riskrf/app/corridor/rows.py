@@ -43,7 +43,7 @@ class _RowContext:
     defaults: dict
     scale: float
     unit: str
-    shared: dict | None
+    shared: object
     m_min_kg: float
     materials: dict
     settings: dict
@@ -149,7 +149,7 @@ def _row_rate(ctx: _RowContext, vals: dict, num: dict, c0: float, c1: float, whe
                                                      f"{where}: column 'inventory' = {vals['inventory']!r}")
         rate, rate_source = ctx.inv_cache[inv_path]
     else:                                  # a share of the corridor-wide inventory, set once all rows are read
-        weight = _face_area(num, c1 - c0, where, "rates.share = 'm2'") if ctx.shared["share"] == "m2" \
+        weight = _face_area(num, c1 - c0, where, "rates.share = 'm2'") if ctx.shared.share == "m2" \
             else (c1 - c0) / M_PER_KM
         rate = math.nan
     if rate_source != "shared" and not rate > 0:
@@ -368,7 +368,7 @@ def _read_section_row(ctx: _RowContext, raw, row: int, sid: str, where: str) -> 
     return section, (weight if rate_source == "shared" else None)
 
 
-def _share_corridor_rate(sections: list, weights: dict, shared: dict, src: str) -> list:
+def _share_corridor_rate(sections: list, weights: dict, shared, src: str) -> list:
     """Give the sections without a rate of their own their share of the corridor-wide ``[rates]`` inventory.
 
     Parameters
@@ -377,8 +377,8 @@ def _share_corridor_rate(sections: list, weights: dict, shared: dict, src: str) 
         The sections read.
     weights : dict
         Section id -> weight (km of road or m2 of rock face) of the sharing sections.
-    shared : dict
-        The corridor-wide rate (:func:`_shared_rate`).
+    shared : SharedRate
+        The corridor-wide rate (:func:`riskrf.app.corridor.rates._shared_rate`).
     src : str
         The corridor file's name for messages.
 
@@ -387,14 +387,14 @@ def _share_corridor_rate(sections: list, weights: dict, shared: dict, src: str) 
     list of Section
         The sections, the sharing ones with ``falls_per_year`` = rate / covered x weight [1/yr].
     """
-    unit = "km" if shared["share"] == "km" else "m2 of face"
-    covered = shared["covered"] if shared["covered"] is not None else sum(weights.values())
+    unit = "km" if shared.share == "km" else "m2 of face"
+    covered = shared.covered if shared.covered is not None else sum(weights.values())
     if covered < sum(weights.values()) * (1 - 1e-9):
-        raise CorridorError(f"{src}: rates.covered_{'length_km' if shared['share'] == 'km' else 'face_area_m2'} "
+        raise CorridorError(f"{src}: rates.covered_{'length_km' if shared.share == 'km' else 'face_area_m2'} "
                             f"= {covered:g} is less than the sharing sections' {sum(weights.values()):g} {unit}")
-    per = shared["rate"] / covered
+    per = shared.rate / covered
     return [replace(s, falls_per_year=per * weights[s.id],
-                    rate_source=f"share of the corridor {shared['note']}: {per:.4g}/yr per {unit} x "
+                    rate_source=f"share of the corridor {shared.note}: {per:.4g}/yr per {unit} x "
                                 f"{weights[s.id]:.4g} {unit}") if s.id in weights else s for s in sections]
 
 
