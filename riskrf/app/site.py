@@ -141,7 +141,7 @@ def load_site(path) -> Site:
     _check_site_files(tables, path)
     rates, rates_used = check_rates(data.get("rates"), inv, path, error=SiteError)
     used += rates_used
-    three_d, scenario, hz = _check_scenario(data, hz, path, used)
+    three_d, scenario, hz = _check_scenario(data, hz, inv, path, used)
     _check_velocity_file(hz, path)
     mitigation = _check_mitigation(data, path, rates, hz, scenario, three_d, used)
     # every declared field against its type and range (shares and probabilities in [0, 1], rates, speeds,
@@ -242,7 +242,7 @@ def _merge_site_tables(data: dict, path: Path) -> tuple[dict, list]:
     return tables, used
 
 
-def _check_hazard(hz: dict, path: Path) -> None:
+def _check_hazard(hz, path: Path) -> None:
     """The [hazard] table's own fields: one source of speeds, block counts, fences, design period, reach, units.
 
     Parameters
@@ -291,7 +291,7 @@ def _check_hazard(hz: dict, path: Path) -> None:
                         "to the barrier line, for the velocity plausibility check)")
 
 
-def _check_inventory(inv: dict, path: Path) -> None:
+def _check_inventory(inv, path: Path) -> None:
     """The [inventory] table's numbers (masses, density, duration, rate scale) and its rate basis.
 
     Parameters
@@ -344,7 +344,7 @@ def _check_site_files(tables: dict, path: Path) -> None:
             raise SiteError(f"{path}: {table}.{key} = {rel!r}: file not found ({(path.parent / rel).resolve()})")
 
 
-def _check_scenario(data: dict, hz: dict, path: Path, used: list) -> tuple:
+def _check_scenario(data: dict, hz, inv, path: Path, used: list) -> tuple:
     """Load hazard.scenario (2-D profile or 3-D terrain) and check the collectors the site names in it.
 
     A missing ``hazard.collector`` defaults to ``"barrier"`` (set in the returned ``hz`` and recorded in ``used``).
@@ -355,6 +355,8 @@ def _check_scenario(data: dict, hz: dict, path: Path, used: list) -> tuple:
         The parsed site file (a 3-D terrain site refuses the tables it does not use yet).
     hz : HazardTable
         The checked [hazard] table.
+    inv : InventoryTable
+        The checked [inventory] table (a 3-D terrain site needs rate_basis 'release').
     path : pathlib.Path
         The site file; the scenario is relative to its folder.
     used : list of str
@@ -383,7 +385,7 @@ def _check_scenario(data: dict, hz: dict, path: Path, used: list) -> tuple:
     three_d = simulation.is_terrain_scenario_file(path.parent / hz.scenario)
     if three_d:
         scenario = simulation.load_terrain_scenario(path.parent / hz.scenario)
-        _check_terrain_site(data, hz, path)
+        _check_terrain_site(data, hz, inv, path)
     else:
         scenario = simulation.load_scenario(path.parent / hz.scenario)
         _fs.check_scenario_file(path.parent / hz.scenario, error=SiteError)
@@ -397,7 +399,7 @@ def _check_scenario(data: dict, hz: dict, path: Path, used: list) -> tuple:
     return three_d, scenario, hz
 
 
-def _check_velocity_file(hz: dict, path: Path) -> None:
+def _check_velocity_file(hz, path: Path) -> None:
     """Read hazard.velocities now, so that a bad velocity file is found before the fits run.
 
     Parameters
@@ -466,7 +468,7 @@ def _check_mitigation(data: dict, path: Path, rates, hz, scenario, three_d: bool
     return mitigation
 
 
-def _check_terrain_site(data, hz, path):
+def _check_terrain_site(data, hz, inv, path):
     """A site on 3-D terrain: what ``riskrf assess`` does with it (hazard, energy at the barrier line, road per
     metre) and what it does not do yet, refused before any work rather than ignored."""
     for table in ("options", "rates", "uncertainty", "model_uncertainty"):
@@ -477,7 +479,7 @@ def _check_terrain_site(data, hz, path):
     if hz.mass_coupling != "simulated":
         raise SiteError(f"{path}: hazard.mass_coupling = {hz.mass_coupling!r}: a 3-D terrain site is assessed "
                         "with the mass-coupled hazard only ('simulated')")
-    if data.get("inventory", {}).get("rate_basis", "release") != "release":
+    if inv.rate_basis != "release":
         raise SiteError(f"{path}: inventory.rate_basis = 'road' is not supported on 3-D terrain yet (the inventory "
                         "must count falls released from the slope)")
 

@@ -631,10 +631,10 @@ def design_basis_from_site(design=None, *, design_T: float = 100.0, free_board_m
                              f"{', '.join(sorted(factor_names))})")
         factors[k] = v
     keep = {k: getattr(d, k) for k in _BASIS_FIELDS if getattr(d, k) is not None}
-    if "mel_classes_kj" in keep:
-        keep["mel_classes_kj"] = tuple(keep["mel_classes_kj"])
-    if "elongation_m" in keep:
-        keep["elongation_m"] = check_elongation(keep["elongation_m"])
+    if d.mel_classes_kj is not None:
+        keep.update(mel_classes_kj=tuple(d.mel_classes_kj))
+    if d.elongation_m is not None:
+        keep.update(elongation_m=check_elongation(d.elongation_m))
     return DesignBasis(basis=basis, factors=factors, stated=tuple(factors), design_T=float(design_T),
                        free_board_m=free_board_m, **keep)
 

@@ -220,7 +220,7 @@ def cost_model_from_site(table=None, *, site_fences=(), source: str = "") -> tup
         lo, hi = (_number(x, f"{at}.cost_range", open_low=True) for x in r)
         if not lo <= 1.0 <= hi:
             raise MitigationError(f"{at}.cost_range = {r!r} must bracket 1 (low <= 1 <= high)")
-        kw["cost_range"] = (lo, hi)
+        kw.update(cost_range=(lo, hi))
     model = BarrierCostModel(**kw)
     if not model.from_site:
         ratios = [cost / model.capital(cap, h, length) for cap, h, cost, length in site_fences
