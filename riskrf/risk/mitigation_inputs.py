@@ -5,6 +5,7 @@ the file, the option and the field).  See :mod:`riskrf.risk.mitigation` for what
 from __future__ import annotations
 
 import difflib
+import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
@@ -745,3 +746,73 @@ def parse_mitigation(data: dict, source: str = "<dict>", *, require_options: boo
     return options, exposure, consequences, economics, tuple(used), uncertainty, criteria
 
 
+def study_inputs(data: dict, source: str, *, require_options: bool = True) -> dict:
+    """Keyword arguments of :class:`~riskrf.risk.mitigation.MitigationStudy` from a parsed mitigation (or site) table
+    (``require_options=False``: none needed, :func:`parse_mitigation`).
+
+    Parameters
+    ----------
+    data : dict
+        The parsed TOML tables of the mitigation (or site) file.
+    source : str
+        The file, named in errors.
+    require_options : bool, optional
+        Whether ``[[option]]`` entries are required (default True).
+
+    Returns
+    -------
+    dict
+        ``options``, ``exposure``, ``consequences``, ``economics``, ``defaults_used``, ``uncertainty`` and
+        ``criteria``.
+    """
+    options, exposure, consequences, economics, used, uncertainty, criteria = parse_mitigation(
+        data, source, require_options=require_options)
+    return {"options": options, "exposure": exposure, "consequences": consequences, "economics": economics,
+            "defaults_used": used, "uncertainty": uncertainty, "criteria": criteria}
+
+
+def check_mitigation_file(path):
+    """Read and check a mitigation TOML file (a site file works too) before any work: every table and option
+    against its declaration and rules, and a closure rule's [rates] table.  Returns (study inputs, the parsed
+    TOML, the checked [rates] or None when no closure rule needs it).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The mitigation or site TOML file.
+
+    Returns
+    -------
+    inputs : dict
+        Keyword arguments of :class:`~riskrf.risk.mitigation.MitigationStudy` (:func:`study_inputs`).
+    raw : dict
+        The parsed TOML.
+    rates : SiteRatesTable or None
+        The checked ``[rates]`` table (:func:`riskrf.risk.site_rates.check_rates`), or None.
+
+    Raises
+    ------
+    FileNotFoundError
+        When ``path`` does not exist.
+    MitigationError
+        Invalid TOML, or a table, option or ``[rates]`` entry that does not fit its declaration.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"mitigation file not found: {path}")
+    with open(path, "rb") as fh:
+        try:
+            raw = tomllib.load(fh)
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:   # a binary file: named, not a bare codec error
+            raise MitigationError(f"{path}: not valid TOML: {exc}") from exc
+    data = {k: v for k, v in raw.items() if k not in ("site", "inventory", "hazard", "design_block", "rates",
+                                                      "design", "report")}
+    inputs = study_inputs(data, str(path))         # a site file works too
+    rates = None
+    if any(o.kind == "closure" and o.has_closure_rule for o in inputs["options"]):
+        # closure rules: share and hours from the file's [rates] model (riskrf.risk.site_rates)
+        from .site_rates import check_closure_options, check_rates, inventory_record
+        rates, _ = check_rates(raw.get("rates"), inventory_record(raw.get("inventory")), path,
+                               error=MitigationError)
+        check_closure_options(inputs["options"], rates, path, error=MitigationError)
+    return inputs, raw, rates
