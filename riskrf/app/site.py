@@ -21,7 +21,7 @@ from ..core import file_schemas as _fs
 from ..core.schema import as_record as _as_record
 from ..core.schema import check as _check_schema
 from ..core.validation import RiskrfError, is_finite_number
-from ..risk.mitigation import MitigationError, study_inputs
+from ..risk.mitigation_inputs import MitigationError, study_inputs
 from ..risk.site_rates import SiteRatesTable, check_closure_options, check_rates
 
 
@@ -40,7 +40,7 @@ OTHER_TABLES = ("rates", "model_uncertainty", "required_barrier")
 
 @dataclass(frozen=True)
 class SiteMitigation:
-    """The checked mitigation tables of a site (:func:`riskrf.risk.mitigation.study_inputs`): ``options`` (list of
+    """The checked mitigation tables of a site (:func:`riskrf.risk.mitigation_inputs.study_inputs`): ``options`` (list of
     :class:`~riskrf.risk.mitigation_inputs.Option`), ``exposure`` ([traffic]), ``consequences``, ``economics``,
     ``uncertainty`` (None when there is no [uncertainty] table) and ``criteria``, each the typed object its parser
     gives; :meth:`study_kwargs` passes them to :class:`~riskrf.risk.mitigation.MitigationStudy`."""
@@ -447,7 +447,7 @@ def _check_mitigation(data: dict, path: Path, rates, hz, scenario, three_d: bool
     Returns
     -------
     SiteMitigation
-        The checked study inputs (:func:`riskrf.risk.mitigation.study_inputs`), without ``defaults_used``.
+        The checked study inputs (:func:`riskrf.risk.mitigation_inputs.study_inputs`), without ``defaults_used``.
 
     Raises
     ------

@@ -80,7 +80,7 @@ def cmd_decide(args) -> int:
         print(f"\nWrote ranking.csv, decision.json and figures to {out}/")
         return 0
 
-    from ..risk.mitigation import check_mitigation_file
+    from ..risk.mitigation_inputs import check_mitigation_file
     check_mitigation_file(args.options)          # every option and table checked before the inventory is read
     inv = _read(args, args.inventory)
     gr, hazard, result = build_energy_hazard(args, inv)

@@ -1,6 +1,6 @@
-"""Inputs of a mitigation study: options, traffic, consequences, economics, criteria, uncertainty, and the
-parser of the TOML tables that hold them (every field is checked before anything is computed; errors name
-the file, the option and the field).  See :mod:`riskrf.risk.mitigation` for what the options do.
+"""Inputs of a mitigation study: options, traffic, consequences, economics, criteria, uncertainty, the
+parser of the TOML tables that hold them and the reader of the file (every field is checked before anything is
+computed; errors name the file, the option and the field).  See :mod:`riskrf.risk.mitigation` for what the options do.
 """
 from __future__ import annotations
 
