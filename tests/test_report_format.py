@@ -1,4 +1,6 @@
 """Numbers and tables as a reader sees them in the report."""
+from pathlib import Path
+
 import pandas as pd
 import pytest
 
@@ -63,23 +65,28 @@ def test_assumption_values_read_as_text():
     assert _field_label("hazard.free_board_m").endswith("[m]") and "." not in _field_label("rates.trend")
 
 
-def test_pdf_waits_once_before_the_first_figure_not_yet_written(tmp_path):
+def test_pdf_waits_for_each_figure_not_yet_written_until_the_gate_opens(tmp_path):
     """report.pdf laid out beside the figures still being drawn (``riskrf assess``): the figures known to be
-    written go in at once; the first other one waits (once) for the rest to be written; an absent figure is left
-    out as before."""
+    written go in at once; each other one is waited for (``wait(path)``) until a wait says the gate is open
+    (every figure written), and then none is; an absent figure is left out as before."""
     from PIL import Image
 
     from riskrf.report.pdf_layout import _Report
-    for name in ("early.png", "late.png", "later.png"):
+    for name in ("early.png", "drawn.png", "late.png", "later.png"):
         Image.new("RGB", (40, 20), "white").save(tmp_path / name)
     calls = []
+
+    def wait(path):
+        calls.append(Path(path).name)
+        return Path(path).name == "absent.png"          # the gate opened while the PDF waited for it
     tb = {k: "x" for k in ("project", "site", "location", "revision", "date", "author", "checker", "client")}
-    rep = _Report(tb, wait=lambda: calls.append(len(rep.pdf.pages)), finished=[tmp_path / "early.png"])
+    rep = _Report(tb, wait=wait, finished=[tmp_path / "early.png"])
     rep.pdf.add_page()
     rep.figure(tmp_path / "early.png", "written before")
     assert calls == []
-    rep.figure(tmp_path / "absent.png", "never drawn")          # not finished: waits, then leaves it out
-    assert calls == [1]
+    rep.figure(tmp_path / "drawn.png", "appeared while waiting")
+    assert calls == ["drawn.png"]
+    rep.figure(tmp_path / "absent.png", "never drawn")          # waits until the gate opens, then leaves it out
     rep.figure(tmp_path / "late.png", "drawn beside")
     rep.figure(tmp_path / "later.png", "drawn beside")
-    assert calls == [1] and len(rep.pdf.image_cache.images) == 3
+    assert calls == ["drawn.png", "absent.png"] and len(rep.pdf.image_cache.images) == 4

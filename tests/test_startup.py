@@ -2,6 +2,7 @@
 before the heavy imports (README "Speed of the demo")."""
 import os
 import subprocess
+import time
 import sys
 
 import pytest
@@ -274,7 +275,31 @@ def test_gate_holds_forked_work_until_this_process_opens_it(tmp_path, monkeypatc
     ready.write_text("written before the gate opened")
     gate.open()
     assert part.result() == "written before the gate opened"
-    gate.wait()                                    # here: returns at once
+    assert gate.wait() and gate.wait(tmp_path / "absent")      # here: returns at once, the gate open
+    gate.close()
+
+
+def test_gate_wait_for_a_file_returns_when_it_appears(tmp_path, monkeypatch):
+    """``wait(path)`` in forked work returns False once the file exists although the gate is still shut, and
+    True once the gate opens; a later ``wait`` returns True at once."""
+    from riskrf.cli.runner import Gate, InBackground
+    monkeypatch.delenv("RISKRF_NO_FORK", raising=False)
+    gate, figure, second = Gate(), tmp_path / "figure.png", tmp_path / "second.png"
+
+    def work():
+        appeared = gate.wait(figure)
+        (tmp_path / "seen.txt").write_text("seen")
+        return appeared, gate.wait(second), gate.wait(second), second.exists()
+    part = InBackground(work)
+    if part.proc is None:
+        pytest.skip("no fork here")
+    figure.write_bytes(b"png")
+    for _ in range(3000):                          # the child saw the file while the gate was still shut
+        if (tmp_path / "seen.txt").exists():
+            break
+        time.sleep(0.01)
+    gate.open()
+    assert part.result() == (False, True, True, False)
     gate.close()
 
 

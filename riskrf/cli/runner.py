@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import select
 import signal
 import sys
 import time
@@ -117,16 +118,21 @@ class Gate:
     the child: returns once this process opened the gate, or ended).
 
     The report's PDF is forked before the decision's figures are finished, so that it lays out the pages before
-    them (fonts, title page, tables) on the other core; it waits at the first figure not finished at the fork.  A
-    pipe: the child's :meth:`wait` closes its copy of the write end first, so that the read ends (EOF) if this
+    them (fonts, title page, tables) on the other core; at each figure not finished at the fork it waits until
+    that figure's file appears (figures are renamed into place whole) or the gate opens.  A pipe: the child's
+    first :meth:`wait` closes its copy of the write end, so that the read end becomes readable (EOF) if this
     process ends without opening the gate.  Work that runs in this process (no fork, or the fork failed) runs
     at its ``result()``, after :meth:`open`, and never waits.
     """
 
+    #: How often [s] a child waiting for a file looks for it.
+    POLL_S = 0.01
+
     def __init__(self):
         self._pid = os.getpid()
         self._read, self._write = os.pipe()
-        self._opened = False           # this process: open() was called; a child: wait() returned
+        self._opened = False           # this process: open() was called; a child: it saw the gate open
+        self._write_closed = False     # a child: its copy of the write end is closed
 
     def open(self) -> None:
         """Let the work waiting in children go on (once; later calls do nothing)."""
@@ -137,13 +143,31 @@ class Gate:
             finally:
                 os.close(self._write)
 
-    def wait(self) -> None:
-        """In a forked child: wait until the gate is open (or the process that made it ended); here: return."""
+    def wait(self, path=None) -> bool:
+        """In a forked child: wait until the gate is open (or the process that made it ended), or until the file
+        ``path`` exists; here: return at once.
+
+        Parameters
+        ----------
+        path : str or path, optional
+            A file whose appearance also ends the wait (default: only the gate does).
+
+        Returns
+        -------
+        bool
+            True when the gate is open (always in this process), False when ``path`` appeared first.
+        """
         if os.getpid() == self._pid or self._opened:
-            return
-        self._opened = True
-        os.close(self._write)          # this child's copy: EOF when the parent's is closed
-        os.read(self._read, 1)
+            return True
+        if not self._write_closed:
+            self._write_closed = True
+            os.close(self._write)      # this child's copy: EOF when the parent's is closed
+        while path is None or not os.path.exists(path):
+            ready, _, _ = select.select([self._read], [], [], None if path is None else self.POLL_S)
+            if ready:                  # the byte written by open(), or EOF: the parent ended
+                self._opened = True
+                return True
+        return False
 
     def close(self) -> None:
         """Open the gate if it is not yet, and close this process's read end (after the work's result)."""

@@ -41,8 +41,9 @@ def write_pdf_report(a, path, figs, *, wait=None, finished=None) -> Path:
     figs : str or path
         Folder of its figures (PNG).
     wait : callable, optional
-        Called (once, with no arguments) before the first figure that is not in ``finished``: it returns when
-        every figure is written (the figures may still be drawn beside this work when it starts).
+        ``wait(path)``, called before each figure that is not in ``finished`` (the figures may still be drawn
+        beside this work when it starts): it returns when that figure's file exists (False) or every figure is
+        written (True; it is not called again).
     finished : collection of str or path, optional
         Figures known to be written already (``wait`` is not called for them); default none.
 

@@ -139,7 +139,8 @@ class _Report:
     def __init__(self, title_block: dict, *, wait=None, finished=None):
         from fpdf import FPDF
 
-        # figures drawn beside this work: wait() once, before the first figure not known to be finished
+        # figures drawn beside this work: wait(path) before each figure not known to be finished, until it says
+        # the gate is open (every figure written)
         self._wait = wait
         self._finished = {str(Path(f).resolve()) for f in (finished or ())}
 
@@ -271,9 +272,8 @@ class _Report:
 
     def figure(self, path, caption: str, width: float = A4_TEXT_WIDTH_MM, max_height: float = 200.0):
         path = Path(path)
-        if self._wait is not None and str(path.resolve()) not in self._finished:
-            wait, self._wait = self._wait, None
-            wait()
+        if self._wait is not None and str(path.resolve()) not in self._finished and self._wait(path):
+            self._wait = None
         if not path.exists():
             return
         pdf = self.pdf

@@ -66,8 +66,8 @@ def write_assessment(a: Assessment, out: Path, log=None, runner=None) -> dict:
     summary = pdf = gate = None
     try:
         if drawn:
-            # The PDF first, beside the decision's figures: it lays out its pages up to the first figure not
-            # written yet (fonts, title page, tables), then waits until the gate opens (every figure written).
+            # The PDF first, beside the decision's figures: it lays out its pages (fonts, title page, tables) and
+            # at each figure not written yet waits until its file appears or the gate opens (every figure written).
             # A *.png present is whole (save_figure renames it into place), so the earlier stages' figures still
             # being drawn are simply not finished yet.
             gate = runner.gate() if hasattr(runner, "gate") else None
