@@ -69,7 +69,18 @@ class OpenGate:
         """Nothing to signal."""
 
     def wait(self, path=None) -> bool:
-        """Return at once: True (the gate is open)."""
+        """Return at once: the gate is open.
+
+        Parameters
+        ----------
+        path : str or path, optional
+            Ignored (see :meth:`riskrf.cli.runner.Gate.wait`).
+
+        Returns
+        -------
+        bool
+            True.
+        """
         return True
 
 
