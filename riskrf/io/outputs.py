@@ -447,9 +447,9 @@ def write_csv(df: pd.DataFrame, path, *, index: bool = False) -> None:
     shortest round-trip form), but only text columns and labels are checked, in memory and vectorised;
     numeric columns never need it.  With pyarrow installed, Arrow formats the numbers and joins the cells
     (the same text; see :func:`_arrow_float_text`), two chunks at a time on two threads (Arrow releases the
-    interpreter lock), each text value once per chunk.  Tables of NumPy float, integer, bool and text (or categorical text)
-    columns are formatted here, :data:`CSV_CHUNK_ROWS` rows at a time; any other table (dates, mixed object
-    columns, an index) goes through pandas and the file check.  :func:`atomic_outputs` does not check
+    interpreter lock), each text value once per chunk.  Tables of NumPy float, integer, bool and text (or
+    categorical text) columns are formatted here, :data:`CSV_CHUNK_ROWS` rows at a time; any other table (dates,
+    mixed object columns, an index) goes through pandas and the file check.  :func:`atomic_outputs` does not check
     the file again.
 
     Parameters
