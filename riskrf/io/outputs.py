@@ -365,7 +365,7 @@ def _column_text(col: pd.Series) -> list[str]:
 
 
 #: Rows formatted and written at a time by :func:`write_csv` (bounds the memory of the text).
-CSV_CHUNK_ROWS = 100_000
+CSV_CHUNK_ROWS = 50_000
 
 
 def _arrow_float_text(arr: np.ndarray, pa, pc):
@@ -380,7 +380,9 @@ def _arrow_float_text(arr: np.ndarray, pa, pc):
     with np.errstate(invalid="ignore"):
         ax = np.abs(arr)
         plain = ((ax >= 1e-4) & (ax < 1e16)) | (ax == 0)            # Arrow: "0", "-0"
-        plain &= ~pc.match_substring(text, "e").to_numpy(zero_copy_only=False)
+        data = text.buffers()[2]                    # the digits of every value: one scan finds any "e"
+        if data is not None and (np.frombuffer(data, dtype=np.uint8) == ord("e")).any():
+            plain &= ~pc.match_substring(text, "e").to_numpy(zero_copy_only=False)
         whole = plain & (arr == np.trunc(arr))      # written without an exponent, so without a fraction
     if whole.any():
         mask = pa.array(whole)
@@ -413,13 +415,14 @@ def _arrow_column_text(col: pd.Series, pa, pc):
     return pa.array(cells, type=pa.string()).take(pa.array(codes))
 
 
-def _arrow_rows(part: pd.DataFrame, pa, pc) -> bytes:
-    """The UTF-8 text of the rows of ``part`` (each ending in ``\n``), joined by Arrow."""
+def _arrow_rows(part: pd.DataFrame, pa, pc):
+    """The UTF-8 text of the rows of ``part`` (each ending in ``\n``), joined by Arrow: a buffer (no copy) that
+    a file's ``write`` takes as it is."""
     cells = [_arrow_column_text(col, pa, pc) for _, col in part.items()]
+    cells[-1] = pc.binary_join_element_wise(cells[-1], "\n", "")        # the line end on the last cell
     lines = pc.binary_join_element_wise(*cells, ",")
-    lines = pc.binary_join_element_wise(lines, "\n", "")
     offsets = np.frombuffer(lines.buffers()[1], dtype=np.int32, count=len(lines) + 1, offset=4 * lines.offset)
-    return lines.buffers()[2].to_pybytes()[offsets[0]:offsets[-1]]
+    return lines.buffers()[2].slice(int(offsets[0]), int(offsets[-1] - offsets[0]))
 
 
 def _in_order(fn, items, *, ahead: int = 2):
