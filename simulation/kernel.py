@@ -47,10 +47,12 @@ EVENTS = {EV_RELEASE: "release", EV_IMPACT: "impact", EV_TAKEOFF: "take-off", EV
 # without the runtime's reference counting): numba otherwise increments and decrements the count of every array
 # argument at each call, atomic operations that took about a quarter of the kernel's time (6-12 per impact
 # search; measured with perf, 2026-12-07).  The numbers are unchanged; under NUMBA_DISABLE_JIT the option is moot.
-# contact.rebound compiled into the event loop itself (numba's inlining of its code; it takes and returns scalars only,
-# so no reference counts are involved): a call per impact otherwise, its four results returned through memory.  The
-# same function, so the same numbers.
-_rebound = njit(cache=True, inline="always")(getattr(rebound, "py_func", rebound))  # a plain function without JIT
+# contact.rebound and _record_path are called, not inlined into the event loop by numba (``inline="always"``):
+# inlining copied their code into each of the kernel's specialisations before type inference, which made compiling
+# the four specialisations 32.6 s against 22.3 s, and did not make the kernel faster (LLVM still inlines what pays;
+# 1.60-1.69 against 1.71-1.84 M trajectories per CPU-s on the peer profile, 474,000-508,000 against 486,000-518,000
+# on the barrier scenario, 2026-12-08).  _record_path is compiled once per pair of literal mode and event codes
+# its call sites pass (10 small versions); it runs only for the few recorded blocks.
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
@@ -120,8 +122,7 @@ def _record_crossing(r_block, r_coll, r_t, r_vx, r_vz, r_w, r_h, r_outcome, r_co
         r_count[1] += 1
 
 
-# inlined: its call sites pass literal mode and event codes, and numba would compile one version per literal
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _record_path(pb, pt, pxs, pzs, pvx, pvz, pw, pmode, pev, pcount, block, t, x, z, vx, vz, w, mode, event):
     """Append one event of a recorded block: state after the event, the mode that follows and the event code."""
     i = pcount[0]
@@ -477,7 +478,7 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
                 else:
                     mu = mat_mu[mat]
                 if vn < 0.0:
-                    vn2, vt2, w, _ = _rebound(vn, vt, w, r, k_in, m_en_law[mat], en, m_en_v0[mat], m_et_law[mat], et,
+                    vn2, vt2, w, _ = rebound(vn, vt, w, r, k_in, m_en_law[mat], en, m_en_v0[mat], m_et_law[mat], et,
                                              mu, gain, m_et_v0[mat])
                 else:
                     vn2, vt2 = 0.0, vt
