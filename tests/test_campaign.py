@@ -63,3 +63,16 @@ def test_a_large_re_simulation_is_thinned_to_its_quantiles(study, monkeypatch):
     assert all(t.size == 50 for t in thin)
     for f, t in zip(full, thin):
         np.testing.assert_allclose(np.median(t), np.median(f), atol=0.05 * (f.max() - f.min()) + 1e-9)
+
+
+def test_a_campaign_value_computed_in_a_forked_child_is_the_one_computed_here(study):
+    # riskrf assess computes it beside the rest of the ranking's report (runner.beside) and hands it over
+    from functools import partial
+
+    from riskrf.cli.runner import InBackground
+    from riskrf.report.mitigation_text import study_report
+    here = study_report(study)
+    beside = InBackground(partial(release_campaign_value, study))
+    there = study_report(study, campaign=beside)
+    assert there["release_campaign"] == here["release_campaign"]
+    assert there["text"] == here["text"]

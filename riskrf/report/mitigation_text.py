@@ -48,7 +48,7 @@ def option_entries(study, ranking: pd.DataFrame) -> list:
     return out
 
 
-def study_report(study, *, tornado=None) -> dict:
+def study_report(study, *, tornado=None, campaign=None) -> dict:
     """Ranking, recommendation, tornado, break-even, value of information and a printable text.
 
     Parameters
@@ -57,6 +57,10 @@ def study_report(study, *, tornado=None) -> dict:
         The study.
     tornado : pandas.DataFrame, optional
         ``study.tornado()`` when it was computed already (it is then not computed again).
+    campaign : object with ``result()``, optional
+        The value of a release campaign being computed elsewhere (``runner.beside`` of
+        :func:`riskrf.risk.campaign.release_campaign_value`), taken once the rest of the report is computed; by
+        default it is computed here.
 
     Returns
     -------
@@ -72,7 +76,7 @@ def study_report(study, *, tornado=None) -> dict:
     be = study.break_even_table()
     rec = study.recommendation(ranking)
     voi = study.value_of_information()
-    campaign = release_campaign_value(study)
+    campaign = release_campaign_value(study) if campaign is None else campaign.result()
     cur = study.currency
     u = study.uncertainty
     ranges = study.parameter_ranges()

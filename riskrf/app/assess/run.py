@@ -122,15 +122,17 @@ def run_assessment(site: Site, *, seed: int | None = None, n_blocks: int | None 
         if figures is not None:
             def decision_report(study):         # the study is final: its tree drawn beside the ranking's report
                 from ...report.mitigation_text import write_mitigation_figures, write_tree_figure
+                from ...risk.campaign import release_campaign_value
+                # the value of a release campaign (the longest part of the report) first, beside the rest
+                campaign = runner.beside(partial(release_campaign_value, study))
                 pending.append(runner.beside(partial(write_tree_figure, study, figures)))
                 early.add("tree")
-                # its tornado and F-N figures too, beside the rest of the report (the value of a release campaign
-                # is the longest part of it)
+                # its tornado and F-N figures too, beside the rest of the report
                 tornado = study.tornado()
                 pending.append(runner.beside(partial(write_mitigation_figures, study, {"tornado": tornado},
                                                      figures)))
                 early.add("mitigation")
-                return study_report(study, tornado=tornado)
+                return study_report(study, tornado=tornado, campaign=campaign)
         replicate = partial(draw_evaluator, site, inventory, rate_scale=rate_scale / release_factor,
                             rate_note=rate_note, design_masses=design_masses)
         mitigation, site_rates, study, decision, site_design = _decision_stage(
