@@ -479,7 +479,7 @@ def simulate(blocks, profile, mats, m_drag, collectors, envelope, settings, sin_
                     mu = mat_mu[mat]
                 if vn < 0.0:
                     vn2, vt2, w, _ = rebound(vn, vt, w, r, k_in, m_en_law[mat], en, m_en_v0[mat], m_et_law[mat], et,
-                                             mu, gain, m_et_v0[mat])
+                                            mu, gain, m_et_v0[mat])
                 else:
                     vn2, vt2 = 0.0, vt
                 vx = vt2 * cos_bp - vn2 * sin_bp
