@@ -49,10 +49,10 @@ EVENTS = {EV_RELEASE: "release", EV_IMPACT: "impact", EV_TAKEOFF: "take-off", EV
 # search; measured with perf, 2026-12-07).  The numbers are unchanged; under NUMBA_DISABLE_JIT the option is moot.
 # contact.rebound and _record_path are called, not inlined into the event loop by numba (``inline="always"``):
 # inlining copied their code into each of the kernel's specialisations before type inference, which made compiling
-# the four specialisations 32.6 s against 22.3-28.2 s, and did not make the kernel faster (LLVM still inlines what pays;
-# 1.60-1.69 against 1.71-1.84 M trajectories per CPU-s on the peer profile, 474,000-508,000 against 486,000-518,000
-# on the barrier scenario, 2026-12-08).  _record_path is compiled once per pair of literal mode and event codes
-# its call sites pass (10 small versions); it runs only for the few recorded blocks.
+# the four specialisations 32.6 s against 22.3-28.2 s, and did not make the kernel faster (LLVM still inlines what
+# pays; tests/benchmarks/bench_simulator.py after the change, 2026-12-08: peer profile 2.95x commit 06331e7 side by
+# side, barrier scenario 459,980-495,323 trajectories/s on one core).  _record_path is compiled once per pair of
+# literal mode and event codes its call sites pass (10 small versions); it runs only for the few recorded blocks.
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
